@@ -1,0 +1,982 @@
+//! The NodeSet2 front end: one streaming pass of quick-xml over a file's text into a [`RawNodeSet`].
+//!
+//! Well-formedness problems (bad syntax, a truncated file, a DOCTYPE) stop the file with one error at the
+//! exact position. Problems inside well-formed XML (a malformed number, a missing BrowseName) are collected
+//! and parsing goes on, so one run reports them all.
+
+use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::raw::*;
+use crate::source::{FileId, Span, Spanned};
+use quick_xml::events::{BytesStart, Event};
+use quick_xml::Reader;
+use std::borrow::Cow;
+
+/// Limits that keep hostile input from exhausting memory or the stack.
+#[derive(Clone, Debug)]
+pub struct Limits {
+    /// Deepest element nesting accepted anywhere in a file.
+    pub max_depth: usize,
+    /// Deepest nesting inside one `<Value>` (ExtensionObjects within arrays within structures ...).
+    pub max_value_depth: usize,
+    /// Longest text content of one element, in bytes.
+    pub max_text_len: usize,
+}
+
+impl Default for Limits {
+    fn default() -> Limits {
+        Limits { max_depth: 128, max_value_depth: 64, max_text_len: 64 << 20 }
+    }
+}
+
+/// Turns the bytes of a file into text: strips a UTF-8 BOM, rejects UTF-16 and invalid UTF-8.
+///
+/// On error, returns the diagnostic and the byte offset it refers to; the caller keeps a lossy copy of the
+/// text so the diagnostic can still show the line.
+pub fn decode_text(bytes: Vec<u8>) -> Result<String, (Diagnostic, usize)> {
+    if bytes.starts_with(&[0xFF, 0xFE]) || bytes.starts_with(&[0xFE, 0xFF]) {
+        return Err((
+            Diagnostic::new(Code::Encoding, "the file is UTF-16 (it starts with a UTF-16 byte order mark)")
+                .help("save the file as UTF-8; NodeSet2 files are UTF-8 in practice and this compiler reads only UTF-8"),
+            0,
+        ));
+    }
+    let bytes = if bytes.starts_with(&[0xEF, 0xBB, 0xBF]) { bytes[3..].to_vec() } else { bytes };
+    match String::from_utf8(bytes) {
+        Ok(s) => Ok(s),
+        Err(e) => {
+            let at = e.utf8_error().valid_up_to();
+            Err((
+                Diagnostic::new(Code::Encoding, format!("invalid UTF-8 at byte {at}"))
+                    .with_span_label("this byte sequence is not UTF-8")
+                    .help("NodeSet2 files must be UTF-8; re-encode the file (iconv -t UTF-8)"),
+                at,
+            ))
+        }
+    }
+}
+
+/// Parses one file. Returns `None` when the file is not usable at all (its errors are in `diags`).
+pub fn parse(file: FileId, text: &str, limits: &Limits, diags: &mut Diagnostics) -> Option<RawNodeSet> {
+    let mut p = Parser::new(file, text, limits, diags);
+    match p.document() {
+        Ok(set) => Some(set),
+        Err(Fatal) => None,
+    }
+}
+
+/// Marker for an error that stops the file; its diagnostic has been pushed.
+struct Fatal;
+
+type PResult<T> = Result<T, Fatal>;
+
+enum Ev<'a> {
+    Start(BytesStart<'a>, Span),
+    End,
+    Text(Cow<'a, str>),
+    Eof,
+}
+
+struct Attr<'a> {
+    key: &'a str,
+    value: Cow<'a, str>,
+    span: Span,
+}
+
+struct Parser<'a, 'd> {
+    file: FileId,
+    text: &'a str,
+    reader: Reader<&'a [u8]>,
+    limits: &'a Limits,
+    diags: &'d mut Diagnostics,
+    /// Open elements: name and start offset, for truncation messages.
+    open: Vec<(&'a str, usize)>,
+}
+
+impl<'a, 'd> Parser<'a, 'd> {
+    fn new(file: FileId, text: &'a str, limits: &'a Limits, diags: &'d mut Diagnostics) -> Self {
+        let mut reader = Reader::from_str(text);
+        let cfg = reader.config_mut();
+        cfg.expand_empty_elements = true;
+        cfg.check_end_names = true;
+        cfg.check_comments = false;
+        cfg.trim_text(false);
+        Parser { file, text, reader, limits, diags, open: Vec::new() }
+    }
+
+    fn span(&self, start: usize, end: usize) -> Span {
+        Span::new(self.file, start, end)
+    }
+
+    fn offset_of(&self, s: &[u8]) -> usize {
+        let base = self.text.as_ptr() as usize;
+        let p = s.as_ptr() as usize;
+        if p >= base && p <= base + self.text.len() {
+            p - base
+        } else {
+            0
+        }
+    }
+
+    fn fatal(&mut self, d: Diagnostic) -> Fatal {
+        self.diags.push(d);
+        Fatal
+    }
+
+    /// The next event that matters: element starts and ends, text. Comments, PIs and the declaration are
+    /// skipped (the declaration after its encoding is checked).
+    fn next(&mut self) -> PResult<Ev<'a>> {
+        loop {
+            let before = self.reader.buffer_position() as usize;
+            let ev = match self.reader.read_event() {
+                Ok(ev) => ev,
+                Err(e) => {
+                    let at = (self.reader.error_position() as usize).min(self.text.len());
+                    let d = xml_error_diag(&e, self.span(at, at + 1));
+                    return Err(self.fatal(d));
+                }
+            };
+            let after = self.reader.buffer_position() as usize;
+            match ev {
+                Event::Start(e) => {
+                    let name = std::str::from_utf8(local(e.name().into_inner())).unwrap_or("?");
+                    // SAFETY of lifetimes: the name borrows from the input text, which lives for 'a.
+                    let name: &'a str = self.text_slice(name);
+                    self.open.push((name, before));
+                    if self.open.len() > self.limits.max_depth {
+                        let d = Diagnostic::new(
+                            Code::TooDeep,
+                            format!("elements are nested more than {} levels deep", self.limits.max_depth),
+                        )
+                        .at(self.span(before, after))
+                        .with_span_label("this element is too deep")
+                        .help("NodeSet2 files need fewer than 20 levels; this file is malformed or hostile");
+                        return Err(self.fatal(d));
+                    }
+                    return Ok(Ev::Start(e, self.span(before, after)));
+                }
+                Event::End(_) => {
+                    self.open.pop();
+                    return Ok(Ev::End);
+                }
+                Event::Empty(_) => unreachable!("expand_empty_elements is set"),
+                Event::Text(t) => match t.unescape() {
+                    Ok(s) => return Ok(Ev::Text(s)),
+                    Err(e) => {
+                        let d = Diagnostic::new(Code::XmlSyntax, format!("malformed character data: {e}"))
+                            .at(self.span(before, after.min(before + 1)))
+                            .help("only the predefined entities (&amp; &lt; &gt; &quot; &apos;) and character references are allowed");
+                        return Err(self.fatal(d));
+                    }
+                },
+                Event::CData(c) => {
+                    let s = String::from_utf8_lossy(&c.into_inner()).into_owned();
+                    return Ok(Ev::Text(Cow::Owned(s)));
+                }
+                Event::Decl(decl) => {
+                    if let Some(Ok(enc)) = decl.encoding() {
+                        let enc = String::from_utf8_lossy(&enc).to_ascii_lowercase();
+                        if enc != "utf-8" && enc != "utf8" {
+                            let d = Diagnostic::new(
+                                Code::Encoding,
+                                format!("the XML declaration says encoding=\"{enc}\"; only UTF-8 is read"),
+                            )
+                            .at(self.span(before, after))
+                            .help("re-encode the file as UTF-8 and declare encoding=\"utf-8\"");
+                            return Err(self.fatal(d));
+                        }
+                    }
+                }
+                Event::DocType(_) => {
+                    let d = Diagnostic::new(Code::Doctype, "DOCTYPE declarations are not accepted")
+                        .at(self.span(before, after))
+                        .with_span_label("document type declaration")
+                        .note("entities declared in a DOCTYPE are never expanded, so a file cannot grow or read other files")
+                        .help("remove the DOCTYPE; NodeSet2 files are validated against UANodeSet.xsd, not a DTD");
+                    return Err(self.fatal(d));
+                }
+                Event::Eof => {
+                    if let Some(&(name, start)) = self.open.last() {
+                        let d = Diagnostic::new(
+                            Code::Truncated,
+                            format!("the file ends before <{name}> is closed"),
+                        )
+                        .at(self.span(start, start + name.len() + 1))
+                        .with_span_label(format!("<{name}> opened here"))
+                        .note(format!("{} element(s) are still open at the end of the file", self.open.len()))
+                        .help("the file is truncated or a closing tag is missing; nothing of it is loaded");
+                        return Err(self.fatal(d));
+                    }
+                    return Ok(Ev::Eof);
+                }
+                Event::Comment(_) | Event::PI(_) => {}
+            }
+        }
+    }
+
+    fn text_slice(&self, s: &str) -> &'a str {
+        let off = self.offset_of(s.as_bytes());
+        if off + s.len() <= self.text.len() && &self.text[off..off + s.len()] == s {
+            &self.text[off..off + s.len()]
+        } else {
+            "?"
+        }
+    }
+
+    fn attrs(&mut self, e: &BytesStart<'a>, tag: Span) -> PResult<Vec<Attr<'a>>> {
+        let mut out = Vec::new();
+        for a in e.attributes().with_checks(true) {
+            let a = match a {
+                Ok(a) => a,
+                Err(err) => {
+                    let d = Diagnostic::new(Code::XmlSyntax, format!("malformed attribute: {err}")).at(tag);
+                    return Err(self.fatal(d));
+                }
+            };
+            let key_bytes = local(a.key.into_inner());
+            let key = std::str::from_utf8(key_bytes).unwrap_or("?");
+            let key = self.text_slice(key);
+            let start = self.offset_of(&a.value);
+            let span = self.span(start, start + a.value.len());
+            let raw_ok = start + a.value.len() <= self.text.len() && !a.value.contains(&b'&');
+            let value: Cow<'a, str> = if raw_ok {
+                Cow::Borrowed(&self.text[start..start + a.value.len()])
+            } else {
+                match a.unescape_value() {
+                Ok(v) => Cow::Owned(v.into_owned()),
+                Err(err) => {
+                    let d = Diagnostic::new(Code::XmlSyntax, format!("malformed attribute value: {err}"))
+                        .at(span)
+                        .help("only the predefined entities (&amp; &lt; &gt; &quot; &apos;) and character references are allowed");
+                    return Err(self.fatal(d));
+                }
+                }
+            };
+            out.push(Attr { key, value, span });
+        }
+        Ok(out)
+    }
+
+    /// Consumes the rest of an element whose start has been read.
+    fn skip(&mut self) -> PResult<()> {
+        let mut depth = 1usize;
+        loop {
+            match self.next()? {
+                Ev::Start(..) => depth += 1,
+                Ev::End => {
+                    depth -= 1;
+                    if depth == 0 {
+                        return Ok(());
+                    }
+                }
+                Ev::Text(_) => {}
+                Ev::Eof => unreachable!("next() reports EOF inside an element"),
+            }
+        }
+    }
+
+    fn unknown(&mut self, e: &BytesStart<'a>, span: Span, within: &str) -> PResult<()> {
+        let name = String::from_utf8_lossy(e.name().into_inner()).into_owned();
+        self.diags.push(
+            Diagnostic::new(Code::UnknownElement, format!("<{name}> is not expected inside <{within}>; it is ignored"))
+                .at(span)
+                .help("check the element name against UANodeSet.xsd"),
+        );
+        self.skip()
+    }
+
+    /// Reads the text content of an element whose start has been read; child elements are reported.
+    fn text_content(&mut self, within: &str) -> PResult<String> {
+        let mut s = String::new();
+        loop {
+            match self.next()? {
+                Ev::Text(t) => {
+                    if s.len() + t.len() > self.limits.max_text_len {
+                        let at = self.reader.buffer_position() as usize;
+                        let d = Diagnostic::new(
+                            Code::TooLarge,
+                            format!("the text of <{within}> is longer than {} bytes", self.limits.max_text_len),
+                        )
+                        .at(self.span(at, at));
+                        return Err(self.fatal(d));
+                    }
+                    s.push_str(&t)
+                }
+                Ev::Start(e, span) => self.unknown(&e, span, within)?,
+                Ev::End => break,
+                Ev::Eof => unreachable!(),
+            }
+        }
+        Ok(normalize_newlines(s))
+    }
+
+    fn localized(&mut self, e: &BytesStart<'a>, span: Span, name: &str) -> PResult<LocalizedText> {
+        let attrs = self.attrs(e, span)?;
+        let locale = attrs.iter().find(|a| a.key == "Locale").map(|a| a.value.to_string()).filter(|l| !l.is_empty());
+        let text = self.text_content(name)?;
+        Ok(LocalizedText { locale, text: text.trim().to_string() })
+    }
+
+    fn document(&mut self) -> PResult<RawNodeSet> {
+        // Find the root element.
+        let (root, root_span) = loop {
+            match self.next()? {
+                Ev::Start(e, span) => break (e, span),
+                Ev::Text(t) if t.trim().is_empty() => {}
+                Ev::Text(_) => {
+                    let at = self.reader.buffer_position() as usize;
+                    let d = Diagnostic::new(Code::XmlSyntax, "text before the root element").at(self.span(at, at));
+                    return Err(self.fatal(d));
+                }
+                Ev::End => unreachable!(),
+                Ev::Eof => {
+                    let d = Diagnostic::new(Code::NotNodeSet, "the file has no root element")
+                        .at(self.span(0, 0))
+                        .help("a NodeSet2 file starts with <UANodeSet xmlns=\"http://opcfoundation.org/UA/2011/03/UANodeSet.xsd\">");
+                    return Err(self.fatal(d));
+                }
+            }
+        };
+        let root_name = String::from_utf8_lossy(local(root.name().into_inner())).into_owned();
+        if root_name != "UANodeSet" {
+            let d = Diagnostic::new(Code::NotNodeSet, format!("the root element is <{root_name}>, not <UANodeSet>"))
+                .at(root_span)
+                .help("pass only NodeSet2 files (root <UANodeSet>); .bsd, .xsd and CSV files are not NodeSets");
+            return Err(self.fatal(d));
+        }
+        let attrs = self.attrs(&root, root_span)?;
+        let mut set = RawNodeSet {
+            file: self.file,
+            root_span,
+            namespace_uris: Vec::new(),
+            server_uris: Vec::new(),
+            models: Vec::new(),
+            aliases: Vec::new(),
+            nodes: Vec::new(),
+            last_modified: attrs.iter().find(|a| a.key == "LastModified").map(|a| a.value.to_string()),
+        };
+        loop {
+            match self.next()? {
+                Ev::Start(e, span) => {
+                    let name = String::from_utf8_lossy(local(e.name().into_inner())).into_owned();
+                    match name.as_str() {
+                        "NamespaceUris" => set.namespace_uris = self.uri_list("NamespaceUris")?,
+                        "ServerUris" => set.server_uris = self.uri_list("ServerUris")?,
+                        "Models" => self.models(&mut set.models)?,
+                        "Aliases" => self.aliases(&mut set.aliases)?,
+                        "Extensions" => self.skip()?,
+                        _ => match NodeClass::from_element(&name) {
+                            Some(class) => {
+                                let node = self.node(class, &e, span)?;
+                                set.nodes.push(node);
+                            }
+                            None => self.unknown(&e, span, "UANodeSet")?,
+                        },
+                    }
+                }
+                Ev::Text(_) => {}
+                Ev::End => break,
+                Ev::Eof => unreachable!(),
+            }
+        }
+        // Anything after the root other than comments and white space is malformed.
+        loop {
+            match self.next()? {
+                Ev::Eof => break,
+                Ev::Text(t) if t.trim().is_empty() => {}
+                Ev::Start(_, span) => {
+                    let d = Diagnostic::new(Code::XmlSyntax, "a second root element after </UANodeSet>").at(span);
+                    return Err(self.fatal(d));
+                }
+                _ => {
+                    let at = self.reader.buffer_position() as usize;
+                    let d = Diagnostic::new(Code::XmlSyntax, "content after </UANodeSet>").at(self.span(at, at));
+                    return Err(self.fatal(d));
+                }
+            }
+        }
+        Ok(set)
+    }
+
+    fn uri_list(&mut self, within: &str) -> PResult<Vec<Spanned<String>>> {
+        let mut out = Vec::new();
+        loop {
+            match self.next()? {
+                Ev::Start(e, span) => {
+                    if local(e.name().into_inner()) == b"Uri" {
+                        let v = self.text_content("Uri")?;
+                        out.push(Spanned { value: v.trim().to_string(), span });
+                    } else {
+                        self.unknown(&e, span, within)?;
+                    }
+                }
+                Ev::Text(_) => {}
+                Ev::End => return Ok(out),
+                Ev::Eof => unreachable!(),
+            }
+        }
+    }
+
+    fn models(&mut self, out: &mut Vec<RawModel>) -> PResult<()> {
+        loop {
+            match self.next()? {
+                Ev::Start(e, span) => {
+                    if local(e.name().into_inner()) != b"Model" {
+                        self.unknown(&e, span, "Models")?;
+                        continue;
+                    }
+                    let attrs = self.attrs(&e, span)?;
+                    let get = |k: &str| attrs.iter().find(|a| a.key == k).map(|a| a.value.to_string());
+                    let uri = match get("ModelUri") {
+                        Some(u) => u,
+                        None => {
+                            self.missing(span, "Model", "ModelUri");
+                            String::new()
+                        }
+                    };
+                    let mut model = RawModel {
+                        uri,
+                        version: get("Version"),
+                        publication_date: get("PublicationDate"),
+                        model_version: get("ModelVersion"),
+                        xml_schema_uri: get("XmlSchemaUri"),
+                        required: Vec::new(),
+                        role_permissions: Vec::new(),
+                        access_restrictions: None,
+                        span,
+                    };
+                    if let Some(a) = attrs.iter().find(|a| a.key == "AccessRestrictions") {
+                        model.access_restrictions = self.number(a);
+                    }
+                    loop {
+                        match self.next()? {
+                            Ev::Start(e, span) => match local(e.name().into_inner()) {
+                                b"RequiredModel" => {
+                                    let attrs = self.attrs(&e, span)?;
+                                    let get =
+                                        |k: &str| attrs.iter().find(|a| a.key == k).map(|a| a.value.to_string());
+                                    let uri = get("ModelUri").unwrap_or_else(|| {
+                                        self.missing(span, "RequiredModel", "ModelUri");
+                                        String::new()
+                                    });
+                                    model.required.push(RawRequiredModel {
+                                        uri,
+                                        version: get("Version"),
+                                        publication_date: get("PublicationDate"),
+                                        model_version: get("ModelVersion"),
+                                        xml_schema_uri: get("XmlSchemaUri"),
+                                        span,
+                                    });
+                                    self.skip()?;
+                                }
+                                b"RolePermissions" => model.role_permissions = self.role_permissions()?,
+                                _ => self.unknown(&e, span, "Model")?,
+                            },
+                            Ev::Text(_) => {}
+                            Ev::End => break,
+                            Ev::Eof => unreachable!(),
+                        }
+                    }
+                    out.push(model);
+                }
+                Ev::Text(_) => {}
+                Ev::End => return Ok(()),
+                Ev::Eof => unreachable!(),
+            }
+        }
+    }
+
+    fn missing(&mut self, span: Span, element: &str, attr: &str) {
+        self.diags.push(
+            Diagnostic::new(Code::MissingAttribute, format!("<{element}> has no {attr} attribute"))
+                .at(span)
+                .help(format!("add {attr}=\"...\"; UANodeSet.xsd requires it")),
+        );
+    }
+
+    fn aliases(&mut self, out: &mut Vec<RawAlias>) -> PResult<()> {
+        loop {
+            match self.next()? {
+                Ev::Start(e, span) => {
+                    if local(e.name().into_inner()) != b"Alias" {
+                        self.unknown(&e, span, "Aliases")?;
+                        continue;
+                    }
+                    let attrs = self.attrs(&e, span)?;
+                    let alias = attrs.iter().find(|a| a.key == "Alias").map(|a| a.value.to_string());
+                    let text_start = self.reader.buffer_position() as usize;
+                    let target = self.text_content("Alias")?;
+                    let trimmed = target.trim();
+                    let lead = target.len() - target.trim_start().len();
+                    let tspan = self.span(text_start + lead, text_start + lead + trimmed.len());
+                    match alias {
+                        Some(alias) => out.push(RawAlias {
+                            alias,
+                            target: Spanned { value: trimmed.to_string(), span: tspan },
+                            span,
+                        }),
+                        None => self.missing(span, "Alias", "Alias"),
+                    }
+                }
+                Ev::Text(_) => {}
+                Ev::End => return Ok(()),
+                Ev::Eof => unreachable!(),
+            }
+        }
+    }
+
+    fn role_permissions(&mut self) -> PResult<Vec<RawRolePermission>> {
+        let mut out = Vec::new();
+        loop {
+            match self.next()? {
+                Ev::Start(e, span) => {
+                    if local(e.name().into_inner()) != b"RolePermission" {
+                        self.unknown(&e, span, "RolePermissions")?;
+                        continue;
+                    }
+                    let attrs = self.attrs(&e, span)?;
+                    let permissions = attrs.iter().find(|a| a.key == "Permissions").and_then(|a| self.number(a));
+                    let text_start = self.reader.buffer_position() as usize;
+                    let role = self.text_content("RolePermission")?;
+                    let lead = role.len() - role.trim_start().len();
+                    let rspan = self.span(text_start + lead, text_start + lead + role.trim().len());
+                    out.push(RawRolePermission {
+                        role: Spanned { value: role.trim().to_string(), span: rspan },
+                        permissions: permissions.unwrap_or(0),
+                    });
+                }
+                Ev::Text(_) => {}
+                Ev::End => return Ok(out),
+                Ev::Eof => unreachable!(),
+            }
+        }
+    }
+
+    fn number<T: std::str::FromStr>(&mut self, a: &Attr<'a>) -> Option<T> {
+        match a.value.trim().parse::<T>() {
+            Ok(v) => Some(v),
+            Err(_) => {
+                self.diags.push(
+                    Diagnostic::new(
+                        Code::BadAttribute,
+                        format!("{}=\"{}\" is not a valid {}", a.key, a.value, std::any::type_name::<T>()),
+                    )
+                    .at(a.span)
+                    .with_span_label("expected a number in range")
+                    .help("see UANodeSet.xsd for the attribute's type"),
+                );
+                None
+            }
+        }
+    }
+
+    fn boolean(&mut self, a: &Attr<'a>) -> Option<bool> {
+        match a.value.trim() {
+            "true" | "1" => Some(true),
+            "false" | "0" => Some(false),
+            other => {
+                self.diags.push(
+                    Diagnostic::new(Code::BadAttribute, format!("{}=\"{other}\" is not a boolean", a.key))
+                        .at(a.span)
+                        .help("write true or false"),
+                );
+                None
+            }
+        }
+    }
+
+    fn node(&mut self, class: NodeClass, e: &BytesStart<'a>, span: Span) -> PResult<RawNode> {
+        let mut node = RawNode::new(class, span);
+        let attrs = self.attrs(e, span)?;
+        let mut have_id = false;
+        let mut have_bn = false;
+        for a in &attrs {
+            let spanned = || Spanned { value: a.value.to_string(), span: a.span };
+            match a.key {
+                "NodeId" => {
+                    node.node_id = spanned();
+                    have_id = true
+                }
+                "BrowseName" => {
+                    node.browse_name = spanned();
+                    have_bn = true
+                }
+                "SymbolicName" => node.symbolic_name = Some(a.value.to_string()),
+                "WriteMask" => node.write_mask = self.number(a),
+                "UserWriteMask" => node.user_write_mask = self.number(a),
+                "AccessRestrictions" => node.access_restrictions = self.number(a),
+                "HasNoPermissions" => node.has_no_permissions = self.boolean(a),
+                "ReleaseStatus" => node.release_status = Some(a.value.to_string()),
+                "ParentNodeId" => node.parent_node_id = Some(spanned()),
+                "DataType" => node.data_type = Some(spanned()),
+                "ValueRank" => node.value_rank = self.number(a),
+                "ArrayDimensions" => node.array_dimensions = Some(a.value.to_string()),
+                "AccessLevel" => node.access_level = self.number(a),
+                "UserAccessLevel" => node.user_access_level = self.number(a),
+                "AccessLevelEx" => node.access_level_ex = self.number(a),
+                "MinimumSamplingInterval" => node.minimum_sampling_interval = self.number(a),
+                "Historizing" => node.historizing = self.boolean(a),
+                "Executable" => node.executable = self.boolean(a),
+                "UserExecutable" => node.user_executable = self.boolean(a),
+                "MethodDeclarationId" => node.method_declaration_id = Some(spanned()),
+                "EventNotifier" => node.event_notifier = self.number(a),
+                "ContainsNoLoops" => node.contains_no_loops = self.boolean(a),
+                "IsAbstract" => node.is_abstract = self.boolean(a),
+                "Symmetric" => node.symmetric = self.boolean(a),
+                "Purpose" => node.purpose = Some(a.value.to_string()),
+                _ => {}
+            }
+        }
+        if !have_id {
+            self.missing(span, class.element(), "NodeId");
+        }
+        if !have_bn {
+            self.missing(span, class.element(), "BrowseName");
+        }
+        loop {
+            match self.next()? {
+                Ev::Start(e, cspan) => {
+                    let name = local(e.name().into_inner());
+                    match name {
+                        b"DisplayName" => {
+                            let t = self.localized(&e, cspan, "DisplayName")?;
+                            node.display_names.push(t)
+                        }
+                        b"Description" => {
+                            let t = self.localized(&e, cspan, "Description")?;
+                            node.descriptions.push(t)
+                        }
+                        b"InverseName" => {
+                            let t = self.localized(&e, cspan, "InverseName")?;
+                            node.inverse_names.push(t)
+                        }
+                        b"Category" => {
+                            let t = self.text_content("Category")?;
+                            node.category.push(t.trim().to_string())
+                        }
+                        b"Documentation" => node.documentation = Some(self.text_content("Documentation")?),
+                        b"References" => self.references(&mut node.references)?,
+                        b"RolePermissions" => node.role_permissions = self.role_permissions()?,
+                        b"Extensions" => {
+                            let tree = self.tree(&e, cspan, usize::MAX)?;
+                            node.extensions = tree.children;
+                        }
+                        b"Value" => {
+                            let tree = self.tree(&e, cspan, self.limits.max_value_depth)?;
+                            node.value = tree.children.into_iter().next();
+                        }
+                        b"Definition" => node.definition = Some(self.definition(&e, cspan)?),
+                        _ => {
+                            let within = class.element();
+                            self.unknown(&e, cspan, within)?
+                        }
+                    }
+                }
+                Ev::Text(_) => {}
+                Ev::End => break,
+                Ev::Eof => unreachable!(),
+            }
+        }
+        Ok(node)
+    }
+
+    fn references(&mut self, out: &mut Vec<RawReference>) -> PResult<()> {
+        loop {
+            match self.next()? {
+                Ev::Start(e, span) => {
+                    if local(e.name().into_inner()) != b"Reference" {
+                        self.unknown(&e, span, "References")?;
+                        continue;
+                    }
+                    let attrs = self.attrs(&e, span)?;
+                    let mut is_forward = true;
+                    let mut rt = None;
+                    for a in &attrs {
+                        match a.key {
+                            "ReferenceType" => rt = Some(Spanned { value: a.value.trim().to_string(), span: a.span }),
+                            "IsForward" => is_forward = self.boolean(a).unwrap_or(true),
+                            _ => {}
+                        }
+                    }
+                    let text_start = self.reader.buffer_position() as usize;
+                    let target = self.text_content("Reference")?;
+                    let lead = target.len() - target.trim_start().len();
+                    let tspan = self.span(text_start + lead, text_start + lead + target.trim().len());
+                    let Some(reference_type) = rt else {
+                        self.missing(span, "Reference", "ReferenceType");
+                        continue;
+                    };
+                    out.push(RawReference {
+                        reference_type,
+                        target: Spanned { value: target.trim().to_string(), span: tspan },
+                        is_forward,
+                        span,
+                    });
+                }
+                Ev::Text(_) => {}
+                Ev::End => return Ok(()),
+                Ev::Eof => unreachable!(),
+            }
+        }
+    }
+
+    fn definition(&mut self, e: &BytesStart<'a>, span: Span) -> PResult<RawDefinition> {
+        let attrs = self.attrs(e, span)?;
+        let mut def = RawDefinition {
+            name: String::new(),
+            symbolic_name: None,
+            base_type: None,
+            is_union: false,
+            is_option_set: false,
+            fields: Vec::new(),
+            span,
+        };
+        for a in &attrs {
+            match a.key {
+                "Name" => def.name = a.value.to_string(),
+                "SymbolicName" => def.symbolic_name = Some(a.value.to_string()),
+                "BaseType" => def.base_type = Some(Spanned { value: a.value.to_string(), span: a.span }),
+                "IsUnion" => def.is_union = self.boolean(a).unwrap_or(false),
+                "IsOptionSet" => def.is_option_set = self.boolean(a).unwrap_or(false),
+                _ => {}
+            }
+        }
+        loop {
+            match self.next()? {
+                Ev::Start(e, fspan) => {
+                    if local(e.name().into_inner()) != b"Field" {
+                        self.unknown(&e, fspan, "Definition")?;
+                        continue;
+                    }
+                    let attrs = self.attrs(&e, fspan)?;
+                    let mut f = RawField {
+                        name: String::new(),
+                        symbolic_name: None,
+                        data_type: None,
+                        value_rank: None,
+                        array_dimensions: None,
+                        max_string_length: None,
+                        is_optional: false,
+                        allow_sub_types: false,
+                        value: None,
+                        display_names: Vec::new(),
+                        descriptions: Vec::new(),
+                        span: fspan,
+                    };
+                    let mut have_name = false;
+                    for a in &attrs {
+                        match a.key {
+                            "Name" => {
+                                f.name = a.value.to_string();
+                                have_name = true
+                            }
+                            "SymbolicName" => f.symbolic_name = Some(a.value.to_string()),
+                            "DataType" => f.data_type = Some(Spanned { value: a.value.to_string(), span: a.span }),
+                            "ValueRank" => f.value_rank = self.number(a),
+                            "ArrayDimensions" => f.array_dimensions = Some(a.value.to_string()),
+                            "MaxStringLength" => f.max_string_length = self.number(a),
+                            "IsOptional" => f.is_optional = self.boolean(a).unwrap_or(false),
+                            "AllowSubTypes" => f.allow_sub_types = self.boolean(a).unwrap_or(false),
+                            "Value" => f.value = self.number(a),
+                            _ => {}
+                        }
+                    }
+                    if !have_name {
+                        self.missing(fspan, "Field", "Name");
+                    }
+                    loop {
+                        match self.next()? {
+                            Ev::Start(e, s) => match local(e.name().into_inner()) {
+                                b"DisplayName" => {
+                                    let t = self.localized(&e, s, "DisplayName")?;
+                                    f.display_names.push(t)
+                                }
+                                b"Description" => {
+                                    let t = self.localized(&e, s, "Description")?;
+                                    f.descriptions.push(t)
+                                }
+                                _ => self.unknown(&e, s, "Field")?,
+                            },
+                            Ev::Text(_) => {}
+                            Ev::End => break,
+                            Ev::Eof => unreachable!(),
+                        }
+                    }
+                    def.fields.push(f);
+                }
+                Ev::Text(_) => {}
+                Ev::End => return Ok(def),
+                Ev::Eof => unreachable!(),
+            }
+        }
+    }
+
+    /// Reads an element and everything inside it as a tree, iteratively, bounded to `max_depth` levels.
+    fn tree(&mut self, e: &BytesStart<'a>, span: Span, max_depth: usize) -> PResult<XmlElement> {
+        let root = self.element_of(e, span)?;
+        let mut stack = vec![root];
+        loop {
+            match self.next()? {
+                Ev::Start(e, s) => {
+                    if stack.len() >= max_depth {
+                        let d = Diagnostic::new(
+                            Code::TooDeep,
+                            format!("a value is nested more than {max_depth} levels deep"),
+                        )
+                        .at(s)
+                        .help("values in NodeSet2 files are a few levels deep; this one is malformed or hostile");
+                        return Err(self.fatal(d));
+                    }
+                    let el = self.element_of(&e, s)?;
+                    stack.push(el);
+                }
+                Ev::Text(t) => {
+                    let top = stack.last_mut().expect("stack holds the root");
+                    if top.text.len() + t.len() > self.limits.max_text_len {
+                        let d = Diagnostic::new(
+                            Code::TooLarge,
+                            format!("the text of <{}> is longer than {} bytes", top.name, self.limits.max_text_len),
+                        )
+                        .at(top.span);
+                        return Err(self.fatal(d));
+                    }
+                    top.text.push_str(&t);
+                }
+                Ev::End => {
+                    let mut done = stack.pop().expect("stack holds the root");
+                    if done.children.is_empty() {
+                        done.text = normalize_newlines(std::mem::take(&mut done.text));
+                    } else {
+                        // Elements with children carry only formatting white space.
+                        done.text.clear();
+                    }
+                    match stack.last_mut() {
+                        Some(parent) => parent.children.push(done),
+                        None => return Ok(done),
+                    }
+                }
+                Ev::Eof => unreachable!(),
+            }
+        }
+    }
+
+    fn element_of(&mut self, e: &BytesStart<'a>, span: Span) -> PResult<XmlElement> {
+        let attrs = self.attrs(e, span)?;
+        Ok(XmlElement {
+            name: String::from_utf8_lossy(local(e.name().into_inner())).into_owned(),
+            attributes: attrs.into_iter().map(|a| (a.key.to_string(), a.value.into_owned())).collect(),
+            children: Vec::new(),
+            text: String::new(),
+            span,
+        })
+    }
+}
+
+/// The local part of a possibly prefixed XML name.
+fn local(name: &[u8]) -> &[u8] {
+    match name.iter().position(|&b| b == b':') {
+        Some(i) => &name[i + 1..],
+        None => name,
+    }
+}
+
+fn normalize_newlines(s: String) -> String {
+    if s.contains('\r') {
+        s.replace("\r\n", "\n").replace('\r', "\n")
+    } else {
+        s
+    }
+}
+
+fn xml_error_diag(e: &quick_xml::Error, span: Span) -> Diagnostic {
+    use quick_xml::errors::{Error, IllFormedError, SyntaxError};
+    let (msg, help) = match e {
+        Error::Syntax(SyntaxError::UnclosedTag) => {
+            ("the file ends inside a tag".to_string(), "the file is truncated; a `>` is missing")
+        }
+        Error::Syntax(SyntaxError::UnclosedComment) => {
+            ("a comment is never closed".to_string(), "close the comment with `-->`")
+        }
+        Error::Syntax(s) => (format!("malformed XML: {s}"), "the file is not well-formed XML"),
+        Error::IllFormed(IllFormedError::MismatchedEndTag { expected, found }) => (
+            format!("closing tag </{found}> does not match the open element <{expected}>"),
+            "a closing tag is missing or misspelled",
+        ),
+        Error::IllFormed(IllFormedError::UnmatchedEndTag(name)) => {
+            (format!("closing tag </{name}> has no open element"), "remove the extra closing tag")
+        }
+        Error::IllFormed(i) => (format!("ill-formed XML: {i}"), "the file is not well-formed XML"),
+        other => (format!("malformed XML: {other}"), "the file is not well-formed XML"),
+    };
+    Diagnostic::new(Code::XmlSyntax, msg).at(span).help(help)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse_str(text: &str) -> (Option<RawNodeSet>, Diagnostics) {
+        let mut d = Diagnostics::new();
+        let r = parse(FileId(0), text, &Limits::default(), &mut d);
+        (r, d)
+    }
+
+    #[test]
+    fn parses_a_small_nodeset_without_default_namespace() {
+        let xml = "<?xml version=\"1.0\" encoding=\"utf-8\"?>\r\n<!-- c -->\r\n<UANodeSet>\r\n\
+            <NamespaceUris><Uri>http://x/</Uri></NamespaceUris>\r\n\
+            <Models><Model ModelUri=\"http://x/\" Version=\"1.0\"><RequiredModel ModelUri=\"http://opcfoundation.org/UA/\" Version=\"1.04\"/></Model></Models>\r\n\
+            <Aliases><Alias Alias=\"HasComponent\">i=47</Alias></Aliases>\r\n\
+            <UAObject NodeId=\"ns=1;i=1\" BrowseName=\"1:A\" EventNotifier=\"1\"><DisplayName>A</DisplayName>\
+            <DisplayName Locale=\"de\">A de</DisplayName><Description>line1\r\nline2</Description>\
+            <References><Reference ReferenceType=\"HasComponent\" IsForward=\"false\">i=85</Reference></References></UAObject>\r\n\
+            <UAVariable NodeId=\"ns=1;i=2\" BrowseName=\"1:V\" DataType=\"Int32\"><Value><ListOfInt32 xmlns=\"http://opcfoundation.org/UA/2008/02/Types.xsd\"><Int32>1</Int32><Int32>2</Int32></ListOfInt32></Value></UAVariable>\r\n\
+            </UANodeSet>\r\n";
+        let (set, d) = parse_str(xml);
+        assert!(d.items.is_empty(), "{d:?}");
+        let set = set.unwrap();
+        assert_eq!(set.namespace_uris[0].value, "http://x/");
+        assert_eq!(set.models[0].required[0].version.as_deref(), Some("1.04"));
+        assert_eq!(set.aliases[0].target.value, "i=47");
+        assert_eq!(set.nodes.len(), 2);
+        let a = &set.nodes[0];
+        assert_eq!(a.display_names.len(), 2);
+        assert_eq!(a.descriptions[0].text, "line1\nline2");
+        assert!(!a.references[0].is_forward);
+        assert_eq!(&xml[a.node_id.span.start as usize..a.node_id.span.end as usize], "ns=1;i=1");
+        let v = set.nodes[1].value.as_ref().unwrap();
+        assert_eq!(v.name, "ListOfInt32");
+        assert_eq!(v.children.len(), 2);
+        assert_eq!(v.children[1].text, "2");
+    }
+
+    #[test]
+    fn truncated_file_is_an_error_not_a_partial_model() {
+        let (set, d) = parse_str("<UANodeSet><UAObject NodeId=\"i=1\" BrowseName=\"A\"><DisplayName>A</DisplayName>");
+        assert!(set.is_none());
+        assert_eq!(d.items[0].code, Code::Truncated);
+    }
+
+    #[test]
+    fn doctype_is_rejected() {
+        let (set, d) = parse_str("<!DOCTYPE x [<!ENTITY a \"b\">]><UANodeSet/>");
+        assert!(set.is_none());
+        assert_eq!(d.items[0].code, Code::Doctype);
+    }
+
+    #[test]
+    fn deep_nesting_is_bounded() {
+        let depth = 100_000;
+        let xml = format!("<UANodeSet>{}{}</UANodeSet>", "<a>".repeat(depth), "</a>".repeat(depth));
+        let (set, d) = parse_str(&xml);
+        assert!(set.is_none());
+        assert!(d.items.iter().any(|i| i.code == Code::TooDeep), "{d:?}");
+    }
+
+    #[test]
+    fn utf16_and_bad_utf8_are_rejected() {
+        assert!(decode_text(vec![0xFF, 0xFE, b'<', 0]).is_err());
+        let (_, at) = decode_text(b"<a>\xC3\x28</a>".to_vec()).unwrap_err();
+        assert_eq!(at, 3);
+        assert_eq!(decode_text(b"\xEF\xBB\xBF<a/>".to_vec()).unwrap(), "<a/>");
+    }
+}
