@@ -208,7 +208,12 @@ fn update_lock(lock_path: &Path, vendor_dir: &Path, version: Option<String>) -> 
     }
     check_required_models(&files)?;
 
-    let lock = Lock { package: PACKAGE.to_string(), version, integrity, files };
+    let lock = Lock {
+        package: PACKAGE.to_string(),
+        version,
+        integrity,
+        files,
+    };
     fs::create_dir_all(vendor_dir)
         .map_err(|e| format!("cannot create {}: {e}", display_path(vendor_dir)))?;
     for file in &lock.files {
@@ -335,8 +340,10 @@ fn describe(wanted: &Wanted, bytes: &[u8]) -> Result<LockedFile, String> {
 /// Fails unless every `<RequiredModel>` is defined by a selected file, and warns
 /// when the selected file is older than the version required.
 fn check_required_models(files: &[LockedFile]) -> Result<(), String> {
-    let defined: HashMap<&str, &LockedFile> =
-        files.iter().map(|file| (file.model_uri.as_str(), file)).collect();
+    let defined: HashMap<&str, &LockedFile> = files
+        .iter()
+        .map(|file| (file.model_uri.as_str(), file))
+        .collect();
     for file in files {
         for (uri, version) in &file.requires {
             let Some(provider) = defined.get(uri.as_str()) else {
@@ -407,14 +414,18 @@ fn extract<'a>(tarball: &[u8], paths: &[&'a str]) -> Result<BTreeMap<&'a str, Ve
             continue;
         };
         if !entry.header().entry_type().is_file() {
-            return Err(format!("{entry_path} in the package tarball is not a regular file"));
+            return Err(format!(
+                "{entry_path} in the package tarball is not a regular file"
+            ));
         }
         if found.contains_key(wanted) {
             return Err(format!("{entry_path} appears twice in the package tarball"));
         }
         let size = entry.size();
         if size > MAX_FILE_SIZE {
-            return Err(format!("{entry_path} in the package tarball is {size} bytes, which is implausibly large"));
+            return Err(format!(
+                "{entry_path} in the package tarball is {size} bytes, which is implausibly large"
+            ));
         }
         let mut bytes = Vec::with_capacity(size as usize);
         entry
@@ -422,9 +433,16 @@ fn extract<'a>(tarball: &[u8], paths: &[&'a str]) -> Result<BTreeMap<&'a str, Ve
             .map_err(|e| format!("cannot extract {entry_path} from the package tarball: {e}"))?;
         found.insert(wanted, bytes);
     }
-    let missing: Vec<&str> = paths.iter().copied().filter(|path| !found.contains_key(path)).collect();
+    let missing: Vec<&str> = paths
+        .iter()
+        .copied()
+        .filter(|path| !found.contains_key(path))
+        .collect();
     if !missing.is_empty() {
-        return Err(format!("the package does not contain {}", missing.join(", ")));
+        return Err(format!(
+            "the package does not contain {}",
+            missing.join(", ")
+        ));
     }
     Ok(found)
 }
@@ -539,8 +557,16 @@ mod tests {
         names.dedup();
         assert_eq!(names.len(), SELECTION.len(), "duplicate local names");
         for wanted in SELECTION {
-            assert!(!wanted.name.contains('/') && !wanted.name.starts_with('.'), "{}", wanted.name);
-            assert!(!wanted.path.starts_with('/') && !wanted.path.contains(".."), "{}", wanted.path);
+            assert!(
+                !wanted.name.contains('/') && !wanted.name.starts_with('.'),
+                "{}",
+                wanted.name
+            );
+            assert!(
+                !wanted.path.starts_with('/') && !wanted.path.contains(".."),
+                "{}",
+                wanted.path
+            );
         }
     }
 

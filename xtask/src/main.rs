@@ -15,7 +15,10 @@ mod util;
 
 /// The top-level command line of `cargo xtask`.
 #[derive(Debug, Parser)]
-#[command(name = "cargo xtask", about = "Developer tasks for the nodeset-compiler workspace")]
+#[command(
+    name = "cargo xtask",
+    about = "Developer tasks for the nodeset-compiler workspace"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,

@@ -19,7 +19,10 @@ pub fn workspace_root() -> PathBuf {
 /// Shows `path` relative to the workspace root when it lies inside it, for shorter messages.
 pub fn display_path(path: &Path) -> String {
     let root = workspace_root();
-    path.strip_prefix(&root).unwrap_or(path).display().to_string()
+    path.strip_prefix(&root)
+        .unwrap_or(path)
+        .display()
+        .to_string()
 }
 
 /// Writes `bytes` to `path` so that readers see either the old or the new
@@ -45,7 +48,11 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), String> {
             .and_then(|()| file.sync_all())
             .map_err(|e| format!("cannot write {}: {e}", display_path(&temp)))?;
         fs::rename(&temp, path).map_err(|e| {
-            format!("cannot rename {} to {}: {e}", display_path(&temp), display_path(path))
+            format!(
+                "cannot rename {} to {}: {e}",
+                display_path(&temp),
+                display_path(path)
+            )
         })
     })();
     if result.is_err() {

@@ -56,12 +56,14 @@ const BASE64_ALPHABET: &[u8; 64] =
 /// must be zero, so every digest has exactly one accepted spelling.
 pub fn base64_decode(input: &str) -> Result<Vec<u8>, String> {
     let bytes = input.as_bytes();
-    if bytes.len() % 4 != 0 {
+    if !bytes.len().is_multiple_of(4) {
         return Err(format!("length {} is not a multiple of 4", bytes.len()));
     }
     let padding = bytes.iter().rev().take_while(|&&b| b == b'=').count();
     if padding > 2 {
-        return Err(format!("{padding} padding characters, at most 2 are allowed"));
+        return Err(format!(
+            "{padding} padding characters, at most 2 are allowed"
+        ));
     }
     let body = &bytes[..bytes.len() - padding];
 
@@ -138,7 +140,11 @@ mod tests {
             ("Zm9vYmFy", "foobar"),
         ];
         for (encoded, decoded) in vectors {
-            assert_eq!(base64_decode(encoded).as_deref(), Ok(decoded.as_bytes()), "{encoded}");
+            assert_eq!(
+                base64_decode(encoded).as_deref(),
+                Ok(decoded.as_bytes()),
+                "{encoded}"
+            );
             assert_eq!(base64_encode(decoded.as_bytes()), encoded, "{decoded}");
         }
     }
@@ -156,7 +162,10 @@ mod tests {
     fn base64_rejects_malformed_input() {
         assert!(base64_decode("Zg=").is_err(), "length not a multiple of 4");
         assert!(base64_decode("Z===").is_err(), "three padding characters");
-        assert!(base64_decode("Zm9-").is_err(), "URL-safe alphabet is not accepted");
+        assert!(
+            base64_decode("Zm9-").is_err(),
+            "URL-safe alphabet is not accepted"
+        );
         assert!(base64_decode("Zm=v").is_err(), "padding in the middle");
         assert!(base64_decode("Zh==").is_err(), "non-zero trailing bits");
     }
@@ -188,7 +197,10 @@ mod tests {
     #[test]
     fn sri_rejects_other_algorithms_and_truncated_digests() {
         assert!(parse_sri_sha512("sha256-ungWv48Bz+pBQUDeXa4iI7ADYaOWF3qctBD/YfIAFa0=").is_err());
-        assert!(parse_sri_sha512("sha512-Zm9vYmFy").is_err(), "six bytes is not a SHA-512 digest");
+        assert!(
+            parse_sri_sha512("sha512-Zm9vYmFy").is_err(),
+            "six bytes is not a SHA-512 digest"
+        );
     }
 
     #[test]

@@ -92,7 +92,9 @@ impl Lock {
             let single = || -> Result<String, String> {
                 match words.as_slice() {
                     [word] => Ok((*word).to_string()),
-                    _ => Err(at(format!("`{key}` takes exactly one value, found `{value}`"))),
+                    _ => Err(at(format!(
+                        "`{key}` takes exactly one value, found `{value}`"
+                    ))),
                 }
             };
 
@@ -125,9 +127,9 @@ impl Lock {
                         .ok_or_else(|| at(format!("`{key}` appears before the first `file`")))?;
                     if key == "requires" {
                         match words.as_slice() {
-                            [uri, version] => file
-                                .requires
-                                .push(((*uri).to_string(), optional(version))),
+                            [uri, version] => {
+                                file.requires.push(((*uri).to_string(), optional(version)))
+                            }
                             _ => {
                                 return Err(at(format!(
                                     "`requires` takes a ModelUri and a Version, found `{value}`"
@@ -164,7 +166,12 @@ impl Lock {
             .into_iter()
             .map(PartialFile::finish)
             .collect::<Result<Vec<_>, _>>()?;
-        Ok(Lock { package, version, integrity, files })
+        Ok(Lock {
+            package,
+            version,
+            integrity,
+            files,
+        })
     }
 
     /// Renders the lock file, starting with [`HEADER`]; [`Lock::parse`] reads it back unchanged.
@@ -183,7 +190,11 @@ impl Lock {
             let _ = writeln!(out, "  sha256 {}", file.sha256);
             let _ = writeln!(out, "  model-uri {}", file.model_uri);
             let _ = writeln!(out, "  model-version {}", or_dash(&file.model_version));
-            let _ = writeln!(out, "  publication-date {}", or_dash(&file.publication_date));
+            let _ = writeln!(
+                out,
+                "  publication-date {}",
+                or_dash(&file.publication_date)
+            );
             for (uri, version) in &file.requires {
                 let _ = writeln!(out, "  requires {uri} {}", or_dash(version));
             }
@@ -234,7 +245,9 @@ impl PartialFile {
         let sha256 = self.sha256.ok_or_else(|| missing("sha256"))?;
         let is_hex = |c: char| c.is_ascii_digit() || ('a'..='f').contains(&c);
         if sha256.len() != 64 || !sha256.chars().all(is_hex) {
-            return Err(format!("{context}: sha256 `{sha256}` is not 64 lowercase hex digits"));
+            return Err(format!(
+                "{context}: sha256 `{sha256}` is not 64 lowercase hex digits"
+            ));
         }
         Ok(LockedFile {
             name: self.name,
@@ -244,7 +257,9 @@ impl PartialFile {
             model_uri: self.model_uri.ok_or_else(|| missing("model-uri"))?,
             model_version: optional(&self.model_version.ok_or_else(|| missing("model-version"))?),
             publication_date: optional(
-                &self.publication_date.ok_or_else(|| missing("publication-date"))?,
+                &self
+                    .publication_date
+                    .ok_or_else(|| missing("publication-date"))?,
             ),
             requires: self.requires,
         })
@@ -318,7 +333,10 @@ mod tests {
                     model_version: None,
                     publication_date: None,
                     requires: vec![
-                        ("http://opcfoundation.org/UA/".to_string(), Some("1.05.04".to_string())),
+                        (
+                            "http://opcfoundation.org/UA/".to_string(),
+                            Some("1.05.04".to_string()),
+                        ),
                         ("http://example.org/X/".to_string(), None),
                     ],
                 },
@@ -357,7 +375,10 @@ mod tests {
         assert_eq!(file.publication_date.as_deref(), Some("2025-01-01"));
         assert_eq!(
             file.requires,
-            vec![("http://opcfoundation.org/UA/".to_string(), Some("1.05.03".to_string()))]
+            vec![(
+                "http://opcfoundation.org/UA/".to_string(),
+                Some("1.05.03".to_string())
+            )]
         );
         assert!(Lock::parse(&lock_with_block(VALID_BLOCK)).is_ok());
     }
@@ -365,14 +386,20 @@ mod tests {
     #[test]
     fn rejects_missing_header_fields() {
         let text = format!("package p\nintegrity {INTEGRITY}\nfile a.xml\n{VALID_BLOCK}");
-        assert_eq!(Lock::parse(&text), Err("missing `version` line".to_string()));
+        assert_eq!(
+            Lock::parse(&text),
+            Err("missing `version` line".to_string())
+        );
     }
 
     #[test]
     fn rejects_missing_file_fields_naming_the_file() {
         let block = VALID_BLOCK.replace("size 10\n", "");
         let error = Lock::parse(&lock_with_block(&block)).unwrap_err();
-        assert!(error.contains("a.xml") && error.contains("missing `size`"), "{error}");
+        assert!(
+            error.contains("a.xml") && error.contains("missing `size`"),
+            "{error}"
+        );
     }
 
     #[test]
@@ -389,7 +416,9 @@ mod tests {
         assert_eq!(error, "line 11: unknown key `colour`");
 
         let duplicate = format!("{VALID_BLOCK}size 11\n");
-        assert!(Lock::parse(&lock_with_block(&duplicate)).unwrap_err().contains("duplicate `size`"));
+        assert!(Lock::parse(&lock_with_block(&duplicate))
+            .unwrap_err()
+            .contains("duplicate `size`"));
 
         let two_words = VALID_BLOCK.replace("model-uri u", "model-uri u v");
         assert!(Lock::parse(&lock_with_block(&two_words)).is_err());
@@ -397,12 +426,16 @@ mod tests {
 
     #[test]
     fn rejects_unsafe_names_and_paths() {
-        let text = format!("package p\nversion 1\nintegrity {INTEGRITY}\nfile ../evil.xml\n{VALID_BLOCK}");
+        let text =
+            format!("package p\nversion 1\nintegrity {INTEGRITY}\nfile ../evil.xml\n{VALID_BLOCK}");
         assert!(Lock::parse(&text).unwrap_err().contains("file name"));
 
         for path in ["../x.xml", "/etc/passwd", "a//b.xml", "a\\b.xml", "./a.xml"] {
             let block = VALID_BLOCK.replace("path nodesets/a.xml", &format!("path {path}"));
-            assert!(Lock::parse(&lock_with_block(&block)).is_err(), "{path} was accepted");
+            assert!(
+                Lock::parse(&lock_with_block(&block)).is_err(),
+                "{path} was accepted"
+            );
         }
     }
 
@@ -412,9 +445,13 @@ mod tests {
         assert!(Lock::parse(&text).unwrap_err().contains("64"));
 
         let late_version = format!("{}version 2\n", lock_with_block(VALID_BLOCK));
-        assert!(Lock::parse(&late_version).unwrap_err().contains("before the first `file`"));
+        assert!(Lock::parse(&late_version)
+            .unwrap_err()
+            .contains("before the first `file`"));
 
         let duplicate_file = format!("{}file a.xml\n{VALID_BLOCK}", lock_with_block(VALID_BLOCK));
-        assert!(Lock::parse(&duplicate_file).unwrap_err().contains("duplicate file"));
+        assert!(Lock::parse(&duplicate_file)
+            .unwrap_err()
+            .contains("duplicate file"));
     }
 }

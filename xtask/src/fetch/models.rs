@@ -41,7 +41,9 @@ pub fn read_models(document: &str) -> Result<Vec<ModelHeader>, String> {
             continue;
         }
         if let Some(after) = rest.strip_prefix("<?") {
-            let end = after.find("?>").ok_or("unterminated processing instruction")?;
+            let end = after
+                .find("?>")
+                .ok_or("unterminated processing instruction")?;
             rest = &after[end + 2..];
             continue;
         }
@@ -216,6 +218,9 @@ mod tests {
     fn required_model_without_uri_is_an_error() {
         let document = r#"<UANodeSet><Models><Model ModelUri="u"><RequiredModel Version="1"/></Model></Models></UANodeSet>"#;
         let error = read_models(document).unwrap_err();
-        assert!(error.contains("RequiredModel") && error.contains("ModelUri"), "{error}");
+        assert!(
+            error.contains("RequiredModel") && error.contains("ModelUri"),
+            "{error}"
+        );
     }
 }

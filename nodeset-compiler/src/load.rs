@@ -1,0 +1,671 @@
+//! The loader: from files and model folders to an ordered set of parsed files with one namespace table.
+//!
+//! The user names files; the models they require are taken from among them or found in model folders
+//! (searched recursively, indexed by ModelUri from a cheap scan of each file's `<Models>` header). Of several
+//! versions of one model, the newest that satisfies the requirement wins. Files are then ordered so that a
+//! model comes after everything it requires (ties broken by ModelUri, so input order never matters), and
+//! every file's namespace indices are mapped onto the global table.
+
+use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::nodeid::{parse_node_id, looks_like_node_id, NodeId, NsRef};
+use crate::parse::{self, Limits};
+use crate::raw::{RawModel, RawNodeSet};
+use crate::source::{FileId, SourceFile, SourceMap, Span, Spanned};
+use std::cmp::Ordering;
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::path::{Path, PathBuf};
+
+/// The URI of the OPC UA base namespace, always namespace index 0.
+pub const NS0_URI: &str = "http://opcfoundation.org/UA/";
+
+/// What to load.
+#[derive(Clone, Debug, Default)]
+pub struct LoadOptions {
+    /// Folders searched recursively for required models.
+    pub model_dirs: Vec<PathBuf>,
+    pub limits: Limits,
+}
+
+/// A model a loaded file defines.
+#[derive(Clone, Debug)]
+pub struct ModelInfo {
+    pub uri: String,
+    pub version: Option<String>,
+    pub publication_date: Option<String>,
+    pub model_version: Option<String>,
+    pub file: FileId,
+    /// Global namespace index of the model.
+    pub ns: u16,
+    pub required: Vec<RequiredInfo>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug)]
+pub struct RequiredInfo {
+    pub uri: String,
+    pub version: Option<String>,
+    pub publication_date: Option<String>,
+    pub span: Span,
+}
+
+/// One parsed file with its namespace mapping and alias table.
+#[derive(Debug)]
+pub struct LoadedFile {
+    pub raw: RawNodeSet,
+    /// Local namespace index to global index (`ns_map[0] == 0`).
+    pub ns_map: Vec<u16>,
+    pub aliases: HashMap<String, Spanned<String>>,
+}
+
+impl LoadedFile {
+    /// Expands an alias or parses a NodeId written in this file, mapped to the global namespace table.
+    pub fn resolve_node_id(&self, text: &Spanned<String>, namespaces: &[String]) -> Result<NodeId, Diagnostic> {
+        let s = text.value.trim();
+        let (id_text, via_alias) = match self.aliases.get(s) {
+            Some(t) => (t.value.as_str(), Some(t)),
+            None => (s, None),
+        };
+        if via_alias.is_none() && !looks_like_node_id(id_text) {
+            let mut d = Diagnostic::new(Code::UnknownAlias, format!("`{s}` is neither a declared alias nor a NodeId"))
+                .at(text.span)
+                .with_span_label("unknown alias");
+            let near = nearest(s, self.aliases.keys().map(String::as_str));
+            d = match near {
+                Some(n) => d.help(format!("did you mean the alias `{n}`? Otherwise declare it in <Aliases>")),
+                None => d.help("declare it in <Aliases> (<Alias Alias=\"Name\">i=...</Alias>) or write the NodeId"),
+            };
+            return Err(d);
+        }
+        let raw = parse_node_id(id_text).map_err(|why| {
+            let mut d = Diagnostic::new(Code::MalformedNodeId, format!("malformed NodeId `{id_text}`: {why}"));
+            if let Some(t) = via_alias {
+                d = d.at(t.span).label(text.span, format!("used through alias `{s}` here"));
+            } else {
+                d = d.at(text.span);
+            }
+            d.help("NodeIds are written i=123, s=Name, g=GUID or b=Base64, with an optional ns=N; or nsu=URI; prefix")
+        })?;
+        let ns = match raw.ns {
+            NsRef::Index(i) => match self.ns_map.get(i as usize) {
+                Some(&g) => g,
+                None => {
+                    return Err(Diagnostic::new(
+                        Code::UnknownNamespaceIndex,
+                        format!("namespace index {i} is not declared in this file's NamespaceUris"),
+                    )
+                    .at(via_alias.map(|t| t.span).unwrap_or(text.span))
+                    .with_span_label(format!("ns={i}"))
+                    .note(format!("this file declares {} namespace URI(s)", self.ns_map.len() - 1))
+                    .help("add the namespace's URI to <NamespaceUris> at that position"))
+                }
+            },
+            NsRef::Uri(u) => match namespaces.iter().position(|n| *n == u) {
+                Some(g) => g as u16,
+                None => {
+                    return Err(Diagnostic::new(
+                        Code::UnknownNamespaceUri,
+                        format!("namespace `{u}` is not a loaded model or declared namespace"),
+                    )
+                    .at(text.span)
+                    .help("load the model that defines this namespace (see --models)"))
+                }
+            },
+        };
+        Ok(NodeId { ns, id: raw.id })
+    }
+}
+
+/// Everything loaded, in dependency order.
+#[derive(Debug)]
+pub struct Loaded {
+    pub sources: SourceMap,
+    /// Parsed files, each after the files it requires.
+    pub files: Vec<LoadedFile>,
+    /// The global namespace table: index 0 is the OPC UA namespace.
+    pub namespaces: Vec<String>,
+    pub models: Vec<ModelInfo>,
+}
+
+impl Loaded {
+    pub fn file(&self, id: FileId) -> Option<&LoadedFile> {
+        self.files.iter().find(|f| f.raw.file == id)
+    }
+
+    pub fn model_of_namespace(&self, ns: u16) -> Option<&ModelInfo> {
+        self.models.iter().find(|m| m.ns == ns)
+    }
+}
+
+/// A file offered by a models folder, known from its header only.
+#[derive(Clone, Debug)]
+struct Candidate {
+    path: PathBuf,
+    models: Vec<(String, Option<String>, Option<String>)>,
+}
+
+/// A source of input: a file on disk or text held in memory (tests, fuzzing, build scripts).
+pub enum Input {
+    Path(PathBuf),
+    Text { name: String, text: String },
+}
+
+/// Loads the named inputs and the models they require.
+pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> Loaded {
+    let mut sources = SourceMap::new();
+    let mut parsed: Vec<RawNodeSet> = Vec::new();
+    for input in inputs {
+        let (path, display, bytes) = match input {
+            Input::Path(p) => match std::fs::read(&p) {
+                Ok(b) => (p.clone(), p.display().to_string(), b),
+                Err(e) => {
+                    diags.push(
+                        Diagnostic::new(Code::Io, format!("cannot read {}: {e}", p.display()))
+                            .help("check the path; folders of required models go after --models"),
+                    );
+                    continue;
+                }
+            },
+            Input::Text { name, text } => (PathBuf::from(&name), name, text.into_bytes()),
+        };
+        if let Some(set) = read_and_parse(&mut sources, path, display, bytes, true, &opts.limits, diags) {
+            parsed.push(set);
+        }
+    }
+
+    // Models provided by the named files.
+    let mut provided: BTreeMap<String, FileId> = BTreeMap::new();
+    for set in &parsed {
+        for m in &set.models {
+            if let Some(&other) = provided.get(&m.uri) {
+                if other != set.file {
+                    let first = parsed.iter().find(|s| s.file == other).and_then(|s| s.models.iter().find(|x| x.uri == m.uri));
+                    let mut d = Diagnostic::new(Code::DuplicateModel, format!("model `{}` is defined by two input files", m.uri))
+                        .at(m.span)
+                        .with_span_label("defined again here");
+                    if let Some(f) = first {
+                        d = d.label(f.span, "first defined here");
+                    }
+                    diags.push(d.help("pass only one version of each model; the others belong in a --models folder"));
+                }
+                continue;
+            }
+            provided.insert(m.uri.clone(), set.file);
+        }
+        if set.models.is_empty() {
+            diags.push(
+                Diagnostic::new(Code::NoModel, "the file declares no <Models>; its nodes are loaded but it cannot be required by others")
+                    .at(set.root_span)
+                    .help("add <Models><Model ModelUri=\"...\" Version=\"...\" PublicationDate=\"...\"/></Models>"),
+            );
+        }
+    }
+
+    // Resolve requirements transitively, from the named files and from the models folders.
+    let mut index: Option<Vec<Candidate>> = None;
+    let mut queue: Vec<usize> = (0..parsed.len()).collect();
+    let mut checked: BTreeSet<(String, FileId)> = BTreeSet::new();
+    while let Some(i) = queue.pop() {
+        let set_file = parsed[i].file;
+        let mut reqs: Vec<(RequiredInfo, bool)> = Vec::new();
+        for m in &parsed[i].models {
+            for r in &m.required {
+                reqs.push((
+                    RequiredInfo { uri: r.uri.clone(), version: r.version.clone(), publication_date: r.publication_date.clone(), span: r.span },
+                    true,
+                ));
+            }
+        }
+        // Every file needs the OPC UA namespace, whether or not it says so.
+        let is_ns0 = parsed[i].models.iter().any(|m| m.uri == NS0_URI);
+        if !is_ns0 && !reqs.iter().any(|(r, _)| r.uri == NS0_URI) {
+            reqs.push((RequiredInfo { uri: NS0_URI.into(), version: None, publication_date: None, span: parsed[i].root_span }, false));
+        }
+        for (req, explicit) in reqs {
+            if !checked.insert((req.uri.clone(), set_file)) {
+                continue;
+            }
+            if let Some(&fid) = provided.get(&req.uri) {
+                let set = parsed.iter().find(|s| s.file == fid).expect("provided file is parsed");
+                let m = set.models.iter().find(|m| m.uri == req.uri).expect("provided model exists");
+                check_version(&req, m.version.as_deref(), m.publication_date.as_deref(), &sources.get(fid).display, diags);
+                continue;
+            }
+            let idx = index.get_or_insert_with(|| scan_dirs(&opts.model_dirs));
+            let mut options: Vec<&Candidate> = idx.iter().filter(|c| c.models.iter().any(|m| m.0 == req.uri)).collect();
+            let version_of = |c: &Candidate| c.models.iter().find(|m| m.0 == req.uri).map(|m| (m.1.clone(), m.2.clone())).unwrap_or_default();
+            options.sort_by(|a, b| {
+                let (va, da) = version_of(a);
+                let (vb, db) = version_of(b);
+                cmp_version(vb.as_deref(), va.as_deref())
+                    .then_with(|| db.cmp(&da))
+                    .then_with(|| a.path.as_os_str().len().cmp(&b.path.as_os_str().len()))
+                    .then_with(|| a.path.cmp(&b.path))
+            });
+            let satisfying = options.iter().find(|c| {
+                let (v, _) = version_of(c);
+                req.version.is_none() || cmp_version(v.as_deref(), req.version.as_deref()) != Ordering::Less
+            });
+            let requirer = sources.get(set_file).display.clone();
+            match satisfying {
+                Some(c) => {
+                    let path = c.path.clone();
+                    let (v, d) = version_of(c);
+                    check_version(&req, v.as_deref(), d.as_deref(), &path.display().to_string(), diags);
+                    let bytes = match std::fs::read(&path) {
+                        Ok(b) => b,
+                        Err(e) => {
+                            diags.push(Diagnostic::new(Code::Io, format!("cannot read {}: {e}", path.display())).at(req.span));
+                            continue;
+                        }
+                    };
+                    let display = path.display().to_string();
+                    if let Some(set) = read_and_parse(&mut sources, path, display, bytes, false, &opts.limits, diags) {
+                        for m in &set.models {
+                            provided.entry(m.uri.clone()).or_insert(set.file);
+                        }
+                        parsed.push(set);
+                        queue.push(parsed.len() - 1);
+                    } else {
+                        // Do not try this model again for every file that requires it.
+                        provided.insert(req.uri.clone(), FileId(u32::MAX));
+                    }
+                }
+                None if !options.is_empty() => {
+                    let best = options[0];
+                    let (v, _) = version_of(best);
+                    diags.push(
+                        Diagnostic::new(
+                            Code::ModelTooOld,
+                            format!(
+                                "`{}` requires model `{}` version {}, but only version {} is available",
+                                requirer,
+                                req.uri,
+                                req.version.as_deref().unwrap_or("?"),
+                                v.as_deref().unwrap_or("(none)")
+                            ),
+                        )
+                        .at(req.span)
+                        .with_span_label(format!("requires version {}", req.version.as_deref().unwrap_or("?")))
+                        .note(format!("newest available: {} in {}", v.as_deref().unwrap_or("(no version)"), best.path.display()))
+                        .help("get a newer release of that model (for the companion specs: `cargo xtask fetch-nodesets`), or correct the RequiredModel Version"),
+                    );
+                }
+                None => {
+                    if provided.get(&req.uri) == Some(&FileId(u32::MAX)) {
+                        continue;
+                    }
+                    let looked = if opts.model_dirs.is_empty() {
+                        "no --models folder was given".to_string()
+                    } else {
+                        format!(
+                            "looked in the named files and in {} ({} NodeSet2 files)",
+                            opts.model_dirs.iter().map(|d| d.display().to_string()).collect::<Vec<_>>().join(", "),
+                            idx.len()
+                        )
+                    };
+                    let msg = if explicit {
+                        format!("required model `{}` is not available", req.uri)
+                    } else {
+                        format!("the OPC UA base model `{}` is not available", req.uri)
+                    };
+                    diags.push(
+                        Diagnostic::new(Code::MissingModel, msg)
+                            .at(req.span)
+                            .with_span_label(if explicit { "required here" } else { "every NodeSet requires the base model" })
+                            .note(looked)
+                            .help("name the file that defines this model, or add the folder holding it with --models DIR"),
+                    );
+                }
+            }
+        }
+    }
+
+    // Order files by requirement, ties by model URI then file name, never by input order.
+    let order = topo_order(&parsed, &sources, diags);
+    let mut files_sorted: Vec<RawNodeSet> = Vec::with_capacity(parsed.len());
+    let mut slots: Vec<Option<RawNodeSet>> = parsed.into_iter().map(Some).collect();
+    for i in order {
+        files_sorted.push(slots[i].take().expect("each file once"));
+    }
+
+    // The namespace table.
+    let mut namespaces: Vec<String> = vec![NS0_URI.to_string()];
+    let intern = |uri: &str, namespaces: &mut Vec<String>| -> u16 {
+        match namespaces.iter().position(|n| n == uri) {
+            Some(i) => i as u16,
+            None => {
+                namespaces.push(uri.to_string());
+                (namespaces.len() - 1) as u16
+            }
+        }
+    };
+    for set in &files_sorted {
+        for m in &set.models {
+            intern(&m.uri, &mut namespaces);
+        }
+    }
+    for set in &files_sorted {
+        for u in &set.namespace_uris {
+            intern(&u.value, &mut namespaces);
+        }
+    }
+
+    let mut models = Vec::new();
+    let mut files = Vec::new();
+    for set in files_sorted {
+        let mut ns_map = vec![0u16];
+        for u in &set.namespace_uris {
+            ns_map.push(intern(&u.value, &mut namespaces));
+        }
+        for m in &set.models {
+            models.push(model_info(m, set.file, intern(&m.uri, &mut namespaces)));
+        }
+        let mut aliases: HashMap<String, Spanned<String>> = HashMap::with_capacity(set.aliases.len());
+        for a in &set.aliases {
+            if let Some(prev) = aliases.get(&a.alias) {
+                if prev.value != a.target.value {
+                    diags.push(
+                        Diagnostic::new(Code::DuplicateAlias, format!("alias `{}` is declared twice with different targets", a.alias))
+                            .at(a.span)
+                            .label(prev.span, format!("first declared as {}", prev.value))
+                            .help("keep one declaration"),
+                    );
+                }
+                continue;
+            }
+            aliases.insert(a.alias.clone(), a.target.clone());
+        }
+        files.push(LoadedFile { raw: set, ns_map, aliases });
+    }
+    Loaded { sources, files, namespaces, models }
+}
+
+fn model_info(m: &RawModel, file: FileId, ns: u16) -> ModelInfo {
+    ModelInfo {
+        uri: m.uri.clone(),
+        version: m.version.clone(),
+        publication_date: m.publication_date.clone(),
+        model_version: m.model_version.clone(),
+        file,
+        ns,
+        required: m
+            .required
+            .iter()
+            .map(|r| RequiredInfo { uri: r.uri.clone(), version: r.version.clone(), publication_date: r.publication_date.clone(), span: r.span })
+            .collect(),
+        span: m.span,
+    }
+}
+
+fn read_and_parse(
+    sources: &mut SourceMap,
+    path: PathBuf,
+    display: String,
+    bytes: Vec<u8>,
+    named: bool,
+    limits: &Limits,
+    diags: &mut Diagnostics,
+) -> Option<RawNodeSet> {
+    match parse::decode_text(bytes.clone()) {
+        Ok(text) => {
+            let id = sources.add(SourceFile::new(path, display, text, named));
+            let text = &sources.get(id).text;
+            parse::parse(id, text, limits, diags)
+        }
+        Err((d, at)) => {
+            let lossy = String::from_utf8_lossy(&bytes).into_owned();
+            let id = sources.add(SourceFile::new(path, display, lossy, named));
+            diags.push(d.at(Span::new(id, at, at + 1)));
+            None
+        }
+    }
+}
+
+fn check_version(req: &RequiredInfo, have: Option<&str>, have_date: Option<&str>, where_: &str, diags: &mut Diagnostics) {
+    let Some(want) = req.version.as_deref() else { return };
+    match cmp_version(have, Some(want)) {
+        Ordering::Less => diags.push(
+            Diagnostic::new(
+                Code::ModelTooOld,
+                format!("model `{}` is required in version {want}, but {where_} holds version {}", req.uri, have.unwrap_or("(none)")),
+            )
+            .at(req.span)
+            .with_span_label(format!("requires version {want}"))
+            .help("use a newer release of the required model"),
+        ),
+        Ordering::Equal => {
+            if let (Some(want_d), Some(have_d)) = (req.publication_date.as_deref(), have_date) {
+                if date_key(have_d) < date_key(want_d) {
+                    diags.push(
+                        Diagnostic::new(
+                            Code::ModelDateOlder,
+                            format!(
+                                "model `{}` version {want} is required as published {want_d}, but {where_} was published {have_d}",
+                                req.uri
+                            ),
+                        )
+                        .at(req.span)
+                        .help("use the release published on or after the required date"),
+                    );
+                }
+            }
+        }
+        Ordering::Greater => {}
+    }
+}
+
+fn date_key(d: &str) -> &str {
+    d.get(..10).unwrap_or(d)
+}
+
+/// Compares dotted versions numerically (`1.05.03` > `1.5.2`, `1.04` == `1.4.0`); absent is lowest.
+pub fn cmp_version(a: Option<&str>, b: Option<&str>) -> Ordering {
+    match (a, b) {
+        (None, None) => Ordering::Equal,
+        (None, Some(_)) => Ordering::Less,
+        (Some(_), None) => Ordering::Greater,
+        (Some(a), Some(b)) => {
+            let pa: Vec<&str> = a.trim().split(['.', '-']).collect();
+            let pb: Vec<&str> = b.trim().split(['.', '-']).collect();
+            for i in 0..pa.len().max(pb.len()) {
+                let x = pa.get(i).copied().unwrap_or("0");
+                let y = pb.get(i).copied().unwrap_or("0");
+                let o = match (x.parse::<u64>(), y.parse::<u64>()) {
+                    (Ok(x), Ok(y)) => x.cmp(&y),
+                    _ => x.cmp(y),
+                };
+                if o != Ordering::Equal {
+                    return o;
+                }
+            }
+            Ordering::Equal
+        }
+    }
+}
+
+/// Lists every NodeSet2 file under the folders with the models its header declares.
+fn scan_dirs(dirs: &[PathBuf]) -> Vec<Candidate> {
+    let mut paths = Vec::new();
+    for d in dirs {
+        walk(d, &mut paths);
+    }
+    paths.sort();
+    paths.dedup();
+    paths.into_iter().filter_map(|p| scan_header(&p).map(|models| Candidate { path: p, models })).collect()
+}
+
+fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        let p = e.path();
+        let Ok(ft) = e.file_type() else { continue };
+        if ft.is_dir() {
+            walk(&p, out);
+        } else if p.extension().and_then(|x| x.to_str()).is_some_and(|x| x.eq_ignore_ascii_case("xml")) {
+            out.push(p);
+        }
+    }
+}
+
+/// Reads the `<Models>` element of a file without parsing the rest.
+fn scan_header(path: &Path) -> Option<Vec<(String, Option<String>, Option<String>)>> {
+    use std::io::Read;
+    let mut f = std::fs::File::open(path).ok()?;
+    let mut buf = vec![0u8; 256 * 1024];
+    let mut n = 0;
+    while n < buf.len() {
+        let k = f.read(&mut buf[n..]).ok()?;
+        if k == 0 {
+            break;
+        }
+        n += k;
+    }
+    buf.truncate(n);
+    let text = String::from_utf8_lossy(&buf);
+    if !text.contains("UANodeSet") {
+        return None;
+    }
+    let start = text.find("<Models>")?;
+    let end = text[start..].find("</Models>")? + start + "</Models>".len();
+    let mut reader = quick_xml::Reader::from_str(&text[start..end]);
+    let mut out = Vec::new();
+    loop {
+        match reader.read_event() {
+            Ok(quick_xml::events::Event::Start(e)) | Ok(quick_xml::events::Event::Empty(e)) => {
+                if e.local_name().as_ref() == b"Model" {
+                    let get = |k: &[u8]| {
+                        e.attributes()
+                            .flatten()
+                            .find(|a| a.key.local_name().as_ref() == k)
+                            .and_then(|a| a.unescape_value().ok().map(|v| v.into_owned()))
+                    };
+                    if let Some(uri) = get(b"ModelUri") {
+                        out.push((uri, get(b"Version"), get(b"PublicationDate")));
+                    }
+                }
+            }
+            Ok(quick_xml::events::Event::Eof) | Err(_) => break,
+            _ => {}
+        }
+    }
+    Some(out)
+}
+
+fn topo_order(parsed: &[RawNodeSet], sources: &SourceMap, diags: &mut Diagnostics) -> Vec<usize> {
+    let provider: HashMap<&str, usize> = {
+        let mut m = HashMap::new();
+        for (i, s) in parsed.iter().enumerate() {
+            for model in &s.models {
+                m.entry(model.uri.as_str()).or_insert(i);
+            }
+        }
+        m
+    };
+    let ns0 = provider.get(NS0_URI).copied();
+    let deps: Vec<BTreeSet<usize>> = parsed
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let mut d: BTreeSet<usize> = s
+                .models
+                .iter()
+                .flat_map(|m| m.required.iter())
+                .filter_map(|r| provider.get(r.uri.as_str()).copied())
+                .filter(|&j| j != i)
+                .collect();
+            if let Some(n) = ns0 {
+                if n != i {
+                    d.insert(n);
+                }
+            }
+            d
+        })
+        .collect();
+    let key = |i: usize| {
+        let s = &parsed[i];
+        let uri = s.models.first().map(|m| m.uri.clone()).unwrap_or_default();
+        let f = sources.get(s.file);
+        let name = f.path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+        (uri.is_empty(), uri, name, f.path.clone())
+    };
+    let mut done = vec![false; parsed.len()];
+    let mut order = Vec::with_capacity(parsed.len());
+    loop {
+        let mut ready: Vec<usize> = (0..parsed.len()).filter(|&i| !done[i] && deps[i].iter().all(|&d| done[d])).collect();
+        if ready.is_empty() {
+            break;
+        }
+        ready.sort_by_key(|&i| key(i));
+        let i = ready[0];
+        done[i] = true;
+        order.push(i);
+    }
+    let rest: Vec<usize> = (0..parsed.len()).filter(|&i| !done[i]).collect();
+    if !rest.is_empty() {
+        let mut rest_sorted = rest.clone();
+        rest_sorted.sort_by_key(|&i| key(i));
+        let names: Vec<String> = rest_sorted
+            .iter()
+            .map(|&i| parsed[i].models.first().map(|m| m.uri.clone()).unwrap_or_else(|| sources.get(parsed[i].file).display.clone()))
+            .collect();
+        let first = &parsed[rest_sorted[0]];
+        let mut d = Diagnostic::new(Code::ModelCycle, format!("these models require each other in a cycle: {}", names.join(" -> ")))
+            .help("a model cannot require itself through others; remove one RequiredModel");
+        if let Some(r) = first.models.first().and_then(|m| m.required.first()) {
+            d = d.at(r.span);
+        }
+        diags.push(d);
+        order.extend(rest_sorted);
+    }
+    order
+}
+
+/// The candidate closest to `name` by edit distance, if close enough to be a likely typo.
+pub fn nearest<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<&'a str> {
+    let mut best: Option<(usize, &str)> = None;
+    for c in candidates {
+        let d = edit_distance(&name.to_lowercase(), &c.to_lowercase());
+        let limit = (name.len().max(c.len()) / 3).max(1);
+        if d <= limit && best.is_none_or(|(bd, bc)| (d, c) < (bd, bc)) {
+            best = Some((d, c));
+        }
+    }
+    best.map(|(_, c)| c)
+}
+
+pub fn edit_distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.chars().collect();
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    let mut cur = vec![0; b.len() + 1];
+    for i in 1..=a.len() {
+        cur[0] = i;
+        for j in 1..=b.len() {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            cur[j] = (prev[j] + 1).min(cur[j - 1] + 1).min(prev[j - 1] + cost);
+        }
+        std::mem::swap(&mut prev, &mut cur);
+    }
+    prev[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn versions_compare_numerically() {
+        assert_eq!(cmp_version(Some("1.05.03"), Some("1.5.2")), Ordering::Greater);
+        assert_eq!(cmp_version(Some("1.04"), Some("1.4.0")), Ordering::Equal);
+        assert_eq!(cmp_version(Some("1.02"), Some("1.04.0")), Ordering::Less);
+        assert_eq!(cmp_version(None, Some("1.0")), Ordering::Less);
+        assert_eq!(cmp_version(Some("9.99.99"), Some("1.05")), Ordering::Greater);
+    }
+
+    #[test]
+    fn nearest_finds_typos_only() {
+        let c = ["HasComponent", "HasProperty", "Organizes"];
+        assert_eq!(nearest("HasComponnet", c.iter().copied()), Some("HasComponent"));
+        assert_eq!(nearest("Zebra", c.iter().copied()), None);
+    }
+}
