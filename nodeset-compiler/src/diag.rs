@@ -68,13 +68,14 @@ codes! {
     DuplicateAlias = "NS0110", Error, "an alias is declared twice with different targets";
     MalformedQualifiedName = "NS0111", Error, "a QualifiedName is malformed";
     UnknownNamespaceUri = "NS0112", Error, "a namespace URI names no loaded model";
+    AliasByBrowseName = "NS0113", Warning, "an undeclared alias was resolved by the BrowseName of a base type";
     // Resolving one model of all files.
     DuplicateNodeId = "NS0201", Error, "a NodeId is defined twice";
     DanglingReference = "NS0202", Error, "a reference points to a node that does not exist";
     BadReferenceType = "NS0203", Error, "a reference type is not a ReferenceType node";
     SubtypeCycle = "NS0204", Error, "a type is its own supertype";
     BadTypeDefinition = "NS0205", Error, "a TypeDefinition has the wrong node class";
-    BrowseNameCollision = "NS0206", Error, "two children of one node share a BrowseName";
+    BrowseNameCollision = "NS0206", Warning, "two children of one node share a BrowseName";
     UnknownFieldType = "NS0207", Error, "a structure field has an unknown DataType";
     DuplicateEnumValue = "NS0208", Error, "an enumeration repeats a value or a name";
     ValueTypeMismatch = "NS0209", Warning, "a value contradicts its DataType";

@@ -60,8 +60,20 @@ pub struct LoadedFile {
 impl LoadedFile {
     /// Expands an alias or parses a NodeId written in this file, mapped to the global namespace table.
     pub fn resolve_node_id(&self, text: &Spanned<String>, namespaces: &[String]) -> Result<NodeId, Diagnostic> {
+        resolve_node_id_in(&self.ns_map, &self.aliases, text, namespaces)
+    }
+}
+
+/// Expands an alias or parses a NodeId written in a file with this namespace map and alias table.
+pub fn resolve_node_id_in(
+    ns_map: &[u16],
+    aliases: &HashMap<String, Spanned<String>>,
+    text: &Spanned<String>,
+    namespaces: &[String],
+) -> Result<NodeId, Diagnostic> {
+    {
         let s = text.value.trim();
-        let (id_text, via_alias) = match self.aliases.get(s) {
+        let (id_text, via_alias) = match aliases.get(s) {
             Some(t) => (t.value.as_str(), Some(t)),
             None => (s, None),
         };
@@ -69,7 +81,7 @@ impl LoadedFile {
             let mut d = Diagnostic::new(Code::UnknownAlias, format!("`{s}` is neither a declared alias nor a NodeId"))
                 .at(text.span)
                 .with_span_label("unknown alias");
-            let near = nearest(s, self.aliases.keys().map(String::as_str));
+            let near = nearest(s, aliases.keys().map(String::as_str));
             d = match near {
                 Some(n) => d.help(format!("did you mean the alias `{n}`? Otherwise declare it in <Aliases>")),
                 None => d.help("declare it in <Aliases> (<Alias Alias=\"Name\">i=...</Alias>) or write the NodeId"),
@@ -86,7 +98,7 @@ impl LoadedFile {
             d.help("NodeIds are written i=123, s=Name, g=GUID or b=Base64, with an optional ns=N; or nsu=URI; prefix")
         })?;
         let ns = match raw.ns {
-            NsRef::Index(i) => match self.ns_map.get(i as usize) {
+            NsRef::Index(i) => match ns_map.get(i as usize) {
                 Some(&g) => g,
                 None => {
                     return Err(Diagnostic::new(
@@ -95,7 +107,7 @@ impl LoadedFile {
                     )
                     .at(via_alias.map(|t| t.span).unwrap_or(text.span))
                     .with_span_label(format!("ns={i}"))
-                    .note(format!("this file declares {} namespace URI(s)", self.ns_map.len() - 1))
+                    .note(format!("this file declares {} namespace URI(s)", ns_map.len() - 1))
                     .help("add the namespace's URI to <NamespaceUris> at that position"))
                 }
             },

@@ -1,0 +1,265 @@
+//! Classifies every DataType: built-in, simple subtype, enumeration, OptionSet, structure (plain, with
+//! optional fields, union), with inherited fields and resolved field types.
+
+use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::model::*;
+use crate::raw::NodeClass;
+use crate::value::{BuiltinType, Variant};
+use std::collections::{BTreeMap, HashMap};
+
+pub(crate) fn classify(model: &mut Model, diags: &mut Diagnostics) {
+    let types: Vec<NodeIx> =
+        (0..model.nodes.len() as u32).map(NodeIx).filter(|&ix| model.node(ix).class == NodeClass::DataType).collect();
+    // Supertypes first, so inherited fields are known.
+    let mut order: Vec<(usize, NodeIx)> = types.iter().map(|&t| (model.super_chain(t).len(), t)).collect();
+    order.sort();
+    let has_encoding = model.ns0(ids::HAS_ENCODING);
+    let mut out: BTreeMap<NodeIx, DataTypeInfo> = BTreeMap::new();
+    for (_, t) in order {
+        let node = model.node(t);
+        let chain = model.super_chain(t);
+        let ns0_in_chain = |n: u32| chain.iter().any(|&c| model.node(c).id.ns0() == Some(n));
+        let own_builtin = node.id.ns0().and_then(BuiltinType::from_id);
+        let base_builtin = chain.iter().find_map(|&c| model.node(c).id.ns0().and_then(BuiltinType::from_id));
+        let encodings: Vec<(String, NodeIx)> = node
+            .references
+            .iter()
+            .filter(|r| r.forward && Some(r.reference_type) == has_encoding)
+            .map(|r| (model.node(r.target).browse_name.name.clone(), r.target))
+            .collect();
+        let is_abstract = node.is_abstract();
+        let def = node.definition.as_ref();
+        let kind = if let Some(b) = own_builtin.filter(|b| !matches!(b, BuiltinType::ExtensionObject | BuiltinType::Variant)) {
+            DataTypeKind::Builtin(b)
+        } else if matches!(node.id.ns0(), Some(ids::BASE_DATA_TYPE | ids::NUMBER | ids::INTEGER | ids::UINTEGER | ids::DECIMAL)) {
+            DataTypeKind::AbstractBuiltin
+        } else if ns0_in_chain(ids::ENUMERATION) {
+            enumeration(model, t, diags)
+        } else if def.is_some_and(|d| d.is_option_set) {
+            let base = base_builtin.unwrap_or(BuiltinType::UInt32);
+            let bits: Vec<EnumValue> = def
+                .map(|d| {
+                    d.fields
+                        .iter()
+                        .enumerate()
+                        .map(|(i, f)| EnumValue {
+                            name: f.name.clone(),
+                            value: f.value.unwrap_or(i as i64),
+                            display_name: f.display_names.first().map(|d| d.text.clone()),
+                            description: f.descriptions.first().map(|d| d.text.clone()),
+                        })
+                        .collect::<Vec<_>>()
+                })
+                .unwrap_or_default();
+            check_unique(model, t, &bits, diags);
+            DataTypeKind::OptionSet { base, bits }
+        } else if ns0_in_chain(ids::STRUCTURE) {
+            structure(model, t, &out, diags)
+        } else if let Some(b) = base_builtin {
+            if b == BuiltinType::Variant {
+                DataTypeKind::AbstractBuiltin
+            } else {
+                DataTypeKind::Simple(b)
+            }
+        } else {
+            DataTypeKind::AbstractBuiltin
+        };
+        let encoding = match &kind {
+            DataTypeKind::Builtin(b) | DataTypeKind::Simple(b) => *b,
+            DataTypeKind::OptionSet { base, .. } => *base,
+            DataTypeKind::Enumeration { .. } => BuiltinType::Int32,
+            DataTypeKind::Structure { .. } => BuiltinType::ExtensionObject,
+            DataTypeKind::AbstractBuiltin => {
+                if node.id.ns0() == Some(ids::STRUCTURE) {
+                    BuiltinType::ExtensionObject
+                } else {
+                    BuiltinType::Variant
+                }
+            }
+        };
+        out.insert(t, DataTypeInfo { node: t, kind, encoding, is_abstract, encodings });
+    }
+    model.data_types = out;
+}
+
+fn structure(model: &Model, t: NodeIx, done: &BTreeMap<NodeIx, DataTypeInfo>, diags: &mut Diagnostics) -> DataTypeKind {
+    let node = model.node(t);
+    let inherited: Vec<Field> = node
+        .super_type
+        .and_then(|s| done.get(&s))
+        .and_then(|i| match &i.kind {
+            DataTypeKind::Structure { fields, .. } => Some(fields.clone()),
+            _ => None,
+        })
+        .unwrap_or_default();
+    let Some(def) = &node.definition else {
+        return DataTypeKind::Structure { kind: StructureKind::Structure, fields: inherited, has_definition: false };
+    };
+    let ctx = &model.files[&node.file];
+    let mut own = Vec::new();
+    for f in &def.fields {
+        let data_type = match &f.data_type {
+            None => model.ns0(ids::BASE_DATA_TYPE),
+            Some(dt) => match crate::resolve::resolve_in(ctx, model, dt, diags) {
+                Ok(id) => match model.lookup(&id) {
+                    Some(ix) if model.node(ix).class == NodeClass::DataType => Some(ix),
+                    found => {
+                        let what = match found {
+                            Some(ix) => format!("is a {}", model.node(ix).class.name()),
+                            None => "names no loaded node".to_string(),
+                        };
+                        diags.push(
+                            Diagnostic::new(
+                                Code::UnknownFieldType,
+                                format!("field `{}` of `{}` has DataType `{}`, which {what}", f.name, node.browse_name.name, dt.value),
+                            )
+                            .at(dt.span)
+                            .help("name a DataType defined in this model or one it requires"),
+                        );
+                        None
+                    }
+                },
+                Err(mut d) => {
+                    d.code = match d.code {
+                        Code::UnknownAlias | Code::MalformedNodeId | Code::UnknownNamespaceIndex => d.code,
+                        _ => Code::UnknownFieldType,
+                    };
+                    diags.push(d);
+                    None
+                }
+            },
+        };
+        let Some(data_type) = data_type else { continue };
+        let array_dimensions =
+            f.array_dimensions.as_deref().map(|a| a.split(',').filter_map(|x| x.trim().parse().ok()).collect()).unwrap_or_default();
+        own.push(Field {
+            name: f.name.clone(),
+            symbolic_name: f.symbolic_name.clone(),
+            data_type,
+            value_rank: f.value_rank.unwrap_or(-1),
+            array_dimensions,
+            max_string_length: f.max_string_length,
+            is_optional: f.is_optional,
+            allow_sub_types: f.allow_sub_types,
+            description: f.descriptions.first().map(|d| d.text.clone()).filter(|d| !d.is_empty()),
+            declared_in: t,
+            span: f.span,
+        });
+    }
+    // Some files repeat the supertype's fields in the subtype's definition; others list only their own.
+    let repeats = !inherited.is_empty()
+        && own.len() >= inherited.len()
+        && inherited.iter().zip(&own).all(|(a, b)| a.name == b.name);
+    let mut fields = if repeats { Vec::new() } else { inherited };
+    fields.extend(own);
+    let mut seen: HashMap<&str, usize> = HashMap::new();
+    for (i, f) in fields.iter().enumerate() {
+        if let Some(&j) = seen.get(f.name.as_str()) {
+            diags.push(
+                Diagnostic::new(Code::DuplicateEnumValue, format!("structure `{}` has two fields named `{}`", node.browse_name.name, f.name))
+                    .at(f.span)
+                    .label(fields[j].span, "first field with this name")
+                    .help("field names must be unique within a structure and its supertypes"),
+            );
+        } else {
+            seen.insert(&f.name, i);
+        }
+    }
+    let kind = if def.is_union || model.is_subtype_of_ns0(t, ids::UNION) {
+        StructureKind::Union
+    } else if fields.iter().any(|f| f.is_optional) {
+        StructureKind::StructureWithOptionalFields
+    } else {
+        StructureKind::Structure
+    };
+    DataTypeKind::Structure { kind, fields, has_definition: true }
+}
+
+fn enumeration(model: &Model, t: NodeIx, diags: &mut Diagnostics) -> DataTypeKind {
+    let node = model.node(t);
+    if let Some(def) = &node.definition {
+        if !def.fields.is_empty() {
+            let values: Vec<EnumValue> = def
+                .fields
+                .iter()
+                .enumerate()
+                .map(|(i, f)| EnumValue {
+                    name: f.name.clone(),
+                    value: f.value.unwrap_or(i as i64),
+                    display_name: f.display_names.first().map(|d| d.text.clone()),
+                    description: f.descriptions.first().map(|d| d.text.clone()).filter(|d| !d.is_empty()),
+                })
+                .collect();
+            check_unique(model, t, &values, diags);
+            return DataTypeKind::Enumeration { values, source: EnumSource::Definition };
+        }
+    }
+    for (_, child) in model.children(t) {
+        let c = model.node(child);
+        if c.browse_name.ns != 0 {
+            continue;
+        }
+        let which = c.browse_name.name.as_str();
+        if which != "EnumStrings" && which != "EnumValues" {
+            continue;
+        }
+        let Some(Ok(v)) = model.value(child) else { continue };
+        let items = match v {
+            Variant::Array(_, items) => items,
+            other => vec![other],
+        };
+        let mut values = Vec::new();
+        for (i, it) in items.into_iter().enumerate() {
+            match it {
+                Variant::LocalizedText(lt) => values.push(EnumValue {
+                    name: lt.text.clone(),
+                    value: i as i64,
+                    display_name: Some(lt.text),
+                    description: None,
+                }),
+                Variant::ExtensionObject(eo) => {
+                    let Some(body) = eo.body else { continue };
+                    let value = body.child_text("Value").and_then(|v| v.trim().parse().ok()).unwrap_or(i as i64);
+                    let text = body.child("DisplayName").and_then(|d| d.child_text("Text")).unwrap_or("").to_string();
+                    let description = body.child("Description").and_then(|d| d.child_text("Text")).map(str::to_string).filter(|d| !d.is_empty());
+                    values.push(EnumValue { name: text.clone(), value, display_name: Some(text), description });
+                }
+                _ => {}
+            }
+        }
+        check_unique(model, t, &values, diags);
+        let source = if which == "EnumStrings" { EnumSource::EnumStrings } else { EnumSource::EnumValues };
+        return DataTypeKind::Enumeration { values, source };
+    }
+    DataTypeKind::Enumeration { values: Vec::new(), source: EnumSource::Definition }
+}
+
+fn check_unique(model: &Model, t: NodeIx, values: &[EnumValue], diags: &mut Diagnostics) {
+    let node = model.node(t);
+    let mut by_value: HashMap<i64, &str> = HashMap::new();
+    let mut by_name: HashMap<&str, i64> = HashMap::new();
+    for v in values {
+        if let Some(prev) = by_value.insert(v.value, &v.name) {
+            diags.push(
+                Diagnostic::new(
+                    Code::DuplicateEnumValue,
+                    format!("`{}` gives value {} to both `{prev}` and `{}`", node.browse_name.name, v.value, v.name),
+                )
+                .at(node.definition.as_ref().map(|d| d.span).unwrap_or(node.span))
+                .help("each enumeration value and option bit must be distinct"),
+            );
+        }
+        if let Some(prev) = by_name.insert(&v.name, v.value) {
+            if prev != v.value {
+                diags.push(
+                    Diagnostic::new(
+                        Code::DuplicateEnumValue,
+                        format!("`{}` has two entries named `{}` ({prev} and {})", node.browse_name.name, v.name, v.value),
+                    )
+                    .at(node.definition.as_ref().map(|d| d.span).unwrap_or(node.span))
+                    .help("each enumeration name must be distinct"),
+                );
+            }
+        }
+    }
+}

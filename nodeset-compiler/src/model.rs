@@ -1,0 +1,509 @@
+//! The resolved model: one arena of nodes for all files, with the derived tables both emitters need.
+//!
+//! Every node gets a [`NodeIx`] before anything links to anything, so forward references and cycles are
+//! ordinary. Tables are keyed by `NodeIx` and iterated in node order (files in dependency order, nodes in
+//! file order), which does not depend on the order the user named the files in.
+
+use crate::load::{ModelInfo, NS0_URI};
+use crate::nodeid::{NodeId, QualifiedName};
+use crate::raw::{LocalizedText, NodeClass, RawDefinition, RawRolePermission, XmlElement};
+use crate::source::{FileId, SourceMap, Span, Spanned};
+use crate::value::{BuiltinType, Variant};
+use std::collections::{BTreeMap, HashMap};
+
+/// Well-known NodeIds of namespace 0.
+pub mod ids {
+    pub const REFERENCES: u32 = 31;
+    pub const HIERARCHICAL_REFERENCES: u32 = 33;
+    pub const HAS_CHILD: u32 = 34;
+    pub const ORGANIZES: u32 = 35;
+    pub const HAS_MODELLING_RULE: u32 = 37;
+    pub const HAS_ENCODING: u32 = 38;
+    pub const HAS_TYPE_DEFINITION: u32 = 40;
+    pub const AGGREGATES: u32 = 44;
+    pub const HAS_SUBTYPE: u32 = 45;
+    pub const HAS_PROPERTY: u32 = 46;
+    pub const HAS_COMPONENT: u32 = 47;
+    pub const FROM_STATE: u32 = 51;
+    pub const TO_STATE: u32 = 52;
+    pub const HAS_CAUSE: u32 = 53;
+    pub const HAS_EFFECT: u32 = 54;
+    pub const HAS_INTERFACE: u32 = 17603;
+    pub const HAS_ADD_IN: u32 = 17604;
+
+    pub const STRUCTURE: u32 = 22;
+    pub const BASE_DATA_TYPE: u32 = 24;
+    pub const NUMBER: u32 = 26;
+    pub const INTEGER: u32 = 27;
+    pub const UINTEGER: u32 = 28;
+    pub const ENUMERATION: u32 = 29;
+    pub const DECIMAL: u32 = 50;
+    pub const OPTION_SET: u32 = 12755;
+    pub const UNION: u32 = 12756;
+    pub const ARGUMENT: u32 = 296;
+    pub const ENUM_VALUE_TYPE: u32 = 7594;
+
+    pub const BASE_OBJECT_TYPE: u32 = 58;
+    pub const FOLDER_TYPE: u32 = 61;
+    pub const BASE_VARIABLE_TYPE: u32 = 62;
+    pub const BASE_DATA_VARIABLE_TYPE: u32 = 63;
+    pub const PROPERTY_TYPE: u32 = 68;
+    pub const MODELLING_RULE_TYPE: u32 = 77;
+    pub const BASE_EVENT_TYPE: u32 = 2041;
+    pub const BASE_INTERFACE_TYPE: u32 = 17602;
+    pub const STATE_MACHINE_TYPE: u32 = 2299;
+    pub const FINITE_STATE_MACHINE_TYPE: u32 = 2771;
+    pub const STATE_TYPE: u32 = 2307;
+    pub const INITIAL_STATE_TYPE: u32 = 2309;
+    pub const TRANSITION_TYPE: u32 = 2310;
+    pub const PROGRAM_STATE_MACHINE_TYPE: u32 = 2391;
+
+    pub const MANDATORY: u32 = 78;
+    pub const OPTIONAL: u32 = 80;
+    pub const EXPOSES_ITS_ARRAY: u32 = 83;
+    pub const OPTIONAL_PLACEHOLDER: u32 = 11508;
+    pub const MANDATORY_PLACEHOLDER: u32 = 11510;
+}
+
+/// Index of a node in [`Model::nodes`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct NodeIx(pub u32);
+
+impl NodeIx {
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum ModellingRule {
+    Mandatory,
+    Optional,
+    ExposesItsArray,
+    OptionalPlaceholder,
+    MandatoryPlaceholder,
+    /// A rule node this compiler does not know.
+    Other(NodeIx),
+}
+
+impl ModellingRule {
+    pub fn name(self) -> &'static str {
+        match self {
+            ModellingRule::Mandatory => "Mandatory",
+            ModellingRule::Optional => "Optional",
+            ModellingRule::ExposesItsArray => "ExposesItsArray",
+            ModellingRule::OptionalPlaceholder => "OptionalPlaceholder",
+            ModellingRule::MandatoryPlaceholder => "MandatoryPlaceholder",
+            ModellingRule::Other(_) => "Other",
+        }
+    }
+
+    pub fn is_placeholder(self) -> bool {
+        matches!(self, ModellingRule::OptionalPlaceholder | ModellingRule::MandatoryPlaceholder)
+    }
+
+    pub fn is_mandatory(self) -> bool {
+        matches!(self, ModellingRule::Mandatory | ModellingRule::MandatoryPlaceholder)
+    }
+}
+
+/// A reference as stored on a node: outgoing when `forward`, incoming otherwise.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct Reference {
+    pub reference_type: NodeIx,
+    pub target: NodeIx,
+    pub forward: bool,
+    /// False for the inverse the resolver added on the other node.
+    pub declared: bool,
+}
+
+/// Attributes that only some node classes have; `None` where the file leaves the default.
+#[derive(Clone, Debug, Default)]
+pub struct Attributes {
+    pub write_mask: Option<u32>,
+    pub user_write_mask: Option<u32>,
+    pub access_restrictions: Option<u16>,
+    pub release_status: Option<String>,
+    pub data_type: Option<NodeIx>,
+    pub value_rank: Option<i32>,
+    pub array_dimensions: Vec<u32>,
+    pub access_level: Option<u8>,
+    pub user_access_level: Option<u8>,
+    pub access_level_ex: Option<u32>,
+    pub minimum_sampling_interval: Option<f64>,
+    pub historizing: Option<bool>,
+    pub executable: Option<bool>,
+    pub user_executable: Option<bool>,
+    pub event_notifier: Option<u8>,
+    pub contains_no_loops: Option<bool>,
+    pub is_abstract: Option<bool>,
+    pub symmetric: Option<bool>,
+    pub inverse_name: Vec<LocalizedText>,
+    pub role_permissions: Vec<RawRolePermission>,
+    pub category: Vec<String>,
+    pub documentation: Option<String>,
+    pub method_declaration: Option<NodeIx>,
+}
+
+#[derive(Clone, Debug)]
+pub struct Node {
+    pub id: NodeId,
+    pub class: NodeClass,
+    pub browse_name: QualifiedName,
+    pub symbolic_name: Option<String>,
+    pub display_name: Vec<LocalizedText>,
+    pub description: Vec<LocalizedText>,
+    pub attrs: Attributes,
+    /// The value element as written; decode with [`Model::value`].
+    pub value_xml: Option<XmlElement>,
+    pub definition: Option<RawDefinition>,
+    pub extensions: Vec<XmlElement>,
+    pub references: Vec<Reference>,
+    pub super_type: Option<NodeIx>,
+    pub type_definition: Option<NodeIx>,
+    pub modelling_rule: Option<ModellingRule>,
+    /// The node this one hangs under (ParentNodeId, or the source of its first inverse hierarchical reference).
+    pub parent: Option<NodeIx>,
+    pub file: FileId,
+    /// The start tag of the node's element.
+    pub span: Span,
+    pub node_id_span: Span,
+    pub browse_name_span: Span,
+}
+
+impl Node {
+    pub fn is_abstract(&self) -> bool {
+        self.attrs.is_abstract.unwrap_or(false)
+    }
+
+    /// The first DisplayName (the file's default locale), or the BrowseName.
+    pub fn display(&self) -> &str {
+        self.display_name.first().map(|t| t.text.as_str()).unwrap_or(&self.browse_name.name)
+    }
+
+    /// The Description in the default (first) locale.
+    pub fn doc(&self) -> Option<&str> {
+        self.description.first().map(|t| t.text.as_str()).filter(|t| !t.is_empty())
+    }
+}
+
+/// A member of a type: an instance declaration, own or inherited.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Member {
+    pub browse_name: QualifiedName,
+    /// The declaring node (the override, if a subtype redeclares the member).
+    pub node: NodeIx,
+    /// The type (or instance declaration) whose children list holds `node`.
+    pub declared_in: NodeIx,
+    pub reference_type: NodeIx,
+    /// The member of a supertype this one overrides.
+    pub overrides: Option<NodeIx>,
+}
+
+/// A field of a structure, resolved.
+#[derive(Clone, Debug)]
+pub struct Field {
+    pub name: String,
+    pub symbolic_name: Option<String>,
+    pub data_type: NodeIx,
+    pub value_rank: i32,
+    pub array_dimensions: Vec<u32>,
+    pub max_string_length: Option<u32>,
+    pub is_optional: bool,
+    pub allow_sub_types: bool,
+    pub description: Option<String>,
+    /// The structure that declares the field (a supertype for inherited fields).
+    pub declared_in: NodeIx,
+    pub span: Span,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StructureKind {
+    Structure,
+    StructureWithOptionalFields,
+    Union,
+}
+
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct EnumValue {
+    pub name: String,
+    pub value: i64,
+    pub display_name: Option<String>,
+    pub description: Option<String>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EnumSource {
+    Definition,
+    EnumStrings,
+    EnumValues,
+}
+
+#[derive(Clone, Debug)]
+pub enum DataTypeKind {
+    /// One of the 25 built-in types (or an abstract one such as Number, which has no encoding of its own).
+    Builtin(BuiltinType),
+    /// Abstract BaseDataType, Number, Integer, UInteger, Decimal: encoded as a Variant where used.
+    AbstractBuiltin,
+    /// A subtype of a built-in scalar type, encoded as that type (Duration as Double).
+    Simple(BuiltinType),
+    Enumeration { values: Vec<EnumValue>, source: EnumSource },
+    /// Bits of an unsigned integer (`IsOptionSet` definitions).
+    OptionSet { base: BuiltinType, bits: Vec<EnumValue> },
+    Structure { kind: StructureKind, fields: Vec<Field>, has_definition: bool },
+}
+
+#[derive(Clone, Debug)]
+pub struct DataTypeInfo {
+    pub node: NodeIx,
+    pub kind: DataTypeKind,
+    /// The built-in type values of this DataType are encoded as.
+    pub encoding: BuiltinType,
+    pub is_abstract: bool,
+    /// Encoding nodes (`Default Binary`, `Default XML`, `Default JSON`) by BrowseName.
+    pub encodings: Vec<(String, NodeIx)>,
+}
+
+/// A method argument decoded from an InputArguments or OutputArguments property.
+#[derive(Clone, Debug)]
+pub struct Argument {
+    pub name: String,
+    pub data_type: Option<NodeIx>,
+    pub value_rank: i32,
+    pub array_dimensions: Vec<u32>,
+    pub description: Option<String>,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct MethodInfo {
+    pub inputs: Vec<Argument>,
+    pub outputs: Vec<Argument>,
+}
+
+#[derive(Clone, Debug)]
+pub struct State {
+    pub node: NodeIx,
+    pub name: String,
+    pub number: Option<u32>,
+    pub initial: bool,
+}
+
+#[derive(Clone, Debug)]
+pub struct Transition {
+    pub node: NodeIx,
+    pub name: String,
+    pub number: Option<u32>,
+    pub from: Option<NodeIx>,
+    pub to: Option<NodeIx>,
+    pub causes: Vec<NodeIx>,
+    pub effects: Vec<NodeIx>,
+}
+
+#[derive(Clone, Debug, Default)]
+pub struct StateMachineInfo {
+    pub states: Vec<State>,
+    pub transitions: Vec<Transition>,
+}
+
+/// How a loaded file maps its local namespace indices and aliases (needed to decode its values).
+#[derive(Clone, Debug)]
+pub struct FileContext {
+    pub ns_map: Vec<u16>,
+    pub aliases: HashMap<String, Spanned<String>>,
+}
+
+/// One model of every loaded file.
+#[derive(Debug)]
+pub struct Model {
+    pub sources: SourceMap,
+    pub namespaces: Vec<String>,
+    pub models: Vec<ModelInfo>,
+    pub nodes: Vec<Node>,
+    pub(crate) index: HashMap<NodeId, NodeIx>,
+    pub files: BTreeMap<FileId, FileContext>,
+    pub data_types: BTreeMap<NodeIx, DataTypeInfo>,
+    pub methods: BTreeMap<NodeIx, MethodInfo>,
+    pub state_machines: BTreeMap<NodeIx, StateMachineInfo>,
+    /// Instance declarations of every ObjectType and VariableType, inherited ones included.
+    pub members: BTreeMap<NodeIx, Vec<Member>>,
+    pub(crate) hierarchical: Vec<bool>,
+    /// BrowseNames of ns0 DataTypes and ReferenceTypes, for undeclared aliases such as `IdType`.
+    pub(crate) ns0_type_names: HashMap<String, NodeIx>,
+}
+
+impl Model {
+    pub fn node(&self, ix: NodeIx) -> &Node {
+        &self.nodes[ix.index()]
+    }
+
+    pub fn lookup(&self, id: &NodeId) -> Option<NodeIx> {
+        self.index.get(id).copied()
+    }
+
+    pub fn ns0(&self, n: u32) -> Option<NodeIx> {
+        self.lookup(&NodeId::numeric(0, n))
+    }
+
+    pub fn model_of_namespace(&self, ns: u16) -> Option<&ModelInfo> {
+        self.models.iter().find(|m| m.ns == ns)
+    }
+
+    pub fn namespace_uri(&self, ns: u16) -> &str {
+        self.namespaces.get(ns as usize).map(String::as_str).unwrap_or("")
+    }
+
+    pub fn is_ns0(&self, ix: NodeIx, n: u32) -> bool {
+        self.node(ix).id.ns0() == Some(n)
+    }
+
+    /// Whether `ix` is `ancestor` or one of its subtypes.
+    pub fn is_subtype_of(&self, ix: NodeIx, ancestor: NodeIx) -> bool {
+        let mut cur = Some(ix);
+        let mut steps = 0;
+        while let Some(c) = cur {
+            if c == ancestor {
+                return true;
+            }
+            steps += 1;
+            if steps > 10_000 {
+                return false;
+            }
+            cur = self.node(c).super_type;
+        }
+        false
+    }
+
+    /// Whether `ix` is the ns0 type `n` or one of its subtypes.
+    pub fn is_subtype_of_ns0(&self, ix: NodeIx, n: u32) -> bool {
+        self.ns0(n).is_some_and(|a| self.is_subtype_of(ix, a))
+    }
+
+    /// The chain from `ix` up to its root type, `ix` first.
+    pub fn super_chain(&self, ix: NodeIx) -> Vec<NodeIx> {
+        let mut out = vec![ix];
+        let mut cur = self.node(ix).super_type;
+        while let Some(c) = cur {
+            if out.contains(&c) {
+                break;
+            }
+            out.push(c);
+            cur = self.node(c).super_type;
+        }
+        out
+    }
+
+    pub fn is_hierarchical(&self, reference_type: NodeIx) -> bool {
+        self.hierarchical.get(reference_type.index()).copied().unwrap_or(false)
+    }
+
+    /// Forward hierarchical references to non-type nodes (HasSubtype excluded): the children of a node.
+    pub fn children(&self, ix: NodeIx) -> impl Iterator<Item = (NodeIx, NodeIx)> + '_ {
+        self.node(ix).references.iter().filter_map(move |r| {
+            (r.forward && self.is_hierarchical(r.reference_type) && !self.node(r.target).class.is_type())
+                .then_some((r.reference_type, r.target))
+        })
+    }
+
+    /// The children of an instance declaration or instance: its type's members, overridden by its own children.
+    pub fn instance_members(&self, ix: NodeIx) -> Vec<Member> {
+        let node = self.node(ix);
+        let mut out: Vec<Member> = match node.type_definition.and_then(|t| self.members.get(&t)) {
+            Some(m) => m.clone(),
+            None => Vec::new(),
+        };
+        for (rt, child) in self.children(ix) {
+            let bn = self.node(child).browse_name.clone();
+            match out.iter_mut().find(|m| m.browse_name == bn) {
+                Some(m) => {
+                    m.overrides = Some(m.node);
+                    m.node = child;
+                    m.declared_in = ix;
+                    m.reference_type = rt;
+                }
+                None => out.push(Member { browse_name: bn, node: child, declared_in: ix, reference_type: rt, overrides: None }),
+            }
+        }
+        out
+    }
+
+    /// Decodes a node's value, mapping the NodeIds in it through its file's namespace table.
+    pub fn value(&self, ix: NodeIx) -> Option<Result<Variant, String>> {
+        let node = self.node(ix);
+        let xml = node.value_xml.as_ref()?;
+        Some(self.decode_in_file(node.file, xml))
+    }
+
+    /// Decodes an XML value written in `file`.
+    pub fn decode_in_file(&self, file: FileId, xml: &XmlElement) -> Result<Variant, String> {
+        let ctx = self.files.get(&file);
+        let ids = |s: &str| -> Result<NodeId, String> {
+            let ctx = ctx.ok_or("unknown file")?;
+            self.map_node_id(ctx, s)
+        };
+        let ns = |i: u16| ctx.and_then(|c| c.ns_map.get(i as usize).copied());
+        crate::value::decode(xml, &ids, &ns)
+    }
+
+    pub(crate) fn map_node_id(&self, ctx: &FileContext, s: &str) -> Result<NodeId, String> {
+        let s = s.trim();
+        let text = ctx.aliases.get(s).map(|t| t.value.as_str()).unwrap_or(s);
+        let raw = crate::nodeid::parse_node_id(text)?;
+        let ns = match raw.ns {
+            crate::nodeid::NsRef::Index(i) => {
+                *ctx.ns_map.get(i as usize).ok_or_else(|| format!("namespace index {i} is not declared"))?
+            }
+            crate::nodeid::NsRef::Uri(u) => {
+                self.namespaces.iter().position(|n| *n == u).ok_or_else(|| format!("namespace `{u}` is not loaded"))?
+                    as u16
+            }
+        };
+        Ok(NodeId { ns, id: raw.id })
+    }
+
+    /// Finds a node by `ns=…;i=…` (global index), `nsu=URI;…`, or a BrowseName (`Name` or `URI#Name`,
+    /// searching types first).
+    pub fn find(&self, query: &str) -> Vec<NodeIx> {
+        if crate::nodeid::looks_like_node_id(query) {
+            if let Ok(raw) = crate::nodeid::parse_node_id(query) {
+                let ns = match raw.ns {
+                    crate::nodeid::NsRef::Index(i) => Some(i),
+                    crate::nodeid::NsRef::Uri(u) => self.namespaces.iter().position(|n| *n == u).map(|i| i as u16),
+                };
+                if let Some(ns) = ns {
+                    return self.lookup(&NodeId { ns, id: raw.id }).into_iter().collect();
+                }
+            }
+            return Vec::new();
+        }
+        let (uri, name) = match query.rsplit_once('#') {
+            Some((u, n)) => (Some(u), n),
+            None => (None, query),
+        };
+        let mut hits: Vec<NodeIx> = (0..self.nodes.len() as u32)
+            .map(NodeIx)
+            .filter(|&ix| {
+                let n = self.node(ix);
+                n.browse_name.name == name && uri.is_none_or(|u| self.namespace_uri(n.browse_name.ns) == u)
+            })
+            .collect();
+        hits.sort_by_key(|&ix| (!self.node(ix).class.is_type(), ix));
+        hits
+    }
+
+    /// Whether a namespace is the OPC UA base namespace.
+    pub fn is_base_namespace(&self, ns: u16) -> bool {
+        self.namespace_uri(ns) == NS0_URI
+    }
+
+    /// `Name` for ns0 types, `prefix:Name` otherwise, for messages.
+    pub fn qualified(&self, ix: NodeIx) -> String {
+        let n = self.node(ix);
+        if n.browse_name.ns == 0 {
+            n.browse_name.name.clone()
+        } else {
+            let uri = self.namespace_uri(n.browse_name.ns);
+            let short = uri.trim_end_matches('/').rsplit('/').next().unwrap_or(uri);
+            format!("{short}:{}", n.browse_name.name)
+        }
+    }
+}

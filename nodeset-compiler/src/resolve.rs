@@ -1,0 +1,806 @@
+//! The resolver: one [`Model`] from the loaded files, and the checks that need the whole model.
+//!
+//! Passes, each over the whole arena: (1) give every node its index, (2) resolve references and add
+//! inverses, (3) type hierarchy, type definitions, modelling rules, parents, (4) instance declarations per
+//! type, (5) data types, (6) method arguments, (7) state machines, (8) checks on values and names.
+//! Every pass collects its problems; nothing stops at the first one.
+
+use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::load::Loaded;
+use crate::model::*;
+use crate::nodeid::{parse_qualified_name, NodeId, QualifiedName};
+use crate::raw::{NodeClass, RawNode};
+use crate::source::Span;
+use crate::value::{BuiltinType, Variant};
+use std::collections::{BTreeMap, HashMap, HashSet};
+
+/// Builds the model. Problems go to `diags`; the model is returned even when there are errors, with the
+/// offending parts left out, so that later checks can still report what they find.
+pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
+    let Loaded { sources, files, namespaces, models } = loaded;
+    let mut model = Model {
+        sources,
+        namespaces,
+        models,
+        nodes: Vec::new(),
+        index: HashMap::new(),
+        files: BTreeMap::new(),
+        data_types: BTreeMap::new(),
+        methods: BTreeMap::new(),
+        state_machines: BTreeMap::new(),
+        members: BTreeMap::new(),
+        hierarchical: Vec::new(),
+        ns0_type_names: HashMap::new(),
+    };
+    let total: usize = files.iter().map(|f| f.raw.nodes.len()).sum();
+    model.nodes.reserve(total);
+    model.index.reserve(total);
+
+    // Pass 1: every node gets its index.
+    let mut pending: Vec<(NodeIx, RawNode)> = Vec::with_capacity(total);
+    for mut f in files {
+        let file = f.raw.file;
+        let ctx = FileContext { ns_map: f.ns_map.clone(), aliases: f.aliases.clone() };
+        let raw_nodes = std::mem::take(&mut f.raw.nodes);
+        for raw in raw_nodes {
+            let id = match f.resolve_node_id(&raw.node_id, &model.namespaces) {
+                Ok(id) => id,
+                Err(d) => {
+                    diags.push(d);
+                    continue;
+                }
+            };
+            let browse_name = match parse_qualified_name(&raw.browse_name.value) {
+                Ok(q) => match f.ns_map.get(q.ns as usize) {
+                    Some(&ns) => QualifiedName { ns, name: q.name },
+                    None => {
+                        diags.push(
+                            Diagnostic::new(
+                                Code::UnknownNamespaceIndex,
+                                format!("BrowseName namespace index {} is not declared in NamespaceUris", q.ns),
+                            )
+                            .at(raw.browse_name.span)
+                            .help("add the namespace's URI to <NamespaceUris> or correct the prefix"),
+                        );
+                        QualifiedName { ns: 0, name: q.name }
+                    }
+                },
+                Err(why) => {
+                    if !raw.browse_name.value.is_empty() || raw.browse_name.span != raw.span {
+                        diags.push(
+                            Diagnostic::new(Code::MalformedQualifiedName, format!("malformed BrowseName: {why}"))
+                                .at(raw.browse_name.span)
+                                .help("write N:Name, N being the namespace index"),
+                        );
+                    }
+                    QualifiedName { ns: 0, name: raw.browse_name.value.clone() }
+                }
+            };
+            if let Some(&prev) = model.index.get(&id) {
+                let p = &model.nodes[prev.index()];
+                diags.push(
+                    Diagnostic::new(Code::DuplicateNodeId, format!("NodeId `{}` is defined twice", display_id(&model, &id)))
+                        .at(raw.node_id.span)
+                        .with_span_label("defined again here")
+                        .label(p.node_id_span, "first defined here")
+                        .help("every node needs its own NodeId; the second definition is ignored"),
+                );
+                continue;
+            }
+            let ix = NodeIx(model.nodes.len() as u32);
+            model.index.insert(id.clone(), ix);
+            model.nodes.push(Node {
+                id,
+                class: raw.class,
+                browse_name,
+                symbolic_name: raw.symbolic_name.clone(),
+                display_name: raw.display_names.clone(),
+                description: raw.descriptions.clone(),
+                attrs: Attributes::default(),
+                value_xml: None,
+                definition: None,
+                extensions: Vec::new(),
+                references: Vec::new(),
+                super_type: None,
+                type_definition: None,
+                modelling_rule: None,
+                parent: None,
+                file,
+                span: raw.span,
+                node_id_span: raw.node_id.span,
+                browse_name_span: raw.browse_name.span,
+            });
+            pending.push((ix, raw));
+        }
+        model.files.insert(file, ctx);
+    }
+
+    for (i, n) in model.nodes.iter().enumerate() {
+        if n.id.ns == 0 && matches!(n.class, NodeClass::DataType | NodeClass::ReferenceType) {
+            model.ns0_type_names.insert(n.browse_name.name.clone(), NodeIx(i as u32));
+        }
+    }
+
+    // Pass 2: attributes and references.
+    let mut seen_refs: HashSet<(NodeIx, NodeIx, NodeIx)> = HashSet::with_capacity(total * 3);
+    let mut incoming: Vec<(NodeIx, Reference)> = Vec::with_capacity(total * 3);
+    let contexts = std::mem::take(&mut model.files);
+    for (ix, raw) in &mut pending {
+        let ix = *ix;
+        let file = model.nodes[ix.index()].file;
+        let ctx = &contexts[&file];
+        let resolve_ref = |model: &Model, s: &crate::source::Spanned<String>, diags: &mut Diagnostics| -> Option<NodeIx> {
+            match resolve_in(ctx, model, s, diags) {
+                Ok(id) => match model.lookup(&id) {
+                    Some(t) => Some(t),
+                    None => {
+                        diags.push(dangling(model, ix, &id, s.span));
+                        None
+                    }
+                },
+                Err(d) => {
+                    diags.push(d);
+                    None
+                }
+            }
+        };
+        let mut attrs = Attributes {
+            write_mask: raw.write_mask,
+            user_write_mask: raw.user_write_mask,
+            access_restrictions: raw.access_restrictions,
+            release_status: raw.release_status.take(),
+            data_type: None,
+            value_rank: raw.value_rank,
+            array_dimensions: Vec::new(),
+            access_level: raw.access_level,
+            user_access_level: raw.user_access_level,
+            access_level_ex: raw.access_level_ex,
+            minimum_sampling_interval: raw.minimum_sampling_interval,
+            historizing: raw.historizing,
+            executable: raw.executable,
+            user_executable: raw.user_executable,
+            event_notifier: raw.event_notifier,
+            contains_no_loops: raw.contains_no_loops,
+            is_abstract: raw.is_abstract,
+            symmetric: raw.symmetric,
+            inverse_name: std::mem::take(&mut raw.inverse_names),
+            role_permissions: std::mem::take(&mut raw.role_permissions),
+            category: std::mem::take(&mut raw.category),
+            documentation: raw.documentation.take(),
+            method_declaration: None,
+        };
+        if let Some(ad) = &raw.array_dimensions {
+            for part in ad.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+                match part.parse::<u32>() {
+                    Ok(v) => attrs.array_dimensions.push(v),
+                    Err(_) => diags.push(
+                        Diagnostic::new(Code::BadAttribute, format!("ArrayDimensions=\"{ad}\" is not a list of numbers"))
+                            .at(raw.span)
+                            .help("write a comma-separated list such as 3,3 (0 for an unknown length)"),
+                    ),
+                }
+            }
+        }
+        if let Some(dt) = &raw.data_type {
+            if let Some(t) = resolve_ref(&model, dt, diags) {
+                if model.nodes[t.index()].class != NodeClass::DataType {
+                    diags.push(
+                        Diagnostic::new(
+                            Code::BadDataType,
+                            format!("DataType `{}` is a {}, not a DataType", dt.value, model.nodes[t.index()].class.name()),
+                        )
+                        .at(dt.span)
+                        .help("name a DataType node (an alias such as Int32, or its NodeId)"),
+                    );
+                } else {
+                    attrs.data_type = Some(t);
+                }
+            }
+        }
+        if let Some(m) = &raw.method_declaration_id {
+            attrs.method_declaration = resolve_ref(&model, m, diags);
+        }
+        for r in &raw.references {
+            let rt = match resolve_in(ctx, &model, &r.reference_type, diags) {
+                Ok(id) => match model.lookup(&id) {
+                    Some(t) if model.nodes[t.index()].class == NodeClass::ReferenceType => t,
+                    Some(t) => {
+                        diags.push(
+                            Diagnostic::new(
+                                Code::BadReferenceType,
+                                format!(
+                                    "ReferenceType `{}` is a {}, not a ReferenceType",
+                                    r.reference_type.value,
+                                    model.nodes[t.index()].class.name()
+                                ),
+                            )
+                            .at(r.reference_type.span)
+                            .help("use a ReferenceType such as HasComponent (i=47)"),
+                        );
+                        continue;
+                    }
+                    None => {
+                        diags.push(
+                            Diagnostic::new(
+                                Code::BadReferenceType,
+                                format!("ReferenceType `{}` names no loaded node", r.reference_type.value),
+                            )
+                            .at(r.reference_type.span)
+                            .help("load the model that defines the reference type"),
+                        );
+                        continue;
+                    }
+                },
+                Err(d) => {
+                    diags.push(d);
+                    continue;
+                }
+            };
+            let Some(target) = resolve_ref(&model, &r.target, diags) else { continue };
+            let (src, dst) = if r.is_forward { (ix, target) } else { (target, ix) };
+            if !seen_refs.insert((src, rt, dst)) {
+                continue;
+            }
+            model.nodes[ix.index()].references.push(Reference { reference_type: rt, target, forward: r.is_forward, declared: true });
+            incoming.push((target, Reference { reference_type: rt, target: ix, forward: !r.is_forward, declared: false }));
+        }
+        if let Some(p) = &raw.parent_node_id {
+            if let Ok(id) = resolve_in(ctx, &model, p, diags) {
+                model.nodes[ix.index()].parent = model.lookup(&id);
+            }
+        }
+        let node = &mut model.nodes[ix.index()];
+        node.attrs = attrs;
+        node.value_xml = raw.value.take();
+        node.definition = raw.definition.take();
+        node.extensions = std::mem::take(&mut raw.extensions);
+    }
+    model.files = contexts;
+    for (target, r) in incoming {
+        model.nodes[target.index()].references.push(r);
+    }
+
+    // Pass 3: hierarchy flags, supertypes, type definitions, modelling rules, parents.
+    link_types(&mut model, diags);
+
+    // Pass 4: instance declarations.
+    build_members(&mut model, diags);
+
+    // Pass 5-7: data types, methods, state machines.
+    crate::datatypes::classify(&mut model, diags);
+    methods(&mut model, diags);
+    state_machines(&mut model, diags);
+
+    // Pass 8: values against DataTypes.
+    check_values(&model, diags);
+    model
+}
+
+/// Resolves a NodeId or alias written in a file. An alias the file forgot to declare that is the BrowseName
+/// of a base DataType or ReferenceType (`IdType`, `NumericRange`) resolves to it, with a warning: official
+/// nodesets contain such omissions and every lenient server accepts them.
+pub(crate) fn resolve_in(
+    ctx: &FileContext,
+    model: &Model,
+    s: &crate::source::Spanned<String>,
+    diags: &mut Diagnostics,
+) -> Result<NodeId, Diagnostic> {
+    match crate::load::resolve_node_id_in(&ctx.ns_map, &ctx.aliases, s, &model.namespaces) {
+        Err(d) if d.code == Code::UnknownAlias => match model.ns0_type_names.get(s.value.trim()) {
+            Some(&ix) => {
+                let id = model.node(ix).id.clone();
+                diags.push(
+                    Diagnostic::new(Code::AliasByBrowseName, format!("alias `{}` is not declared; using the base type `{}` ({id})", s.value.trim(), s.value.trim()))
+                        .at(s.span)
+                        .help(format!("declare it: <Alias Alias=\"{}\">{id}</Alias>", s.value.trim())),
+                );
+                Ok(id)
+            }
+            None => Err(d),
+        },
+        other => other,
+    }
+}
+
+pub(crate) fn display_id(model: &Model, id: &NodeId) -> String {
+    if id.ns == 0 {
+        id.to_string()
+    } else {
+        format!("nsu={};{}", model.namespace_uri(id.ns), id.id)
+    }
+}
+
+fn dangling(model: &Model, from: NodeIx, id: &NodeId, span: Span) -> Diagnostic {
+    let from_node = model.node(from);
+    let same_model = {
+        let own_ns = model.models.iter().find(|m| m.file == from_node.file).map(|m| m.ns);
+        own_ns == Some(id.ns) || model.models.iter().all(|m| m.ns != id.ns)
+    };
+    let code = if same_model { Code::DanglingReference } else { Code::DanglingForeignReference };
+    let owner = model.models.iter().find(|m| m.ns == id.ns);
+    let mut d = Diagnostic::new(code, format!("`{}` names no node", display_id(model, id)))
+        .at(span)
+        .with_span_label("no node has this NodeId");
+    if let Some(o) = owner {
+        d = d.note(format!(
+            "namespace {} is model `{}` version {}",
+            id.ns,
+            o.uri,
+            o.version.as_deref().unwrap_or("(none)")
+        ));
+    }
+    if same_model {
+        d.help("define the node, or correct the NodeId (a typo, or a node removed from this file)")
+    } else {
+        d.help("the other model's loaded version lacks this node; the reference is dropped")
+    }
+}
+
+fn link_types(model: &mut Model, diags: &mut Diagnostics) {
+    let n = model.nodes.len();
+    // Hierarchical reference types: HierarchicalReferences and its subtypes, minus HasSubtype.
+    let has_subtype = model.ns0(ids::HAS_SUBTYPE);
+    // Supertypes first (needed for the hierarchy flags).
+    for i in 0..n {
+        let ix = NodeIx(i as u32);
+        let mut supers: Vec<NodeIx> = Vec::new();
+        for r in &model.nodes[i].references {
+            if Some(r.reference_type) == has_subtype && !r.forward {
+                supers.push(r.target);
+            }
+        }
+        supers.dedup();
+        if supers.is_empty() {
+            continue;
+        }
+        let class = model.nodes[i].class;
+        let sup = supers[0];
+        if model.nodes[sup.index()].class != class {
+            let s = &model.nodes[sup.index()];
+            diags.push(
+                Diagnostic::new(
+                    Code::BadSubtype,
+                    format!(
+                        "{} `{}` is declared a subtype of {} `{}`",
+                        class.name(),
+                        model.nodes[i].browse_name.name,
+                        s.class.name(),
+                        s.browse_name.name
+                    ),
+                )
+                .at(model.nodes[i].span)
+                .help("a type's supertype must have the same node class"),
+            );
+            continue;
+        }
+        if supers.len() > 1 && class != NodeClass::ReferenceType {
+            diags.push(
+                Diagnostic::new(Code::BadSubtype, format!("`{}` has {} supertypes", model.nodes[i].browse_name.name, supers.len()))
+                    .at(model.nodes[i].span)
+                    .help("OPC UA types have exactly one supertype; the first is used"),
+            );
+        }
+        model.nodes[i].super_type = Some(sup);
+        let _ = ix;
+    }
+    // Break cycles, reporting each once.
+    let mut state = vec![0u8; n]; // 0 unvisited, 1 on the current path, 2 done
+    for start in 0..n {
+        let mut path = Vec::new();
+        let mut cur = Some(start);
+        while let Some(c) = cur {
+            if state[c] == 2 {
+                break;
+            }
+            if state[c] == 1 {
+                let cycle: Vec<String> = path
+                    .iter()
+                    .skip_while(|&&p| p != c)
+                    .map(|&p: &usize| model.nodes[p].browse_name.name.clone())
+                    .collect();
+                diags.push(
+                    Diagnostic::new(Code::SubtypeCycle, format!("subtype cycle: {} -> {}", cycle.join(" -> "), model.nodes[c].browse_name.name))
+                        .at(model.nodes[c].span)
+                        .help("a type cannot be its own supertype; remove one HasSubtype reference"),
+                );
+                model.nodes[c].super_type = None;
+                break;
+            }
+            state[c] = 1;
+            path.push(c);
+            cur = model.nodes[c].super_type.map(NodeIx::index);
+        }
+        for p in path {
+            state[p] = 2;
+        }
+    }
+    let hier = model.ns0(ids::HIERARCHICAL_REFERENCES);
+    model.hierarchical = (0..n)
+        .map(|i| {
+            let ix = NodeIx(i as u32);
+            model.nodes[i].class == NodeClass::ReferenceType
+                && Some(ix) != has_subtype
+                && hier.is_some_and(|h| model.is_subtype_of(ix, h))
+                && !has_subtype.is_some_and(|h| model.is_subtype_of(ix, h))
+        })
+        .collect();
+
+    let has_type_def = model.ns0(ids::HAS_TYPE_DEFINITION);
+    let has_rule = model.ns0(ids::HAS_MODELLING_RULE);
+    for i in 0..n {
+        let ix = NodeIx(i as u32);
+        let mut type_def = None;
+        let mut rule = None;
+        let mut parent = model.nodes[i].parent;
+        for r in &model.nodes[i].references {
+            if r.forward && Some(r.reference_type) == has_type_def {
+                type_def = Some(r.target);
+            } else if r.forward && Some(r.reference_type) == has_rule {
+                rule = Some(r.target);
+            } else if !r.forward && parent.is_none() && model.is_hierarchical(r.reference_type) {
+                parent = Some(r.target);
+            }
+        }
+        let node = &model.nodes[i];
+        if let Some(t) = type_def {
+            let expected = match node.class {
+                NodeClass::Object => Some(NodeClass::ObjectType),
+                NodeClass::Variable => Some(NodeClass::VariableType),
+                _ => None,
+            };
+            let actual = model.nodes[t.index()].class;
+            if expected != Some(actual) {
+                diags.push(
+                    Diagnostic::new(
+                        Code::BadTypeDefinition,
+                        format!(
+                            "{} `{}` has TypeDefinition `{}`, a {}",
+                            node.class.name(),
+                            node.browse_name.name,
+                            model.nodes[t.index()].browse_name.name,
+                            actual.name()
+                        ),
+                    )
+                    .at(node.span)
+                    .help(match node.class {
+                        NodeClass::Object => "an Object's TypeDefinition must be an ObjectType",
+                        NodeClass::Variable => "a Variable's TypeDefinition must be a VariableType",
+                        _ => "only Objects and Variables have a TypeDefinition",
+                    }),
+                );
+            } else {
+                model.nodes[i].type_definition = Some(t);
+            }
+        } else if matches!(node.class, NodeClass::Object | NodeClass::Variable) {
+            diags.push(
+                Diagnostic::new(
+                    Code::MissingTypeDefinition,
+                    format!("{} `{}` has no HasTypeDefinition reference", node.class.name(), node.browse_name.name),
+                )
+                .at(node.span)
+                .help("add <Reference ReferenceType=\"HasTypeDefinition\">i=58</Reference> (BaseObjectType) or the right type"),
+            );
+        }
+        if let Some(r) = rule {
+            let rule = match model.nodes[r.index()].id.ns0() {
+                Some(ids::MANDATORY) => ModellingRule::Mandatory,
+                Some(ids::OPTIONAL) => ModellingRule::Optional,
+                Some(ids::EXPOSES_ITS_ARRAY) => ModellingRule::ExposesItsArray,
+                Some(ids::OPTIONAL_PLACEHOLDER) => ModellingRule::OptionalPlaceholder,
+                Some(ids::MANDATORY_PLACEHOLDER) => ModellingRule::MandatoryPlaceholder,
+                _ => {
+                    diags.push(
+                        Diagnostic::new(
+                            Code::BadModellingRule,
+                            format!("`{}` is not a standard ModellingRule", model.nodes[r.index()].browse_name.name),
+                        )
+                        .at(model.nodes[i].span)
+                        .help("use Mandatory, Optional, ExposesItsArray, OptionalPlaceholder or MandatoryPlaceholder"),
+                    );
+                    ModellingRule::Other(r)
+                }
+            };
+            model.nodes[i].modelling_rule = Some(rule);
+        }
+        model.nodes[i].parent = parent;
+        let _ = ix;
+    }
+}
+
+fn build_members(model: &mut Model, diags: &mut Diagnostics) {
+    // Types in an order where supertypes come first.
+    let types: Vec<NodeIx> = (0..model.nodes.len() as u32)
+        .map(NodeIx)
+        .filter(|&ix| matches!(model.node(ix).class, NodeClass::ObjectType | NodeClass::VariableType))
+        .collect();
+    let mut depth: Vec<(usize, NodeIx)> = types.iter().map(|&t| (model.super_chain(t).len(), t)).collect();
+    depth.sort();
+    let mut members: BTreeMap<NodeIx, Vec<Member>> = BTreeMap::new();
+    for (_, t) in depth {
+        let mut list: Vec<Member> = model.node(t).super_type.and_then(|s| members.get(&s)).cloned().unwrap_or_default();
+        let mut own: HashMap<QualifiedName, NodeIx> = HashMap::new();
+        for (rt, child) in model.children(t).collect::<Vec<_>>() {
+            let bn = model.node(child).browse_name.clone();
+            if let Some(&prev) = own.get(&bn) {
+                if prev != child {
+                    collision(model, t, prev, child, diags);
+                }
+                continue;
+            }
+            own.insert(bn.clone(), child);
+            match list.iter_mut().find(|m| m.browse_name == bn) {
+                Some(m) => {
+                    m.overrides = Some(m.node);
+                    m.node = child;
+                    m.declared_in = t;
+                    m.reference_type = rt;
+                }
+                None => list.push(Member { browse_name: bn, node: child, declared_in: t, reference_type: rt, overrides: None }),
+            }
+        }
+        members.insert(t, list);
+    }
+    // Collisions among the children of instances and instance declarations too.
+    for i in 0..model.nodes.len() {
+        let ix = NodeIx(i as u32);
+        if model.node(ix).class.is_type() {
+            continue;
+        }
+        let mut own: HashMap<&QualifiedName, NodeIx> = HashMap::new();
+        let mut found = Vec::new();
+        for (_, child) in model.children(ix) {
+            let bn = &model.node(child).browse_name;
+            match own.get(bn) {
+                Some(&prev) if prev != child => found.push((prev, child)),
+                Some(_) => {}
+                None => {
+                    own.insert(bn, child);
+                }
+            }
+        }
+        for (a, b) in found {
+            collision(model, ix, a, b, diags);
+        }
+    }
+    model.members = members;
+}
+
+fn collision(model: &Model, parent: NodeIx, a: NodeIx, b: NodeIx, diags: &mut Diagnostics) {
+    let (na, nb) = (model.node(a), model.node(b));
+    // Organizes between folders of a server's address space may legitimately reach a shared node twice.
+    diags.push(
+        Diagnostic::new(
+            Code::BrowseNameCollision,
+            format!(
+                "`{}` has two children named `{}`: {} and {}",
+                model.node(parent).browse_name.name,
+                na.browse_name.name,
+                display_id(model, &na.id),
+                display_id(model, &nb.id)
+            ),
+        )
+        .at(nb.browse_name_span)
+        .with_span_label("second child with this BrowseName")
+        .label(na.browse_name_span, "first child with this BrowseName")
+        .help("browse paths must be unique: rename one child or give it another namespace"),
+    );
+}
+
+fn methods(model: &mut Model, diags: &mut Diagnostics) {
+    let mut out = BTreeMap::new();
+    for i in 0..model.nodes.len() {
+        let ix = NodeIx(i as u32);
+        if model.node(ix).class != NodeClass::Method {
+            continue;
+        }
+        let mut info = MethodInfo::default();
+        for (_, child) in model.children(ix).collect::<Vec<_>>() {
+            let c = model.node(child);
+            let which = match (c.browse_name.ns, c.browse_name.name.as_str()) {
+                (0, "InputArguments") => 0,
+                (0, "OutputArguments") => 1,
+                _ => continue,
+            };
+            let Some(value) = model.value(child) else { continue };
+            let args = match value.and_then(|v| decode_arguments(model, c.file, v)) {
+                Ok(a) => a,
+                Err(why) => {
+                    diags.push(
+                        Diagnostic::new(Code::BadArgument, format!("the {} of method `{}` cannot be decoded: {why}", c.browse_name.name, model.node(ix).browse_name.name))
+                            .at(c.span)
+                            .help("write a ListOfExtensionObject of Argument (TypeId i=297)"),
+                    );
+                    continue;
+                }
+            };
+            if which == 0 {
+                info.inputs = args;
+            } else {
+                info.outputs = args;
+            }
+        }
+        out.insert(ix, info);
+    }
+    model.methods = out;
+}
+
+fn decode_arguments(model: &Model, file: crate::source::FileId, v: Variant) -> Result<Vec<Argument>, String> {
+    let items = match v {
+        Variant::Array(_, items) => items,
+        other => vec![other],
+    };
+    let ctx = &model.files[&file];
+    let mut out = Vec::new();
+    for it in items {
+        let Variant::ExtensionObject(eo) = it else { return Err("an element is not an ExtensionObject".into()) };
+        let body = eo.body.ok_or("an Argument has no body")?;
+        let name = body.child_text("Name").unwrap_or("").trim().to_string();
+        let data_type = match body.child("DataType").and_then(|d| d.child_text("Identifier")) {
+            Some(t) => {
+                let id = model.map_node_id(ctx, t)?;
+                Some(model.lookup(&id).ok_or_else(|| format!("argument `{name}` has DataType {} which names no node", display_id(model, &id)))?)
+            }
+            None => None,
+        };
+        let value_rank = match body.child_text("ValueRank") {
+            Some(t) => t.trim().parse().map_err(|_| format!("ValueRank `{}` is not a number", t.trim()))?,
+            None => -1,
+        };
+        let array_dimensions = body
+            .child("ArrayDimensions")
+            .map(|a| a.children.iter().filter_map(|c| c.text.trim().parse().ok()).collect())
+            .unwrap_or_default();
+        let description = body.child("Description").and_then(|d| d.child_text("Text")).map(|s| s.to_string()).filter(|s| !s.is_empty());
+        out.push(Argument { name, data_type, value_rank, array_dimensions, description });
+    }
+    Ok(out)
+}
+
+fn state_machines(model: &mut Model, diags: &mut Diagnostics) {
+    let Some(sm) = model.ns0(ids::STATE_MACHINE_TYPE) else { return };
+    let state_t = model.ns0(ids::STATE_TYPE);
+    let initial_t = model.ns0(ids::INITIAL_STATE_TYPE);
+    let trans_t = model.ns0(ids::TRANSITION_TYPE);
+    let (from, to, cause, effect) =
+        (model.ns0(ids::FROM_STATE), model.ns0(ids::TO_STATE), model.ns0(ids::HAS_CAUSE), model.ns0(ids::HAS_EFFECT));
+    let mut out = BTreeMap::new();
+    for (&t, members) in &model.members {
+        if model.node(t).class != NodeClass::ObjectType || !model.is_subtype_of(t, sm) {
+            continue;
+        }
+        let mut info = StateMachineInfo::default();
+        for m in members {
+            let node = model.node(m.node);
+            let Some(td) = node.type_definition else { continue };
+            let number = |name: &str| -> Option<u32> {
+                let prop = model.children(m.node).find(|&(_, c)| model.node(c).browse_name.name == name).map(|(_, c)| c)?;
+                model.value(prop)?.ok()?.as_i64().and_then(|v| u32::try_from(v).ok())
+            };
+            if state_t.is_some_and(|s| model.is_subtype_of(td, s)) {
+                info.states.push(State {
+                    node: m.node,
+                    name: node.browse_name.name.clone(),
+                    number: number("StateNumber"),
+                    initial: initial_t.is_some_and(|s| model.is_subtype_of(td, s)),
+                });
+            } else if trans_t.is_some_and(|s| model.is_subtype_of(td, s)) {
+                let mut tr = Transition {
+                    node: m.node,
+                    name: node.browse_name.name.clone(),
+                    number: number("TransitionNumber"),
+                    from: None,
+                    to: None,
+                    causes: Vec::new(),
+                    effects: Vec::new(),
+                };
+                for r in node.references.iter().filter(|r| r.forward) {
+                    let rt = Some(r.reference_type);
+                    if rt == from {
+                        tr.from = Some(r.target);
+                    } else if rt == to {
+                        tr.to = Some(r.target);
+                    } else if rt == cause {
+                        tr.causes.push(r.target);
+                    } else if rt == effect {
+                        tr.effects.push(r.target);
+                    }
+                }
+                info.transitions.push(tr);
+            }
+        }
+        for tr in &info.transitions {
+            for (what, end) in [("FromState", tr.from), ("ToState", tr.to)] {
+                match end {
+                    None if !model.node(t).is_abstract() => diags.push(
+                        Diagnostic::new(Code::StateMachine, format!("transition `{}` of `{}` has no {what}", tr.name, model.node(t).browse_name.name))
+                            .at(model.node(tr.node).span)
+                            .help(format!("add a {what} reference to one of the machine's states")),
+                    ),
+                    Some(s) if !info.states.iter().any(|st| st.node == s) && model.node(s).class != NodeClass::Object => diags.push(
+                        Diagnostic::new(Code::StateMachine, format!("{what} of transition `{}` is not a state", tr.name))
+                            .at(model.node(tr.node).span)
+                            .help("point it at a State object"),
+                    ),
+                    _ => {}
+                }
+            }
+        }
+        if !info.states.is_empty() || !info.transitions.is_empty() {
+            out.insert(t, info);
+        }
+    }
+    model.state_machines = out;
+}
+
+/// Whether a value of built-in type `have` may stand for DataType `dt`.
+fn value_fits(model: &Model, dt: NodeIx, have: BuiltinType) -> bool {
+    let Some(info) = model.data_types.get(&dt) else { return true };
+    match &info.kind {
+        DataTypeKind::AbstractBuiltin => {
+            let n = model.node(dt).id.ns0();
+            match n {
+                Some(ids::NUMBER) => have.is_number(),
+                Some(ids::INTEGER) => have.is_integer() && !have.is_unsigned() || have.is_integer(),
+                Some(ids::UINTEGER) => have.is_unsigned(),
+                _ => true,
+            }
+        }
+        DataTypeKind::Builtin(BuiltinType::Variant) => true,
+        DataTypeKind::Enumeration { .. } => have == BuiltinType::Int32,
+        DataTypeKind::Structure { .. } => have == BuiltinType::ExtensionObject,
+        _ => info.encoding == have || (info.encoding == BuiltinType::ExtensionObject && have == BuiltinType::ExtensionObject),
+    }
+}
+
+fn check_values(model: &Model, diags: &mut Diagnostics) {
+    for (i, node) in model.nodes.iter().enumerate() {
+        let ix = NodeIx(i as u32);
+        let Some(xml) = &node.value_xml else { continue };
+        let v = match model.value(ix) {
+            Some(Ok(v)) => v,
+            Some(Err(why)) => {
+                diags.push(
+                    Diagnostic::new(Code::BadValue, format!("the value of `{}` cannot be decoded: {why}", node.browse_name.name))
+                        .at(xml.span)
+                        .help("see OPC UA Part 6, 5.3 for the XML encoding of values"),
+                );
+                continue;
+            }
+            None => continue,
+        };
+        let Some(dt) = node.attrs.data_type else { continue };
+        let Some(have) = v.builtin() else { continue };
+        if !value_fits(model, dt, have) {
+            diags.push(
+                Diagnostic::new(
+                    Code::ValueTypeMismatch,
+                    format!(
+                        "the value of `{}` is a {}, but its DataType is {}",
+                        node.browse_name.name,
+                        xml.name,
+                        model.node(dt).browse_name.name
+                    ),
+                )
+                .at(xml.span)
+                .with_span_label(format!("a {}", have.type_name()))
+                .help("a server would reject this value; write it in the DataType's encoding"),
+            );
+            continue;
+        }
+        let rank = node.attrs.value_rank.unwrap_or(-1);
+        if v.is_array() && rank == -1 || !v.is_array() && rank >= 1 {
+            diags.push(
+                Diagnostic::new(
+                    Code::ValueTypeMismatch,
+                    format!(
+                        "the value of `{}` is {}, but its ValueRank is {rank}",
+                        node.browse_name.name,
+                        if v.is_array() { "an array" } else { "a scalar" }
+                    ),
+                )
+                .at(xml.span)
+                .help("ValueRank -1 is a scalar, 1 an array, 0 one or more dimensions, -2 any, -3 scalar or array"),
+            );
+        }
+    }
+}

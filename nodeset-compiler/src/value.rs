@@ -1,0 +1,427 @@
+//! Decoding `<Value>` trees into typed values.
+//!
+//! The parser keeps a value as an [`XmlElement`] tree. This module turns it into a [`Variant`]: every
+//! built-in scalar, `ListOf…` arrays, and ExtensionObjects whose TypeId is resolved and whose body is kept as a
+//! tree (its fields are decoded against the DataType's definition by whoever needs them). NodeIds inside
+//! values are written with file-local namespace indices, so decoding takes a function that maps them.
+
+use crate::nodeid::{base64_decode, parse_guid, NodeId, QualifiedName};
+use crate::raw::{LocalizedText, XmlElement};
+
+/// The built-in types of OPC UA Part 6, by their ns0 numeric id.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[repr(u8)]
+pub enum BuiltinType {
+    Boolean = 1,
+    SByte = 2,
+    Byte = 3,
+    Int16 = 4,
+    UInt16 = 5,
+    Int32 = 6,
+    UInt32 = 7,
+    Int64 = 8,
+    UInt64 = 9,
+    Float = 10,
+    Double = 11,
+    String = 12,
+    DateTime = 13,
+    Guid = 14,
+    ByteString = 15,
+    XmlElement = 16,
+    NodeId = 17,
+    ExpandedNodeId = 18,
+    StatusCode = 19,
+    QualifiedName = 20,
+    LocalizedText = 21,
+    ExtensionObject = 22,
+    DataValue = 23,
+    Variant = 24,
+    DiagnosticInfo = 25,
+}
+
+impl BuiltinType {
+    pub const ALL: [BuiltinType; 25] = [
+        BuiltinType::Boolean,
+        BuiltinType::SByte,
+        BuiltinType::Byte,
+        BuiltinType::Int16,
+        BuiltinType::UInt16,
+        BuiltinType::Int32,
+        BuiltinType::UInt32,
+        BuiltinType::Int64,
+        BuiltinType::UInt64,
+        BuiltinType::Float,
+        BuiltinType::Double,
+        BuiltinType::String,
+        BuiltinType::DateTime,
+        BuiltinType::Guid,
+        BuiltinType::ByteString,
+        BuiltinType::XmlElement,
+        BuiltinType::NodeId,
+        BuiltinType::ExpandedNodeId,
+        BuiltinType::StatusCode,
+        BuiltinType::QualifiedName,
+        BuiltinType::LocalizedText,
+        BuiltinType::ExtensionObject,
+        BuiltinType::DataValue,
+        BuiltinType::Variant,
+        BuiltinType::DiagnosticInfo,
+    ];
+
+    pub fn from_id(id: u32) -> Option<BuiltinType> {
+        BuiltinType::ALL.get((id as usize).wrapping_sub(1)).copied()
+    }
+
+    pub fn id(self) -> u32 {
+        self as u32
+    }
+
+    /// The XML element name of a scalar of this type.
+    pub fn xml_name(self) -> &'static str {
+        match self {
+            BuiltinType::ExtensionObject => "ExtensionObject",
+            BuiltinType::Variant => "Variant",
+            other => other.type_name(),
+        }
+    }
+
+    /// The DataType's BrowseName in ns0 (`Structure` for ExtensionObject, `BaseDataType` for Variant).
+    pub fn type_name(self) -> &'static str {
+        match self {
+            BuiltinType::Boolean => "Boolean",
+            BuiltinType::SByte => "SByte",
+            BuiltinType::Byte => "Byte",
+            BuiltinType::Int16 => "Int16",
+            BuiltinType::UInt16 => "UInt16",
+            BuiltinType::Int32 => "Int32",
+            BuiltinType::UInt32 => "UInt32",
+            BuiltinType::Int64 => "Int64",
+            BuiltinType::UInt64 => "UInt64",
+            BuiltinType::Float => "Float",
+            BuiltinType::Double => "Double",
+            BuiltinType::String => "String",
+            BuiltinType::DateTime => "DateTime",
+            BuiltinType::Guid => "Guid",
+            BuiltinType::ByteString => "ByteString",
+            BuiltinType::XmlElement => "XmlElement",
+            BuiltinType::NodeId => "NodeId",
+            BuiltinType::ExpandedNodeId => "ExpandedNodeId",
+            BuiltinType::StatusCode => "StatusCode",
+            BuiltinType::QualifiedName => "QualifiedName",
+            BuiltinType::LocalizedText => "LocalizedText",
+            BuiltinType::ExtensionObject => "Structure",
+            BuiltinType::DataValue => "DataValue",
+            BuiltinType::Variant => "BaseDataType",
+            BuiltinType::DiagnosticInfo => "DiagnosticInfo",
+        }
+    }
+
+    pub fn from_xml_name(name: &str) -> Option<BuiltinType> {
+        BuiltinType::ALL.into_iter().find(|b| b.xml_name() == name)
+    }
+
+    pub fn is_integer(self) -> bool {
+        matches!(
+            self,
+            BuiltinType::SByte
+                | BuiltinType::Byte
+                | BuiltinType::Int16
+                | BuiltinType::UInt16
+                | BuiltinType::Int32
+                | BuiltinType::UInt32
+                | BuiltinType::Int64
+                | BuiltinType::UInt64
+        )
+    }
+
+    pub fn is_unsigned(self) -> bool {
+        matches!(self, BuiltinType::Byte | BuiltinType::UInt16 | BuiltinType::UInt32 | BuiltinType::UInt64)
+    }
+
+    pub fn is_number(self) -> bool {
+        self.is_integer() || matches!(self, BuiltinType::Float | BuiltinType::Double)
+    }
+}
+
+/// An ExtensionObject from a value: its encoding or type id and its body as a tree.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExtensionObject {
+    /// The TypeId as written (usually the XML encoding node, sometimes the DataType itself).
+    pub type_id: Option<NodeId>,
+    /// The element inside `<Body>`, whose name is the structure's name.
+    pub body: Option<XmlElement>,
+}
+
+/// A decoded value.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Variant {
+    Boolean(bool),
+    SByte(i8),
+    Byte(u8),
+    Int16(i16),
+    UInt16(u16),
+    Int32(i32),
+    UInt32(u32),
+    Int64(i64),
+    UInt64(u64),
+    Float(f32),
+    Double(f64),
+    String(String),
+    DateTime(String),
+    Guid([u8; 16]),
+    ByteString(Vec<u8>),
+    XmlElement(XmlElement),
+    NodeId(NodeId),
+    ExpandedNodeId(NodeId),
+    StatusCode(u32),
+    QualifiedName(QualifiedName),
+    LocalizedText(LocalizedText),
+    ExtensionObject(Box<ExtensionObject>),
+    Variant(Box<Variant>),
+    /// `ListOf…`: the element type and the items.
+    Array(BuiltinType, Vec<Variant>),
+    /// An element that decodes to nothing (`<String/>` is an empty string, but `<NodeId/>` is null).
+    Null,
+}
+
+impl Variant {
+    /// The built-in type of the value (for arrays, of their elements).
+    pub fn builtin(&self) -> Option<BuiltinType> {
+        Some(match self {
+            Variant::Boolean(_) => BuiltinType::Boolean,
+            Variant::SByte(_) => BuiltinType::SByte,
+            Variant::Byte(_) => BuiltinType::Byte,
+            Variant::Int16(_) => BuiltinType::Int16,
+            Variant::UInt16(_) => BuiltinType::UInt16,
+            Variant::Int32(_) => BuiltinType::Int32,
+            Variant::UInt32(_) => BuiltinType::UInt32,
+            Variant::Int64(_) => BuiltinType::Int64,
+            Variant::UInt64(_) => BuiltinType::UInt64,
+            Variant::Float(_) => BuiltinType::Float,
+            Variant::Double(_) => BuiltinType::Double,
+            Variant::String(_) => BuiltinType::String,
+            Variant::DateTime(_) => BuiltinType::DateTime,
+            Variant::Guid(_) => BuiltinType::Guid,
+            Variant::ByteString(_) => BuiltinType::ByteString,
+            Variant::XmlElement(_) => BuiltinType::XmlElement,
+            Variant::NodeId(_) => BuiltinType::NodeId,
+            Variant::ExpandedNodeId(_) => BuiltinType::ExpandedNodeId,
+            Variant::StatusCode(_) => BuiltinType::StatusCode,
+            Variant::QualifiedName(_) => BuiltinType::QualifiedName,
+            Variant::LocalizedText(_) => BuiltinType::LocalizedText,
+            Variant::ExtensionObject(_) => BuiltinType::ExtensionObject,
+            Variant::Variant(_) => BuiltinType::Variant,
+            Variant::Array(b, _) => *b,
+            Variant::Null => return None,
+        })
+    }
+
+    pub fn is_array(&self) -> bool {
+        matches!(self, Variant::Array(..))
+    }
+
+    pub fn as_i64(&self) -> Option<i64> {
+        match *self {
+            Variant::SByte(v) => Some(v.into()),
+            Variant::Byte(v) => Some(v.into()),
+            Variant::Int16(v) => Some(v.into()),
+            Variant::UInt16(v) => Some(v.into()),
+            Variant::Int32(v) => Some(v.into()),
+            Variant::UInt32(v) => Some(v.into()),
+            Variant::Int64(v) => Some(v),
+            Variant::UInt64(v) => i64::try_from(v).ok(),
+            _ => None,
+        }
+    }
+}
+
+/// Maps a NodeId string found inside a value (file-local namespace indices, aliases) to a global NodeId.
+pub type NodeIdMapper<'a> = dyn Fn(&str) -> Result<NodeId, String> + 'a;
+/// Maps a file-local namespace index (of a QualifiedName) to a global one.
+pub type NsMapper<'a> = dyn Fn(u16) -> Option<u16> + 'a;
+
+/// Decodes one value element. Errors name the element and what is wrong with it.
+pub fn decode(el: &XmlElement, ids: &NodeIdMapper, ns: &NsMapper) -> Result<Variant, String> {
+    decode_depth(el, ids, ns, 0)
+}
+
+fn decode_depth(el: &XmlElement, ids: &NodeIdMapper, ns: &NsMapper, depth: usize) -> Result<Variant, String> {
+    if depth > 64 {
+        return Err("the value is nested more than 64 levels deep".into());
+    }
+    if let Some(item) = el.name.strip_prefix("ListOf") {
+        let b = BuiltinType::from_xml_name(item).ok_or_else(|| format!("<{}> is not a known array type", el.name))?;
+        let mut items = Vec::with_capacity(el.children.len());
+        for c in &el.children {
+            if c.name != item {
+                return Err(format!("<{}> inside <{}>: expected <{item}>", c.name, el.name));
+            }
+            items.push(decode_scalar(b, c, ids, ns, depth)?);
+        }
+        return Ok(Variant::Array(b, items));
+    }
+    let b = BuiltinType::from_xml_name(&el.name).ok_or_else(|| format!("<{}> is not a built-in type", el.name))?;
+    decode_scalar(b, el, ids, ns, depth)
+}
+
+fn num<T: std::str::FromStr>(el: &XmlElement) -> Result<T, String> {
+    let t = el.text.trim();
+    t.parse::<T>().map_err(|_| format!("<{}>{t}</{}> is not a valid {}", el.name, el.name, el.name))
+}
+
+fn float<T: std::str::FromStr>(el: &XmlElement) -> Result<T, String> {
+    let t = el.text.trim();
+    let t = match t {
+        "INF" => "inf",
+        "-INF" => "-inf",
+        "NaN" => "NaN",
+        other => other,
+    };
+    t.parse::<T>().map_err(|_| format!("<{}>{}</{}> is not a valid {}", el.name, el.text.trim(), el.name, el.name))
+}
+
+/// Decodes an element known to hold a scalar of type `b`.
+pub fn decode_scalar(
+    b: BuiltinType,
+    el: &XmlElement,
+    ids: &NodeIdMapper,
+    ns: &NsMapper,
+    depth: usize,
+) -> Result<Variant, String> {
+    Ok(match b {
+        BuiltinType::Boolean => match el.text.trim() {
+            "true" | "1" => Variant::Boolean(true),
+            "false" | "0" => Variant::Boolean(false),
+            t => return Err(format!("<Boolean>{t}</Boolean> is not true or false")),
+        },
+        BuiltinType::SByte => Variant::SByte(num(el)?),
+        BuiltinType::Byte => Variant::Byte(num(el)?),
+        BuiltinType::Int16 => Variant::Int16(num(el)?),
+        BuiltinType::UInt16 => Variant::UInt16(num(el)?),
+        BuiltinType::Int32 => Variant::Int32(num(el)?),
+        BuiltinType::UInt32 => Variant::UInt32(num(el)?),
+        BuiltinType::Int64 => Variant::Int64(num(el)?),
+        BuiltinType::UInt64 => Variant::UInt64(num(el)?),
+        BuiltinType::Float => Variant::Float(float(el)?),
+        BuiltinType::Double => Variant::Double(float(el)?),
+        BuiltinType::String => Variant::String(el.text.clone()),
+        BuiltinType::DateTime => Variant::DateTime(el.text.trim().to_string()),
+        BuiltinType::Guid => {
+            let t = el.child_text("String").unwrap_or(&el.text);
+            Variant::Guid(parse_guid(t).ok_or_else(|| format!("`{}` is not a GUID", t.trim()))?)
+        }
+        BuiltinType::ByteString => {
+            Variant::ByteString(base64_decode(&el.text).ok_or_else(|| "the ByteString is not base64".to_string())?)
+        }
+        BuiltinType::XmlElement => Variant::XmlElement(el.clone()),
+        BuiltinType::NodeId | BuiltinType::ExpandedNodeId => {
+            let t = el.child_text("Identifier").unwrap_or("").trim();
+            if t.is_empty() {
+                Variant::Null
+            } else {
+                let id = ids(t)?;
+                if b == BuiltinType::NodeId {
+                    Variant::NodeId(id)
+                } else {
+                    Variant::ExpandedNodeId(id)
+                }
+            }
+        }
+        BuiltinType::StatusCode => {
+            let t = el.child_text("Code").unwrap_or(&el.text).trim();
+            let code = if let Some(h) = t.strip_prefix("0x").or_else(|| t.strip_prefix("0X")) {
+                u32::from_str_radix(h, 16).ok()
+            } else {
+                t.parse::<u32>().ok()
+            };
+            Variant::StatusCode(code.ok_or_else(|| format!("`{t}` is not a StatusCode"))?)
+        }
+        BuiltinType::QualifiedName => {
+            let idx: u16 = match el.child_text("NamespaceIndex") {
+                Some(t) => t.trim().parse().map_err(|_| format!("NamespaceIndex `{}` is not a number", t.trim()))?,
+                None => 0,
+            };
+            let g = ns(idx).ok_or_else(|| format!("namespace index {idx} of a QualifiedName is not declared"))?;
+            Variant::QualifiedName(QualifiedName { ns: g, name: el.child_text("Name").unwrap_or("").trim().to_string() })
+        }
+        BuiltinType::LocalizedText => Variant::LocalizedText(LocalizedText {
+            locale: el.child_text("Locale").map(|s| s.trim().to_string()).filter(|s| !s.is_empty()),
+            text: el.child_text("Text").unwrap_or("").to_string(),
+        }),
+        BuiltinType::ExtensionObject => {
+            let type_id = match el.child("TypeId").and_then(|t| t.child_text("Identifier")) {
+                Some(t) if !t.trim().is_empty() => Some(ids(t.trim())?),
+                _ => None,
+            };
+            let body = el.child("Body").and_then(|b| b.children.first().cloned());
+            Variant::ExtensionObject(Box::new(ExtensionObject { type_id, body }))
+        }
+        BuiltinType::Variant => {
+            let inner = el.children.first().ok_or_else(|| "<Variant> is empty".to_string())?;
+            let inner = if inner.name == "Value" {
+                inner.children.first().ok_or_else(|| "<Variant><Value> is empty".to_string())?
+            } else {
+                inner
+            };
+            Variant::Variant(Box::new(decode_depth(inner, ids, ns, depth + 1)?))
+        }
+        BuiltinType::DataValue | BuiltinType::DiagnosticInfo => Variant::XmlElement(el.clone()),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::source::{FileId, Span};
+
+    fn el(name: &str, text: &str, children: Vec<XmlElement>) -> XmlElement {
+        XmlElement {
+            name: name.into(),
+            attributes: vec![],
+            children,
+            text: text.into(),
+            span: Span::new(FileId(0), 0, 0),
+        }
+    }
+
+    fn ids(s: &str) -> Result<NodeId, String> {
+        let r = crate::nodeid::parse_node_id(s)?;
+        match r.ns {
+            crate::nodeid::NsRef::Index(i) => Ok(NodeId { ns: i + 10, id: r.id }),
+            crate::nodeid::NsRef::Uri(_) => Err("uri".into()),
+        }
+    }
+
+    #[test]
+    fn decodes_scalars_arrays_and_extension_objects() {
+        let ns = |i: u16| Some(i + 10);
+        assert_eq!(decode(&el("Int32", " -5 ", vec![]), &ids, &ns).unwrap(), Variant::Int32(-5));
+        assert!(decode(&el("Byte", "256", vec![]), &ids, &ns).is_err());
+        assert_eq!(decode(&el("Double", "INF", vec![]), &ids, &ns).unwrap(), Variant::Double(f64::INFINITY));
+        let list = el("ListOfUInt32", "", vec![el("UInt32", "1", vec![]), el("UInt32", "2", vec![])]);
+        assert_eq!(
+            decode(&list, &ids, &ns).unwrap(),
+            Variant::Array(BuiltinType::UInt32, vec![Variant::UInt32(1), Variant::UInt32(2)])
+        );
+        let eo = el(
+            "ExtensionObject",
+            "",
+            vec![
+                el("TypeId", "", vec![el("Identifier", "ns=1;i=5", vec![])]),
+                el("Body", "", vec![el("Argument", "", vec![el("Name", "X", vec![])])]),
+            ],
+        );
+        match decode(&eo, &ids, &ns).unwrap() {
+            Variant::ExtensionObject(e) => {
+                assert_eq!(e.type_id, Some(NodeId::numeric(11, 5)));
+                assert_eq!(e.body.unwrap().child_text("Name"), Some("X"));
+            }
+            other => panic!("{other:?}"),
+        }
+        let qn = el("QualifiedName", "", vec![el("NamespaceIndex", "1", vec![]), el("Name", "N", vec![])]);
+        assert_eq!(
+            decode(&qn, &ids, &ns).unwrap(),
+            Variant::QualifiedName(QualifiedName { ns: 11, name: "N".into() })
+        );
+    }
+}

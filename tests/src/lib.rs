@@ -1,0 +1,49 @@
+//! Shared helpers of the integration tests: where the workspace, the pinned nodesets and the corpus are.
+
+use std::path::{Path, PathBuf};
+
+/// The workspace root.
+pub fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("tests/ sits in the workspace").to_path_buf()
+}
+
+/// The folder `cargo xtask fetch-nodesets` fills with the pinned companion specs.
+pub fn vendor() -> PathBuf {
+    let dir = root().join("nodesets/vendor");
+    assert!(
+        dir.join("Opc.Ua.NodeSet2.xml").is_file(),
+        "the pinned nodesets are missing from {}; run `cargo xtask fetch-nodesets` first",
+        dir.display()
+    );
+    dir
+}
+
+/// The OPC Foundation UA-Nodeset tree beside the project (`../shared/nodesets/ua-nodeset`).
+pub fn corpus() -> PathBuf {
+    let dir = root().join("../shared/nodesets/ua-nodeset");
+    assert!(dir.is_dir(), "the ua-nodeset corpus is missing at {}; CI puts ../shared beside the project", dir.display());
+    dir
+}
+
+/// Every NodeSet2 file below a folder (root element UANodeSet), sorted.
+pub fn nodeset_files(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    walk(dir, &mut out);
+    out.sort();
+    out
+}
+
+fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            walk(&p, out);
+        } else if p.extension().is_some_and(|x| x.eq_ignore_ascii_case("xml")) {
+            let head = std::fs::read(&p).map(|b| b.into_iter().take(8192).collect::<Vec<u8>>()).unwrap_or_default();
+            if String::from_utf8_lossy(&head).contains("<UANodeSet") {
+                out.push(p);
+            }
+        }
+    }
+}
