@@ -407,8 +407,10 @@ impl Model {
     /// The children of an instance declaration or instance: its type's members, overridden by its own children.
     pub fn instance_members(&self, ix: NodeIx) -> Vec<Member> {
         let node = self.node(ix);
+        // Only members with a ModellingRule are instantiated; a type's own rule-less children (such as
+        // DefaultInstanceBrowseName, or the states of a state machine type) stay on the type.
         let mut out: Vec<Member> = match node.type_definition.and_then(|t| self.members.get(&t)) {
-            Some(m) => m.clone(),
+            Some(m) => m.iter().filter(|m| self.node(m.node).modelling_rule.is_some()).cloned().collect(),
             None => Vec::new(),
         };
         for (rt, child) in self.children(ix) {

@@ -100,3 +100,120 @@ fn tree(model: &Model, members: &[crate::model::Member], level: usize, depth: us
         }
     }
 }
+
+/// A complete, stable text dump of the resolved model: namespaces, models, then every node sorted by NodeId
+/// with its attributes, resolved references and derived facts. Used by snapshot and determinism tests.
+pub fn dump(model: &Model) -> String {
+    let mut s = String::new();
+    for (i, ns) in model.namespaces.iter().enumerate() {
+        let _ = writeln!(s, "namespace {i} {ns}");
+    }
+    let mut models: Vec<_> = model.models.iter().collect();
+    models.sort_by_key(|m| m.ns);
+    for m in models {
+        let req: Vec<String> =
+            m.required.iter().map(|r| format!("{}@{}", r.uri, r.version.as_deref().unwrap_or("-"))).collect();
+        let _ = writeln!(s, "model {} {} requires [{}]", m.uri, m.version.as_deref().unwrap_or("-"), req.join(", "));
+    }
+    let mut order: Vec<NodeIx> = (0..model.nodes.len() as u32).map(NodeIx).collect();
+    order.sort_by(|a, b| model.node(*a).id.cmp(&model.node(*b).id));
+    let id = |ix: NodeIx| model.node(ix).id.to_string();
+    for ix in order {
+        let n = model.node(ix);
+        let _ = write!(s, "{} {} {}", n.id, n.class.name(), n.browse_name);
+        if let Some(t) = n.super_type {
+            let _ = write!(s, " super={}", id(t));
+        }
+        if let Some(t) = n.type_definition {
+            let _ = write!(s, " type={}", id(t));
+        }
+        if let Some(r) = n.modelling_rule {
+            let _ = write!(s, " rule={}", r.name());
+        }
+        if let Some(dt) = n.attrs.data_type {
+            let _ = write!(s, " dataType={}", id(dt));
+        }
+        if let Some(r) = n.attrs.value_rank {
+            let _ = write!(s, " valueRank={r}");
+        }
+        if n.is_abstract() {
+            s.push_str(" abstract");
+        }
+        s.push('\n');
+        let mut refs: Vec<String> = n
+            .references
+            .iter()
+            .map(|r| format!("{}{}{}", model.node(r.reference_type).browse_name.name, if r.forward { "->" } else { "<-" }, id(r.target)))
+            .collect();
+        refs.sort();
+        if !refs.is_empty() {
+            let _ = writeln!(s, "    refs {}", refs.join(" "));
+        }
+        if let Some(dt) = model.data_types.get(&ix) {
+            let _ = writeln!(s, "    datatype {:?} encoding={:?}", kind_summary(model, &dt.kind), dt.encoding);
+        }
+        if let Some(m) = model.methods.get(&ix) {
+            let args = |a: &[crate::model::Argument]| {
+                a.iter()
+                    .map(|x| format!("{}:{}[{}]", x.name, x.data_type.map(id).unwrap_or_default(), x.value_rank))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            let _ = writeln!(s, "    method in ({}) out ({})", args(&m.inputs), args(&m.outputs));
+        }
+        if let Some(sm) = model.state_machines.get(&ix) {
+            for st in &sm.states {
+                let _ = writeln!(s, "    state {} number={:?} initial={}", st.name, st.number, st.initial);
+            }
+            for t in &sm.transitions {
+                let _ = writeln!(
+                    s,
+                    "    transition {} number={:?} from={} to={} causes={}",
+                    t.name,
+                    t.number,
+                    t.from.map(|f| model.node(f).browse_name.name.clone()).unwrap_or_default(),
+                    t.to.map(|f| model.node(f).browse_name.name.clone()).unwrap_or_default(),
+                    t.causes.iter().map(|c| model.node(*c).browse_name.name.clone()).collect::<Vec<_>>().join("|")
+                );
+            }
+        }
+        if let Some(members) = model.members.get(&ix) {
+            for m in members {
+                let _ = writeln!(s, "    member {} = {} (declared in {})", m.browse_name, id(m.node), id(m.declared_in));
+            }
+        }
+    }
+    s
+}
+
+fn kind_summary(model: &Model, k: &crate::model::DataTypeKind) -> String {
+    use crate::model::DataTypeKind as K;
+    match k {
+        K::Builtin(b) => format!("builtin {}", b.type_name()),
+        K::AbstractBuiltin => "abstract".into(),
+        K::Simple(b) => format!("simple {}", b.type_name()),
+        K::Enumeration { values, source } => format!(
+            "enum({source:?}) {}",
+            values.iter().map(|v| format!("{}={}", v.name, v.value)).collect::<Vec<_>>().join(",")
+        ),
+        K::OptionSet { base, bits } => format!(
+            "optionset {} {}",
+            base.type_name(),
+            bits.iter().map(|v| format!("{}={}", v.name, v.value)).collect::<Vec<_>>().join(",")
+        ),
+        K::Structure { kind, fields, .. } => format!(
+            "{kind:?} {}",
+            fields
+                .iter()
+                .map(|f| format!(
+                    "{}{}:{}[{}]",
+                    f.name,
+                    if f.is_optional { "?" } else { "" },
+                    model.node(f.data_type).browse_name.name,
+                    f.value_rank
+                ))
+                .collect::<Vec<_>>()
+                .join(",")
+        ),
+    }
+}

@@ -1,0 +1,367 @@
+//! Measures the foundation stage of the compiler (parse + load + resolve) on real NodeSet2 files.
+//!
+//! This is the measured program behind `cargo xtask bench`, which builds it in release mode and runs every
+//! scenario in a fresh process, so that the peak resident memory (`VmHWM`) belongs to one scenario only.
+//! It can also be run by hand:
+//!
+//! ```text
+//! cargo run --release --example load_bench -p nodeset-compiler -- robotics --runs 20
+//! cargo run --release --example load_bench -p nodeset-compiler -- tree --runs 3 --tree ../shared/nodesets/ua-nodeset
+//! ```
+//!
+//! Scenarios:
+//!
+//! * `robotics`: one `compile` of ns0 + DI + IA + Robotics from `nodesets/vendor/` (all four named).
+//! * `tree`: one `compile` per NodeSet2 file of a tree such as the OPC Foundation's `UA-Nodeset`
+//!   repository, each with its required models resolved from the tree itself (`model_dirs = [tree]`);
+//!   one run is one pass over all files. (A single compile of every file at once is not possible: the tree
+//!   holds several versions of some models.)
+//!
+//! Output: progress and details on stderr, and on stdout one line `BENCH key=value ...` (times in ms,
+//! memory in KiB) that `cargo xtask bench` reads. Stage times come from separate runs that call
+//! `load::load` and `resolve::resolve` one after the other; within loading, the share of reading, decoding
+//! and parsing is estimated from standalone measurements of each file (`parse::decode_text`, `parse::parse`)
+//! summed over the files each compile loaded.
+
+use nodeset_compiler::diag::Diagnostics;
+use nodeset_compiler::load::{self, Input, LoadOptions};
+use nodeset_compiler::parse::{self, Limits};
+use nodeset_compiler::source::FileId;
+use nodeset_compiler::{compile, resolve, Options};
+use std::collections::HashMap;
+use std::hint::black_box;
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+/// The four files of the `robotics` scenario, in `nodesets/vendor/`.
+const ROBOTICS_FILES: &[&str] =
+    &["Opc.Ua.NodeSet2.xml", "Opc.Ua.Di.NodeSet2.xml", "Opc.Ua.IA.NodeSet2.xml", "Opc.Ua.Robotics.NodeSet2.xml"];
+
+fn workspace_root() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    dir.parent().map(Path::to_path_buf).unwrap_or(dir)
+}
+
+struct Cli {
+    scenario: String,
+    runs: usize,
+    vendor: PathBuf,
+    tree: PathBuf,
+    split: bool,
+}
+
+fn usage() -> String {
+    "usage: load_bench <robotics|tree> [--runs N] [--vendor DIR] [--tree DIR] [--no-split]".to_string()
+}
+
+fn parse_cli() -> Result<Cli, String> {
+    let root = workspace_root();
+    let mut cli = Cli {
+        scenario: String::new(),
+        runs: 0,
+        vendor: root.join("nodesets/vendor"),
+        tree: root.join("../shared/nodesets/ua-nodeset"),
+        split: true,
+    };
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        let mut value = |name: &str| args.next().ok_or_else(|| format!("{name} needs a value\n{}", usage()));
+        match a.as_str() {
+            "--runs" => cli.runs = value("--runs")?.parse().map_err(|e| format!("--runs: {e}"))?,
+            "--vendor" => cli.vendor = PathBuf::from(value("--vendor")?),
+            "--tree" => cli.tree = PathBuf::from(value("--tree")?),
+            "--no-split" => cli.split = false,
+            "-h" | "--help" => return Err(usage()),
+            s if !s.starts_with('-') && cli.scenario.is_empty() => cli.scenario = s.to_string(),
+            s => return Err(format!("unexpected argument `{s}`\n{}", usage())),
+        }
+    }
+    if cli.runs == 0 {
+        cli.runs = match cli.scenario.as_str() {
+            "tree" => 3,
+            _ => 20,
+        };
+    }
+    match cli.scenario.as_str() {
+        "robotics" | "tree" => Ok(cli),
+        "" => Err(usage()),
+        s => Err(format!("unknown scenario `{s}`\n{}", usage())),
+    }
+}
+
+/// One compile job: the named files and the model folders.
+struct Job {
+    label: String,
+    inputs: Vec<PathBuf>,
+    model_dirs: Vec<PathBuf>,
+}
+
+impl Job {
+    fn inputs(&self) -> Vec<Input> {
+        self.inputs.iter().cloned().map(Input::Path).collect()
+    }
+
+    fn options(&self) -> Options {
+        Options { model_dirs: self.model_dirs.clone(), ..Options::default() }
+    }
+}
+
+fn jobs(cli: &Cli) -> Result<Vec<Job>, String> {
+    match cli.scenario.as_str() {
+        "robotics" => {
+            let inputs: Vec<PathBuf> = ROBOTICS_FILES.iter().map(|f| cli.vendor.join(f)).collect();
+            if let Some(missing) = inputs.iter().find(|p| !p.is_file()) {
+                return Err(format!("{} is missing; run `cargo xtask fetch-nodesets`", missing.display()));
+            }
+            Ok(vec![Job { label: "ns0+DI+IA+Robotics".into(), inputs, model_dirs: vec![cli.vendor.clone()] }])
+        }
+        _ => {
+            if !cli.tree.is_dir() {
+                return Err(format!("the NodeSet tree {} does not exist", cli.tree.display()));
+            }
+            let tree = cli.tree.canonicalize().map_err(|e| format!("{}: {e}", cli.tree.display()))?;
+            let mut files = Vec::new();
+            walk(&tree, &mut files);
+            files.sort();
+            if files.is_empty() {
+                return Err(format!("no *NodeSet2*.xml file under {}", tree.display()));
+            }
+            Ok(files
+                .into_iter()
+                .map(|f| Job {
+                    label: f.strip_prefix(&tree).unwrap_or(&f).display().to_string(),
+                    inputs: vec![f],
+                    model_dirs: vec![tree.clone()],
+                })
+                .collect())
+        }
+    }
+}
+
+fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for e in entries.flatten() {
+        let p = e.path();
+        let Ok(ft) = e.file_type() else { continue };
+        if ft.is_dir() {
+            walk(&p, out);
+        } else {
+            let name = e.file_name().to_string_lossy().to_ascii_lowercase();
+            if name.ends_with(".xml") && name.contains("nodeset2") {
+                out.push(p);
+            }
+        }
+    }
+}
+
+/// A line of `/proc/self/status`, in KiB (0 where there is no procfs).
+fn proc_status_kib(key: &str) -> u64 {
+    let Ok(s) = std::fs::read_to_string("/proc/self/status") else { return 0 };
+    s.lines()
+        .find_map(|l| l.strip_prefix(key)?.strip_prefix(':'))
+        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
+        .unwrap_or(0)
+}
+
+fn ms(d: Duration) -> f64 {
+    d.as_secs_f64() * 1e3
+}
+
+fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    match s.len() {
+        0 => 0.0,
+        n if n % 2 == 1 => s[n / 2],
+        n => (s[n / 2 - 1] + s[n / 2]) / 2.0,
+    }
+}
+
+fn min(v: &[f64]) -> f64 {
+    v.iter().copied().fold(f64::INFINITY, f64::min)
+}
+
+/// What one compile of a job produced (from the first run).
+#[derive(Default, Clone)]
+struct Outcome {
+    nodes: usize,
+    files: usize,
+    errors: usize,
+    warnings: usize,
+    loaded_paths: Vec<PathBuf>,
+}
+
+/// Standalone cost of one file, ms: read, decode (UTF-8 check, BOM), parse (quick-xml pass into RawNodeSet).
+#[derive(Default, Clone, Copy)]
+struct FileCost {
+    read: f64,
+    decode: f64,
+    parse: f64,
+    nodes: usize,
+}
+
+fn file_cost(path: &Path, reps: usize) -> FileCost {
+    let (mut r, mut d, mut p) = (Vec::new(), Vec::new(), Vec::new());
+    let mut nodes = 0;
+    for _ in 0..reps.max(1) {
+        let t = Instant::now();
+        let Ok(bytes) = std::fs::read(path) else { return FileCost::default() };
+        r.push(ms(t.elapsed()));
+        let t = Instant::now();
+        let text = parse::decode_text(bytes);
+        d.push(ms(t.elapsed()));
+        let Ok(text) = text else { return FileCost::default() };
+        let mut diags = Diagnostics::new();
+        let t = Instant::now();
+        let set = parse::parse(FileId(0), &text, &Limits::default(), &mut diags);
+        p.push(ms(t.elapsed()));
+        nodes = set.as_ref().map_or(0, |s| s.nodes.len());
+        drop(black_box(set));
+    }
+    FileCost { read: median(&r), decode: median(&d), parse: median(&p), nodes }
+}
+
+fn run() -> Result<(), String> {
+    let cli = parse_cli()?;
+    let hwm_start = proc_status_kib("VmHWM");
+    let jobs = jobs(&cli)?;
+    eprintln!("load_bench: scenario `{}`, {} compile(s) per run, {} run(s)", cli.scenario, jobs.len(), cli.runs);
+
+    // Headline: the public all-in-one `compile`, as users call it.
+    let mut totals = Vec::with_capacity(cli.runs);
+    let mut per_job: Vec<Vec<f64>> = vec![Vec::with_capacity(cli.runs); jobs.len()];
+    let mut outcomes: Vec<Outcome> = vec![Outcome::default(); jobs.len()];
+    let mut hwm_first = 0;
+    for run in 0..cli.runs {
+        let pass = Instant::now();
+        for (j, job) in jobs.iter().enumerate() {
+            let t = Instant::now();
+            let out = compile(job.inputs(), &job.options());
+            per_job[j].push(ms(t.elapsed()));
+            if run == 0 {
+                outcomes[j] = Outcome {
+                    nodes: out.model.nodes.len(),
+                    files: out.model.sources.len(),
+                    errors: out.diagnostics.error_count(),
+                    warnings: out.diagnostics.warning_count(),
+                    loaded_paths: out.model.sources.files().map(|(_, f)| f.path.clone()).collect(),
+                };
+            }
+            drop(black_box(out));
+        }
+        totals.push(ms(pass.elapsed()));
+        if run == 0 {
+            hwm_first = proc_status_kib("VmHWM");
+        }
+    }
+    let hwm_runs = proc_status_kib("VmHWM");
+
+    // Stage split: load, then resolve, timed separately (separate runs, so the headline is untouched).
+    let (mut loads, mut resolves) = (Vec::new(), Vec::new());
+    if cli.split {
+        for _ in 0..cli.runs {
+            let (mut l, mut r) = (Duration::ZERO, Duration::ZERO);
+            for job in &jobs {
+                let opts = LoadOptions { model_dirs: job.model_dirs.clone(), limits: Limits::default() };
+                let mut diags = Diagnostics::new();
+                let t = Instant::now();
+                let mut loaded = load::load(job.inputs(), &opts, &mut diags);
+                l += t.elapsed();
+                if diags.has_errors() {
+                    loaded.files.clear(); // as `compile` does
+                }
+                let t = Instant::now();
+                let model = resolve::resolve(loaded, &mut diags);
+                r += t.elapsed();
+                drop(black_box((model, diags)));
+            }
+            loads.push(ms(l));
+            resolves.push(ms(r));
+        }
+    }
+
+    // Standalone per-file costs, summed over the files each compile loaded.
+    let mut costs: HashMap<PathBuf, FileCost> = HashMap::new();
+    let reps = if jobs.len() > 1 { 3 } else { cli.runs.clamp(3, 20) };
+    let (mut read, mut decode, mut parse_ms) = (0.0, 0.0, 0.0);
+    for o in &outcomes {
+        for p in &o.loaded_paths {
+            let c = *costs.entry(p.clone()).or_insert_with(|| file_cost(p, reps));
+            read += c.read;
+            decode += c.decode;
+            parse_ms += c.parse;
+        }
+    }
+    // Parsing every distinct file once: what a pass would cost if nothing were parsed twice.
+    let unique_parse: f64 = costs.values().map(|c| c.read + c.decode + c.parse).sum();
+    let unique_nodes: usize = costs.values().map(|c| c.nodes).sum();
+
+    let nodes: usize = outcomes.iter().map(|o| o.nodes).sum();
+    let max_nodes = outcomes.iter().map(|o| o.nodes).max().unwrap_or(0);
+    let files_loaded: usize = outcomes.iter().map(|o| o.files).sum();
+    let errors: usize = outcomes.iter().map(|o| o.errors).sum();
+    let warnings: usize = outcomes.iter().map(|o| o.warnings).sum();
+    let failed: Vec<&Job> = jobs.iter().zip(&outcomes).filter(|(_, o)| o.errors > 0).map(|(j, _)| j).collect();
+
+    // Details for people.
+    if jobs.len() > 1 {
+        let mut slow: Vec<(f64, usize)> = per_job.iter().enumerate().map(|(j, t)| (median(t), j)).collect();
+        slow.sort_by(|a, b| b.0.total_cmp(&a.0));
+        eprintln!("slowest compiles (median ms, nodes, files loaded):");
+        for &(t, j) in slow.iter().take(8) {
+            eprintln!("  {t:9.2}  {:7} {:3}  {}", outcomes[j].nodes, outcomes[j].files, jobs[j].label);
+        }
+        if !failed.is_empty() {
+            eprintln!("{} compile(s) reported errors:", failed.len());
+            for j in &failed {
+                eprintln!("  {}", j.label);
+            }
+        }
+    } else if let Some(o) = outcomes.first() {
+        if o.errors > 0 {
+            eprintln!("warning: the compile reported {} error(s); timings may not be representative", o.errors);
+        }
+    }
+
+    let load_med = median(&loads);
+    let kv: Vec<(&str, String)> = vec![
+        ("scenario", cli.scenario.clone()),
+        ("runs", cli.runs.to_string()),
+        ("compiles", jobs.len().to_string()),
+        ("total_median_ms", format!("{:.3}", median(&totals))),
+        ("total_min_ms", format!("{:.3}", min(&totals))),
+        ("total_max_ms", format!("{:.3}", totals.iter().copied().fold(0.0, f64::max))),
+        ("load_median_ms", format!("{:.3}", load_med)),
+        ("resolve_median_ms", format!("{:.3}", median(&resolves))),
+        ("read_ms", format!("{read:.3}")),
+        ("decode_ms", format!("{decode:.3}")),
+        ("parse_ms", format!("{parse_ms:.3}")),
+        ("load_other_ms", format!("{:.3}", if cli.split { load_med - read - decode - parse_ms } else { 0.0 })),
+        ("unique_files", costs.len().to_string()),
+        ("unique_parse_ms", format!("{unique_parse:.3}")),
+        ("unique_nodes", unique_nodes.to_string()),
+        ("hwm_start_kib", hwm_start.to_string()),
+        ("hwm_kib", hwm_first.to_string()),
+        ("hwm_all_runs_kib", hwm_runs.to_string()),
+        ("nodes", nodes.to_string()),
+        ("max_nodes", max_nodes.to_string()),
+        ("files_loaded", files_loaded.to_string()),
+        ("failed_compiles", failed.len().to_string()),
+        ("errors", errors.to_string()),
+        ("warnings", warnings.to_string()),
+    ];
+    let line: Vec<String> = kv.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    println!("BENCH {}", line.join(" "));
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    match run() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("load_bench: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
