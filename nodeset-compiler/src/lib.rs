@@ -24,6 +24,7 @@ pub mod datatypes;
 pub mod diag;
 pub mod load;
 pub mod model;
+pub mod names;
 pub mod nodeid;
 pub mod parse;
 pub mod raw;
