@@ -32,6 +32,7 @@ pub mod resolve;
 pub mod source;
 pub mod summary;
 pub mod value;
+pub mod write;
 
 use diag::{Diagnostics, Severity};
 use load::{Input, LoadOptions};

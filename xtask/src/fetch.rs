@@ -90,6 +90,11 @@ pub struct Args {
     package_version: Option<String>,
 }
 
+/// Fetches and verifies the pinned files unless they are already present and verified.
+pub fn ensure_fetched() -> Result<(), String> {
+    run(Args { update_lock: false, package_version: None })
+}
+
 /// Runs the subcommand.
 pub fn run(args: Args) -> Result<(), String> {
     let root = workspace_root();

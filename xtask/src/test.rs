@@ -1,0 +1,38 @@
+//! `cargo xtask test`: everything a fresh machine needs, then every test.
+//!
+//! 1. The pinned companion specs (`fetch-nodesets`, a no-op when they are present and verified).
+//! 2. `cargo test --workspace --locked`, whose summary lines CI reads.
+
+use crate::util::workspace_root;
+use std::process::Command;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Extra arguments passed to `cargo test` (after `--workspace --locked`), e.g. a test name filter.
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+    cargo_args: Vec<String>,
+}
+
+pub fn run(args: Args) -> Result<(), String> {
+    let root = workspace_root();
+    crate::fetch::ensure_fetched()?;
+    let shared = root.join("../shared/nodesets/ua-nodeset");
+    if !shared.is_dir() {
+        return Err(format!(
+            "the ua-nodeset corpus is missing at {}; the tests need ../shared beside the project (CI provides it)",
+            shared.display()
+        ));
+    }
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let status = Command::new(cargo)
+        .current_dir(&root)
+        .args(["test", "--workspace", "--locked"])
+        .args(&args.cargo_args)
+        .status()
+        .map_err(|e| format!("cannot run cargo test: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("cargo test failed ({status})"))
+    }
+}
