@@ -5,6 +5,7 @@ use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::model::*;
 use crate::raw::NodeClass;
 use crate::value::{BuiltinType, Variant};
+use crate::source::Span;
 use std::collections::{BTreeMap, HashMap};
 
 pub(crate) fn classify(model: &mut Model, diags: &mut Diagnostics) {
@@ -51,7 +52,8 @@ pub(crate) fn classify(model: &mut Model, diags: &mut Diagnostics) {
                         .collect::<Vec<_>>()
                 })
                 .unwrap_or_default();
-            check_unique(model, t, &bits, diags);
+            let spans: Vec<Span> = def.map(|d| d.fields.iter().map(|f| f.span).collect()).unwrap_or_default();
+            check_unique(model, t, &bits, &spans, diags);
             DataTypeKind::OptionSet { base, bits }
         } else if ns0_in_chain(ids::STRUCTURE) {
             structure(model, t, &out, diags)
@@ -190,7 +192,8 @@ fn enumeration(model: &Model, t: NodeIx, diags: &mut Diagnostics) -> DataTypeKin
                     description: f.descriptions.first().map(|d| d.text.clone()).filter(|d| !d.is_empty()),
                 })
                 .collect();
-            check_unique(model, t, &values, diags);
+            let spans: Vec<Span> = def.fields.iter().map(|f| f.span).collect();
+            check_unique(model, t, &values, &spans, diags);
             return DataTypeKind::Enumeration { values, source: EnumSource::Definition };
         }
     }
@@ -209,7 +212,10 @@ fn enumeration(model: &Model, t: NodeIx, diags: &mut Diagnostics) -> DataTypeKin
             other => vec![other],
         };
         let mut values = Vec::new();
+        let item_spans: Vec<Span> = c.value_xml.as_ref().map(|x| x.children.iter().map(|e| e.span).collect()).unwrap_or_default();
+        let mut spans = Vec::new();
         for (i, it) in items.into_iter().enumerate() {
+            let before = values.len();
             match it {
                 Variant::LocalizedText(lt) => values.push(EnumValue {
                     name: lt.text.clone(),
@@ -226,40 +232,51 @@ fn enumeration(model: &Model, t: NodeIx, diags: &mut Diagnostics) -> DataTypeKin
                 }
                 _ => {}
             }
+            if values.len() > before {
+                spans.push(item_spans.get(i).copied().unwrap_or(c.span));
+            }
         }
-        check_unique(model, t, &values, diags);
+        check_unique(model, t, &values, &spans, diags);
         let source = if which == "EnumStrings" { EnumSource::EnumStrings } else { EnumSource::EnumValues };
         return DataTypeKind::Enumeration { values, source };
     }
     DataTypeKind::Enumeration { values: Vec::new(), source: EnumSource::Definition }
 }
 
-fn check_unique(model: &Model, t: NodeIx, values: &[EnumValue], diags: &mut Diagnostics) {
+fn check_unique(model: &Model, t: NodeIx, values: &[EnumValue], spans: &[Span], diags: &mut Diagnostics) {
     let node = model.node(t);
-    let mut by_value: HashMap<i64, &str> = HashMap::new();
-    let mut by_name: HashMap<&str, i64> = HashMap::new();
-    for v in values {
-        if let Some(prev) = by_value.insert(v.value, &v.name) {
+    let fallback = node.definition.as_ref().map(|d| d.span).unwrap_or(node.span);
+    let span_of = |i: usize| spans.get(i).copied().unwrap_or(fallback);
+    let mut by_value: HashMap<i64, usize> = HashMap::new();
+    let mut by_name: HashMap<&str, usize> = HashMap::new();
+    for (i, v) in values.iter().enumerate() {
+        if let Some(&j) = by_value.get(&v.value) {
             diags.push(
                 Diagnostic::new(
                     Code::DuplicateEnumValue,
-                    format!("`{}` gives value {} to both `{prev}` and `{}`", node.browse_name.name, v.value, v.name),
+                    format!("`{}` gives value {} to both `{}` and `{}`", node.browse_name.name, v.value, values[j].name, v.name),
                 )
-                .at(node.definition.as_ref().map(|d| d.span).unwrap_or(node.span))
+                .at(span_of(i))
+                .with_span_label(format!("value {} again", v.value))
+                .label(span_of(j), format!("first used by `{}`", values[j].name))
                 .help("each enumeration value and option bit must be distinct"),
             );
+        } else {
+            by_value.insert(v.value, i);
         }
-        if let Some(prev) = by_name.insert(&v.name, v.value) {
-            if prev != v.value {
-                diags.push(
-                    Diagnostic::new(
-                        Code::DuplicateEnumValue,
-                        format!("`{}` has two entries named `{}` ({prev} and {})", node.browse_name.name, v.name, v.value),
-                    )
-                    .at(node.definition.as_ref().map(|d| d.span).unwrap_or(node.span))
-                    .help("each enumeration name must be distinct"),
-                );
-            }
+        if let Some(&j) = by_name.get(v.name.as_str()) {
+            diags.push(
+                Diagnostic::new(
+                    Code::DuplicateEnumValue,
+                    format!("`{}` has two entries named `{}` ({} and {})", node.browse_name.name, v.name, values[j].value, v.value),
+                )
+                .at(span_of(i))
+                .with_span_label("second entry with this name")
+                .label(span_of(j), "first entry with this name")
+                .help("each enumeration name must be distinct"),
+            );
+        } else {
+            by_name.insert(&v.name, i);
         }
     }
 }

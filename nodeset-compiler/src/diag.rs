@@ -77,7 +77,7 @@ codes! {
     BadTypeDefinition = "NS0205", Error, "a TypeDefinition has the wrong node class";
     BrowseNameCollision = "NS0206", Warning, "two children of one node share a BrowseName";
     UnknownFieldType = "NS0207", Error, "a structure field has an unknown DataType";
-    DuplicateEnumValue = "NS0208", Error, "an enumeration repeats a value or a name";
+    DuplicateEnumValue = "NS0208", Error, "an enumeration, OptionSet or structure repeats a value or a name";
     ValueTypeMismatch = "NS0209", Warning, "a value contradicts its DataType";
     BadSubtype = "NS0210", Error, "a HasSubtype reference joins nodes of different classes";
     MissingTypeDefinition = "NS0211", Warning, "an instance has no TypeDefinition";

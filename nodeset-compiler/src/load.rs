@@ -171,7 +171,7 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
                 Ok(b) => (p.clone(), p.display().to_string(), b),
                 Err(e) => {
                     diags.push(
-                        Diagnostic::new(Code::Io, format!("cannot read {}: {e}", p.display()))
+                        Diagnostic::new(Code::Io, format!("cannot read {}: {}", p.display(), io_reason(&e)))
                             .help("check the path; folders of required models go after --models"),
                     );
                     continue;
@@ -425,12 +425,35 @@ fn read_and_parse(
             parse::parse(id, text, limits, diags)
         }
         Err((d, at)) => {
-            let lossy = String::from_utf8_lossy(&bytes).into_owned();
-            let id = sources.add(SourceFile::new(path, display, lossy, named));
+            let id = sources.add(SourceFile::new(path, display, displayable(&bytes), named));
             diags.push(d.at(Span::new(id, at, at + 1)));
             None
         }
     }
+}
+
+/// The reason an I/O operation failed, without the platform's error number.
+fn io_reason(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".into(),
+        std::io::ErrorKind::PermissionDenied => "permission denied".into(),
+        std::io::ErrorKind::IsADirectory => "it is a folder (folders of required models go after --models)".into(),
+        k => k.to_string(),
+    }
+}
+
+/// Text to show the lines of a file that is not UTF-8: UTF-16 decoded, NUL bytes shown as `␀`.
+fn displayable(bytes: &[u8]) -> String {
+    let le = bytes.starts_with(&[0xFF, 0xFE]) || bytes.starts_with(&[0x3C, 0x00]);
+    let be = bytes.starts_with(&[0xFE, 0xFF]) || bytes.starts_with(&[0x00, 0x3C]);
+    if le || be {
+        let units: Vec<u16> = bytes
+            .chunks_exact(2)
+            .map(|c| if le { u16::from_le_bytes([c[0], c[1]]) } else { u16::from_be_bytes([c[0], c[1]]) })
+            .collect();
+        return String::from_utf16_lossy(&units).trim_start_matches('\u{feff}').to_string();
+    }
+    String::from_utf8_lossy(bytes).replace('\0', "\u{2400}")
 }
 
 fn check_version(req: &RequiredInfo, have: Option<&str>, have_date: Option<&str>, where_: &str, diags: &mut Diagnostics) {
@@ -616,15 +639,40 @@ fn topo_order(parsed: &[RawNodeSet], sources: &SourceMap, diags: &mut Diagnostic
     if !rest.is_empty() {
         let mut rest_sorted = rest.clone();
         rest_sorted.sort_by_key(|&i| key(i));
-        let names: Vec<String> = rest_sorted
-            .iter()
-            .map(|&i| parsed[i].models.first().map(|m| m.uri.clone()).unwrap_or_else(|| sources.get(parsed[i].file).display.clone()))
-            .collect();
-        let first = &parsed[rest_sorted[0]];
-        let mut d = Diagnostic::new(Code::ModelCycle, format!("these models require each other in a cycle: {}", names.join(" -> ")))
-            .help("a model cannot require itself through others; remove one RequiredModel");
-        if let Some(r) = first.models.first().and_then(|m| m.required.first()) {
-            d = d.at(r.span);
+        // Walk the requirements from the first file until a file repeats: that is the cycle.
+        let mut path: Vec<usize> = vec![rest_sorted[0]];
+        loop {
+            let cur = *path.last().expect("path is never empty");
+            let Some(&next) = deps[cur].iter().find(|d| rest.contains(d)) else { break };
+            if let Some(pos) = path.iter().position(|&p| p == next) {
+                path.drain(..pos);
+                path.push(next);
+                break;
+            }
+            path.push(next);
+        }
+        let name = |i: usize| {
+            parsed[i].models.first().map(|m| m.uri.clone()).unwrap_or_else(|| sources.get(parsed[i].file).display.clone())
+        };
+        let names: Vec<String> = path.iter().map(|&i| name(i)).collect();
+        let files: Vec<String> = path.iter().take(path.len().saturating_sub(1)).map(|&i| sources.get(parsed[i].file).display.clone()).collect();
+        let mut d = Diagnostic::new(Code::ModelCycle, format!("models require each other in a cycle: {}", names.join(" -> ")))
+            .note(format!("files: {}", files.join(", ")))
+            .help("a model cannot require itself through others; remove one of these RequiredModel elements");
+        // The caret goes on the RequiredModel of the first file that closes the loop.
+        if path.len() >= 2 {
+            let (from, to) = (path[0], path[1]);
+            let to_uris: Vec<&str> = parsed[to].models.iter().map(|m| m.uri.as_str()).collect();
+            if let Some(r) = parsed[from].models.iter().flat_map(|m| m.required.iter()).find(|r| to_uris.contains(&r.uri.as_str())) {
+                d = d.at(r.span).with_span_label(format!("requires {}", r.uri));
+            }
+            if let Some(r) = parsed[path[path.len() - 2]].models.iter().flat_map(|m| m.required.iter()).find(|r| {
+                parsed[from].models.iter().any(|m| m.uri == r.uri)
+            }) {
+                if path.len() > 2 {
+                    d = d.label(r.span, "which requires the first again");
+                }
+            }
         }
         diags.push(d);
         order.extend(rest_sorted);

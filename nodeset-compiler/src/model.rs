@@ -11,6 +11,15 @@ use crate::source::{FileId, SourceMap, Span, Spanned};
 use crate::value::{BuiltinType, Variant};
 use std::collections::{BTreeMap, HashMap};
 
+/// "a" or "an" before a node class or type name, for messages.
+pub fn article(word: &str) -> &'static str {
+    if word.starts_with(['A', 'E', 'I', 'O', 'U', 'a', 'e', 'i', 'o', 'u']) {
+        "an"
+    } else {
+        "a"
+    }
+}
+
 /// Well-known NodeIds of namespace 0.
 pub mod ids {
     pub const REFERENCES: u32 = 31;
@@ -115,6 +124,8 @@ pub struct Reference {
     pub forward: bool,
     /// False for the inverse the resolver added on the other node.
     pub declared: bool,
+    /// The `<Reference>` element that declared the reference (on either node).
+    pub span: Span,
 }
 
 /// Attributes that only some node classes have; `None` where the file leaves the default.

@@ -40,6 +40,20 @@ pub fn decode_text(bytes: Vec<u8>) -> Result<String, (Diagnostic, usize)> {
             0,
         ));
     }
+    if bytes.starts_with(&[0x3C, 0x00, 0x3F, 0x00]) || bytes.starts_with(&[0x00, 0x3C, 0x00, 0x3F]) {
+        return Err((
+            Diagnostic::new(Code::Encoding, "the file is UTF-16 (without a byte order mark)")
+                .help("save the file as UTF-8; NodeSet2 files are UTF-8 in practice and this compiler reads only UTF-8"),
+            0,
+        ));
+    }
+    if let Some(at) = bytes.iter().position(|&b| b == 0) {
+        return Err((
+            Diagnostic::new(Code::Encoding, format!("the file contains a NUL byte at byte {at}; it is not a text file"))
+                .help("NodeSet2 files are UTF-8 text; check that the right file was given"),
+            at,
+        ));
+    }
     let bytes = if bytes.starts_with(&[0xEF, 0xBB, 0xBF]) { bytes[3..].to_vec() } else { bytes };
     match String::from_utf8(bytes) {
         Ok(s) => Ok(s),
@@ -72,7 +86,8 @@ type PResult<T> = Result<T, Fatal>;
 enum Ev<'a> {
     Start(BytesStart<'a>, Span),
     End,
-    Text(Cow<'a, str>),
+    /// Text and the byte offset it starts at.
+    Text(Cow<'a, str>, usize),
     Eof,
 }
 
@@ -131,7 +146,8 @@ impl<'a, 'd> Parser<'a, 'd> {
                 Ok(ev) => ev,
                 Err(e) => {
                     let at = (self.reader.error_position() as usize).min(self.text.len());
-                    let d = xml_error_diag(&e, self.span(at, at + 1));
+                    let open = self.open.last().map(|(n, _)| *n);
+                    let d = xml_error_diag(&e, self.span(at, at + 1), open);
                     return Err(self.fatal(d));
                 }
             };
@@ -160,22 +176,20 @@ impl<'a, 'd> Parser<'a, 'd> {
                 }
                 Event::Empty(_) => unreachable!("expand_empty_elements is set"),
                 Event::Text(t) => match t.unescape() {
-                    Ok(s) => return Ok(Ev::Text(s)),
+                    Ok(s) => return Ok(Ev::Text(s, before)),
                     Err(e) => {
-                        let d = Diagnostic::new(Code::XmlSyntax, format!("malformed character data: {e}"))
-                            .at(self.span(before, after.min(before + 1)))
-                            .help("only the predefined entities (&amp; &lt; &gt; &quot; &apos;) and character references are allowed");
+                        let d = escape_diag(&e, before, |a, b| self.span(a, b));
                         return Err(self.fatal(d));
                     }
                 },
                 Event::CData(c) => {
                     let s = String::from_utf8_lossy(&c.into_inner()).into_owned();
-                    return Ok(Ev::Text(Cow::Owned(s)));
+                    return Ok(Ev::Text(Cow::Owned(s), before));
                 }
                 Event::Decl(decl) => {
                     if let Some(Ok(enc)) = decl.encoding() {
-                        let enc = String::from_utf8_lossy(&enc).to_ascii_lowercase();
-                        if enc != "utf-8" && enc != "utf8" {
+                        let enc = String::from_utf8_lossy(&enc).into_owned();
+                        if !enc.eq_ignore_ascii_case("utf-8") && !enc.eq_ignore_ascii_case("utf8") {
                             let d = Diagnostic::new(
                                 Code::Encoding,
                                 format!("the XML declaration says encoding=\"{enc}\"; only UTF-8 is read"),
@@ -268,7 +282,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                         return Ok(());
                     }
                 }
-                Ev::Text(_) => {}
+                Ev::Text(..) => {}
                 Ev::Eof => unreachable!("next() reports EOF inside an element"),
             }
         }
@@ -287,16 +301,18 @@ impl<'a, 'd> Parser<'a, 'd> {
     /// Reads the text content of an element whose start has been read; child elements are reported.
     fn text_content(&mut self, within: &str) -> PResult<String> {
         let mut s = String::new();
+        let element_start = self.open.last().map(|(_, start)| *start).unwrap_or(0);
         loop {
             match self.next()? {
-                Ev::Text(t) => {
+                Ev::Text(t, _) => {
                     if s.len() + t.len() > self.limits.max_text_len {
-                        let at = self.reader.buffer_position() as usize;
                         let d = Diagnostic::new(
                             Code::TooLarge,
                             format!("the text of <{within}> is longer than {} bytes", self.limits.max_text_len),
                         )
-                        .at(self.span(at, at));
+                        .at(self.span(element_start, element_start + within.len() + 1))
+                        .with_span_label("this element's text is too long")
+                        .help("no NodeSet2 text needs this much; raise the limit in parse::Limits if the file is trusted");
                         return Err(self.fatal(d));
                     }
                     s.push_str(&t)
@@ -321,10 +337,14 @@ impl<'a, 'd> Parser<'a, 'd> {
         let (root, root_span) = loop {
             match self.next()? {
                 Ev::Start(e, span) => break (e, span),
-                Ev::Text(t) if t.trim().is_empty() => {}
-                Ev::Text(_) => {
-                    let at = self.reader.buffer_position() as usize;
-                    let d = Diagnostic::new(Code::XmlSyntax, "text before the root element").at(self.span(at, at));
+                Ev::Text(t, _) if t.trim().is_empty() => {}
+                Ev::Text(t, at) => {
+                    let lead = t.len() - t.trim_start().len();
+                    let at = at + lead;
+                    let d = Diagnostic::new(Code::XmlSyntax, "text before the root element")
+                        .at(self.span(at, at + t.trim().len().min(40)))
+                        .with_span_label("not markup")
+                        .help("a NodeSet2 file holds only the XML declaration, comments and one <UANodeSet> element");
                     return Err(self.fatal(d));
                 }
                 Ev::End => unreachable!(),
@@ -373,7 +393,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                         },
                     }
                 }
-                Ev::Text(_) => {}
+                Ev::Text(..) => {}
                 Ev::End => break,
                 Ev::Eof => unreachable!(),
             }
@@ -382,16 +402,21 @@ impl<'a, 'd> Parser<'a, 'd> {
         loop {
             match self.next()? {
                 Ev::Eof => break,
-                Ev::Text(t) if t.trim().is_empty() => {}
+                Ev::Text(t, _) if t.trim().is_empty() => {}
                 Ev::Start(_, span) => {
-                    let d = Diagnostic::new(Code::XmlSyntax, "a second root element after </UANodeSet>").at(span);
+                    let d = Diagnostic::new(Code::XmlSyntax, "a second root element after </UANodeSet>")
+                        .at(span)
+                        .help("an XML document has exactly one root element; merge the content into <UANodeSet> or split the files");
                     return Err(self.fatal(d));
                 }
-                _ => {
-                    let at = self.reader.buffer_position() as usize;
-                    let d = Diagnostic::new(Code::XmlSyntax, "content after </UANodeSet>").at(self.span(at, at));
+                Ev::Text(t, at) => {
+                    let at = at + (t.len() - t.trim_start().len());
+                    let d = Diagnostic::new(Code::XmlSyntax, "content after </UANodeSet>")
+                        .at(self.span(at, at + 1))
+                        .help("remove everything after the closing </UANodeSet> tag");
                     return Err(self.fatal(d));
                 }
+                Ev::End => unreachable!("no element is open after the root"),
             }
         }
         Ok(set)
@@ -409,7 +434,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                         self.unknown(&e, span, within)?;
                     }
                 }
-                Ev::Text(_) => {}
+                Ev::Text(..) => {}
                 Ev::End => return Ok(out),
                 Ev::Eof => unreachable!(),
             }
@@ -471,14 +496,14 @@ impl<'a, 'd> Parser<'a, 'd> {
                                 b"RolePermissions" => model.role_permissions = self.role_permissions()?,
                                 _ => self.unknown(&e, span, "Model")?,
                             },
-                            Ev::Text(_) => {}
+                            Ev::Text(..) => {}
                             Ev::End => break,
                             Ev::Eof => unreachable!(),
                         }
                     }
                     out.push(model);
                 }
-                Ev::Text(_) => {}
+                Ev::Text(..) => {}
                 Ev::End => return Ok(()),
                 Ev::Eof => unreachable!(),
             }
@@ -517,7 +542,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                         None => self.missing(span, "Alias", "Alias"),
                     }
                 }
-                Ev::Text(_) => {}
+                Ev::Text(..) => {}
                 Ev::End => return Ok(()),
                 Ev::Eof => unreachable!(),
             }
@@ -544,7 +569,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                         permissions: permissions.unwrap_or(0),
                     });
                 }
-                Ev::Text(_) => {}
+                Ev::Text(..) => {}
                 Ev::End => return Ok(out),
                 Ev::Eof => unreachable!(),
             }
@@ -555,11 +580,17 @@ impl<'a, 'd> Parser<'a, 'd> {
         match a.value.trim().parse::<T>() {
             Ok(v) => Some(v),
             Err(_) => {
+                let what = match std::any::type_name::<T>() {
+                    "u8" => "a Byte (0 to 255)",
+                    "u16" => "a UInt16 (0 to 65535)",
+                    "u32" => "a UInt32 (0 to 4294967295)",
+                    "i32" => "an Int32",
+                    "i64" => "an Int64",
+                    "f64" => "a Double",
+                    _ => "a number",
+                };
                 self.diags.push(
-                    Diagnostic::new(
-                        Code::BadAttribute,
-                        format!("{}=\"{}\" is not a valid {}", a.key, a.value, std::any::type_name::<T>()),
-                    )
+                    Diagnostic::new(Code::BadAttribute, format!("{}=\"{}\" is not {what}", a.key, a.value))
                     .at(a.span)
                     .with_span_label("expected a number in range")
                     .help("see UANodeSet.xsd for the attribute's type"),
@@ -609,7 +640,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                 "ParentNodeId" => node.parent_node_id = Some(spanned()),
                 "DataType" => node.data_type = Some(spanned()),
                 "ValueRank" => node.value_rank = self.number(a),
-                "ArrayDimensions" => node.array_dimensions = Some(a.value.to_string()),
+                "ArrayDimensions" => node.array_dimensions = Some(spanned()),
                 "AccessLevel" => node.access_level = self.number(a),
                 "UserAccessLevel" => node.user_access_level = self.number(a),
                 "AccessLevelEx" => node.access_level_ex = self.number(a),
@@ -671,7 +702,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                         }
                     }
                 }
-                Ev::Text(_) => {}
+                Ev::Text(..) => {}
                 Ev::End => break,
                 Ev::Eof => unreachable!(),
             }
@@ -712,7 +743,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                         span,
                     });
                 }
-                Ev::Text(_) => {}
+                Ev::Text(..) => {}
                 Ev::End => return Ok(()),
                 Ev::Eof => unreachable!(),
             }
@@ -796,14 +827,14 @@ impl<'a, 'd> Parser<'a, 'd> {
                                 }
                                 _ => self.unknown(&e, s, "Field")?,
                             },
-                            Ev::Text(_) => {}
+                            Ev::Text(..) => {}
                             Ev::End => break,
                             Ev::Eof => unreachable!(),
                         }
                     }
                     def.fields.push(f);
                 }
-                Ev::Text(_) => {}
+                Ev::Text(..) => {}
                 Ev::End => return Ok(def),
                 Ev::Eof => unreachable!(),
             }
@@ -829,14 +860,15 @@ impl<'a, 'd> Parser<'a, 'd> {
                     let el = self.element_of(&e, s)?;
                     stack.push(el);
                 }
-                Ev::Text(t) => {
+                Ev::Text(t, _) => {
                     let top = stack.last_mut().expect("stack holds the root");
                     if top.text.len() + t.len() > self.limits.max_text_len {
                         let d = Diagnostic::new(
                             Code::TooLarge,
                             format!("the text of <{}> is longer than {} bytes", top.name, self.limits.max_text_len),
                         )
-                        .at(top.span);
+                        .at(top.span)
+                        .help("no NodeSet2 value needs this much; raise the limit in parse::Limits if the file is trusted");
                         return Err(self.fatal(d));
                     }
                     top.text.push_str(&t);
@@ -871,6 +903,41 @@ impl<'a, 'd> Parser<'a, 'd> {
     }
 }
 
+/// A diagnostic for a bad entity or character reference in text that starts at `text_start`.
+fn escape_diag(e: &quick_xml::Error, text_start: usize, span: impl Fn(usize, usize) -> Span) -> Diagnostic {
+    let esc = match e {
+        quick_xml::Error::Escape(esc) => esc,
+        other => {
+            return Diagnostic::new(Code::XmlSyntax, format!("malformed character data: {other}"))
+                .at(span(text_start, text_start + 1))
+                .help("the file is not well-formed XML")
+        }
+    };
+    escape_error_diag(esc, text_start, span)
+}
+
+fn escape_error_diag(esc: &quick_xml::escape::EscapeError, text_start: usize, span: impl Fn(usize, usize) -> Span) -> Diagnostic {
+    use quick_xml::escape::EscapeError;
+    let help = "only the predefined entities (&amp; &lt; &gt; &quot; &apos;) and character references such as &#160; are allowed; DOCTYPE entities are never expanded";
+    match esc {
+        EscapeError::UnrecognizedEntity(range, name) => {
+            let amp = text_start + range.start.saturating_sub(1);
+            Diagnostic::new(Code::XmlSyntax, format!("unknown entity `&{name};`"))
+                .at(span(amp, text_start + range.end + 1))
+                .with_span_label("not a predefined entity")
+                .help(help)
+        }
+        EscapeError::UnterminatedEntity(range) => {
+            Diagnostic::new(Code::XmlSyntax, "an `&` is not followed by an entity name and `;`")
+                .at(span(text_start + range.start, text_start + range.start + 1))
+                .help("write a literal ampersand as &amp;")
+        }
+        EscapeError::InvalidCharRef(e) => Diagnostic::new(Code::XmlSyntax, format!("invalid character reference: {e}"))
+            .at(span(text_start, text_start + 1))
+            .help(help),
+    }
+}
+
 /// The local part of a possibly prefixed XML name.
 fn local(name: &[u8]) -> &[u8] {
     match name.iter().position(|&b| b == b':') {
@@ -887,12 +954,19 @@ fn normalize_newlines(s: String) -> String {
     }
 }
 
-fn xml_error_diag(e: &quick_xml::Error, span: Span) -> Diagnostic {
+fn xml_error_diag(e: &quick_xml::Error, span: Span, open: Option<&str>) -> Diagnostic {
     use quick_xml::errors::{Error, IllFormedError, SyntaxError};
+    if let Error::Syntax(SyntaxError::UnclosedTag) = e {
+        let within = open.map(|o| format!(", inside <{o}>")).unwrap_or_default();
+        return Diagnostic::new(Code::Truncated, format!("the file ends in the middle of a tag{within}"))
+            .at(span)
+            .with_span_label("this tag is never closed")
+            .help("the file is truncated (a `>` and the rest of the document are missing); nothing of it is loaded");
+    }
+    if let Error::Escape(esc) = e {
+        return escape_error_diag(esc, span.start as usize, |a, b| Span::new(span.file, a, b));
+    }
     let (msg, help) = match e {
-        Error::Syntax(SyntaxError::UnclosedTag) => {
-            ("the file ends inside a tag".to_string(), "the file is truncated; a `>` is missing")
-        }
         Error::Syntax(SyntaxError::UnclosedComment) => {
             ("a comment is never closed".to_string(), "close the comment with `-->`")
         }

@@ -208,7 +208,7 @@ pub struct RawNode {
     // Variable and VariableType attributes.
     pub data_type: Option<Spanned<String>>,
     pub value_rank: Option<i32>,
-    pub array_dimensions: Option<String>,
+    pub array_dimensions: Option<Spanned<String>>,
     pub access_level: Option<u8>,
     pub user_access_level: Option<u8>,
     pub access_level_ex: Option<u32>,

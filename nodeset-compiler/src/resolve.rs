@@ -125,6 +125,8 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
     let mut seen_refs: HashSet<(NodeIx, NodeIx, NodeIx)> = HashSet::with_capacity(total * 3);
     let mut incoming: Vec<(NodeIx, Reference)> = Vec::with_capacity(total * 3);
     let contexts = std::mem::take(&mut model.files);
+    // Nodes with a reference that could not be resolved (already reported): no follow-on warnings.
+    let mut broken: HashSet<NodeIx> = HashSet::new();
     for (ix, raw) in &mut pending {
         let ix = *ix;
         let file = model.nodes[ix.index()].file;
@@ -170,12 +172,13 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
             method_declaration: None,
         };
         if let Some(ad) = &raw.array_dimensions {
-            for part in ad.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+            for part in ad.value.split(',').map(str::trim).filter(|p| !p.is_empty()) {
                 match part.parse::<u32>() {
                     Ok(v) => attrs.array_dimensions.push(v),
                     Err(_) => diags.push(
-                        Diagnostic::new(Code::BadAttribute, format!("ArrayDimensions=\"{ad}\" is not a list of numbers"))
-                            .at(raw.span)
+                        Diagnostic::new(Code::BadAttribute, format!("ArrayDimensions=\"{}\" is not a list of numbers", ad.value))
+                            .at(ad.span)
+                            .with_span_label(format!("`{part}` is not a UInt32"))
                             .help("write a comma-separated list such as 3,3 (0 for an unknown length)"),
                     ),
                 }
@@ -184,10 +187,11 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         if let Some(dt) = &raw.data_type {
             if let Some(t) = resolve_ref(&model, dt, diags) {
                 if model.nodes[t.index()].class != NodeClass::DataType {
+                    let class = model.nodes[t.index()].class.name();
                     diags.push(
                         Diagnostic::new(
                             Code::BadDataType,
-                            format!("DataType `{}` is a {}, not a DataType", dt.value, model.nodes[t.index()].class.name()),
+                            format!("DataType `{}` is {} {class}, not a DataType", dt.value, article(class)),
                         )
                         .at(dt.span)
                         .help("name a DataType node (an alias such as Int32, or its NodeId)"),
@@ -205,14 +209,11 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 Ok(id) => match model.lookup(&id) {
                     Some(t) if model.nodes[t.index()].class == NodeClass::ReferenceType => t,
                     Some(t) => {
+                        let class = model.nodes[t.index()].class.name();
                         diags.push(
                             Diagnostic::new(
                                 Code::BadReferenceType,
-                                format!(
-                                    "ReferenceType `{}` is a {}, not a ReferenceType",
-                                    r.reference_type.value,
-                                    model.nodes[t.index()].class.name()
-                                ),
+                                format!("ReferenceType `{}` is {} {class}, not a ReferenceType", r.reference_type.value, article(class)),
                             )
                             .at(r.reference_type.span)
                             .help("use a ReferenceType such as HasComponent (i=47)"),
@@ -233,16 +234,26 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 },
                 Err(d) => {
                     diags.push(d);
+                    broken.insert(ix);
                     continue;
                 }
             };
-            let Some(target) = resolve_ref(&model, &r.target, diags) else { continue };
+            let Some(target) = resolve_ref(&model, &r.target, diags) else {
+                broken.insert(ix);
+                continue;
+            };
             let (src, dst) = if r.is_forward { (ix, target) } else { (target, ix) };
             if !seen_refs.insert((src, rt, dst)) {
                 continue;
             }
-            model.nodes[ix.index()].references.push(Reference { reference_type: rt, target, forward: r.is_forward, declared: true });
-            incoming.push((target, Reference { reference_type: rt, target: ix, forward: !r.is_forward, declared: false }));
+            model.nodes[ix.index()].references.push(Reference {
+                reference_type: rt,
+                target,
+                forward: r.is_forward,
+                declared: true,
+                span: r.span,
+            });
+            incoming.push((target, Reference { reference_type: rt, target: ix, forward: !r.is_forward, declared: false, span: r.span }));
         }
         if let Some(p) = &raw.parent_node_id {
             if let Ok(id) = resolve_in(ctx, &model, p, diags) {
@@ -261,7 +272,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
     }
 
     // Pass 3: hierarchy flags, supertypes, type definitions, modelling rules, parents.
-    link_types(&mut model, diags);
+    link_types(&mut model, &broken, diags);
 
     // Pass 4: instance declarations.
     build_members(&mut model, diags);
@@ -336,7 +347,7 @@ fn dangling(model: &Model, from: NodeIx, id: &NodeId, span: Span) -> Diagnostic 
     }
 }
 
-fn link_types(model: &mut Model, diags: &mut Diagnostics) {
+fn link_types(model: &mut Model, broken: &HashSet<NodeIx>, diags: &mut Diagnostics) {
     let n = model.nodes.len();
     // Hierarchical reference types: HierarchicalReferences and its subtypes, minus HasSubtype.
     let has_subtype = model.ns0(ids::HAS_SUBTYPE);
@@ -344,8 +355,12 @@ fn link_types(model: &mut Model, diags: &mut Diagnostics) {
     for i in 0..n {
         let ix = NodeIx(i as u32);
         let mut supers: Vec<NodeIx> = Vec::new();
+        let mut sub_span = model.nodes[i].span;
         for r in &model.nodes[i].references {
             if Some(r.reference_type) == has_subtype && !r.forward {
+                if supers.is_empty() {
+                    sub_span = r.span;
+                }
                 supers.push(r.target);
             }
         }
@@ -361,14 +376,16 @@ fn link_types(model: &mut Model, diags: &mut Diagnostics) {
                 Diagnostic::new(
                     Code::BadSubtype,
                     format!(
-                        "{} `{}` is declared a subtype of {} `{}`",
+                        "{} `{}` is declared a subtype of {} {} `{}`",
                         class.name(),
                         model.nodes[i].browse_name.name,
+                        article(s.class.name()),
                         s.class.name(),
                         s.browse_name.name
                     ),
                 )
-                .at(model.nodes[i].span)
+                .at(sub_span)
+                .with_span_label("this HasSubtype reference")
                 .help("a type's supertype must have the same node class"),
             );
             continue;
@@ -434,15 +451,15 @@ fn link_types(model: &mut Model, diags: &mut Diagnostics) {
         let mut parent = model.nodes[i].parent;
         for r in &model.nodes[i].references {
             if r.forward && Some(r.reference_type) == has_type_def {
-                type_def = Some(r.target);
+                type_def = Some((r.target, r.span));
             } else if r.forward && Some(r.reference_type) == has_rule {
-                rule = Some(r.target);
+                rule = Some((r.target, r.span));
             } else if !r.forward && parent.is_none() && model.is_hierarchical(r.reference_type) {
                 parent = Some(r.target);
             }
         }
         let node = &model.nodes[i];
-        if let Some(t) = type_def {
+        if let Some((t, ref_span)) = type_def {
             let expected = match node.class {
                 NodeClass::Object => Some(NodeClass::ObjectType),
                 NodeClass::Variable => Some(NodeClass::VariableType),
@@ -454,14 +471,16 @@ fn link_types(model: &mut Model, diags: &mut Diagnostics) {
                     Diagnostic::new(
                         Code::BadTypeDefinition,
                         format!(
-                            "{} `{}` has TypeDefinition `{}`, a {}",
+                            "{} `{}` has TypeDefinition `{}`, {} {}",
                             node.class.name(),
                             node.browse_name.name,
                             model.nodes[t.index()].browse_name.name,
+                            article(actual.name()),
                             actual.name()
                         ),
                     )
-                    .at(node.span)
+                    .at(ref_span)
+                    .with_span_label("this HasTypeDefinition reference")
                     .help(match node.class {
                         NodeClass::Object => "an Object's TypeDefinition must be an ObjectType",
                         NodeClass::Variable => "a Variable's TypeDefinition must be a VariableType",
@@ -471,7 +490,7 @@ fn link_types(model: &mut Model, diags: &mut Diagnostics) {
             } else {
                 model.nodes[i].type_definition = Some(t);
             }
-        } else if matches!(node.class, NodeClass::Object | NodeClass::Variable) {
+        } else if matches!(node.class, NodeClass::Object | NodeClass::Variable) && !broken.contains(&ix) {
             diags.push(
                 Diagnostic::new(
                     Code::MissingTypeDefinition,
@@ -481,7 +500,7 @@ fn link_types(model: &mut Model, diags: &mut Diagnostics) {
                 .help("add <Reference ReferenceType=\"HasTypeDefinition\">i=58</Reference> (BaseObjectType) or the right type"),
             );
         }
-        if let Some(r) = rule {
+        if let Some((r, rule_span)) = rule {
             let rule = match model.nodes[r.index()].id.ns0() {
                 Some(ids::MANDATORY) => ModellingRule::Mandatory,
                 Some(ids::OPTIONAL) => ModellingRule::Optional,
@@ -494,7 +513,8 @@ fn link_types(model: &mut Model, diags: &mut Diagnostics) {
                             Code::BadModellingRule,
                             format!("`{}` is not a standard ModellingRule", model.nodes[r.index()].browse_name.name),
                         )
-                        .at(model.nodes[i].span)
+                        .at(rule_span)
+                        .with_span_label("this HasModellingRule reference")
                         .help("use Mandatory, Optional, ExposesItsArray, OptionalPlaceholder or MandatoryPlaceholder"),
                     );
                     ModellingRule::Other(r)
