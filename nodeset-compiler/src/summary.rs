@@ -136,10 +136,37 @@ pub fn dump(model: &Model) -> String {
         if let Some(r) = n.attrs.value_rank {
             let _ = write!(s, " valueRank={r}");
         }
+        if !n.attrs.array_dimensions.is_empty() {
+            let _ = write!(s, " arrayDimensions={:?}", n.attrs.array_dimensions);
+        }
+        if let Some(a) = n.attrs.access_level {
+            let _ = write!(s, " accessLevel={a}");
+        }
         if n.is_abstract() {
             s.push_str(" abstract");
         }
+        if let Some(p) = n.parent {
+            let _ = write!(s, " parent={}", id(p));
+        }
+        if let Some(m) = n.attrs.method_declaration {
+            let _ = write!(s, " methodDeclaration={}", id(m));
+        }
         s.push('\n');
+        match model.value(ix) {
+            Some(Ok(v)) => {
+                let mut text = format!("{v:?}");
+                if text.len() > 160 {
+                    let cut = (0..=160).rev().find(|&i| text.is_char_boundary(i)).unwrap_or(0);
+                    text.truncate(cut);
+                    text.push_str("...");
+                }
+                let _ = writeln!(s, "    value {text}");
+            }
+            Some(Err(e)) => {
+                let _ = writeln!(s, "    value error: {e}");
+            }
+            None => {}
+        }
         let mut refs: Vec<String> = n
             .references
             .iter()
@@ -150,7 +177,7 @@ pub fn dump(model: &Model) -> String {
             let _ = writeln!(s, "    refs {}", refs.join(" "));
         }
         if let Some(dt) = model.data_types.get(&ix) {
-            let _ = writeln!(s, "    datatype {:?} encoding={:?}", kind_summary(model, &dt.kind), dt.encoding);
+            let _ = writeln!(s, "    datatype {} encoding={:?}", kind_summary(model, &dt.kind), dt.encoding);
         }
         if let Some(m) = model.methods.get(&ix) {
             let args = |a: &[crate::model::Argument]| {
@@ -206,11 +233,13 @@ fn kind_summary(model: &Model, k: &crate::model::DataTypeKind) -> String {
             fields
                 .iter()
                 .map(|f| format!(
-                    "{}{}:{}[{}]",
+                    "{}{}:{}[{}{}]{}",
                     f.name,
                     if f.is_optional { "?" } else { "" },
                     model.node(f.data_type).browse_name.name,
-                    f.value_rank
+                    f.value_rank,
+                    if f.array_dimensions.is_empty() { String::new() } else { format!(";{:?}", f.array_dimensions) },
+                    if f.allow_sub_types { "+subtypes" } else { "" }
                 ))
                 .collect::<Vec<_>>()
                 .join(",")
