@@ -35,8 +35,12 @@ use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
 /// The four files of the `robotics` scenario, in `nodesets/vendor/`.
-const ROBOTICS_FILES: &[&str] =
-    &["Opc.Ua.NodeSet2.xml", "Opc.Ua.Di.NodeSet2.xml", "Opc.Ua.IA.NodeSet2.xml", "Opc.Ua.Robotics.NodeSet2.xml"];
+const ROBOTICS_FILES: &[&str] = &[
+    "Opc.Ua.NodeSet2.xml",
+    "Opc.Ua.Di.NodeSet2.xml",
+    "Opc.Ua.IA.NodeSet2.xml",
+    "Opc.Ua.Robotics.NodeSet2.xml",
+];
 
 fn workspace_root() -> PathBuf {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
@@ -49,10 +53,12 @@ struct Cli {
     vendor: PathBuf,
     tree: PathBuf,
     split: bool,
+    /// Only the headline `compile` runs (no stage split, no per-file costs): for profilers.
+    compile_only: bool,
 }
 
 fn usage() -> String {
-    "usage: load_bench <robotics|tree> [--runs N] [--vendor DIR] [--tree DIR] [--no-split]".to_string()
+    "usage: load_bench <robotics|tree> [--runs N] [--vendor DIR] [--tree DIR] [--no-split] [--compile-only]".to_string()
 }
 
 fn parse_cli() -> Result<Cli, String> {
@@ -63,15 +69,27 @@ fn parse_cli() -> Result<Cli, String> {
         vendor: root.join("nodesets/vendor"),
         tree: root.join("../shared/nodesets/ua-nodeset"),
         split: true,
+        compile_only: false,
     };
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
-        let mut value = |name: &str| args.next().ok_or_else(|| format!("{name} needs a value\n{}", usage()));
+        let mut value = |name: &str| {
+            args.next()
+                .ok_or_else(|| format!("{name} needs a value\n{}", usage()))
+        };
         match a.as_str() {
-            "--runs" => cli.runs = value("--runs")?.parse().map_err(|e| format!("--runs: {e}"))?,
+            "--runs" => {
+                cli.runs = value("--runs")?
+                    .parse()
+                    .map_err(|e| format!("--runs: {e}"))?
+            }
             "--vendor" => cli.vendor = PathBuf::from(value("--vendor")?),
             "--tree" => cli.tree = PathBuf::from(value("--tree")?),
             "--no-split" => cli.split = false,
+            "--compile-only" => {
+                cli.split = false;
+                cli.compile_only = true;
+            }
             "-h" | "--help" => return Err(usage()),
             s if !s.starts_with('-') && cli.scenario.is_empty() => cli.scenario = s.to_string(),
             s => return Err(format!("unexpected argument `{s}`\n{}", usage())),
@@ -103,7 +121,10 @@ impl Job {
     }
 
     fn options(&self) -> Options {
-        Options { model_dirs: self.model_dirs.clone(), ..Options::default() }
+        Options {
+            model_dirs: self.model_dirs.clone(),
+            ..Options::default()
+        }
     }
 }
 
@@ -112,15 +133,28 @@ fn jobs(cli: &Cli) -> Result<Vec<Job>, String> {
         "robotics" => {
             let inputs: Vec<PathBuf> = ROBOTICS_FILES.iter().map(|f| cli.vendor.join(f)).collect();
             if let Some(missing) = inputs.iter().find(|p| !p.is_file()) {
-                return Err(format!("{} is missing; run `cargo xtask fetch-nodesets`", missing.display()));
+                return Err(format!(
+                    "{} is missing; run `cargo xtask fetch-nodesets`",
+                    missing.display()
+                ));
             }
-            Ok(vec![Job { label: "ns0+DI+IA+Robotics".into(), inputs, model_dirs: vec![cli.vendor.clone()] }])
+            Ok(vec![Job {
+                label: "ns0+DI+IA+Robotics".into(),
+                inputs,
+                model_dirs: vec![cli.vendor.clone()],
+            }])
         }
         _ => {
             if !cli.tree.is_dir() {
-                return Err(format!("the NodeSet tree {} does not exist", cli.tree.display()));
+                return Err(format!(
+                    "the NodeSet tree {} does not exist",
+                    cli.tree.display()
+                ));
             }
-            let tree = cli.tree.canonicalize().map_err(|e| format!("{}: {e}", cli.tree.display()))?;
+            let tree = cli
+                .tree
+                .canonicalize()
+                .map_err(|e| format!("{}: {e}", cli.tree.display()))?;
             let mut files = Vec::new();
             walk(&tree, &mut files);
             files.sort();
@@ -140,7 +174,9 @@ fn jobs(cli: &Cli) -> Result<Vec<Job>, String> {
 }
 
 fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
     for e in entries.flatten() {
         let p = e.path();
         let Ok(ft) = e.file_type() else { continue };
@@ -157,11 +193,43 @@ fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
 
 /// A line of `/proc/self/status`, in KiB (0 where there is no procfs).
 fn proc_status_kib(key: &str) -> u64 {
-    let Ok(s) = std::fs::read_to_string("/proc/self/status") else { return 0 };
+    let Ok(s) = std::fs::read_to_string("/proc/self/status") else {
+        return 0;
+    };
     s.lines()
         .find_map(|l| l.strip_prefix(key)?.strip_prefix(':'))
         .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
         .unwrap_or(0)
+}
+
+/// CPU time this thread has run, ms (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`; NaN where unavailable).
+/// Unlike wall time, it does not grow when other processes compete for the CPU.
+#[cfg(all(target_os = "linux", target_pointer_width = "64"))]
+fn thread_cpu_ms() -> f64 {
+    #[repr(C)]
+    struct Timespec {
+        tv_sec: i64,
+        tv_nsec: i64,
+    }
+    extern "C" {
+        fn clock_gettime(clock: i32, tp: *mut Timespec) -> i32;
+    }
+    const CLOCK_THREAD_CPUTIME_ID: i32 = 3;
+    let mut ts = Timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec of the 64-bit Linux layout.
+    if unsafe { clock_gettime(CLOCK_THREAD_CPUTIME_ID, &mut ts) } == 0 {
+        ts.tv_sec as f64 * 1e3 + ts.tv_nsec as f64 / 1e6
+    } else {
+        f64::NAN
+    }
+}
+
+#[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
+fn thread_cpu_ms() -> f64 {
+    f64::NAN
 }
 
 fn ms(d: Duration) -> f64 {
@@ -206,12 +274,16 @@ fn file_cost(path: &Path, reps: usize) -> FileCost {
     let mut nodes = 0;
     for _ in 0..reps.max(1) {
         let t = Instant::now();
-        let Ok(bytes) = std::fs::read(path) else { return FileCost::default() };
+        let Ok(bytes) = std::fs::read(path) else {
+            return FileCost::default();
+        };
         r.push(ms(t.elapsed()));
         let t = Instant::now();
         let text = parse::decode_text(bytes);
         d.push(ms(t.elapsed()));
-        let Ok(text) = text else { return FileCost::default() };
+        let Ok(text) = text else {
+            return FileCost::default();
+        };
         let mut diags = Diagnostics::new();
         let t = Instant::now();
         let set = parse::parse(FileId(0), &text, &Limits::default(), &mut diags);
@@ -219,38 +291,64 @@ fn file_cost(path: &Path, reps: usize) -> FileCost {
         nodes = set.as_ref().map_or(0, |s| s.nodes.len());
         drop(black_box(set));
     }
-    FileCost { read: median(&r), decode: median(&d), parse: median(&p), nodes }
+    FileCost {
+        read: median(&r),
+        decode: median(&d),
+        parse: median(&p),
+        nodes,
+    }
 }
 
 fn run() -> Result<(), String> {
     let cli = parse_cli()?;
     let hwm_start = proc_status_kib("VmHWM");
     let jobs = jobs(&cli)?;
-    eprintln!("load_bench: scenario `{}`, {} compile(s) per run, {} run(s)", cli.scenario, jobs.len(), cli.runs);
+    eprintln!(
+        "load_bench: scenario `{}`, {} compile(s) per run, {} run(s)",
+        cli.scenario,
+        jobs.len(),
+        cli.runs
+    );
 
     // Headline: the public all-in-one `compile`, as users call it.
     let mut totals = Vec::with_capacity(cli.runs);
+    let mut cpu = Vec::with_capacity(cli.runs);
+    let mut drops = Vec::with_capacity(cli.runs);
     let mut per_job: Vec<Vec<f64>> = vec![Vec::with_capacity(cli.runs); jobs.len()];
     let mut outcomes: Vec<Outcome> = vec![Outcome::default(); jobs.len()];
     let mut hwm_first = 0;
     for run in 0..cli.runs {
-        let pass = Instant::now();
+        // Per pass: the compile calls only; dropping each result is timed apart (`drop_*`).
+        let (mut wall, mut cpu_ms, mut drop_ms) = (0.0, 0.0, 0.0);
         for (j, job) in jobs.iter().enumerate() {
+            let cpu0 = thread_cpu_ms();
             let t = Instant::now();
             let out = compile(job.inputs(), &job.options());
-            per_job[j].push(ms(t.elapsed()));
+            let dt = ms(t.elapsed());
+            cpu_ms += thread_cpu_ms() - cpu0;
+            wall += dt;
+            per_job[j].push(dt);
             if run == 0 {
                 outcomes[j] = Outcome {
                     nodes: out.model.nodes.len(),
                     files: out.model.sources.len(),
                     errors: out.diagnostics.error_count(),
                     warnings: out.diagnostics.warning_count(),
-                    loaded_paths: out.model.sources.files().map(|(_, f)| f.path.clone()).collect(),
+                    loaded_paths: out
+                        .model
+                        .sources
+                        .files()
+                        .map(|(_, f)| f.path.clone())
+                        .collect(),
                 };
             }
+            let t = Instant::now();
             drop(black_box(out));
+            drop_ms += ms(t.elapsed());
         }
-        totals.push(ms(pass.elapsed()));
+        totals.push(wall);
+        cpu.push(cpu_ms);
+        drops.push(drop_ms);
         if run == 0 {
             hwm_first = proc_status_kib("VmHWM");
         }
@@ -263,7 +361,10 @@ fn run() -> Result<(), String> {
         for _ in 0..cli.runs {
             let (mut l, mut r) = (Duration::ZERO, Duration::ZERO);
             for job in &jobs {
-                let opts = LoadOptions { model_dirs: job.model_dirs.clone(), limits: Limits::default() };
+                let opts = LoadOptions {
+                    model_dirs: job.model_dirs.clone(),
+                    limits: Limits::default(),
+                };
                 let mut diags = Diagnostics::new();
                 let t = Instant::now();
                 let mut loaded = load::load(job.inputs(), &opts, &mut diags);
@@ -283,9 +384,13 @@ fn run() -> Result<(), String> {
 
     // Standalone per-file costs, summed over the files each compile loaded.
     let mut costs: HashMap<PathBuf, FileCost> = HashMap::new();
-    let reps = if jobs.len() > 1 { 3 } else { cli.runs.clamp(3, 20) };
+    let reps = if jobs.len() > 1 {
+        3
+    } else {
+        cli.runs.clamp(3, 20)
+    };
     let (mut read, mut decode, mut parse_ms) = (0.0, 0.0, 0.0);
-    for o in &outcomes {
+    for o in outcomes.iter().filter(|_| !cli.compile_only) {
         for p in &o.loaded_paths {
             let c = *costs.entry(p.clone()).or_insert_with(|| file_cost(p, reps));
             read += c.read;
@@ -302,15 +407,27 @@ fn run() -> Result<(), String> {
     let files_loaded: usize = outcomes.iter().map(|o| o.files).sum();
     let errors: usize = outcomes.iter().map(|o| o.errors).sum();
     let warnings: usize = outcomes.iter().map(|o| o.warnings).sum();
-    let failed: Vec<&Job> = jobs.iter().zip(&outcomes).filter(|(_, o)| o.errors > 0).map(|(j, _)| j).collect();
+    let failed: Vec<&Job> = jobs
+        .iter()
+        .zip(&outcomes)
+        .filter(|(_, o)| o.errors > 0)
+        .map(|(j, _)| j)
+        .collect();
 
     // Details for people.
     if jobs.len() > 1 {
-        let mut slow: Vec<(f64, usize)> = per_job.iter().enumerate().map(|(j, t)| (median(t), j)).collect();
+        let mut slow: Vec<(f64, usize)> = per_job
+            .iter()
+            .enumerate()
+            .map(|(j, t)| (median(t), j))
+            .collect();
         slow.sort_by(|a, b| b.0.total_cmp(&a.0));
         eprintln!("slowest compiles (median ms, nodes, files loaded):");
         for &(t, j) in slow.iter().take(8) {
-            eprintln!("  {t:9.2}  {:7} {:3}  {}", outcomes[j].nodes, outcomes[j].files, jobs[j].label);
+            eprintln!(
+                "  {t:9.2}  {:7} {:3}  {}",
+                outcomes[j].nodes, outcomes[j].files, jobs[j].label
+            );
         }
         if !failed.is_empty() {
             eprintln!("{} compile(s) reported errors:", failed.len());
@@ -320,7 +437,10 @@ fn run() -> Result<(), String> {
         }
     } else if let Some(o) = outcomes.first() {
         if o.errors > 0 {
-            eprintln!("warning: the compile reported {} error(s); timings may not be representative", o.errors);
+            eprintln!(
+                "warning: the compile reported {} error(s); timings may not be representative",
+                o.errors
+            );
         }
     }
 
@@ -331,13 +451,29 @@ fn run() -> Result<(), String> {
         ("compiles", jobs.len().to_string()),
         ("total_median_ms", format!("{:.3}", median(&totals))),
         ("total_min_ms", format!("{:.3}", min(&totals))),
-        ("total_max_ms", format!("{:.3}", totals.iter().copied().fold(0.0, f64::max))),
+        (
+            "total_max_ms",
+            format!("{:.3}", totals.iter().copied().fold(0.0, f64::max)),
+        ),
+        ("cpu_median_ms", format!("{:.3}", median(&cpu))),
+        ("cpu_min_ms", format!("{:.3}", min(&cpu))),
+        ("drop_median_ms", format!("{:.3}", median(&drops))),
         ("load_median_ms", format!("{:.3}", load_med)),
         ("resolve_median_ms", format!("{:.3}", median(&resolves))),
         ("read_ms", format!("{read:.3}")),
         ("decode_ms", format!("{decode:.3}")),
         ("parse_ms", format!("{parse_ms:.3}")),
-        ("load_other_ms", format!("{:.3}", if cli.split { load_med - read - decode - parse_ms } else { 0.0 })),
+        (
+            "load_other_ms",
+            format!(
+                "{:.3}",
+                if cli.split {
+                    load_med - read - decode - parse_ms
+                } else {
+                    0.0
+                }
+            ),
+        ),
         ("unique_files", costs.len().to_string()),
         ("unique_parse_ms", format!("{unique_parse:.3}")),
         ("unique_nodes", unique_nodes.to_string()),

@@ -10,8 +10,11 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
+mod bench;
 mod fetch;
+mod test;
 mod util;
+mod venv;
 
 /// The top-level command line of `cargo xtask`.
 #[derive(Debug, Parser)]
@@ -30,12 +33,21 @@ enum Command {
     /// Fetch the pinned official NodeSet2 files into `nodesets/vendor/` and verify them against
     /// `nodesets/node-opcua-nodesets.lock`.
     FetchNodesets(fetch::Args),
+    /// Time parse + load + resolve on the vendored models and the UA-Nodeset tree (a report, not a test).
+    Bench(bench::Args),
+    /// Everything a fresh machine needs (pinned nodesets, Python test peers), then every test.
+    Test(test::Args),
+    /// Create or update the Python venv `.venv` with the test peers of `tests/requirements.txt`.
+    Venv(venv::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::FetchNodesets(args) => fetch::run(args),
+        Command::Bench(args) => bench::run(args),
+        Command::Test(args) => test::run(args),
+        Command::Venv(args) => venv::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

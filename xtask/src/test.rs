@@ -1,7 +1,8 @@
 //! `cargo xtask test`: everything a fresh machine needs, then every test.
 //!
 //! 1. The pinned companion specs (`fetch-nodesets`, a no-op when they are present and verified).
-//! 2. `cargo test --workspace --locked`, whose summary lines CI reads.
+//! 2. The Python venv with the test peers (`.venv`, from `tests/requirements.txt`).
+//! 3. `cargo test --workspace --locked`, whose summary lines CI reads.
 
 use crate::util::workspace_root;
 use std::process::Command;
@@ -16,6 +17,7 @@ pub struct Args {
 pub fn run(args: Args) -> Result<(), String> {
     let root = workspace_root();
     crate::fetch::ensure_fetched()?;
+    crate::venv::ensure_venv()?;
     let shared = root.join("../shared/nodesets/ua-nodeset");
     if !shared.is_dir() {
         return Err(format!(
