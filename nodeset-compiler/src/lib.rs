@@ -22,6 +22,7 @@
 
 pub mod datatypes;
 pub mod diag;
+pub mod fxhash;
 pub mod load;
 pub mod model;
 pub mod names;

@@ -6,6 +6,7 @@
 //! model comes after everything it requires (ties broken by ModelUri, so input order never matters), and
 //! every file's namespace indices are mapped onto the global table.
 
+use crate::fxhash::FxHashMap;
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::nodeid::{parse_node_id, looks_like_node_id, NodeId, NsRef};
 use crate::parse::{self, Limits};
@@ -54,7 +55,7 @@ pub struct LoadedFile {
     pub raw: RawNodeSet,
     /// Local namespace index to global index (`ns_map[0] == 0`).
     pub ns_map: Vec<u16>,
-    pub aliases: HashMap<String, Spanned<String>>,
+    pub aliases: FxHashMap<String, Spanned<String>>,
 }
 
 impl LoadedFile {
@@ -67,7 +68,7 @@ impl LoadedFile {
 /// Expands an alias or parses a NodeId written in a file with this namespace map and alias table.
 pub fn resolve_node_id_in(
     ns_map: &[u16],
-    aliases: &HashMap<String, Spanned<String>>,
+    aliases: &FxHashMap<String, Spanned<String>>,
     text: &Spanned<String>,
     namespaces: &[String],
 ) -> Result<NodeId, Diagnostic> {
@@ -372,7 +373,7 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
         for m in &set.models {
             models.push(model_info(m, set.file, intern(&m.uri, &mut namespaces)));
         }
-        let mut aliases: HashMap<String, Spanned<String>> = HashMap::with_capacity(set.aliases.len());
+        let mut aliases: FxHashMap<String, Spanned<String>> = FxHashMap::with_capacity_and_hasher(set.aliases.len(), Default::default());
         for a in &set.aliases {
             if let Some(prev) = aliases.get(&a.alias) {
                 if prev.value != a.target.value {
@@ -418,13 +419,13 @@ fn read_and_parse(
     limits: &Limits,
     diags: &mut Diagnostics,
 ) -> Option<RawNodeSet> {
-    match parse::decode_text(bytes.clone()) {
+    match parse::decode_text_keeping(bytes) {
         Ok(text) => {
             let id = sources.add(SourceFile::new(path, display, text, named));
             let text = &sources.get(id).text;
             parse::parse(id, text, limits, diags)
         }
-        Err((d, at)) => {
+        Err((d, at, bytes)) => {
             let id = sources.add(SourceFile::new(path, display, displayable(&bytes), named));
             diags.push(d.at(Span::new(id, at, at + 1)));
             None

@@ -4,12 +4,13 @@
 //! ordinary. Tables are keyed by `NodeIx` and iterated in node order (files in dependency order, nodes in
 //! file order), which does not depend on the order the user named the files in.
 
+use crate::fxhash::FxHashMap;
 use crate::load::{ModelInfo, NS0_URI};
 use crate::nodeid::{NodeId, QualifiedName};
 use crate::raw::{LocalizedText, NodeClass, RawDefinition, RawRolePermission, XmlElement};
 use crate::source::{FileId, SourceMap, Span, Spanned};
 use crate::value::{BuiltinType, Variant};
-use std::collections::{BTreeMap, HashMap};
+use std::collections::BTreeMap;
 
 /// "a" or "an" before a node class or type name, for messages.
 pub fn article(word: &str) -> &'static str {
@@ -320,7 +321,7 @@ pub struct StateMachineInfo {
 #[derive(Clone, Debug)]
 pub struct FileContext {
     pub ns_map: Vec<u16>,
-    pub aliases: HashMap<String, Spanned<String>>,
+    pub aliases: FxHashMap<String, Spanned<String>>,
 }
 
 /// One model of every loaded file.
@@ -330,7 +331,7 @@ pub struct Model {
     pub namespaces: Vec<String>,
     pub models: Vec<ModelInfo>,
     pub nodes: Vec<Node>,
-    pub(crate) index: HashMap<NodeId, NodeIx>,
+    pub(crate) index: FxHashMap<NodeId, NodeIx>,
     pub files: BTreeMap<FileId, FileContext>,
     pub data_types: BTreeMap<NodeIx, DataTypeInfo>,
     pub methods: BTreeMap<NodeIx, MethodInfo>,
@@ -339,7 +340,7 @@ pub struct Model {
     pub members: BTreeMap<NodeIx, Vec<Member>>,
     pub(crate) hierarchical: Vec<bool>,
     /// BrowseNames of ns0 DataTypes and ReferenceTypes, for undeclared aliases such as `IdType`.
-    pub(crate) ns0_type_names: HashMap<String, NodeIx>,
+    pub(crate) ns0_type_names: FxHashMap<String, NodeIx>,
 }
 
 impl Model {

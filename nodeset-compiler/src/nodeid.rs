@@ -155,25 +155,39 @@ pub fn format_guid(g: &[u8; 16]) -> String {
 
 const B64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 
+/// The value of each base64 character, 255 for characters that are not base64.
+const B64_INV: [u8; 256] = {
+    let mut t = [255u8; 256];
+    let mut i = 0;
+    while i < 64 {
+        t[B64[i] as usize] = i as u8;
+        i += 1;
+    }
+    t
+};
+
 /// Decodes standard base64, ignoring white space (NodeSet2 files wrap long ByteStrings).
 pub fn base64_decode(s: &str) -> Option<Vec<u8>> {
     let mut out = Vec::with_capacity(s.len() * 3 / 4);
     let mut acc = 0u32;
     let mut bits = 0;
     let mut padding = 0;
-    for c in s.bytes() {
-        if c.is_ascii_whitespace() {
-            continue;
-        }
-        if c == b'=' {
-            padding += 1;
-            continue;
+    for &c in s.as_bytes() {
+        let v = B64_INV[c as usize];
+        if v == 255 {
+            if c.is_ascii_whitespace() {
+                continue;
+            }
+            if c == b'=' {
+                padding += 1;
+                continue;
+            }
+            return None;
         }
         if padding > 0 {
             return None;
         }
-        let v = B64.iter().position(|&b| b == c)? as u32;
-        acc = (acc << 6) | v;
+        acc = (acc << 6) | u32::from(v);
         bits += 6;
         if bits >= 8 {
             bits -= 8;

@@ -32,12 +32,13 @@ impl Default for Limits {
 ///
 /// On error, returns the diagnostic and the byte offset it refers to; the caller keeps a lossy copy of the
 /// text so the diagnostic can still show the line.
-pub fn decode_text(bytes: Vec<u8>) -> Result<String, (Diagnostic, usize)> {
+pub fn decode_text_keeping(bytes: Vec<u8>) -> Result<String, (Diagnostic, usize, Vec<u8>)> {
     if bytes.starts_with(&[0xFF, 0xFE]) || bytes.starts_with(&[0xFE, 0xFF]) {
         return Err((
             Diagnostic::new(Code::Encoding, "the file is UTF-16 (it starts with a UTF-16 byte order mark)")
                 .help("save the file as UTF-8; NodeSet2 files are UTF-8 in practice and this compiler reads only UTF-8"),
             0,
+            bytes,
         ));
     }
     if bytes.starts_with(&[0x3C, 0x00, 0x3F, 0x00]) || bytes.starts_with(&[0x00, 0x3C, 0x00, 0x3F]) {
@@ -45,28 +46,44 @@ pub fn decode_text(bytes: Vec<u8>) -> Result<String, (Diagnostic, usize)> {
             Diagnostic::new(Code::Encoding, "the file is UTF-16 (without a byte order mark)")
                 .help("save the file as UTF-8; NodeSet2 files are UTF-8 in practice and this compiler reads only UTF-8"),
             0,
+            bytes,
         ));
     }
-    if let Some(at) = bytes.iter().position(|&b| b == 0) {
+    if let Some(at) = bytes.contains(&0).then(|| bytes.iter().position(|&b| b == 0)).flatten() {
         return Err((
             Diagnostic::new(Code::Encoding, format!("the file contains a NUL byte at byte {at}; it is not a text file"))
                 .help("NodeSet2 files are UTF-8 text; check that the right file was given"),
             at,
+            bytes,
         ));
     }
-    let bytes = if bytes.starts_with(&[0xEF, 0xBB, 0xBF]) { bytes[3..].to_vec() } else { bytes };
+    let mut bytes = bytes;
+    let bom = bytes.starts_with(&[0xEF, 0xBB, 0xBF]);
+    if bom {
+        bytes.drain(..3);
+    }
     match String::from_utf8(bytes) {
         Ok(s) => Ok(s),
         Err(e) => {
-            let at = e.utf8_error().valid_up_to();
+            let at = e.utf8_error().valid_up_to() + if bom { 3 } else { 0 };
+            let mut bytes = e.into_bytes();
+            if bom {
+                bytes.splice(0..0, [0xEF, 0xBB, 0xBF]);
+            }
             Err((
                 Diagnostic::new(Code::Encoding, format!("invalid UTF-8 at byte {at}"))
                     .with_span_label("this byte sequence is not UTF-8")
                     .help("NodeSet2 files must be UTF-8; re-encode the file (iconv -t UTF-8)"),
                 at,
+                bytes,
             ))
         }
     }
+}
+
+/// [`decode_text_keeping`] without the bytes in the error.
+pub fn decode_text(bytes: Vec<u8>) -> Result<String, (Diagnostic, usize)> {
+    decode_text_keeping(bytes).map_err(|(d, at, _)| (d, at))
 }
 
 /// Parses one file. Returns `None` when the file is not usable at all (its errors are in `diags`).
@@ -175,13 +192,26 @@ impl<'a, 'd> Parser<'a, 'd> {
                     return Ok(Ev::End);
                 }
                 Event::Empty(_) => unreachable!("expand_empty_elements is set"),
-                Event::Text(t) => match t.unescape() {
+                Event::Text(t) => {
+                    // Fast paths: white space between tags, and text without references, borrowed as is.
+                    let raw: &[u8] = &t;
+                    if raw.iter().all(u8::is_ascii_whitespace) {
+                        return Ok(Ev::Text(Cow::Borrowed(""), before));
+                    }
+                    if !raw.contains(&b'&') {
+                        let start = self.offset_of(raw);
+                        if start + raw.len() <= self.text.len() && self.text.is_char_boundary(start) && self.text.is_char_boundary(start + raw.len()) {
+                            return Ok(Ev::Text(Cow::Borrowed(&self.text[start..start + raw.len()]), before));
+                        }
+                    }
+                    match t.unescape() {
                     Ok(s) => return Ok(Ev::Text(s, before)),
                     Err(e) => {
                         let d = escape_diag(&e, before, |a, b| self.span(a, b));
                         return Err(self.fatal(d));
                     }
-                },
+                    }
+                }
                 Event::CData(c) => {
                     let s = String::from_utf8_lossy(&c.into_inner()).into_owned();
                     return Ok(Ev::Text(Cow::Owned(s), before));
@@ -371,7 +401,7 @@ impl<'a, 'd> Parser<'a, 'd> {
             server_uris: Vec::new(),
             models: Vec::new(),
             aliases: Vec::new(),
-            nodes: Vec::new(),
+            nodes: Vec::with_capacity(self.text.len() / 800),
             last_modified: attrs.iter().find(|a| a.key == "LastModified").map(|a| a.value.to_string()),
         };
         loop {

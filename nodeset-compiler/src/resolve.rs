@@ -5,11 +5,12 @@
 //! type, (5) data types, (6) method arguments, (7) state machines, (8) checks on values and names.
 //! Every pass collects its problems; nothing stops at the first one.
 
+use crate::fxhash::{FxHashMap, FxHashSet};
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::load::Loaded;
 use crate::model::*;
 use crate::nodeid::{parse_qualified_name, NodeId, QualifiedName};
-use crate::raw::{NodeClass, RawNode};
+use crate::raw::NodeClass;
 use crate::source::Span;
 use crate::value::{BuiltinType, Variant};
 use std::collections::{BTreeMap, HashMap, HashSet};
@@ -23,27 +24,31 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         namespaces,
         models,
         nodes: Vec::new(),
-        index: HashMap::new(),
+        index: FxHashMap::default(),
         files: BTreeMap::new(),
         data_types: BTreeMap::new(),
         methods: BTreeMap::new(),
         state_machines: BTreeMap::new(),
         members: BTreeMap::new(),
         hierarchical: Vec::new(),
-        ns0_type_names: HashMap::new(),
+        ns0_type_names: FxHashMap::default(),
     };
     let total: usize = files.iter().map(|f| f.raw.nodes.len()).sum();
     model.nodes.reserve(total);
     model.index.reserve(total);
 
-    // Pass 1: every node gets its index.
-    let mut pending: Vec<(NodeIx, RawNode)> = Vec::with_capacity(total);
-    for mut f in files {
+    // Pass 1: every node gets its index. Raw nodes stay where the loader put them; `pending` says where.
+    let mut files = files;
+    let contexts: Vec<FileContext> = files
+        .iter_mut()
+        .map(|f| FileContext { ns_map: std::mem::take(&mut f.ns_map), aliases: std::mem::take(&mut f.aliases) })
+        .collect();
+    let mut pending: Vec<(NodeIx, u32, u32)> = Vec::with_capacity(total);
+    for (fi, f) in files.iter_mut().enumerate() {
         let file = f.raw.file;
-        let ctx = FileContext { ns_map: f.ns_map.clone(), aliases: f.aliases.clone() };
-        let raw_nodes = std::mem::take(&mut f.raw.nodes);
-        for raw in raw_nodes {
-            let id = match f.resolve_node_id(&raw.node_id, &model.namespaces) {
+        let ctx = &contexts[fi];
+        for (ni, raw) in f.raw.nodes.iter_mut().enumerate() {
+            let id = match crate::load::resolve_node_id_in(&ctx.ns_map, &ctx.aliases, &raw.node_id, &model.namespaces) {
                 Ok(id) => id,
                 Err(d) => {
                     diags.push(d);
@@ -51,7 +56,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 }
             };
             let browse_name = match parse_qualified_name(&raw.browse_name.value) {
-                Ok(q) => match f.ns_map.get(q.ns as usize) {
+                Ok(q) => match ctx.ns_map.get(q.ns as usize) {
                     Some(&ns) => QualifiedName { ns, name: q.name },
                     None => {
                         diags.push(
@@ -93,9 +98,9 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 id,
                 class: raw.class,
                 browse_name,
-                symbolic_name: raw.symbolic_name.clone(),
-                display_name: raw.display_names.clone(),
-                description: raw.descriptions.clone(),
+                symbolic_name: raw.symbolic_name.take(),
+                display_name: std::mem::take(&mut raw.display_names),
+                description: std::mem::take(&mut raw.descriptions),
                 attrs: Attributes::default(),
                 value_xml: None,
                 definition: None,
@@ -110,9 +115,8 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 node_id_span: raw.node_id.span,
                 browse_name_span: raw.browse_name.span,
             });
-            pending.push((ix, raw));
+            pending.push((ix, fi as u32, ni as u32));
         }
-        model.files.insert(file, ctx);
     }
 
     for (i, n) in model.nodes.iter().enumerate() {
@@ -122,19 +126,30 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
     }
 
     // Pass 2: attributes and references.
-    let mut seen_refs: HashSet<(NodeIx, NodeIx, NodeIx)> = HashSet::with_capacity(total * 3);
+    let mut seen_refs: FxHashSet<(NodeIx, NodeIx, NodeIx)> = FxHashSet::with_capacity_and_hasher(total * 3, Default::default());
     let mut incoming: Vec<(NodeIx, Reference)> = Vec::with_capacity(total * 3);
-    let contexts = std::mem::take(&mut model.files);
     // Nodes with a reference that could not be resolved (already reported): no follow-on warnings.
     let mut broken: HashSet<NodeIx> = HashSet::new();
-    for (ix, raw) in &mut pending {
-        let ix = *ix;
-        let file = model.nodes[ix.index()].file;
-        let ctx = &contexts[&file];
-        let resolve_ref = |model: &Model, s: &crate::source::Spanned<String>, diags: &mut Diagnostics| -> Option<NodeIx> {
+    // Per file: NodeId strings already resolved (reference types and common targets repeat thousands of times).
+    let mut caches: Vec<FxHashMap<String, NodeIx>> = contexts.iter().map(|_| FxHashMap::default()).collect();
+    for &(ix, fi, ni) in &pending {
+        let raw = &mut files[fi as usize].raw.nodes[ni as usize];
+        let ctx = &contexts[fi as usize];
+        let cache = &mut caches[fi as usize];
+        let resolve_ref = |cache: &mut FxHashMap<String, NodeIx>,
+                           model: &Model,
+                           s: &crate::source::Spanned<String>,
+                           diags: &mut Diagnostics|
+         -> Option<NodeIx> {
+            if let Some(&t) = cache.get(s.value.as_str()) {
+                return Some(t);
+            }
             match resolve_in(ctx, model, s, diags) {
                 Ok(id) => match model.lookup(&id) {
-                    Some(t) => Some(t),
+                    Some(t) => {
+                        cache.insert(s.value.clone(), t);
+                        Some(t)
+                    }
                     None => {
                         diags.push(dangling(model, ix, &id, s.span));
                         None
@@ -185,7 +200,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
             }
         }
         if let Some(dt) = &raw.data_type {
-            if let Some(t) = resolve_ref(&model, dt, diags) {
+            if let Some(t) = resolve_ref(cache, &model, dt, diags) {
                 if model.nodes[t.index()].class != NodeClass::DataType {
                     let class = model.nodes[t.index()].class.name();
                     diags.push(
@@ -202,12 +217,18 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
             }
         }
         if let Some(m) = &raw.method_declaration_id {
-            attrs.method_declaration = resolve_ref(&model, m, diags);
+            attrs.method_declaration = resolve_ref(cache, &model, m, diags);
         }
         for r in &raw.references {
-            let rt = match resolve_in(ctx, &model, &r.reference_type, diags) {
-                Ok(id) => match model.lookup(&id) {
-                    Some(t) if model.nodes[t.index()].class == NodeClass::ReferenceType => t,
+            let cached = cache.get(r.reference_type.value.as_str()).copied();
+            let rt = match cached.map(|t| Ok(model.nodes[t.index()].id.clone())).unwrap_or_else(|| resolve_in(ctx, &model, &r.reference_type, diags)) {
+                Ok(id) => match cached.or_else(|| model.lookup(&id)) {
+                    Some(t) if model.nodes[t.index()].class == NodeClass::ReferenceType => {
+                        if cached.is_none() {
+                            cache.insert(r.reference_type.value.clone(), t);
+                        }
+                        t
+                    }
                     Some(t) => {
                         let class = model.nodes[t.index()].class.name();
                         diags.push(
@@ -238,7 +259,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                     continue;
                 }
             };
-            let Some(target) = resolve_ref(&model, &r.target, diags) else {
+            let Some(target) = resolve_ref(cache, &model, &r.target, diags) else {
                 broken.insert(ix);
                 continue;
             };
@@ -266,7 +287,8 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         node.definition = raw.definition.take();
         node.extensions = std::mem::take(&mut raw.extensions);
     }
-    model.files = contexts;
+    model.files = files.iter().map(|f| f.raw.file).zip(contexts).collect();
+    drop(pending);
     for (target, r) in incoming {
         model.nodes[target.index()].references.push(r);
     }
