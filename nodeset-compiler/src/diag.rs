@@ -87,6 +87,9 @@ codes! {
     DanglingForeignReference = "NS0215", Warning, "a reference points to a missing node of another model";
     BadModellingRule = "NS0216", Warning, "a ModellingRule reference names no known rule";
     StateMachine = "NS0217", Warning, "a state machine's states or transitions are inconsistent";
+    // Generating code.
+    NameCollision = "NS0301", Warning, "two names map to one identifier in generated code";
+    UnsupportedFeature = "NS0302", Warning, "a model feature has no faithful representation in generated code";
 }
 
 /// A secondary position with a message.

@@ -12,6 +12,7 @@ use clap::{Parser, Subcommand};
 
 mod bench;
 mod fetch;
+mod generate;
 mod test;
 mod util;
 mod venv;
@@ -35,6 +36,8 @@ enum Command {
     FetchNodesets(fetch::Args),
     /// Time parse + load + resolve on the vendored models and the UA-Nodeset tree (a report, not a test).
     Bench(bench::Args),
+    /// Regenerate generated/ from the pinned companion specifications (`--check`: fail if stale).
+    Generate(generate::Args),
     /// Everything a fresh machine needs (pinned nodesets, Python test peers), then every test.
     Test(test::Args),
     /// Create or update the Python venv `.venv` with the test peers of `tests/requirements.txt`.
@@ -46,6 +49,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::FetchNodesets(args) => fetch::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Generate(args) => generate::run(args),
         Command::Test(args) => test::run(args),
         Command::Venv(args) => venv::run(args),
     };

@@ -1,0 +1,1205 @@
+//! The Rust back end: typed Rust for async-opcua 0.19 from the resolved model.
+//!
+//! For each namespace it emits a module with four files:
+//!
+//! - `mod.rs`: the namespace URI, model version, and re-exports;
+//! - `ids.rs`: a constant for every node (`NsNodeId`: the namespace by URI, resolved at run time), named from
+//!   the SymbolicName or the browse path below the node's type, grouped by node class;
+//! - `types.rs`: the data types: structures (inherited fields included), structures with optional fields
+//!   (`Option<T>` with the encoding mask), unions (enums with one-field variants), enumerations with the
+//!   nodeset's values, OptionSets as bit flags of the right width, simple subtypes as aliases, plus the
+//!   encoding ids and a type loader so servers and clients decode them;
+//! - `nodes.rs`: the address space as one static [`NodeSetTable`] (data, one row per node), which the
+//!   hand-written runtime imports into a server with the namespace indices of that server.
+//!
+//! `generate` is a pure function of the model and the configuration; it returns files in memory.
+//!
+//! [`NodeSetTable`]: https://docs.rs/nodeset-models (runtime::table::NodeSetTable)
+
+mod async_opcua_ns0;
+
+use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::model::{ids, DataTypeKind, Model, NodeIx, StructureKind};
+use crate::names::{self, Case, Scope, Target};
+use crate::nodeid::Identifier;
+use crate::raw::NodeClass;
+use crate::value::{BuiltinType, Variant};
+use crate::write::OutFile;
+use proc_macro2::{Ident, Literal, Span, TokenStream};
+use quote::quote;
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::PathBuf;
+
+/// One namespace to generate.
+#[derive(Clone, Debug)]
+pub struct RustNamespace {
+    pub uri: String,
+    /// The module name (a Rust identifier), e.g. `robotics`.
+    pub module: String,
+}
+
+/// What to generate and how generated code reaches its dependencies.
+#[derive(Clone, Debug)]
+pub struct RustConfig {
+    pub namespaces: Vec<RustNamespace>,
+    /// Rust paths of namespaces generated elsewhere (URI -> path of their module, e.g.
+    /// `nodeset_models::models::di`). Namespaces generated in this run are reached as `super::<module>`.
+    pub extern_paths: BTreeMap<String, String>,
+    /// Path of the runtime module (`crate::runtime` inside nodeset-models, `nodeset_models::runtime` elsewhere).
+    pub runtime_path: String,
+    /// The command that regenerates the output, for file headers.
+    pub command: String,
+}
+
+/// Generated files and the diagnostics of generation.
+#[derive(Debug, Default)]
+pub struct RustOutput {
+    pub files: Vec<OutFile>,
+    pub diagnostics: Diagnostics,
+}
+
+/// A default module name for a model URI: the last path segment in snake case (`.../Robotics/` -> `robotics`).
+pub fn default_module_name(uri: &str) -> String {
+    let seg = uri.trim_end_matches('/').rsplit(['/', ':']).next().unwrap_or(uri);
+    names::sanitize(seg, Case::Snake, Target::Rust)
+}
+
+/// Generates Rust for the configured namespaces.
+pub fn generate(model: &Model, cfg: &RustConfig) -> RustOutput {
+    let mut out = RustOutput::default();
+    let mut modules = Vec::new();
+    for ns_cfg in &cfg.namespaces {
+        let Some(ns) = model.namespaces.iter().position(|u| *u == ns_cfg.uri).map(|i| i as u16) else {
+            out.diagnostics.push(
+                Diagnostic::new(Code::MissingModel, format!("namespace `{}` is not in the loaded model", ns_cfg.uri))
+                    .help("name the NodeSet2 file that defines it"),
+            );
+            continue;
+        };
+        let mut g = Gen::new(model, cfg, ns, &ns_cfg.module);
+        let files = g.namespace();
+        out.diagnostics.extend(std::mem::take(&mut g.diags));
+        modules.push(ns_cfg.module.clone());
+        out.files.extend(files);
+    }
+    out.files.sort_by(|a, b| a.path.cmp(&b.path));
+    out
+}
+
+/// Per-namespace generation state.
+struct Gen<'m> {
+    model: &'m Model,
+    cfg: &'m RustConfig,
+    ns: u16,
+    module: String,
+    diags: Diagnostics,
+    /// Rust type names of this namespace's data types.
+    type_names: BTreeMap<NodeIx, String>,
+    /// Type names of other namespaces, computed on demand with the same rules.
+    foreign_type_names: std::cell::RefCell<BTreeMap<u16, BTreeMap<NodeIx, String>>>,
+    ns0_types: BTreeSet<&'static str>,
+}
+
+fn ident(s: &str) -> Ident {
+    match s.strip_prefix("r#") {
+        Some(raw) => Ident::new_raw(raw, Span::call_site()),
+        None => Ident::new(s, Span::call_site()),
+    }
+}
+
+fn path(s: &str) -> TokenStream {
+    s.parse().unwrap_or_else(|_| panic!("internal error: `{s}` is not a Rust path"))
+}
+
+fn doc(text: &str) -> TokenStream {
+    let lines: Vec<TokenStream> = text
+        .lines()
+        .map(|l| {
+            let l = format!(" {}", l.trim_end());
+            quote! { #[doc = #l] }
+        })
+        .collect();
+    quote! { #(#lines)* }
+}
+
+/// A string literal token.
+fn lit(s: &str) -> Literal {
+    Literal::string(s)
+}
+
+/// Whether a data type gets a Rust type of its own in its namespace's `types.rs`.
+fn has_rust_type(model: &Model, t: NodeIx) -> bool {
+    let Some(info) = model.data_types.get(&t) else { return false };
+    match &info.kind {
+        DataTypeKind::Structure { .. } => !info.is_abstract,
+        DataTypeKind::Enumeration { values, .. } => !values.is_empty(),
+        DataTypeKind::OptionSet { base, bits } => base.is_unsigned() && !bits.is_empty(),
+        DataTypeKind::Simple(_) => true,
+        _ => false,
+    }
+}
+
+/// The Rust type names of a namespace's data types (one scope per namespace, UpperCamel).
+fn type_names_of(model: &Model, ns: u16) -> BTreeMap<NodeIx, String> {
+    let mut scope: Scope<NodeIx> = Scope::new(Target::Rust, Case::UpperCamel);
+    for reserved in ["TypeLoader", "NAMESPACE_URI"] {
+        scope.reserve(reserved);
+    }
+    for (&t, _) in model.data_types.iter() {
+        let n = model.node(t);
+        if n.id.ns == ns && has_rust_type(model, t) {
+            scope.add(n.symbolic_name.as_deref().unwrap_or(&n.browse_name.name), t);
+        }
+    }
+    scope.finish().0
+}
+
+impl<'m> Gen<'m> {
+    fn new(model: &'m Model, cfg: &'m RustConfig, ns: u16, module: &str) -> Gen<'m> {
+        let type_names = type_names_of(model, ns);
+        Gen {
+            model,
+            cfg,
+            ns,
+            module: module.to_string(),
+            diags: Diagnostics::new(),
+            type_names,
+            foreign_type_names: Default::default(),
+            ns0_types: async_opcua_ns0::TYPES.iter().copied().collect(),
+        }
+    }
+
+    fn uri(&self) -> &str {
+        self.model.namespace_uri(self.ns)
+    }
+
+    fn header(&self, what: &str) -> String {
+        let m = self.model.model_of_namespace(self.ns);
+        let file = m.map(|m| self.model.sources.get(m.file).path.file_name().map(|f| f.to_string_lossy().into_owned()).unwrap_or_default()).unwrap_or_default();
+        format!(
+            "// {what} of {} {} ({file}).\n// Generated by nodeset-compiler; do not edit. Regenerate with `{}`.\n\n",
+            self.uri(),
+            m.and_then(|m| m.version.as_deref()).unwrap_or("(no version)"),
+            self.cfg.command
+        )
+    }
+
+    fn file(&self, name: &str, what: &str, tokens: TokenStream) -> OutFile {
+        let parsed: syn::File = syn::parse2(tokens.clone())
+            .unwrap_or_else(|e| panic!("internal error: generated {name} for {} does not parse: {e}\n{tokens}", self.uri()));
+        let text = prettyplease::unparse(&parsed);
+        OutFile { path: PathBuf::from(&self.module).join(name), contents: format!("{}{text}", self.header(what)) }
+    }
+
+    fn namespace(&mut self) -> Vec<OutFile> {
+        let ids = self.ids_file();
+        let types = self.types_file();
+        let nodes = self.nodes_file();
+        let m = self.model.model_of_namespace(self.ns);
+        let uri = lit(self.uri());
+        let version = lit(m.and_then(|m| m.version.as_deref()).unwrap_or(""));
+        let date = lit(m.and_then(|m| m.publication_date.as_deref()).unwrap_or(""));
+        let title = format!(" The OPC UA information model `{}`.", self.uri());
+        let mod_rs = quote! {
+            #![doc = #title]
+            #![allow(clippy::all)]
+            pub mod ids;
+            pub mod nodes;
+            pub mod types;
+            /// The namespace URI of this model.
+            pub const NAMESPACE_URI: &str = #uri;
+            /// The model's version, as its NodeSet2 file declares it.
+            pub const VERSION: &str = #version;
+            /// The model's publication date, as its NodeSet2 file declares it.
+            pub const PUBLICATION_DATE: &str = #date;
+            pub use nodes::TABLE;
+            pub use types::TypeLoader;
+        };
+        vec![self.file("mod.rs", "Module", mod_rs), ids, types, nodes]
+    }
+
+    // ----- NodeId constants -------------------------------------------------------------------------
+
+    /// The name of a node for its constant: SymbolicName, or the browse path below its type or top object.
+    fn path_name(&self, ix: NodeIx) -> String {
+        let model = self.model;
+        // Encoding objects hang off their DataType by HasEncoding, which is not hierarchical.
+        if let Some(enc) = model.ns0(ids::HAS_ENCODING) {
+            let n = model.node(ix);
+            if n.parent.is_none() {
+                if let Some(r) = n.references.iter().find(|r| !r.forward && r.reference_type == enc) {
+                    let dt = model.node(r.target);
+                    let dt_name = dt.symbolic_name.clone().unwrap_or_else(|| dt.browse_name.name.clone());
+                    return format!("{dt_name}_Encoding_{}", n.symbolic_name.clone().unwrap_or_else(|| n.browse_name.name.clone()));
+                }
+            }
+        }
+        let mut parts = Vec::new();
+        let mut cur = Some(ix);
+        let mut guard = 0;
+        while let Some(c) = cur {
+            let n = self.model.node(c);
+            parts.push(n.symbolic_name.clone().unwrap_or_else(|| n.browse_name.name.clone()));
+            if n.class.is_type() {
+                break;
+            }
+            guard += 1;
+            cur = n.parent.filter(|p| self.model.node(*p).id.ns == self.ns && guard < 12);
+        }
+        parts.reverse();
+        parts.join("_")
+    }
+
+    fn ids_file(&mut self) -> OutFile {
+        let mut groups: BTreeMap<NodeClass, Vec<NodeIx>> = BTreeMap::new();
+        for (i, n) in self.model.nodes.iter().enumerate() {
+            if n.id.ns == self.ns {
+                groups.entry(n.class).or_default().push(NodeIx(i as u32));
+            }
+        }
+        let runtime = path(&self.cfg.runtime_path);
+        let mut mods = Vec::new();
+        for (class, nodes) in groups {
+            let mut scope: Scope<NodeIx> = Scope::new(Target::Rust, Case::ShoutySnake);
+            for &ix in &nodes {
+                scope.add(&self.path_name(ix), ix);
+            }
+            let (names, collisions) = scope.finish();
+            for c in collisions {
+                self.collision_warning(&c, "NodeId constants");
+            }
+            let mut items: Vec<(NodeIx, String)> = names.into_iter().collect();
+            items.sort_by(|a, b| a.1.cmp(&b.1));
+            let consts: Vec<TokenStream> = items
+                .iter()
+                .map(|(ix, name)| {
+                    let n = self.model.node(*ix);
+                    let name = ident(name);
+                    let mut text = format!("`{}` ({}).", n.browse_name.name, n.class.name());
+                    if let Some(d) = n.doc() {
+                        text.push_str("\n\n");
+                        text.push_str(d);
+                    }
+                    let docs = doc(&text);
+                    let value = match &n.id.id {
+                        Identifier::Numeric(v) => quote! { #runtime::NsNodeId::numeric(super::super::NAMESPACE_URI, #v) },
+                        Identifier::String(s) => {
+                            let s = lit(s);
+                            quote! { #runtime::NsNodeId::string(super::super::NAMESPACE_URI, #s) }
+                        }
+                        other => {
+                            let idk = self.id_kind(other);
+                            let idk = path(&idk.to_string().replacen("rt ::", &format!("{} ::", self.cfg.runtime_path), 1));
+                            quote! { #runtime::NsNodeId { namespace_uri: super::super::NAMESPACE_URI, id: #idk } }
+                        }
+                    };
+                    quote! { #docs pub const #name: #runtime::NsNodeId = #value; }
+                })
+                .collect();
+            let module = ident(&names::sanitize(&format!("{}s", class.name()), Case::Snake, Target::Rust));
+            let mdoc = format!(" The {} nodes of this namespace.", class.name());
+            mods.push(quote! { #[doc = #mdoc] pub mod #module { #(#consts)* } });
+        }
+        let tokens = quote! {
+            //! NodeIds of every node of this namespace, resolved against a namespace table at run time.
+            #(#mods)*
+        };
+        self.file("ids.rs", "NodeIds", tokens)
+    }
+
+    fn collision_warning(&mut self, c: &names::Collision<NodeIx>, scope: &str) {
+        let model = self.model;
+        let list: Vec<String> = c
+            .members
+            .iter()
+            .map(|(orig, ix)| format!("`{orig}` ({})", crate::resolve::display_id(model, &model.node(*ix).id)))
+            .collect();
+        let first = c.members.first().map(|(_, ix)| *ix);
+        let mut d = Diagnostic::new(
+            Code::NameCollision,
+            format!("{} map to the Rust name `{}` among the {scope}", list.join(" and "), c.ident),
+        )
+        .help("the first in sorted order keeps the name, the others get _2, _3, ...; rename one in the nodeset or set a SymbolicName");
+        if let Some(ix) = first {
+            d = d.at(model.node(ix).browse_name_span);
+        }
+        self.diags.push(d);
+    }
+
+    // ----- data types -------------------------------------------------------------------------------
+
+    /// The Rust type of values of DataType `dt` (a scalar).
+    fn rust_type(&self, dt: NodeIx) -> TokenStream {
+        let model = self.model;
+        let n = model.node(dt);
+        let Some(info) = model.data_types.get(&dt) else { return quote! { opcua::types::Variant } };
+        if n.id.ns == 0 {
+            if let DataTypeKind::Builtin(b) = info.kind {
+                return builtin_type(b);
+            }
+            if let Some(name) = self.ns0_rust_name(dt) {
+                let name = ident(&name);
+                return quote! { opcua::types::#name };
+            }
+            return self.encoding_type(dt);
+        }
+        if !has_rust_type(model, dt) {
+            return self.encoding_type(dt);
+        }
+        let name = if n.id.ns == self.ns {
+            self.type_names.get(&dt).cloned()
+        } else {
+            let mut cache = self.foreign_type_names.borrow_mut();
+            cache.entry(n.id.ns).or_insert_with(|| type_names_of(model, n.id.ns)).get(&dt).cloned()
+        };
+        let Some(name) = name else { return self.encoding_type(dt) };
+        let name = ident(&name);
+        if n.id.ns == self.ns {
+            return quote! { #name };
+        }
+        let uri = model.namespace_uri(n.id.ns);
+        let module = if let Some(p) = self.cfg.extern_paths.get(uri) {
+            path(p)
+        } else if let Some(m) = self.cfg.namespaces.iter().find(|m| m.uri == uri) {
+            let m = ident(&m.module);
+            quote! { super::super::#m }
+        } else {
+            return self.encoding_type(dt);
+        };
+        quote! { #module::types::#name }
+    }
+
+    /// The type of a value encoded as the DataType's encoding (when no better Rust type exists).
+    fn encoding_type(&self, dt: NodeIx) -> TokenStream {
+        let info = &self.model.data_types[&dt];
+        match info.encoding {
+            BuiltinType::ExtensionObject => quote! { opcua::types::ExtensionObject },
+            b => builtin_type(b),
+        }
+    }
+
+    /// async-opcua's name for an ns0 data type, if it has one.
+    fn ns0_rust_name(&self, dt: NodeIx) -> Option<String> {
+        let n = self.model.node(dt);
+        let name = n.browse_name.name.replace("3D", "ThreeD");
+        self.ns0_types.contains(name.as_str()).then_some(name)
+    }
+
+    fn field_type(&self, f: &crate::model::Field) -> TokenStream {
+        let info = &self.model.data_types[&f.data_type];
+        let scalar = match &info.kind {
+            DataTypeKind::Structure { .. } if info.is_abstract || f.allow_sub_types => {
+                quote! { opcua::types::ExtensionObject }
+            }
+            _ => self.rust_type(f.data_type),
+        };
+        if f.value_rank >= 0 || f.value_rank == -2 || f.value_rank == -3 {
+            quote! { Option<Vec<#scalar>> }
+        } else {
+            scalar
+        }
+    }
+
+    fn types_file(&mut self) -> OutFile {
+        let model = self.model;
+        let mut items = Vec::new();
+        let mut loader = Vec::new();
+        let runtime = path(&self.cfg.runtime_path);
+        let types: Vec<(NodeIx, String)> = self.type_names.iter().map(|(k, v)| (*k, v.clone())).collect();
+        for (t, name) in types {
+            let n = model.node(t);
+            let info = &model.data_types[&t];
+            let name_id = ident(&name);
+            let mut text = format!("`{}` ({}).", n.browse_name.name, crate::resolve::display_id(model, &n.id));
+            if let Some(d) = n.doc() {
+                text.push_str("\n\n");
+                text.push_str(d);
+            }
+            let docs = doc(&text);
+            match &info.kind {
+                DataTypeKind::Simple(b) => {
+                    let ty = builtin_type(*b);
+                    items.push(quote! { #docs pub type #name_id = #ty; });
+                }
+                DataTypeKind::Enumeration { values, .. } => {
+                    let mut scope: Scope<usize> = Scope::new(Target::Rust, Case::UpperCamel);
+                    for (i, v) in values.iter().enumerate() {
+                        scope.add(&v.name, i);
+                    }
+                    let (vnames, collisions) = scope.finish();
+                    for c in collisions {
+                        let members: Vec<(String, NodeIx)> = c.members.iter().map(|(o, _)| (o.clone(), t)).collect();
+                        self.collision_warning(&names::Collision { ident: c.ident.clone(), members }, "enumeration values");
+                    }
+                    // The default is the value 0 if there is one, else the first.
+                    let default = values.iter().position(|v| v.value == 0).unwrap_or(0);
+                    let variants: Vec<TokenStream> = values
+                        .iter()
+                        .enumerate()
+                        .filter_map(|(i, v)| {
+                            let vn = ident(&vnames[&i]);
+                            let Ok(value) = i32::try_from(v.value) else {
+                                return None;
+                            };
+                            let value = Literal::i32_unsuffixed(value);
+                            let d = doc(&match &v.description {
+                                Some(desc) => format!("`{}` = {}: {desc}", v.name, v.value),
+                                None => format!("`{}` = {}", v.name, v.value),
+                            });
+                            let def = (i == default).then(|| quote! { #[opcua(default)] });
+                            Some(quote! { #d #def #vn = #value })
+                        })
+                        .collect();
+                    items.push(quote! {
+                        #docs
+                        #[opcua::types::ua_encodable]
+                        #[derive(Debug, Copy, Clone, PartialEq, Eq, Hash)]
+                        #[repr(i32)]
+                        pub enum #name_id { #(#variants),* }
+                    });
+                }
+                DataTypeKind::OptionSet { base, bits } => {
+                    let width = builtin_type(*base);
+                    let mut scope: Scope<usize> = Scope::new(Target::Rust, Case::ShoutySnake);
+                    for (i, v) in bits.iter().enumerate() {
+                        scope.add(&v.name, i);
+                    }
+                    let (bnames, _) = scope.finish();
+                    let max_bit = match base {
+                        BuiltinType::Byte => 8,
+                        BuiltinType::UInt16 => 16,
+                        BuiltinType::UInt32 => 32,
+                        _ => 64,
+                    };
+                    let flags: Vec<TokenStream> = bits
+                        .iter()
+                        .enumerate()
+                        .filter(|(_, v)| v.value >= 0 && v.value < max_bit)
+                        .map(|(i, v)| {
+                            let bn = ident(&bnames[&i]);
+                            let bit = Literal::u32_unsuffixed(v.value as u32);
+                            let d = doc(&format!("`{}`: bit {}{}", v.name, v.value, v.description.as_deref().map(|d| format!(". {d}")).unwrap_or_default()));
+                            quote! { #d const #bn = 1 << #bit; }
+                        })
+                        .collect();
+                    items.push(quote! {
+                        bitflags::bitflags! {
+                            #docs
+                            #[derive(Debug, Copy, Clone, PartialEq, Eq, Hash, Default)]
+                            pub struct #name_id: #width { #(#flags)* }
+                        }
+                        impl opcua::types::UaNullable for #name_id {
+                            fn is_ua_null(&self) -> bool { self.is_empty() }
+                        }
+                        opcua::types::impl_encoded_as!(
+                            #name_id,
+                            |v| Ok(#name_id::from_bits_truncate(v)),
+                            |v: &#name_id| Ok::<_, opcua::types::Error>(v.bits()),
+                            |v: &#name_id| opcua::types::SimpleBinaryEncodable::byte_len(&v.bits())
+                        );
+                        impl opcua::types::IntoVariant for #name_id {
+                            fn into_variant(self) -> opcua::types::Variant {
+                                opcua::types::IntoVariant::into_variant(self.bits())
+                            }
+                        }
+                        #[cfg(feature = "xml")]
+                        impl opcua::types::xml::XmlType for #name_id {
+                            const TAG: &'static str = stringify!(#name_id);
+                        }
+                    });
+                }
+                DataTypeKind::Structure { kind, fields, .. } => {
+                    let mut scope: Scope<usize> = Scope::new(
+                        Target::Rust,
+                        if *kind == StructureKind::Union { Case::UpperCamel } else { Case::Snake },
+                    );
+                    if *kind == StructureKind::Union {
+                        scope.reserve("Null");
+                    }
+                    for (i, f) in fields.iter().enumerate() {
+                        scope.add(f.symbolic_name.as_deref().unwrap_or(&f.name), i);
+                    }
+                    let (fnames, collisions) = scope.finish();
+                    for c in collisions {
+                        let members: Vec<(String, NodeIx)> = c.members.iter().map(|(o, _)| (o.clone(), t)).collect();
+                        self.collision_warning(&names::Collision { ident: c.ident.clone(), members }, "structure fields");
+                    }
+                    for f in fields {
+                        if f.value_rank > 1 {
+                            self.diags.push(
+                                Diagnostic::new(
+                                    Code::UnsupportedFeature,
+                                    format!("field `{}` of `{}` has ValueRank {}; it is generated as a one-dimensional array", f.name, n.browse_name.name, f.value_rank),
+                                )
+                                .at(f.span)
+                                .help("the binary encoding of multi-dimensional structure fields is not supported by async-opcua's derive"),
+                            );
+                        }
+                    }
+                    let body = if *kind == StructureKind::Union {
+                        let variants: Vec<TokenStream> = fields
+                            .iter()
+                            .enumerate()
+                            .map(|(i, f)| {
+                                let vn = ident(&fnames[&i]);
+                                let ty = self.field_type(f);
+                                let d = doc(&field_doc(f));
+                                quote! { #d #vn(#ty) }
+                            })
+                            .collect();
+                        quote! {
+                            #docs
+                            #[opcua::types::ua_encodable]
+                            #[derive(Debug, Clone, PartialEq)]
+                            pub enum #name_id {
+                                /// No field is set (SwitchField 0).
+                                Null,
+                                #(#variants),*
+                            }
+                            impl Default for #name_id {
+                                fn default() -> Self { Self::Null }
+                            }
+                        }
+                    } else {
+                        let fs: Vec<TokenStream> = fields
+                            .iter()
+                            .enumerate()
+                            .map(|(i, f)| {
+                                let fname = ident(&fnames[&i]);
+                                let ty = self.field_type(f);
+                                let d = doc(&field_doc(f));
+                                let original = lit(&f.name);
+                                if f.is_optional {
+                                    quote! { #d #[opcua(optional, rename = #original)] pub #fname: Option<#ty> }
+                                } else {
+                                    quote! { #d #[opcua(rename = #original)] pub #fname: #ty }
+                                }
+                            })
+                            .collect();
+                        quote! {
+                            #docs
+                            #[opcua::types::ua_encodable]
+                            #[derive(Debug, Clone, PartialEq, Default)]
+                            pub struct #name_id { #(#fs),* }
+                        }
+                    };
+                    items.push(body);
+                    // Encoding ids and the type loader.
+                    let enc = |which: &str| info.encodings.iter().find(|(n, _)| n == which).map(|(_, ix)| *ix);
+                    let binary = enc("Default Binary");
+                    let dt_num = numeric(model, t);
+                    let uri = quote! { super::NAMESPACE_URI };
+                    let id_expr = |ix: Option<NodeIx>| -> TokenStream {
+                        match ix.and_then(|ix| numeric(model, ix)).or(dt_num) {
+                            Some(v) => quote! { opcua::types::ExpandedNodeId::from((#v, #uri)) },
+                            None => quote! { opcua::types::ExpandedNodeId::null() },
+                        }
+                    };
+                    let (bin, json, xml, dtid) =
+                        (id_expr(binary), id_expr(enc("Default JSON")), id_expr(enc("Default XML")), id_expr(Some(t)));
+                    items.push(quote! {
+                        impl opcua::types::ExpandedMessageInfo for #name_id {
+                            fn full_type_id(&self) -> opcua::types::ExpandedNodeId { #bin }
+                            fn full_json_type_id(&self) -> opcua::types::ExpandedNodeId { #json }
+                            fn full_xml_type_id(&self) -> opcua::types::ExpandedNodeId { #xml }
+                            fn full_data_type_id(&self) -> opcua::types::ExpandedNodeId { #dtid }
+                        }
+                    });
+                    match (dt_num, binary.and_then(|b| numeric(model, b))) {
+                        (Some(d), Some(b)) => loader.push(quote! {
+                            inst.add_binary_type(#d, #b, opcua::types::binary_decode_to_enc::<#name_id>);
+                        }),
+                        _ => self.diags.push(
+                            Diagnostic::new(
+                                Code::UnsupportedFeature,
+                                format!("structure `{}` has no numeric Default Binary encoding; servers and clients cannot decode it from the wire", n.browse_name.name),
+                            )
+                            .at(n.browse_name_span)
+                            .help("add a `Default Binary` encoding object with a numeric NodeId (HasEncoding, TypeDefinition DataTypeEncodingType)"),
+                        ),
+                    }
+                }
+                _ => {}
+            }
+        }
+        let _ = &runtime;
+        let tokens = quote! {
+            //! Data types of this namespace, encodable with async-opcua.
+            #(#items)*
+
+            static TYPES: std::sync::LazyLock<opcua::types::TypeLoaderInstance> = std::sync::LazyLock::new(|| {
+                #[allow(unused_mut)]
+                let mut inst = opcua::types::TypeLoaderInstance::new();
+                #(#loader)*
+                inst
+            });
+
+            /// Decodes this namespace's structures from the wire: register it with the server
+            /// (`ServerBuilder::with_type_loader`) and clients (`Session::add_type_loader`).
+            pub struct TypeLoader;
+
+            impl opcua::types::StaticTypeLoader for TypeLoader {
+                fn instance() -> &'static opcua::types::TypeLoaderInstance { &TYPES }
+                fn namespace() -> &'static str { super::NAMESPACE_URI }
+            }
+        };
+        self.file("types.rs", "Data types", tokens)
+    }
+
+    // ----- the address space table -----------------------------------------------------------------
+
+    fn id_kind(&self, id: &Identifier) -> TokenStream {
+        let rt = quote! { rt };
+        match id {
+            Identifier::Numeric(v) => {
+                let v = Literal::u32_unsuffixed(*v);
+                quote! { #rt::IdKind::Numeric(#v) }
+            }
+            Identifier::String(s) => {
+                let s = lit(s);
+                quote! { #rt::IdKind::String(#s) }
+            }
+            Identifier::Guid(g) => {
+                let bytes = g.iter().map(|b| Literal::u8_unsuffixed(*b));
+                quote! { #rt::IdKind::Guid([#(#bytes),*]) }
+            }
+            Identifier::Opaque(b) => {
+                let bytes = proc_macro2::Literal::byte_string(b);
+                quote! { #rt::IdKind::Opaque(#bytes) }
+            }
+        }
+    }
+
+    fn nodes_file(&mut self) -> OutFile {
+        let model = self.model;
+        // Table-local namespace indices: 0 is ns0, then every namespace a row refers to, in global order.
+        let mut used: BTreeSet<u16> = BTreeSet::new();
+        used.insert(self.ns);
+        let mine: Vec<NodeIx> =
+            (0..model.nodes.len() as u32).map(NodeIx).filter(|&ix| model.node(ix).id.ns == self.ns).collect();
+        for &ix in &mine {
+            let n = model.node(ix);
+            used.insert(n.browse_name.ns);
+            for r in &n.references {
+                used.insert(model.node(r.reference_type).id.ns);
+                used.insert(model.node(r.target).id.ns);
+            }
+            if let Some(dt) = n.attrs.data_type {
+                used.insert(model.node(dt).id.ns);
+            }
+        }
+        used.remove(&0);
+        let locals: Vec<u16> = std::iter::once(0).chain(used.iter().copied()).collect();
+        let local = |g: u16| locals.iter().position(|&l| l == g).unwrap_or(0) as u16;
+        let rt = quote! { rt };
+        let id_of = |ix: NodeIx| -> TokenStream {
+            let n = model.node(ix);
+            let ns = Literal::u16_unsuffixed(local(n.id.ns));
+            let k = self.id_kind(&n.id.id);
+            quote! { #rt::table::Id { ns: #ns, id: #k } }
+        };
+        let mut rows: Vec<String> = Vec::with_capacity(mine.len());
+        let mut value_fns: Vec<TokenStream> = Vec::new();
+        let mut dropped_values = 0usize;
+        for &ix in &mine {
+            let n = model.node(ix);
+            let id = id_of(ix);
+            let bns = Literal::u16_unsuffixed(local(n.browse_name.ns));
+            let bname = lit(&n.browse_name.name);
+            let dname = lit(n.display());
+            let desc = opt_str(n.doc());
+            let wm = n.attrs.write_mask.unwrap_or(0);
+            let uwm = n.attrs.user_write_mask.unwrap_or(0);
+            let refs: Vec<TokenStream> = n
+                .references
+                .iter()
+                .filter(|r| r.declared)
+                .map(|r| {
+                    let (t, tg, f) = (id_of(r.reference_type), id_of(r.target), r.forward);
+                    quote! { #rt::table::Ref { reference_type: #t, target: #tg, forward: #f } }
+                })
+                .collect();
+            let kind = match n.class {
+                NodeClass::Object => {
+                    let e = n.attrs.event_notifier.unwrap_or(0);
+                    quote! { #rt::table::Kind::Object { event_notifier: #e } }
+                }
+                NodeClass::ObjectType => {
+                    let a = n.is_abstract();
+                    quote! { #rt::table::Kind::ObjectType { is_abstract: #a } }
+                }
+                NodeClass::Variable | NodeClass::VariableType => {
+                    let dt = n.attrs.data_type.map(id_of).unwrap_or_else(|| quote! { #rt::table::Id::ns0(24) });
+                    let vr = n.attrs.value_rank.unwrap_or(-1);
+                    let dims = n.attrs.array_dimensions.iter();
+                    let value = match self.value_tokens(ix, &local, &mut value_fns) {
+                        Some(v) => v,
+                        None => {
+                            dropped_values += 1;
+                            quote! { #rt::table::Val::None }
+                        }
+                    };
+                    if n.class == NodeClass::Variable {
+                        let al = n.attrs.access_level.unwrap_or(1);
+                        let ual = n.attrs.user_access_level.unwrap_or(al);
+                        let h = n.attrs.historizing.unwrap_or(false);
+                        let msi = match n.attrs.minimum_sampling_interval {
+                            Some(v) => quote! { Some(#v) },
+                            None => quote! { None },
+                        };
+                        quote! { #rt::table::Kind::Variable { data_type: #dt, value_rank: #vr, array_dimensions: &[#(#dims),*], access_level: #al, user_access_level: #ual, historizing: #h, minimum_sampling_interval: #msi, value: #value } }
+                    } else {
+                        let a = n.is_abstract();
+                        quote! { #rt::table::Kind::VariableType { data_type: #dt, value_rank: #vr, array_dimensions: &[#(#dims),*], is_abstract: #a, value: #value } }
+                    }
+                }
+                NodeClass::Method => {
+                    let e = n.attrs.executable.unwrap_or(true);
+                    let ue = n.attrs.user_executable.unwrap_or(e);
+                    quote! { #rt::table::Kind::Method { executable: #e, user_executable: #ue } }
+                }
+                NodeClass::ReferenceType => {
+                    let s = n.attrs.symmetric.unwrap_or(false);
+                    let a = n.is_abstract();
+                    let inv = opt_str(n.attrs.inverse_name.first().map(|t| t.text.as_str()));
+                    quote! { #rt::table::Kind::ReferenceType { symmetric: #s, is_abstract: #a, inverse_name: #inv } }
+                }
+                NodeClass::DataType => {
+                    let a = n.is_abstract();
+                    let def = self.definition_tokens(ix, &id_of);
+                    quote! { #rt::table::Kind::DataType { is_abstract: #a, definition: #def } }
+                }
+                NodeClass::View => {
+                    let e = n.attrs.event_notifier.unwrap_or(0);
+                    let c = n.attrs.contains_no_loops.unwrap_or(false);
+                    quote! { #rt::table::Kind::View { event_notifier: #e, contains_no_loops: #c } }
+                }
+            };
+            let row = quote! {
+                #rt::table::NodeRow { id: #id, browse_name: (#bns, #bname), display_name: #dname, description: #desc, write_mask: #wm, user_write_mask: #uwm, kind: #kind, refs: &[#(#refs),*] },
+            };
+            rows.push(compact(&row));
+        }
+        if dropped_values > 0 {
+            self.diags.push(
+                Diagnostic::new(
+                    Code::UnsupportedFeature,
+                    format!("{dropped_values} value(s) of `{}` are structures the generator cannot build yet; those variables start without a value", self.uri()),
+                )
+                .help("Argument and EnumValueType values are supported; other ExtensionObject values are not yet"),
+            );
+        }
+        let uri = lit(self.uri());
+        let m = model.model_of_namespace(self.ns);
+        let version = lit(m.and_then(|m| m.version.as_deref()).unwrap_or(""));
+        let date = lit(m.and_then(|m| m.publication_date.as_deref()).unwrap_or(""));
+        let ns_uris: Vec<Literal> = locals.iter().map(|&g| lit(model.namespace_uri(g))).collect();
+        let own = local(self.ns);
+        // The rows are data: one line per node, printed from the token trees without re-wrapping, so the
+        // table stays compact (the folder's rustfmt.toml keeps rustfmt off it).
+        let runtime = path(&self.cfg.runtime_path);
+        let head = quote! {
+            //! The address space of this namespace as data, imported into a server by the runtime.
+            #[allow(unused_imports)]
+            use super::types;
+            use #runtime as rt;
+            #(#value_fns)*
+        };
+        let head_file: syn::File = syn::parse2(head).expect("internal error: value functions do not parse");
+        let mut text = prettyplease::unparse(&head_file);
+        let table_head = quote! {
+            pub static TABLE: rt::table::NodeSetTable = rt::table::NodeSetTable {
+                namespace_uri: #uri,
+                version: #version,
+                publication_date: #date,
+                namespaces: &[#(#ns_uris),*],
+                own: #own,
+                nodes: &[ ROWS ],
+            };
+        };
+        let table_file: syn::File = syn::parse2(table_head).expect("internal error: table does not parse");
+        let table_text = prettyplease::unparse(&table_file);
+        let rows_text = rows.iter().map(|r| format!("        {r}\n")).collect::<String>();
+        let table_text = table_text.replace("ROWS", &format!("\n{rows_text}    "));
+        text.push('\n');
+        text.push_str("/// Every node of this namespace, one row per node.\n");
+        text.push_str(&table_text);
+        OutFile { path: PathBuf::from(&self.module).join("nodes.rs"), contents: format!("{}{text}", self.header("Address space")) }
+    }
+
+    fn definition_tokens(&self, t: NodeIx, id_of: &dyn Fn(NodeIx) -> TokenStream) -> TokenStream {
+        let model = self.model;
+        let rt = quote! { rt };
+        let Some(info) = model.data_types.get(&t) else { return quote! { None } };
+        match &info.kind {
+            DataTypeKind::Structure { kind, fields, has_definition: true } => {
+                let base = model.node(t).super_type.map(id_of).unwrap_or_else(|| quote! { #rt::table::Id::ns0(22) });
+                let enc = info.encodings.iter().find(|(n, _)| n == "Default Binary").map(|(_, ix)| id_of(*ix));
+                let enc = match enc {
+                    Some(e) => quote! { Some(#e) },
+                    None => quote! { None },
+                };
+                let k = match kind {
+                    StructureKind::Structure => quote! { #rt::table::StructureKind::Structure },
+                    StructureKind::StructureWithOptionalFields => quote! { #rt::table::StructureKind::StructureWithOptionalFields },
+                    StructureKind::Union => quote! { #rt::table::StructureKind::Union },
+                };
+                let fs: Vec<TokenStream> = fields
+                    .iter()
+                    .map(|f| {
+                        let name = lit(&f.name);
+                        let desc = opt_str(f.description.as_deref());
+                        let dt = id_of(f.data_type);
+                        let vr = f.value_rank;
+                        let dims = f.array_dimensions.iter();
+                        let msl = f.max_string_length.unwrap_or(0);
+                        let o = f.is_optional;
+                        quote! { #rt::table::FieldRow { name: #name, description: #desc, data_type: #dt, value_rank: #vr, array_dimensions: &[#(#dims),*], max_string_length: #msl, is_optional: #o } }
+                    })
+                    .collect();
+                quote! { Some(#rt::table::Def::Structure { base: #base, default_encoding: #enc, kind: #k, fields: &[#(#fs),*] }) }
+            }
+            DataTypeKind::Enumeration { values, .. } | DataTypeKind::OptionSet { bits: values, .. } => {
+                let rows = values.iter().map(|v| enum_row(&rt, v));
+                quote! { Some(#rt::table::Def::Enum { fields: &[#(#rows),*] }) }
+            }
+            _ => quote! { None },
+        }
+    }
+
+    /// The table value of a variable or variable type, or `None` if it cannot be expressed.
+    fn value_tokens(&self, ix: NodeIx, local: &dyn Fn(u16) -> u16, _fns: &mut Vec<TokenStream>) -> Option<TokenStream> {
+        let rt = quote! { rt };
+        let v = match self.model.value(ix) {
+            None => return Some(quote! { #rt::table::Val::None }),
+            Some(Ok(v)) => v,
+            Some(Err(_)) => return None,
+        };
+        self.val(&v, local)
+    }
+
+    fn val(&self, v: &Variant, local: &dyn Fn(u16) -> u16) -> Option<TokenStream> {
+        let rt = quote! { rt };
+        let model = self.model;
+        let nid = |id: &crate::nodeid::NodeId| -> TokenStream {
+            let ns = local(id.ns);
+            let k = self.id_kind(&id.id);
+            quote! { #rt::table::Id { ns: #ns, id: #k } }
+        };
+        Some(match v {
+            Variant::Boolean(b) => quote! { #rt::table::Val::Boolean(#b) },
+            Variant::SByte(x) => quote! { #rt::table::Val::SByte(#x) },
+            Variant::Byte(x) => quote! { #rt::table::Val::Byte(#x) },
+            Variant::Int16(x) => quote! { #rt::table::Val::Int16(#x) },
+            Variant::UInt16(x) => quote! { #rt::table::Val::UInt16(#x) },
+            Variant::Int32(x) => quote! { #rt::table::Val::Int32(#x) },
+            Variant::UInt32(x) => quote! { #rt::table::Val::UInt32(#x) },
+            Variant::Int64(x) => quote! { #rt::table::Val::Int64(#x) },
+            Variant::UInt64(x) => quote! { #rt::table::Val::UInt64(#x) },
+            Variant::Float(x) => float_tokens(&rt, f64::from(*x), true)?,
+            Variant::Double(x) => float_tokens(&rt, *x, false)?,
+            Variant::String(s) => {
+                let s = lit(s);
+                quote! { #rt::table::Val::String(#s) }
+            }
+            Variant::DateTime(s) => {
+                let s = lit(s);
+                quote! { #rt::table::Val::DateTime(#s) }
+            }
+            Variant::Guid(g) => {
+                let b = g.iter().map(|x| Literal::u8_unsuffixed(*x));
+                quote! { #rt::table::Val::Guid([#(#b),*]) }
+            }
+            Variant::ByteString(b) => {
+                let b = Literal::byte_string(b);
+                quote! { #rt::table::Val::ByteString(#b) }
+            }
+            Variant::NodeId(id) => {
+                let i = nid(id);
+                quote! { #rt::table::Val::NodeId(#i) }
+            }
+            Variant::ExpandedNodeId(id) => {
+                let i = nid(id);
+                quote! { #rt::table::Val::ExpandedNodeId(#i) }
+            }
+            Variant::StatusCode(c) => quote! { #rt::table::Val::StatusCode(#c) },
+            Variant::QualifiedName(q) => {
+                let ns = local(q.ns);
+                let n = lit(&q.name);
+                quote! { #rt::table::Val::QualifiedName(#ns, #n) }
+            }
+            Variant::LocalizedText(t) => {
+                let loc = opt_str(t.locale.as_deref());
+                let s = lit(&t.text);
+                quote! { #rt::table::Val::LocalizedText(#loc, #s) }
+            }
+            Variant::Array(b, items) => {
+                if *b == BuiltinType::ExtensionObject {
+                    return self.struct_array(items, local);
+                }
+                let items: Option<Vec<TokenStream>> = items.iter().map(|i| self.val(i, local)).collect();
+                let items = items?;
+                let t = b.id();
+                quote! { #rt::table::Val::Array(#t, &[#(#items),*]) }
+            }
+            Variant::ExtensionObject(_) => return self.struct_array(std::slice::from_ref(v), local),
+            Variant::Variant(inner) => return self.val(inner, local),
+            Variant::XmlElement(_) | Variant::Null => return None,
+        })
+        .filter(|_| model.nodes.len() < usize::MAX)
+    }
+
+    /// Arrays of Argument or EnumValueType structures (the ExtensionObject values every nodeset has).
+    fn struct_array(&self, items: &[Variant], local: &dyn Fn(u16) -> u16) -> Option<TokenStream> {
+        let rt = quote! { rt };
+        let model = self.model;
+        let type_of = |v: &Variant| -> Option<u32> {
+            let Variant::ExtensionObject(eo) = v else { return None };
+            let ix = model.lookup(eo.type_id.as_ref()?)?;
+            // The TypeId is usually the encoding node; go to its DataType.
+            let n = model.node(ix);
+            if n.class == NodeClass::DataType {
+                return n.id.ns0();
+            }
+            let has_enc = model.ns0(ids::HAS_ENCODING)?;
+            n.references.iter().find(|r| !r.forward && r.reference_type == has_enc).and_then(|r| model.node(r.target).id.ns0())
+        };
+        let kind = type_of(items.first()?)?;
+        if !items.iter().all(|i| type_of(i) == Some(kind)) {
+            return None;
+        }
+        let bodies: Vec<&crate::raw::XmlElement> = items
+            .iter()
+            .filter_map(|i| match i {
+                Variant::ExtensionObject(eo) => eo.body.as_ref(),
+                _ => None,
+            })
+            .collect();
+        if bodies.len() != items.len() {
+            return None;
+        }
+        match kind {
+            ids::ARGUMENT => {
+                let mut rows = Vec::new();
+                for b in bodies {
+                    let name = lit(b.child_text("Name").unwrap_or("").trim());
+                    let dt_text = b.child("DataType").and_then(|d| d.child_text("Identifier")).unwrap_or("i=24");
+                    let dt = self.map_value_node_id(dt_text)?;
+                    let ns = local(dt.ns);
+                    let k = self.id_kind(&dt.id);
+                    let vr: i32 = b.child_text("ValueRank").and_then(|t| t.trim().parse().ok()).unwrap_or(-1);
+                    let dims: Vec<u32> = b
+                        .child("ArrayDimensions")
+                        .map(|a| a.children.iter().filter_map(|c| c.text.trim().parse().ok()).collect())
+                        .unwrap_or_default();
+                    let desc = opt_str(b.child("Description").and_then(|d| d.child_text("Text")).filter(|t| !t.is_empty()));
+                    rows.push(quote! { #rt::table::ArgRow { name: #name, data_type: #rt::table::Id { ns: #ns, id: #k }, value_rank: #vr, array_dimensions: &[#(#dims),*], description: #desc } });
+                }
+                Some(quote! { #rt::table::Val::Arguments(&[#(#rows),*]) })
+            }
+            ids::ENUM_VALUE_TYPE => {
+                let rows = bodies.iter().map(|b| {
+                    let value: i64 = b.child_text("Value").and_then(|t| t.trim().parse().ok()).unwrap_or(0);
+                    let dn = b.child("DisplayName").and_then(|d| d.child_text("Text")).unwrap_or("");
+                    let desc = opt_str(b.child("Description").and_then(|d| d.child_text("Text")).filter(|t| !t.is_empty()));
+                    let (name, dn) = (lit(dn), lit(dn));
+                    quote! { #rt::table::EnumRow { value: #value, name: #name, display_name: #dn, description: #desc } }
+                });
+                Some(quote! { #rt::table::Val::EnumValues(&[#(#rows),*]) })
+            }
+            _ => None,
+        }
+    }
+
+    /// Maps a NodeId string written inside a value of one of this namespace's files.
+    fn map_value_node_id(&self, text: &str) -> Option<crate::nodeid::NodeId> {
+        let m = self.model.model_of_namespace(self.ns)?;
+        let ctx = self.model.files.get(&m.file)?;
+        self.model.map_node_id(ctx, text).ok()
+    }
+}
+
+/// Prints tokens on one line with the spacing a person would write (`a::b { x: 1, y: &[2] }`), for table
+/// rows. String literals are printed as the tokens hold them, so their content is never touched.
+fn compact(tokens: &TokenStream) -> String {
+    use proc_macro2::{Delimiter, Spacing, TokenTree};
+    fn go(ts: TokenStream, out: &mut String) {
+        let mut prev_word = false;
+        let mut prev_joint_colon = false;
+        for tt in ts {
+            match tt {
+                TokenTree::Ident(i) => {
+                    if prev_word {
+                        out.push(' ');
+                    }
+                    out.push_str(&i.to_string());
+                    prev_word = true;
+                    prev_joint_colon = false;
+                }
+                TokenTree::Literal(l) => {
+                    if prev_word {
+                        out.push(' ');
+                    }
+                    out.push_str(&l.to_string());
+                    prev_word = true;
+                    prev_joint_colon = false;
+                }
+                TokenTree::Punct(p) => {
+                    let c = p.as_char();
+                    match c {
+                        ',' => out.push_str(", "),
+                        ':' if p.spacing() == Spacing::Joint => {
+                            out.push(':');
+                            prev_joint_colon = true;
+                            prev_word = false;
+                            continue;
+                        }
+                        ':' if prev_joint_colon => out.push(':'),
+                        ':' => out.push_str(": "),
+                        other => out.push(other),
+                    }
+                    prev_word = false;
+                    prev_joint_colon = false;
+                }
+                TokenTree::Group(g) => {
+                    let (open, close) = match g.delimiter() {
+                        Delimiter::Brace => (" { ", " }"),
+                        Delimiter::Parenthesis => ("(", ")"),
+                        Delimiter::Bracket => ("[", "]"),
+                        Delimiter::None => ("", ""),
+                    };
+                    if g.delimiter() == Delimiter::Brace && out.ends_with(' ') {
+                        out.pop();
+                    }
+                    out.push_str(open);
+                    let mut inner = String::new();
+                    go(g.stream(), &mut inner);
+                    out.push_str(inner.trim_end_matches(", ").trim_end());
+                    out.push_str(close);
+                    prev_word = false;
+                    prev_joint_colon = false;
+                }
+            }
+        }
+    }
+    let mut out = String::new();
+    go(tokens.clone(), &mut out);
+    out
+}
+
+fn numeric(model: &Model, ix: NodeIx) -> Option<u32> {
+    match model.node(ix).id.id {
+        Identifier::Numeric(v) => Some(v),
+        _ => None,
+    }
+}
+
+fn field_doc(f: &crate::model::Field) -> String {
+    let mut s = format!("`{}`", f.name);
+    if f.value_rank >= 1 {
+        s.push_str(&format!(" (ValueRank {})", f.value_rank));
+    }
+    if let Some(d) = &f.description {
+        s.push_str(": ");
+        s.push_str(d);
+    }
+    s
+}
+
+fn opt_str(s: Option<&str>) -> TokenStream {
+    match s {
+        Some(s) => {
+            let s = lit(s);
+            quote! { Some(#s) }
+        }
+        None => quote! { None },
+    }
+}
+
+fn enum_row(rt: &TokenStream, v: &crate::model::EnumValue) -> TokenStream {
+    let value = v.value;
+    let name = lit(&v.name);
+    let dn = lit(v.display_name.as_deref().unwrap_or(&v.name));
+    let desc = opt_str(v.description.as_deref());
+    quote! { #rt::table::EnumRow { value: #value, name: #name, display_name: #dn, description: #desc } }
+}
+
+fn float_tokens(rt: &TokenStream, x: f64, single: bool) -> Option<TokenStream> {
+    let expr = if x.is_nan() {
+        quote! { f64::NAN }
+    } else if x.is_infinite() {
+        if x > 0.0 { quote! { f64::INFINITY } } else { quote! { f64::NEG_INFINITY } }
+    } else {
+        let l = Literal::f64_suffixed(x);
+        quote! { #l }
+    };
+    Some(if single {
+        let expr = if x.is_finite() {
+            let l = Literal::f32_suffixed(x as f32);
+            quote! { #l }
+        } else {
+            quote! { (#expr) as f32 }
+        };
+        quote! { #rt::table::Val::Float(#expr) }
+    } else {
+        quote! { #rt::table::Val::Double(#expr) }
+    })
+}
+
+fn builtin_type(b: BuiltinType) -> TokenStream {
+    match b {
+        BuiltinType::Boolean => quote! { bool },
+        BuiltinType::SByte => quote! { i8 },
+        BuiltinType::Byte => quote! { u8 },
+        BuiltinType::Int16 => quote! { i16 },
+        BuiltinType::UInt16 => quote! { u16 },
+        BuiltinType::Int32 => quote! { i32 },
+        BuiltinType::UInt32 => quote! { u32 },
+        BuiltinType::Int64 => quote! { i64 },
+        BuiltinType::UInt64 => quote! { u64 },
+        BuiltinType::Float => quote! { f32 },
+        BuiltinType::Double => quote! { f64 },
+        BuiltinType::String => quote! { opcua::types::UAString },
+        BuiltinType::DateTime => quote! { opcua::types::DateTime },
+        BuiltinType::Guid => quote! { opcua::types::Guid },
+        BuiltinType::ByteString => quote! { opcua::types::ByteString },
+        BuiltinType::XmlElement => quote! { opcua::types::XmlElement },
+        BuiltinType::NodeId => quote! { opcua::types::NodeId },
+        BuiltinType::ExpandedNodeId => quote! { opcua::types::ExpandedNodeId },
+        BuiltinType::StatusCode => quote! { opcua::types::StatusCode },
+        BuiltinType::QualifiedName => quote! { opcua::types::QualifiedName },
+        BuiltinType::LocalizedText => quote! { opcua::types::LocalizedText },
+        BuiltinType::ExtensionObject => quote! { opcua::types::ExtensionObject },
+        BuiltinType::DataValue => quote! { opcua::types::DataValue },
+        BuiltinType::Variant => quote! { opcua::types::Variant },
+        BuiltinType::DiagnosticInfo => quote! { opcua::types::DiagnosticInfo },
+    }
+}
+
+/// The `mod.rs` of a folder holding several generated namespaces.
+pub fn models_mod(modules: &[(String, String)], command: &str) -> OutFile {
+    let items: Vec<TokenStream> = modules
+        .iter()
+        .map(|(m, uri)| {
+            let m = ident(m);
+            let d = format!(" `{uri}`");
+            quote! { #[doc = #d] pub mod #m; }
+        })
+        .collect();
+    let file: syn::File = syn::parse2(quote! { #(#items)* }).expect("internal error: models mod.rs");
+    OutFile {
+        path: PathBuf::from("mod.rs"),
+        contents: format!(
+            "// Generated by nodeset-compiler; do not edit. Regenerate with `{command}`.\n\n{}",
+            prettyplease::unparse(&file)
+        ),
+    }
+}
+
+/// The rustfmt configuration that keeps `cargo fmt` off generated files.
+pub fn rustfmt_toml() -> OutFile {
+    OutFile {
+        path: PathBuf::from("rustfmt.toml"),
+        contents: "# Generated code is formatted by nodeset-compiler (prettyplease); rustfmt leaves it alone.\ndisable_all_formatting = true\n".into(),
+    }
+}

@@ -1,0 +1,107 @@
+//! `cargo xtask generate`: regenerates `generated/` from the pinned companion specifications.
+//!
+//! The model is compiled once (ns0, DI, IA and Robotics from `nodesets/vendor/`); each back end returns its
+//! files in memory; only when everything succeeded are the output folders replaced, each atomically
+//! (`write_tree`). `--check` writes nothing and fails when a file is stale.
+
+use crate::util::workspace_root;
+use nodeset_compiler::emit::rust::{self as rust_emit, RustConfig, RustNamespace};
+use nodeset_compiler::load::Input;
+use nodeset_compiler::write::{write_tree, Mode, OutFile};
+use nodeset_compiler::{compile, Options};
+use std::path::PathBuf;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Compare instead of writing; fail if anything is stale.
+    #[arg(long)]
+    check: bool,
+    /// Treat generation warnings as errors.
+    #[arg(long)]
+    deny_warnings: bool,
+}
+
+/// The namespaces of `generated/`: (file in nodesets/vendor, module name).
+pub const NAMESPACES: &[(&str, &str)] = &[
+    ("Opc.Ua.Di.NodeSet2.xml", "di"),
+    ("Opc.Ua.IA.NodeSet2.xml", "ia"),
+    ("Opc.Ua.Robotics.NodeSet2.xml", "robotics"),
+];
+
+pub const COMMAND: &str = "cargo xtask generate";
+
+/// Everything `generate` would write, by output folder.
+pub fn plan(deny_warnings: bool) -> Result<Vec<(PathBuf, Vec<OutFile>)>, String> {
+    let root = workspace_root();
+    let vendor = root.join("nodesets/vendor");
+    let inputs = NAMESPACES.iter().map(|(f, _)| Input::Path(vendor.join(f))).collect();
+    let out = compile(inputs, &Options { model_dirs: vec![vendor.clone()], deny_warnings, ..Options::default() });
+    let rendered = out.render_diagnostics();
+    if !out.ok() {
+        return Err(format!("{rendered}the pinned nodesets do not compile; generated/ is left as it was"));
+    }
+    eprint!("{rendered}");
+    let model = &out.model;
+
+    let mut namespaces = Vec::new();
+    for (file, module) in NAMESPACES {
+        let m = model
+            .models
+            .iter()
+            .find(|m| model.sources.get(m.file).path.file_name().is_some_and(|n| n == *file))
+            .ok_or_else(|| format!("{file} defines no model"))?;
+        namespaces.push(RustNamespace { uri: m.uri.clone(), module: (*module).to_string() });
+    }
+    let cfg = RustConfig {
+        namespaces: namespaces.clone(),
+        extern_paths: Default::default(),
+        runtime_path: "crate::runtime".into(),
+        command: COMMAND.into(),
+    };
+    let mut rust = rust_emit::generate(model, &cfg);
+    let mut diags = rust.diagnostics;
+    if deny_warnings {
+        diags.deny_warnings();
+    }
+    diags.sort(&model.sources);
+    eprint!("{}", diags.render(&model.sources));
+    if diags.has_errors() {
+        return Err("Rust generation failed; generated/ is left as it was".into());
+    }
+    let modules: Vec<(String, String)> = namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
+    rust.files.push(rust_emit::models_mod(&modules, COMMAND));
+    rust.files.push(rust_emit::rustfmt_toml());
+    Ok(vec![(root.join("generated/src/models"), rust.files)])
+}
+
+pub fn run(args: Args) -> Result<(), String> {
+    crate::fetch::ensure_fetched()?;
+    let plan = plan(args.deny_warnings)?;
+    let mode = if args.check { Mode::Check } else { Mode::Write };
+    let mut stale = String::new();
+    for (dir, files) in &plan {
+        let report = write_tree(dir, files, mode)?;
+        let shown = crate::util::display_path(dir);
+        if args.check {
+            if !report.is_clean() {
+                stale.push_str(&report.describe(dir));
+            }
+        } else {
+            println!(
+                "{shown}: {} file(s), {} new, {} changed, {} removed, {} unchanged",
+                files.len(),
+                report.added.len(),
+                report.changed.len(),
+                report.removed.len(),
+                report.unchanged
+            );
+        }
+    }
+    if !stale.is_empty() {
+        return Err(format!("generated/ is stale:\n{stale}run `cargo xtask generate`"));
+    }
+    if args.check {
+        println!("generated/ is up to date");
+    }
+    Ok(())
+}
