@@ -22,6 +22,7 @@
 
 pub mod datatypes;
 pub mod diag;
+pub mod emit;
 pub mod fxhash;
 pub mod load;
 pub mod model;
