@@ -20,6 +20,7 @@
 //! assert!(!out.diagnostics.has_errors());
 //! ```
 
+pub mod build;
 pub mod datatypes;
 pub mod diag;
 pub mod emit;

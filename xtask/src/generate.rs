@@ -105,3 +105,30 @@ pub fn run(args: Args) -> Result<(), String> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// generated/ must be what the compiler produces from the pinned specs today.
+    #[test]
+    fn generated_tree_is_fresh() {
+        crate::fetch::ensure_fetched().expect("the pinned nodesets are needed; run `cargo xtask fetch-nodesets`");
+        let plan = plan(false).expect("generation succeeds");
+        let mut stale = String::new();
+        for (dir, files) in &plan {
+            let report = write_tree(dir, files, Mode::Check).expect("check mode reads only");
+            stale.push_str(&report.describe(dir));
+        }
+        assert!(stale.is_empty(), "generated/ is stale:\n{stale}run `cargo xtask generate`");
+    }
+
+    /// Generation is a pure function of the inputs: twice the same bytes.
+    #[test]
+    fn generation_is_deterministic() {
+        crate::fetch::ensure_fetched().expect("the pinned nodesets are needed");
+        let a = plan(false).expect("generation succeeds");
+        let b = plan(false).expect("generation succeeds");
+        assert_eq!(a, b);
+    }
+}

@@ -1,0 +1,22 @@
+//! Generates every one-feature fixture of tests/fixtures through the build.rs API (bad inputs excepted).
+
+fn main() {
+    let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures");
+    let vendor = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../nodesets/vendor");
+    let mut builder = nodeset_compiler::build::Builder::new().models_dir(&vendor).models_dir(&fixtures);
+    let mut cases: Vec<_> = std::fs::read_dir(&fixtures)
+        .expect("tests/fixtures exists")
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.is_dir() && p.file_name().is_some_and(|n| n != "bad"))
+        .collect();
+    cases.sort();
+    for case in cases {
+        let mut files: Vec<_> = std::fs::read_dir(&case).expect("fixture folder").flatten().map(|e| e.path()).collect();
+        files.sort();
+        for f in files.into_iter().filter(|f| f.extension().is_some_and(|x| x == "xml")) {
+            builder = builder.file(f);
+        }
+    }
+    builder.generate().unwrap_or_else(|e| panic!("{e}"));
+}
