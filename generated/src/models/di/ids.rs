@@ -4,2289 +4,1214 @@
 //! NodeIds of every node of this namespace, resolved against a namespace table at run time.
 /// The Object nodes of this namespace.
 pub mod objects {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `FallbackVersion` (Object).
-    pub const CACHED_LOADING_TYPE_FALLBACK_VERSION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        188u32,
-    );
+    pub const CACHED_LOADING_TYPE_FALLBACK_VERSION: NsNodeId = id(188);
     /// `PendingVersion` (Object).
-    pub const CACHED_LOADING_TYPE_PENDING_VERSION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        187u32,
-    );
+    pub const CACHED_LOADING_TYPE_PENDING_VERSION: NsNodeId = id(187);
     /// `<ObjectIdentifier>` (Object).
-    pub const CONFIGURABLE_OBJECT_TYPE_OBJECT_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6026u32,
-    );
+    pub const CONFIGURABLE_OBJECT_TYPE_OBJECT_IDENTIFIER: NsNodeId = id(6026);
     /// `SupportedTypes` (Object).
-    pub const CONFIGURABLE_OBJECT_TYPE_SUPPORTED_TYPES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5004u32,
-    );
+    pub const CONFIGURABLE_OBJECT_TYPE_SUPPORTED_TYPES: NsNodeId = id(5004);
     /// `Configuration` (Object).
-    pub const CONFIGURATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        73u32,
-    );
+    pub const CONFIGURATION: NsNodeId = id(73);
     /// `NotWaitingForConfirm` (Object).
-    pub const CONFIRMATION_STATE_MACHINE_TYPE_NOT_WAITING_FOR_CONFIRM: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        323u32,
+    pub const CONFIRMATION_STATE_MACHINE_TYPE_NOT_WAITING_FOR_CONFIRM: NsNodeId = id(
+        323,
     );
     /// `NotWaitingForConfirmToWaitingForConfirm` (Object).
-    pub const CONFIRMATION_STATE_MACHINE_TYPE_NOT_WAITING_FOR_CONFIRM_TO_WAITING_FOR_CONFIRM: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        327u32,
+    pub const CONFIRMATION_STATE_MACHINE_TYPE_NOT_WAITING_FOR_CONFIRM_TO_WAITING_FOR_CONFIRM: NsNodeId = id(
+        327,
     );
     /// `WaitingForConfirm` (Object).
-    pub const CONFIRMATION_STATE_MACHINE_TYPE_WAITING_FOR_CONFIRM: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        325u32,
-    );
+    pub const CONFIRMATION_STATE_MACHINE_TYPE_WAITING_FOR_CONFIRM: NsNodeId = id(325);
     /// `WaitingForConfirmToNotWaitingForConfirm` (Object).
-    pub const CONFIRMATION_STATE_MACHINE_TYPE_WAITING_FOR_CONFIRM_TO_NOT_WAITING_FOR_CONFIRM: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        329u32,
+    pub const CONFIRMATION_STATE_MACHINE_TYPE_WAITING_FOR_CONFIRM_TO_NOT_WAITING_FOR_CONFIRM: NsNodeId = id(
+        329,
     );
     /// `NetworkAddress` (Object).
-    pub const CONNECTION_POINT_TYPE_NETWORK_ADDRESS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6354u32,
-    );
+    pub const CONNECTION_POINT_TYPE_NETWORK_ADDRESS: NsNodeId = id(6354);
     /// `<NetworkIdentifier>` (Object).
-    pub const CONNECTION_POINT_TYPE_NETWORK_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6599u32,
-    );
+    pub const CONNECTION_POINT_TYPE_NETWORK_IDENTIFIER: NsNodeId = id(6599);
     /// `<ProfileIdentifier>` (Object).
-    pub const CONNECTION_POINT_TYPE_PROFILE_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6499u32,
-    );
+    pub const CONNECTION_POINT_TYPE_PROFILE_IDENTIFIER: NsNodeId = id(6499);
     /// `DeviceSet` (Object).
-    pub const DEVICE_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5001u32,
-    );
+    pub const DEVICE_SET: NsNodeId = id(5001);
     /// `DeviceFeatures` (Object).
-    pub const DEVICE_SET_DEVICE_FEATURES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15034u32,
-    );
+    pub const DEVICE_SET_DEVICE_FEATURES: NsNodeId = id(15034);
     /// `DeviceTopology` (Object).
-    pub const DEVICE_TOPOLOGY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6094u32,
-    );
+    pub const DEVICE_TOPOLOGY: NsNodeId = id(6094);
     /// `<CPIdentifier>` (Object).
-    pub const DEVICE_TYPE_CP_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6571u32,
-    );
+    pub const DEVICE_TYPE_CP_IDENTIFIER: NsNodeId = id(6571);
     /// `NetworkAddress` (Object).
-    pub const DEVICE_TYPE_CP_IDENTIFIER_NETWORK_ADDRESS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6592u32,
-    );
+    pub const DEVICE_TYPE_CP_IDENTIFIER_NETWORK_ADDRESS: NsNodeId = id(6592);
     /// `DeviceHealthAlarms` (Object).
-    pub const DEVICE_TYPE_DEVICE_HEALTH_ALARMS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15105u32,
-    );
+    pub const DEVICE_TYPE_DEVICE_HEALTH_ALARMS: NsNodeId = id(15105);
     /// `DeviceTypeImage` (Object).
-    pub const DEVICE_TYPE_DEVICE_TYPE_IMAGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6209u32,
-    );
+    pub const DEVICE_TYPE_DEVICE_TYPE_IMAGE: NsNodeId = id(6209);
     /// `Documentation` (Object).
-    pub const DEVICE_TYPE_DOCUMENTATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6211u32,
-    );
+    pub const DEVICE_TYPE_DOCUMENTATION: NsNodeId = id(6211);
     /// `ImageSet` (Object).
-    pub const DEVICE_TYPE_IMAGE_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6215u32,
-    );
+    pub const DEVICE_TYPE_IMAGE_SET: NsNodeId = id(6215);
     /// `ProtocolSupport` (Object).
-    pub const DEVICE_TYPE_PROTOCOL_SUPPORT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6213u32,
-    );
+    pub const DEVICE_TYPE_PROTOCOL_SUPPORT: NsNodeId = id(6213);
     /// `Diagnostics` (Object).
-    pub const DIAGNOSTICS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        90u32,
-    );
+    pub const DIAGNOSTICS: NsNodeId = id(90);
     /// `Default Binary` (Object).
-    pub const FETCH_RESULT_DATA_TYPE_ENCODING_DEFAULT_BINARY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6551u32,
-    );
+    pub const FETCH_RESULT_DATA_TYPE_ENCODING_DEFAULT_BINARY: NsNodeId = id(6551);
     /// `Default JSON` (Object).
-    pub const FETCH_RESULT_DATA_TYPE_ENCODING_DEFAULT_JSON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15909u32,
-    );
+    pub const FETCH_RESULT_DATA_TYPE_ENCODING_DEFAULT_JSON: NsNodeId = id(15909);
     /// `Default XML` (Object).
-    pub const FETCH_RESULT_DATA_TYPE_ENCODING_DEFAULT_XML: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6535u32,
-    );
+    pub const FETCH_RESULT_DATA_TYPE_ENCODING_DEFAULT_XML: NsNodeId = id(6535);
     /// `FileSystem` (Object).
-    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        194u32,
-    );
+    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM: NsNodeId = id(194);
     /// `<GroupIdentifier>` (Object).
-    pub const FUNCTIONAL_GROUP_TYPE_GROUP_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6027u32,
-    );
+    pub const FUNCTIONAL_GROUP_TYPE_GROUP_IDENTIFIER: NsNodeId = id(6027);
     /// `Identification` (Object).
-    pub const IDENTIFICATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        95u32,
-    );
+    pub const IDENTIFICATION: NsNodeId = id(95);
     /// `Error` (Object).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_ERROR: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        275u32,
-    );
+    pub const INSTALLATION_STATE_MACHINE_TYPE_ERROR: NsNodeId = id(275);
     /// `ErrorToIdle` (Object).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_ERROR_TO_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        283u32,
-    );
+    pub const INSTALLATION_STATE_MACHINE_TYPE_ERROR_TO_IDLE: NsNodeId = id(283);
     /// `Idle` (Object).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        271u32,
-    );
+    pub const INSTALLATION_STATE_MACHINE_TYPE_IDLE: NsNodeId = id(271);
     /// `IdleToInstalling` (Object).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_IDLE_TO_INSTALLING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        277u32,
-    );
+    pub const INSTALLATION_STATE_MACHINE_TYPE_IDLE_TO_INSTALLING: NsNodeId = id(277);
     /// `Installing` (Object).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALLING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        273u32,
-    );
+    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALLING: NsNodeId = id(273);
     /// `InstallingToError` (Object).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALLING_TO_ERROR: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        281u32,
-    );
+    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALLING_TO_ERROR: NsNodeId = id(281);
     /// `InstallingToIdle` (Object).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALLING_TO_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        279u32,
-    );
+    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALLING_TO_IDLE: NsNodeId = id(279);
     /// `DeviceHealthAlarms` (Object).
-    pub const I_DEVICE_HEALTH_TYPE_DEVICE_HEALTH_ALARMS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15053u32,
-    );
+    pub const I_DEVICE_HEALTH_TYPE_DEVICE_HEALTH_ALARMS: NsNodeId = id(15053);
     /// `DeviceTypeImage` (Object).
-    pub const I_SUPPORT_INFO_TYPE_DEVICE_TYPE_IMAGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15055u32,
-    );
+    pub const I_SUPPORT_INFO_TYPE_DEVICE_TYPE_IMAGE: NsNodeId = id(15055);
     /// `Documentation` (Object).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15057u32,
-    );
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION: NsNodeId = id(15057);
     /// `DocumentationFiles` (Object).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        27u32,
-    );
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES: NsNodeId = id(27);
     /// `<DocumentFileId>` (Object).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        28u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID: NsNodeId = id(
+        28,
     );
     /// `ImageSet` (Object).
-    pub const I_SUPPORT_INFO_TYPE_IMAGE_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15061u32,
-    );
+    pub const I_SUPPORT_INFO_TYPE_IMAGE_SET: NsNodeId = id(15061);
     /// `ProtocolSupport` (Object).
-    pub const I_SUPPORT_INFO_TYPE_PROTOCOL_SUPPORT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15059u32,
-    );
+    pub const I_SUPPORT_INFO_TYPE_PROTOCOL_SUPPORT: NsNodeId = id(15059);
     /// `Maintenance` (Object).
-    pub const MAINTENANCE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        75u32,
-    );
+    pub const MAINTENANCE: NsNodeId = id(75);
     /// `NetworkSet` (Object).
-    pub const NETWORK_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6078u32,
-    );
+    pub const NETWORK_SET: NsNodeId = id(6078);
     /// `<CPIdentifier>` (Object).
-    pub const NETWORK_TYPE_CP_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6248u32,
-    );
+    pub const NETWORK_TYPE_CP_IDENTIFIER: NsNodeId = id(6248);
     /// `NetworkAddress` (Object).
-    pub const NETWORK_TYPE_CP_IDENTIFIER_NETWORK_ADDRESS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6292u32,
-    );
+    pub const NETWORK_TYPE_CP_IDENTIFIER_NETWORK_ADDRESS: NsNodeId = id(6292);
     /// `Lock` (Object).
-    pub const NETWORK_TYPE_LOCK: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6294u32,
-    );
+    pub const NETWORK_TYPE_LOCK: NsNodeId = id(6294);
     /// `<ProfileIdentifier>` (Object).
-    pub const NETWORK_TYPE_PROFILE_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6596u32,
-    );
+    pub const NETWORK_TYPE_PROFILE_IDENTIFIER: NsNodeId = id(6596);
     /// `http://opcfoundation.org/UA/DI/` (Object).
-    pub const OPCUADI_NAMESPACE_METADATA: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15001u32,
-    );
+    pub const OPCUADI_NAMESPACE_METADATA: NsNodeId = id(15001);
     /// `Operational` (Object).
-    pub const OPERATIONAL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        93u32,
-    );
+    pub const OPERATIONAL: NsNodeId = id(93);
     /// `OperationCounters` (Object).
-    pub const OPERATION_COUNTERS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        94u32,
-    );
+    pub const OPERATION_COUNTERS: NsNodeId = id(94);
     /// `CurrentVersion` (Object).
-    pub const PACKAGE_LOADING_TYPE_CURRENT_VERSION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        139u32,
-    );
+    pub const PACKAGE_LOADING_TYPE_CURRENT_VERSION: NsNodeId = id(139);
     /// `FileTransfer` (Object).
-    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        140u32,
-    );
+    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER: NsNodeId = id(140);
     /// `Default Binary` (Object).
-    pub const PARAMETER_RESULT_DATA_TYPE_ENCODING_DEFAULT_BINARY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6554u32,
-    );
+    pub const PARAMETER_RESULT_DATA_TYPE_ENCODING_DEFAULT_BINARY: NsNodeId = id(6554);
     /// `Default JSON` (Object).
-    pub const PARAMETER_RESULT_DATA_TYPE_ENCODING_DEFAULT_JSON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15912u32,
-    );
+    pub const PARAMETER_RESULT_DATA_TYPE_ENCODING_DEFAULT_JSON: NsNodeId = id(15912);
     /// `Default XML` (Object).
-    pub const PARAMETER_RESULT_DATA_TYPE_ENCODING_DEFAULT_XML: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6538u32,
-    );
+    pub const PARAMETER_RESULT_DATA_TYPE_ENCODING_DEFAULT_XML: NsNodeId = id(6538);
     /// `NotWaitingForPowerCycle` (Object).
-    pub const POWER_CYCLE_STATE_MACHINE_TYPE_NOT_WAITING_FOR_POWER_CYCLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        299u32,
+    pub const POWER_CYCLE_STATE_MACHINE_TYPE_NOT_WAITING_FOR_POWER_CYCLE: NsNodeId = id(
+        299,
     );
     /// `NotWaitingForPowerCycleToWaitingForPowerCycle` (Object).
-    pub const POWER_CYCLE_STATE_MACHINE_TYPE_NOT_WAITING_FOR_POWER_CYCLE_TO_WAITING_FOR_POWER_CYCLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        303u32,
+    pub const POWER_CYCLE_STATE_MACHINE_TYPE_NOT_WAITING_FOR_POWER_CYCLE_TO_WAITING_FOR_POWER_CYCLE: NsNodeId = id(
+        303,
     );
     /// `WaitingForPowerCycle` (Object).
-    pub const POWER_CYCLE_STATE_MACHINE_TYPE_WAITING_FOR_POWER_CYCLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        301u32,
-    );
+    pub const POWER_CYCLE_STATE_MACHINE_TYPE_WAITING_FOR_POWER_CYCLE: NsNodeId = id(301);
     /// `WaitingForPowerCycleToNotWaitingForPowerCycle` (Object).
-    pub const POWER_CYCLE_STATE_MACHINE_TYPE_WAITING_FOR_POWER_CYCLE_TO_NOT_WAITING_FOR_POWER_CYCLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        305u32,
+    pub const POWER_CYCLE_STATE_MACHINE_TYPE_WAITING_FOR_POWER_CYCLE_TO_NOT_WAITING_FOR_POWER_CYCLE: NsNodeId = id(
+        305,
     );
     /// `Idle` (Object).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        231u32,
-    );
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_IDLE: NsNodeId = id(231);
     /// `IdleToPreparing` (Object).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_IDLE_TO_PREPARING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        239u32,
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_IDLE_TO_PREPARING: NsNodeId = id(
+        239,
     );
     /// `PreparedForUpdate` (Object).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARED_FOR_UPDATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        235u32,
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARED_FOR_UPDATE: NsNodeId = id(
+        235,
     );
     /// `PreparedForUpdateToResuming` (Object).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARED_FOR_UPDATE_TO_RESUMING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        245u32,
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARED_FOR_UPDATE_TO_RESUMING: NsNodeId = id(
+        245,
     );
     /// `Preparing` (Object).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        233u32,
-    );
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARING: NsNodeId = id(233);
     /// `PreparingToIdle` (Object).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARING_TO_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        241u32,
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARING_TO_IDLE: NsNodeId = id(
+        241,
     );
     /// `PreparingToPreparedForUpdate` (Object).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARING_TO_PREPARED_FOR_UPDATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        243u32,
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARING_TO_PREPARED_FOR_UPDATE: NsNodeId = id(
+        243,
     );
     /// `Resuming` (Object).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_RESUMING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        237u32,
-    );
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_RESUMING: NsNodeId = id(237);
     /// `ResumingToIdle` (Object).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_RESUMING_TO_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        247u32,
-    );
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_RESUMING_TO_IDLE: NsNodeId = id(247);
     /// `Confirmation` (Object).
-    pub const SOFTWARE_UPDATE_TYPE_CONFIRMATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        98u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_CONFIRMATION: NsNodeId = id(98);
     /// `Installation` (Object).
-    pub const SOFTWARE_UPDATE_TYPE_INSTALLATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        40u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_INSTALLATION: NsNodeId = id(40);
     /// `Loading` (Object).
-    pub const SOFTWARE_UPDATE_TYPE_LOADING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        2u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_LOADING: NsNodeId = id(2);
     /// `Parameters` (Object).
-    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        122u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS: NsNodeId = id(122);
     /// `PowerCycle` (Object).
-    pub const SOFTWARE_UPDATE_TYPE_POWER_CYCLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        76u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_POWER_CYCLE: NsNodeId = id(76);
     /// `PrepareForUpdate` (Object).
-    pub const SOFTWARE_UPDATE_TYPE_PREPARE_FOR_UPDATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        4u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_PREPARE_FOR_UPDATE: NsNodeId = id(4);
     /// `Statistics` (Object).
-    pub const STATISTICS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        91u32,
-    );
+    pub const STATISTICS: NsNodeId = id(91);
     /// `Status` (Object).
-    pub const STATUS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        92u32,
-    );
+    pub const STATUS: NsNodeId = id(92);
     /// `<GroupIdentifier>` (Object).
-    pub const TOPOLOGY_ELEMENT_TYPE_GROUP_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6567u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_GROUP_IDENTIFIER: NsNodeId = id(6567);
     /// `Identification` (Object).
-    pub const TOPOLOGY_ELEMENT_TYPE_IDENTIFICATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6014u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_IDENTIFICATION: NsNodeId = id(6014);
     /// `Lock` (Object).
-    pub const TOPOLOGY_ELEMENT_TYPE_LOCK: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6161u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_LOCK: NsNodeId = id(6161);
     /// `MethodSet` (Object).
-    pub const TOPOLOGY_ELEMENT_TYPE_METHOD_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5003u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_METHOD_SET: NsNodeId = id(5003);
     /// `ParameterSet` (Object).
-    pub const TOPOLOGY_ELEMENT_TYPE_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5002u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_PARAMETER_SET: NsNodeId = id(5002);
     /// `Default Binary` (Object).
-    pub const TRANSFER_RESULT_DATA_DATA_TYPE_ENCODING_DEFAULT_BINARY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15892u32,
+    pub const TRANSFER_RESULT_DATA_DATA_TYPE_ENCODING_DEFAULT_BINARY: NsNodeId = id(
+        15892,
     );
     /// `Default JSON` (Object).
-    pub const TRANSFER_RESULT_DATA_DATA_TYPE_ENCODING_DEFAULT_JSON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15911u32,
-    );
+    pub const TRANSFER_RESULT_DATA_DATA_TYPE_ENCODING_DEFAULT_JSON: NsNodeId = id(15911);
     /// `Default XML` (Object).
-    pub const TRANSFER_RESULT_DATA_DATA_TYPE_ENCODING_DEFAULT_XML: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15901u32,
-    );
+    pub const TRANSFER_RESULT_DATA_DATA_TYPE_ENCODING_DEFAULT_XML: NsNodeId = id(15901);
     /// `Default Binary` (Object).
-    pub const TRANSFER_RESULT_ERROR_DATA_TYPE_ENCODING_DEFAULT_BINARY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15891u32,
+    pub const TRANSFER_RESULT_ERROR_DATA_TYPE_ENCODING_DEFAULT_BINARY: NsNodeId = id(
+        15891,
     );
     /// `Default JSON` (Object).
-    pub const TRANSFER_RESULT_ERROR_DATA_TYPE_ENCODING_DEFAULT_JSON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15910u32,
+    pub const TRANSFER_RESULT_ERROR_DATA_TYPE_ENCODING_DEFAULT_JSON: NsNodeId = id(
+        15910,
     );
     /// `Default XML` (Object).
-    pub const TRANSFER_RESULT_ERROR_DATA_TYPE_ENCODING_DEFAULT_XML: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15900u32,
-    );
+    pub const TRANSFER_RESULT_ERROR_DATA_TYPE_ENCODING_DEFAULT_XML: NsNodeId = id(15900);
     /// `Tuning` (Object).
-    pub const TUNING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        74u32,
-    );
+    pub const TUNING: NsNodeId = id(74);
 }
 /// The Variable nodes of this namespace.
 pub mod variables {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `ActualMode` (Variable).
-    pub const BLOCK_TYPE_ACTUAL_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6010u32,
-    );
+    pub const BLOCK_TYPE_ACTUAL_MODE: NsNodeId = id(6010);
     /// `NormalMode` (Variable).
-    pub const BLOCK_TYPE_NORMAL_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6012u32,
-    );
+    pub const BLOCK_TYPE_NORMAL_MODE: NsNodeId = id(6012);
     /// `PermittedMode` (Variable).
-    pub const BLOCK_TYPE_PERMITTED_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6011u32,
-    );
+    pub const BLOCK_TYPE_PERMITTED_MODE: NsNodeId = id(6011);
     /// `RevisionCounter` (Variable).
-    pub const BLOCK_TYPE_REVISION_COUNTER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6009u32,
-    );
+    pub const BLOCK_TYPE_REVISION_COUNTER: NsNodeId = id(6009);
     /// `TargetMode` (Variable).
-    pub const BLOCK_TYPE_TARGET_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6013u32,
-    );
+    pub const BLOCK_TYPE_TARGET_MODE: NsNodeId = id(6013);
     /// `Manufacturer` (Variable).
-    pub const CACHED_LOADING_TYPE_FALLBACK_VERSION_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        373u32,
-    );
+    pub const CACHED_LOADING_TYPE_FALLBACK_VERSION_MANUFACTURER: NsNodeId = id(373);
     /// `ManufacturerUri` (Variable).
-    pub const CACHED_LOADING_TYPE_FALLBACK_VERSION_MANUFACTURER_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        374u32,
-    );
+    pub const CACHED_LOADING_TYPE_FALLBACK_VERSION_MANUFACTURER_URI: NsNodeId = id(374);
     /// `SoftwareRevision` (Variable).
-    pub const CACHED_LOADING_TYPE_FALLBACK_VERSION_SOFTWARE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        375u32,
-    );
+    pub const CACHED_LOADING_TYPE_FALLBACK_VERSION_SOFTWARE_REVISION: NsNodeId = id(375);
     /// `InputArguments` (Variable).
-    pub const CACHED_LOADING_TYPE_GET_UPDATE_BEHAVIOR_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        190u32,
+    pub const CACHED_LOADING_TYPE_GET_UPDATE_BEHAVIOR_INPUT_ARGUMENTS: NsNodeId = id(
+        190,
     );
     /// `OutputArguments` (Variable).
-    pub const CACHED_LOADING_TYPE_GET_UPDATE_BEHAVIOR_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        191u32,
+    pub const CACHED_LOADING_TYPE_GET_UPDATE_BEHAVIOR_OUTPUT_ARGUMENTS: NsNodeId = id(
+        191,
     );
     /// `Manufacturer` (Variable).
-    pub const CACHED_LOADING_TYPE_PENDING_VERSION_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        366u32,
-    );
+    pub const CACHED_LOADING_TYPE_PENDING_VERSION_MANUFACTURER: NsNodeId = id(366);
     /// `ManufacturerUri` (Variable).
-    pub const CACHED_LOADING_TYPE_PENDING_VERSION_MANUFACTURER_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        367u32,
-    );
+    pub const CACHED_LOADING_TYPE_PENDING_VERSION_MANUFACTURER_URI: NsNodeId = id(367);
     /// `SoftwareRevision` (Variable).
-    pub const CACHED_LOADING_TYPE_PENDING_VERSION_SOFTWARE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        368u32,
-    );
+    pub const CACHED_LOADING_TYPE_PENDING_VERSION_SOFTWARE_REVISION: NsNodeId = id(368);
     /// `AssetId` (Variable).
-    pub const COMPONENT_TYPE_ASSET_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15098u32,
-    );
+    pub const COMPONENT_TYPE_ASSET_ID: NsNodeId = id(15098);
     /// `ComponentName` (Variable).
-    pub const COMPONENT_TYPE_COMPONENT_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15099u32,
-    );
+    pub const COMPONENT_TYPE_COMPONENT_NAME: NsNodeId = id(15099);
     /// `DeviceClass` (Variable).
-    pub const COMPONENT_TYPE_DEVICE_CLASS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15094u32,
-    );
+    pub const COMPONENT_TYPE_DEVICE_CLASS: NsNodeId = id(15094);
     /// `DeviceManual` (Variable).
-    pub const COMPONENT_TYPE_DEVICE_MANUAL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15093u32,
-    );
+    pub const COMPONENT_TYPE_DEVICE_MANUAL: NsNodeId = id(15093);
     /// `DeviceRevision` (Variable).
-    pub const COMPONENT_TYPE_DEVICE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15091u32,
-    );
+    pub const COMPONENT_TYPE_DEVICE_REVISION: NsNodeId = id(15091);
     /// `HardwareRevision` (Variable).
-    pub const COMPONENT_TYPE_HARDWARE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15089u32,
-    );
+    pub const COMPONENT_TYPE_HARDWARE_REVISION: NsNodeId = id(15089);
     /// `Manufacturer` (Variable).
-    pub const COMPONENT_TYPE_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15086u32,
-    );
+    pub const COMPONENT_TYPE_MANUFACTURER: NsNodeId = id(15086);
     /// `ManufacturerUri` (Variable).
-    pub const COMPONENT_TYPE_MANUFACTURER_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15087u32,
-    );
+    pub const COMPONENT_TYPE_MANUFACTURER_URI: NsNodeId = id(15087);
     /// `Model` (Variable).
-    pub const COMPONENT_TYPE_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15088u32,
-    );
+    pub const COMPONENT_TYPE_MODEL: NsNodeId = id(15088);
     /// `ProductCode` (Variable).
-    pub const COMPONENT_TYPE_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15092u32,
-    );
+    pub const COMPONENT_TYPE_PRODUCT_CODE: NsNodeId = id(15092);
     /// `ProductInstanceUri` (Variable).
-    pub const COMPONENT_TYPE_PRODUCT_INSTANCE_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15096u32,
-    );
+    pub const COMPONENT_TYPE_PRODUCT_INSTANCE_URI: NsNodeId = id(15096);
     /// `RevisionCounter` (Variable).
-    pub const COMPONENT_TYPE_REVISION_COUNTER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15097u32,
-    );
+    pub const COMPONENT_TYPE_REVISION_COUNTER: NsNodeId = id(15097);
     /// `SerialNumber` (Variable).
-    pub const COMPONENT_TYPE_SERIAL_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15095u32,
-    );
+    pub const COMPONENT_TYPE_SERIAL_NUMBER: NsNodeId = id(15095);
     /// `SoftwareRevision` (Variable).
-    pub const COMPONENT_TYPE_SOFTWARE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15090u32,
-    );
+    pub const COMPONENT_TYPE_SOFTWARE_REVISION: NsNodeId = id(15090);
     /// `ConfirmationTimeout` (Variable).
-    pub const CONFIRMATION_STATE_MACHINE_TYPE_CONFIRMATION_TIMEOUT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        322u32,
-    );
+    pub const CONFIRMATION_STATE_MACHINE_TYPE_CONFIRMATION_TIMEOUT: NsNodeId = id(322);
     /// `StateNumber` (Variable).
-    pub const CONFIRMATION_STATE_MACHINE_TYPE_NOT_WAITING_FOR_CONFIRM_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        324u32,
+    pub const CONFIRMATION_STATE_MACHINE_TYPE_NOT_WAITING_FOR_CONFIRM_STATE_NUMBER: NsNodeId = id(
+        324,
     );
     /// `TransitionNumber` (Variable).
-    pub const CONFIRMATION_STATE_MACHINE_TYPE_NOT_WAITING_FOR_CONFIRM_TO_WAITING_FOR_CONFIRM_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        328u32,
+    pub const CONFIRMATION_STATE_MACHINE_TYPE_NOT_WAITING_FOR_CONFIRM_TO_WAITING_FOR_CONFIRM_TRANSITION_NUMBER: NsNodeId = id(
+        328,
     );
     /// `StateNumber` (Variable).
-    pub const CONFIRMATION_STATE_MACHINE_TYPE_WAITING_FOR_CONFIRM_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        326u32,
+    pub const CONFIRMATION_STATE_MACHINE_TYPE_WAITING_FOR_CONFIRM_STATE_NUMBER: NsNodeId = id(
+        326,
     );
     /// `TransitionNumber` (Variable).
-    pub const CONFIRMATION_STATE_MACHINE_TYPE_WAITING_FOR_CONFIRM_TO_NOT_WAITING_FOR_CONFIRM_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        330u32,
+    pub const CONFIRMATION_STATE_MACHINE_TYPE_WAITING_FOR_CONFIRM_TO_NOT_WAITING_FOR_CONFIRM_TRANSITION_NUMBER: NsNodeId = id(
+        330,
     );
     /// `EnumStrings` (Variable).
-    pub const DEVICE_HEALTH_ENUMERATION_ENUM_STRINGS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6450u32,
-    );
+    pub const DEVICE_HEALTH_ENUMERATION_ENUM_STRINGS: NsNodeId = id(6450);
     /// `OnlineAccess` (Variable).
-    pub const DEVICE_TOPOLOGY_ONLINE_ACCESS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6095u32,
-    );
+    pub const DEVICE_TOPOLOGY_ONLINE_ACCESS: NsNodeId = id(6095);
     /// `DeviceClass` (Variable).
-    pub const DEVICE_TYPE_DEVICE_CLASS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6470u32,
-    );
+    pub const DEVICE_TYPE_DEVICE_CLASS: NsNodeId = id(6470);
     /// `DeviceHealth` (Variable).
-    pub const DEVICE_TYPE_DEVICE_HEALTH: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6208u32,
-    );
+    pub const DEVICE_TYPE_DEVICE_HEALTH: NsNodeId = id(6208);
     /// `DeviceManual` (Variable).
-    pub const DEVICE_TYPE_DEVICE_MANUAL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6005u32,
-    );
+    pub const DEVICE_TYPE_DEVICE_MANUAL: NsNodeId = id(6005);
     /// `DeviceRevision` (Variable).
-    pub const DEVICE_TYPE_DEVICE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6006u32,
-    );
+    pub const DEVICE_TYPE_DEVICE_REVISION: NsNodeId = id(6006);
     /// `<ImageIdentifier>` (Variable).
-    pub const DEVICE_TYPE_DEVICE_TYPE_IMAGE_IMAGE_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6210u32,
-    );
+    pub const DEVICE_TYPE_DEVICE_TYPE_IMAGE_IMAGE_IDENTIFIER: NsNodeId = id(6210);
     /// `<DocumentIdentifier>` (Variable).
-    pub const DEVICE_TYPE_DOCUMENTATION_DOCUMENT_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6212u32,
-    );
+    pub const DEVICE_TYPE_DOCUMENTATION_DOCUMENT_IDENTIFIER: NsNodeId = id(6212);
     /// `HardwareRevision` (Variable).
-    pub const DEVICE_TYPE_HARDWARE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6008u32,
-    );
+    pub const DEVICE_TYPE_HARDWARE_REVISION: NsNodeId = id(6008);
     /// `<ImageIdentifier>` (Variable).
-    pub const DEVICE_TYPE_IMAGE_SET_IMAGE_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6216u32,
-    );
+    pub const DEVICE_TYPE_IMAGE_SET_IMAGE_IDENTIFIER: NsNodeId = id(6216);
     /// `Manufacturer` (Variable).
-    pub const DEVICE_TYPE_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6003u32,
-    );
+    pub const DEVICE_TYPE_MANUFACTURER: NsNodeId = id(6003);
     /// `ManufacturerUri` (Variable).
-    pub const DEVICE_TYPE_MANUFACTURER_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15100u32,
-    );
+    pub const DEVICE_TYPE_MANUFACTURER_URI: NsNodeId = id(15100);
     /// `Model` (Variable).
-    pub const DEVICE_TYPE_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6004u32,
-    );
+    pub const DEVICE_TYPE_MODEL: NsNodeId = id(6004);
     /// `ProductCode` (Variable).
-    pub const DEVICE_TYPE_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15101u32,
-    );
+    pub const DEVICE_TYPE_PRODUCT_CODE: NsNodeId = id(15101);
     /// `ProductInstanceUri` (Variable).
-    pub const DEVICE_TYPE_PRODUCT_INSTANCE_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15102u32,
-    );
+    pub const DEVICE_TYPE_PRODUCT_INSTANCE_URI: NsNodeId = id(15102);
     /// `<ProtocolSupportIdentifier>` (Variable).
-    pub const DEVICE_TYPE_PROTOCOL_SUPPORT_PROTOCOL_SUPPORT_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6214u32,
+    pub const DEVICE_TYPE_PROTOCOL_SUPPORT_PROTOCOL_SUPPORT_IDENTIFIER: NsNodeId = id(
+        6214,
     );
     /// `RevisionCounter` (Variable).
-    pub const DEVICE_TYPE_REVISION_COUNTER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6002u32,
-    );
+    pub const DEVICE_TYPE_REVISION_COUNTER: NsNodeId = id(6002);
     /// `SerialNumber` (Variable).
-    pub const DEVICE_TYPE_SERIAL_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6001u32,
-    );
+    pub const DEVICE_TYPE_SERIAL_NUMBER: NsNodeId = id(6001);
     /// `SoftwareRevision` (Variable).
-    pub const DEVICE_TYPE_SOFTWARE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6007u32,
-    );
+    pub const DEVICE_TYPE_SOFTWARE_REVISION: NsNodeId = id(6007);
     /// `UpdateBehavior` (Variable).
-    pub const DIRECT_LOADING_TYPE_UPDATE_BEHAVIOR: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        169u32,
-    );
+    pub const DIRECT_LOADING_TYPE_UPDATE_BEHAVIOR: NsNodeId = id(169);
     /// `WriteTimeout` (Variable).
-    pub const DIRECT_LOADING_TYPE_WRITE_TIMEOUT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        170u32,
-    );
+    pub const DIRECT_LOADING_TYPE_WRITE_TIMEOUT: NsNodeId = id(170);
     /// `InputArguments` (Variable).
-    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_CREATE_DIRECTORY_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        196u32,
+    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_CREATE_DIRECTORY_INPUT_ARGUMENTS: NsNodeId = id(
+        196,
     );
     /// `OutputArguments` (Variable).
-    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_CREATE_DIRECTORY_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        197u32,
+    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_CREATE_DIRECTORY_OUTPUT_ARGUMENTS: NsNodeId = id(
+        197,
     );
     /// `InputArguments` (Variable).
-    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_CREATE_FILE_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        199u32,
+    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_CREATE_FILE_INPUT_ARGUMENTS: NsNodeId = id(
+        199,
     );
     /// `OutputArguments` (Variable).
-    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_CREATE_FILE_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        200u32,
+    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_CREATE_FILE_OUTPUT_ARGUMENTS: NsNodeId = id(
+        200,
     );
     /// `InputArguments` (Variable).
-    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_DELETE_FILE_SYSTEM_OBJECT_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        202u32,
+    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_DELETE_FILE_SYSTEM_OBJECT_INPUT_ARGUMENTS: NsNodeId = id(
+        202,
     );
     /// `InputArguments` (Variable).
-    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_MOVE_OR_COPY_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        204u32,
+    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_MOVE_OR_COPY_INPUT_ARGUMENTS: NsNodeId = id(
+        204,
     );
     /// `OutputArguments` (Variable).
-    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_MOVE_OR_COPY_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        205u32,
+    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_MOVE_OR_COPY_OUTPUT_ARGUMENTS: NsNodeId = id(
+        205,
     );
     /// `InputArguments` (Variable).
-    pub const FILE_SYSTEM_LOADING_TYPE_GET_UPDATE_BEHAVIOR_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        207u32,
+    pub const FILE_SYSTEM_LOADING_TYPE_GET_UPDATE_BEHAVIOR_INPUT_ARGUMENTS: NsNodeId = id(
+        207,
     );
     /// `OutputArguments` (Variable).
-    pub const FILE_SYSTEM_LOADING_TYPE_GET_UPDATE_BEHAVIOR_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        208u32,
+    pub const FILE_SYSTEM_LOADING_TYPE_GET_UPDATE_BEHAVIOR_OUTPUT_ARGUMENTS: NsNodeId = id(
+        208,
     );
     /// `InputArguments` (Variable).
-    pub const FILE_SYSTEM_LOADING_TYPE_VALIDATE_FILES_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        210u32,
+    pub const FILE_SYSTEM_LOADING_TYPE_VALIDATE_FILES_INPUT_ARGUMENTS: NsNodeId = id(
+        210,
     );
     /// `OutputArguments` (Variable).
-    pub const FILE_SYSTEM_LOADING_TYPE_VALIDATE_FILES_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        211u32,
+    pub const FILE_SYSTEM_LOADING_TYPE_VALIDATE_FILES_OUTPUT_ARGUMENTS: NsNodeId = id(
+        211,
     );
     /// `UIElement` (Variable).
-    pub const FUNCTIONAL_GROUP_TYPE_GROUP_IDENTIFIER_UI_ELEMENT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6242u32,
-    );
+    pub const FUNCTIONAL_GROUP_TYPE_GROUP_IDENTIFIER_UI_ELEMENT: NsNodeId = id(6242);
     /// `UIElement` (Variable).
-    pub const FUNCTIONAL_GROUP_TYPE_UI_ELEMENT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6243u32,
+    pub const FUNCTIONAL_GROUP_TYPE_UI_ELEMENT: NsNodeId = id(6243);
+    /// `StateNumber` (Variable).
+    pub const INSTALLATION_STATE_MACHINE_TYPE_ERROR_STATE_NUMBER: NsNodeId = id(276);
+    /// `TransitionNumber` (Variable).
+    pub const INSTALLATION_STATE_MACHINE_TYPE_ERROR_TO_IDLE_TRANSITION_NUMBER: NsNodeId = id(
+        284,
     );
     /// `StateNumber` (Variable).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_ERROR_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        276u32,
-    );
+    pub const INSTALLATION_STATE_MACHINE_TYPE_IDLE_STATE_NUMBER: NsNodeId = id(272);
     /// `TransitionNumber` (Variable).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_ERROR_TO_IDLE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        284u32,
-    );
-    /// `StateNumber` (Variable).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_IDLE_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        272u32,
-    );
-    /// `TransitionNumber` (Variable).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_IDLE_TO_INSTALLING_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        387u32,
+    pub const INSTALLATION_STATE_MACHINE_TYPE_IDLE_TO_INSTALLING_TRANSITION_NUMBER: NsNodeId = id(
+        387,
     );
     /// `InstallationDelay` (Variable).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALLATION_DELAY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        264u32,
-    );
+    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALLATION_DELAY: NsNodeId = id(264);
     /// `StateNumber` (Variable).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALLING_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        274u32,
+    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALLING_STATE_NUMBER: NsNodeId = id(
+        274,
     );
     /// `TransitionNumber` (Variable).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALLING_TO_ERROR_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        282u32,
+    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALLING_TO_ERROR_TRANSITION_NUMBER: NsNodeId = id(
+        282,
     );
     /// `TransitionNumber` (Variable).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALLING_TO_IDLE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        280u32,
+    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALLING_TO_IDLE_TRANSITION_NUMBER: NsNodeId = id(
+        280,
     );
     /// `InputArguments` (Variable).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALL_FILES_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        269u32,
+    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALL_FILES_INPUT_ARGUMENTS: NsNodeId = id(
+        269,
     );
     /// `InputArguments` (Variable).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALL_SOFTWARE_PACKAGE_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        266u32,
+    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALL_SOFTWARE_PACKAGE_INPUT_ARGUMENTS: NsNodeId = id(
+        266,
     );
     /// `PercentComplete` (Variable).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_PERCENT_COMPLETE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        263u32,
-    );
+    pub const INSTALLATION_STATE_MACHINE_TYPE_PERCENT_COMPLETE: NsNodeId = id(263);
     /// `IsIndicating` (Variable).
-    pub const I_ASSET_LOCATION_INDICATION_TYPE_IS_INDICATING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        154u32,
-    );
+    pub const I_ASSET_LOCATION_INDICATION_TYPE_IS_INDICATING: NsNodeId = id(154);
     /// `InputArguments` (Variable).
-    pub const I_ASSET_LOCATION_INDICATION_TYPE_START_LOCATION_INDICATION_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        413u32,
+    pub const I_ASSET_LOCATION_INDICATION_TYPE_START_LOCATION_INDICATION_INPUT_ARGUMENTS: NsNodeId = id(
+        413,
     );
     /// `SupportedIndicationTypes` (Variable).
-    pub const I_ASSET_LOCATION_INDICATION_TYPE_SUPPORTED_INDICATION_TYPES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        156u32,
+    pub const I_ASSET_LOCATION_INDICATION_TYPE_SUPPORTED_INDICATION_TYPES: NsNodeId = id(
+        156,
     );
     /// `UsedIndicationType` (Variable).
-    pub const I_ASSET_LOCATION_INDICATION_TYPE_USED_INDICATION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        155u32,
-    );
+    pub const I_ASSET_LOCATION_INDICATION_TYPE_USED_INDICATION_TYPE: NsNodeId = id(155);
     /// `DeviceHealth` (Variable).
-    pub const I_DEVICE_HEALTH_TYPE_DEVICE_HEALTH: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15052u32,
-    );
+    pub const I_DEVICE_HEALTH_TYPE_DEVICE_HEALTH: NsNodeId = id(15052);
     /// `OperationCycleCounter` (Variable).
     ///
     /// OperationCycleCounter is counting the times the Device switches from not performing an activity to performing an activity. For example, each time a valve starts moving, is counted. This value shall only increase during the lifetime of the Device and shall not be reset when the Device is restarted.
-    pub const I_OPERATION_COUNTER_TYPE_OPERATION_CYCLE_COUNTER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        483u32,
-    );
+    pub const I_OPERATION_COUNTER_TYPE_OPERATION_CYCLE_COUNTER: NsNodeId = id(483);
     /// `OperationDuration` (Variable).
     ///
     /// OperationDuration is the duration the Device has been powered and performing an activity. This counter is intended for Devices where a distinction is made between switched on and in operation. For example, a drive can be powered on but not operating. It is not intended for Devices always performing an activity like sensors always measuring data. This value shall only increase during the lifetime of the Device and shall not be reset when the Device is restarted. The OperationDuration is provided as Duration, i.e., in milliseconds or even fractions of a millisecond. However, the Server is not expected to update the value in such a high frequency, but possibly once a minute or once an hour, depending on the application.
-    pub const I_OPERATION_COUNTER_TYPE_OPERATION_DURATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        482u32,
-    );
+    pub const I_OPERATION_COUNTER_TYPE_OPERATION_DURATION: NsNodeId = id(482);
     /// `PowerOnDuration` (Variable).
     ///
     /// PowerOnDuration is the duration the Device has been powered. The main purpose is to determine the time in which degradation of the Device occurred. The details, when the time is counted, is implementation-specific. Companion specifications can define specific rules. Typically, when the Device has supply voltage and the main CPU is running, the time is counted. This can include any kind of sleep mode, but cannot include pure Wake on LAN. This value shall only increase during the lifetime of the Device and shall not be reset when the Device is restarted. The PowerOnDuration is provided as Duration, i.e., in milliseconds or even fractions of a millisecond. However, the Server is not expected to update the value in such a high frequency, but possibly once a minute or once an hour, depending on the application.
-    pub const I_OPERATION_COUNTER_TYPE_POWER_ON_DURATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        481u32,
-    );
+    pub const I_OPERATION_COUNTER_TYPE_POWER_ON_DURATION: NsNodeId = id(481);
     /// `<ImageIdentifier>` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_DEVICE_TYPE_IMAGE_IMAGE_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15056u32,
+    pub const I_SUPPORT_INFO_TYPE_DEVICE_TYPE_IMAGE_IMAGE_IDENTIFIER: NsNodeId = id(
+        15056,
     );
     /// `<DocumentIdentifier>` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_DOCUMENT_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15058u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_DOCUMENT_IDENTIFIER: NsNodeId = id(
+        15058,
     );
     /// `InputArguments` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_CLOSE_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        62u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_CLOSE_INPUT_ARGUMENTS: NsNodeId = id(
+        62,
     );
     /// `InputArguments` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_GET_POSITION_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        69u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_GET_POSITION_INPUT_ARGUMENTS: NsNodeId = id(
+        69,
     );
     /// `OutputArguments` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_GET_POSITION_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        70u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_GET_POSITION_OUTPUT_ARGUMENTS: NsNodeId = id(
+        70,
     );
     /// `OpenCount` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_OPEN_COUNT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        32u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_OPEN_COUNT: NsNodeId = id(
+        32,
     );
     /// `InputArguments` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_OPEN_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        37u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_OPEN_INPUT_ARGUMENTS: NsNodeId = id(
+        37,
     );
     /// `OutputArguments` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_OPEN_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        38u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_OPEN_OUTPUT_ARGUMENTS: NsNodeId = id(
+        38,
     );
     /// `InputArguments` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_READ_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        64u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_READ_INPUT_ARGUMENTS: NsNodeId = id(
+        64,
     );
     /// `OutputArguments` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_READ_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        65u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_READ_OUTPUT_ARGUMENTS: NsNodeId = id(
+        65,
     );
     /// `InputArguments` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_SET_POSITION_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        72u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_SET_POSITION_INPUT_ARGUMENTS: NsNodeId = id(
+        72,
     );
     /// `Size` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_SIZE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        29u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_SIZE: NsNodeId = id(
+        29,
     );
     /// `UserWritable` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_USER_WRITABLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        31u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_USER_WRITABLE: NsNodeId = id(
+        31,
     );
     /// `Writable` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_WRITABLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        30u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_WRITABLE: NsNodeId = id(
+        30,
     );
     /// `InputArguments` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_WRITE_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        67u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_WRITE_INPUT_ARGUMENTS: NsNodeId = id(
+        67,
     );
     /// `<ImageIdentifier>` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_IMAGE_SET_IMAGE_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15062u32,
-    );
+    pub const I_SUPPORT_INFO_TYPE_IMAGE_SET_IMAGE_IDENTIFIER: NsNodeId = id(15062);
     /// `<ProtocolSupportIdentifier>` (Variable).
-    pub const I_SUPPORT_INFO_TYPE_PROTOCOL_SUPPORT_PROTOCOL_SUPPORT_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15060u32,
+    pub const I_SUPPORT_INFO_TYPE_PROTOCOL_SUPPORT_PROTOCOL_SUPPORT_IDENTIFIER: NsNodeId = id(
+        15060,
     );
     /// `AssetId` (Variable).
-    pub const I_TAG_NAMEPLATE_TYPE_ASSET_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15049u32,
-    );
+    pub const I_TAG_NAMEPLATE_TYPE_ASSET_ID: NsNodeId = id(15049);
     /// `ComponentName` (Variable).
-    pub const I_TAG_NAMEPLATE_TYPE_COMPONENT_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15050u32,
-    );
+    pub const I_TAG_NAMEPLATE_TYPE_COMPONENT_NAME: NsNodeId = id(15050);
     /// `DeviceClass` (Variable).
-    pub const I_VENDOR_NAMEPLATE_TYPE_DEVICE_CLASS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15044u32,
-    );
+    pub const I_VENDOR_NAMEPLATE_TYPE_DEVICE_CLASS: NsNodeId = id(15044);
     /// `DeviceManual` (Variable).
-    pub const I_VENDOR_NAMEPLATE_TYPE_DEVICE_MANUAL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15043u32,
-    );
+    pub const I_VENDOR_NAMEPLATE_TYPE_DEVICE_MANUAL: NsNodeId = id(15043);
     /// `DeviceRevision` (Variable).
-    pub const I_VENDOR_NAMEPLATE_TYPE_DEVICE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15041u32,
-    );
+    pub const I_VENDOR_NAMEPLATE_TYPE_DEVICE_REVISION: NsNodeId = id(15041);
     /// `HardwareRevision` (Variable).
-    pub const I_VENDOR_NAMEPLATE_TYPE_HARDWARE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15039u32,
-    );
+    pub const I_VENDOR_NAMEPLATE_TYPE_HARDWARE_REVISION: NsNodeId = id(15039);
     /// `Manufacturer` (Variable).
-    pub const I_VENDOR_NAMEPLATE_TYPE_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15036u32,
-    );
+    pub const I_VENDOR_NAMEPLATE_TYPE_MANUFACTURER: NsNodeId = id(15036);
     /// `ManufacturerUri` (Variable).
-    pub const I_VENDOR_NAMEPLATE_TYPE_MANUFACTURER_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15037u32,
-    );
+    pub const I_VENDOR_NAMEPLATE_TYPE_MANUFACTURER_URI: NsNodeId = id(15037);
     /// `Model` (Variable).
-    pub const I_VENDOR_NAMEPLATE_TYPE_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15038u32,
-    );
+    pub const I_VENDOR_NAMEPLATE_TYPE_MODEL: NsNodeId = id(15038);
     /// `PatchIdentifiers` (Variable).
-    pub const I_VENDOR_NAMEPLATE_TYPE_PATCH_IDENTIFIERS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        24u32,
-    );
+    pub const I_VENDOR_NAMEPLATE_TYPE_PATCH_IDENTIFIERS: NsNodeId = id(24);
     /// `ProductCode` (Variable).
-    pub const I_VENDOR_NAMEPLATE_TYPE_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15042u32,
-    );
+    pub const I_VENDOR_NAMEPLATE_TYPE_PRODUCT_CODE: NsNodeId = id(15042);
     /// `ProductInstanceUri` (Variable).
-    pub const I_VENDOR_NAMEPLATE_TYPE_PRODUCT_INSTANCE_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15046u32,
-    );
+    pub const I_VENDOR_NAMEPLATE_TYPE_PRODUCT_INSTANCE_URI: NsNodeId = id(15046);
     /// `RevisionCounter` (Variable).
-    pub const I_VENDOR_NAMEPLATE_TYPE_REVISION_COUNTER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15047u32,
-    );
+    pub const I_VENDOR_NAMEPLATE_TYPE_REVISION_COUNTER: NsNodeId = id(15047);
     /// `SerialNumber` (Variable).
-    pub const I_VENDOR_NAMEPLATE_TYPE_SERIAL_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15045u32,
-    );
+    pub const I_VENDOR_NAMEPLATE_TYPE_SERIAL_NUMBER: NsNodeId = id(15045);
     /// `SoftwareReleaseDate` (Variable).
-    pub const I_VENDOR_NAMEPLATE_TYPE_SOFTWARE_RELEASE_DATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        23u32,
-    );
+    pub const I_VENDOR_NAMEPLATE_TYPE_SOFTWARE_RELEASE_DATE: NsNodeId = id(23);
     /// `SoftwareRevision` (Variable).
-    pub const I_VENDOR_NAMEPLATE_TYPE_SOFTWARE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15040u32,
-    );
+    pub const I_VENDOR_NAMEPLATE_TYPE_SOFTWARE_REVISION: NsNodeId = id(15040);
     /// `Indication` (Variable).
     ///
     /// Indication gives an indication of what is actually measured / represented by the Value of the Variable and the StartValue and LimitValue.
-    pub const LIFETIME_VARIABLE_TYPE_INDICATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        471u32,
-    );
+    pub const LIFETIME_VARIABLE_TYPE_INDICATION: NsNodeId = id(471);
     /// `LimitValue` (Variable).
     ///
     /// LimitValue indicates when the end of lifetime has been reached.
-    pub const LIFETIME_VARIABLE_TYPE_LIMIT_VALUE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        470u32,
-    );
+    pub const LIFETIME_VARIABLE_TYPE_LIMIT_VALUE: NsNodeId = id(470);
     /// `StartValue` (Variable).
     ///
     /// StartValue indicates the initial value, when there is still the full lifetime left.
-    pub const LIFETIME_VARIABLE_TYPE_START_VALUE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        469u32,
-    );
+    pub const LIFETIME_VARIABLE_TYPE_START_VALUE: NsNodeId = id(469);
     /// `WarningValues` (Variable).
     ///
     /// WarningValues indicates one or more levels when the end of lifetime is reached soon and can be used to inform the user when reached.
-    pub const LIFETIME_VARIABLE_TYPE_WARNING_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        472u32,
-    );
+    pub const LIFETIME_VARIABLE_TYPE_WARNING_VALUES: NsNodeId = id(472);
     /// `OptionSetValues` (Variable).
-    pub const LOCATION_INDICATION_TYPE_OPTION_SET_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        411u32,
-    );
+    pub const LOCATION_INDICATION_TYPE_OPTION_SET_VALUES: NsNodeId = id(411);
     /// `OutputArguments` (Variable).
-    pub const LOCKING_SERVICES_TYPE_BREAK_LOCK_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6401u32,
-    );
+    pub const LOCKING_SERVICES_TYPE_BREAK_LOCK_OUTPUT_ARGUMENTS: NsNodeId = id(6401);
     /// `DefaultInstanceBrowseName` (Variable).
-    pub const LOCKING_SERVICES_TYPE_DEFAULT_INSTANCE_BROWSE_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15890u32,
-    );
+    pub const LOCKING_SERVICES_TYPE_DEFAULT_INSTANCE_BROWSE_NAME: NsNodeId = id(15890);
     /// `OutputArguments` (Variable).
-    pub const LOCKING_SERVICES_TYPE_EXIT_LOCK_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6399u32,
-    );
+    pub const LOCKING_SERVICES_TYPE_EXIT_LOCK_OUTPUT_ARGUMENTS: NsNodeId = id(6399);
     /// `InputArguments` (Variable).
-    pub const LOCKING_SERVICES_TYPE_INIT_LOCK_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6394u32,
-    );
+    pub const LOCKING_SERVICES_TYPE_INIT_LOCK_INPUT_ARGUMENTS: NsNodeId = id(6394);
     /// `OutputArguments` (Variable).
-    pub const LOCKING_SERVICES_TYPE_INIT_LOCK_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6395u32,
-    );
+    pub const LOCKING_SERVICES_TYPE_INIT_LOCK_OUTPUT_ARGUMENTS: NsNodeId = id(6395);
     /// `Locked` (Variable).
-    pub const LOCKING_SERVICES_TYPE_LOCKED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6534u32,
-    );
+    pub const LOCKING_SERVICES_TYPE_LOCKED: NsNodeId = id(6534);
     /// `LockingClient` (Variable).
-    pub const LOCKING_SERVICES_TYPE_LOCKING_CLIENT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6390u32,
-    );
+    pub const LOCKING_SERVICES_TYPE_LOCKING_CLIENT: NsNodeId = id(6390);
     /// `LockingUser` (Variable).
-    pub const LOCKING_SERVICES_TYPE_LOCKING_USER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6391u32,
-    );
+    pub const LOCKING_SERVICES_TYPE_LOCKING_USER: NsNodeId = id(6391);
     /// `RemainingLockTime` (Variable).
-    pub const LOCKING_SERVICES_TYPE_REMAINING_LOCK_TIME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6392u32,
-    );
+    pub const LOCKING_SERVICES_TYPE_REMAINING_LOCK_TIME: NsNodeId = id(6392);
     /// `OutputArguments` (Variable).
-    pub const LOCKING_SERVICES_TYPE_RENEW_LOCK_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6397u32,
-    );
+    pub const LOCKING_SERVICES_TYPE_RENEW_LOCK_OUTPUT_ARGUMENTS: NsNodeId = id(6397);
     /// `MaxInactiveLockTime` (Variable).
-    pub const MAX_INACTIVE_LOCK_TIME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6387u32,
-    );
+    pub const MAX_INACTIVE_LOCK_TIME: NsNodeId = id(6387);
     /// `OutputArguments` (Variable).
-    pub const NETWORK_TYPE_LOCK_BREAK_LOCK_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6307u32,
-    );
+    pub const NETWORK_TYPE_LOCK_BREAK_LOCK_OUTPUT_ARGUMENTS: NsNodeId = id(6307);
     /// `OutputArguments` (Variable).
-    pub const NETWORK_TYPE_LOCK_EXIT_LOCK_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6305u32,
-    );
+    pub const NETWORK_TYPE_LOCK_EXIT_LOCK_OUTPUT_ARGUMENTS: NsNodeId = id(6305);
     /// `InputArguments` (Variable).
-    pub const NETWORK_TYPE_LOCK_INIT_LOCK_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6300u32,
-    );
+    pub const NETWORK_TYPE_LOCK_INIT_LOCK_INPUT_ARGUMENTS: NsNodeId = id(6300);
     /// `OutputArguments` (Variable).
-    pub const NETWORK_TYPE_LOCK_INIT_LOCK_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6301u32,
-    );
+    pub const NETWORK_TYPE_LOCK_INIT_LOCK_OUTPUT_ARGUMENTS: NsNodeId = id(6301);
     /// `Locked` (Variable).
-    pub const NETWORK_TYPE_LOCK_LOCKED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6497u32,
-    );
+    pub const NETWORK_TYPE_LOCK_LOCKED: NsNodeId = id(6497);
     /// `LockingClient` (Variable).
-    pub const NETWORK_TYPE_LOCK_LOCKING_CLIENT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6296u32,
-    );
+    pub const NETWORK_TYPE_LOCK_LOCKING_CLIENT: NsNodeId = id(6296);
     /// `LockingUser` (Variable).
-    pub const NETWORK_TYPE_LOCK_LOCKING_USER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6297u32,
-    );
+    pub const NETWORK_TYPE_LOCK_LOCKING_USER: NsNodeId = id(6297);
     /// `RemainingLockTime` (Variable).
-    pub const NETWORK_TYPE_LOCK_REMAINING_LOCK_TIME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6298u32,
-    );
+    pub const NETWORK_TYPE_LOCK_REMAINING_LOCK_TIME: NsNodeId = id(6298);
     /// `OutputArguments` (Variable).
-    pub const NETWORK_TYPE_LOCK_RENEW_LOCK_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6303u32,
-    );
+    pub const NETWORK_TYPE_LOCK_RENEW_LOCK_OUTPUT_ARGUMENTS: NsNodeId = id(6303);
     /// `DefaultAccessRestrictions` (Variable).
-    pub const OPCUADI_NAMESPACE_METADATA_DEFAULT_ACCESS_RESTRICTIONS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15033u32,
+    pub const OPCUADI_NAMESPACE_METADATA_DEFAULT_ACCESS_RESTRICTIONS: NsNodeId = id(
+        15033,
     );
     /// `DefaultRolePermissions` (Variable).
-    pub const OPCUADI_NAMESPACE_METADATA_DEFAULT_ROLE_PERMISSIONS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15031u32,
-    );
+    pub const OPCUADI_NAMESPACE_METADATA_DEFAULT_ROLE_PERMISSIONS: NsNodeId = id(15031);
     /// `DefaultUserRolePermissions` (Variable).
-    pub const OPCUADI_NAMESPACE_METADATA_DEFAULT_USER_ROLE_PERMISSIONS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15032u32,
+    pub const OPCUADI_NAMESPACE_METADATA_DEFAULT_USER_ROLE_PERMISSIONS: NsNodeId = id(
+        15032,
     );
     /// `IsNamespaceSubset` (Variable).
-    pub const OPCUADI_NAMESPACE_METADATA_IS_NAMESPACE_SUBSET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15005u32,
-    );
+    pub const OPCUADI_NAMESPACE_METADATA_IS_NAMESPACE_SUBSET: NsNodeId = id(15005);
     /// `ModelVersion` (Variable).
-    pub const OPCUADI_NAMESPACE_METADATA_MODEL_VERSION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        489u32,
-    );
+    pub const OPCUADI_NAMESPACE_METADATA_MODEL_VERSION: NsNodeId = id(489);
     /// `NamespacePublicationDate` (Variable).
-    pub const OPCUADI_NAMESPACE_METADATA_NAMESPACE_PUBLICATION_DATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15004u32,
+    pub const OPCUADI_NAMESPACE_METADATA_NAMESPACE_PUBLICATION_DATE: NsNodeId = id(
+        15004,
     );
     /// `NamespaceUri` (Variable).
-    pub const OPCUADI_NAMESPACE_METADATA_NAMESPACE_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15002u32,
-    );
+    pub const OPCUADI_NAMESPACE_METADATA_NAMESPACE_URI: NsNodeId = id(15002);
     /// `NamespaceVersion` (Variable).
-    pub const OPCUADI_NAMESPACE_METADATA_NAMESPACE_VERSION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15003u32,
-    );
+    pub const OPCUADI_NAMESPACE_METADATA_NAMESPACE_VERSION: NsNodeId = id(15003);
     /// `StaticNodeIdTypes` (Variable).
-    pub const OPCUADI_NAMESPACE_METADATA_STATIC_NODE_ID_TYPES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15006u32,
-    );
+    pub const OPCUADI_NAMESPACE_METADATA_STATIC_NODE_ID_TYPES: NsNodeId = id(15006);
     /// `StaticNumericNodeIdRange` (Variable).
-    pub const OPCUADI_NAMESPACE_METADATA_STATIC_NUMERIC_NODE_ID_RANGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15007u32,
+    pub const OPCUADI_NAMESPACE_METADATA_STATIC_NUMERIC_NODE_ID_RANGE: NsNodeId = id(
+        15007,
     );
     /// `StaticStringNodeIdPattern` (Variable).
-    pub const OPCUADI_NAMESPACE_METADATA_STATIC_STRING_NODE_ID_PATTERN: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15008u32,
+    pub const OPCUADI_NAMESPACE_METADATA_STATIC_STRING_NODE_ID_PATTERN: NsNodeId = id(
+        15008,
     );
     /// `Opc.Ua.Di` (Variable).
-    pub const OPC_UA_DI_BINARY_SCHEMA: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6435u32,
-    );
+    pub const OPC_UA_DI_BINARY_SCHEMA: NsNodeId = id(6435);
     /// `Deprecated` (Variable).
-    pub const OPC_UA_DI_BINARY_SCHEMA_DEPRECATED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15893u32,
-    );
+    pub const OPC_UA_DI_BINARY_SCHEMA_DEPRECATED: NsNodeId = id(15893);
     /// `FetchResultDataType` (Variable).
-    pub const OPC_UA_DI_BINARY_SCHEMA_FETCH_RESULT_DATA_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6555u32,
-    );
+    pub const OPC_UA_DI_BINARY_SCHEMA_FETCH_RESULT_DATA_TYPE: NsNodeId = id(6555);
     /// `NamespaceUri` (Variable).
-    pub const OPC_UA_DI_BINARY_SCHEMA_NAMESPACE_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6437u32,
-    );
+    pub const OPC_UA_DI_BINARY_SCHEMA_NAMESPACE_URI: NsNodeId = id(6437);
     /// `ParameterResultDataType` (Variable).
-    pub const OPC_UA_DI_BINARY_SCHEMA_PARAMETER_RESULT_DATA_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6564u32,
-    );
+    pub const OPC_UA_DI_BINARY_SCHEMA_PARAMETER_RESULT_DATA_TYPE: NsNodeId = id(6564);
     /// `TransferResultDataDataType` (Variable).
-    pub const OPC_UA_DI_BINARY_SCHEMA_TRANSFER_RESULT_DATA_DATA_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15897u32,
+    pub const OPC_UA_DI_BINARY_SCHEMA_TRANSFER_RESULT_DATA_DATA_TYPE: NsNodeId = id(
+        15897,
     );
     /// `TransferResultErrorDataType` (Variable).
-    pub const OPC_UA_DI_BINARY_SCHEMA_TRANSFER_RESULT_ERROR_DATA_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15894u32,
+    pub const OPC_UA_DI_BINARY_SCHEMA_TRANSFER_RESULT_ERROR_DATA_TYPE: NsNodeId = id(
+        15894,
     );
     /// `Opc.Ua.Di` (Variable).
-    pub const OPC_UA_DI_XML_SCHEMA: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6423u32,
-    );
+    pub const OPC_UA_DI_XML_SCHEMA: NsNodeId = id(6423);
     /// `Deprecated` (Variable).
-    pub const OPC_UA_DI_XML_SCHEMA_DEPRECATED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15902u32,
-    );
+    pub const OPC_UA_DI_XML_SCHEMA_DEPRECATED: NsNodeId = id(15902);
     /// `FetchResultDataType` (Variable).
-    pub const OPC_UA_DI_XML_SCHEMA_FETCH_RESULT_DATA_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6539u32,
-    );
+    pub const OPC_UA_DI_XML_SCHEMA_FETCH_RESULT_DATA_TYPE: NsNodeId = id(6539);
     /// `NamespaceUri` (Variable).
-    pub const OPC_UA_DI_XML_SCHEMA_NAMESPACE_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6425u32,
-    );
+    pub const OPC_UA_DI_XML_SCHEMA_NAMESPACE_URI: NsNodeId = id(6425);
     /// `ParameterResultDataType` (Variable).
-    pub const OPC_UA_DI_XML_SCHEMA_PARAMETER_RESULT_DATA_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6548u32,
-    );
+    pub const OPC_UA_DI_XML_SCHEMA_PARAMETER_RESULT_DATA_TYPE: NsNodeId = id(6548);
     /// `TransferResultDataDataType` (Variable).
-    pub const OPC_UA_DI_XML_SCHEMA_TRANSFER_RESULT_DATA_DATA_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15906u32,
-    );
+    pub const OPC_UA_DI_XML_SCHEMA_TRANSFER_RESULT_DATA_DATA_TYPE: NsNodeId = id(15906);
     /// `TransferResultErrorDataType` (Variable).
-    pub const OPC_UA_DI_XML_SCHEMA_TRANSFER_RESULT_ERROR_DATA_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15903u32,
-    );
+    pub const OPC_UA_DI_XML_SCHEMA_TRANSFER_RESULT_ERROR_DATA_TYPE: NsNodeId = id(15903);
     /// `Manufacturer` (Variable).
-    pub const PACKAGE_LOADING_TYPE_CURRENT_VERSION_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        345u32,
-    );
+    pub const PACKAGE_LOADING_TYPE_CURRENT_VERSION_MANUFACTURER: NsNodeId = id(345);
     /// `ManufacturerUri` (Variable).
-    pub const PACKAGE_LOADING_TYPE_CURRENT_VERSION_MANUFACTURER_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        346u32,
-    );
+    pub const PACKAGE_LOADING_TYPE_CURRENT_VERSION_MANUFACTURER_URI: NsNodeId = id(346);
     /// `SoftwareRevision` (Variable).
-    pub const PACKAGE_LOADING_TYPE_CURRENT_VERSION_SOFTWARE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        347u32,
-    );
+    pub const PACKAGE_LOADING_TYPE_CURRENT_VERSION_SOFTWARE_REVISION: NsNodeId = id(347);
     /// `ErrorMessage` (Variable).
-    pub const PACKAGE_LOADING_TYPE_ERROR_MESSAGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        151u32,
-    );
+    pub const PACKAGE_LOADING_TYPE_ERROR_MESSAGE: NsNodeId = id(151);
     /// `ClientProcessingTimeout` (Variable).
-    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_CLIENT_PROCESSING_TIMEOUT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        141u32,
+    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_CLIENT_PROCESSING_TIMEOUT: NsNodeId = id(
+        141,
     );
     /// `InputArguments` (Variable).
-    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_CLOSE_AND_COMMIT_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        149u32,
+    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_CLOSE_AND_COMMIT_INPUT_ARGUMENTS: NsNodeId = id(
+        149,
     );
     /// `OutputArguments` (Variable).
-    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_CLOSE_AND_COMMIT_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        150u32,
+    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_CLOSE_AND_COMMIT_OUTPUT_ARGUMENTS: NsNodeId = id(
+        150,
     );
     /// `InputArguments` (Variable).
-    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_GENERATE_FILE_FOR_READ_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        143u32,
+    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_GENERATE_FILE_FOR_READ_INPUT_ARGUMENTS: NsNodeId = id(
+        143,
     );
     /// `OutputArguments` (Variable).
-    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_GENERATE_FILE_FOR_READ_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        144u32,
+    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_GENERATE_FILE_FOR_READ_OUTPUT_ARGUMENTS: NsNodeId = id(
+        144,
     );
     /// `InputArguments` (Variable).
-    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_GENERATE_FILE_FOR_WRITE_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        146u32,
+    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_GENERATE_FILE_FOR_WRITE_INPUT_ARGUMENTS: NsNodeId = id(
+        146,
     );
     /// `OutputArguments` (Variable).
-    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_GENERATE_FILE_FOR_WRITE_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        147u32,
+    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_GENERATE_FILE_FOR_WRITE_OUTPUT_ARGUMENTS: NsNodeId = id(
+        147,
     );
     /// `WriteBlockSize` (Variable).
-    pub const PACKAGE_LOADING_TYPE_WRITE_BLOCK_SIZE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        152u32,
-    );
+    pub const PACKAGE_LOADING_TYPE_WRITE_BLOCK_SIZE: NsNodeId = id(152);
     /// `StateNumber` (Variable).
-    pub const POWER_CYCLE_STATE_MACHINE_TYPE_NOT_WAITING_FOR_POWER_CYCLE_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        300u32,
+    pub const POWER_CYCLE_STATE_MACHINE_TYPE_NOT_WAITING_FOR_POWER_CYCLE_STATE_NUMBER: NsNodeId = id(
+        300,
     );
     /// `TransitionNumber` (Variable).
-    pub const POWER_CYCLE_STATE_MACHINE_TYPE_NOT_WAITING_FOR_POWER_CYCLE_TO_WAITING_FOR_POWER_CYCLE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        304u32,
+    pub const POWER_CYCLE_STATE_MACHINE_TYPE_NOT_WAITING_FOR_POWER_CYCLE_TO_WAITING_FOR_POWER_CYCLE_TRANSITION_NUMBER: NsNodeId = id(
+        304,
     );
     /// `StateNumber` (Variable).
-    pub const POWER_CYCLE_STATE_MACHINE_TYPE_WAITING_FOR_POWER_CYCLE_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        302u32,
+    pub const POWER_CYCLE_STATE_MACHINE_TYPE_WAITING_FOR_POWER_CYCLE_STATE_NUMBER: NsNodeId = id(
+        302,
     );
     /// `TransitionNumber` (Variable).
-    pub const POWER_CYCLE_STATE_MACHINE_TYPE_WAITING_FOR_POWER_CYCLE_TO_NOT_WAITING_FOR_POWER_CYCLE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        306u32,
+    pub const POWER_CYCLE_STATE_MACHINE_TYPE_WAITING_FOR_POWER_CYCLE_TO_NOT_WAITING_FOR_POWER_CYCLE_TRANSITION_NUMBER: NsNodeId = id(
+        306,
     );
     /// `StateNumber` (Variable).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_IDLE_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        232u32,
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_IDLE_STATE_NUMBER: NsNodeId = id(
+        232,
     );
     /// `TransitionNumber` (Variable).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_IDLE_TO_PREPARING_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        240u32,
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_IDLE_TO_PREPARING_TRANSITION_NUMBER: NsNodeId = id(
+        240,
     );
     /// `PercentComplete` (Variable).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PERCENT_COMPLETE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        227u32,
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PERCENT_COMPLETE: NsNodeId = id(227);
+    /// `StateNumber` (Variable).
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARED_FOR_UPDATE_STATE_NUMBER: NsNodeId = id(
+        236,
+    );
+    /// `TransitionNumber` (Variable).
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARED_FOR_UPDATE_TO_RESUMING_TRANSITION_NUMBER: NsNodeId = id(
+        246,
     );
     /// `StateNumber` (Variable).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARED_FOR_UPDATE_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        236u32,
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARING_STATE_NUMBER: NsNodeId = id(
+        234,
     );
     /// `TransitionNumber` (Variable).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARED_FOR_UPDATE_TO_RESUMING_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        246u32,
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARING_TO_IDLE_TRANSITION_NUMBER: NsNodeId = id(
+        242,
+    );
+    /// `TransitionNumber` (Variable).
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARING_TO_PREPARED_FOR_UPDATE_TRANSITION_NUMBER: NsNodeId = id(
+        244,
     );
     /// `StateNumber` (Variable).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARING_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        234u32,
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_RESUMING_STATE_NUMBER: NsNodeId = id(
+        238,
     );
     /// `TransitionNumber` (Variable).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARING_TO_IDLE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        242u32,
-    );
-    /// `TransitionNumber` (Variable).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARING_TO_PREPARED_FOR_UPDATE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        244u32,
-    );
-    /// `StateNumber` (Variable).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_RESUMING_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        238u32,
-    );
-    /// `TransitionNumber` (Variable).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_RESUMING_TO_IDLE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        248u32,
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_RESUMING_TO_IDLE_TRANSITION_NUMBER: NsNodeId = id(
+        248,
     );
     /// `EnumStrings` (Variable).
-    pub const SOFTWARE_CLASS_ENUM_STRINGS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        409u32,
-    );
+    pub const SOFTWARE_CLASS_ENUM_STRINGS: NsNodeId = id(409);
     /// `InputArguments` (Variable).
-    pub const SOFTWARE_FOLDER_TYPE_ADD_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        404u32,
-    );
+    pub const SOFTWARE_FOLDER_TYPE_ADD_INPUT_ARGUMENTS: NsNodeId = id(404);
     /// `InputArguments` (Variable).
-    pub const SOFTWARE_FOLDER_TYPE_DELETE_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        406u32,
-    );
+    pub const SOFTWARE_FOLDER_TYPE_DELETE_INPUT_ARGUMENTS: NsNodeId = id(406);
     /// `SoftwareClass` (Variable).
-    pub const SOFTWARE_FOLDER_TYPE_SOFTWARE_CLASS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        365u32,
-    );
+    pub const SOFTWARE_FOLDER_TYPE_SOFTWARE_CLASS: NsNodeId = id(365);
     /// `UpdateKey` (Variable).
-    pub const SOFTWARE_LOADING_TYPE_UPDATE_KEY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        136u32,
-    );
+    pub const SOFTWARE_LOADING_TYPE_UPDATE_KEY: NsNodeId = id(136);
     /// `Manufacturer` (Variable).
-    pub const SOFTWARE_TYPE_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15129u32,
-    );
+    pub const SOFTWARE_TYPE_MANUFACTURER: NsNodeId = id(15129);
     /// `Model` (Variable).
-    pub const SOFTWARE_TYPE_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15131u32,
-    );
+    pub const SOFTWARE_TYPE_MODEL: NsNodeId = id(15131);
     /// `SoftwareRevision` (Variable).
-    pub const SOFTWARE_TYPE_SOFTWARE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15133u32,
-    );
+    pub const SOFTWARE_TYPE_SOFTWARE_REVISION: NsNodeId = id(15133);
     /// `ConfirmationTimeout` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_CONFIRMATION_CONFIRMATION_TIMEOUT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        113u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_CONFIRMATION_CONFIRMATION_TIMEOUT: NsNodeId = id(113);
     /// `CurrentState` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_CONFIRMATION_CURRENT_STATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        99u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_CONFIRMATION_CURRENT_STATE: NsNodeId = id(99);
     /// `Id` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_CONFIRMATION_CURRENT_STATE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        100u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_CONFIRMATION_CURRENT_STATE_ID: NsNodeId = id(100);
     /// `DefaultInstanceBrowseName` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_DEFAULT_INSTANCE_BROWSE_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        134u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_DEFAULT_INSTANCE_BROWSE_NAME: NsNodeId = id(134);
     /// `CurrentState` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_INSTALLATION_CURRENT_STATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        41u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_INSTALLATION_CURRENT_STATE: NsNodeId = id(41);
     /// `Id` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_INSTALLATION_CURRENT_STATE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        42u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_INSTALLATION_CURRENT_STATE_ID: NsNodeId = id(42);
     /// `ClientProcessingTimeout` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_CLIENT_PROCESSING_TIMEOUT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        123u32,
+    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_CLIENT_PROCESSING_TIMEOUT: NsNodeId = id(
+        123,
     );
     /// `InputArguments` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_CLOSE_AND_COMMIT_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        131u32,
+    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_CLOSE_AND_COMMIT_INPUT_ARGUMENTS: NsNodeId = id(
+        131,
     );
     /// `OutputArguments` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_CLOSE_AND_COMMIT_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        132u32,
+    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_CLOSE_AND_COMMIT_OUTPUT_ARGUMENTS: NsNodeId = id(
+        132,
     );
     /// `InputArguments` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_GENERATE_FILE_FOR_READ_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        125u32,
+    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_GENERATE_FILE_FOR_READ_INPUT_ARGUMENTS: NsNodeId = id(
+        125,
     );
     /// `OutputArguments` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_GENERATE_FILE_FOR_READ_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        126u32,
+    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_GENERATE_FILE_FOR_READ_OUTPUT_ARGUMENTS: NsNodeId = id(
+        126,
     );
     /// `InputArguments` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_GENERATE_FILE_FOR_WRITE_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        128u32,
+    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_GENERATE_FILE_FOR_WRITE_INPUT_ARGUMENTS: NsNodeId = id(
+        128,
     );
     /// `OutputArguments` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_GENERATE_FILE_FOR_WRITE_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        129u32,
+    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_GENERATE_FILE_FOR_WRITE_OUTPUT_ARGUMENTS: NsNodeId = id(
+        129,
     );
     /// `CurrentState` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_POWER_CYCLE_CURRENT_STATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        77u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_POWER_CYCLE_CURRENT_STATE: NsNodeId = id(77);
     /// `Id` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_POWER_CYCLE_CURRENT_STATE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        78u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_POWER_CYCLE_CURRENT_STATE_ID: NsNodeId = id(78);
     /// `CurrentState` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_PREPARE_FOR_UPDATE_CURRENT_STATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_PREPARE_FOR_UPDATE_CURRENT_STATE: NsNodeId = id(5);
     /// `Id` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_PREPARE_FOR_UPDATE_CURRENT_STATE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_PREPARE_FOR_UPDATE_CURRENT_STATE_ID: NsNodeId = id(6);
     /// `SoftwareClass` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_SOFTWARE_CLASS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        352u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_SOFTWARE_CLASS: NsNodeId = id(352);
     /// `SoftwareName` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_SOFTWARE_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        354u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_SOFTWARE_NAME: NsNodeId = id(354);
     /// `SoftwareSubclass` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_SOFTWARE_SUBCLASS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        353u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_SOFTWARE_SUBCLASS: NsNodeId = id(353);
     /// `UnsignedPackageAllowed` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_UNSIGNED_PACKAGE_ALLOWED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        355u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_UNSIGNED_PACKAGE_ALLOWED: NsNodeId = id(355);
     /// `UpdateStatus` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_UPDATE_STATUS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        133u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_UPDATE_STATUS: NsNodeId = id(133);
     /// `VendorErrorCode` (Variable).
-    pub const SOFTWARE_UPDATE_TYPE_VENDOR_ERROR_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        402u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_VENDOR_ERROR_CODE: NsNodeId = id(402);
     /// `EnumStrings` (Variable).
-    pub const SOFTWARE_VERSION_FILE_TYPE_ENUM_STRINGS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        332u32,
-    );
+    pub const SOFTWARE_VERSION_FILE_TYPE_ENUM_STRINGS: NsNodeId = id(332);
     /// `ChangeLogReference` (Variable).
-    pub const SOFTWARE_VERSION_TYPE_CHANGE_LOG_REFERENCE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        385u32,
-    );
+    pub const SOFTWARE_VERSION_TYPE_CHANGE_LOG_REFERENCE: NsNodeId = id(385);
     /// `Hash` (Variable).
-    pub const SOFTWARE_VERSION_TYPE_HASH: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        386u32,
-    );
+    pub const SOFTWARE_VERSION_TYPE_HASH: NsNodeId = id(386);
     /// `Manufacturer` (Variable).
-    pub const SOFTWARE_VERSION_TYPE_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        380u32,
-    );
+    pub const SOFTWARE_VERSION_TYPE_MANUFACTURER: NsNodeId = id(380);
     /// `ManufacturerUri` (Variable).
-    pub const SOFTWARE_VERSION_TYPE_MANUFACTURER_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        381u32,
-    );
+    pub const SOFTWARE_VERSION_TYPE_MANUFACTURER_URI: NsNodeId = id(381);
     /// `PatchIdentifiers` (Variable).
-    pub const SOFTWARE_VERSION_TYPE_PATCH_IDENTIFIERS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        383u32,
-    );
+    pub const SOFTWARE_VERSION_TYPE_PATCH_IDENTIFIERS: NsNodeId = id(383);
     /// `ReleaseDate` (Variable).
-    pub const SOFTWARE_VERSION_TYPE_RELEASE_DATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        384u32,
-    );
+    pub const SOFTWARE_VERSION_TYPE_RELEASE_DATE: NsNodeId = id(384);
     /// `SoftwareRevision` (Variable).
-    pub const SOFTWARE_VERSION_TYPE_SOFTWARE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        382u32,
+    pub const SOFTWARE_VERSION_TYPE_SOFTWARE_REVISION: NsNodeId = id(382);
+    /// `OutputArguments` (Variable).
+    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_BREAK_LOCK_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6174,
     );
     /// `OutputArguments` (Variable).
-    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_BREAK_LOCK_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6174u32,
-    );
-    /// `OutputArguments` (Variable).
-    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_EXIT_LOCK_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6172u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_EXIT_LOCK_OUTPUT_ARGUMENTS: NsNodeId = id(6172);
     /// `InputArguments` (Variable).
-    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_INIT_LOCK_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6167u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_INIT_LOCK_INPUT_ARGUMENTS: NsNodeId = id(6167);
     /// `OutputArguments` (Variable).
-    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_INIT_LOCK_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6168u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_INIT_LOCK_OUTPUT_ARGUMENTS: NsNodeId = id(6168);
     /// `Locked` (Variable).
-    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_LOCKED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6468u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_LOCKED: NsNodeId = id(6468);
     /// `LockingClient` (Variable).
-    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_LOCKING_CLIENT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6163u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_LOCKING_CLIENT: NsNodeId = id(6163);
     /// `LockingUser` (Variable).
-    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_LOCKING_USER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6164u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_LOCKING_USER: NsNodeId = id(6164);
     /// `RemainingLockTime` (Variable).
-    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_REMAINING_LOCK_TIME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6165u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_REMAINING_LOCK_TIME: NsNodeId = id(6165);
     /// `OutputArguments` (Variable).
-    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_RENEW_LOCK_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6170u32,
+    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_RENEW_LOCK_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6170,
     );
     /// `<ParameterIdentifier>` (Variable).
-    pub const TOPOLOGY_ELEMENT_TYPE_PARAMETER_SET_PARAMETER_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6017u32,
+    pub const TOPOLOGY_ELEMENT_TYPE_PARAMETER_SET_PARAMETER_IDENTIFIER: NsNodeId = id(
+        6017,
     );
     /// `InputArguments` (Variable).
-    pub const TRANSFER_SERVICES_TYPE_FETCH_TRANSFER_RESULT_DATA_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6532u32,
+    pub const TRANSFER_SERVICES_TYPE_FETCH_TRANSFER_RESULT_DATA_INPUT_ARGUMENTS: NsNodeId = id(
+        6532,
     );
     /// `OutputArguments` (Variable).
-    pub const TRANSFER_SERVICES_TYPE_FETCH_TRANSFER_RESULT_DATA_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6533u32,
+    pub const TRANSFER_SERVICES_TYPE_FETCH_TRANSFER_RESULT_DATA_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6533,
     );
     /// `OutputArguments` (Variable).
-    pub const TRANSFER_SERVICES_TYPE_TRANSFER_FROM_DEVICE_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6530u32,
+    pub const TRANSFER_SERVICES_TYPE_TRANSFER_FROM_DEVICE_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6530,
     );
     /// `OutputArguments` (Variable).
-    pub const TRANSFER_SERVICES_TYPE_TRANSFER_TO_DEVICE_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6528u32,
+    pub const TRANSFER_SERVICES_TYPE_TRANSFER_TO_DEVICE_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6528,
     );
     /// `OptionSetValues` (Variable).
-    pub const UPDATE_BEHAVIOR_OPTION_SET_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        388u32,
-    );
+    pub const UPDATE_BEHAVIOR_OPTION_SET_VALUES: NsNodeId = id(388);
 }
 /// The Method nodes of this namespace.
 pub mod methods {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `GetUpdateBehavior` (Method).
-    pub const CACHED_LOADING_TYPE_GET_UPDATE_BEHAVIOR: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        189u32,
-    );
+    pub const CACHED_LOADING_TYPE_GET_UPDATE_BEHAVIOR: NsNodeId = id(189);
     /// `Confirm` (Method).
-    pub const CONFIRMATION_STATE_MACHINE_TYPE_CONFIRM: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        321u32,
-    );
+    pub const CONFIRMATION_STATE_MACHINE_TYPE_CONFIRM: NsNodeId = id(321);
     /// `CreateDirectory` (Method).
-    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_CREATE_DIRECTORY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        195u32,
-    );
+    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_CREATE_DIRECTORY: NsNodeId = id(195);
     /// `CreateFile` (Method).
-    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_CREATE_FILE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        198u32,
-    );
+    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_CREATE_FILE: NsNodeId = id(198);
     /// `Delete` (Method).
-    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_DELETE_FILE_SYSTEM_OBJECT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        201u32,
+    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_DELETE_FILE_SYSTEM_OBJECT: NsNodeId = id(
+        201,
     );
     /// `MoveOrCopy` (Method).
-    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_MOVE_OR_COPY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        203u32,
-    );
+    pub const FILE_SYSTEM_LOADING_TYPE_FILE_SYSTEM_MOVE_OR_COPY: NsNodeId = id(203);
     /// `GetUpdateBehavior` (Method).
-    pub const FILE_SYSTEM_LOADING_TYPE_GET_UPDATE_BEHAVIOR: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        206u32,
-    );
+    pub const FILE_SYSTEM_LOADING_TYPE_GET_UPDATE_BEHAVIOR: NsNodeId = id(206);
     /// `ValidateFiles` (Method).
-    pub const FILE_SYSTEM_LOADING_TYPE_VALIDATE_FILES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        209u32,
-    );
+    pub const FILE_SYSTEM_LOADING_TYPE_VALIDATE_FILES: NsNodeId = id(209);
     /// `InstallFiles` (Method).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALL_FILES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        268u32,
-    );
+    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALL_FILES: NsNodeId = id(268);
     /// `InstallSoftwarePackage` (Method).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALL_SOFTWARE_PACKAGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        265u32,
+    pub const INSTALLATION_STATE_MACHINE_TYPE_INSTALL_SOFTWARE_PACKAGE: NsNodeId = id(
+        265,
     );
     /// `Resume` (Method).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_RESUME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        270u32,
-    );
+    pub const INSTALLATION_STATE_MACHINE_TYPE_RESUME: NsNodeId = id(270);
     /// `Uninstall` (Method).
-    pub const INSTALLATION_STATE_MACHINE_TYPE_UNINSTALL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        407u32,
-    );
+    pub const INSTALLATION_STATE_MACHINE_TYPE_UNINSTALL: NsNodeId = id(407);
     /// `StartLocationIndication` (Method).
-    pub const I_ASSET_LOCATION_INDICATION_TYPE_START_LOCATION_INDICATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        119u32,
+    pub const I_ASSET_LOCATION_INDICATION_TYPE_START_LOCATION_INDICATION: NsNodeId = id(
+        119,
     );
     /// `StopLocationIndication` (Method).
-    pub const I_ASSET_LOCATION_INDICATION_TYPE_STOP_LOCATION_INDICATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        121u32,
+    pub const I_ASSET_LOCATION_INDICATION_TYPE_STOP_LOCATION_INDICATION: NsNodeId = id(
+        121,
     );
     /// `Close` (Method).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_CLOSE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        39u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_CLOSE: NsNodeId = id(
+        39,
     );
     /// `GetPosition` (Method).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_GET_POSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        68u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_GET_POSITION: NsNodeId = id(
+        68,
     );
     /// `Open` (Method).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_OPEN: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        36u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_OPEN: NsNodeId = id(
+        36,
     );
     /// `Read` (Method).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_READ: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        63u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_READ: NsNodeId = id(
+        63,
     );
     /// `SetPosition` (Method).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_SET_POSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        71u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_SET_POSITION: NsNodeId = id(
+        71,
     );
     /// `Write` (Method).
-    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_WRITE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        66u32,
+    pub const I_SUPPORT_INFO_TYPE_DOCUMENTATION_FILES_DOCUMENT_FILE_ID_WRITE: NsNodeId = id(
+        66,
     );
     /// `BreakLock` (Method).
-    pub const LOCKING_SERVICES_TYPE_BREAK_LOCK: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6400u32,
-    );
+    pub const LOCKING_SERVICES_TYPE_BREAK_LOCK: NsNodeId = id(6400);
     /// `ExitLock` (Method).
-    pub const LOCKING_SERVICES_TYPE_EXIT_LOCK: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6398u32,
-    );
+    pub const LOCKING_SERVICES_TYPE_EXIT_LOCK: NsNodeId = id(6398);
     /// `InitLock` (Method).
-    pub const LOCKING_SERVICES_TYPE_INIT_LOCK: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6393u32,
-    );
+    pub const LOCKING_SERVICES_TYPE_INIT_LOCK: NsNodeId = id(6393);
     /// `RenewLock` (Method).
-    pub const LOCKING_SERVICES_TYPE_RENEW_LOCK: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6396u32,
-    );
+    pub const LOCKING_SERVICES_TYPE_RENEW_LOCK: NsNodeId = id(6396);
     /// `BreakLock` (Method).
-    pub const NETWORK_TYPE_LOCK_BREAK_LOCK: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6306u32,
-    );
+    pub const NETWORK_TYPE_LOCK_BREAK_LOCK: NsNodeId = id(6306);
     /// `ExitLock` (Method).
-    pub const NETWORK_TYPE_LOCK_EXIT_LOCK: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6304u32,
-    );
+    pub const NETWORK_TYPE_LOCK_EXIT_LOCK: NsNodeId = id(6304);
     /// `InitLock` (Method).
-    pub const NETWORK_TYPE_LOCK_INIT_LOCK: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6299u32,
-    );
+    pub const NETWORK_TYPE_LOCK_INIT_LOCK: NsNodeId = id(6299);
     /// `RenewLock` (Method).
-    pub const NETWORK_TYPE_LOCK_RENEW_LOCK: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6302u32,
-    );
+    pub const NETWORK_TYPE_LOCK_RENEW_LOCK: NsNodeId = id(6302);
     /// `CloseAndCommit` (Method).
-    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_CLOSE_AND_COMMIT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        148u32,
-    );
+    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_CLOSE_AND_COMMIT: NsNodeId = id(148);
     /// `GenerateFileForRead` (Method).
-    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_GENERATE_FILE_FOR_READ: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        142u32,
+    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_GENERATE_FILE_FOR_READ: NsNodeId = id(
+        142,
     );
     /// `GenerateFileForWrite` (Method).
-    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_GENERATE_FILE_FOR_WRITE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        145u32,
+    pub const PACKAGE_LOADING_TYPE_FILE_TRANSFER_GENERATE_FILE_FOR_WRITE: NsNodeId = id(
+        145,
     );
     /// `Abort` (Method).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_ABORT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        229u32,
-    );
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_ABORT: NsNodeId = id(229);
     /// `Prepare` (Method).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        228u32,
-    );
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_PREPARE: NsNodeId = id(228);
     /// `Resume` (Method).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_RESUME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        230u32,
-    );
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE_RESUME: NsNodeId = id(230);
     /// `Add` (Method).
-    pub const SOFTWARE_FOLDER_TYPE_ADD: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        403u32,
-    );
+    pub const SOFTWARE_FOLDER_TYPE_ADD: NsNodeId = id(403);
     /// `Delete` (Method).
-    pub const SOFTWARE_FOLDER_TYPE_DELETE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        405u32,
-    );
+    pub const SOFTWARE_FOLDER_TYPE_DELETE: NsNodeId = id(405);
     /// `Confirm` (Method).
-    pub const SOFTWARE_UPDATE_TYPE_CONFIRMATION_CONFIRM: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        112u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_CONFIRMATION_CONFIRM: NsNodeId = id(112);
     /// `Resume` (Method).
-    pub const SOFTWARE_UPDATE_TYPE_INSTALLATION_RESUME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        61u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_INSTALLATION_RESUME: NsNodeId = id(61);
     /// `CloseAndCommit` (Method).
-    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_CLOSE_AND_COMMIT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        130u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_CLOSE_AND_COMMIT: NsNodeId = id(130);
     /// `GenerateFileForRead` (Method).
-    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_GENERATE_FILE_FOR_READ: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        124u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_GENERATE_FILE_FOR_READ: NsNodeId = id(124);
     /// `GenerateFileForWrite` (Method).
-    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_GENERATE_FILE_FOR_WRITE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        127u32,
+    pub const SOFTWARE_UPDATE_TYPE_PARAMETERS_GENERATE_FILE_FOR_WRITE: NsNodeId = id(
+        127,
     );
     /// `Abort` (Method).
-    pub const SOFTWARE_UPDATE_TYPE_PREPARE_FOR_UPDATE_ABORT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        20u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_PREPARE_FOR_UPDATE_ABORT: NsNodeId = id(20);
     /// `Prepare` (Method).
-    pub const SOFTWARE_UPDATE_TYPE_PREPARE_FOR_UPDATE_PREPARE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        19u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE_PREPARE_FOR_UPDATE_PREPARE: NsNodeId = id(19);
     /// `Clear` (Method).
-    pub const SOFTWARE_VERSION_TYPE_CLEAR: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        359u32,
-    );
+    pub const SOFTWARE_VERSION_TYPE_CLEAR: NsNodeId = id(359);
     /// `BreakLock` (Method).
-    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_BREAK_LOCK: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6173u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_BREAK_LOCK: NsNodeId = id(6173);
     /// `ExitLock` (Method).
-    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_EXIT_LOCK: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6171u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_EXIT_LOCK: NsNodeId = id(6171);
     /// `InitLock` (Method).
-    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_INIT_LOCK: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6166u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_INIT_LOCK: NsNodeId = id(6166);
     /// `RenewLock` (Method).
-    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_RENEW_LOCK: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6169u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE_LOCK_RENEW_LOCK: NsNodeId = id(6169);
     /// `FetchTransferResultData` (Method).
-    pub const TRANSFER_SERVICES_TYPE_FETCH_TRANSFER_RESULT_DATA: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6531u32,
-    );
+    pub const TRANSFER_SERVICES_TYPE_FETCH_TRANSFER_RESULT_DATA: NsNodeId = id(6531);
     /// `TransferFromDevice` (Method).
-    pub const TRANSFER_SERVICES_TYPE_TRANSFER_FROM_DEVICE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6529u32,
-    );
+    pub const TRANSFER_SERVICES_TYPE_TRANSFER_FROM_DEVICE: NsNodeId = id(6529);
     /// `TransferToDevice` (Method).
-    pub const TRANSFER_SERVICES_TYPE_TRANSFER_TO_DEVICE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6527u32,
-    );
+    pub const TRANSFER_SERVICES_TYPE_TRANSFER_TO_DEVICE: NsNodeId = id(6527);
 }
 /// The ObjectType nodes of this namespace.
 pub mod object_types {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `BaseLifetimeIndicationType` (ObjectType).
     ///
     /// Base indication type not further defining a semantic
-    pub const BASE_LIFETIME_INDICATION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        473u32,
-    );
+    pub const BASE_LIFETIME_INDICATION_TYPE: NsNodeId = id(473);
     /// `BlockType` (ObjectType).
-    pub const BLOCK_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1003u32,
-    );
+    pub const BLOCK_TYPE: NsNodeId = id(1003);
     /// `CachedLoadingType` (ObjectType).
-    pub const CACHED_LOADING_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        171u32,
-    );
+    pub const CACHED_LOADING_TYPE: NsNodeId = id(171);
     /// `CheckFunctionAlarmType` (ObjectType).
-    pub const CHECK_FUNCTION_ALARM_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15441u32,
-    );
+    pub const CHECK_FUNCTION_ALARM_TYPE: NsNodeId = id(15441);
     /// `ComponentType` (ObjectType).
-    pub const COMPONENT_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15063u32,
-    );
+    pub const COMPONENT_TYPE: NsNodeId = id(15063);
     /// `ConfigurableObjectType` (ObjectType).
-    pub const CONFIGURABLE_OBJECT_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1004u32,
-    );
+    pub const CONFIGURABLE_OBJECT_TYPE: NsNodeId = id(1004);
     /// `ConfirmationStateMachineType` (ObjectType).
-    pub const CONFIRMATION_STATE_MACHINE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        307u32,
-    );
+    pub const CONFIRMATION_STATE_MACHINE_TYPE: NsNodeId = id(307);
     /// `ConnectionPointType` (ObjectType).
-    pub const CONNECTION_POINT_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6308u32,
-    );
+    pub const CONNECTION_POINT_TYPE: NsNodeId = id(6308);
     /// `DeviceHealthDiagnosticAlarmType` (ObjectType).
-    pub const DEVICE_HEALTH_DIAGNOSTIC_ALARM_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15143u32,
-    );
+    pub const DEVICE_HEALTH_DIAGNOSTIC_ALARM_TYPE: NsNodeId = id(15143);
     /// `DeviceType` (ObjectType).
-    pub const DEVICE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1002u32,
-    );
+    pub const DEVICE_TYPE: NsNodeId = id(1002);
     /// `DiameterIndicationType` (ObjectType).
     ///
     /// Indicates the abraded diameter, for example of a drill.
-    pub const DIAMETER_INDICATION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        478u32,
-    );
+    pub const DIAMETER_INDICATION_TYPE: NsNodeId = id(478);
     /// `DirectLoadingType` (ObjectType).
-    pub const DIRECT_LOADING_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        153u32,
-    );
+    pub const DIRECT_LOADING_TYPE: NsNodeId = id(153);
     /// `FailureAlarmType` (ObjectType).
-    pub const FAILURE_ALARM_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15292u32,
-    );
+    pub const FAILURE_ALARM_TYPE: NsNodeId = id(15292);
     /// `FileSystemLoadingType` (ObjectType).
-    pub const FILE_SYSTEM_LOADING_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        192u32,
-    );
+    pub const FILE_SYSTEM_LOADING_TYPE: NsNodeId = id(192);
     /// `FunctionalGroupType` (ObjectType).
-    pub const FUNCTIONAL_GROUP_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1005u32,
-    );
+    pub const FUNCTIONAL_GROUP_TYPE: NsNodeId = id(1005);
     /// `InstallationStateMachineType` (ObjectType).
-    pub const INSTALLATION_STATE_MACHINE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        249u32,
-    );
+    pub const INSTALLATION_STATE_MACHINE_TYPE: NsNodeId = id(249);
     /// `IAssetLocationIndicationType` (ObjectType).
-    pub const I_ASSET_LOCATION_INDICATION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        118u32,
-    );
+    pub const I_ASSET_LOCATION_INDICATION_TYPE: NsNodeId = id(118);
     /// `IDeviceHealthType` (ObjectType).
-    pub const I_DEVICE_HEALTH_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15051u32,
-    );
+    pub const I_DEVICE_HEALTH_TYPE: NsNodeId = id(15051);
     /// `IOperationCounterType` (ObjectType).
     ///
     /// Interface defining counters for the duration of operation
-    pub const I_OPERATION_COUNTER_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        480u32,
-    );
+    pub const I_OPERATION_COUNTER_TYPE: NsNodeId = id(480);
     /// `ISupportInfoType` (ObjectType).
-    pub const I_SUPPORT_INFO_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15054u32,
-    );
+    pub const I_SUPPORT_INFO_TYPE: NsNodeId = id(15054);
     /// `ITagNameplateType` (ObjectType).
-    pub const I_TAG_NAMEPLATE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15048u32,
-    );
+    pub const I_TAG_NAMEPLATE_TYPE: NsNodeId = id(15048);
     /// `IVendorNameplateType` (ObjectType).
-    pub const I_VENDOR_NAMEPLATE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15035u32,
-    );
+    pub const I_VENDOR_NAMEPLATE_TYPE: NsNodeId = id(15035);
     /// `LengthIndicationType` (ObjectType).
     ///
     /// Indicates the abraded length, for example of a drill.
-    pub const LENGTH_INDICATION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        477u32,
-    );
+    pub const LENGTH_INDICATION_TYPE: NsNodeId = id(477);
     /// `LockingServicesType` (ObjectType).
-    pub const LOCKING_SERVICES_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6388u32,
-    );
+    pub const LOCKING_SERVICES_TYPE: NsNodeId = id(6388);
     /// `MaintenanceRequiredAlarmType` (ObjectType).
-    pub const MAINTENANCE_REQUIRED_ALARM_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15739u32,
-    );
+    pub const MAINTENANCE_REQUIRED_ALARM_TYPE: NsNodeId = id(15739);
     /// `NetworkType` (ObjectType).
-    pub const NETWORK_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6247u32,
-    );
+    pub const NETWORK_TYPE: NsNodeId = id(6247);
     /// `NumberOfPartsIndicationType` (ObjectType).
     ///
     /// Indicates the total number of parts that have been produced or can still be produced.
-    pub const NUMBER_OF_PARTS_INDICATION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        475u32,
-    );
+    pub const NUMBER_OF_PARTS_INDICATION_TYPE: NsNodeId = id(475);
     /// `NumberOfUsagesIndicationType` (ObjectType).
     ///
     /// Indicates counting the process steps the entity has been used or can still be used for (for example usages of a punching tool).
-    pub const NUMBER_OF_USAGES_INDICATION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        476u32,
-    );
+    pub const NUMBER_OF_USAGES_INDICATION_TYPE: NsNodeId = id(476);
     /// `OffSpecAlarmType` (ObjectType).
-    pub const OFF_SPEC_ALARM_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15590u32,
-    );
+    pub const OFF_SPEC_ALARM_TYPE: NsNodeId = id(15590);
     /// `PackageLoadingType` (ObjectType).
-    pub const PACKAGE_LOADING_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        137u32,
-    );
+    pub const PACKAGE_LOADING_TYPE: NsNodeId = id(137);
     /// `PowerCycleStateMachineType` (ObjectType).
-    pub const POWER_CYCLE_STATE_MACHINE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        285u32,
-    );
+    pub const POWER_CYCLE_STATE_MACHINE_TYPE: NsNodeId = id(285);
     /// `PrepareForUpdateStateMachineType` (ObjectType).
-    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        213u32,
-    );
+    pub const PREPARE_FOR_UPDATE_STATE_MACHINE_TYPE: NsNodeId = id(213);
     /// `ProtocolType` (ObjectType).
-    pub const PROTOCOL_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1006u32,
-    );
+    pub const PROTOCOL_TYPE: NsNodeId = id(1006);
     /// `SoftwareFolderType` (ObjectType).
-    pub const SOFTWARE_FOLDER_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        364u32,
-    );
+    pub const SOFTWARE_FOLDER_TYPE: NsNodeId = id(364);
     /// `SoftwareLoadingType` (ObjectType).
-    pub const SOFTWARE_LOADING_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        135u32,
-    );
+    pub const SOFTWARE_LOADING_TYPE: NsNodeId = id(135);
     /// `SoftwareType` (ObjectType).
-    pub const SOFTWARE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15106u32,
-    );
+    pub const SOFTWARE_TYPE: NsNodeId = id(15106);
     /// `SoftwareUpdateType` (ObjectType).
-    pub const SOFTWARE_UPDATE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1u32,
-    );
+    pub const SOFTWARE_UPDATE_TYPE: NsNodeId = id(1);
     /// `SoftwareVersionType` (ObjectType).
-    pub const SOFTWARE_VERSION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        212u32,
-    );
+    pub const SOFTWARE_VERSION_TYPE: NsNodeId = id(212);
     /// `SubstanceVolumeIndicationType` (ObjectType).
     ///
     /// Indicates the volume of a substance, for example of a liquid.
-    pub const SUBSTANCE_VOLUME_INDICATION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        479u32,
-    );
+    pub const SUBSTANCE_VOLUME_INDICATION_TYPE: NsNodeId = id(479);
     /// `TimeIndicationType` (ObjectType).
     ///
     /// Indicates the time the entity has been in use or can still be used
-    pub const TIME_INDICATION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        474u32,
-    );
+    pub const TIME_INDICATION_TYPE: NsNodeId = id(474);
     /// `TopologyElementType` (ObjectType).
-    pub const TOPOLOGY_ELEMENT_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1001u32,
-    );
+    pub const TOPOLOGY_ELEMENT_TYPE: NsNodeId = id(1001);
     /// `TransferServicesType` (ObjectType).
-    pub const TRANSFER_SERVICES_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6526u32,
-    );
+    pub const TRANSFER_SERVICES_TYPE: NsNodeId = id(6526);
 }
 /// The VariableType nodes of this namespace.
 pub mod variable_types {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `LifetimeVariableType` (VariableType).
     ///
     /// Remaining lifetime
-    pub const LIFETIME_VARIABLE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        468u32,
-    );
+    pub const LIFETIME_VARIABLE_TYPE: NsNodeId = id(468);
     /// `UIElementType` (VariableType).
-    pub const UI_ELEMENT_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6246u32,
-    );
+    pub const UI_ELEMENT_TYPE: NsNodeId = id(6246);
 }
 /// The ReferenceType nodes of this namespace.
 pub mod reference_types {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `CanUpdate` (ReferenceType).
-    pub const CAN_UPDATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        97u32,
-    );
+    pub const CAN_UPDATE: NsNodeId = id(97);
     /// `ConnectsTo` (ReferenceType).
-    pub const CONNECTS_TO: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6030u32,
-    );
+    pub const CONNECTS_TO: NsNodeId = id(6030);
     /// `ConnectsToParent` (ReferenceType).
-    pub const CONNECTS_TO_PARENT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6467u32,
-    );
+    pub const CONNECTS_TO_PARENT: NsNodeId = id(6467);
     /// `IsOnline` (ReferenceType).
-    pub const IS_ONLINE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6031u32,
-    );
+    pub const IS_ONLINE: NsNodeId = id(6031);
     /// `UpdateParent` (ReferenceType).
-    pub const UPDATE_PARENT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        96u32,
-    );
+    pub const UPDATE_PARENT: NsNodeId = id(96);
 }
 /// The DataType nodes of this namespace.
 pub mod data_types {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `DeviceHealthEnumeration` (DataType).
-    pub const DEVICE_HEALTH_ENUMERATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6244u32,
-    );
+    pub const DEVICE_HEALTH_ENUMERATION: NsNodeId = id(6244);
     /// `FetchResultDataType` (DataType).
-    pub const FETCH_RESULT_DATA_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6522u32,
-    );
+    pub const FETCH_RESULT_DATA_TYPE: NsNodeId = id(6522);
     /// `LocationIndicationType` (DataType).
-    pub const LOCATION_INDICATION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        410u32,
-    );
+    pub const LOCATION_INDICATION_TYPE: NsNodeId = id(410);
     /// `ParameterResultDataType` (DataType).
-    pub const PARAMETER_RESULT_DATA_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6525u32,
-    );
+    pub const PARAMETER_RESULT_DATA_TYPE: NsNodeId = id(6525);
     /// `SoftwareClass` (DataType).
-    pub const SOFTWARE_CLASS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        408u32,
-    );
+    pub const SOFTWARE_CLASS: NsNodeId = id(408);
     /// `SoftwareVersionFileType` (DataType).
-    pub const SOFTWARE_VERSION_FILE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        331u32,
-    );
+    pub const SOFTWARE_VERSION_FILE_TYPE: NsNodeId = id(331);
     /// `TransferResultDataDataType` (DataType).
-    pub const TRANSFER_RESULT_DATA_DATA_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15889u32,
-    );
+    pub const TRANSFER_RESULT_DATA_DATA_TYPE: NsNodeId = id(15889);
     /// `TransferResultErrorDataType` (DataType).
-    pub const TRANSFER_RESULT_ERROR_DATA_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15888u32,
-    );
+    pub const TRANSFER_RESULT_ERROR_DATA_TYPE: NsNodeId = id(15888);
     /// `UpdateBehavior` (DataType).
-    pub const UPDATE_BEHAVIOR: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        333u32,
-    );
+    pub const UPDATE_BEHAVIOR: NsNodeId = id(333);
 }

@@ -4,786 +4,500 @@
 //! NodeIds of every node of this namespace, resolved against a namespace table at run time.
 /// The Object nodes of this namespace.
 pub mod objects {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `<OrderedObject>` (Object).
     ///
     /// Represent the stack elements (lamps and acoustic elements) the stacklight is composed of. The HasOrderedComponent Reference shall represent the ordering from the base of the stacklight.
-    pub const BASIC_STACKLIGHT_TYPE_ORDERED_OBJECT_PLACEHOLDER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5006u32,
-    );
+    pub const BASIC_STACKLIGHT_TYPE_ORDERED_OBJECT_PLACEHOLDER: NsNodeId = id(5006);
     /// `StackLevel` (Object).
     ///
     /// Valid if the stacklight is used in “Levelmeter” StacklightMode. If so, the whole stack is controlled by a single percentual value. In this case, the SignalOn parameter of any stack element of StackElementLightType has no meaning.
-    pub const BASIC_STACKLIGHT_TYPE_STACK_LEVEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5001u32,
-    );
+    pub const BASIC_STACKLIGHT_TYPE_STACK_LEVEL: NsNodeId = id(5001);
     /// `StackRunning` (Object).
     ///
     /// Valid if the stacklight is used in “Running_Light” StacklightMode.
-    pub const BASIC_STACKLIGHT_TYPE_STACK_RUNNING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5005u32,
-    );
+    pub const BASIC_STACKLIGHT_TYPE_STACK_RUNNING: NsNodeId = id(5005);
     /// `CalibrationTargetCategory` (Object).
     ///
     /// Defines what category the calibration target is of.
-    pub const CALIBRATION_TARGET_TYPE_CALIBRATION_TARGET_CATEGORY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5011u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_CALIBRATION_TARGET_CATEGORY: NsNodeId = id(5011);
     /// `CalibrationTargetFeatures` (Object).
     ///
     /// A folder containing information about the features of a calibration target, that is, what can be calibrated with the calibration target.
-    pub const CALIBRATION_TARGET_TYPE_CALIBRATION_TARGET_FEATURES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5013u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_CALIBRATION_TARGET_FEATURES: NsNodeId = id(5013);
     /// `Identification` (Object).
     ///
     /// Provides identification information.
-    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5010u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION: NsNodeId = id(5010);
     /// `OperationalConditions` (Object).
     ///
     /// A folder containing information about operational conditions of the calibration target. For example, it might provide in what ranges of humidity the calibration target can be operated. It might also provide correction information, for example, depending on the temperature the calibration values need to be corrected (in case of a length, the length might increase with high temperatures). If no operational conditions are provided, this folder should be omitted.
-    pub const CALIBRATION_TARGET_TYPE_OPERATIONAL_CONDITIONS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5012u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_OPERATIONAL_CONDITIONS: NsNodeId = id(5012);
     /// `http://opcfoundation.org/UA/IA/` (Object).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_IA: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5008u32,
-    );
+    pub const HTTP_OPCFOUNDATION_ORG_UA_IA: NsNodeId = id(5008);
     /// `Default Binary` (Object).
-    pub const RGBW_DATA_TYPE_ENCODING_DEFAULT_BINARY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5009u32,
-    );
+    pub const RGBW_DATA_TYPE_ENCODING_DEFAULT_BINARY: NsNodeId = id(5009);
     /// `Default XML` (Object).
-    pub const RGBW_DATA_TYPE_ENCODING_DEFAULT_XML: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5014u32,
-    );
+    pub const RGBW_DATA_TYPE_ENCODING_DEFAULT_XML: NsNodeId = id(5014);
     /// `DeviceHealthAlarms` (Object).
     ///
     /// Contains alarms of the stacklights providing more detailed information on the health of the stacklight.
-    pub const STACKLIGHT_TYPE_DEVICE_HEALTH_ALARMS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5007u32,
-    );
+    pub const STACKLIGHT_TYPE_DEVICE_HEALTH_ALARMS: NsNodeId = id(5007);
     /// `AcousticSignals` (Object).
     ///
     /// Contains a list of audio signals used by this acoustic stacklight element.
-    pub const STACK_ELEMENT_ACOUSTIC_TYPE_ACOUSTIC_SIGNALS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5003u32,
-    );
+    pub const STACK_ELEMENT_ACOUSTIC_TYPE_ACOUSTIC_SIGNALS: NsNodeId = id(5003);
     /// `<OrderedObject>` (Object).
     ///
     /// Represents an acoustic signal.
-    pub const STACK_ELEMENT_ACOUSTIC_TYPE_ACOUSTIC_SIGNALS_ORDERED_OBJECT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5004u32,
+    pub const STACK_ELEMENT_ACOUSTIC_TYPE_ACOUSTIC_SIGNALS_ORDERED_OBJECT: NsNodeId = id(
+        5004,
     );
     /// `<ControlChannel>` (Object).
     ///
     /// The list of <ControlChannel> instances shows the control information for each independent colour channel of the stacked element.
-    pub const STACK_ELEMENT_LIGHT_TYPE_CONTROL_CHANNEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5002u32,
-    );
+    pub const STACK_ELEMENT_LIGHT_TYPE_CONTROL_CHANNEL: NsNodeId = id(5002);
 }
 /// The Variable nodes of this namespace.
 pub mod variables {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `AudioSample` (Variable).
     ///
     /// Contains the audio data, e.g. for devices capable of audio playback.
-    pub const ACOUSTIC_SIGNAL_TYPE_AUDIO_SAMPLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6029u32,
-    );
+    pub const ACOUSTIC_SIGNAL_TYPE_AUDIO_SAMPLE: NsNodeId = id(6029);
     /// `NumberInList` (Variable).
     ///
     /// Enumerate the acoustic signals. Instances of StackElementAcousticType index into this number using the OperationMode Property.
-    pub const ACOUSTIC_SIGNAL_TYPE_NUMBER_IN_LIST: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6028u32,
-    );
+    pub const ACOUSTIC_SIGNAL_TYPE_NUMBER_IN_LIST: NsNodeId = id(6028);
     /// `NumberInList` (Variable).
     ///
     /// Enumerate the stacklight elements counting upwards beginning from the base of the stacklight.
-    pub const BASIC_STACKLIGHT_TYPE_ORDERED_OBJECT_PLACEHOLDER_NUMBER_IN_LIST: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6037u32,
+    pub const BASIC_STACKLIGHT_TYPE_ORDERED_OBJECT_PLACEHOLDER_NUMBER_IN_LIST: NsNodeId = id(
+        6037,
     );
     /// `StacklightMode` (Variable).
     ///
     /// Shows in what way (stack of individual lights, level meter, running light) the stacklight unit is used.
-    pub const BASIC_STACKLIGHT_TYPE_STACKLIGHT_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6009u32,
-    );
+    pub const BASIC_STACKLIGHT_TYPE_STACKLIGHT_MODE: NsNodeId = id(6009);
     /// `DisplayMode` (Variable).
     ///
     /// Indicates in what way the percentual value is displayed with the stacklight.
-    pub const BASIC_STACKLIGHT_TYPE_STACK_LEVEL_DISPLAY_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6034u32,
-    );
+    pub const BASIC_STACKLIGHT_TYPE_STACK_LEVEL_DISPLAY_MODE: NsNodeId = id(6034);
     /// `LevelPercent` (Variable).
     ///
     /// Shows the percentual value the stacklight is representing. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent.
-    pub const BASIC_STACKLIGHT_TYPE_STACK_LEVEL_LEVEL_PERCENT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6035u32,
-    );
+    pub const BASIC_STACKLIGHT_TYPE_STACK_LEVEL_LEVEL_PERCENT: NsNodeId = id(6035);
     /// `EURange` (Variable).
-    pub const BASIC_STACKLIGHT_TYPE_STACK_LEVEL_LEVEL_PERCENT_EU_RANGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6036u32,
+    pub const BASIC_STACKLIGHT_TYPE_STACK_LEVEL_LEVEL_PERCENT_EU_RANGE: NsNodeId = id(
+        6036,
     );
     /// `<CalibrationValue>` (Variable).
     ///
     /// A calibration value indicates the value the calibration target provides for calibration and includes its quantity and engineering unit.
-    pub const CALIBRATION_TARGET_TYPE_CALIBRATION_TARGET_FEATURES_CALIBRATION_VALUE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6064u32,
+    pub const CALIBRATION_TARGET_TYPE_CALIBRATION_TARGET_FEATURES_CALIBRATION_VALUE: NsNodeId = id(
+        6064,
     );
     /// `EngineeringUnits` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_CALIBRATION_TARGET_FEATURES_CALIBRATION_VALUE_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6065u32,
+    pub const CALIBRATION_TARGET_TYPE_CALIBRATION_TARGET_FEATURES_CALIBRATION_VALUE_ENGINEERING_UNITS: NsNodeId = id(
+        6065,
     );
     /// `<CapacityRange>` (Variable).
     ///
     /// A capacity range indicates a range (low and high value) as well as a resolution, and thus defines a number of values the calibration target provides for calibration and includes the quantity and engineering unit.
-    pub const CALIBRATION_TARGET_TYPE_CALIBRATION_TARGET_FEATURES_CAPACITY_RANGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6066u32,
+    pub const CALIBRATION_TARGET_TYPE_CALIBRATION_TARGET_FEATURES_CAPACITY_RANGE: NsNodeId = id(
+        6066,
     );
     /// `EngineeringUnits` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_CALIBRATION_TARGET_FEATURES_CAPACITY_RANGE_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6067u32,
+    pub const CALIBRATION_TARGET_TYPE_CALIBRATION_TARGET_FEATURES_CAPACITY_RANGE_ENGINEERING_UNITS: NsNodeId = id(
+        6067,
     );
     /// `Resolution` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_CALIBRATION_TARGET_FEATURES_CAPACITY_RANGE_RESOLUTION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6068u32,
+    pub const CALIBRATION_TARGET_TYPE_CALIBRATION_TARGET_FEATURES_CAPACITY_RANGE_RESOLUTION: NsNodeId = id(
+        6068,
     );
     /// `CertificateUri` (Variable).
     ///
     /// Contains the Uri of a certificate of the calibration target, in case the calibration target is certified and the information available. Otherwise, the Property should be omitted.
-    pub const CALIBRATION_TARGET_TYPE_CERTIFICATE_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6063u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_CERTIFICATE_URI: NsNodeId = id(6063);
     /// `AssetId` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_ASSET_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6080u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_ASSET_ID: NsNodeId = id(6080);
     /// `ComponentName` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_COMPONENT_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6081u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_COMPONENT_NAME: NsNodeId = id(6081);
     /// `DeviceClass` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_DEVICE_CLASS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6076u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_DEVICE_CLASS: NsNodeId = id(6076);
     /// `DeviceManual` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_DEVICE_MANUAL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6082u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_DEVICE_MANUAL: NsNodeId = id(6082);
     /// `DeviceRevision` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_DEVICE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6075u32,
+    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_DEVICE_REVISION: NsNodeId = id(
+        6075,
     );
     /// `HardwareRevision` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_HARDWARE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6073u32,
+    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_HARDWARE_REVISION: NsNodeId = id(
+        6073,
     );
     /// `Manufacturer` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6069u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_MANUFACTURER: NsNodeId = id(6069);
     /// `ManufacturerUri` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_MANUFACTURER_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6070u32,
+    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_MANUFACTURER_URI: NsNodeId = id(
+        6070,
     );
     /// `Model` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6071u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_MODEL: NsNodeId = id(6071);
     /// `ProductCode` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6072u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_PRODUCT_CODE: NsNodeId = id(6072);
     /// `ProductInstanceUri` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_PRODUCT_INSTANCE_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6078u32,
+    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_PRODUCT_INSTANCE_URI: NsNodeId = id(
+        6078,
     );
     /// `RevisionCounter` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_REVISION_COUNTER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6079u32,
+    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_REVISION_COUNTER: NsNodeId = id(
+        6079,
     );
     /// `SerialNumber` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_SERIAL_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6077u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_SERIAL_NUMBER: NsNodeId = id(6077);
     /// `SoftwareRevision` (Variable).
-    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_SOFTWARE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6074u32,
+    pub const CALIBRATION_TARGET_TYPE_IDENTIFICATION_SOFTWARE_REVISION: NsNodeId = id(
+        6074,
     );
     /// `LastValidationDate` (Variable).
     ///
     /// Provides the date, the calibration target was validated the last time. If there is no specific validation date known, the date when the calibration target was bought or created should be used.
-    pub const CALIBRATION_TARGET_TYPE_LAST_VALIDATION_DATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6060u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_LAST_VALIDATION_DATE: NsNodeId = id(6060);
     /// `NextValidationDate` (Variable).
     ///
     /// Provides the date, when the calibration target should be validated the next time. If this date is not known, the Property should be omitted. Note: Potentially the NextValidationDate is in the past, when the next validation did not take place.
-    pub const CALIBRATION_TARGET_TYPE_NEXT_VALIDATION_DATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6061u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_NEXT_VALIDATION_DATE: NsNodeId = id(6061);
     /// `Quality` (Variable).
     ///
     /// Provides the quality of the calibration target in percentage, this is, the value shall be between 0 and 100. 100 means the highest quality, 0 the lowest. The semantic of the quality is application-specific.
-    pub const CALIBRATION_TARGET_TYPE_QUALITY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6062u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE_QUALITY: NsNodeId = id(6062);
     /// `EngineeringUnits` (Variable).
-    pub const CALIBRATION_VALUE_TYPE_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6057u32,
-    );
+    pub const CALIBRATION_VALUE_TYPE_ENGINEERING_UNITS: NsNodeId = id(6057);
     /// `EngineeringUnits` (Variable).
-    pub const CAPACITY_RANGE_TYPE_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6058u32,
-    );
+    pub const CAPACITY_RANGE_TYPE_ENGINEERING_UNITS: NsNodeId = id(6058);
     /// `Resolution` (Variable).
-    pub const CAPACITY_RANGE_TYPE_RESOLUTION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6059u32,
-    );
+    pub const CAPACITY_RANGE_TYPE_RESOLUTION: NsNodeId = id(6059);
     /// `ChannelColor` (Variable).
     ///
     /// Indicates in what mode (continuously on, blinking, flashing) the channel operates when switched on.
-    pub const CONTROL_CHANNEL_TYPE_CHANNEL_COLOR: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6024u32,
-    );
+    pub const CONTROL_CHANNEL_TYPE_CHANNEL_COLOR: NsNodeId = id(6024);
     /// `Intensity` (Variable).
     ///
     /// Shows the channel’s intensity, thus its brightness. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent.
-    pub const CONTROL_CHANNEL_TYPE_INTENSITY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6026u32,
-    );
+    pub const CONTROL_CHANNEL_TYPE_INTENSITY: NsNodeId = id(6026);
     /// `EURange` (Variable).
-    pub const CONTROL_CHANNEL_TYPE_INTENSITY_EU_RANGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6027u32,
-    );
+    pub const CONTROL_CHANNEL_TYPE_INTENSITY_EU_RANGE: NsNodeId = id(6027);
     /// `SignalMode` (Variable).
     ///
     /// Contains a list of audio signals used by this acoustic stacklight element.
-    pub const CONTROL_CHANNEL_TYPE_SIGNAL_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6025u32,
-    );
+    pub const CONTROL_CHANNEL_TYPE_SIGNAL_MODE: NsNodeId = id(6025);
     /// `SignalOn` (Variable).
     ///
     /// Indicates if the colour is switched on.
-    pub const CONTROL_CHANNEL_TYPE_SIGNAL_ON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6023u32,
-    );
+    pub const CONTROL_CHANNEL_TYPE_SIGNAL_ON: NsNodeId = id(6023);
     /// `IsNamespaceSubset` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_IA_IS_NAMESPACE_SUBSET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6039u32,
-    );
+    pub const HTTP_OPCFOUNDATION_ORG_UA_IA_IS_NAMESPACE_SUBSET: NsNodeId = id(6039);
     /// `NamespacePublicationDate` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_IA_NAMESPACE_PUBLICATION_DATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6040u32,
+    pub const HTTP_OPCFOUNDATION_ORG_UA_IA_NAMESPACE_PUBLICATION_DATE: NsNodeId = id(
+        6040,
     );
     /// `NamespaceUri` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_IA_NAMESPACE_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6041u32,
-    );
+    pub const HTTP_OPCFOUNDATION_ORG_UA_IA_NAMESPACE_URI: NsNodeId = id(6041);
     /// `NamespaceVersion` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_IA_NAMESPACE_VERSION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6042u32,
-    );
+    pub const HTTP_OPCFOUNDATION_ORG_UA_IA_NAMESPACE_VERSION: NsNodeId = id(6042);
     /// `StaticNodeIdTypes` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_IA_STATIC_NODE_ID_TYPES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6043u32,
-    );
+    pub const HTTP_OPCFOUNDATION_ORG_UA_IA_STATIC_NODE_ID_TYPES: NsNodeId = id(6043);
     /// `StaticNumericNodeIdRange` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_IA_STATIC_NUMERIC_NODE_ID_RANGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6044u32,
+    pub const HTTP_OPCFOUNDATION_ORG_UA_IA_STATIC_NUMERIC_NODE_ID_RANGE: NsNodeId = id(
+        6044,
     );
     /// `StaticStringNodeIdPattern` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_IA_STATIC_STRING_NODE_ID_PATTERN: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6045u32,
+    pub const HTTP_OPCFOUNDATION_ORG_UA_IA_STATIC_STRING_NODE_ID_PATTERN: NsNodeId = id(
+        6045,
     );
     /// `ResetCondition` (Variable).
     ///
     /// The reason and context for the reset of the statistics, which is done without a trigger from an OPC UA Client, like calling the ResetStatistics Method. ResetCondition is a vendor-specific, human readable string. ResetCondition is non-localized and might contain an expression that can be parsed by certain clients. Examples are: “AFTER 4 HOURS”, “AFTER 1000 ITEMS”, “OPERATOR”. “OPERATOR” means, that an operator resets the statistics on a local HMI.
-    pub const I_AGGREGATE_STATISTICS_TYPE_RESET_CONDITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6047u32,
-    );
+    pub const I_AGGREGATE_STATISTICS_TYPE_RESET_CONDITION: NsNodeId = id(6047);
     /// `WindowDuration` (Variable).
     ///
     /// The duration after the statistical data are rolled over. Only the data that were gathered during that duration are considered for the statistical data, even if the time interval between the StartTime and the current time is longer.
-    pub const I_ROLLING_STATISTICS_TYPE_WINDOW_DURATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6048u32,
-    );
+    pub const I_ROLLING_STATISTICS_TYPE_WINDOW_DURATION: NsNodeId = id(6048);
     /// `WindowNumberOfValues` (Variable).
     ///
     /// The number of values before the data gets rolled over. For the statistical data, only the data fitting into the number of values is considered, even if more data were gathered since StartTime.
-    pub const I_ROLLING_STATISTICS_TYPE_WINDOW_NUMBER_OF_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6049u32,
-    );
+    pub const I_ROLLING_STATISTICS_TYPE_WINDOW_NUMBER_OF_VALUES: NsNodeId = id(6049);
     /// `StartTime` (Variable).
     ///
     /// Indicates the point in time at which the collection of the statistical data has been started.
-    pub const I_STATISTICS_TYPE_START_TIME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6046u32,
-    );
+    pub const I_STATISTICS_TYPE_START_TIME: NsNodeId = id(6046);
     /// `EnumValues` (Variable).
-    pub const LEVEL_DISPLAY_MODE_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6001u32,
-    );
+    pub const LEVEL_DISPLAY_MODE_ENUM_VALUES: NsNodeId = id(6001);
     /// `EnumValues` (Variable).
-    pub const SIGNAL_COLOR_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6007u32,
-    );
+    pub const SIGNAL_COLOR_ENUM_VALUES: NsNodeId = id(6007);
     /// `EnumValues` (Variable).
-    pub const SIGNAL_MODE_LIGHT_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6008u32,
-    );
+    pub const SIGNAL_MODE_LIGHT_ENUM_VALUES: NsNodeId = id(6008);
     /// `EnumValues` (Variable).
-    pub const STACKLIGHT_OPERATION_MODE_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6006u32,
-    );
+    pub const STACKLIGHT_OPERATION_MODE_ENUM_VALUES: NsNodeId = id(6006);
     /// `DeviceHealth` (Variable).
     ///
     /// Contains the health status information of the stacklight.
-    pub const STACKLIGHT_TYPE_DEVICE_HEALTH: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6038u32,
-    );
+    pub const STACKLIGHT_TYPE_DEVICE_HEALTH: NsNodeId = id(6038);
     /// `NumberInList` (Variable).
     ///
     /// Enumerate the acoustic signals. Instances of StackElementAcousticType index into this number using the OperationMode Property.
-    pub const STACK_ELEMENT_ACOUSTIC_TYPE_ACOUSTIC_SIGNALS_ORDERED_OBJECT_NUMBER_IN_LIST: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6030u32,
+    pub const STACK_ELEMENT_ACOUSTIC_TYPE_ACOUSTIC_SIGNALS_ORDERED_OBJECT_NUMBER_IN_LIST: NsNodeId = id(
+        6030,
     );
     /// `Intensity` (Variable).
     ///
     /// Indicates the sound pressure level of the acoustic signal when switched on. This value shall only have positive values. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent.
-    pub const STACK_ELEMENT_ACOUSTIC_TYPE_INTENSITY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6021u32,
-    );
+    pub const STACK_ELEMENT_ACOUSTIC_TYPE_INTENSITY: NsNodeId = id(6021);
     /// `EURange` (Variable).
-    pub const STACK_ELEMENT_ACOUSTIC_TYPE_INTENSITY_EU_RANGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6022u32,
-    );
+    pub const STACK_ELEMENT_ACOUSTIC_TYPE_INTENSITY_EU_RANGE: NsNodeId = id(6022);
     /// `OperationMode` (Variable).
     ///
     /// Indicates what signal of the list of AcousticSignalType nodes is played when the acoustic element is switched on. It shall contain an index into the NumberInList of the respective AcousticSignalType Object of AcousticSignals.
-    pub const STACK_ELEMENT_ACOUSTIC_TYPE_OPERATION_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6020u32,
-    );
+    pub const STACK_ELEMENT_ACOUSTIC_TYPE_OPERATION_MODE: NsNodeId = id(6020);
     /// `ChannelColor` (Variable).
     ///
     /// Indicates in what mode (continuously on, blinking, flashing) the channel operates when switched on.
-    pub const STACK_ELEMENT_LIGHT_TYPE_CONTROL_CHANNEL_CHANNEL_COLOR: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6031u32,
+    pub const STACK_ELEMENT_LIGHT_TYPE_CONTROL_CHANNEL_CHANNEL_COLOR: NsNodeId = id(
+        6031,
     );
     /// `SignalMode` (Variable).
     ///
     /// Contains a list of audio signals used by this acoustic stacklight element.
-    pub const STACK_ELEMENT_LIGHT_TYPE_CONTROL_CHANNEL_SIGNAL_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6032u32,
-    );
+    pub const STACK_ELEMENT_LIGHT_TYPE_CONTROL_CHANNEL_SIGNAL_MODE: NsNodeId = id(6032);
     /// `SignalOn` (Variable).
     ///
     /// Indicates if the colour is switched on.
-    pub const STACK_ELEMENT_LIGHT_TYPE_CONTROL_CHANNEL_SIGNAL_ON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6033u32,
-    );
+    pub const STACK_ELEMENT_LIGHT_TYPE_CONTROL_CHANNEL_SIGNAL_ON: NsNodeId = id(6033);
     /// `Intensity` (Variable).
     ///
     /// Intensity of the lamp, thus its brightness. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent.
-    pub const STACK_ELEMENT_LIGHT_TYPE_INTENSITY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6018u32,
-    );
+    pub const STACK_ELEMENT_LIGHT_TYPE_INTENSITY: NsNodeId = id(6018);
     /// `EURange` (Variable).
-    pub const STACK_ELEMENT_LIGHT_TYPE_INTENSITY_EU_RANGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6019u32,
-    );
+    pub const STACK_ELEMENT_LIGHT_TYPE_INTENSITY_EU_RANGE: NsNodeId = id(6019);
     /// `SignalColor` (Variable).
     ///
     /// Indicates the colour the lamp element has when switched on.
-    pub const STACK_ELEMENT_LIGHT_TYPE_SIGNAL_COLOR: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6016u32,
-    );
+    pub const STACK_ELEMENT_LIGHT_TYPE_SIGNAL_COLOR: NsNodeId = id(6016);
     /// `SignalMode` (Variable).
     ///
     /// Shows in what way the lamp is used (continuous light, flashing, blinking) when switched on.
-    pub const STACK_ELEMENT_LIGHT_TYPE_SIGNAL_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6017u32,
-    );
+    pub const STACK_ELEMENT_LIGHT_TYPE_SIGNAL_MODE: NsNodeId = id(6017);
     /// `SignalRGBWValue` (Variable).
-    pub const STACK_ELEMENT_LIGHT_TYPE_SIGNAL_RGBW_VALUE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6052u32,
-    );
+    pub const STACK_ELEMENT_LIGHT_TYPE_SIGNAL_RGBW_VALUE: NsNodeId = id(6052);
     /// `IsPartOfBase` (Variable).
     ///
     /// Indicates, if the element is contained in the mounting base of the stacklight. All elements contained in the mounting base shall be at the beginning of the list of stack elements.
-    pub const STACK_ELEMENT_TYPE_IS_PART_OF_BASE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6014u32,
-    );
+    pub const STACK_ELEMENT_TYPE_IS_PART_OF_BASE: NsNodeId = id(6014);
     /// `NumberInList` (Variable).
     ///
     /// Enumerate the stacklight elements counting upwards beginning from the base of the stacklight.
-    pub const STACK_ELEMENT_TYPE_NUMBER_IN_LIST: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6015u32,
-    );
+    pub const STACK_ELEMENT_TYPE_NUMBER_IN_LIST: NsNodeId = id(6015);
     /// `SignalOn` (Variable).
     ///
     /// Indicates if the signal emitted by the stack element is currently switched on or not.
-    pub const STACK_ELEMENT_TYPE_SIGNAL_ON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6013u32,
-    );
+    pub const STACK_ELEMENT_TYPE_SIGNAL_ON: NsNodeId = id(6013);
     /// `DisplayMode` (Variable).
     ///
     /// Indicates in what way the percentual value is displayed with the stacklight.
-    pub const STACK_LEVEL_TYPE_DISPLAY_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6012u32,
-    );
+    pub const STACK_LEVEL_TYPE_DISPLAY_MODE: NsNodeId = id(6012);
     /// `LevelPercent` (Variable).
     ///
     /// Shows the percentual value the stacklight is representing. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent.
-    pub const STACK_LEVEL_TYPE_LEVEL_PERCENT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6010u32,
-    );
+    pub const STACK_LEVEL_TYPE_LEVEL_PERCENT: NsNodeId = id(6010);
     /// `EURange` (Variable).
-    pub const STACK_LEVEL_TYPE_LEVEL_PERCENT_EU_RANGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6011u32,
-    );
+    pub const STACK_LEVEL_TYPE_LEVEL_PERCENT_EU_RANGE: NsNodeId = id(6011);
     /// `TypeDictionary` (Variable).
     ///
     /// Collects the data type descriptions of http://opcfoundation.org/UA/IA
-    pub const TYPE_DICTIONARY_BINARY_SCHEMA: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6002u32,
-    );
+    pub const TYPE_DICTIONARY_BINARY_SCHEMA: NsNodeId = id(6002);
     /// `Deprecated` (Variable).
     ///
     /// Indicates that all of the DataType definitions represented by the DataTypeDictionaryType are available through a DataTypeDefinition Attribute.
-    pub const TYPE_DICTIONARY_BINARY_SCHEMA_DEPRECATED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6053u32,
-    );
+    pub const TYPE_DICTIONARY_BINARY_SCHEMA_DEPRECATED: NsNodeId = id(6053);
     /// `NamespaceUri` (Variable).
-    pub const TYPE_DICTIONARY_BINARY_SCHEMA_NAMESPACE_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6003u32,
-    );
+    pub const TYPE_DICTIONARY_BINARY_SCHEMA_NAMESPACE_URI: NsNodeId = id(6003);
     /// `RGBWDataType` (Variable).
-    pub const TYPE_DICTIONARY_BINARY_SCHEMA_RGBW_DATA_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6050u32,
-    );
+    pub const TYPE_DICTIONARY_BINARY_SCHEMA_RGBW_DATA_TYPE: NsNodeId = id(6050);
     /// `TypeDictionary` (Variable).
     ///
     /// Collects the data type descriptions of http://opcfoundation.org/UA/IA
-    pub const TYPE_DICTIONARY_XML_SCHEMA: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6004u32,
-    );
+    pub const TYPE_DICTIONARY_XML_SCHEMA: NsNodeId = id(6004);
     /// `Deprecated` (Variable).
     ///
     /// Indicates that all of the DataType definitions represented by the DataTypeDictionaryType are available through a DataTypeDefinition Attribute.
-    pub const TYPE_DICTIONARY_XML_SCHEMA_DEPRECATED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6054u32,
-    );
+    pub const TYPE_DICTIONARY_XML_SCHEMA_DEPRECATED: NsNodeId = id(6054);
     /// `NamespaceUri` (Variable).
-    pub const TYPE_DICTIONARY_XML_SCHEMA_NAMESPACE_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6005u32,
-    );
+    pub const TYPE_DICTIONARY_XML_SCHEMA_NAMESPACE_URI: NsNodeId = id(6005);
     /// `RGBWDataType` (Variable).
-    pub const TYPE_DICTIONARY_XML_SCHEMA_RGBW_DATA_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6051u32,
-    );
+    pub const TYPE_DICTIONARY_XML_SCHEMA_RGBW_DATA_TYPE: NsNodeId = id(6051);
 }
 /// The Method nodes of this namespace.
 pub mod methods {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `ResetStatistics` (Method).
     ///
     /// Restarts all statistical data, including a reset of the StartTime to the current time.
-    pub const I_STATISTICS_TYPE_RESET_STATISTICS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7001u32,
-    );
+    pub const I_STATISTICS_TYPE_RESET_STATISTICS: NsNodeId = id(7001);
 }
 /// The ObjectType nodes of this namespace.
 pub mod object_types {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `AcousticSignalType` (ObjectType).
     ///
     /// Represents an acoustic signal.
-    pub const ACOUSTIC_SIGNAL_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1009u32,
-    );
+    pub const ACOUSTIC_SIGNAL_TYPE: NsNodeId = id(1009);
     /// `BaseCalibrationTargetCategoryType` (ObjectType).
     ///
     /// Abstract base type for categorizing calibration targets. Subtypes define the concrete categories.
-    pub const BASE_CALIBRATION_TARGET_CATEGORY_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1014u32,
-    );
+    pub const BASE_CALIBRATION_TARGET_CATEGORY_TYPE: NsNodeId = id(1014);
     /// `BasicStacklightType` (ObjectType).
     ///
     /// Entry point to a stacklight containing elements of the stacklight as well as additional information valid for the whole unit.
-    pub const BASIC_STACKLIGHT_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1002u32,
-    );
+    pub const BASIC_STACKLIGHT_TYPE: NsNodeId = id(1002);
     /// `CalibrationTargetType` (ObjectType).
     ///
     /// Provides information about a calibration target.
-    pub const CALIBRATION_TARGET_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1019u32,
-    );
+    pub const CALIBRATION_TARGET_TYPE: NsNodeId = id(1019);
     /// `ControlChannelType` (ObjectType).
     ///
     /// Used for control channels of single colour elements within a stack element (e.g. RGB elements would use three ControlChannels, one for each controllable colour).
-    pub const CONTROL_CHANNEL_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1008u32,
-    );
+    pub const CONTROL_CHANNEL_TYPE: NsNodeId = id(1008);
     /// `DynamicCalibrationTargetCategoryType` (ObjectType).
     ///
     /// Characterizes a calibration target to be used together with a measurement instrument, that determines the values to be calibrated. It can be a piece created during the normal production process or an item specifically created for calibration purposes. The calibration target represents an individual piece or item, that is, if a new piece should be used or item is created, a new Object of this ObjectType is created.
-    pub const DYNAMIC_CALIBRATION_TARGET_CATEGORY_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1018u32,
-    );
+    pub const DYNAMIC_CALIBRATION_TARGET_CATEGORY_TYPE: NsNodeId = id(1018);
     /// `IAggregateStatisticsType` (ObjectType).
     ///
     /// Base interface for managing statistical data that is not rolled over. All data from the start of tracking the statistical data are considered, until the tracking gets reset.
-    pub const I_AGGREGATE_STATISTICS_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1012u32,
-    );
+    pub const I_AGGREGATE_STATISTICS_TYPE: NsNodeId = id(1012);
     /// `IRollingStatisticsType` (ObjectType).
     ///
     /// Base interface for managing statistical data that is rolled over, i.e. only a certain amount of data is considered for statistical data.
-    pub const I_ROLLING_STATISTICS_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1013u32,
-    );
+    pub const I_ROLLING_STATISTICS_TYPE: NsNodeId = id(1013);
     /// `IStatisticsType` (ObjectType).
     ///
     /// Base interface for managing statistical data.
-    pub const I_STATISTICS_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1011u32,
-    );
+    pub const I_STATISTICS_TYPE: NsNodeId = id(1011);
     /// `OneTimeCalibrationTargetCategoryType` (ObjectType).
     ///
     /// Categorizes a calibration target to be used only once, for example because the calibration destroys the target. Typically, Objects of this ObjectType do not represent one individual calibration target, but a batch of calibration targets with the same characteristics.
-    pub const ONE_TIME_CALIBRATION_TARGET_CATEGORY_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1017u32,
-    );
+    pub const ONE_TIME_CALIBRATION_TARGET_CATEGORY_TYPE: NsNodeId = id(1017);
     /// `ReusableCalibrationTargetCategoryType` (ObjectType).
     ///
     /// Categorizes a calibration target to be reused several times. For example, a calibration target like a meter, that is bought specifically for calibration and not destroyed by an individual usage is of this category.
-    pub const REUSABLE_CALIBRATION_TARGET_CATEGORY_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1015u32,
-    );
+    pub const REUSABLE_CALIBRATION_TARGET_CATEGORY_TYPE: NsNodeId = id(1015);
     /// `ReusableDeviceCalibrationTargetCategoryType` (ObjectType).
     ///
     /// Categorizes a calibration target to be a reusable device that produces a certain environment like pressure that can be used for calibration.
-    pub const REUSABLE_DEVICE_CALIBRATION_TARGET_CATEGORY_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1016u32,
-    );
+    pub const REUSABLE_DEVICE_CALIBRATION_TARGET_CATEGORY_TYPE: NsNodeId = id(1016);
     /// `StacklightType` (ObjectType).
     ///
     /// Entry point to a stacklight with the possibility to show the stacklight’s health status.
-    pub const STACKLIGHT_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1010u32,
-    );
+    pub const STACKLIGHT_TYPE: NsNodeId = id(1010);
     /// `StackElementAcousticType` (ObjectType).
     ///
     /// Represents an acoustic element in a stacklight.
-    pub const STACK_ELEMENT_ACOUSTIC_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1007u32,
-    );
+    pub const STACK_ELEMENT_ACOUSTIC_TYPE: NsNodeId = id(1007);
     /// `StackElementLightType` (ObjectType).
     ///
     /// Represents a lamp element in a stacklight.
-    pub const STACK_ELEMENT_LIGHT_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1006u32,
-    );
+    pub const STACK_ELEMENT_LIGHT_TYPE: NsNodeId = id(1006);
     /// `StackElementType` (ObjectType).
     ///
     /// Base class for elements in a stacklight.
-    pub const STACK_ELEMENT_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1005u32,
-    );
+    pub const STACK_ELEMENT_TYPE: NsNodeId = id(1005);
     /// `StackLevelType` (ObjectType).
     ///
     /// Contains information relevant to a stacklight operating as a level meter. The whole stack is controlled by a percentual value.
-    pub const STACK_LEVEL_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1003u32,
-    );
+    pub const STACK_LEVEL_TYPE: NsNodeId = id(1003);
     /// `StackRunningType` (ObjectType).
     ///
     /// Contains information relevant to a stacklight operating as a running light. This base type does not define any specific information, but can be extended.
-    pub const STACK_RUNNING_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1004u32,
-    );
+    pub const STACK_RUNNING_TYPE: NsNodeId = id(1004);
 }
 /// The VariableType nodes of this namespace.
 pub mod variable_types {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `CalibrationValueType` (VariableType).
     ///
     /// Represents the specific quantity and value (with engineering unit) that a calibration target provides for calibration of equipment.
-    pub const CALIBRATION_VALUE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        2002u32,
-    );
+    pub const CALIBRATION_VALUE_TYPE: NsNodeId = id(2002);
     /// `CapacityRangeType` (VariableType).
     ///
     /// Represent a scale of calibration values. The value defines the range (lowest and highest value), and the resolution property the size of each step.
-    pub const CAPACITY_RANGE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        2003u32,
-    );
+    pub const CAPACITY_RANGE_TYPE: NsNodeId = id(2003);
 }
 /// The ReferenceType nodes of this namespace.
 pub mod reference_types {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `HasReferenceMeasurementInstrument` (ReferenceType).
     ///
     /// Relates the source node to a reference measurement instrument, like for example a calibration target using a reference measurement instrument.
-    pub const HAS_REFERENCE_MEASUREMENT_INSTRUMENT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        4003u32,
-    );
+    pub const HAS_REFERENCE_MEASUREMENT_INSTRUMENT: NsNodeId = id(4003);
     /// `HasStatisticComponent` (ReferenceType).
     ///
     /// References of this type link Variables managing statistical data either directly or indirectly to an Object or ObjectType implementing the IStatisticsType interface.
-    pub const HAS_STATISTIC_COMPONENT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        4002u32,
-    );
+    pub const HAS_STATISTIC_COMPONENT: NsNodeId = id(4002);
 }
 /// The DataType nodes of this namespace.
 pub mod data_types {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `LevelDisplayMode` (DataType).
     ///
     /// Contains the values used to indicate how a percentual value is displayed if the stacklight unit works in Levelmeter mode.
-    pub const LEVEL_DISPLAY_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        3003u32,
-    );
+    pub const LEVEL_DISPLAY_MODE: NsNodeId = id(3003);
     /// `RGBWDataType` (DataType).
-    pub const RGBW_DATA_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        3007u32,
-    );
+    pub const RGBW_DATA_TYPE: NsNodeId = id(3007);
     /// `SignalColor` (DataType).
     ///
     /// Holds the possible colour values for stacklight lamps.
-    pub const SIGNAL_COLOR: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        3004u32,
-    );
+    pub const SIGNAL_COLOR: NsNodeId = id(3004);
     /// `SignalModeLight` (DataType).
     ///
     /// Contains the values used to indicate in what way a lamp behaves when switched on.
-    pub const SIGNAL_MODE_LIGHT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        3005u32,
-    );
+    pub const SIGNAL_MODE_LIGHT: NsNodeId = id(3005);
     /// `StacklightOperationMode` (DataType).
     ///
     /// Contains the values used to indicate how a stacklight (as a whole unit) is used.
-    pub const STACKLIGHT_OPERATION_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        3002u32,
-    );
+    pub const STACKLIGHT_OPERATION_MODE: NsNodeId = id(3002);
 }

@@ -4,2966 +4,1911 @@
 //! NodeIds of every node of this namespace, resolved against a namespace table at run time.
 /// The Object nodes of this namespace.
 pub mod objects {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `AdditionalLoad` (Object).
     ///
     /// The additional load which is mounted on this axis. E.g. for process-need a transformer for welding.
-    pub const AXIS_TYPE_ADDITIONAL_LOAD: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16638u32,
-    );
+    pub const AXIS_TYPE_ADDITIONAL_LOAD: NsNodeId = id(16638);
     /// `ParameterSet` (Object).
     ///
     /// Flat list of Parameters
-    pub const AXIS_TYPE_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16602u32,
-    );
+    pub const AXIS_TYPE_PARAMETER_SET: NsNodeId = id(16602);
     /// `<PowerTrainIdentifier>` (Object).
     ///
     /// The Requires reference provides the relationship of axes to powertrains. For complex kinematics this does not need to be a one to one relationship, because more than one power train might influence the motion of one axis. This reference connects all power trains to an axis that must be actively driven when only this axis should move and all other axes should stand still. Virtual axes that are not actively driven by a power train do not have this reference.
-    pub const AXIS_TYPE_POWER_TRAIN_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18344u32,
-    );
+    pub const AXIS_TYPE_POWER_TRAIN_IDENTIFIER: NsNodeId = id(18344);
     /// `Components` (Object).
     ///
     /// Components is a container for one or more instances of subtypes of ComponentType defined in OPC UA DI. The listed components are installed in the motion device system, e.g. a processing-unit, a power-supply, an IO-board or a drive, and have an electrical interface to the controller.
-    pub const CONTROLLER_TYPE_COMPONENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17252u32,
-    );
+    pub const CONTROLLER_TYPE_COMPONENTS: NsNodeId = id(17252);
     /// `<ComponentIdentifier>` (Object).
     ///
     /// The intention is to integrate inside this container devices which are defined in other companion specifications using DI.
-    pub const CONTROLLER_TYPE_COMPONENTS_COMPONENT_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18813u32,
-    );
+    pub const CONTROLLER_TYPE_COMPONENTS_COMPONENT_IDENTIFIER: NsNodeId = id(18813);
     /// `CurrentUser` (Object).
     ///
     /// The current user of the system.
-    pub const CONTROLLER_TYPE_CURRENT_USER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17249u32,
-    );
+    pub const CONTROLLER_TYPE_CURRENT_USER: NsNodeId = id(17249);
     /// `<MotionDeviceIdentifier>` (Object).
     ///
     /// The relationship of a motion device and controller.
-    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18964u32,
-    );
+    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER: NsNodeId = id(18964);
     /// `Axes` (Object).
     ///
     /// Axes is a container for one or more instances of the AxisType.
-    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_AXES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        19002u32,
-    );
+    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_AXES: NsNodeId = id(19002);
     /// `ParameterSet` (Object).
     ///
     /// Flat list of Parameters
-    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18965u32,
+    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_PARAMETER_SET: NsNodeId = id(
+        18965,
     );
     /// `PowerTrains` (Object).
     ///
     /// PowerTrains is a container for one or more instances of the PowerTrainType.
-    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_POWER_TRAINS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        19080u32,
+    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_POWER_TRAINS: NsNodeId = id(
+        19080,
     );
     /// `ParameterSet` (Object).
     ///
     /// Flat list of Parameters
-    pub const CONTROLLER_TYPE_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5004u32,
-    );
+    pub const CONTROLLER_TYPE_PARAMETER_SET: NsNodeId = id(5004);
     /// `Programs` (Object).
-    pub const CONTROLLER_TYPE_PROGRAMS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5054u32,
-    );
+    pub const CONTROLLER_TYPE_PROGRAMS: NsNodeId = id(5054);
     /// `<SafetyStatesIdentifier>` (Object).
     ///
     /// The relationship of safety states to a controller.
-    pub const CONTROLLER_TYPE_SAFETY_STATES_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18918u32,
-    );
+    pub const CONTROLLER_TYPE_SAFETY_STATES_IDENTIFIER: NsNodeId = id(18918);
     /// `ParameterSet` (Object).
     ///
     /// Flat list of Parameters
-    pub const CONTROLLER_TYPE_SAFETY_STATES_IDENTIFIER_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18919u32,
+    pub const CONTROLLER_TYPE_SAFETY_STATES_IDENTIFIER_PARAMETER_SET: NsNodeId = id(
+        18919,
     );
     /// `Software` (Object).
     ///
     /// Software is a container for one or more instances of SoftwareType defined in OPC UA DI.
-    pub const CONTROLLER_TYPE_SOFTWARE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15800u32,
-    );
+    pub const CONTROLLER_TYPE_SOFTWARE: NsNodeId = id(15800);
     /// `<SoftwareIdentifier>` (Object).
-    pub const CONTROLLER_TYPE_SOFTWARE_SOFTWARE_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18847u32,
-    );
+    pub const CONTROLLER_TYPE_SOFTWARE_SOFTWARE_IDENTIFIER: NsNodeId = id(18847);
     /// `SystemOperation` (Object).
-    pub const CONTROLLER_TYPE_SYSTEM_OPERATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5055u32,
-    );
+    pub const CONTROLLER_TYPE_SYSTEM_OPERATION: NsNodeId = id(5055);
     /// `SystemOperationStateMachine` (Object).
-    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5056u32,
+    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE: NsNodeId = id(
+        5056,
     );
     /// `TaskControls` (Object).
     ///
     /// TaskControls is a container for one or more instances of TaskControlType.
-    pub const CONTROLLER_TYPE_TASK_CONTROLS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15826u32,
-    );
+    pub const CONTROLLER_TYPE_TASK_CONTROLS: NsNodeId = id(15826);
     /// `<TaskControlIdentifier>` (Object).
-    pub const CONTROLLER_TYPE_TASK_CONTROLS_TASK_CONTROL_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18881u32,
+    pub const CONTROLLER_TYPE_TASK_CONTROLS_TASK_CONTROL_IDENTIFIER: NsNodeId = id(
+        18881,
     );
     /// `ParameterSet` (Object).
     ///
     /// Flat list of Parameters
-    pub const CONTROLLER_TYPE_TASK_CONTROLS_TASK_CONTROL_IDENTIFIER_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18882u32,
+    pub const CONTROLLER_TYPE_TASK_CONTROLS_TASK_CONTROL_IDENTIFIER_PARAMETER_SET: NsNodeId = id(
+        18882,
     );
     /// `Running` (Object).
-    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_RUNNING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5020u32,
-    );
+    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_RUNNING: NsNodeId = id(5020);
     /// `RunningToStopping` (Object).
-    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_RUNNING_TO_STOPPING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5022u32,
-    );
+    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_RUNNING_TO_STOPPING: NsNodeId = id(5022);
     /// `Stopping` (Object).
-    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_STOPPING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5021u32,
-    );
+    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_STOPPING: NsNodeId = id(5021);
     /// `http://opcfoundation.org/UA/Robotics/` (Object).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15011u32,
-    );
+    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS: NsNodeId = id(15011);
     /// `GettingReady` (Object).
-    pub const IDLE_SUBSTATE_MACHINE_TYPE_GETTING_READY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5017u32,
-    );
+    pub const IDLE_SUBSTATE_MACHINE_TYPE_GETTING_READY: NsNodeId = id(5017);
     /// `GettingReadyToStandBy` (Object).
-    pub const IDLE_SUBSTATE_MACHINE_TYPE_GETTING_READY_TO_STAND_BY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5018u32,
-    );
+    pub const IDLE_SUBSTATE_MACHINE_TYPE_GETTING_READY_TO_STAND_BY: NsNodeId = id(5018);
     /// `StandBy` (Object).
-    pub const IDLE_SUBSTATE_MACHINE_TYPE_STAND_BY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5015u32,
-    );
+    pub const IDLE_SUBSTATE_MACHINE_TYPE_STAND_BY: NsNodeId = id(5015);
     /// `StandByToGettingReady` (Object).
-    pub const IDLE_SUBSTATE_MACHINE_TYPE_STAND_BY_TO_GETTING_READY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5019u32,
-    );
+    pub const IDLE_SUBSTATE_MACHINE_TYPE_STAND_BY_TO_GETTING_READY: NsNodeId = id(5019);
     /// `Controllers` (Object).
     ///
     /// Contains the set of controllers in the motion device system.
-    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5001u32,
-    );
+    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS: NsNodeId = id(5001);
     /// `<ControllerIdentifier>` (Object).
-    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15405u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER: NsNodeId = id(
+        15405,
     );
     /// `CurrentUser` (Object).
     ///
     /// The given name of the device.
-    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_CURRENT_USER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15440u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_CURRENT_USER: NsNodeId = id(
+        15440,
     );
     /// `Software` (Object).
     ///
     /// Software is a container for one or more instances of SoftwareType defined in OPC UA DI.
-    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_SOFTWARE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15483u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_SOFTWARE: NsNodeId = id(
+        15483,
     );
     /// `TaskControls` (Object).
     ///
     /// TaskControls is a container for one or more instances of TaskControlType.
-    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_TASK_CONTROLS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15518u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_TASK_CONTROLS: NsNodeId = id(
+        15518,
     );
     /// `MotionDevices` (Object).
     ///
     /// Contains any kinematic or motion device which is part of the motion device system.
-    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5002u32,
-    );
+    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES: NsNodeId = id(5002);
     /// `<MotionDeviceIdentifier>` (Object).
-    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15008u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER: NsNodeId = id(
+        15008,
     );
     /// `Axes` (Object).
     ///
     /// Axes is a container for one or more instances of the AxisType.
-    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_AXES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15062u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_AXES: NsNodeId = id(
+        15062,
     );
     /// `ParameterSet` (Object).
     ///
     /// Flat list of Parameters
-    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15024u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_PARAMETER_SET: NsNodeId = id(
+        15024,
     );
     /// `PowerTrains` (Object).
     ///
     /// PowerTrains is a container for one or more instances of the PowerTrainType.
-    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_POWER_TRAINS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15208u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_POWER_TRAINS: NsNodeId = id(
+        15208,
     );
     /// `SafetyStates` (Object).
     ///
     /// Contains safety-related data from motion device system.
-    pub const MOTION_DEVICE_SYSTEM_TYPE_SAFETY_STATES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5010u32,
-    );
+    pub const MOTION_DEVICE_SYSTEM_TYPE_SAFETY_STATES: NsNodeId = id(5010);
     /// `<SafetyStateIdentifier>` (Object).
-    pub const MOTION_DEVICE_SYSTEM_TYPE_SAFETY_STATES_SAFETY_STATE_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15697u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_SAFETY_STATES_SAFETY_STATE_IDENTIFIER: NsNodeId = id(
+        15697,
     );
     /// `ParameterSet` (Object).
     ///
     /// Flat list of Parameters
-    pub const MOTION_DEVICE_SYSTEM_TYPE_SAFETY_STATES_SAFETY_STATE_IDENTIFIER_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15698u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_SAFETY_STATES_SAFETY_STATE_IDENTIFIER_PARAMETER_SET: NsNodeId = id(
+        15698,
     );
     /// `AdditionalComponents` (Object).
     ///
     /// AdditionalComponents is a container for one or more instances of subtypes of ComponentType defined in OPC UA DI. The listed components are installed at the motion device, e.g. an IO-board.
-    pub const MOTION_DEVICE_TYPE_ADDITIONAL_COMPONENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16566u32,
-    );
+    pub const MOTION_DEVICE_TYPE_ADDITIONAL_COMPONENTS: NsNodeId = id(16566);
     /// `<AdditionalComponentIdentifier>` (Object).
-    pub const MOTION_DEVICE_TYPE_ADDITIONAL_COMPONENTS_ADDITIONAL_COMPONENT_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5003u32,
+    pub const MOTION_DEVICE_TYPE_ADDITIONAL_COMPONENTS_ADDITIONAL_COMPONENT_IDENTIFIER: NsNodeId = id(
+        5003,
     );
     /// `Axes` (Object).
     ///
     /// Axes is a container for one or more instances of the AxisType.
-    pub const MOTION_DEVICE_TYPE_AXES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15305u32,
-    );
+    pub const MOTION_DEVICE_TYPE_AXES: NsNodeId = id(15305);
     /// `<AxisIdentifier>` (Object).
-    pub const MOTION_DEVICE_TYPE_AXES_AXIS_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15743u32,
-    );
+    pub const MOTION_DEVICE_TYPE_AXES_AXIS_IDENTIFIER: NsNodeId = id(15743);
     /// `ParameterSet` (Object).
     ///
     /// Flat list of Parameters
-    pub const MOTION_DEVICE_TYPE_AXES_AXIS_IDENTIFIER_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15744u32,
+    pub const MOTION_DEVICE_TYPE_AXES_AXIS_IDENTIFIER_PARAMETER_SET: NsNodeId = id(
+        15744,
     );
     /// `FlangeLoad` (Object).
     ///
     /// The FlangeLoad is the load on the flange or at the mounting point of the MotionDevice. This can be the maximum load of the MotionDevice.
-    pub const MOTION_DEVICE_TYPE_FLANGE_LOAD: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5091u32,
-    );
+    pub const MOTION_DEVICE_TYPE_FLANGE_LOAD: NsNodeId = id(5091);
     /// `ParameterSet` (Object).
     ///
     /// Flat list of Parameters
-    pub const MOTION_DEVICE_TYPE_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5029u32,
-    );
+    pub const MOTION_DEVICE_TYPE_PARAMETER_SET: NsNodeId = id(5029);
     /// `PowerTrains` (Object).
     ///
     /// PowerTrains is a container for one or more instances of the PowerTrainType.
-    pub const MOTION_DEVICE_TYPE_POWER_TRAINS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16443u32,
-    );
+    pub const MOTION_DEVICE_TYPE_POWER_TRAINS: NsNodeId = id(16443);
     /// `<PowerTrainIdentifier>` (Object).
-    pub const MOTION_DEVICE_TYPE_POWER_TRAINS_POWER_TRAIN_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15905u32,
+    pub const MOTION_DEVICE_TYPE_POWER_TRAINS_POWER_TRAIN_IDENTIFIER: NsNodeId = id(
+        15905,
     );
     /// `<DriveIdentifier>` (Object).
-    pub const MOTOR_TYPE_DRIVE_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5060u32,
-    );
+    pub const MOTOR_TYPE_DRIVE_IDENTIFIER: NsNodeId = id(5060);
     /// `ParameterSet` (Object).
     ///
     /// Flat list of Parameters
-    pub const MOTOR_TYPE_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5105u32,
-    );
+    pub const MOTOR_TYPE_PARAMETER_SET: NsNodeId = id(5105);
     /// `Executing` (Object).
     ///
     /// Entity is in a condition of execution.
-    pub const OPERATION_STATE_MACHINE_TYPE_EXECUTING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5007u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_EXECUTING: NsNodeId = id(5007);
     /// `ExecutingToIdle` (Object).
     ///
     /// Changes from Executing to Idle
-    pub const OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5013u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_IDLE: NsNodeId = id(5013);
     /// `ExecutingToReady` (Object).
     ///
     /// Changes from Executing to Ready
-    pub const OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_READY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5011u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_READY: NsNodeId = id(5011);
     /// `Idle` (Object).
     ///
     /// Entity is not in a condition to start execution.
-    pub const OPERATION_STATE_MACHINE_TYPE_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5005u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_IDLE: NsNodeId = id(5005);
     /// `IdleToIdle` (Object).
     ///
     /// Changes from Idle to Idle.
-    pub const OPERATION_STATE_MACHINE_TYPE_IDLE_TO_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5014u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_IDLE_TO_IDLE: NsNodeId = id(5014);
     /// `IdleToReady` (Object).
     ///
     /// Changes from Idle to Ready
-    pub const OPERATION_STATE_MACHINE_TYPE_IDLE_TO_READY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5009u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_IDLE_TO_READY: NsNodeId = id(5009);
     /// `Ready` (Object).
     ///
     /// Entity is in a condition to start execution.
-    pub const OPERATION_STATE_MACHINE_TYPE_READY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5006u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_READY: NsNodeId = id(5006);
     /// `ReadyToExecuting` (Object).
     ///
     /// Changes from Ready to Executing
-    pub const OPERATION_STATE_MACHINE_TYPE_READY_TO_EXECUTING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5012u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_READY_TO_EXECUTING: NsNodeId = id(5012);
     /// `ReadyToIdle` (Object).
     ///
     /// Changes from Ready to Idle
-    pub const OPERATION_STATE_MACHINE_TYPE_READY_TO_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5008u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_READY_TO_IDLE: NsNodeId = id(5008);
     /// `<AxisIdentifier>` (Object).
     ///
     /// Moves is a reference to provide the relationship of powertrains to axes. For complex kinematics this does not need to be a one to one relationship, because a powertrain might influence the motion of more than one axis. This reference connects all axis to a powertrain that that move when only this powertrain moves and all other powertrains stand still.
-    pub const POWER_TRAIN_TYPE_AXIS_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18536u32,
-    );
+    pub const POWER_TRAIN_TYPE_AXIS_IDENTIFIER: NsNodeId = id(18536);
     /// `ParameterSet` (Object).
     ///
     /// Flat list of Parameters
-    pub const POWER_TRAIN_TYPE_AXIS_IDENTIFIER_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18537u32,
-    );
+    pub const POWER_TRAIN_TYPE_AXIS_IDENTIFIER_PARAMETER_SET: NsNodeId = id(18537);
     /// `<GearIdentifier>` (Object).
-    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16041u32,
-    );
+    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER: NsNodeId = id(16041);
     /// `<MotorIdentifier>` (Object).
-    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15998u32,
-    );
+    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER: NsNodeId = id(15998);
     /// `ParameterSet` (Object).
     ///
     /// Flat list of Parameters
-    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15999u32,
-    );
+    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER_PARAMETER_SET: NsNodeId = id(15999);
     /// `<PowerTrainIdentifier>` (Object).
     ///
     /// HasSlave is a reference to provide the master-slave relationship of powertrains which provide torque for a common axis. The InverseName is IsSlaveOf.
-    pub const POWER_TRAIN_TYPE_POWER_TRAIN_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18613u32,
-    );
+    pub const POWER_TRAIN_TYPE_POWER_TRAIN_IDENTIFIER: NsNodeId = id(18613);
     /// `AtProgramStart` (Object).
-    pub const READY_SUBSTATE_MACHINE_TYPE_AT_PROGRAM_START: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5023u32,
-    );
+    pub const READY_SUBSTATE_MACHINE_TYPE_AT_PROGRAM_START: NsNodeId = id(5023);
     /// `ProgramStartToSuspended` (Object).
-    pub const READY_SUBSTATE_MACHINE_TYPE_PROGRAM_START_TO_SUSPENDED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5025u32,
+    pub const READY_SUBSTATE_MACHINE_TYPE_PROGRAM_START_TO_SUSPENDED: NsNodeId = id(
+        5025,
     );
     /// `Suspended` (Object).
-    pub const READY_SUBSTATE_MACHINE_TYPE_SUSPENDED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5024u32,
-    );
+    pub const READY_SUBSTATE_MACHINE_TYPE_SUSPENDED: NsNodeId = id(5024);
     /// `SuspendedToProgramStart` (Object).
-    pub const READY_SUBSTATE_MACHINE_TYPE_SUSPENDED_TO_PROGRAM_START: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5026u32,
+    pub const READY_SUBSTATE_MACHINE_TYPE_SUSPENDED_TO_PROGRAM_START: NsNodeId = id(
+        5026,
     );
     /// `EmergencyStopFunctions` (Object).
     ///
     /// EmergencyStopFunctions is a container for one or more instances of the EmergencyStopFunctionType.
-    pub const SAFETY_STATE_TYPE_EMERGENCY_STOP_FUNCTIONS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17221u32,
-    );
+    pub const SAFETY_STATE_TYPE_EMERGENCY_STOP_FUNCTIONS: NsNodeId = id(17221);
     /// `<EmergencyStopFunctionIdentifier>` (Object).
-    pub const SAFETY_STATE_TYPE_EMERGENCY_STOP_FUNCTIONS_EMERGENCY_STOP_FUNCTION_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18806u32,
+    pub const SAFETY_STATE_TYPE_EMERGENCY_STOP_FUNCTIONS_EMERGENCY_STOP_FUNCTION_IDENTIFIER: NsNodeId = id(
+        18806,
     );
     /// `ParameterSet` (Object).
     ///
     /// Flat list of Parameters
-    pub const SAFETY_STATE_TYPE_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5016u32,
-    );
+    pub const SAFETY_STATE_TYPE_PARAMETER_SET: NsNodeId = id(5016);
     /// `ProtectiveStopFunctions` (Object).
     ///
     /// ProtectiveStopFunctions is a container for one or more instances of the ProtectiveStopFunctionType.
-    pub const SAFETY_STATE_TYPE_PROTECTIVE_STOP_FUNCTIONS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17225u32,
-    );
+    pub const SAFETY_STATE_TYPE_PROTECTIVE_STOP_FUNCTIONS: NsNodeId = id(17225);
     /// `<ProtectiveStopFunctionIdentifier>` (Object).
-    pub const SAFETY_STATE_TYPE_PROTECTIVE_STOP_FUNCTIONS_PROTECTIVE_STOP_FUNCTION_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18809u32,
+    pub const SAFETY_STATE_TYPE_PROTECTIVE_STOP_FUNCTIONS_PROTECTIVE_STOP_FUNCTION_IDENTIFIER: NsNodeId = id(
+        18809,
     );
     /// `Executing` (Object).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5032u32,
-    );
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING: NsNodeId = id(5032);
     /// `ExecutingSubstateMachine` (Object).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5028u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE: NsNodeId = id(
+        5028,
     );
     /// `ExecutingToIdle` (Object).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5038u32,
-    );
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_IDLE: NsNodeId = id(5038);
     /// `ExecutingToReady` (Object).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_READY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5037u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_READY: NsNodeId = id(
+        5037,
     );
     /// `Idle` (Object).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5030u32,
-    );
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE: NsNodeId = id(5030);
     /// `IdleSubstateMachine` (Object).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5027u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE: NsNodeId = id(
+        5027,
     );
     /// `IdleToIdle` (Object).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_TO_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5033u32,
-    );
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_TO_IDLE: NsNodeId = id(5033);
     /// `IdleToReady` (Object).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_TO_READY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5034u32,
-    );
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_TO_READY: NsNodeId = id(5034);
     /// `Ready` (Object).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_READY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5031u32,
-    );
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_READY: NsNodeId = id(5031);
     /// `ReadyToExecuting` (Object).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_READY_TO_EXECUTING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5036u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_READY_TO_EXECUTING: NsNodeId = id(
+        5036,
     );
     /// `ReadyToIdle` (Object).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_READY_TO_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5035u32,
-    );
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_READY_TO_IDLE: NsNodeId = id(5035);
     /// `Conditions` (Object).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5050u32,
-    );
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS: NsNodeId = id(5050);
     /// `<AcknowledgeableCondition>` (Object).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5059u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION: NsNodeId = id(
+        5059,
     );
     /// `SystemOperationStateMachine` (Object).
-    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5049u32,
-    );
+    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE: NsNodeId = id(5049);
     /// `TaskControlStateMachine` (Object).
-    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5051u32,
+    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE: NsNodeId = id(
+        5051,
     );
     /// `Executing` (Object).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_EXECUTING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5042u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_EXECUTING: NsNodeId = id(5042);
     /// `ExecutingToIdle` (Object).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_EXECUTING_TO_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5048u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_EXECUTING_TO_IDLE: NsNodeId = id(5048);
     /// `ExecutingToReady` (Object).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_EXECUTING_TO_READY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5047u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_EXECUTING_TO_READY: NsNodeId = id(5047);
     /// `Idle` (Object).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5040u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_IDLE: NsNodeId = id(5040);
     /// `IdleToIdle` (Object).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_IDLE_TO_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5043u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_IDLE_TO_IDLE: NsNodeId = id(5043);
     /// `IdleToReady` (Object).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_IDLE_TO_READY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5044u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_IDLE_TO_READY: NsNodeId = id(5044);
     /// `Ready` (Object).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5041u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY: NsNodeId = id(5041);
     /// `ReadySubstateMachine` (Object).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5039u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE: NsNodeId = id(
+        5039,
     );
     /// `ReadyToExecuting` (Object).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_TO_EXECUTING: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5046u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_TO_EXECUTING: NsNodeId = id(5046);
     /// `ReadyToIdle` (Object).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_TO_IDLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5045u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_TO_IDLE: NsNodeId = id(5045);
     /// `<MotionDeviceIdentifier>` (Object).
     ///
     /// Controls is a reference to provide the relationship between a task control and a motion device.
-    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        19254u32,
-    );
+    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER: NsNodeId = id(19254);
     /// `Axes` (Object).
     ///
     /// Axes is a container for one or more instances of the AxisType.
-    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_AXES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        19292u32,
-    );
+    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_AXES: NsNodeId = id(19292);
     /// `ParameterSet` (Object).
     ///
     /// Flat list of Parameters
-    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        19255u32,
+    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_PARAMETER_SET: NsNodeId = id(
+        19255,
     );
     /// `PowerTrains` (Object).
     ///
     /// PowerTrains is a container for one or more instances of the PowerTrainType.
-    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_POWER_TRAINS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        19370u32,
+    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_POWER_TRAINS: NsNodeId = id(
+        19370,
     );
     /// `ParameterSet` (Object).
     ///
     /// Flat list of Parameters
-    pub const TASK_CONTROL_TYPE_PARAMETER_SET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15883u32,
-    );
+    pub const TASK_CONTROL_TYPE_PARAMETER_SET: NsNodeId = id(15883);
     /// `TaskControlOperation` (Object).
-    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5052u32,
-    );
+    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION: NsNodeId = id(5052);
     /// `TaskControlStateMachine` (Object).
-    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5053u32,
+    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE: NsNodeId = id(
+        5053,
     );
     /// `TaskModules` (Object).
-    pub const TASK_CONTROL_TYPE_TASK_MODULES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5057u32,
-    );
+    pub const TASK_CONTROL_TYPE_TASK_MODULES: NsNodeId = id(5057);
     /// `<TaskModule>` (Object).
-    pub const TASK_CONTROL_TYPE_TASK_MODULES_TASK_MODULE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        5058u32,
-    );
+    pub const TASK_CONTROL_TYPE_TASK_MODULES_TASK_MODULE: NsNodeId = id(5058);
 }
 /// The Variable nodes of this namespace.
 pub mod variables {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `AssetId` (Variable).
-    pub const AUXILIARY_COMPONENT_TYPE_ASSET_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6183u32,
-    );
+    pub const AUXILIARY_COMPONENT_TYPE_ASSET_ID: NsNodeId = id(6183);
     /// `ProductCode` (Variable).
     ///
     /// The ProductCode property provides a unique combination of numbers and letters used to identify the product. It may be the order information displayed on type shields or in ERP systems.
-    pub const AUXILIARY_COMPONENT_TYPE_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17756u32,
-    );
+    pub const AUXILIARY_COMPONENT_TYPE_PRODUCT_CODE: NsNodeId = id(17756);
     /// `EnumStrings` (Variable).
-    pub const AXIS_MOTION_PROFILE_ENUMERATION_ENUM_STRINGS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6027u32,
-    );
+    pub const AXIS_MOTION_PROFILE_ENUMERATION_ENUM_STRINGS: NsNodeId = id(6027);
     /// `Mass` (Variable).
     ///
     /// The weight of the load mounted on one mounting point.
-    pub const AXIS_TYPE_ADDITIONAL_LOAD_MASS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16639u32,
-    );
+    pub const AXIS_TYPE_ADDITIONAL_LOAD_MASS: NsNodeId = id(16639);
     /// `EngineeringUnits` (Variable).
-    pub const AXIS_TYPE_ADDITIONAL_LOAD_MASS_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16644u32,
-    );
+    pub const AXIS_TYPE_ADDITIONAL_LOAD_MASS_ENGINEERING_UNITS: NsNodeId = id(16644);
     /// `AssetId` (Variable).
-    pub const AXIS_TYPE_ASSET_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6175u32,
-    );
+    pub const AXIS_TYPE_ASSET_ID: NsNodeId = id(6175);
     /// `MotionProfile` (Variable).
     ///
     /// The kind of axis motion as defined with the AxisMotionProfileEnumeration.
-    pub const AXIS_TYPE_MOTION_PROFILE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16637u32,
-    );
+    pub const AXIS_TYPE_MOTION_PROFILE: NsNodeId = id(16637);
     /// `ActualAcceleration` (Variable).
     ///
     /// : The ActualAcceleration variable provides the axis acceleration. Applicable acceleration limits of the axis shall be provided by the EURange property of the AnalogUnitType.
-    pub const AXIS_TYPE_PARAMETER_SET_ACTUAL_ACCELERATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16674u32,
-    );
+    pub const AXIS_TYPE_PARAMETER_SET_ACTUAL_ACCELERATION: NsNodeId = id(16674);
     /// `EngineeringUnits` (Variable).
-    pub const AXIS_TYPE_PARAMETER_SET_ACTUAL_ACCELERATION_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16679u32,
+    pub const AXIS_TYPE_PARAMETER_SET_ACTUAL_ACCELERATION_ENGINEERING_UNITS: NsNodeId = id(
+        16679,
     );
     /// `ActualPosition` (Variable).
     ///
     /// The axis position inclusive Unit and RangeOfMotion.
-    pub const AXIS_TYPE_PARAMETER_SET_ACTUAL_POSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16662u32,
-    );
+    pub const AXIS_TYPE_PARAMETER_SET_ACTUAL_POSITION: NsNodeId = id(16662);
     /// `EngineeringUnits` (Variable).
-    pub const AXIS_TYPE_PARAMETER_SET_ACTUAL_POSITION_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16667u32,
+    pub const AXIS_TYPE_PARAMETER_SET_ACTUAL_POSITION_ENGINEERING_UNITS: NsNodeId = id(
+        16667,
     );
     /// `ActualSpeed` (Variable).
     ///
     /// The axis speed on load side (after gear/spindle) inclusive Unit.
-    pub const AXIS_TYPE_PARAMETER_SET_ACTUAL_SPEED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16668u32,
-    );
+    pub const AXIS_TYPE_PARAMETER_SET_ACTUAL_SPEED: NsNodeId = id(16668);
     /// `EngineeringUnits` (Variable).
-    pub const AXIS_TYPE_PARAMETER_SET_ACTUAL_SPEED_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16673u32,
+    pub const AXIS_TYPE_PARAMETER_SET_ACTUAL_SPEED_ENGINEERING_UNITS: NsNodeId = id(
+        16673,
     );
     /// `AssetId` (Variable).
-    pub const CONTROLLER_TYPE_ASSET_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6180u32,
-    );
+    pub const CONTROLLER_TYPE_ASSET_ID: NsNodeId = id(6180);
     /// `ComponentName` (Variable).
-    pub const CONTROLLER_TYPE_COMPONENT_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6181u32,
-    );
+    pub const CONTROLLER_TYPE_COMPONENT_NAME: NsNodeId = id(6181);
     /// `Level` (Variable).
     ///
     /// The weight of the load mounted on one mounting point.
-    pub const CONTROLLER_TYPE_CURRENT_USER_LEVEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17250u32,
-    );
+    pub const CONTROLLER_TYPE_CURRENT_USER_LEVEL: NsNodeId = id(17250);
     /// `DeviceManual` (Variable).
-    pub const CONTROLLER_TYPE_DEVICE_MANUAL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6182u32,
-    );
+    pub const CONTROLLER_TYPE_DEVICE_MANUAL: NsNodeId = id(6182);
     /// `Manufacturer` (Variable).
-    pub const CONTROLLER_TYPE_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17237u32,
+    pub const CONTROLLER_TYPE_MANUFACTURER: NsNodeId = id(17237);
+    /// `Model` (Variable).
+    pub const CONTROLLER_TYPE_MODEL: NsNodeId = id(17239);
+    /// `Manufacturer` (Variable).
+    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_MANUFACTURER: NsNodeId = id(
+        18985,
     );
     /// `Model` (Variable).
-    pub const CONTROLLER_TYPE_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17239u32,
-    );
-    /// `Manufacturer` (Variable).
-    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18985u32,
-    );
-    /// `Model` (Variable).
-    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18987u32,
-    );
+    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_MODEL: NsNodeId = id(18987);
     /// `MotionDeviceCategory` (Variable).
     ///
     /// The variable MotionDeviceCategory provides the kind of motion device defined by MotionDeviceCategoryEnumeration based on ISO 8373.
-    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_MOTION_DEVICE_CATEGORY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18998u32,
+    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_MOTION_DEVICE_CATEGORY: NsNodeId = id(
+        18998,
     );
     /// `SpeedOverride` (Variable).
     ///
     /// SpeedOverride provides the current speed setting in percent of programmed speed (0 - 100%).
-    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_PARAMETER_SET_SPEED_OVERRIDE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        19001u32,
+    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_PARAMETER_SET_SPEED_OVERRIDE: NsNodeId = id(
+        19001,
     );
     /// `ProductCode` (Variable).
-    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18993u32,
+    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_PRODUCT_CODE: NsNodeId = id(
+        18993,
     );
     /// `SerialNumber` (Variable).
-    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_SERIAL_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18988u32,
+    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_SERIAL_NUMBER: NsNodeId = id(
+        18988,
     );
     /// `TaskControlReference` (Variable).
-    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_TASK_CONTROL_REFERENCE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6003u32,
+    pub const CONTROLLER_TYPE_MOTION_DEVICE_IDENTIFIER_TASK_CONTROL_REFERENCE: NsNodeId = id(
+        6003,
     );
     /// `CabinetFanSpeed` (Variable).
     ///
     /// The speed of the cabinet fan.
-    pub const CONTROLLER_TYPE_PARAMETER_SET_CABINET_FAN_SPEED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17365u32,
-    );
+    pub const CONTROLLER_TYPE_PARAMETER_SET_CABINET_FAN_SPEED: NsNodeId = id(17365);
     /// `EngineeringUnits` (Variable).
-    pub const CONTROLLER_TYPE_PARAMETER_SET_CABINET_FAN_SPEED_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17370u32,
+    pub const CONTROLLER_TYPE_PARAMETER_SET_CABINET_FAN_SPEED_ENGINEERING_UNITS: NsNodeId = id(
+        17370,
     );
     /// `CPUFanSpeed` (Variable).
     ///
     /// The speed of the CPU fan.
-    pub const CONTROLLER_TYPE_PARAMETER_SET_CPU_FAN_SPEED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17371u32,
-    );
+    pub const CONTROLLER_TYPE_PARAMETER_SET_CPU_FAN_SPEED: NsNodeId = id(17371);
     /// `EngineeringUnits` (Variable).
-    pub const CONTROLLER_TYPE_PARAMETER_SET_CPU_FAN_SPEED_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17376u32,
+    pub const CONTROLLER_TYPE_PARAMETER_SET_CPU_FAN_SPEED_ENGINEERING_UNITS: NsNodeId = id(
+        17376,
     );
     /// `InputVoltage` (Variable).
     ///
     /// The input voltage of the controller which can be a configured value. To distinguish between an AC or DC supply the optional property Definition of the base type DataItemType shall be used.
-    pub const CONTROLLER_TYPE_PARAMETER_SET_INPUT_VOLTAGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17377u32,
-    );
+    pub const CONTROLLER_TYPE_PARAMETER_SET_INPUT_VOLTAGE: NsNodeId = id(17377);
     /// `EngineeringUnits` (Variable).
-    pub const CONTROLLER_TYPE_PARAMETER_SET_INPUT_VOLTAGE_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17382u32,
+    pub const CONTROLLER_TYPE_PARAMETER_SET_INPUT_VOLTAGE_ENGINEERING_UNITS: NsNodeId = id(
+        17382,
     );
     /// `StartUpTime` (Variable).
     ///
     /// The date and time of the last start-up of the controller.
-    pub const CONTROLLER_TYPE_PARAMETER_SET_START_UP_TIME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15366u32,
-    );
+    pub const CONTROLLER_TYPE_PARAMETER_SET_START_UP_TIME: NsNodeId = id(15366);
     /// `Temperature` (Variable).
     ///
     /// The controller temperature given by a temperature sensor inside of the controller.
-    pub const CONTROLLER_TYPE_PARAMETER_SET_TEMPERATURE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17383u32,
-    );
+    pub const CONTROLLER_TYPE_PARAMETER_SET_TEMPERATURE: NsNodeId = id(17383);
     /// `EngineeringUnits` (Variable).
-    pub const CONTROLLER_TYPE_PARAMETER_SET_TEMPERATURE_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17388u32,
+    pub const CONTROLLER_TYPE_PARAMETER_SET_TEMPERATURE_ENGINEERING_UNITS: NsNodeId = id(
+        17388,
     );
     /// `TotalEnergyConsumption` (Variable).
     ///
     /// The total accumulated energy consumed by the motion devices related with this controller instance.
-    pub const CONTROLLER_TYPE_PARAMETER_SET_TOTAL_ENERGY_CONSUMPTION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17359u32,
+    pub const CONTROLLER_TYPE_PARAMETER_SET_TOTAL_ENERGY_CONSUMPTION: NsNodeId = id(
+        17359,
     );
     /// `EngineeringUnits` (Variable).
-    pub const CONTROLLER_TYPE_PARAMETER_SET_TOTAL_ENERGY_CONSUMPTION_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17364u32,
+    pub const CONTROLLER_TYPE_PARAMETER_SET_TOTAL_ENERGY_CONSUMPTION_ENGINEERING_UNITS: NsNodeId = id(
+        17364,
     );
     /// `TotalPowerOnTime` (Variable).
     ///
     /// The total accumulated time the controller was powered on.
-    pub const CONTROLLER_TYPE_PARAMETER_SET_TOTAL_POWER_ON_TIME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17358u32,
-    );
+    pub const CONTROLLER_TYPE_PARAMETER_SET_TOTAL_POWER_ON_TIME: NsNodeId = id(17358);
     /// `UpsState` (Variable).
     ///
     /// The vendor specific status of an integrated UPS or accumulator system.
-    pub const CONTROLLER_TYPE_PARAMETER_SET_UPS_STATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15365u32,
-    );
+    pub const CONTROLLER_TYPE_PARAMETER_SET_UPS_STATE: NsNodeId = id(15365);
     /// `ProductCode` (Variable).
-    pub const CONTROLLER_TYPE_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17245u32,
-    );
+    pub const CONTROLLER_TYPE_PRODUCT_CODE: NsNodeId = id(17245);
     /// `InputArguments` (Variable).
-    pub const CONTROLLER_TYPE_PROGRAMS_CREATE_DIRECTORY_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6155u32,
+    pub const CONTROLLER_TYPE_PROGRAMS_CREATE_DIRECTORY_INPUT_ARGUMENTS: NsNodeId = id(
+        6155,
     );
     /// `OutputArguments` (Variable).
-    pub const CONTROLLER_TYPE_PROGRAMS_CREATE_DIRECTORY_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6156u32,
+    pub const CONTROLLER_TYPE_PROGRAMS_CREATE_DIRECTORY_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6156,
     );
     /// `InputArguments` (Variable).
-    pub const CONTROLLER_TYPE_PROGRAMS_CREATE_FILE_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6157u32,
-    );
+    pub const CONTROLLER_TYPE_PROGRAMS_CREATE_FILE_INPUT_ARGUMENTS: NsNodeId = id(6157);
     /// `OutputArguments` (Variable).
-    pub const CONTROLLER_TYPE_PROGRAMS_CREATE_FILE_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6158u32,
-    );
+    pub const CONTROLLER_TYPE_PROGRAMS_CREATE_FILE_OUTPUT_ARGUMENTS: NsNodeId = id(6158);
     /// `InputArguments` (Variable).
-    pub const CONTROLLER_TYPE_PROGRAMS_DELETE_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6159u32,
-    );
+    pub const CONTROLLER_TYPE_PROGRAMS_DELETE_INPUT_ARGUMENTS: NsNodeId = id(6159);
     /// `InputArguments` (Variable).
-    pub const CONTROLLER_TYPE_PROGRAMS_MOVE_OR_COPY_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6160u32,
-    );
+    pub const CONTROLLER_TYPE_PROGRAMS_MOVE_OR_COPY_INPUT_ARGUMENTS: NsNodeId = id(6160);
     /// `OutputArguments` (Variable).
-    pub const CONTROLLER_TYPE_PROGRAMS_MOVE_OR_COPY_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6161u32,
+    pub const CONTROLLER_TYPE_PROGRAMS_MOVE_OR_COPY_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6161,
     );
     /// `EmergencyStop` (Variable).
     ///
     /// The EmergencyStop variable is TRUE if one or more of the emergency stop functions in the robot system are active, FALSE otherwise. If the EmergencyStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed emergency stop functions are active.
-    pub const CONTROLLER_TYPE_SAFETY_STATES_IDENTIFIER_PARAMETER_SET_EMERGENCY_STOP: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18962u32,
+    pub const CONTROLLER_TYPE_SAFETY_STATES_IDENTIFIER_PARAMETER_SET_EMERGENCY_STOP: NsNodeId = id(
+        18962,
     );
     /// `OperationalMode` (Variable).
     ///
     /// The OperationalMode variable provides information about the current operational mode. Allowed values are described in OperationalModeEnumeration, see ISO 10218-1:2011 Ch.5.7 Operational Modes.
-    pub const CONTROLLER_TYPE_SAFETY_STATES_IDENTIFIER_PARAMETER_SET_OPERATIONAL_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18961u32,
+    pub const CONTROLLER_TYPE_SAFETY_STATES_IDENTIFIER_PARAMETER_SET_OPERATIONAL_MODE: NsNodeId = id(
+        18961,
     );
     /// `ProtectiveStop` (Variable).
     ///
     /// The ProtectiveStop variable is TRUE if one or more of the enabled protective stop functions in the system are active, FALSE otherwise. If the ProtectiveStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed protective stop functions are enabled and active.
-    pub const CONTROLLER_TYPE_SAFETY_STATES_IDENTIFIER_PARAMETER_SET_PROTECTIVE_STOP: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18963u32,
+    pub const CONTROLLER_TYPE_SAFETY_STATES_IDENTIFIER_PARAMETER_SET_PROTECTIVE_STOP: NsNodeId = id(
+        18963,
     );
     /// `SerialNumber` (Variable).
-    pub const CONTROLLER_TYPE_SERIAL_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17240u32,
-    );
+    pub const CONTROLLER_TYPE_SERIAL_NUMBER: NsNodeId = id(17240);
     /// `Manufacturer` (Variable).
-    pub const CONTROLLER_TYPE_SOFTWARE_SOFTWARE_IDENTIFIER_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18868u32,
+    pub const CONTROLLER_TYPE_SOFTWARE_SOFTWARE_IDENTIFIER_MANUFACTURER: NsNodeId = id(
+        18868,
     );
     /// `Model` (Variable).
-    pub const CONTROLLER_TYPE_SOFTWARE_SOFTWARE_IDENTIFIER_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18870u32,
-    );
+    pub const CONTROLLER_TYPE_SOFTWARE_SOFTWARE_IDENTIFIER_MODEL: NsNodeId = id(18870);
     /// `SoftwareRevision` (Variable).
-    pub const CONTROLLER_TYPE_SOFTWARE_SOFTWARE_IDENTIFIER_SOFTWARE_REVISION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18873u32,
+    pub const CONTROLLER_TYPE_SOFTWARE_SOFTWARE_IDENTIFIER_SOFTWARE_REVISION: NsNodeId = id(
+        18873,
     );
     /// `CurrentState` (Variable).
-    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE_CURRENT_STATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6162u32,
+    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE_CURRENT_STATE: NsNodeId = id(
+        6162,
     );
     /// `Id` (Variable).
-    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE_CURRENT_STATE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6163u32,
+    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE_CURRENT_STATE_ID: NsNodeId = id(
+        6163,
     );
     /// `LastTransition` (Variable).
-    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6164u32,
+    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION: NsNodeId = id(
+        6164,
     );
     /// `Id` (Variable).
-    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6165u32,
+    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_ID: NsNodeId = id(
+        6165,
     );
     /// `LastTransitionReason` (Variable).
-    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_REASON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6166u32,
+    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_REASON: NsNodeId = id(
+        6166,
     );
     /// `EnumValues` (Variable).
-    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_REASON_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6167u32,
+    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_REASON_ENUM_VALUES: NsNodeId = id(
+        6167,
     );
     /// `ValueAsText` (Variable).
-    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6168u32,
+    pub const CONTROLLER_TYPE_SYSTEM_OPERATION_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: NsNodeId = id(
+        6168,
     );
     /// `ComponentName` (Variable).
     ///
     /// A user writable name provided by the vendor, integrator or user of the device.
-    pub const CONTROLLER_TYPE_TASK_CONTROLS_TASK_CONTROL_IDENTIFIER_COMPONENT_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18914u32,
+    pub const CONTROLLER_TYPE_TASK_CONTROLS_TASK_CONTROL_IDENTIFIER_COMPONENT_NAME: NsNodeId = id(
+        18914,
     );
     /// `TaskProgramLoaded` (Variable).
     ///
     /// The TaskProgramLoaded variable is TRUE if a task program is loaded in the task control, FALSE otherwise.
-    pub const CONTROLLER_TYPE_TASK_CONTROLS_TASK_CONTROL_IDENTIFIER_PARAMETER_SET_TASK_PROGRAM_LOADED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18916u32,
+    pub const CONTROLLER_TYPE_TASK_CONTROLS_TASK_CONTROL_IDENTIFIER_PARAMETER_SET_TASK_PROGRAM_LOADED: NsNodeId = id(
+        18916,
     );
     /// `TaskProgramName` (Variable).
     ///
     /// A customer given identifier for the task program.
-    pub const CONTROLLER_TYPE_TASK_CONTROLS_TASK_CONTROL_IDENTIFIER_PARAMETER_SET_TASK_PROGRAM_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18915u32,
+    pub const CONTROLLER_TYPE_TASK_CONTROLS_TASK_CONTROL_IDENTIFIER_PARAMETER_SET_TASK_PROGRAM_NAME: NsNodeId = id(
+        18915,
     );
     /// `AssetId` (Variable).
-    pub const DRIVE_TYPE_ASSET_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6184u32,
-    );
+    pub const DRIVE_TYPE_ASSET_ID: NsNodeId = id(6184);
     /// `ProductCode` (Variable).
     ///
     /// The ProductCode property provides a unique combination of numbers and letters used to identify the product. It may be the order information displayed on type shields or in ERP systems.
-    pub const DRIVE_TYPE_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17824u32,
-    );
+    pub const DRIVE_TYPE_PRODUCT_CODE: NsNodeId = id(17824);
     /// `Active` (Variable).
     ///
     /// The Active variable is TRUE if this particular emergency stop function is active, e.g. that the emergency stop button is pressed, FALSE otherwise.
-    pub const EMERGENCY_STOP_FUNCTION_TYPE_ACTIVE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17232u32,
-    );
+    pub const EMERGENCY_STOP_FUNCTION_TYPE_ACTIVE: NsNodeId = id(17232);
     /// `Name` (Variable).
     ///
     /// The Name of the EmergencyStopFunctionType provides a manufacturer-specific emergency stop function identifier within the safety system.
-    pub const EMERGENCY_STOP_FUNCTION_TYPE_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17231u32,
-    );
+    pub const EMERGENCY_STOP_FUNCTION_TYPE_NAME: NsNodeId = id(17231);
     /// `LastTransition` (Variable).
-    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6036u32,
-    );
+    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION: NsNodeId = id(6036);
     /// `Id` (Variable).
-    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6037u32,
-    );
+    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_ID: NsNodeId = id(6037);
     /// `LastTransitionReason` (Variable).
-    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6038u32,
+    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON: NsNodeId = id(
+        6038,
     );
     /// `EnumValues` (Variable).
-    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6039u32,
+    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON_ENUM_VALUES: NsNodeId = id(
+        6039,
     );
     /// `ValueAsText` (Variable).
-    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6040u32,
+    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: NsNodeId = id(
+        6040,
     );
     /// `StateNumber` (Variable).
-    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_RUNNING_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6041u32,
-    );
+    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_RUNNING_STATE_NUMBER: NsNodeId = id(6041);
     /// `TransitionNumber` (Variable).
-    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_RUNNING_TO_STOPPING_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6043u32,
+    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_RUNNING_TO_STOPPING_TRANSITION_NUMBER: NsNodeId = id(
+        6043,
     );
     /// `StateNumber` (Variable).
-    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_STOPPING_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6042u32,
-    );
+    pub const EXECUTING_SUBSTATE_MACHINE_TYPE_STOPPING_STATE_NUMBER: NsNodeId = id(6042);
     /// `EnumStrings` (Variable).
-    pub const EXECUTION_MODE_ENUMERATION_ENUM_STRINGS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18192u32,
-    );
+    pub const EXECUTION_MODE_ENUMERATION_ENUM_STRINGS: NsNodeId = id(18192);
     /// `AssetId` (Variable).
-    pub const GEAR_TYPE_ASSET_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6178u32,
-    );
+    pub const GEAR_TYPE_ASSET_ID: NsNodeId = id(6178);
     /// `GearRatio` (Variable).
     ///
     /// The transmission ratio of the gear expressed as a fraction as input velocity (motor side) by output velocity (load side).
-    pub const GEAR_TYPE_GEAR_RATIO: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15941u32,
-    );
+    pub const GEAR_TYPE_GEAR_RATIO: NsNodeId = id(15941);
     /// `Denominator` (Variable).
-    pub const GEAR_TYPE_GEAR_RATIO_DENOMINATOR: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15616u32,
-    );
+    pub const GEAR_TYPE_GEAR_RATIO_DENOMINATOR: NsNodeId = id(15616);
     /// `Numerator` (Variable).
-    pub const GEAR_TYPE_GEAR_RATIO_NUMERATOR: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15615u32,
-    );
+    pub const GEAR_TYPE_GEAR_RATIO_NUMERATOR: NsNodeId = id(15615);
     /// `Manufacturer` (Variable).
-    pub const GEAR_TYPE_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17152u32,
-    );
+    pub const GEAR_TYPE_MANUFACTURER: NsNodeId = id(17152);
     /// `Model` (Variable).
-    pub const GEAR_TYPE_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17154u32,
-    );
+    pub const GEAR_TYPE_MODEL: NsNodeId = id(17154);
     /// `Pitch` (Variable).
     ///
     /// Pitch describes the distance covered in millimeters (mm) for linear motion per one revolution of the output side of the driving unit. Pitch is used in combination with GearRatio to describe the overall transmission from input to output of the gear.
-    pub const GEAR_TYPE_PITCH: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17165u32,
-    );
+    pub const GEAR_TYPE_PITCH: NsNodeId = id(17165);
     /// `ProductCode` (Variable).
-    pub const GEAR_TYPE_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17160u32,
-    );
+    pub const GEAR_TYPE_PRODUCT_CODE: NsNodeId = id(17160);
     /// `SerialNumber` (Variable).
-    pub const GEAR_TYPE_SERIAL_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17155u32,
-    );
+    pub const GEAR_TYPE_SERIAL_NUMBER: NsNodeId = id(17155);
     /// `DefaultAccessRestrictions` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_DEFAULT_ACCESS_RESTRICTIONS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15585u32,
+    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_DEFAULT_ACCESS_RESTRICTIONS: NsNodeId = id(
+        15585,
     );
     /// `DefaultRolePermissions` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_DEFAULT_ROLE_PERMISSIONS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15583u32,
+    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_DEFAULT_ROLE_PERMISSIONS: NsNodeId = id(
+        15583,
     );
     /// `DefaultUserRolePermissions` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_DEFAULT_USER_ROLE_PERMISSIONS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15584u32,
+    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_DEFAULT_USER_ROLE_PERMISSIONS: NsNodeId = id(
+        15584,
     );
     /// `IsNamespaceSubset` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_IS_NAMESPACE_SUBSET: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15114u32,
+    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_IS_NAMESPACE_SUBSET: NsNodeId = id(
+        15114,
     );
     /// `NamespacePublicationDate` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_NAMESPACE_PUBLICATION_DATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15091u32,
+    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_NAMESPACE_PUBLICATION_DATE: NsNodeId = id(
+        15091,
     );
     /// `NamespaceUri` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_NAMESPACE_URI: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15034u32,
-    );
+    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_NAMESPACE_URI: NsNodeId = id(15034);
     /// `NamespaceVersion` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_NAMESPACE_VERSION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15064u32,
-    );
+    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_NAMESPACE_VERSION: NsNodeId = id(15064);
     /// `StaticNodeIdTypes` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_STATIC_NODE_ID_TYPES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15145u32,
+    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_STATIC_NODE_ID_TYPES: NsNodeId = id(
+        15145,
     );
     /// `StaticNumericNodeIdRange` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_STATIC_NUMERIC_NODE_ID_RANGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15173u32,
+    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_STATIC_NUMERIC_NODE_ID_RANGE: NsNodeId = id(
+        15173,
     );
     /// `StaticStringNodeIdPattern` (Variable).
-    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_STATIC_STRING_NODE_ID_PATTERN: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15209u32,
+    pub const HTTP_OPCFOUNDATION_ORG_UA_ROBOTICS_STATIC_STRING_NODE_ID_PATTERN: NsNodeId = id(
+        15209,
     );
     /// `StateNumber` (Variable).
-    pub const IDLE_SUBSTATE_MACHINE_TYPE_GETTING_READY_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6031u32,
-    );
+    pub const IDLE_SUBSTATE_MACHINE_TYPE_GETTING_READY_STATE_NUMBER: NsNodeId = id(6031);
     /// `TransitionNumber` (Variable).
-    pub const IDLE_SUBSTATE_MACHINE_TYPE_GETTING_READY_TO_STAND_BY_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6032u32,
+    pub const IDLE_SUBSTATE_MACHINE_TYPE_GETTING_READY_TO_STAND_BY_TRANSITION_NUMBER: NsNodeId = id(
+        6032,
     );
     /// `LastTransition` (Variable).
-    pub const IDLE_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6026u32,
-    );
+    pub const IDLE_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION: NsNodeId = id(6026);
     /// `Id` (Variable).
-    pub const IDLE_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6028u32,
-    );
+    pub const IDLE_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_ID: NsNodeId = id(6028);
     /// `LastTransitionReason` (Variable).
-    pub const IDLE_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6029u32,
-    );
+    pub const IDLE_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON: NsNodeId = id(6029);
     /// `EnumValues` (Variable).
-    pub const IDLE_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6034u32,
+    pub const IDLE_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON_ENUM_VALUES: NsNodeId = id(
+        6034,
     );
     /// `ValueAsText` (Variable).
-    pub const IDLE_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6035u32,
+    pub const IDLE_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: NsNodeId = id(
+        6035,
     );
     /// `StateNumber` (Variable).
-    pub const IDLE_SUBSTATE_MACHINE_TYPE_STAND_BY_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6030u32,
-    );
+    pub const IDLE_SUBSTATE_MACHINE_TYPE_STAND_BY_STATE_NUMBER: NsNodeId = id(6030);
     /// `TransitionNumber` (Variable).
-    pub const IDLE_SUBSTATE_MACHINE_TYPE_STAND_BY_TO_GETTING_READY_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6033u32,
+    pub const IDLE_SUBSTATE_MACHINE_TYPE_STAND_BY_TO_GETTING_READY_TRANSITION_NUMBER: NsNodeId = id(
+        6033,
     );
     /// `CenterOfMass` (Variable).
     ///
     /// The position and orientation of the center of the mass related to the mounting point using a FrameType. X, Y, Z define the position of the center of gravity relative to the mounting point coordinate system. A, B, C define the orientation of the principal axes of inertia relative to the mounting point coordinate system. Orientation A, B, C can be "0" for systems which do not need these  values.
-    pub const LOAD_TYPE_CENTER_OF_MASS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6013u32,
-    );
+    pub const LOAD_TYPE_CENTER_OF_MASS: NsNodeId = id(6013);
     /// `CartesianCoordinates` (Variable).
-    pub const LOAD_TYPE_CENTER_OF_MASS_CARTESIAN_COORDINATES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16130u32,
-    );
+    pub const LOAD_TYPE_CENTER_OF_MASS_CARTESIAN_COORDINATES: NsNodeId = id(16130);
     /// `X` (Variable).
-    pub const LOAD_TYPE_CENTER_OF_MASS_CARTESIAN_COORDINATES_X: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16134u32,
-    );
+    pub const LOAD_TYPE_CENTER_OF_MASS_CARTESIAN_COORDINATES_X: NsNodeId = id(16134);
     /// `Y` (Variable).
-    pub const LOAD_TYPE_CENTER_OF_MASS_CARTESIAN_COORDINATES_Y: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16135u32,
-    );
+    pub const LOAD_TYPE_CENTER_OF_MASS_CARTESIAN_COORDINATES_Y: NsNodeId = id(16135);
     /// `Z` (Variable).
-    pub const LOAD_TYPE_CENTER_OF_MASS_CARTESIAN_COORDINATES_Z: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16136u32,
-    );
+    pub const LOAD_TYPE_CENTER_OF_MASS_CARTESIAN_COORDINATES_Z: NsNodeId = id(16136);
     /// `Orientation` (Variable).
-    pub const LOAD_TYPE_CENTER_OF_MASS_ORIENTATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16132u32,
-    );
+    pub const LOAD_TYPE_CENTER_OF_MASS_ORIENTATION: NsNodeId = id(16132);
     /// `A` (Variable).
-    pub const LOAD_TYPE_CENTER_OF_MASS_ORIENTATION_A: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16137u32,
-    );
+    pub const LOAD_TYPE_CENTER_OF_MASS_ORIENTATION_A: NsNodeId = id(16137);
     /// `B` (Variable).
-    pub const LOAD_TYPE_CENTER_OF_MASS_ORIENTATION_B: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16138u32,
-    );
+    pub const LOAD_TYPE_CENTER_OF_MASS_ORIENTATION_B: NsNodeId = id(16138);
     /// `C` (Variable).
-    pub const LOAD_TYPE_CENTER_OF_MASS_ORIENTATION_C: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16139u32,
-    );
+    pub const LOAD_TYPE_CENTER_OF_MASS_ORIENTATION_C: NsNodeId = id(16139);
     /// `Inertia` (Variable).
     ///
     /// The Inertia uses the VectorType to describe the three values of the principal moments of inertia with respect to the mounting point coordinate system. If inertia values are provided for rotary axis the CenterOfMass shall be completely filled as well.
-    pub const LOAD_TYPE_INERTIA: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18170u32,
-    );
+    pub const LOAD_TYPE_INERTIA: NsNodeId = id(18170);
     /// `X` (Variable).
-    pub const LOAD_TYPE_INERTIA_X: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18171u32,
-    );
+    pub const LOAD_TYPE_INERTIA_X: NsNodeId = id(18171);
     /// `Y` (Variable).
-    pub const LOAD_TYPE_INERTIA_Y: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18172u32,
-    );
+    pub const LOAD_TYPE_INERTIA_Y: NsNodeId = id(18172);
     /// `Z` (Variable).
-    pub const LOAD_TYPE_INERTIA_Z: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18173u32,
-    );
+    pub const LOAD_TYPE_INERTIA_Z: NsNodeId = id(18173);
     /// `Mass` (Variable).
     ///
     /// The weight of the load mounted on one mounting point.
-    pub const LOAD_TYPE_MASS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6723u32,
-    );
+    pub const LOAD_TYPE_MASS: NsNodeId = id(6723);
     /// `EngineeringUnits` (Variable).
-    pub const LOAD_TYPE_MASS_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6728u32,
-    );
+    pub const LOAD_TYPE_MASS_ENGINEERING_UNITS: NsNodeId = id(6728);
     /// `EnumStrings` (Variable).
-    pub const MOTION_DEVICE_CATEGORY_ENUMERATION_ENUM_STRINGS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18194u32,
-    );
+    pub const MOTION_DEVICE_CATEGORY_ENUMERATION_ENUM_STRINGS: NsNodeId = id(18194);
     /// `ComponentName` (Variable).
-    pub const MOTION_DEVICE_SYSTEM_TYPE_COMPONENT_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6171u32,
-    );
+    pub const MOTION_DEVICE_SYSTEM_TYPE_COMPONENT_NAME: NsNodeId = id(6171);
     /// `Level` (Variable).
     ///
     /// The weight of the load mounted on one mounting point.
-    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_CURRENT_USER_LEVEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15441u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_CURRENT_USER_LEVEL: NsNodeId = id(
+        15441,
     );
     /// `Manufacturer` (Variable).
-    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15426u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_MANUFACTURER: NsNodeId = id(
+        15426,
     );
     /// `Model` (Variable).
-    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15428u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_MODEL: NsNodeId = id(
+        15428,
     );
     /// `ProductCode` (Variable).
-    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15434u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_PRODUCT_CODE: NsNodeId = id(
+        15434,
     );
     /// `SerialNumber` (Variable).
-    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_SERIAL_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15429u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_CONTROLLERS_CONTROLLER_IDENTIFIER_SERIAL_NUMBER: NsNodeId = id(
+        15429,
     );
     /// `Manufacturer` (Variable).
-    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15045u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_MANUFACTURER: NsNodeId = id(
+        15045,
     );
     /// `Model` (Variable).
-    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15047u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_MODEL: NsNodeId = id(
+        15047,
     );
     /// `MotionDeviceCategory` (Variable).
     ///
     /// The variable MotionDeviceCategory provides the kind of motion device defined by MotionDeviceCategoryEnumeration based on ISO 8373.
-    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_MOTION_DEVICE_CATEGORY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15058u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_MOTION_DEVICE_CATEGORY: NsNodeId = id(
+        15058,
     );
     /// `SpeedOverride` (Variable).
     ///
     /// SpeedOverride provides the current speed setting in percent of programmed speed (0 - 100%).
-    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_PARAMETER_SET_SPEED_OVERRIDE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15061u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_PARAMETER_SET_SPEED_OVERRIDE: NsNodeId = id(
+        15061,
     );
     /// `ProductCode` (Variable).
-    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15053u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_PRODUCT_CODE: NsNodeId = id(
+        15053,
     );
     /// `SerialNumber` (Variable).
-    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_SERIAL_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15048u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_SERIAL_NUMBER: NsNodeId = id(
+        15048,
     );
     /// `TaskControlReference` (Variable).
-    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_TASK_CONTROL_REFERENCE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6002u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_MOTION_DEVICES_MOTION_DEVICE_IDENTIFIER_TASK_CONTROL_REFERENCE: NsNodeId = id(
+        6002,
     );
     /// `EmergencyStop` (Variable).
     ///
     /// The EmergencyStop variable is TRUE if one or more of the emergency stop functions in the robot system are active, FALSE otherwise. If the EmergencyStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed emergency stop functions are active.
-    pub const MOTION_DEVICE_SYSTEM_TYPE_SAFETY_STATES_SAFETY_STATE_IDENTIFIER_PARAMETER_SET_EMERGENCY_STOP: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15741u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_SAFETY_STATES_SAFETY_STATE_IDENTIFIER_PARAMETER_SET_EMERGENCY_STOP: NsNodeId = id(
+        15741,
     );
     /// `OperationalMode` (Variable).
     ///
     /// The OperationalMode variable provides information about the current operational mode. Allowed values are described in OperationalModeEnumeration, see ISO 10218-1:2011 Ch.5.7 Operational Modes.
-    pub const MOTION_DEVICE_SYSTEM_TYPE_SAFETY_STATES_SAFETY_STATE_IDENTIFIER_PARAMETER_SET_OPERATIONAL_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15740u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_SAFETY_STATES_SAFETY_STATE_IDENTIFIER_PARAMETER_SET_OPERATIONAL_MODE: NsNodeId = id(
+        15740,
     );
     /// `ProtectiveStop` (Variable).
     ///
     /// The ProtectiveStop variable is TRUE if one or more of the enabled protective stop functions in the system are active, FALSE otherwise. If the ProtectiveStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed protective stop functions are enabled and active.
-    pub const MOTION_DEVICE_SYSTEM_TYPE_SAFETY_STATES_SAFETY_STATE_IDENTIFIER_PARAMETER_SET_PROTECTIVE_STOP: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15742u32,
+    pub const MOTION_DEVICE_SYSTEM_TYPE_SAFETY_STATES_SAFETY_STATE_IDENTIFIER_PARAMETER_SET_PROTECTIVE_STOP: NsNodeId = id(
+        15742,
     );
     /// `AssetId` (Variable).
-    pub const MOTION_DEVICE_TYPE_ASSET_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6172u32,
-    );
+    pub const MOTION_DEVICE_TYPE_ASSET_ID: NsNodeId = id(6172);
     /// `MotionProfile` (Variable).
     ///
     /// The kind of axis motion as defined with the AxisMotionProfileEnumeration.
-    pub const MOTION_DEVICE_TYPE_AXES_AXIS_IDENTIFIER_MOTION_PROFILE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15808u32,
+    pub const MOTION_DEVICE_TYPE_AXES_AXIS_IDENTIFIER_MOTION_PROFILE: NsNodeId = id(
+        15808,
     );
     /// `ActualPosition` (Variable).
     ///
     /// The axis position inclusive Unit and RangeOfMotion.
-    pub const MOTION_DEVICE_TYPE_AXES_AXIS_IDENTIFIER_PARAMETER_SET_ACTUAL_POSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15863u32,
+    pub const MOTION_DEVICE_TYPE_AXES_AXIS_IDENTIFIER_PARAMETER_SET_ACTUAL_POSITION: NsNodeId = id(
+        15863,
     );
     /// `EngineeringUnits` (Variable).
-    pub const MOTION_DEVICE_TYPE_AXES_AXIS_IDENTIFIER_PARAMETER_SET_ACTUAL_POSITION_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15869u32,
+    pub const MOTION_DEVICE_TYPE_AXES_AXIS_IDENTIFIER_PARAMETER_SET_ACTUAL_POSITION_ENGINEERING_UNITS: NsNodeId = id(
+        15869,
     );
     /// `ComponentName` (Variable).
-    pub const MOTION_DEVICE_TYPE_COMPONENT_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6173u32,
-    );
+    pub const MOTION_DEVICE_TYPE_COMPONENT_NAME: NsNodeId = id(6173);
     /// `DeviceManual` (Variable).
-    pub const MOTION_DEVICE_TYPE_DEVICE_MANUAL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6174u32,
-    );
+    pub const MOTION_DEVICE_TYPE_DEVICE_MANUAL: NsNodeId = id(6174);
     /// `Mass` (Variable).
     ///
     /// The weight of the load mounted on one mounting point.
-    pub const MOTION_DEVICE_TYPE_FLANGE_LOAD_MASS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6624u32,
-    );
+    pub const MOTION_DEVICE_TYPE_FLANGE_LOAD_MASS: NsNodeId = id(6624);
     /// `EngineeringUnits` (Variable).
-    pub const MOTION_DEVICE_TYPE_FLANGE_LOAD_MASS_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15659u32,
+    pub const MOTION_DEVICE_TYPE_FLANGE_LOAD_MASS_ENGINEERING_UNITS: NsNodeId = id(
+        15659,
     );
     /// `Manufacturer` (Variable).
-    pub const MOTION_DEVICE_TYPE_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16351u32,
-    );
+    pub const MOTION_DEVICE_TYPE_MANUFACTURER: NsNodeId = id(16351);
     /// `Model` (Variable).
-    pub const MOTION_DEVICE_TYPE_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16353u32,
-    );
+    pub const MOTION_DEVICE_TYPE_MODEL: NsNodeId = id(16353);
     /// `MotionDeviceCategory` (Variable).
     ///
     /// The variable MotionDeviceCategory provides the kind of motion device defined by MotionDeviceCategoryEnumeration based on ISO 8373.
-    pub const MOTION_DEVICE_TYPE_MOTION_DEVICE_CATEGORY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16362u32,
-    );
+    pub const MOTION_DEVICE_TYPE_MOTION_DEVICE_CATEGORY: NsNodeId = id(16362);
     /// `InControl` (Variable).
     ///
     /// InControl provides the information if the actuators (in most cases a motor) of the motion device are powered up and in control: "true". The motion device might be in a standstill.
-    pub const MOTION_DEVICE_TYPE_PARAMETER_SET_IN_CONTROL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16364u32,
-    );
+    pub const MOTION_DEVICE_TYPE_PARAMETER_SET_IN_CONTROL: NsNodeId = id(16364);
     /// `OnPath` (Variable).
     ///
     /// OnPath is true if the motion device is on or near enough the planned program path such that program execution can continue. If the MotionDevice deviates too much from this path in case of errors or an emergency stop, this value becomes false. If OnPath is false, the motion device needs repositioning to continue program execution.
-    pub const MOTION_DEVICE_TYPE_PARAMETER_SET_ON_PATH: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16363u32,
-    );
+    pub const MOTION_DEVICE_TYPE_PARAMETER_SET_ON_PATH: NsNodeId = id(16363);
     /// `SpeedOverride` (Variable).
     ///
     /// SpeedOverride provides the current speed setting in percent of programmed speed (0 - 100%).
-    pub const MOTION_DEVICE_TYPE_PARAMETER_SET_SPEED_OVERRIDE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16365u32,
-    );
+    pub const MOTION_DEVICE_TYPE_PARAMETER_SET_SPEED_OVERRIDE: NsNodeId = id(16365);
     /// `ProductCode` (Variable).
-    pub const MOTION_DEVICE_TYPE_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16359u32,
-    );
+    pub const MOTION_DEVICE_TYPE_PRODUCT_CODE: NsNodeId = id(16359);
     /// `SerialNumber` (Variable).
-    pub const MOTION_DEVICE_TYPE_SERIAL_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16354u32,
-    );
+    pub const MOTION_DEVICE_TYPE_SERIAL_NUMBER: NsNodeId = id(16354);
     /// `TaskControlReference` (Variable).
-    pub const MOTION_DEVICE_TYPE_TASK_CONTROL_REFERENCE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6001u32,
-    );
+    pub const MOTION_DEVICE_TYPE_TASK_CONTROL_REFERENCE: NsNodeId = id(6001);
     /// `AssetId` (Variable).
-    pub const MOTOR_TYPE_ASSET_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6177u32,
-    );
+    pub const MOTOR_TYPE_ASSET_ID: NsNodeId = id(6177);
     /// `Manufacturer` (Variable).
-    pub const MOTOR_TYPE_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17101u32,
-    );
+    pub const MOTOR_TYPE_MANUFACTURER: NsNodeId = id(17101);
     /// `Model` (Variable).
-    pub const MOTOR_TYPE_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17103u32,
-    );
+    pub const MOTOR_TYPE_MODEL: NsNodeId = id(17103);
     /// `BrakeReleased` (Variable).
     ///
     /// Indicates an optional variable used only for motors with brakes. If BrakeReleased is TRUE the motor is free to run. FALSE means that the motor shaft is locked by the brake.
-    pub const MOTOR_TYPE_PARAMETER_SET_BRAKE_RELEASED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17150u32,
-    );
+    pub const MOTOR_TYPE_PARAMETER_SET_BRAKE_RELEASED: NsNodeId = id(17150);
     /// `EffectiveLoadRate` (Variable).
     ///
     /// EffectiveLoadRate is expressed as a percentage of maximum continuous load. The Joule integral is typically used to calculate the current load. Duration should be defined and documented by the vendor.
-    pub const MOTOR_TYPE_PARAMETER_SET_EFFECTIVE_LOAD_RATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6776u32,
-    );
+    pub const MOTOR_TYPE_PARAMETER_SET_EFFECTIVE_LOAD_RATE: NsNodeId = id(6776);
     /// `MotorTemperature` (Variable).
     ///
     /// The motor temperature provides the temperature of the motor. If there is no temperature sensor the value is set to \"null\".
-    pub const MOTOR_TYPE_PARAMETER_SET_MOTOR_TEMPERATURE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6757u32,
-    );
+    pub const MOTOR_TYPE_PARAMETER_SET_MOTOR_TEMPERATURE: NsNodeId = id(6757);
     /// `EngineeringUnits` (Variable).
-    pub const MOTOR_TYPE_PARAMETER_SET_MOTOR_TEMPERATURE_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6762u32,
+    pub const MOTOR_TYPE_PARAMETER_SET_MOTOR_TEMPERATURE_ENGINEERING_UNITS: NsNodeId = id(
+        6762,
     );
     /// `ProductCode` (Variable).
-    pub const MOTOR_TYPE_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17109u32,
-    );
+    pub const MOTOR_TYPE_PRODUCT_CODE: NsNodeId = id(17109);
     /// `SerialNumber` (Variable).
-    pub const MOTOR_TYPE_SERIAL_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17104u32,
-    );
+    pub const MOTOR_TYPE_SERIAL_NUMBER: NsNodeId = id(17104);
     /// `ConditionDescriptions` (Variable).
-    pub const MULTI_ACKNOWLEDGEABLE_CONDITION_TYPE_CONDITION_DESCRIPTIONS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6140u32,
+    pub const MULTI_ACKNOWLEDGEABLE_CONDITION_TYPE_CONDITION_DESCRIPTIONS: NsNodeId = id(
+        6140,
     );
     /// `EnumStrings` (Variable).
-    pub const OPERATIONAL_MODE_ENUMERATION_ENUM_STRINGS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6022u32,
-    );
+    pub const OPERATIONAL_MODE_ENUMERATION_ENUM_STRINGS: NsNodeId = id(6022);
     /// `ConfiguredDefaultStopMode` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_CONFIGURED_DEFAULT_STOP_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6009u32,
+    pub const OPERATION_STATE_MACHINE_TYPE_CONFIGURED_DEFAULT_STOP_MODE: NsNodeId = id(
+        6009,
     );
     /// `StateNumber` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_EXECUTING_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6012u32,
+    pub const OPERATION_STATE_MACHINE_TYPE_EXECUTING_STATE_NUMBER: NsNodeId = id(6012);
+    /// `TransitionNumber` (Variable).
+    pub const OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_IDLE_TRANSITION_NUMBER: NsNodeId = id(
+        6018,
     );
     /// `TransitionNumber` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_IDLE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6018u32,
-    );
-    /// `TransitionNumber` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_READY_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6016u32,
+    pub const OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_READY_TRANSITION_NUMBER: NsNodeId = id(
+        6016,
     );
     /// `StateNumber` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_IDLE_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6010u32,
+    pub const OPERATION_STATE_MACHINE_TYPE_IDLE_STATE_NUMBER: NsNodeId = id(6010);
+    /// `TransitionNumber` (Variable).
+    pub const OPERATION_STATE_MACHINE_TYPE_IDLE_TO_IDLE_TRANSITION_NUMBER: NsNodeId = id(
+        6019,
     );
     /// `TransitionNumber` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_IDLE_TO_IDLE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6019u32,
-    );
-    /// `TransitionNumber` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_IDLE_TO_READY_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6015u32,
+    pub const OPERATION_STATE_MACHINE_TYPE_IDLE_TO_READY_TRANSITION_NUMBER: NsNodeId = id(
+        6015,
     );
     /// `LastTransition` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6005u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION: NsNodeId = id(6005);
     /// `Id` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6006u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_ID: NsNodeId = id(6006);
     /// `LastTransitionReason` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6007u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON: NsNodeId = id(6007);
     /// `EnumValues` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6020u32,
+    pub const OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON_ENUM_VALUES: NsNodeId = id(
+        6020,
     );
     /// `ValueAsText` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6021u32,
+    pub const OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: NsNodeId = id(
+        6021,
     );
     /// `PossibleStopModes` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_POSSIBLE_STOP_MODES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6008u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_POSSIBLE_STOP_MODES: NsNodeId = id(6008);
     /// `StateNumber` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_READY_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6011u32,
+    pub const OPERATION_STATE_MACHINE_TYPE_READY_STATE_NUMBER: NsNodeId = id(6011);
+    /// `TransitionNumber` (Variable).
+    pub const OPERATION_STATE_MACHINE_TYPE_READY_TO_EXECUTING_TRANSITION_NUMBER: NsNodeId = id(
+        6017,
     );
     /// `TransitionNumber` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_READY_TO_EXECUTING_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6017u32,
-    );
-    /// `TransitionNumber` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_READY_TO_IDLE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6014u32,
+    pub const OPERATION_STATE_MACHINE_TYPE_READY_TO_IDLE_TRANSITION_NUMBER: NsNodeId = id(
+        6014,
     );
     /// `OutputArguments` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_START_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6023u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_START_OUTPUT_ARGUMENTS: NsNodeId = id(6023);
     /// `InputArguments` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_STOP_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6024u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_STOP_INPUT_ARGUMENTS: NsNodeId = id(6024);
     /// `OutputArguments` (Variable).
-    pub const OPERATION_STATE_MACHINE_TYPE_STOP_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6025u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_STOP_OUTPUT_ARGUMENTS: NsNodeId = id(6025);
     /// `MotionProfile` (Variable).
     ///
     /// The kind of axis motion as defined with the AxisMotionProfileEnumeration.
-    pub const POWER_TRAIN_TYPE_AXIS_IDENTIFIER_MOTION_PROFILE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18570u32,
-    );
+    pub const POWER_TRAIN_TYPE_AXIS_IDENTIFIER_MOTION_PROFILE: NsNodeId = id(18570);
     /// `ActualPosition` (Variable).
     ///
     /// The axis position inclusive Unit and RangeOfMotion.
-    pub const POWER_TRAIN_TYPE_AXIS_IDENTIFIER_PARAMETER_SET_ACTUAL_POSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18595u32,
+    pub const POWER_TRAIN_TYPE_AXIS_IDENTIFIER_PARAMETER_SET_ACTUAL_POSITION: NsNodeId = id(
+        18595,
     );
     /// `EngineeringUnits` (Variable).
-    pub const POWER_TRAIN_TYPE_AXIS_IDENTIFIER_PARAMETER_SET_ACTUAL_POSITION_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18600u32,
+    pub const POWER_TRAIN_TYPE_AXIS_IDENTIFIER_PARAMETER_SET_ACTUAL_POSITION_ENGINEERING_UNITS: NsNodeId = id(
+        18600,
     );
     /// `ComponentName` (Variable).
-    pub const POWER_TRAIN_TYPE_COMPONENT_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6176u32,
-    );
+    pub const POWER_TRAIN_TYPE_COMPONENT_NAME: NsNodeId = id(6176);
     /// `GearRatio` (Variable).
     ///
     /// The transmission ratio of the gear expressed as a fraction as input velocity (motor side) by output velocity (load side).
-    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER_GEAR_RATIO: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16076u32,
-    );
+    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER_GEAR_RATIO: NsNodeId = id(16076);
     /// `Denominator` (Variable).
-    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER_GEAR_RATIO_DENOMINATOR: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16078u32,
+    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER_GEAR_RATIO_DENOMINATOR: NsNodeId = id(
+        16078,
     );
     /// `Numerator` (Variable).
-    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER_GEAR_RATIO_NUMERATOR: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16077u32,
+    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER_GEAR_RATIO_NUMERATOR: NsNodeId = id(
+        16077,
     );
     /// `Manufacturer` (Variable).
-    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16062u32,
-    );
+    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER_MANUFACTURER: NsNodeId = id(16062);
     /// `Model` (Variable).
-    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16064u32,
-    );
+    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER_MODEL: NsNodeId = id(16064);
     /// `ProductCode` (Variable).
-    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16068u32,
-    );
+    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER_PRODUCT_CODE: NsNodeId = id(16068);
     /// `SerialNumber` (Variable).
-    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER_SERIAL_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16071u32,
-    );
+    pub const POWER_TRAIN_TYPE_GEAR_IDENTIFIER_SERIAL_NUMBER: NsNodeId = id(16071);
     /// `Manufacturer` (Variable).
-    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16019u32,
-    );
+    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER_MANUFACTURER: NsNodeId = id(16019);
     /// `Model` (Variable).
-    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16021u32,
-    );
+    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER_MODEL: NsNodeId = id(16021);
     /// `MotorTemperature` (Variable).
     ///
     /// The motor temperature provides the temperature of the motor. If there is no temperature sensor the value is set to \"null\".
-    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER_PARAMETER_SET_MOTOR_TEMPERATURE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16034u32,
+    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER_PARAMETER_SET_MOTOR_TEMPERATURE: NsNodeId = id(
+        16034,
     );
     /// `EngineeringUnits` (Variable).
-    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER_PARAMETER_SET_MOTOR_TEMPERATURE_ENGINEERING_UNITS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16039u32,
+    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER_PARAMETER_SET_MOTOR_TEMPERATURE_ENGINEERING_UNITS: NsNodeId = id(
+        16039,
     );
     /// `ProductCode` (Variable).
-    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16025u32,
-    );
+    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER_PRODUCT_CODE: NsNodeId = id(16025);
     /// `SerialNumber` (Variable).
-    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER_SERIAL_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16028u32,
-    );
+    pub const POWER_TRAIN_TYPE_MOTOR_IDENTIFIER_SERIAL_NUMBER: NsNodeId = id(16028);
     /// `Active` (Variable).
     ///
     /// –	The Active variable is TRUE if this particular protective stop function is active, i.e. that a stop is initiated, FALSE otherwise. If Enabled is FALSE then Active shall be FALSE.
-    pub const PROTECTIVE_STOP_FUNCTION_TYPE_ACTIVE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17236u32,
-    );
+    pub const PROTECTIVE_STOP_FUNCTION_TYPE_ACTIVE: NsNodeId = id(17236);
     /// `Enabled` (Variable).
     ///
     /// –	The Enabled variable is TRUE if this protective stop function is currently supervising the system, FALSE otherwise. A protective stop function may or may not be enabled at all times, e.g. the protective stop function of the safety doors are typically enabled in automatic operational mode and disabled in manual mode. On the other hand for example, the protective stop function of the teach pendant enabling device is enabled in manual modes and disabled in automatic modes.
-    pub const PROTECTIVE_STOP_FUNCTION_TYPE_ENABLED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17235u32,
-    );
+    pub const PROTECTIVE_STOP_FUNCTION_TYPE_ENABLED: NsNodeId = id(17235);
     /// `Name` (Variable).
     ///
     /// The Name of the ProtectiveStopFunctionType provides a manufacturer-specific protective stop function identifier within the safety system.
-    pub const PROTECTIVE_STOP_FUNCTION_TYPE_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17234u32,
-    );
+    pub const PROTECTIVE_STOP_FUNCTION_TYPE_NAME: NsNodeId = id(17234);
     /// `StateNumber` (Variable).
-    pub const READY_SUBSTATE_MACHINE_TYPE_AT_PROGRAM_START_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6049u32,
+    pub const READY_SUBSTATE_MACHINE_TYPE_AT_PROGRAM_START_STATE_NUMBER: NsNodeId = id(
+        6049,
     );
     /// `LastTransition` (Variable).
-    pub const READY_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6044u32,
-    );
+    pub const READY_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION: NsNodeId = id(6044);
     /// `Id` (Variable).
-    pub const READY_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6045u32,
-    );
+    pub const READY_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_ID: NsNodeId = id(6045);
     /// `LastTransitionReason` (Variable).
-    pub const READY_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6046u32,
-    );
+    pub const READY_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON: NsNodeId = id(6046);
     /// `EnumValues` (Variable).
-    pub const READY_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6047u32,
+    pub const READY_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON_ENUM_VALUES: NsNodeId = id(
+        6047,
     );
     /// `ValueAsText` (Variable).
-    pub const READY_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6048u32,
+    pub const READY_SUBSTATE_MACHINE_TYPE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: NsNodeId = id(
+        6048,
     );
     /// `TransitionNumber` (Variable).
-    pub const READY_SUBSTATE_MACHINE_TYPE_PROGRAM_START_TO_SUSPENDED_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6051u32,
+    pub const READY_SUBSTATE_MACHINE_TYPE_PROGRAM_START_TO_SUSPENDED_TRANSITION_NUMBER: NsNodeId = id(
+        6051,
     );
     /// `OutputArguments` (Variable).
-    pub const READY_SUBSTATE_MACHINE_TYPE_RESET_TO_PROGRAM_START_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6053u32,
+    pub const READY_SUBSTATE_MACHINE_TYPE_RESET_TO_PROGRAM_START_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6053,
     );
     /// `StateNumber` (Variable).
-    pub const READY_SUBSTATE_MACHINE_TYPE_SUSPENDED_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6050u32,
-    );
+    pub const READY_SUBSTATE_MACHINE_TYPE_SUSPENDED_STATE_NUMBER: NsNodeId = id(6050);
     /// `TransitionNumber` (Variable).
-    pub const READY_SUBSTATE_MACHINE_TYPE_SUSPENDED_TO_PROGRAM_START_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6052u32,
+    pub const READY_SUBSTATE_MACHINE_TYPE_SUSPENDED_TO_PROGRAM_START_TRANSITION_NUMBER: NsNodeId = id(
+        6052,
     );
     /// `ComponentName` (Variable).
-    pub const SAFETY_STATE_TYPE_COMPONENT_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6179u32,
-    );
+    pub const SAFETY_STATE_TYPE_COMPONENT_NAME: NsNodeId = id(6179);
     /// `Active` (Variable).
     ///
     /// The Active variable is TRUE if this particular emergency stop function is active, e.g. that the emergency stop button is pressed, FALSE otherwise.
-    pub const SAFETY_STATE_TYPE_EMERGENCY_STOP_FUNCTIONS_EMERGENCY_STOP_FUNCTION_IDENTIFIER_ACTIVE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18808u32,
+    pub const SAFETY_STATE_TYPE_EMERGENCY_STOP_FUNCTIONS_EMERGENCY_STOP_FUNCTION_IDENTIFIER_ACTIVE: NsNodeId = id(
+        18808,
     );
     /// `Name` (Variable).
     ///
     /// The Name of the EmergencyStopFunctionType provides a manufacturer-specific emergency stop function identifier within the safety system.
-    pub const SAFETY_STATE_TYPE_EMERGENCY_STOP_FUNCTIONS_EMERGENCY_STOP_FUNCTION_IDENTIFIER_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18807u32,
+    pub const SAFETY_STATE_TYPE_EMERGENCY_STOP_FUNCTIONS_EMERGENCY_STOP_FUNCTION_IDENTIFIER_NAME: NsNodeId = id(
+        18807,
     );
     /// `EmergencyStop` (Variable).
     ///
     /// The EmergencyStop variable is TRUE if one or more of the emergency stop functions in the robot system are active, FALSE otherwise. If the EmergencyStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed emergency stop functions are active.
-    pub const SAFETY_STATE_TYPE_PARAMETER_SET_EMERGENCY_STOP: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15882u32,
-    );
+    pub const SAFETY_STATE_TYPE_PARAMETER_SET_EMERGENCY_STOP: NsNodeId = id(15882);
     /// `OperationalMode` (Variable).
     ///
     /// The OperationalMode variable provides information about the current operational mode. Allowed values are described in OperationalModeEnumeration, see ISO 10218-1:2011 Ch.5.7 Operational Modes.
-    pub const SAFETY_STATE_TYPE_PARAMETER_SET_OPERATIONAL_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15912u32,
-    );
+    pub const SAFETY_STATE_TYPE_PARAMETER_SET_OPERATIONAL_MODE: NsNodeId = id(15912);
     /// `ProtectiveStop` (Variable).
     ///
     /// The ProtectiveStop variable is TRUE if one or more of the enabled protective stop functions in the system are active, FALSE otherwise. If the ProtectiveStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed protective stop functions are enabled and active.
-    pub const SAFETY_STATE_TYPE_PARAMETER_SET_PROTECTIVE_STOP: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        15913u32,
-    );
+    pub const SAFETY_STATE_TYPE_PARAMETER_SET_PROTECTIVE_STOP: NsNodeId = id(15913);
     /// `Active` (Variable).
     ///
     /// –	The Active variable is TRUE if this particular protective stop function is active, i.e. that a stop is initiated, FALSE otherwise. If Enabled is FALSE then Active shall be FALSE.
-    pub const SAFETY_STATE_TYPE_PROTECTIVE_STOP_FUNCTIONS_PROTECTIVE_STOP_FUNCTION_IDENTIFIER_ACTIVE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18812u32,
+    pub const SAFETY_STATE_TYPE_PROTECTIVE_STOP_FUNCTIONS_PROTECTIVE_STOP_FUNCTION_IDENTIFIER_ACTIVE: NsNodeId = id(
+        18812,
     );
     /// `Enabled` (Variable).
     ///
     /// –	The Enabled variable is TRUE if this protective stop function is currently supervising the system, FALSE otherwise. A protective stop function may or may not be enabled at all times, e.g. the protective stop function of the safety doors are typically enabled in automatic operational mode and disabled in manual mode. On the other hand for example, the protective stop function of the teach pendant enabling device is enabled in manual modes and disabled in automatic modes.
-    pub const SAFETY_STATE_TYPE_PROTECTIVE_STOP_FUNCTIONS_PROTECTIVE_STOP_FUNCTION_IDENTIFIER_ENABLED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18811u32,
+    pub const SAFETY_STATE_TYPE_PROTECTIVE_STOP_FUNCTIONS_PROTECTIVE_STOP_FUNCTION_IDENTIFIER_ENABLED: NsNodeId = id(
+        18811,
     );
     /// `Name` (Variable).
     ///
     /// The Name of the ProtectiveStopFunctionType provides a manufacturer-specific protective stop function identifier within the safety system.
-    pub const SAFETY_STATE_TYPE_PROTECTIVE_STOP_FUNCTIONS_PROTECTIVE_STOP_FUNCTION_IDENTIFIER_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18810u32,
+    pub const SAFETY_STATE_TYPE_PROTECTIVE_STOP_FUNCTIONS_PROTECTIVE_STOP_FUNCTION_IDENTIFIER_NAME: NsNodeId = id(
+        18810,
     );
     /// `ConfiguredDefaultStopMode` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_CONFIGURED_DEFAULT_STOP_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6057u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_CONFIGURED_DEFAULT_STOP_MODE: NsNodeId = id(
+        6057,
     );
     /// `StateNumber` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6087u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_STATE_NUMBER: NsNodeId = id(
+        6087,
     );
     /// `CurrentState` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE_CURRENT_STATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6083u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE_CURRENT_STATE: NsNodeId = id(
+        6083,
     );
     /// `Id` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE_CURRENT_STATE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6084u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE_CURRENT_STATE_ID: NsNodeId = id(
+        6084,
     );
     /// `LastTransition` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE_LAST_TRANSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6078u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE_LAST_TRANSITION: NsNodeId = id(
+        6078,
     );
     /// `Id` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE_LAST_TRANSITION_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6079u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE_LAST_TRANSITION_ID: NsNodeId = id(
+        6079,
     );
     /// `LastTransitionReason` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE_LAST_TRANSITION_REASON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6080u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE_LAST_TRANSITION_REASON: NsNodeId = id(
+        6080,
     );
     /// `EnumValues` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE_LAST_TRANSITION_REASON_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6081u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE_LAST_TRANSITION_REASON_ENUM_VALUES: NsNodeId = id(
+        6081,
     );
     /// `ValueAsText` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6082u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_SUBSTATE_MACHINE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: NsNodeId = id(
+        6082,
     );
     /// `TransitionNumber` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_IDLE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6093u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_IDLE_TRANSITION_NUMBER: NsNodeId = id(
+        6093,
     );
     /// `TransitionNumber` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_READY_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6092u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_EXECUTING_TO_READY_TRANSITION_NUMBER: NsNodeId = id(
+        6092,
     );
     /// `OutputArguments` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_GET_READY_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6068u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_GET_READY_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6068,
     );
     /// `StateNumber` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6085u32,
-    );
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_STATE_NUMBER: NsNodeId = id(6085);
     /// `CurrentState` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE_CURRENT_STATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6076u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE_CURRENT_STATE: NsNodeId = id(
+        6076,
     );
     /// `Id` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE_CURRENT_STATE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6077u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE_CURRENT_STATE_ID: NsNodeId = id(
+        6077,
     );
     /// `LastTransition` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE_LAST_TRANSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6071u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE_LAST_TRANSITION: NsNodeId = id(
+        6071,
     );
     /// `Id` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE_LAST_TRANSITION_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6072u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE_LAST_TRANSITION_ID: NsNodeId = id(
+        6072,
     );
     /// `LastTransitionReason` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE_LAST_TRANSITION_REASON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6073u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE_LAST_TRANSITION_REASON: NsNodeId = id(
+        6073,
     );
     /// `EnumValues` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE_LAST_TRANSITION_REASON_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6074u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE_LAST_TRANSITION_REASON_ENUM_VALUES: NsNodeId = id(
+        6074,
     );
     /// `ValueAsText` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6075u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_SUBSTATE_MACHINE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: NsNodeId = id(
+        6075,
     );
     /// `TransitionNumber` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_TO_IDLE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6088u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_TO_IDLE_TRANSITION_NUMBER: NsNodeId = id(
+        6088,
     );
     /// `TransitionNumber` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_TO_READY_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6089u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_IDLE_TO_READY_TRANSITION_NUMBER: NsNodeId = id(
+        6089,
     );
     /// `LastTransition` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6058u32,
-    );
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION: NsNodeId = id(6058);
     /// `Id` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6059u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_ID: NsNodeId = id(
+        6059,
     );
     /// `LastTransitionReason` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6060u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON: NsNodeId = id(
+        6060,
     );
     /// `EnumValues` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6061u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON_ENUM_VALUES: NsNodeId = id(
+        6061,
     );
     /// `ValueAsText` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6062u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: NsNodeId = id(
+        6062,
     );
     /// `PossibleStopModes` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_POSSIBLE_STOP_MODES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6063u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_POSSIBLE_STOP_MODES: NsNodeId = id(
+        6063,
     );
     /// `StateNumber` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_READY_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6086u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_READY_STATE_NUMBER: NsNodeId = id(
+        6086,
     );
     /// `TransitionNumber` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_READY_TO_EXECUTING_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6091u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_READY_TO_EXECUTING_TRANSITION_NUMBER: NsNodeId = id(
+        6091,
     );
     /// `TransitionNumber` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_READY_TO_IDLE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6090u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_READY_TO_IDLE_TRANSITION_NUMBER: NsNodeId = id(
+        6090,
     );
     /// `OutputArguments` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_STAND_DOWN_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6070u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_STAND_DOWN_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6070,
     );
     /// `OutputArguments` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_START_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6064u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_START_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6064,
     );
     /// `InputArguments` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_STOP_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6065u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_STOP_INPUT_ARGUMENTS: NsNodeId = id(
+        6065,
     );
     /// `OutputArguments` (Variable).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_STOP_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6066u32,
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_STOP_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6066,
     );
     /// `AckedState` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ACKED_STATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6185u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ACKED_STATE: NsNodeId = id(
+        6185,
     );
     /// `Id` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ACKED_STATE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6186u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ACKED_STATE_ID: NsNodeId = id(
+        6186,
     );
     /// `InputArguments` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ACKNOWLEDGE_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6187u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ACKNOWLEDGE_INPUT_ARGUMENTS: NsNodeId = id(
+        6187,
     );
     /// `InputArguments` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ADD_COMMENT_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6190u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ADD_COMMENT_INPUT_ARGUMENTS: NsNodeId = id(
+        6190,
     );
     /// `BranchId` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_BRANCH_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6191u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_BRANCH_ID: NsNodeId = id(
+        6191,
     );
     /// `ClientUserId` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_CLIENT_USER_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6192u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_CLIENT_USER_ID: NsNodeId = id(
+        6192,
     );
     /// `Comment` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_COMMENT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6193u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_COMMENT: NsNodeId = id(
+        6193,
     );
     /// `SourceTimestamp` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_COMMENT_SOURCE_TIMESTAMP: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6194u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_COMMENT_SOURCE_TIMESTAMP: NsNodeId = id(
+        6194,
     );
     /// `ConditionClassId` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_CONDITION_CLASS_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6195u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_CONDITION_CLASS_ID: NsNodeId = id(
+        6195,
     );
     /// `ConditionClassName` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_CONDITION_CLASS_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6196u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_CONDITION_CLASS_NAME: NsNodeId = id(
+        6196,
     );
     /// `ConditionName` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_CONDITION_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6197u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_CONDITION_NAME: NsNodeId = id(
+        6197,
     );
     /// `ConditionSubClassId` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_CONDITION_SUB_CLASS_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6198u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_CONDITION_SUB_CLASS_ID: NsNodeId = id(
+        6198,
     );
     /// `ConditionSubClassName` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_CONDITION_SUB_CLASS_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6199u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_CONDITION_SUB_CLASS_NAME: NsNodeId = id(
+        6199,
     );
     /// `EnabledState` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ENABLED_STATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6188u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ENABLED_STATE: NsNodeId = id(
+        6188,
     );
     /// `Id` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ENABLED_STATE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6189u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ENABLED_STATE_ID: NsNodeId = id(
+        6189,
     );
     /// `EventId` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_EVENT_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6205u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_EVENT_ID: NsNodeId = id(
+        6205,
     );
     /// `EventType` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_EVENT_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6206u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_EVENT_TYPE: NsNodeId = id(
+        6206,
     );
     /// `LastSeverity` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_LAST_SEVERITY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6200u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_LAST_SEVERITY: NsNodeId = id(
+        6200,
     );
     /// `SourceTimestamp` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_LAST_SEVERITY_SOURCE_TIMESTAMP: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6201u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_LAST_SEVERITY_SOURCE_TIMESTAMP: NsNodeId = id(
+        6201,
     );
     /// `Message` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_MESSAGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6207u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_MESSAGE: NsNodeId = id(
+        6207,
     );
     /// `Quality` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_QUALITY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6202u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_QUALITY: NsNodeId = id(
+        6202,
     );
     /// `SourceTimestamp` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_QUALITY_SOURCE_TIMESTAMP: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6203u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_QUALITY_SOURCE_TIMESTAMP: NsNodeId = id(
+        6203,
     );
     /// `ReceiveTime` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_RECEIVE_TIME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6208u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_RECEIVE_TIME: NsNodeId = id(
+        6208,
     );
     /// `Retain` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_RETAIN: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6204u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_RETAIN: NsNodeId = id(
+        6204,
     );
     /// `Severity` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_SEVERITY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6209u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_SEVERITY: NsNodeId = id(
+        6209,
     );
     /// `SourceName` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_SOURCE_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6210u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_SOURCE_NAME: NsNodeId = id(
+        6210,
     );
     /// `SourceNode` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_SOURCE_NODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6211u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_SOURCE_NODE: NsNodeId = id(
+        6211,
     );
     /// `Time` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_TIME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6212u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_TIME: NsNodeId = id(
+        6212,
     );
     /// `DefaultInstanceBrowseName` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_DEFAULT_INSTANCE_BROWSE_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6130u32,
-    );
+    pub const SYSTEM_OPERATION_TYPE_DEFAULT_INSTANCE_BROWSE_NAME: NsNodeId = id(6130);
     /// `CurrentState` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE_CURRENT_STATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6128u32,
+    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE_CURRENT_STATE: NsNodeId = id(
+        6128,
     );
     /// `Id` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE_CURRENT_STATE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6129u32,
+    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE_CURRENT_STATE_ID: NsNodeId = id(
+        6129,
     );
     /// `LastTransition` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6123u32,
+    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION: NsNodeId = id(
+        6123,
     );
     /// `Id` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6124u32,
+    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_ID: NsNodeId = id(
+        6124,
     );
     /// `LastTransitionReason` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_REASON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6125u32,
+    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_REASON: NsNodeId = id(
+        6125,
     );
     /// `EnumValues` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_REASON_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6126u32,
+    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_REASON_ENUM_VALUES: NsNodeId = id(
+        6126,
     );
     /// `ValueAsText` (Variable).
-    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6127u32,
+    pub const SYSTEM_OPERATION_TYPE_SYSTEM_OPERATION_STATE_MACHINE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: NsNodeId = id(
+        6127,
     );
     /// `DefaultInstanceBrowseName` (Variable).
-    pub const TASK_CONTROL_OPERATION_TYPE_DEFAULT_INSTANCE_BROWSE_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6132u32,
+    pub const TASK_CONTROL_OPERATION_TYPE_DEFAULT_INSTANCE_BROWSE_NAME: NsNodeId = id(
+        6132,
     );
     /// `MotionDevicesUnderControl` (Variable).
-    pub const TASK_CONTROL_OPERATION_TYPE_MOTION_DEVICES_UNDER_CONTROL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6131u32,
+    pub const TASK_CONTROL_OPERATION_TYPE_MOTION_DEVICES_UNDER_CONTROL: NsNodeId = id(
+        6131,
     );
     /// `CurrentState` (Variable).
-    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE_CURRENT_STATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6138u32,
+    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE_CURRENT_STATE: NsNodeId = id(
+        6138,
     );
     /// `Id` (Variable).
-    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE_CURRENT_STATE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6139u32,
+    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE_CURRENT_STATE_ID: NsNodeId = id(
+        6139,
     );
     /// `LastTransition` (Variable).
-    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6133u32,
+    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION: NsNodeId = id(
+        6133,
     );
     /// `Id` (Variable).
-    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6134u32,
+    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_ID: NsNodeId = id(
+        6134,
     );
     /// `LastTransitionReason` (Variable).
-    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_REASON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6135u32,
+    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_REASON: NsNodeId = id(
+        6135,
     );
     /// `EnumValues` (Variable).
-    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_REASON_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6136u32,
+    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_REASON_ENUM_VALUES: NsNodeId = id(
+        6136,
     );
     /// `ValueAsText` (Variable).
-    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6137u32,
+    pub const TASK_CONTROL_OPERATION_TYPE_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: NsNodeId = id(
+        6137,
     );
     /// `ConfiguredDefaultStopMode` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_CONFIGURED_DEFAULT_STOP_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6094u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_CONFIGURED_DEFAULT_STOP_MODE: NsNodeId = id(
+        6094,
     );
     /// `StateNumber` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_EXECUTING_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6114u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_EXECUTING_STATE_NUMBER: NsNodeId = id(
+        6114,
     );
     /// `TransitionNumber` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_EXECUTING_TO_IDLE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6122u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_EXECUTING_TO_IDLE_TRANSITION_NUMBER: NsNodeId = id(
+        6122,
     );
     /// `TransitionNumber` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_EXECUTING_TO_READY_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6121u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_EXECUTING_TO_READY_TRANSITION_NUMBER: NsNodeId = id(
+        6121,
     );
     /// `StateNumber` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_IDLE_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6112u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_IDLE_STATE_NUMBER: NsNodeId = id(6112);
+    /// `TransitionNumber` (Variable).
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_IDLE_TO_IDLE_TRANSITION_NUMBER: NsNodeId = id(
+        6115,
     );
     /// `TransitionNumber` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_IDLE_TO_IDLE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6115u32,
-    );
-    /// `TransitionNumber` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_IDLE_TO_READY_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6116u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_IDLE_TO_READY_TRANSITION_NUMBER: NsNodeId = id(
+        6116,
     );
     /// `LastTransition` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LAST_TRANSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6095u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LAST_TRANSITION: NsNodeId = id(6095);
     /// `Id` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LAST_TRANSITION_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6096u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LAST_TRANSITION_ID: NsNodeId = id(6096);
     /// `LastTransitionReason` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6097u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON: NsNodeId = id(
+        6097,
     );
     /// `EnumValues` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6098u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON_ENUM_VALUES: NsNodeId = id(
+        6098,
     );
     /// `ValueAsText` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6099u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: NsNodeId = id(
+        6099,
     );
     /// `InputArguments` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LOAD_BY_NAME_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6143u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LOAD_BY_NAME_INPUT_ARGUMENTS: NsNodeId = id(
+        6143,
     );
     /// `OutputArguments` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LOAD_BY_NAME_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6144u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LOAD_BY_NAME_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6144,
     );
     /// `InputArguments` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LOAD_BY_NODE_ID_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6141u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LOAD_BY_NODE_ID_INPUT_ARGUMENTS: NsNodeId = id(
+        6141,
     );
     /// `OutputArguments` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LOAD_BY_NODE_ID_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6142u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LOAD_BY_NODE_ID_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6142,
     );
     /// `PossibleStopModes` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_POSSIBLE_STOP_MODES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6100u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_POSSIBLE_STOP_MODES: NsNodeId = id(6100);
     /// `StateNumber` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_STATE_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6113u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_STATE_NUMBER: NsNodeId = id(6113);
     /// `CurrentState` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE_CURRENT_STATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6109u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE_CURRENT_STATE: NsNodeId = id(
+        6109,
     );
     /// `Id` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE_CURRENT_STATE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6111u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE_CURRENT_STATE_ID: NsNodeId = id(
+        6111,
     );
     /// `LastTransition` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE_LAST_TRANSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6104u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE_LAST_TRANSITION: NsNodeId = id(
+        6104,
     );
     /// `Id` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE_LAST_TRANSITION_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6105u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE_LAST_TRANSITION_ID: NsNodeId = id(
+        6105,
     );
     /// `LastTransitionReason` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE_LAST_TRANSITION_REASON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6106u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE_LAST_TRANSITION_REASON: NsNodeId = id(
+        6106,
     );
     /// `EnumValues` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE_LAST_TRANSITION_REASON_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6107u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE_LAST_TRANSITION_REASON_ENUM_VALUES: NsNodeId = id(
+        6107,
     );
     /// `ValueAsText` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6108u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_SUBSTATE_MACHINE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: NsNodeId = id(
+        6108,
     );
     /// `TransitionNumber` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_TO_EXECUTING_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6120u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_TO_EXECUTING_TRANSITION_NUMBER: NsNodeId = id(
+        6120,
     );
     /// `TransitionNumber` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_TO_IDLE_TRANSITION_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6119u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_READY_TO_IDLE_TRANSITION_NUMBER: NsNodeId = id(
+        6119,
     );
     /// `OutputArguments` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_START_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6101u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_START_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6101,
     );
     /// `InputArguments` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_STOP_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6102u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_STOP_INPUT_ARGUMENTS: NsNodeId = id(6102);
+    /// `OutputArguments` (Variable).
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_STOP_OUTPUT_ARGUMENTS: NsNodeId = id(6103);
+    /// `InputArguments` (Variable).
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_BY_NAME_INPUT_ARGUMENTS: NsNodeId = id(
+        6067,
     );
     /// `OutputArguments` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_STOP_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6103u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_BY_NAME_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6069,
     );
     /// `InputArguments` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_BY_NAME_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6067u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_BY_NODE_ID_INPUT_ARGUMENTS: NsNodeId = id(
+        6146,
     );
     /// `OutputArguments` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_BY_NAME_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6069u32,
-    );
-    /// `InputArguments` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_BY_NODE_ID_INPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6146u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_BY_NODE_ID_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6147,
     );
     /// `OutputArguments` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_BY_NODE_ID_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6147u32,
-    );
-    /// `OutputArguments` (Variable).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_PROGRAM_OUTPUT_ARGUMENTS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6145u32,
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_PROGRAM_OUTPUT_ARGUMENTS: NsNodeId = id(
+        6145,
     );
     /// `ComponentName` (Variable).
     ///
     /// A user writable name provided by the vendor, integrator or user of the device.
-    pub const TASK_CONTROL_TYPE_COMPONENT_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17873u32,
-    );
+    pub const TASK_CONTROL_TYPE_COMPONENT_NAME: NsNodeId = id(17873);
     /// `Manufacturer` (Variable).
-    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_MANUFACTURER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        19275u32,
+    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_MANUFACTURER: NsNodeId = id(
+        19275,
     );
     /// `Model` (Variable).
-    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_MODEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        19277u32,
-    );
+    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_MODEL: NsNodeId = id(19277);
     /// `MotionDeviceCategory` (Variable).
     ///
     /// The variable MotionDeviceCategory provides the kind of motion device defined by MotionDeviceCategoryEnumeration based on ISO 8373.
-    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_MOTION_DEVICE_CATEGORY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        19288u32,
+    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_MOTION_DEVICE_CATEGORY: NsNodeId = id(
+        19288,
     );
     /// `SpeedOverride` (Variable).
     ///
     /// SpeedOverride provides the current speed setting in percent of programmed speed (0 - 100%).
-    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_PARAMETER_SET_SPEED_OVERRIDE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        19291u32,
+    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_PARAMETER_SET_SPEED_OVERRIDE: NsNodeId = id(
+        19291,
     );
     /// `ProductCode` (Variable).
-    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_PRODUCT_CODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        19283u32,
+    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_PRODUCT_CODE: NsNodeId = id(
+        19283,
     );
     /// `SerialNumber` (Variable).
-    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_SERIAL_NUMBER: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        19278u32,
+    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_SERIAL_NUMBER: NsNodeId = id(
+        19278,
     );
     /// `TaskControlReference` (Variable).
-    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_TASK_CONTROL_REFERENCE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6004u32,
+    pub const TASK_CONTROL_TYPE_MOTION_DEVICE_IDENTIFIER_TASK_CONTROL_REFERENCE: NsNodeId = id(
+        6004,
     );
     /// `ExecutionMode` (Variable).
     ///
     /// Execution mode of the task control (continuous or step-wise).
-    pub const TASK_CONTROL_TYPE_PARAMETER_SET_EXECUTION_MODE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17876u32,
-    );
+    pub const TASK_CONTROL_TYPE_PARAMETER_SET_EXECUTION_MODE: NsNodeId = id(17876);
     /// `TaskProgramLoaded` (Variable).
     ///
     /// The TaskProgramLoaded variable is TRUE if a task program is loaded in the task control, FALSE otherwise.
-    pub const TASK_CONTROL_TYPE_PARAMETER_SET_TASK_PROGRAM_LOADED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17875u32,
-    );
+    pub const TASK_CONTROL_TYPE_PARAMETER_SET_TASK_PROGRAM_LOADED: NsNodeId = id(17875);
     /// `TaskProgramName` (Variable).
     ///
     /// A customer given identifier for the task program.
-    pub const TASK_CONTROL_TYPE_PARAMETER_SET_TASK_PROGRAM_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17874u32,
-    );
+    pub const TASK_CONTROL_TYPE_PARAMETER_SET_TASK_PROGRAM_NAME: NsNodeId = id(17874);
     /// `CurrentState` (Variable).
-    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE_CURRENT_STATE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6148u32,
+    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE_CURRENT_STATE: NsNodeId = id(
+        6148,
     );
     /// `Id` (Variable).
-    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE_CURRENT_STATE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6149u32,
+    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE_CURRENT_STATE_ID: NsNodeId = id(
+        6149,
     );
     /// `LastTransition` (Variable).
-    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6150u32,
+    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION: NsNodeId = id(
+        6150,
     );
     /// `Id` (Variable).
-    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6151u32,
+    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_ID: NsNodeId = id(
+        6151,
     );
     /// `LastTransitionReason` (Variable).
-    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_REASON: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6152u32,
+    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_REASON: NsNodeId = id(
+        6152,
     );
     /// `EnumValues` (Variable).
-    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_REASON_ENUM_VALUES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6153u32,
+    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_REASON_ENUM_VALUES: NsNodeId = id(
+        6153,
     );
     /// `ValueAsText` (Variable).
-    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6154u32,
+    pub const TASK_CONTROL_TYPE_TASK_CONTROL_OPERATION_TASK_CONTROL_STATE_MACHINE_LAST_TRANSITION_REASON_VALUE_AS_TEXT: NsNodeId = id(
+        6154,
     );
     /// `Name` (Variable).
-    pub const TASK_CONTROL_TYPE_TASK_MODULES_TASK_MODULE_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6169u32,
-    );
+    pub const TASK_CONTROL_TYPE_TASK_MODULES_TASK_MODULE_NAME: NsNodeId = id(6169);
     /// `IsReferenced` (Variable).
-    pub const TASK_MODULE_TYPE_IS_REFERENCED: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6056u32,
-    );
+    pub const TASK_MODULE_TYPE_IS_REFERENCED: NsNodeId = id(6056);
     /// `Name` (Variable).
-    pub const TASK_MODULE_TYPE_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6054u32,
-    );
+    pub const TASK_MODULE_TYPE_NAME: NsNodeId = id(6054);
     /// `Version` (Variable).
-    pub const TASK_MODULE_TYPE_VERSION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        6055u32,
-    );
+    pub const TASK_MODULE_TYPE_VERSION: NsNodeId = id(6055);
     /// `Level` (Variable).
     ///
     /// Provides information about the access rights and determines what can be viewed, updated, or deleted by a user
-    pub const USER_TYPE_LEVEL: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18176u32,
-    );
+    pub const USER_TYPE_LEVEL: NsNodeId = id(18176);
     /// `Name` (Variable).
     ///
     /// The name for the current user within the control system.
-    pub const USER_TYPE_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18177u32,
-    );
+    pub const USER_TYPE_NAME: NsNodeId = id(18177);
 }
 /// The Method nodes of this namespace.
 pub mod methods {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `CreateDirectory` (Method).
-    pub const CONTROLLER_TYPE_PROGRAMS_CREATE_DIRECTORY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7015u32,
-    );
+    pub const CONTROLLER_TYPE_PROGRAMS_CREATE_DIRECTORY: NsNodeId = id(7015);
     /// `CreateFile` (Method).
-    pub const CONTROLLER_TYPE_PROGRAMS_CREATE_FILE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7016u32,
-    );
+    pub const CONTROLLER_TYPE_PROGRAMS_CREATE_FILE: NsNodeId = id(7016);
     /// `Delete` (Method).
-    pub const CONTROLLER_TYPE_PROGRAMS_DELETE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7017u32,
-    );
+    pub const CONTROLLER_TYPE_PROGRAMS_DELETE: NsNodeId = id(7017);
     /// `MoveOrCopy` (Method).
-    pub const CONTROLLER_TYPE_PROGRAMS_MOVE_OR_COPY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7018u32,
-    );
+    pub const CONTROLLER_TYPE_PROGRAMS_MOVE_OR_COPY: NsNodeId = id(7018);
     /// `Start` (Method).
-    pub const OPERATION_STATE_MACHINE_TYPE_START: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7001u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_START: NsNodeId = id(7001);
     /// `Stop` (Method).
-    pub const OPERATION_STATE_MACHINE_TYPE_STOP: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7002u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE_STOP: NsNodeId = id(7002);
     /// `ResetToProgramStart` (Method).
-    pub const READY_SUBSTATE_MACHINE_TYPE_RESET_TO_PROGRAM_START: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7003u32,
-    );
+    pub const READY_SUBSTATE_MACHINE_TYPE_RESET_TO_PROGRAM_START: NsNodeId = id(7003);
     /// `GetReady` (Method).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_GET_READY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7006u32,
-    );
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_GET_READY: NsNodeId = id(7006);
     /// `StandDown` (Method).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_STAND_DOWN: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7007u32,
-    );
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_STAND_DOWN: NsNodeId = id(7007);
     /// `Start` (Method).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_START: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7004u32,
-    );
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_START: NsNodeId = id(7004);
     /// `Stop` (Method).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_STOP: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7005u32,
-    );
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE_STOP: NsNodeId = id(7005);
     /// `Acknowledge` (Method).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ACKNOWLEDGE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7019u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ACKNOWLEDGE: NsNodeId = id(
+        7019,
     );
     /// `AddComment` (Method).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ADD_COMMENT: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7020u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ADD_COMMENT: NsNodeId = id(
+        7020,
     );
     /// `Disable` (Method).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_DISABLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7021u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_DISABLE: NsNodeId = id(
+        7021,
     );
     /// `Enable` (Method).
-    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ENABLE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7022u32,
+    pub const SYSTEM_OPERATION_TYPE_CONDITIONS_ACKNOWLEDGEABLE_CONDITION_ENABLE: NsNodeId = id(
+        7022,
     );
     /// `LoadByName` (Method).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LOAD_BY_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7011u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LOAD_BY_NAME: NsNodeId = id(7011);
     /// `LoadByNodeId` (Method).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LOAD_BY_NODE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7010u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_LOAD_BY_NODE_ID: NsNodeId = id(7010);
     /// `Start` (Method).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_START: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7008u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_START: NsNodeId = id(7008);
     /// `Stop` (Method).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_STOP: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7009u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_STOP: NsNodeId = id(7009);
     /// `UnloadByName` (Method).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_BY_NAME: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7014u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_BY_NAME: NsNodeId = id(7014);
     /// `UnloadByNodeId` (Method).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_BY_NODE_ID: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7013u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_BY_NODE_ID: NsNodeId = id(7013);
     /// `UnloadProgram` (Method).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_PROGRAM: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        7012u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE_UNLOAD_PROGRAM: NsNodeId = id(7012);
 }
 /// The ObjectType nodes of this namespace.
 pub mod object_types {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `AuxiliaryComponentType` (ObjectType).
     ///
     /// Components mounted in a controller cabinet or a motion device e.g. an IO-board or a power supply.
-    pub const AUXILIARY_COMPONENT_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17725u32,
-    );
+    pub const AUXILIARY_COMPONENT_TYPE: NsNodeId = id(17725);
     /// `AxisType` (ObjectType).
     ///
     /// The AxisType describes an axis of a motion device.
-    pub const AXIS_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16601u32,
-    );
+    pub const AXIS_TYPE: NsNodeId = id(16601);
     /// `ControllerType` (ObjectType).
     ///
     /// The ControllerType describes the control unit of motion devices. One motion device system can have one or more instances of the ControllerType.
-    pub const CONTROLLER_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1003u32,
-    );
+    pub const CONTROLLER_TYPE: NsNodeId = id(1003);
     /// `DriveType` (ObjectType).
     ///
     /// Drives (multi-slot or single-slot axis amplifier) mounted in a controller cabinet or a motion device.
-    pub const DRIVE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17793u32,
-    );
+    pub const DRIVE_TYPE: NsNodeId = id(17793);
     /// `EmergencyStopFunctionType` (ObjectType).
     ///
     /// According to ISO 10218-1:2011 Ch.5.5.2 Emergency stop the robot shall have one or more emergency stop functions.
-    pub const EMERGENCY_STOP_FUNCTION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17230u32,
-    );
+    pub const EMERGENCY_STOP_FUNCTION_TYPE: NsNodeId = id(17230);
     /// `ExecutingSubstateMachineType` (ObjectType).
-    pub const EXECUTING_SUBSTATE_MACHINE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1007u32,
-    );
+    pub const EXECUTING_SUBSTATE_MACHINE_TYPE: NsNodeId = id(1007);
     /// `GearType` (ObjectType).
     ///
     /// The GearType describes a gear in a powertrain, e.g. a gear box or a spindle.
-    pub const GEAR_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1022u32,
-    );
+    pub const GEAR_TYPE: NsNodeId = id(1022);
     /// `IdleSubstateMachineType` (ObjectType).
-    pub const IDLE_SUBSTATE_MACHINE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1009u32,
-    );
+    pub const IDLE_SUBSTATE_MACHINE_TYPE: NsNodeId = id(1009);
     /// `LoadType` (ObjectType).
     ///
     /// The LoadType is for describing loads mounted on the motion device typically by an integrator or a customer.
-    pub const LOAD_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1018u32,
-    );
+    pub const LOAD_TYPE: NsNodeId = id(1018);
     /// `MotionDeviceSystemType` (ObjectType).
     ///
     /// Contains the set of controllers and motion devices in a closely-coupled motion device system.
-    pub const MOTION_DEVICE_SYSTEM_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1002u32,
-    );
+    pub const MOTION_DEVICE_SYSTEM_TYPE: NsNodeId = id(1002);
     /// `MotionDeviceType` (ObjectType).
     ///
     /// Represents a specific motion device in the motion device system like a robot, a linear unit or a positioner. A MotionDevice should have at least one axis.
-    pub const MOTION_DEVICE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1004u32,
-    );
+    pub const MOTION_DEVICE_TYPE: NsNodeId = id(1004);
     /// `MotorType` (ObjectType).
     ///
     /// The MotorType is for representing instances of electric motors.
-    pub const MOTOR_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1019u32,
-    );
+    pub const MOTOR_TYPE: NsNodeId = id(1019);
     /// `MultiAcknowledgeableConditionType` (ObjectType).
-    pub const MULTI_ACKNOWLEDGEABLE_CONDITION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1015u32,
-    );
+    pub const MULTI_ACKNOWLEDGEABLE_CONDITION_TYPE: NsNodeId = id(1015);
     /// `OperationStateMachineType` (ObjectType).
-    pub const OPERATION_STATE_MACHINE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1006u32,
-    );
+    pub const OPERATION_STATE_MACHINE_TYPE: NsNodeId = id(1006);
     /// `PowerTrainType` (ObjectType).
     ///
     /// The PowerTrainType represents instances of powertrains of a motion device.
-    pub const POWER_TRAIN_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        16794u32,
-    );
+    pub const POWER_TRAIN_TYPE: NsNodeId = id(16794);
     /// `ProtectiveStopFunctionType` (ObjectType).
     ///
     /// According to ISO 10218-1:2011 Ch.5.5.3 the robot shall have one or more protective stop functions designed for the connection of external protective devices.
-    pub const PROTECTIVE_STOP_FUNCTION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        17233u32,
-    );
+    pub const PROTECTIVE_STOP_FUNCTION_TYPE: NsNodeId = id(17233);
     /// `ReadySubstateMachineType` (ObjectType).
-    pub const READY_SUBSTATE_MACHINE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1012u32,
-    );
+    pub const READY_SUBSTATE_MACHINE_TYPE: NsNodeId = id(1012);
     /// `SafetyStateType` (ObjectType).
     ///
     /// SafetyStateType describes the safety states of the motion devices and controllers. One motion device system is associated with one or more instances of the SafetyStateType.
-    pub const SAFETY_STATE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1013u32,
-    );
+    pub const SAFETY_STATE_TYPE: NsNodeId = id(1013);
     /// `SystemOperationStateMachineType` (ObjectType).
-    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1021u32,
-    );
+    pub const SYSTEM_OPERATION_STATE_MACHINE_TYPE: NsNodeId = id(1021);
     /// `SystemOperationType` (ObjectType).
-    pub const SYSTEM_OPERATION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1028u32,
-    );
+    pub const SYSTEM_OPERATION_TYPE: NsNodeId = id(1028);
     /// `TaskControlOperationType` (ObjectType).
-    pub const TASK_CONTROL_OPERATION_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1008u32,
-    );
+    pub const TASK_CONTROL_OPERATION_TYPE: NsNodeId = id(1008);
     /// `TaskControlStateMachineType` (ObjectType).
-    pub const TASK_CONTROL_STATE_MACHINE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1025u32,
-    );
+    pub const TASK_CONTROL_STATE_MACHINE_TYPE: NsNodeId = id(1025);
     /// `TaskControlType` (ObjectType).
     ///
     /// Represents a specific task control active on the controller.
-    pub const TASK_CONTROL_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1011u32,
-    );
+    pub const TASK_CONTROL_TYPE: NsNodeId = id(1011);
     /// `TaskModuleType` (ObjectType).
-    pub const TASK_MODULE_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        1016u32,
-    );
+    pub const TASK_MODULE_TYPE: NsNodeId = id(1016);
     /// `UserType` (ObjectType).
     ///
     /// The UserType ObjectType describes information of the registered user groups within the control system.
-    pub const USER_TYPE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18175u32,
-    );
+    pub const USER_TYPE: NsNodeId = id(18175);
 }
 /// The ReferenceType nodes of this namespace.
 pub mod reference_types {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `Controls` (ReferenceType).
     ///
     /// Reference: Describe dependencies between objects which have a controlling character.
-    pub const CONTROLS: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        4002u32,
-    );
+    pub const CONTROLS: NsNodeId = id(4002);
     /// `HasSafetyStates` (ReferenceType).
     ///
     /// Reference: Describe dependencies between objects to show which (controller) object is responsible for the execution of the safety-functionality. The BrowseName HasSafetyStates and the InverseName SafetyStatesOf describe semantically the hierarchical dependency.
-    pub const HAS_SAFETY_STATES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18182u32,
-    );
+    pub const HAS_SAFETY_STATES: NsNodeId = id(18182);
     /// `HasSlave` (ReferenceType).
     ///
     /// Reference: Provide the master-slave relationship of powertrains which provide torque for a common axis. The InverseName is IsSlaveOf.
-    pub const HAS_SLAVE: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18183u32,
-    );
+    pub const HAS_SLAVE: NsNodeId = id(18183);
     /// `IsConnectedTo` (ReferenceType).
     ///
     /// Reference: Describe dependencies between objects which are mounted or mechanically linked or connected to each other. The IsConnectedTo reference is symmetric and has no InverseName.
-    pub const IS_CONNECTED_TO: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18181u32,
-    );
+    pub const IS_CONNECTED_TO: NsNodeId = id(18181);
     /// `IsDrivenBy` (ReferenceType).
     ///
     /// Reference: Describe dependencies between objects which have a driving or powering character. The BrowseName IsDrivenBy and the InverseName Drives describe semantically the hierarchical dependency.
-    pub const IS_DRIVEN_BY: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18180u32,
-    );
+    pub const IS_DRIVEN_BY: NsNodeId = id(18180);
     /// `Moves` (ReferenceType).
     ///
     /// Reference: Describe the coupling between a powertrain and the axes from the powertrain point of view.
-    pub const MOVES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18178u32,
-    );
+    pub const MOVES: NsNodeId = id(18178);
     /// `Requires` (ReferenceType).
     ///
     /// Reference: Describe the coupling between a powertrain and axes from the axis point of view. An axis has a Requires reference to all powertrains that need to move such that only this single axis moves.
-    pub const REQUIRES: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18179u32,
-    );
+    pub const REQUIRES: NsNodeId = id(18179);
 }
 /// The DataType nodes of this namespace.
 pub mod data_types {
+    use super::super::NAMESPACE_URI as NS;
+    use crate::runtime::NsNodeId;
+    #[allow(dead_code)]
+    const fn id(n: u32) -> NsNodeId {
+        NsNodeId::numeric(NS, n)
+    }
     /// `AxisMotionProfileEnumeration` (DataType).
-    pub const AXIS_MOTION_PROFILE_ENUMERATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        3008u32,
-    );
+    pub const AXIS_MOTION_PROFILE_ENUMERATION: NsNodeId = id(3008);
     /// `ExecutionModeEnumeration` (DataType).
-    pub const EXECUTION_MODE_ENUMERATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18191u32,
-    );
+    pub const EXECUTION_MODE_ENUMERATION: NsNodeId = id(18191);
     /// `MotionDeviceCategoryEnumeration` (DataType).
-    pub const MOTION_DEVICE_CATEGORY_ENUMERATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        18193u32,
-    );
+    pub const MOTION_DEVICE_CATEGORY_ENUMERATION: NsNodeId = id(18193);
     /// `OperationalModeEnumeration` (DataType).
-    pub const OPERATIONAL_MODE_ENUMERATION: crate::runtime::NsNodeId = crate::runtime::NsNodeId::numeric(
-        super::super::NAMESPACE_URI,
-        3006u32,
-    );
+    pub const OPERATIONAL_MODE_ENUMERATION: NsNodeId = id(3006);
 }

@@ -282,23 +282,35 @@ impl<'m> Gen<'m> {
                     }
                     let docs = doc(&text);
                     let value = match &n.id.id {
-                        Identifier::Numeric(v) => quote! { #runtime::NsNodeId::numeric(super::super::NAMESPACE_URI, #v) },
+                        Identifier::Numeric(v) => {
+                            let v = Literal::u32_unsuffixed(*v);
+                            quote! { id(#v) }
+                        }
                         Identifier::String(s) => {
                             let s = lit(s);
-                            quote! { #runtime::NsNodeId::string(super::super::NAMESPACE_URI, #s) }
+                            quote! { NsNodeId::string(NS, #s) }
                         }
                         other => {
                             let idk = self.id_kind(other);
                             let idk = path(&idk.to_string().replacen("rt ::", &format!("{} ::", self.cfg.runtime_path), 1));
-                            quote! { #runtime::NsNodeId { namespace_uri: super::super::NAMESPACE_URI, id: #idk } }
+                            quote! { NsNodeId { namespace_uri: NS, id: #idk } }
                         }
                     };
-                    quote! { #docs pub const #name: #runtime::NsNodeId = #value; }
+                    quote! { #docs pub const #name: NsNodeId = #value; }
                 })
                 .collect();
             let module = ident(&names::sanitize(&format!("{}s", class.name()), Case::Snake, Target::Rust));
             let mdoc = format!(" The {} nodes of this namespace.", class.name());
-            mods.push(quote! { #[doc = #mdoc] pub mod #module { #(#consts)* } });
+            mods.push(quote! {
+                #[doc = #mdoc]
+                pub mod #module {
+                    use super::super::NAMESPACE_URI as NS;
+                    use #runtime::NsNodeId;
+                    #[allow(dead_code)]
+                    const fn id(n: u32) -> NsNodeId { NsNodeId::numeric(NS, n) }
+                    #(#consts)*
+                }
+            });
         }
         let tokens = quote! {
             //! NodeIds of every node of this namespace, resolved against a namespace table at run time.
