@@ -11,6 +11,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 
 mod bench;
+mod corpus;
 mod fetch;
 mod generate;
 mod test;
@@ -36,6 +37,8 @@ enum Command {
     FetchNodesets(fetch::Args),
     /// Time parse + load + resolve on the vendored models and the UA-Nodeset tree (a report, not a test).
     Bench(bench::Args),
+    /// Generate Rust for every resolvable ua-nodeset file into one crate and `cargo check` it.
+    Corpus(corpus::Args),
     /// Regenerate generated/ from the pinned companion specifications (`--check`: fail if stale).
     Generate(generate::Args),
     /// Everything a fresh machine needs (pinned nodesets, Python test peers), then every test.
@@ -49,6 +52,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::FetchNodesets(args) => fetch::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Corpus(args) => corpus::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Test(args) => test::run(args),
         Command::Venv(args) => venv::run(args),

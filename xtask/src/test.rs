@@ -3,6 +3,7 @@
 //! 1. The pinned companion specs (`fetch-nodesets`, a no-op when they are present and verified).
 //! 2. The Python venv with the test peers (`.venv`, from `tests/requirements.txt`).
 //! 3. `cargo test --workspace --locked`, whose summary lines CI reads.
+//! 4. `cargo xtask corpus`: Rust for every resolvable ua-nodeset file, compiled.
 
 use crate::util::workspace_root;
 use std::process::Command;
@@ -32,9 +33,10 @@ pub fn run(args: Args) -> Result<(), String> {
         .args(&args.cargo_args)
         .status()
         .map_err(|e| format!("cannot run cargo test: {e}"))?;
-    if status.success() {
-        Ok(())
-    } else {
-        Err(format!("cargo test failed ({status})"))
+    if !status.success() {
+        return Err(format!("cargo test failed ({status})"));
     }
+    // The whole corpus as Rust, compiled: too long for a #[test] among others, so it runs after them.
+    crate::corpus::run(crate::corpus::Args::default())
+}
 }
