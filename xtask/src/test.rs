@@ -39,4 +39,3 @@ pub fn run(args: Args) -> Result<(), String> {
     // The whole corpus as Rust, compiled: too long for a #[test] among others, so it runs after them.
     crate::corpus::run(crate::corpus::Args::default())
 }
-}
