@@ -36,11 +36,123 @@ enum Command {
         #[arg(long, default_value_t = 3)]
         depth: usize,
     },
+    /// Generate Rust for async-opcua 0.19 from NodeSet2 files: one module folder per namespace.
+    Rust {
+        /// NodeSet2 files whose models are generated.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Folders searched recursively for the models the files require.
+        #[arg(long = "models", value_name = "DIR")]
+        models: Vec<PathBuf>,
+        /// Output folder (replaced atomically; it must hold only generated files).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// A namespace generated elsewhere, as URI=RUST_PATH (e.g. http://opcfoundation.org/UA/DI/=nodeset_models::models::di).
+        #[arg(long = "extern", value_name = "URI=PATH")]
+        externs: Vec<String>,
+        /// The module name of a namespace, as URI=NAME.
+        #[arg(long = "module", value_name = "URI=NAME")]
+        modules: Vec<String>,
+        /// The Rust path of the runtime module.
+        #[arg(long, default_value = "nodeset_models::runtime")]
+        runtime: String,
+        /// Compare with the output folder instead of writing; fail if it differs.
+        #[arg(long)]
+        check: bool,
+        /// `--deny warnings` turns warnings into errors.
+        #[arg(long, value_name = "WHAT", value_parser = ["warnings"])]
+        deny: Option<String>,
+    },
+}
+
+fn pairs(items: &[String], what: &str) -> Result<Vec<(String, String)>, String> {
+    items
+        .iter()
+        .map(|i| {
+            // URIs contain `=` rarely but `:` always; split at the last `=`.
+            i.rsplit_once('=')
+                .map(|(a, b)| (a.to_string(), b.to_string()))
+                .ok_or_else(|| format!("--{what} takes URI=VALUE, got `{i}`"))
+        })
+        .collect()
+}
+
+fn rust_command(
+    files: Vec<PathBuf>,
+    models: Vec<PathBuf>,
+    out: PathBuf,
+    externs: Vec<String>,
+    modules: Vec<String>,
+    runtime: String,
+    check: bool,
+    deny: bool,
+) -> Result<(), String> {
+    use nodeset_compiler::emit::rust::{self as r, RustConfig, RustNamespace};
+    use nodeset_compiler::write::{write_tree, Mode};
+    let externs = pairs(&externs, "extern")?;
+    let modules = pairs(&modules, "module")?;
+    let opts = Options { model_dirs: models, deny_warnings: deny, ..Options::default() };
+    let compiled = compile(files.into_iter().map(Input::Path).collect(), &opts);
+    eprint!("{}", compiled.render_diagnostics());
+    if !compiled.ok() {
+        return Err("the NodeSet2 files do not compile; nothing was written".into());
+    }
+    let model = &compiled.model;
+    let namespaces: Vec<RustNamespace> = model
+        .models
+        .iter()
+        .filter(|m| model.sources.get(m.file).named)
+        .map(|m| RustNamespace {
+            uri: m.uri.clone(),
+            module: modules.iter().find(|(u, _)| *u == m.uri).map(|(_, n)| n.clone()).unwrap_or_else(|| r::default_module_name(&m.uri)),
+        })
+        .collect();
+    let cfg = RustConfig {
+        namespaces: namespaces.clone(),
+        extern_paths: externs.into_iter().collect(),
+        runtime_path: runtime,
+        command: "nodeset-compiler rust ...".into(),
+    };
+    let mut gen = r::generate(model, &cfg);
+    if deny {
+        gen.diagnostics.deny_warnings();
+    }
+    gen.diagnostics.sort(&model.sources);
+    eprint!("{}", gen.diagnostics.render(&model.sources));
+    if gen.diagnostics.has_errors() {
+        return Err("generation failed; nothing was written".into());
+    }
+    let list: Vec<(String, String)> = namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
+    gen.files.push(r::models_mod(&list, "nodeset-compiler rust ..."));
+    gen.files.push(r::rustfmt_toml());
+    let report = write_tree(&out, &gen.files, if check { Mode::Check } else { Mode::Write })?;
+    if check && !report.is_clean() {
+        return Err(format!("{} is stale:\n{}", out.display(), report.describe(&out)));
+    }
+    eprintln!(
+        "{}: {} file(s), {} new, {} changed, {} removed, {} unchanged",
+        out.display(),
+        gen.files.len(),
+        report.added.len(),
+        report.changed.len(),
+        report.removed.len(),
+        report.unchanged
+    );
+    Ok(())
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
+        Command::Rust { files, models, out, externs, modules, runtime, check, deny } => {
+            match rust_command(files, models, out, externs, modules, runtime, check, deny.is_some()) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::FAILURE
+                }
+            }
+        }
         Command::Check { files, models, deny, all_warnings, show, depth } => {
             let opts = Options {
                 model_dirs: models,
