@@ -1,6 +1,11 @@
 //! The hand-written runtime the generated namespaces need: static tables ([`table`]), NodeIds that carry
-//! their namespace URI ([`NsNodeId`]), and the mapping of table-local namespace indices to the server's.
+//! their namespace URI ([`NsNodeId`]), the mapping of table-local namespace indices to the server's, the
+//! import of a table into an async-opcua address space ([`import`]) and a server that serves tables
+//! ([`server`]).
 
+pub mod demo;
+pub mod import;
+pub mod server;
 pub mod table;
 
 use opcua::types::NodeId;
@@ -10,15 +15,19 @@ pub use table::{Id, IdKind};
 /// namespace table at run time (generated code never hard-codes a namespace index).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct NsNodeId {
+    /// The namespace URI.
     pub namespace_uri: &'static str,
+    /// The identifier within the namespace.
     pub id: IdKind,
 }
 
 impl NsNodeId {
+    /// A numeric NodeId.
     pub const fn numeric(namespace_uri: &'static str, n: u32) -> NsNodeId {
         NsNodeId { namespace_uri, id: IdKind::Numeric(n) }
     }
 
+    /// A string NodeId.
     pub const fn string(namespace_uri: &'static str, s: &'static str) -> NsNodeId {
         NsNodeId { namespace_uri, id: IdKind::String(s) }
     }
@@ -44,19 +53,33 @@ pub fn make_node_id(ns: u16, id: IdKind) -> NodeId {
 /// Maps a table's local namespace indices to the server's, once the table's namespaces are registered.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct NamespaceMap {
-    /// Server index of each table-local index.
+    /// Server index of each table-local index; `u16::MAX` where the namespace is not registered.
     pub indices: Vec<u16>,
 }
 
 impl NamespaceMap {
     /// The server NodeId of a table NodeId.
+    ///
+    /// An index the map does not know is kept as it is; use [`NamespaceMap::try_id`] to notice that.
     pub fn id(&self, id: Id) -> NodeId {
-        let ns = self.indices.get(id.ns as usize).copied().unwrap_or(id.ns);
-        make_node_id(ns, id.id)
+        make_node_id(self.index(id.ns), id.id)
     }
 
-    /// The server namespace index of a table-local index.
+    /// The server namespace index of a table-local index (kept as it is if the map does not know it).
     pub fn index(&self, local: u16) -> u16 {
-        self.indices.get(local as usize).copied().unwrap_or(local)
+        self.try_index(local).unwrap_or(local)
+    }
+
+    /// The server NodeId of a table NodeId, `None` if its namespace is not registered.
+    pub fn try_id(&self, id: Id) -> Option<NodeId> {
+        Some(make_node_id(self.try_index(id.ns)?, id.id))
+    }
+
+    /// The server namespace index of a table-local index, `None` if it is not registered.
+    pub fn try_index(&self, local: u16) -> Option<u16> {
+        if local == 0 {
+            return Some(0);
+        }
+        self.indices.get(local as usize).copied().filter(|&i| i != import::UNMAPPED)
     }
 }

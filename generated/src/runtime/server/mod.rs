@@ -1,0 +1,176 @@
+//! An OPC UA server for generated namespaces.
+//!
+//! [`ServerConfig`] builds an async-opcua server with the OPC UA namespace (ns0), the generated tables and
+//! their type loaders, on one SecurityPolicy None endpoint that accepts anonymous users:
+//!
+//! ```no_run
+//! # async fn demo(table: &'static nodeset_models::runtime::table::NodeSetTable) -> Result<(), String> {
+//! use nodeset_models::runtime::server::ServerConfig;
+//! use opcua::types::{StatusCode, Variant};
+//!
+//! let server = ServerConfig::new("My robot").port(4855).table(table).build()?;
+//! let manager = server.manager().clone();
+//! let speed = manager.resolve(nodeset_models::runtime::NsNodeId::numeric(table.namespace_uri, 6001)).unwrap();
+//! manager.on_write(&speed, |v| match v {
+//!     Variant::Double(d) if *d > 100.0 => Err(StatusCode::BadOutOfRange),
+//!     _ => Ok(None),
+//! });
+//! let handle = server.handle().clone();
+//! let task = tokio::spawn(server.run());
+//! manager.set_value(&speed, 12.5).map_err(|s| s.to_string())?;
+//! // ... later
+//! handle.cancel();
+//! task.await.map_err(|e| e.to_string())??;
+//! # Ok(())
+//! # }
+//! ```
+//!
+//! The node manager behind it ([`ModelNodes`], reached through [`ModelManager`]) can also be added to a
+//! server configured by hand, with [`model_node_manager`].
+
+mod check;
+mod manager;
+
+use std::net::TcpListener;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+use opcua::server::{Server, ServerBuilder, ServerHandle};
+use opcua::types::TypeLoader;
+
+pub use manager::{
+    model_node_manager, MethodError, MethodHandler, MethodInvocation, MethodResult, ModelManager, ModelNodeManager,
+    ModelNodes, WriteHandler,
+};
+
+use super::table::NodeSetTable;
+
+/// What a model server serves and where.
+#[derive(Clone)]
+pub struct ServerConfig {
+    /// The host name or address to listen on, and the one endpoint URLs name. Defaults to `127.0.0.1`.
+    pub host: String,
+    /// The TCP port; 0 (the default) picks a free one when the server is built.
+    pub port: u16,
+    /// The ApplicationName of the server.
+    pub application_name: String,
+    /// The ApplicationUri of the server, which becomes namespace 1. Defaults to `urn:nodeset-models:<name>`.
+    pub application_uri: String,
+    /// The generated namespaces to serve, in the order their namespace indices are assigned. A table's
+    /// dependencies should come before it (DI, then IA, then Robotics).
+    pub tables: Vec<&'static NodeSetTable>,
+    /// Type loaders of the generated data types, so that structures written by clients or passed to
+    /// methods arrive decoded.
+    pub type_loaders: Vec<Arc<dyn TypeLoader>>,
+    /// Where async-opcua keeps certificates. The endpoint needs none; the default is a folder in the
+    /// system's temporary directory, so that nothing is written beside the program.
+    pub pki_dir: PathBuf,
+}
+
+impl ServerConfig {
+    /// A configuration with the defaults above and no tables.
+    pub fn new(application_name: impl Into<String>) -> ServerConfig {
+        let application_name = application_name.into();
+        let slug: String = application_name
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c.to_ascii_lowercase() } else { '-' })
+            .collect();
+        ServerConfig {
+            host: "127.0.0.1".to_owned(),
+            port: 0,
+            application_uri: format!("urn:nodeset-models:{slug}"),
+            application_name,
+            tables: Vec::new(),
+            type_loaders: Vec::new(),
+            pki_dir: std::env::temp_dir().join("nodeset-models-pki"),
+        }
+    }
+
+    /// Sets the host.
+    pub fn host(mut self, host: impl Into<String>) -> ServerConfig {
+        self.host = host.into();
+        self
+    }
+
+    /// Sets the port (0 picks a free one).
+    pub fn port(mut self, port: u16) -> ServerConfig {
+        self.port = port;
+        self
+    }
+
+    /// Adds a table to serve.
+    pub fn table(mut self, table: &'static NodeSetTable) -> ServerConfig {
+        self.tables.push(table);
+        self
+    }
+
+    /// Adds a type loader.
+    pub fn type_loader(mut self, loader: impl TypeLoader + 'static) -> ServerConfig {
+        self.type_loaders.push(Arc::new(loader));
+        self
+    }
+
+    /// Binds the port and builds the server, importing every table.
+    ///
+    /// Fails if the port cannot be bound or async-opcua rejects the configuration.
+    pub fn build(self) -> Result<ModelServer, String> {
+        let listener = TcpListener::bind((self.host.as_str(), self.port))
+            .map_err(|e| format!("cannot listen on {}:{}: {e}", self.host, self.port))?;
+        let port = listener.local_addr().map_err(|e| format!("cannot read the bound address: {e}"))?.port();
+        let mut builder = ServerBuilder::new_anonymous(self.application_name)
+            .application_uri(&self.application_uri)
+            .product_uri(&self.application_uri)
+            .host(&self.host)
+            .port(port)
+            .pki_dir(self.pki_dir)
+            .create_sample_keypair(false)
+            .with_node_manager(model_node_manager(self.tables));
+        for loader in self.type_loaders {
+            builder = builder.with_type_loader(loader);
+        }
+        let (server, handle) = builder.build()?;
+        let manager = ModelManager::from_handle(&handle).ok_or("the model node manager is missing from the server")?;
+        let endpoint_url = format!("opc.tcp://{}:{port}/", self.host);
+        Ok(ModelServer { server, handle, manager, listener, endpoint_url })
+    }
+}
+
+/// A built server, bound to its port, not yet serving.
+pub struct ModelServer {
+    server: Server,
+    handle: ServerHandle,
+    manager: ModelManager,
+    listener: TcpListener,
+    endpoint_url: String,
+}
+
+impl ModelServer {
+    /// async-opcua's handle of the server: clone it before [`ModelServer::run`] to stop the server later
+    /// (`handle.cancel()`).
+    pub fn handle(&self) -> &ServerHandle {
+        &self.handle
+    }
+
+    /// The handle to the generated namespaces.
+    pub fn manager(&self) -> &ModelManager {
+        &self.manager
+    }
+
+    /// The URL clients connect to, `opc.tcp://<host>:<port>/`.
+    pub fn endpoint_url(&self) -> &str {
+        &self.endpoint_url
+    }
+
+    /// The port the server listens on.
+    pub fn port(&self) -> u16 {
+        self.listener.local_addr().map(|a| a.port()).unwrap_or_default()
+    }
+
+    /// Serves clients until the handle is cancelled; must run inside a tokio runtime.
+    pub async fn run(self) -> Result<(), String> {
+        self.listener.set_nonblocking(true).map_err(|e| format!("cannot make the listener non-blocking: {e}"))?;
+        let listener = tokio::net::TcpListener::from_std(self.listener)
+            .map_err(|e| format!("cannot hand the listener to tokio: {e}"))?;
+        self.server.run_with(listener).await
+    }
+}

@@ -1,0 +1,51 @@
+//! The generated DI, IA and Robotics tables import completely into a server: every row becomes a node,
+//! the namespaces get the indices of the order they are given in, and the types join the type tree.
+
+mod common;
+
+use nodeset_models::models::{di, ia, robotics};
+use nodeset_models::runtime::server::ServerConfig;
+use nodeset_models::runtime::table::NodeSetTable;
+use opcua::nodes::TypeTree;
+use opcua::types::{AttributeId, NodeId};
+
+const TABLES: [&NodeSetTable; 3] = [&di::TABLE, &ia::TABLE, &robotics::TABLE];
+
+#[tokio::test]
+async fn generated_tables_import_completely() {
+    let running = common::serve(
+        ServerConfig::new("models test")
+            .table(&di::TABLE)
+            .type_loader(di::TypeLoader)
+            .table(&ia::TABLE)
+            .type_loader(ia::TypeLoader)
+            .table(&robotics::TABLE)
+            .type_loader(robotics::TypeLoader),
+    )
+    .await;
+    let m = &running.manager;
+    assert_eq!(m.namespace_index(di::NAMESPACE_URI), Some(2));
+    assert_eq!(m.namespace_index(ia::NAMESPACE_URI), Some(3));
+    assert_eq!(m.namespace_index(robotics::NAMESPACE_URI), Some(4));
+
+    for table in TABLES {
+        let map = m.namespace_map(table.namespace_uri).expect("the table is served");
+        let missing: Vec<_> = table
+            .nodes
+            .iter()
+            .map(|row| map.try_id(row.id).expect("every row's namespace is registered"))
+            .filter(|id| running.attribute(id, AttributeId::NodeClass).is_none())
+            .collect();
+        assert!(missing.is_empty(), "{}: rows missing from the address space: {missing:?}", table.namespace_uri);
+        let served = m.node_manager().address_space().read().namespaces().len();
+        assert_eq!(served, TABLES.len(), "the node manager owns exactly the three namespaces");
+    }
+
+    // MotionDeviceSystemType (Robotics i=1002) derives from DI's ComponentType (i=15063).
+    {
+        let tree = running.handle.type_tree().read();
+        assert!(tree.is_subtype_of(&NodeId::new(4, 1002u32), &NodeId::new(2, 15063u32)));
+        assert!(tree.is_subtype_of(&NodeId::new(4, 1002u32), &NodeId::new(0, 58u32)));
+    }
+    running.stop().await;
+}

@@ -1,0 +1,127 @@
+//! Interoperability: a real third-party OPC UA client (python asyncua, from `.venv`) against the example
+//! server of `nodeset-models`, run as its own process.
+//!
+//! The test builds the example (`cargo build -p nodeset-models --example server`, a no-op when it is
+//! fresh), starts it on a free port, runs `tests/interop/robotics_check.py` with the suites below, and
+//! stops the server with SIGTERM, which must end it cleanly. It fails, never skips, when the venv is
+//! missing: run `cargo xtask venv`.
+
+use std::io::{BufRead, BufReader, Read};
+use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::Duration;
+
+use nodeset_tests::root;
+
+/// The suites of `robotics_check.py` to run: the runtime's demo namespace (writes, methods, subscriptions)
+/// and the generated DI, IA and Robotics namespaces against their NodeSet2 files.
+const SUITES: &[&str] = &["demo", "robotics"];
+
+/// The venv's python, or a failure that says how to create it.
+fn python() -> PathBuf {
+    let python = root().join(".venv/bin/python");
+    assert!(python.is_file(), "the Python venv is missing ({}); run `cargo xtask venv`", python.display());
+    let ok = Command::new(&python).args(["-c", "import asyncua"]).output().is_ok_and(|o| o.status.success());
+    assert!(ok, "asyncua is not installed in {}; run `cargo xtask venv`", python.display());
+    python
+}
+
+/// Builds the example server and returns the path of its executable.
+fn build_server() -> PathBuf {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+    let output = Command::new(cargo)
+        .current_dir(root())
+        .args(["build", "-p", "nodeset-models", "--example", "server", "--message-format=json-render-diagnostics"])
+        .stderr(Stdio::inherit())
+        .output()
+        .expect("cargo runs");
+    assert!(output.status.success(), "cargo build -p nodeset-models --example server failed");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    let line = stdout
+        .lines()
+        .filter(|l| l.contains("\"reason\":\"compiler-artifact\"") && l.contains("\"executable\":\""))
+        .find(|l| l.contains("\"name\":\"server\""))
+        .expect("cargo reports the example's executable");
+    let start = line.find("\"executable\":\"").unwrap() + "\"executable\":\"".len();
+    let end = start + line[start..].find('"').unwrap();
+    PathBuf::from(&line[start..end])
+}
+
+/// The server process; killed if the test panics before stopping it.
+struct Server {
+    child: Child,
+    stdout: mpsc::Receiver<String>,
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+impl Server {
+    fn start(exe: &PathBuf) -> (Server, String) {
+        let mut child = Command::new(exe)
+            .args(["--port", "0", "--demo"])
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .unwrap_or_else(|e| panic!("cannot start {}: {e}", exe.display()));
+        let out = child.stdout.take().unwrap();
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(out).lines().map_while(Result::ok) {
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        let server = Server { child, stdout: rx };
+        let first = server.stdout.recv_timeout(Duration::from_secs(60)).expect("the server prints its URL");
+        let url = first.strip_prefix("listening on ").unwrap_or_else(|| panic!("unexpected first line {first:?}"));
+        (server, url.to_owned())
+    }
+
+    /// Sends SIGTERM and checks that the server ends cleanly.
+    fn stop(mut self) {
+        let pid = self.child.id().to_string();
+        let sent = Command::new("kill").args(["-TERM", &pid]).status().is_ok_and(|s| s.success());
+        assert!(sent, "cannot send SIGTERM to the server");
+        let mut rest = Vec::new();
+        while let Ok(line) = self.stdout.recv_timeout(Duration::from_secs(15)) {
+            rest.push(line);
+        }
+        let status = self.child.wait().expect("the server ends");
+        assert!(status.success(), "the server exited with {status}; its output: {rest:?}");
+        assert!(rest.iter().any(|l| l == "server stopped cleanly"), "the server did not stop cleanly: {rest:?}");
+    }
+}
+
+#[test]
+fn asyncua_client_against_the_example_server() {
+    let python = python();
+    let exe = build_server();
+    let (server, url) = Server::start(&exe);
+    let script = root().join("tests/interop/robotics_check.py");
+    let mut check = Command::new(&python);
+    check.arg(&script).args(["--url", &url]).args(["--nodesets"]).arg(root().join("nodesets/vendor"));
+    for suite in SUITES {
+        check.args(["--suite", suite]);
+    }
+    let mut child = check.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("python runs");
+    let mut stdout = String::new();
+    let mut stderr = String::new();
+    child.stdout.take().unwrap().read_to_string(&mut stdout).unwrap();
+    child.stderr.take().unwrap().read_to_string(&mut stderr).unwrap();
+    let status = child.wait().unwrap();
+    println!("{stdout}");
+    eprintln!("{stderr}");
+    let summary = stdout.lines().last().unwrap_or_default();
+    assert!(
+        status.success() && summary.ends_with(" passed, 0 failed"),
+        "robotics_check.py failed ({status}): {summary}"
+    );
+    server.stop();
+}
