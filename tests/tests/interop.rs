@@ -1,7 +1,7 @@
 //! Interoperability: a real third-party OPC UA client (python asyncua, from `.venv`) against the example
 //! server of `nodeset-models`, run as its own process.
 //!
-//! The test builds the example (`cargo build -p nodeset-models --example server`, a no-op when it is
+//! The test builds the example (`cargo build --workspace --example server`, a no-op when it is
 //! fresh), starts it on a free port, runs `tests/interop/robotics_check.py` with the suites below, and
 //! stops the server with SIGTERM, which must end it cleanly. It fails, never skips, when the venv is
 //! missing: run `cargo xtask venv`.
@@ -32,11 +32,12 @@ fn build_server() -> PathBuf {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
     let output = Command::new(cargo)
         .current_dir(root())
-        .args(["build", "-p", "nodeset-models", "--example", "server", "--message-format=json-render-diagnostics"])
+        // --workspace resolves features as `cargo test --workspace` does, so no dependency is built twice.
+        .args(["build", "--workspace", "--example", "server", "--message-format=json-render-diagnostics"])
         .stderr(Stdio::inherit())
         .output()
         .expect("cargo runs");
-    assert!(output.status.success(), "cargo build -p nodeset-models --example server failed");
+    assert!(output.status.success(), "cargo build --workspace --example server failed");
     let stdout = String::from_utf8_lossy(&output.stdout);
     let line = stdout
         .lines()
