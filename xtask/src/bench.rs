@@ -1,16 +1,21 @@
-//! `cargo xtask bench`: times the foundation stage of the compiler (parse + load + resolve) on real
-//! NodeSet2 files and compares it with the project's targets.
+//! `cargo xtask bench`: times the compiler on real NodeSet2 files (the foundation stage, parse + load +
+//! resolve, and the Rust back end) and compares it with the project's targets and with async-opcua-codegen.
 //!
-//! The measured program is the example `nodeset-compiler/examples/load_bench.rs`. This task builds it in
-//! release mode, runs every scenario in its own process (so that the peak resident memory, `VmHWM`, belongs
-//! to that scenario alone), reads the `BENCH key=value ...` line it prints and shows a table. It is a
-//! report, not a test: a missed target prints `OVER` but the task still succeeds.
+//! The measured programs are examples: `nodeset-compiler/examples/load_bench.rs` (front end),
+//! `nodeset-compiler/examples/rust_bench.rs` (Rust generation, and a stopwatch for other programs) and
+//! `generated/examples/import_bench.rs` (address-space import). This task builds them in release mode, runs
+//! every scenario in its own process (so that the peak resident memory, `VmHWM`, belongs to that scenario
+//! alone), reads the `BENCH key=value ...` line each prints and shows a table. It is a report, not a test:
+//! a missed target prints `OVER` but the task still succeeds; it fails only when one of our own steps fails.
 //!
 //! Scenarios:
 //!
 //! * `robotics`: ns0 + DI + IA + Robotics from `nodesets/vendor/` (fetched first if missing).
 //! * `tree`: every NodeSet2 file of the `UA-Nodeset` tree at `../shared/nodesets/ua-nodeset`, one compile
 //!   per file with its required models taken from the tree.
+//! * `rust`: the Rust back end, end to end (module [`rust`] below says how each figure is taken):
+//!   generation time and memory for DI + IA + Robotics, generated lines, build time of the generated crate
+//!   alone, address-space import time, and the same figures for async-opcua-codegen 0.19 on the same inputs.
 
 use std::collections::BTreeMap;
 use std::env;
@@ -39,7 +44,7 @@ const TREE_TIME_MS: f64 = 1000.0;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Which scenario(s) to run.
-    #[arg(long, value_parser = ["all", "robotics", "tree"], default_value = "all")]
+    #[arg(long, value_parser = ["all", "robotics", "tree", "rust"], default_value = "all")]
     scenario: String,
 
     /// Runs of the robotics scenario (ns0 + DI + IA + Robotics).
@@ -50,9 +55,39 @@ pub struct Args {
     #[arg(long, value_name = "N", default_value_t = 3)]
     runs_tree: usize,
 
-    /// The NodeSet tree of the tree scenario (default: ../shared/nodesets/ua-nodeset from the workspace root).
+    /// The NodeSet tree of the tree scenario, and of the XML schemas async-opcua-codegen needs in the rust
+    /// scenario (default: ../shared/nodesets/ua-nodeset from the workspace root).
     #[arg(long, value_name = "DIR")]
     tree: Option<PathBuf>,
+
+    /// Runs of the generation in the rust scenario (compile + Rust emission of DI + IA + Robotics).
+    #[arg(long, value_name = "N", default_value_t = 20)]
+    runs_rust: usize,
+
+    /// Runs of the address-space import in the rust scenario.
+    #[arg(long, value_name = "N", default_value_t = 50)]
+    runs_import: usize,
+
+    /// Runs of each timed debug `cargo build` in the rust scenario (cold crate-only and incremental);
+    /// release builds run once.
+    #[arg(long, value_name = "N", default_value_t = 3)]
+    runs_build: usize,
+
+    /// Runs of each generator process in the rust scenario (our CLI and async-opcua-codegen).
+    #[arg(long, value_name = "N", default_value_t = 3)]
+    runs_process: usize,
+
+    /// Rust scenario: skip the `cargo build` timings and the import bench (no async-opcua build needed).
+    #[arg(long)]
+    no_builds: bool,
+
+    /// Rust scenario: skip async-opcua-codegen.
+    #[arg(long)]
+    no_peer: bool,
+
+    /// Rust scenario: skip the release builds (the import bench is still built in release).
+    #[arg(long)]
+    no_release: bool,
 
     /// Skip the stage-split runs (halves the run time; the table then shows totals only).
     #[arg(long)]
@@ -81,7 +116,7 @@ pub fn run(args: Args) -> Result<(), String> {
     let want = |s: &str| args.scenario == "all" || args.scenario == s;
     let tree = args.tree.clone().unwrap_or_else(|| root.join(DEFAULT_TREE));
 
-    if want("robotics") {
+    if want("robotics") || want("rust") {
         ensure_vendor(&root.join("nodesets/vendor"))?;
     }
     let run_tree = want("tree") && tree.is_dir();
@@ -98,8 +133,12 @@ pub fn run(args: Args) -> Result<(), String> {
         );
     }
 
-    let exe = build(&root)?;
     let mut reports = Vec::new();
+    let exe = if want("robotics") || run_tree {
+        build(&root, "load_bench", &[])?
+    } else {
+        PathBuf::new()
+    };
     if want("robotics") {
         reports.push(measure(
             &exe,
@@ -119,7 +158,12 @@ pub fn run(args: Args) -> Result<(), String> {
             args.no_split,
         )?);
     }
-    print_table(&reports, !args.no_split);
+    if !reports.is_empty() {
+        print_table(&reports, !args.no_split);
+    }
+    if want("rust") {
+        rust::run(&args, &root, &tree)?;
+    }
     Ok(())
 }
 
@@ -136,9 +180,10 @@ fn ensure_vendor(vendor: &Path) -> Result<(), String> {
         .map_err(|e| format!("{e}\n(the bench needs `cargo xtask fetch-nodesets` to succeed)"))
 }
 
-/// Builds the example in release mode and returns the path of its executable.
-fn build(root: &Path) -> Result<PathBuf, String> {
-    eprintln!("building the load_bench example (release) ...");
+/// Builds an example of nodeset-compiler in release mode (with `extra` cargo arguments, such as
+/// `--bin nodeset-compiler`) and returns the path of its executable.
+fn build(root: &Path, example: &str, extra: &[&str]) -> Result<PathBuf, String> {
+    eprintln!("building the {example} example (release) ...");
     let cargo = env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let status = Command::new(cargo)
         .current_dir(root)
@@ -147,26 +192,19 @@ fn build(root: &Path) -> Result<PathBuf, String> {
             "--quiet",
             "--release",
             "--example",
-            "load_bench",
+            example,
             "-p",
             "nodeset-compiler",
         ])
+        .args(extra)
         .status()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
     if !status.success() {
-        return Err(format!("building the load_bench example failed ({status})"));
+        return Err(format!("building the {example} example failed ({status})"));
     }
-    let target = env::var_os("CARGO_TARGET_DIR")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| root.join("target"));
-    let target = if target.is_absolute() {
-        target
-    } else {
-        root.join(target)
-    };
-    let exe = target
-        .join("release/examples")
-        .join(format!("load_bench{}", env::consts::EXE_SUFFIX));
+    let exe = release_dir(root)
+        .join("examples")
+        .join(format!("{example}{}", env::consts::EXE_SUFFIX));
     if exe.is_file() {
         Ok(exe)
     } else {
@@ -175,6 +213,19 @@ fn build(root: &Path) -> Result<PathBuf, String> {
             exe.display()
         ))
     }
+}
+
+/// The `release` folder of the developer's target directory (`CARGO_TARGET_DIR` or `target/`).
+fn release_dir(root: &Path) -> PathBuf {
+    let target = env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root.join("target"));
+    let target = if target.is_absolute() {
+        target
+    } else {
+        root.join(target)
+    };
+    target.join("release")
 }
 
 /// Runs one scenario in a fresh process and parses its `BENCH` line; its stderr goes to ours.
@@ -201,17 +252,19 @@ fn measure(
     if !out.status.success() {
         return Err(format!("scenario `{scenario}` failed ({})", out.status));
     }
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let line = stdout
-        .lines()
-        .find_map(|l| l.strip_prefix("BENCH "))
-        .ok_or_else(|| format!("scenario `{scenario}` printed no BENCH line"))?;
+    parse_report(&String::from_utf8_lossy(&out.stdout))
+        .ok_or_else(|| format!("scenario `{scenario}` printed no BENCH line"))
+}
+
+/// The `BENCH key=value ...` line of a measured program's stdout.
+fn parse_report(stdout: &str) -> Option<Report> {
+    let line = stdout.lines().find_map(|l| l.strip_prefix("BENCH "))?;
     let map = line
         .split_whitespace()
         .filter_map(|kv| kv.split_once('='))
         .map(|(k, v)| (k.to_string(), v.to_string()))
         .collect();
-    Ok(Report(map))
+    Some(Report(map))
 }
 
 fn verdict(value: f64, limit: f64) -> &'static str {
@@ -349,4 +402,1133 @@ fn print_table(reports: &[Report], split: bool) {
         }
     }
     println!();
+}
+
+/// The `rust` scenario: the Rust back end, end to end, next to async-opcua-codegen 0.19.
+///
+/// How each figure is taken:
+///
+/// 1. Generation: `nodeset-compiler/examples/rust_bench.rs generate` in a fresh process: what
+///    `cargo xtask generate` does minus writing (one `compile` of DI, IA and Robotics with ns0 found in
+///    `nodesets/vendor/` as their dependency, then `emit::rust::generate`), each stage timed in every run;
+///    `VmHWM` after the first run. The `nodeset-compiler rust` CLI is also timed as a whole process (start,
+///    read, compile, emit, write; it writes only changed files), which is what the peer's figure means.
+/// 2. Lines: of `generated/src/models/<module>/*.rs` as checked in, compared with this run's output.
+/// 3. Builds: `cargo build -p nodeset-models` in its own target folder (`target/bench-build`, so the
+///    developer's `target/` is not disturbed). Dependencies are built once first (the warm-up); then, per
+///    run, `cargo clean -p nodeset-models` and a timed build (cold, our crate alone), then
+///    `generated/src/models/robotics/types.rs` is touched and the build timed again (incremental). A no-op
+///    build shows cargo's own share of these wall times. Debug builds run `--runs-build` times, release
+///    builds once. The crate also holds the hand-written runtime, so the runtime alone is built the same way
+///    as the crate `nodeset-runtime-only` (`generated/Cargo.toml`'s dependencies, a `lib.rs` that includes
+///    `generated/src/runtime/`), to show what the generated models add.
+/// 4. Import: `generated/examples/import_bench.rs` (release), which says what it includes.
+/// 5. Peer: async-opcua-codegen 0.19.0, installed once into `target/bench-tools`, with a config written to
+///    `target/bench-build/peer/codegen.yml` (a `types` and a `nodes` target per namespace; the nodes target
+///    needs the XML schemas of ns0 and of each model, taken from the UA-Nodeset tree). Its output is built as
+///    the crate `codegen-peer-models` in the same target folder, with a `lib.rs` written here that only
+///    declares the generated modules. A failing peer step is reported in the table, never fatal.
+mod rust {
+    use super::{build, parse_report, release_dir, verdict, Args, Report};
+    use crate::util::display_path;
+    use std::env;
+    use std::fs;
+    use std::path::{Path, PathBuf};
+    use std::process::{Command, Stdio};
+    use std::time::{Instant, SystemTime};
+
+    /// Targets: emission time, generated lines of DI + Robotics, cold crate-only build, import.
+    const EMIT_MS: f64 = 25.0;
+    const LINES_DI_ROBOTICS: usize = 12_000;
+    const CRATE_BUILD_S: f64 = 1.5;
+    const IMPORT_MS: f64 = 1.0;
+
+    /// The generated namespaces: (module, NodeSet2 file in nodesets/vendor, URI, XML schema in the tree).
+    const NAMESPACES: [(&str, &str, &str, &str); 3] = [
+        (
+            "di",
+            "Opc.Ua.Di.NodeSet2.xml",
+            "http://opcfoundation.org/UA/DI/",
+            "DI/Opc.Ua.Di.Types.xsd",
+        ),
+        (
+            "ia",
+            "Opc.Ua.IA.NodeSet2.xml",
+            "http://opcfoundation.org/UA/IA/",
+            "IA/Opc.Ua.IA.Types.xsd",
+        ),
+        (
+            "robotics",
+            "Opc.Ua.Robotics.NodeSet2.xml",
+            "http://opcfoundation.org/UA/Robotics/",
+            "Robotics/Opc.Ua.Robotics.Types.xsd",
+        ),
+    ];
+    /// The XML schema of ns0 in the tree.
+    const NS0_XSD: &str = "Schema/Opc.Ua.Types.xsd";
+    const PEER: &str = "async-opcua-codegen";
+    const PEER_VERSION: &str = "0.19.0";
+    const PEER_CRATE: &str = "codegen-peer-models";
+    const RUNTIME_CRATE: &str = "nodeset-runtime-only";
+    /// Release builds run once: they are slow, and the release profile compiles without incremental.
+    const RELEASE_RUNS: usize = 1;
+    /// Our crate, and the file touched before an incremental build (the peer's counterpart is its Robotics
+    /// types module).
+    const CRATE: &str = "nodeset-models";
+    const TOUCHED: &str = "generated/src/models/robotics/types.rs";
+    const PEER_TOUCHED: &str = "src/robotics/types/mod.rs";
+
+    type Step<T> = Result<T, String>;
+
+    /// Median and min of some wall times, and the median CPU time, in seconds.
+    #[derive(Clone, Copy)]
+    struct Times {
+        median: f64,
+        min: f64,
+        cpu: f64,
+    }
+
+    fn median(v: &[f64]) -> f64 {
+        let mut s = v.to_vec();
+        s.sort_by(f64::total_cmp);
+        match s.len() {
+            0 => f64::NAN,
+            n if n % 2 == 1 => s[n / 2],
+            n => (s[n / 2 - 1] + s[n / 2]) / 2.0,
+        }
+    }
+
+    impl Times {
+        const NONE: Times = Times {
+            median: f64::NAN,
+            min: f64::NAN,
+            cpu: f64::NAN,
+        };
+
+        /// Of (wall, CPU) pairs.
+        fn of(v: &[(f64, f64)]) -> Times {
+            let wall: Vec<f64> = v.iter().map(|p| p.0).collect();
+            let cpu: Vec<f64> = v.iter().map(|p| p.1).collect();
+            Times {
+                median: median(&wall),
+                min: wall.iter().copied().fold(f64::NAN, f64::min),
+                cpu: median(&cpu),
+            }
+        }
+    }
+
+    /// Build times of one crate in one profile.
+    struct Builds {
+        /// The first build, dependencies included (cached from earlier bench runs if they are unchanged).
+        warm: f64,
+        noop: Times,
+        cold: Times,
+        /// None where nothing was touched.
+        incr: Option<Times>,
+    }
+
+    /// Files, lines and bytes of some generated Rust.
+    #[derive(Clone, Copy, Default, PartialEq)]
+    struct Size {
+        files: usize,
+        lines: usize,
+        bytes: usize,
+    }
+
+    impl std::ops::Add for Size {
+        type Output = Size;
+        fn add(self, o: Size) -> Size {
+            Size {
+                files: self.files + o.files,
+                lines: self.lines + o.lines,
+                bytes: self.bytes + o.bytes,
+            }
+        }
+    }
+
+    /// Sizes per module, in `NAMESPACES` order.
+    type Sizes = Vec<(&'static str, Size)>;
+
+    fn sum(sizes: &Sizes, modules: &[&str]) -> Size {
+        sizes
+            .iter()
+            .filter(|(m, _)| modules.contains(m))
+            .fold(Size::default(), |a, (_, s)| a + *s)
+    }
+
+    /// What the peer produced; every part may be missing, with the reason.
+    struct Peer {
+        exe: Step<PathBuf>,
+        install_s: Option<f64>,
+        config: Option<PathBuf>,
+        gen: Step<Report>,
+        sizes: Step<Sizes>,
+        debug: Step<Builds>,
+        release: Step<Builds>,
+    }
+
+    struct Results {
+        gen: Report,
+        cli: Step<Report>,
+        disk: Step<Sizes>,
+        fresh: Option<bool>,
+        debug: Step<Builds>,
+        release: Step<Builds>,
+        runtime_only: Step<Builds>,
+        runtime_size: Step<Size>,
+        import: Step<Report>,
+        peer: Option<Peer>,
+    }
+
+    /// Runs the scenario and prints its table; an error means one of our own steps failed.
+    pub(super) fn run(args: &Args, root: &Path, tree: &Path) -> Result<(), String> {
+        let start = Instant::now();
+        let load_start = load_average();
+        let vendor = root.join("nodesets/vendor");
+        let bench_target = root.join("target/bench-build");
+        let bench = build(root, "rust_bench", &["--bin", "nodeset-compiler"])?;
+        let cli_exe =
+            release_dir(root).join(format!("nodeset-compiler{}", env::consts::EXE_SUFFIX));
+
+        // 1. Generation, in process and as a CLI process.
+        eprintln!("rust: generation ({} run(s)) ...", args.runs_rust.max(1));
+        let gen = run_report(
+            Command::new(&bench)
+                .arg("generate")
+                .arg("--runs")
+                .arg(args.runs_rust.max(1).to_string())
+                .arg("--vendor")
+                .arg(&vendor),
+        )?;
+        eprintln!(
+            "rust: the nodeset-compiler CLI as a process ({} run(s)) ...",
+            args.runs_process.max(1)
+        );
+        let cli_out = bench_target.join("ours-cli/models");
+        let mut cli_args: Vec<String> = vec!["rust".into()];
+        cli_args.extend(
+            NAMESPACES
+                .iter()
+                .map(|n| vendor.join(n.1).display().to_string()),
+        );
+        cli_args.extend(["--models".into(), vendor.display().to_string()]);
+        cli_args.extend(["--out".into(), cli_out.display().to_string()]);
+        cli_args.extend(["--runtime".into(), "crate::runtime".into()]);
+        for (module, _, uri, _) in NAMESPACES {
+            cli_args.extend(["--module".into(), format!("{uri}={module}")]);
+        }
+        let _ = fs::remove_dir_all(&cli_out);
+        let cli = fs::create_dir_all(&bench_target)
+            .map_err(|e| format!("cannot create {}: {e}", bench_target.display()))
+            .and_then(|()| exec(&bench, args.runs_process, root, &[], &cli_exe, &cli_args));
+
+        // 2. Lines, as checked in.
+        let models = root.join("generated/src/models");
+        let disk: Step<Sizes> = NAMESPACES
+            .iter()
+            .map(|n| Ok((n.0, count_rs(&models.join(n.0))?)))
+            .collect();
+        let fresh = disk.as_ref().ok().map(|d| {
+            d.iter().all(|(m, s)| {
+                gen.f(&format!("lines_{m}")) == s.lines as f64
+                    && gen.f(&format!("bytes_{m}")) == s.bytes as f64
+            })
+        });
+
+        // 3 and 4. Builds of our crate, and the import.
+        let skipped = || Err::<Builds, _>("skipped (--no-builds)".to_string());
+        let (mut debug, mut release, mut runtime_only) = (skipped(), skipped(), skipped());
+        let mut import = Err("skipped (--no-builds)".to_string());
+        let runtime_size = count_rs(&root.join("generated/src/runtime"));
+        if !args.no_builds {
+            let touched = root.join(TOUCHED);
+            eprintln!(
+                "rust: building {CRATE} (debug) in {} ...",
+                display_path(&bench_target)
+            );
+            debug = time_builds(
+                &bench,
+                root,
+                &bench_target,
+                CRATE,
+                false,
+                Some(&touched),
+                args.runs_build,
+            );
+            eprintln!("rust: building the runtime alone (debug) ...");
+            let dir = bench_target.join("runtime-only");
+            runtime_only = write_runtime_crate(root, &dir).and_then(|()| {
+                time_builds(
+                    &bench,
+                    &dir,
+                    &bench_target,
+                    RUNTIME_CRATE,
+                    false,
+                    None,
+                    args.runs_build,
+                )
+            });
+            eprintln!("rust: building the import_bench example (release) ...");
+            import = cargo(
+                root,
+                Some(&bench_target),
+                &[
+                    "build",
+                    "--release",
+                    "-p",
+                    CRATE,
+                    "--example",
+                    "import_bench",
+                ],
+            )
+            .and_then(|_| {
+                let exe = bench_target
+                    .join("release/examples")
+                    .join(format!("import_bench{}", env::consts::EXE_SUFFIX));
+                eprintln!("rust: import ({} run(s)) ...", args.runs_import.max(1));
+                run_report(
+                    Command::new(exe)
+                        .arg("--runs")
+                        .arg(args.runs_import.max(1).to_string()),
+                )
+            });
+            release = if args.no_release {
+                Err("skipped (--no-release)".into())
+            } else {
+                eprintln!("rust: building {CRATE} (release) ...");
+                time_builds(
+                    &bench,
+                    root,
+                    &bench_target,
+                    CRATE,
+                    true,
+                    Some(&touched),
+                    RELEASE_RUNS,
+                )
+            };
+        }
+
+        // 5. The peer.
+        let peer =
+            (!args.no_peer).then(|| run_peer(args, root, tree, &vendor, &bench_target, &bench));
+
+        let results = Results {
+            gen,
+            cli,
+            disk,
+            fresh,
+            debug,
+            release,
+            runtime_only,
+            runtime_size,
+            import,
+            peer,
+        };
+        print(
+            &results,
+            args,
+            start.elapsed().as_secs_f64(),
+            (load_start, load_average()),
+        );
+
+        let ours: Vec<String> = [
+            ("the CLI run", results.cli.as_ref().err()),
+            ("counting generated/", results.disk.as_ref().err()),
+            ("the debug builds", results.debug.as_ref().err()),
+            ("the release builds", results.release.as_ref().err()),
+            (
+                "the runtime-only builds",
+                results.runtime_only.as_ref().err(),
+            ),
+            ("the import bench", results.import.as_ref().err()),
+        ]
+        .into_iter()
+        .filter_map(|(what, e)| {
+            e.filter(|e| !e.starts_with("skipped"))
+                .map(|e| format!("{what}: {e}"))
+        })
+        .collect();
+        if ours.is_empty() {
+            Ok(())
+        } else {
+            Err(format!(
+                "rust scenario: our own steps failed:\n{}",
+                ours.join("\n")
+            ))
+        }
+    }
+
+    fn run_peer(
+        args: &Args,
+        root: &Path,
+        tree: &Path,
+        vendor: &Path,
+        target: &Path,
+        bench: &Path,
+    ) -> Peer {
+        let mut peer = Peer {
+            exe: Err(String::new()),
+            install_s: None,
+            config: None,
+            gen: Err("not run".into()),
+            sizes: Err("not run".into()),
+            debug: Err("not run".into()),
+            release: Err("skipped (--no-release)".into()),
+        };
+        let tools = root.join("target/bench-tools");
+        let exe = tools
+            .join("bin")
+            .join(format!("{PEER}{}", env::consts::EXE_SUFFIX));
+        let installed = fs::read_to_string(tools.join(".crates.toml"))
+            .is_ok_and(|t| t.contains(&format!("{PEER} {PEER_VERSION} ")));
+        peer.exe = if exe.is_file() && installed {
+            Ok(exe)
+        } else {
+            eprintln!(
+                "rust: installing {PEER} {PEER_VERSION} into {} (once) ...",
+                display_path(&tools)
+            );
+            let tools_arg = tools.display().to_string();
+            let t = Instant::now();
+            let r = cargo(
+                root,
+                None,
+                &[
+                    "install",
+                    PEER,
+                    "--version",
+                    PEER_VERSION,
+                    "--locked",
+                    "--root",
+                    &tools_arg,
+                ],
+            );
+            peer.install_s = Some(t.elapsed().as_secs_f64());
+            r.map(|_| exe)
+        };
+        let Ok(exe) = peer.exe.clone() else {
+            return peer;
+        };
+
+        // The config: a types and a nodes target per namespace, in a crate folder of our own.
+        let dir = target.join("peer");
+        let schemas: Vec<PathBuf> = std::iter::once(NS0_XSD)
+            .chain(NAMESPACES.iter().map(|n| n.3))
+            .map(|x| tree.join(x))
+            .collect();
+        if let Some(missing) = schemas.iter().find(|p| !p.is_file()) {
+            peer.gen = Err(format!(
+                "impractical here: its nodes target needs the XML schemas (.xsd) of ns0 and of each model, and {} \
+                 is missing (give the UA-Nodeset tree with --tree DIR)",
+                missing.display()
+            ));
+            return peer;
+        }
+        let config = dir.join("codegen.yml");
+        if let Err(e) = write_peer_crate(root, &dir, vendor, &schemas) {
+            peer.gen = Err(e);
+            return peer;
+        }
+        peer.config = Some(config.clone());
+
+        eprintln!("rust: {PEER} ({} run(s)) ...", args.runs_process.max(1));
+        peer.gen = exec(
+            bench,
+            args.runs_process,
+            &dir,
+            &[("RUST_LOG", "warn")],
+            &exe,
+            &[config.display().to_string()],
+        );
+        if peer.gen.is_err() {
+            return peer;
+        }
+        peer.sizes = NAMESPACES
+            .iter()
+            .map(|n| Ok((n.0, count_rs(&dir.join("src").join(n.0))?)))
+            .collect();
+
+        if args.no_builds {
+            peer.debug = Err("skipped (--no-builds)".into());
+            peer.release = Err("skipped (--no-builds)".into());
+            return peer;
+        }
+        let touched = dir.join(PEER_TOUCHED);
+        eprintln!("rust: building the {PEER} output (debug) ...");
+        peer.debug = time_builds(
+            bench,
+            &dir,
+            target,
+            PEER_CRATE,
+            false,
+            Some(&touched),
+            args.runs_build,
+        );
+        if !args.no_release {
+            eprintln!("rust: building the {PEER} output (release) ...");
+            peer.release = time_builds(
+                bench,
+                &dir,
+                target,
+                PEER_CRATE,
+                true,
+                Some(&touched),
+                RELEASE_RUNS,
+            );
+        }
+        peer
+    }
+
+    /// The profiles of the workspace's `Cargo.toml`, for crates built outside it in the same target folder, so
+    /// that they share its dependencies' builds and are compiled the same way.
+    const PROFILES: &str =
+        "[profile.dev.package.\"*\"]\nopt-level = 2\n\n[profile.release]\ndebug = 1\n";
+
+    /// Writes the crate `nodeset-runtime-only`: `generated/Cargo.toml` without the workspace keys and the
+    /// dev-dependencies, and a `lib.rs` that includes `generated/src/runtime/` by path.
+    fn write_runtime_crate(root: &Path, dir: &Path) -> Step<()> {
+        let manifest_path = root.join("generated/Cargo.toml");
+        let manifest = fs::read_to_string(&manifest_path)
+            .map_err(|e| format!("cannot read {}: {e}", manifest_path.display()))?;
+        let mut out = String::from(
+            "# Written by `cargo xtask bench --scenario rust`: generated/Cargo.toml for the runtime alone.\n",
+        );
+        let mut section = String::new();
+        for line in manifest.lines() {
+            let t = line.trim();
+            if t.starts_with('[') {
+                section = t.to_string();
+            }
+            if section == "[dev-dependencies]" || t.contains(".workspace") {
+                continue;
+            }
+            if section == "[package]" && t.starts_with("name") {
+                out.push_str(&format!(
+                    "name = \"{RUNTIME_CRATE}\"\nedition = \"2021\"\npublish = false\n"
+                ));
+                continue;
+            }
+            out.push_str(line);
+            out.push('\n');
+        }
+        out.push_str("\n[workspace]\n\n");
+        out.push_str(PROFILES);
+        let lib = format!(
+            "//! generated/src/runtime/ without the generated models. Written by `cargo xtask bench`.\n\
+             #![allow(warnings)]\n\n#[path = {:?}]\npub mod runtime;\n",
+            root.join("generated/src/runtime/mod.rs").display().to_string()
+        );
+        let write = |path: PathBuf, text: String| {
+            fs::create_dir_all(path.parent().unwrap_or(dir))
+                .and_then(|()| fs::write(&path, text))
+                .map_err(|e| format!("cannot write {}: {e}", path.display()))
+        };
+        write(dir.join("Cargo.toml"), out)?;
+        write(dir.join("src/lib.rs"), lib)?;
+        let _ = fs::copy(root.join("Cargo.lock"), dir.join("Cargo.lock"));
+        Ok(())
+    }
+
+    /// A YAML string (a JSON string is one).
+    fn yaml(s: &str) -> String {
+        let mut out = String::from("\"");
+        for c in s.chars() {
+            match c {
+                '"' => out.push_str("\\\""),
+                '\\' => out.push_str("\\\\"),
+                c => out.push(c),
+            }
+        }
+        out.push('"');
+        out
+    }
+
+    /// Writes the codegen config, `Cargo.toml` and `src/lib.rs` of the peer's crate.
+    fn write_peer_crate(root: &Path, dir: &Path, vendor: &Path, schemas: &[PathBuf]) -> Step<()> {
+        let write = |path: PathBuf, text: String| {
+            fs::create_dir_all(path.parent().unwrap_or(dir))
+                .and_then(|()| fs::write(&path, text))
+                .map_err(|e| format!("cannot write {}: {e}", path.display()))
+        };
+        let xsd_name = |p: &PathBuf| {
+            p.file_name()
+                .map(|f| f.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        };
+        let mut cfg = String::from(
+            "# Written by `cargo xtask bench --scenario rust`: async-opcua-codegen on the inputs of generated/.\n\
+             # Paths are absolute; outputs are relative to this file.\nsources:\n",
+        );
+        cfg.push_str(&format!(
+            "  - {}\n",
+            yaml(&vendor.join("Opc.Ua.NodeSet2.xml").display().to_string())
+        ));
+        for n in NAMESPACES {
+            cfg.push_str(&format!(
+                "  - {}\n",
+                yaml(&vendor.join(n.1).display().to_string())
+            ));
+        }
+        for s in schemas {
+            cfg.push_str(&format!("  - {}\n", yaml(&s.display().to_string())));
+        }
+        cfg.push_str("targets:\n");
+        for (i, (module, file, _, _)) in NAMESPACES.iter().enumerate() {
+            cfg.push_str(&format!(
+                "  - type: types\n    file: {file}\n    output_dir: src/{module}/types\n    node_ids_from_nodeset: true\n"
+            ));
+            if i > 0 {
+                cfg.push_str("    dependent_nodesets:\n");
+                for (dep, dep_file, _, _) in &NAMESPACES[..i] {
+                    cfg.push_str(&format!(
+                        "      - file: {dep_file}\n        import_path: crate::{dep}::types\n"
+                    ));
+                }
+            }
+            let name = format!("{}{}Namespace", module[..1].to_uppercase(), &module[1..]);
+            cfg.push_str(&format!(
+                "  - type: nodes\n    file: {file}\n    output_dir: src/{module}/nodes\n    max_nodes_per_file: 100\n    \
+                 name: {name}\n    types:\n      - file: {}\n        root_path: opcua::types\n      - file: {}\n        \
+                 root_path: crate::{module}::types\n",
+                xsd_name(&schemas[0]),
+                xsd_name(&schemas[i + 1]),
+            ));
+        }
+        write(dir.join("codegen.yml"), cfg)?;
+        write(
+            dir.join("Cargo.toml"),
+            format!(
+                "# Written by `cargo xtask bench --scenario rust`: a crate around async-opcua-codegen's output.\n\
+                 [package]\nname = \"{PEER_CRATE}\"\nversion = \"0.0.0\"\nedition = \"2021\"\npublish = false\n\n\
+                 [workspace]\n\n[features]\njson = [\"async-opcua/json\"]\nxml = [\"async-opcua/xml\"]\n\n\
+                 [dependencies]\nasync-opcua = {{ version = \"=0.19.0\", features = [\"server\"] }}\nbitflags = \"2\"\n\n\
+                 # The workspace's profiles, so that dependencies are shared with nodeset-models in the same target folder.\n\
+                 {PROFILES}"
+            ),
+        )?;
+        let mut lib = String::from(
+            "//! async-opcua-codegen's output for DI, IA and Robotics. Written by `cargo xtask bench`; only this file\n\
+             //! is not generated.\n#![allow(warnings)]\n\n",
+        );
+        for n in NAMESPACES {
+            lib.push_str(&format!(
+                "pub mod {} {{\n    pub mod nodes;\n    pub mod types;\n}}\n",
+                n.0
+            ));
+        }
+        write(dir.join("src/lib.rs"), lib)?;
+        // The workspace's lock file, so that the peer's crate builds against the same dependency versions.
+        let _ = fs::copy(root.join("Cargo.lock"), dir.join("Cargo.lock"));
+        Ok(())
+    }
+
+    /// Runs a measured program and parses its `BENCH` line; its stderr goes to ours.
+    fn run_report(cmd: &mut Command) -> Step<Report> {
+        let out = cmd
+            .stderr(Stdio::inherit())
+            .output()
+            .map_err(|e| format!("cannot run {:?}: {e}", cmd.get_program()))?;
+        if !out.status.success() {
+            return Err(format!("{:?} failed ({})", cmd.get_program(), out.status));
+        }
+        parse_report(&String::from_utf8_lossy(&out.stdout))
+            .ok_or_else(|| format!("{:?} printed no BENCH line", cmd.get_program()))
+    }
+
+    /// Runs `program args` `runs` times under `rust_bench exec` (wall time, peak RSS, CPU).
+    fn exec(
+        bench: &Path,
+        runs: usize,
+        dir: &Path,
+        envs: &[(&str, &str)],
+        program: &Path,
+        args: &[String],
+    ) -> Step<Report> {
+        let mut cmd = Command::new(bench);
+        cmd.arg("exec")
+            .arg("--runs")
+            .arg(runs.max(1).to_string())
+            .arg("--dir")
+            .arg(dir);
+        for (k, v) in envs {
+            cmd.arg("--env").arg(format!("{k}={v}"));
+        }
+        cmd.arg("--").arg(program).args(args);
+        let out = cmd
+            .stderr(Stdio::piped())
+            .output()
+            .map_err(|e| format!("cannot run {}: {e}", bench.display()))?;
+        if !out.status.success() {
+            return Err(format!(
+                "{} failed: {}",
+                program.display(),
+                tail(&out.stderr, 12)
+            ));
+        }
+        parse_report(&String::from_utf8_lossy(&out.stdout))
+            .ok_or_else(|| "rust_bench exec printed no BENCH line".to_string())
+    }
+
+    fn tail(bytes: &[u8], n: usize) -> String {
+        let text = String::from_utf8_lossy(bytes);
+        let lines: Vec<&str> = text.lines().collect();
+        lines[lines.len().saturating_sub(n)..].join("\n")
+    }
+
+    /// Runs cargo quietly in `dir` (with `target` as `CARGO_TARGET_DIR`) and returns its wall time in s.
+    fn cargo(dir: &Path, target: Option<&Path>, args: &[&str]) -> Step<f64> {
+        let cargo = env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+        let mut cmd = Command::new(cargo);
+        cmd.current_dir(dir)
+            .arg("--quiet")
+            .args(args)
+            .stdin(Stdio::null());
+        if let Some(t) = target {
+            cmd.env("CARGO_TARGET_DIR", t);
+        }
+        let t = Instant::now();
+        let out = cmd.output().map_err(|e| format!("cannot run cargo: {e}"))?;
+        let secs = t.elapsed().as_secs_f64();
+        if out.status.success() {
+            Ok(secs)
+        } else {
+            Err(format!(
+                "`cargo {}` failed ({}):\n{}",
+                args.join(" "),
+                out.status,
+                tail(&out.stderr, 20)
+            ))
+        }
+    }
+
+    /// Warm-up, no-op, then per run a clean of `package` alone, a timed (cold) build, and unless `touched`
+    /// is None, a touch of it and a timed (incremental) build.
+    ///
+    /// The timed builds run under `rust_bench exec`, which also takes the CPU time of cargo and rustc.
+    fn time_builds(
+        bench: &Path,
+        dir: &Path,
+        target: &Path,
+        package: &str,
+        release: bool,
+        touched: Option<&Path>,
+        runs: usize,
+    ) -> Step<Builds> {
+        let mut build_args = vec!["build", "-p", package];
+        let mut clean_args = vec!["clean", "-p", package];
+        if release {
+            build_args.push("--release");
+            clean_args.push("--release");
+        }
+        let cargo_exe = PathBuf::from(env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
+        let target_env = target.display().to_string();
+        let mut timed_args = vec!["--quiet".to_string()];
+        timed_args.extend(build_args.iter().map(|a| a.to_string()));
+        let timed = || -> Step<(f64, f64)> {
+            let r = exec(
+                bench,
+                1,
+                dir,
+                &[("CARGO_TARGET_DIR", &target_env)],
+                &cargo_exe,
+                &timed_args,
+            )?;
+            Ok((r.f("wall_median_ms") / 1e3, r.f("cpu_per_run_ms") / 1e3))
+        };
+        let warm = cargo(dir, Some(target), &build_args)?;
+        let (mut noop, mut cold, mut incr) = (Vec::new(), Vec::new(), Vec::new());
+        for _ in 0..runs.max(1) {
+            noop.push(timed()?);
+            cargo(dir, Some(target), &clean_args)?;
+            cold.push(timed()?);
+            if let Some(touched) = touched {
+                touch(touched)?;
+                incr.push(timed()?);
+            }
+        }
+        Ok(Builds {
+            warm,
+            noop: Times::of(&noop),
+            cold: Times::of(&cold),
+            incr: touched.map(|_| Times::of(&incr)),
+        })
+    }
+
+    /// Sets the modification time of `path` to now, without changing its content.
+    fn touch(path: &Path) -> Step<()> {
+        fs::File::options()
+            .append(true)
+            .open(path)
+            .and_then(|f| f.set_modified(SystemTime::now()))
+            .map_err(|e| format!("cannot touch {}: {e}", path.display()))
+    }
+
+    /// Files, lines and bytes of the `.rs` files under `dir`.
+    fn count_rs(dir: &Path) -> Step<Size> {
+        let mut size = Size::default();
+        let entries =
+            fs::read_dir(dir).map_err(|e| format!("cannot read {}: {e}", dir.display()))?;
+        for e in entries.flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                size = size + count_rs(&p)?;
+            } else if p.extension().is_some_and(|x| x == "rs") {
+                let text = fs::read_to_string(&p)
+                    .map_err(|e| format!("cannot read {}: {e}", p.display()))?;
+                size = size
+                    + Size {
+                        files: 1,
+                        lines: text.lines().count(),
+                        bytes: text.len(),
+                    };
+            }
+        }
+        Ok(size)
+    }
+
+    fn mib(kib: f64) -> f64 {
+        kib / 1024.0
+    }
+
+    /// `ours / theirs` as a factor, or `-` where either is missing.
+    fn ratio(ours: f64, theirs: f64) -> String {
+        if ours.is_finite() && theirs.is_finite() && theirs > 0.0 {
+            format!("{:.2}x", ours / theirs)
+        } else {
+            "-".into()
+        }
+    }
+
+    fn print_builds(label: &str, b: &Step<Builds>, target: Option<f64>) {
+        match b {
+            Ok(b) => {
+                let judged = target
+                    .map(|t| format!("   target <= {t} s  {}", verdict(b.cold.median, t)))
+                    .unwrap_or_default();
+                let incr = b.incr.map_or_else(
+                    || format!("{:<49}", "   incremental        -"),
+                    |i| {
+                        format!(
+                            "   incremental {:>6.2} s (min {:>6.2}, CPU {:>6.2})",
+                            i.median, i.min, i.cpu
+                        )
+                    },
+                );
+                println!(
+                    "   {label:<16} cold {:>6.2} s (min {:>6.2}, CPU {:>6.2}){incr}   no-op {:>5.2} s   warm-up {:>6.1} s{judged}",
+                    b.cold.median, b.cold.min, b.cold.cpu, b.noop.median, b.warm
+                );
+            }
+            Err(e) => println!(
+                "   {label:<16} {}",
+                e.replace('\n', "\n                    ")
+            ),
+        }
+    }
+
+    /// The 1-minute load average (`/proc/loadavg`), NaN where unknown.
+    pub(super) fn load_average() -> f64 {
+        fs::read_to_string("/proc/loadavg")
+            .ok()
+            .and_then(|s| s.split_whitespace().next()?.parse().ok())
+            .unwrap_or(f64::NAN)
+    }
+
+    fn print(r: &Results, args: &Args, total_s: f64, load: (f64, f64)) {
+        let g = &r.gen;
+        println!();
+        println!(
+            "Rust back end: DI + IA + Robotics from nodesets/vendor (ns0 as their dependency)."
+        );
+        println!(
+            "Times are wall clock; this machine has {} CPU(s) and may be running other builds, so CPU times are given \
+             where they can be taken, and min is the figure least disturbed by other work.",
+            std::thread::available_parallelism().map_or(0, |n| n.get())
+        );
+        println!(
+            "Load average (1 min) at the start {:.1}, at the end {:.1}: above the CPU count, other work shares the CPUs \
+             and wall times grow.",
+            load.0, load.1
+        );
+
+        println!();
+        println!(
+            "== rust: generation, release build, in process without writing (as `cargo xtask generate` minus writing), {} run(s)",
+            g.s("runs")
+        );
+        for (label, key, cpu) in [
+            ("compile", "compile", Some("compile_cpu_median_ms")),
+            ("emit", "emit", Some("emit_cpu_median_ms")),
+            ("sum", "total", None),
+        ] {
+            let median = g.f(&format!("{key}_median_ms"));
+            let cpu = cpu
+                .map(|k| format!("   CPU median {:>8.2} ms", g.f(k)))
+                .unwrap_or_default();
+            let judged = if key == "emit" {
+                format!("   target <= {EMIT_MS} ms  {}", verdict(median, EMIT_MS))
+            } else {
+                String::new()
+            };
+            println!(
+                "   {label:<8} median {median:>8.2} ms   min {:>8.2} ms   max {:>8.2} ms{cpu}{judged}",
+                g.f(&format!("{key}_min_ms")),
+                g.f(&format!("{key}_max_ms")),
+            );
+        }
+        println!(
+            "   memory   VmHWM after first run {:>6.1} MiB   after all runs {:>6.1} MiB   at start {:>5.1} MiB",
+            mib(g.f("hwm_kib")),
+            mib(g.f("hwm_all_runs_kib")),
+            mib(g.f("hwm_start_kib"))
+        );
+        println!(
+            "   model    {} nodes; compile {} error(s) {} warning(s); emit {} error(s) {} warning(s); {} files",
+            g.s("nodes"),
+            g.s("compile_errors"),
+            g.s("compile_warnings"),
+            g.s("emit_errors"),
+            g.s("emit_warnings"),
+            g.s("files")
+        );
+        match &r.cli {
+            Ok(c) => println!(
+                "   CLI      `nodeset-compiler rust` as a process (start, read, compile, emit, write changed files), {} run(s): \
+                 median {:.1} ms   min {:.1} ms   CPU/run {:.1} ms   max RSS {:.1} MiB",
+                c.s("runs"),
+                c.f("wall_median_ms"),
+                c.f("wall_min_ms"),
+                c.f("cpu_per_run_ms"),
+                mib(c.f("maxrss_kib"))
+            ),
+            Err(e) => println!("   CLI      failed: {e}"),
+        }
+
+        println!();
+        println!("== rust: generated Rust (generated/src/models/<module>/*.rs as checked in)");
+        match &r.disk {
+            Ok(d) => {
+                println!(
+                    "   {:<22} {:>5} {:>8} {:>10}",
+                    "module", "files", "lines", "bytes"
+                );
+                for (m, s) in d {
+                    println!("   {m:<22} {:>5} {:>8} {:>10}", s.files, s.lines, s.bytes);
+                }
+                let dr = sum(d, &["di", "robotics"]);
+                let all = sum(d, &["di", "ia", "robotics"]);
+                println!(
+                    "   {:<22} {:>5} {:>8} {:>10}   target <= {LINES_DI_ROBOTICS} lines  {}",
+                    "DI + Robotics",
+                    dr.files,
+                    dr.lines,
+                    dr.bytes,
+                    verdict(dr.lines as f64, LINES_DI_ROBOTICS as f64)
+                );
+                println!(
+                    "   {:<22} {:>5} {:>8} {:>10}",
+                    "DI + IA + Robotics", all.files, all.lines, all.bytes
+                );
+                println!(
+                    "   (a node table row is one line, so bytes say more than lines; average line {:.0} bytes)",
+                    all.bytes as f64 / all.lines.max(1) as f64
+                );
+                match r.fresh {
+                    Some(true) => println!("   this run's output has the same lines and bytes as the checked-in files"),
+                    _ => println!(
+                        "   NOTE: this run's output differs from the checked-in files (generated/ is stale or being \
+                         regenerated; run `cargo xtask generate`)"
+                    ),
+                }
+            }
+            Err(e) => println!("   failed: {e}"),
+        }
+
+        println!();
+        println!(
+            "== rust: build of {CRATE} alone (dependencies prebuilt; CARGO_TARGET_DIR=target/bench-build), debug {} run(s), \
+             release {RELEASE_RUNS}; incremental = after touching {}",
+            args.runs_build.max(1),
+            TOUCHED.trim_start_matches("generated/src/")
+        );
+        print_builds("debug", &r.debug, Some(CRATE_BUILD_S));
+        print_builds("release", &r.release, None);
+        print_builds("runtime alone", &r.runtime_only, None);
+        if let (Ok(all), Ok(rt), Ok(rt_size), Ok(disk)) =
+            (&r.debug, &r.runtime_only, &r.runtime_size, &r.disk)
+        {
+            let models = sum(disk, &["di", "ia", "robotics"]);
+            println!(
+                "   {:<16} {:>6.2} s, CPU {:.2} s (debug cold, median: {CRATE} - runtime alone); the crate is {} \
+                 generated lines + {} hand-written runtime lines",
+                "models share",
+                all.cold.median - rt.cold.median,
+                all.cold.cpu - rt.cold.cpu,
+                models.lines,
+                rt_size.lines
+            );
+        }
+        println!(
+            "   (wall time of `cargo build`, including cargo's own start-up and checks, which the no-op build shows; \
+             CPU = median CPU time of cargo and rustc (user + system; rustc may use more than one thread); \
+             the release profile compiles without incremental, so there incremental is about cold)"
+        );
+
+        println!();
+        match &r.import {
+            Ok(i) => {
+                println!(
+                    "== rust: import of the DI, IA and Robotics tables into an async-opcua AddressSpace (release), {} run(s)",
+                    i.s("runs")
+                );
+                let median = i.f("import_median_ms");
+                println!(
+                    "   import   median {median:>8.3} ms   min {:>8.3} ms   max {:>8.3} ms   CPU median {:>8.3} ms   \
+                     target <= {IMPORT_MS} ms  {}",
+                    i.f("import_min_ms"),
+                    i.f("import_max_ms"),
+                    i.f("import_cpu_median_ms"),
+                    verdict(median, IMPORT_MS)
+                );
+                println!(
+                    "   types    load_into_type_tree afterwards: median {:.3} ms   min {:.3} ms (not in the import figure)",
+                    i.f("type_tree_median_ms"),
+                    i.f("type_tree_min_ms")
+                );
+                println!(
+                    "   rows     {} in the tables, {} in the address space after the import; ns0 excluded (async-opcua's \
+                     core node manager serves it from its own address space)",
+                    i.s("rows"),
+                    i.s("imported")
+                );
+                let rows = i.f("rows");
+                println!(
+                    "   ns0      for scale: async-opcua's CoreNamespace (codegen output, a function per node), {} nodes, \
+                     imported once in {:.2} ms = {:.2} us/node; ours {:.2} us/node",
+                    i.s("ns0_nodes"),
+                    i.f("ns0_import_ms"),
+                    1e3 * i.f("ns0_import_ms") / i.f("ns0_nodes"),
+                    1e3 * median / rows
+                );
+            }
+            Err(e) => {
+                println!("== rust: import into an async-opcua AddressSpace (release)");
+                println!("   {e}");
+            }
+        }
+
+        if let Some(p) = &r.peer {
+            print_peer(r, p);
+        }
+        println!();
+        println!("rust scenario: {total_s:.1} s in all");
+        println!();
+    }
+
+    fn print_peer(r: &Results, p: &Peer) {
+        println!();
+        println!("== rust: {PEER} {PEER_VERSION} on the same inputs");
+        let exe = match &p.exe {
+            Ok(exe) => exe,
+            Err(e) => {
+                println!("   not available: {e}");
+                return;
+            }
+        };
+        if let Some(s) = p.install_s {
+            println!("   installed into {} in {s:.0} s (once)", display_path(exe));
+        }
+        if let Some(c) = &p.config {
+            println!(
+                "   config   {} (types + nodes target per namespace, max_nodes_per_file 100, RUST_LOG=warn)",
+                display_path(c)
+            );
+        }
+        let gen = match &p.gen {
+            Ok(gen) => gen,
+            Err(e) => {
+                println!("   generation: {}", e.replace('\n', "\n      "));
+                return;
+            }
+        };
+        println!(
+            "   generate process (start, read, generate, write everything), {} run(s): median {:.1} ms   min {:.1} ms   \
+             CPU/run {:.1} ms   max RSS {:.1} MiB",
+            gen.s("runs"),
+            gen.f("wall_median_ms"),
+            gen.f("wall_min_ms"),
+            gen.f("cpu_per_run_ms"),
+            mib(gen.f("maxrss_kib"))
+        );
+        match &p.sizes {
+            Ok(s) => {
+                for (m, z) in s {
+                    println!("   {m:<22} {:>5} {:>8} {:>10}", z.files, z.lines, z.bytes);
+                }
+            }
+            Err(e) => println!("   lines: {e}"),
+        }
+        print_builds("debug", &p.debug, None);
+        print_builds("release", &p.release, None);
+
+        println!("   ratios ours / theirs (below 1 = ours smaller or faster):");
+        if let Ok(c) = &r.cli {
+            println!(
+                "     generation process wall (median)     {:>8}   min {:>8}   CPU/run {:>8}   max RSS {:>8}",
+                ratio(c.f("wall_median_ms"), gen.f("wall_median_ms")),
+                ratio(c.f("wall_min_ms"), gen.f("wall_min_ms")),
+                ratio(c.f("cpu_per_run_ms"), gen.f("cpu_per_run_ms")),
+                ratio(c.f("maxrss_kib"), gen.f("maxrss_kib"))
+            );
+        }
+        if let (Ok(ours), Ok(theirs)) = (&r.disk, &p.sizes) {
+            for (label, mods) in [
+                ("DI + Robotics", &["di", "robotics"][..]),
+                ("DI + IA + Robotics", &["di", "ia", "robotics"][..]),
+            ] {
+                let (a, b) = (sum(ours, mods), sum(theirs, mods));
+                println!(
+                    "     {label:<20} lines {:>8}   bytes {:>8}   ({} vs {} lines)",
+                    ratio(a.lines as f64, b.lines as f64),
+                    ratio(a.bytes as f64, b.bytes as f64),
+                    a.lines,
+                    b.lines
+                );
+            }
+        }
+        for (label, ours, theirs) in [
+            ("debug", &r.debug, &p.debug),
+            ("release", &r.release, &p.release),
+        ] {
+            if let (Ok(a), Ok(b)) = (ours, theirs) {
+                let (ai, bi) = (a.incr.unwrap_or(Times::NONE), b.incr.unwrap_or(Times::NONE));
+                println!(
+                    "     {label:<7} crate build: cold {:>6} (min {:>6}, CPU {:>6})   incremental {:>6} (min {:>6}, CPU {:>6})   \
+                     ({:.2} s vs {:.2} s cold)",
+                    ratio(a.cold.median, b.cold.median),
+                    ratio(a.cold.min, b.cold.min),
+                    ratio(a.cold.cpu, b.cold.cpu),
+                    ratio(ai.median, bi.median),
+                    ratio(ai.min, bi.min),
+                    ratio(ai.cpu, bi.cpu),
+                    a.cold.median,
+                    b.cold.median
+                );
+            }
+        }
+        if let (Ok(a), Ok(rt), Ok(b)) = (&r.debug, &r.runtime_only, &p.debug) {
+            println!(
+                "     debug   models share (ours minus the runtime alone) vs their crate, cold: {} (CPU {})   \
+                 ({:.2} s vs {:.2} s)",
+                ratio(a.cold.median - rt.cold.median, b.cold.median),
+                ratio(a.cold.cpu - rt.cold.cpu, b.cold.cpu),
+                a.cold.median - rt.cold.median,
+                b.cold.median
+            );
+        }
+        println!(
+            "   (the two outputs do not cover the same ground: async-opcua-codegen emits one function per node and skips \
+             union types; ours is node tables plus the runtime's API; compare features as well as sizes)"
+        );
+    }
 }

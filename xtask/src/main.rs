@@ -35,7 +35,7 @@ enum Command {
     /// Fetch the pinned official NodeSet2 files into `nodesets/vendor/` and verify them against
     /// `nodesets/node-opcua-nodesets.lock`.
     FetchNodesets(fetch::Args),
-    /// Time parse + load + resolve on the vendored models and the UA-Nodeset tree (a report, not a test).
+    /// Time the compiler (front end and Rust back end) against its targets and async-opcua-codegen (a report, not a test).
     Bench(bench::Args),
     /// Generate Rust for every resolvable ua-nodeset file into one crate and `cargo check` it.
     Corpus(corpus::Args),
