@@ -543,20 +543,40 @@ fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
+/// How much of a file [`scan_header`] looks at, at most. Real NodeSet2 files close `<Models>` within the
+/// first few KiB.
+const HEADER_LIMIT: usize = 256 * 1024;
+
 /// Reads the `<Models>` element of a file without parsing the rest.
+///
+/// A models folder is scanned once per compile and may hold hundreds of files, so the file is read in
+/// growing chunks and reading stops as soon as `</Models>` has been seen. The answer is the one the first
+/// [`HEADER_LIMIT`] bytes give: reading stops early only when the bytes read so far already contain
+/// everything the tests below look for (the first `<Models>` and the `</Models>` after it, and
+/// `UANodeSet`), and reading more cannot change where those are first found.
 fn scan_header(path: &Path) -> Option<Vec<(String, Option<String>, Option<String>)>> {
     use std::io::Read;
     let mut f = std::fs::File::open(path).ok()?;
-    let mut buf = vec![0u8; 256 * 1024];
-    let mut n = 0;
-    while n < buf.len() {
-        let k = f.read(&mut buf[n..]).ok()?;
-        if k == 0 {
+    let mut buf: Vec<u8> = Vec::new();
+    let mut chunk = 16 * 1024;
+    loop {
+        let want = (buf.len() + chunk).min(HEADER_LIMIT);
+        let mut n = buf.len();
+        buf.resize(want, 0);
+        while n < want {
+            let k = f.read(&mut buf[n..]).ok()?;
+            if k == 0 {
+                break;
+            }
+            n += k;
+        }
+        let at_end = n < want || n == HEADER_LIMIT;
+        buf.truncate(n);
+        if at_end || header_complete(&String::from_utf8_lossy(&buf)) {
             break;
         }
-        n += k;
+        chunk *= 2;
     }
-    buf.truncate(n);
     let text = String::from_utf8_lossy(&buf);
     if !text.contains("UANodeSet") {
         return None;
@@ -585,6 +605,11 @@ fn scan_header(path: &Path) -> Option<Vec<(String, Option<String>, Option<String
         }
     }
     Some(out)
+}
+
+/// Whether a prefix of a file already decides [`scan_header`]'s answer (see there).
+fn header_complete(text: &str) -> bool {
+    text.contains("UANodeSet") && text.find("<Models>").is_some_and(|start| text[start..].contains("</Models>"))
 }
 
 fn topo_order(parsed: &[RawNodeSet], sources: &SourceMap, diags: &mut Diagnostics) -> Vec<usize> {
@@ -721,6 +746,33 @@ mod tests {
         assert_eq!(cmp_version(Some("1.02"), Some("1.04.0")), Ordering::Less);
         assert_eq!(cmp_version(None, Some("1.0")), Ordering::Less);
         assert_eq!(cmp_version(Some("9.99.99"), Some("1.05")), Ordering::Greater);
+    }
+
+    #[test]
+    fn header_scan_stops_at_models_but_answers_as_the_full_prefix_would() {
+        let dir = std::env::temp_dir().join(format!("nodeset-header-scan-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let model = "<Model ModelUri=\"http://x/\" Version=\"1.0\" PublicationDate=\"2020-01-01\"/>";
+        // A header past the first chunk, one that straddles chunks, one past the limit, and no UANodeSet.
+        let pad = "<!--".to_string() + &"x".repeat(40_000) + "-->";
+        let cases = [
+            (format!("<UANodeSet>{pad}<Models>{model}</Models></UANodeSet>"), true),
+            (format!("<UANodeSet><Models>{pad}{model}</Models></UANodeSet>"), true),
+            (format!("<UANodeSet>{}<Models>{model}</Models></UANodeSet>", "x".repeat(HEADER_LIMIT)), false),
+            (format!("<Other><Models>{model}</Models></Other>"), false),
+        ];
+        for (i, (text, found)) in cases.iter().enumerate() {
+            let path = dir.join(format!("{i}.xml"));
+            std::fs::write(&path, text).unwrap();
+            let got = scan_header(&path);
+            if *found {
+                let models = got.unwrap_or_else(|| panic!("case {i}"));
+                assert_eq!(models, vec![("http://x/".to_string(), Some("1.0".to_string()), Some("2020-01-01".to_string()))]);
+            } else {
+                assert!(got.is_none(), "case {i}: {got:?}");
+            }
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
