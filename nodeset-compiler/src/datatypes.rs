@@ -212,7 +212,7 @@ fn enumeration(model: &Model, t: NodeIx, diags: &mut Diagnostics) -> DataTypeKin
             other => vec![other],
         };
         let mut values = Vec::new();
-        let item_spans: Vec<Span> = c.value_xml.as_ref().map(|x| x.children.iter().map(|e| e.span).collect()).unwrap_or_default();
+        let item_spans: Vec<Span> = model.value_element(child).map(|x| x.children().map(|e| e.span()).collect()).unwrap_or_default();
         let mut spans = Vec::new();
         for (i, it) in items.into_iter().enumerate() {
             let before = values.len();

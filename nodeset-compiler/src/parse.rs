@@ -122,6 +122,12 @@ struct Parser<'a, 'd> {
     diags: &'d mut Diagnostics,
     /// Open elements: name and start offset, for truncation messages.
     open: Vec<(&'a str, usize)>,
+    /// The open elements of the tree [`Parser::tree`] is reading: local name, start tag, text length so far.
+    tree_stack: Vec<(&'a str, Span, usize)>,
+    /// The elements of the file's values.
+    values: ValueArena,
+    /// The open elements of the value being read, as indices into `values`.
+    value_stack: Vec<u32>,
 }
 
 impl<'a, 'd> Parser<'a, 'd> {
@@ -132,7 +138,22 @@ impl<'a, 'd> Parser<'a, 'd> {
         cfg.check_end_names = true;
         cfg.check_comments = false;
         cfg.trim_text(false);
-        Parser { file, text, reader, limits, diags, open: Vec::new() }
+        Parser {
+            file,
+            text,
+            reader,
+            limits,
+            diags,
+            open: Vec::new(),
+            tree_stack: Vec::new(),
+            values: ValueArena::default(),
+            value_stack: Vec::new(),
+        }
+    }
+
+    /// The reader's position in the input.
+    fn pos(&self) -> usize {
+        self.reader.buffer_position() as usize
     }
 
     fn span(&self, start: usize, end: usize) -> Span {
@@ -171,9 +192,7 @@ impl<'a, 'd> Parser<'a, 'd> {
             let after = self.reader.buffer_position() as usize;
             match ev {
                 Event::Start(e) => {
-                    let name = std::str::from_utf8(local(e.name().into_inner())).unwrap_or("?");
-                    // SAFETY of lifetimes: the name borrows from the input text, which lives for 'a.
-                    let name: &'a str = self.text_slice(name);
+                    let name = self.str_at(local(e.name().into_inner()));
                     self.open.push((name, before));
                     if self.open.len() > self.limits.max_depth {
                         let d = Diagnostic::new(
@@ -257,13 +276,15 @@ impl<'a, 'd> Parser<'a, 'd> {
         }
     }
 
-    fn text_slice(&self, s: &str) -> &'a str {
-        let off = self.offset_of(s.as_bytes());
-        if off + s.len() <= self.text.len() && &self.text[off..off + s.len()] == s {
-            &self.text[off..off + s.len()]
-        } else {
-            "?"
+    /// The input text at the bytes `s`, which quick-xml handed out as a slice of it: a name, a key or a
+    /// value, with the lifetime of the input ("?" if `s` is not such a slice, which does not happen).
+    fn str_at(&self, s: &[u8]) -> &'a str {
+        let base = self.text.as_ptr() as usize;
+        let p = s.as_ptr() as usize;
+        if p < base || p + s.len() > base + self.text.len() {
+            return "?";
         }
+        self.text.get(p - base..p - base + s.len()).unwrap_or("?")
     }
 
     fn attrs(&mut self, e: &BytesStart<'a>, tag: Span) -> PResult<Vec<Attr<'a>>> {
@@ -276,23 +297,21 @@ impl<'a, 'd> Parser<'a, 'd> {
                     return Err(self.fatal(d));
                 }
             };
-            let key_bytes = local(a.key.into_inner());
-            let key = std::str::from_utf8(key_bytes).unwrap_or("?");
-            let key = self.text_slice(key);
+            let key = self.str_at(local(a.key.into_inner()));
             let start = self.offset_of(&a.value);
             let span = self.span(start, start + a.value.len());
-            let raw_ok = start + a.value.len() <= self.text.len() && !a.value.contains(&b'&');
-            let value: Cow<'a, str> = if raw_ok {
-                Cow::Borrowed(&self.text[start..start + a.value.len()])
+            let raw = self.str_at(&a.value);
+            let value: Cow<'a, str> = if !raw.contains('&') {
+                Cow::Borrowed(raw)
             } else {
                 match a.unescape_value() {
-                Ok(v) => Cow::Owned(v.into_owned()),
-                Err(err) => {
-                    let d = Diagnostic::new(Code::XmlSyntax, format!("malformed attribute value: {err}"))
-                        .at(span)
-                        .help("only the predefined entities (&amp; &lt; &gt; &quot; &apos;) and character references are allowed");
-                    return Err(self.fatal(d));
-                }
+                    Ok(v) => Cow::Owned(v.into_owned()),
+                    Err(err) => {
+                        let d = Diagnostic::new(Code::XmlSyntax, format!("malformed attribute value: {err}"))
+                            .at(span)
+                            .help("only the predefined entities (&amp; &lt; &gt; &quot; &apos;) and character references are allowed");
+                        return Err(self.fatal(d));
+                    }
                 }
             };
             out.push(Attr { key, value, span });
@@ -352,7 +371,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                 Ev::Eof => unreachable!(),
             }
         }
-        Ok(normalize_newlines(s))
+        Ok(normalize_newlines(Cow::Owned(s)).into_owned())
     }
 
     fn localized(&mut self, e: &BytesStart<'a>, span: Span, name: &str) -> PResult<LocalizedText> {
@@ -403,18 +422,19 @@ impl<'a, 'd> Parser<'a, 'd> {
             aliases: Vec::new(),
             nodes: Vec::with_capacity(self.text.len() / 800),
             last_modified: attrs.iter().find(|a| a.key == "LastModified").map(|a| a.value.to_string()),
+            values: ValueArena::default(),
         };
         loop {
             match self.next()? {
                 Ev::Start(e, span) => {
-                    let name = String::from_utf8_lossy(local(e.name().into_inner())).into_owned();
-                    match name.as_str() {
+                    let name = self.str_at(local(e.name().into_inner()));
+                    match name {
                         "NamespaceUris" => set.namespace_uris = self.uri_list("NamespaceUris")?,
                         "ServerUris" => set.server_uris = self.uri_list("ServerUris")?,
                         "Models" => self.models(&mut set.models)?,
                         "Aliases" => self.aliases(&mut set.aliases)?,
                         "Extensions" => self.skip()?,
-                        _ => match NodeClass::from_element(&name) {
+                        _ => match NodeClass::from_element(name) {
                             Some(class) => {
                                 let node = self.node(class, &e, span)?;
                                 set.nodes.push(node);
@@ -449,6 +469,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                 Ev::End => unreachable!("no element is open after the root"),
             }
         }
+        set.values = std::mem::take(&mut self.values);
         Ok(set)
     }
 
@@ -558,7 +579,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                     }
                     let attrs = self.attrs(&e, span)?;
                     let alias = attrs.iter().find(|a| a.key == "Alias").map(|a| a.value.to_string());
-                    let text_start = self.reader.buffer_position() as usize;
+                    let text_start = self.pos();
                     let target = self.text_content("Alias")?;
                     let trimmed = target.trim();
                     let lead = target.len() - target.trim_start().len();
@@ -590,7 +611,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                     }
                     let attrs = self.attrs(&e, span)?;
                     let permissions = attrs.iter().find(|a| a.key == "Permissions").and_then(|a| self.number(a));
-                    let text_start = self.reader.buffer_position() as usize;
+                    let text_start = self.pos();
                     let role = self.text_content("RolePermission")?;
                     let lead = role.len() - role.trim_start().len();
                     let rspan = self.span(text_start + lead, text_start + lead + role.trim().len());
@@ -718,13 +739,11 @@ impl<'a, 'd> Parser<'a, 'd> {
                         b"References" => self.references(&mut node.references)?,
                         b"RolePermissions" => node.role_permissions = self.role_permissions()?,
                         b"Extensions" => {
-                            let tree = self.tree(&e, cspan, usize::MAX)?;
-                            node.extensions = tree.children;
+                            let mut sink = ElementSink::default();
+                            self.tree(&e, cspan, usize::MAX, &mut sink)?;
+                            node.extensions = sink.done.map(|tree| tree.children).unwrap_or_default();
                         }
-                        b"Value" => {
-                            let tree = self.tree(&e, cspan, self.limits.max_value_depth)?;
-                            node.value = tree.children.into_iter().next();
-                        }
+                        b"Value" => node.value = self.value(&e, cspan)?,
                         b"Definition" => node.definition = Some(self.definition(&e, cspan)?),
                         _ => {
                             let within = class.element();
@@ -758,7 +777,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                             _ => {}
                         }
                     }
-                    let text_start = self.reader.buffer_position() as usize;
+                    let text_start = self.pos();
                     let target = self.text_content("Reference")?;
                     let lead = target.len() - target.trim_start().len();
                     let tspan = self.span(text_start + lead, text_start + lead + target.trim().len());
@@ -871,10 +890,29 @@ impl<'a, 'd> Parser<'a, 'd> {
         }
     }
 
-    /// Reads an element and everything inside it as a tree, iteratively, bounded to `max_depth` levels.
-    fn tree(&mut self, e: &BytesStart<'a>, span: Span, max_depth: usize) -> PResult<XmlElement> {
-        let root = self.element_of(e, span)?;
-        let mut stack = vec![root];
+    /// Reads an element whose start has been read and everything inside it, iteratively, bounded to
+    /// `max_depth` levels, handing each element and piece of text to `sink`. The limits are checked here,
+    /// whatever the sink builds.
+    fn tree<S: TreeSink<'a>>(&mut self, e: &BytesStart<'a>, span: Span, max_depth: usize, sink: &mut S) -> PResult<()> {
+        let mut stack = std::mem::take(&mut self.tree_stack);
+        stack.clear();
+        let result = self.tree_with(e, span, max_depth, sink, &mut stack);
+        self.tree_stack = stack;
+        result
+    }
+
+    fn tree_with<S: TreeSink<'a>>(
+        &mut self,
+        e: &BytesStart<'a>,
+        span: Span,
+        max_depth: usize,
+        sink: &mut S,
+        stack: &mut Vec<(&'a str, Span, usize)>,
+    ) -> PResult<()> {
+        let name = self.str_at(local(e.name().into_inner()));
+        let attrs = self.attrs(e, span)?;
+        sink.start(self, name, &attrs, span);
+        stack.push((name, span, 0));
         loop {
             match self.next()? {
                 Ev::Start(e, s) => {
@@ -887,33 +925,30 @@ impl<'a, 'd> Parser<'a, 'd> {
                         .help("values in NodeSet2 files are a few levels deep; this one is malformed or hostile");
                         return Err(self.fatal(d));
                     }
-                    let el = self.element_of(&e, s)?;
-                    stack.push(el);
+                    let name = self.str_at(local(e.name().into_inner()));
+                    let attrs = self.attrs(&e, s)?;
+                    sink.start(self, name, &attrs, s);
+                    stack.push((name, s, 0));
                 }
                 Ev::Text(t, _) => {
                     let top = stack.last_mut().expect("stack holds the root");
-                    if top.text.len() + t.len() > self.limits.max_text_len {
+                    if top.2 + t.len() > self.limits.max_text_len {
                         let d = Diagnostic::new(
                             Code::TooLarge,
-                            format!("the text of <{}> is longer than {} bytes", top.name, self.limits.max_text_len),
+                            format!("the text of <{}> is longer than {} bytes", top.0, self.limits.max_text_len),
                         )
-                        .at(top.span)
+                        .at(top.1)
                         .help("no NodeSet2 value needs this much; raise the limit in parse::Limits if the file is trusted");
                         return Err(self.fatal(d));
                     }
-                    top.text.push_str(&t);
+                    top.2 += t.len();
+                    sink.text(self, t);
                 }
                 Ev::End => {
-                    let mut done = stack.pop().expect("stack holds the root");
-                    if done.children.is_empty() {
-                        done.text = normalize_newlines(std::mem::take(&mut done.text));
-                    } else {
-                        // Elements with children carry only formatting white space.
-                        done.text.clear();
-                    }
-                    match stack.last_mut() {
-                        Some(parent) => parent.children.push(done),
-                        None => return Ok(done),
+                    stack.pop();
+                    sink.end(self);
+                    if stack.is_empty() {
+                        return Ok(());
                     }
                 }
                 Ev::Eof => unreachable!(),
@@ -921,15 +956,88 @@ impl<'a, 'd> Parser<'a, 'd> {
         }
     }
 
-    fn element_of(&mut self, e: &BytesStart<'a>, span: Span) -> PResult<XmlElement> {
-        let attrs = self.attrs(e, span)?;
-        Ok(XmlElement {
-            name: String::from_utf8_lossy(local(e.name().into_inner())).into_owned(),
-            attributes: attrs.into_iter().map(|a| (a.key.to_string(), a.value.into_owned())).collect(),
+    /// Reads a `<Value>` whose start has been read into the file's value arena and returns the element
+    /// inside it, if any.
+    fn value(&mut self, e: &BytesStart<'a>, span: Span) -> PResult<Option<ValueRef>> {
+        let mut sink = ArenaSink { stack: std::mem::take(&mut self.value_stack), root: None };
+        sink.stack.clear();
+        let result = self.tree(e, span, self.limits.max_value_depth, &mut sink);
+        self.value_stack = sink.stack;
+        result?;
+        let root = sink.root.expect("the tree has a root");
+        Ok(self.values.element(ValueRef(root), self.text).children().next().map(|c| ValueRef(c.index())))
+    }
+}
+
+/// What [`Parser::tree`] builds from the elements it reads.
+trait TreeSink<'a> {
+    /// An element starts; its attributes have been read.
+    fn start(&mut self, p: &mut Parser<'a, '_>, name: &'a str, attrs: &[Attr<'a>], span: Span);
+    /// A piece of the innermost open element's text.
+    fn text(&mut self, p: &mut Parser<'a, '_>, text: Cow<'a, str>);
+    /// The innermost open element ends.
+    fn end(&mut self, p: &mut Parser<'a, '_>);
+}
+
+/// Builds an owned [`XmlElement`] tree (for `<Extensions>`).
+#[derive(Default)]
+struct ElementSink {
+    stack: Vec<XmlElement>,
+    done: Option<XmlElement>,
+}
+
+impl<'a> TreeSink<'a> for ElementSink {
+    fn start(&mut self, _: &mut Parser<'a, '_>, name: &'a str, attrs: &[Attr<'a>], span: Span) {
+        self.stack.push(XmlElement {
+            name: name.to_string(),
+            attributes: attrs.iter().map(|a| (a.key.to_string(), a.value.to_string())).collect(),
             children: Vec::new(),
             text: String::new(),
             span,
-        })
+        });
+    }
+
+    fn text(&mut self, _: &mut Parser<'a, '_>, text: Cow<'a, str>) {
+        self.stack.last_mut().expect("an element is open").text.push_str(&text);
+    }
+
+    fn end(&mut self, _: &mut Parser<'a, '_>) {
+        let mut done = self.stack.pop().expect("an element is open");
+        if done.children.is_empty() {
+            done.text = normalize_newlines(Cow::Owned(std::mem::take(&mut done.text))).into_owned();
+        } else {
+            // Elements with children carry only formatting white space.
+            done.text.clear();
+        }
+        match self.stack.last_mut() {
+            Some(parent) => parent.children.push(done),
+            None => self.done = Some(done),
+        }
+    }
+}
+
+/// Records the elements into the parser's [`ValueArena`] (for `<Value>`).
+struct ArenaSink {
+    /// The open elements, as arena indices.
+    stack: Vec<u32>,
+    root: Option<u32>,
+}
+
+impl<'a> TreeSink<'a> for ArenaSink {
+    fn start(&mut self, p: &mut Parser<'a, '_>, name: &'a str, attrs: &[Attr<'a>], span: Span) {
+        let ix = p.values.open(span, name, attrs.iter().map(|a| (a.key, &*a.value)), p.text);
+        self.root.get_or_insert(ix);
+        self.stack.push(ix);
+    }
+
+    fn text(&mut self, p: &mut Parser<'a, '_>, text: Cow<'a, str>) {
+        let ix = *self.stack.last().expect("an element is open");
+        p.values.push_text(ix, &text, p.text);
+    }
+
+    fn end(&mut self, p: &mut Parser<'a, '_>) {
+        let ix = self.stack.pop().expect("an element is open");
+        p.values.close(ix, p.text);
     }
 }
 
@@ -976,9 +1084,9 @@ fn local(name: &[u8]) -> &[u8] {
     }
 }
 
-fn normalize_newlines(s: String) -> String {
+fn normalize_newlines(s: Cow<'_, str>) -> Cow<'_, str> {
     if s.contains('\r') {
-        s.replace("\r\n", "\n").replace('\r', "\n")
+        Cow::Owned(s.replace("\r\n", "\n").replace('\r', "\n"))
     } else {
         s
     }
@@ -1047,10 +1155,63 @@ mod tests {
         assert_eq!(a.descriptions[0].text, "line1\nline2");
         assert!(!a.references[0].is_forward);
         assert_eq!(&xml[a.node_id.span.start as usize..a.node_id.span.end as usize], "ns=1;i=1");
-        let v = set.nodes[1].value.as_ref().unwrap();
-        assert_eq!(v.name, "ListOfInt32");
-        assert_eq!(v.children.len(), 2);
-        assert_eq!(v.children[1].text, "2");
+        let v = set.values.element(set.nodes[1].value.unwrap(), xml);
+        assert_eq!(v.name(), "ListOfInt32");
+        assert_eq!(v.attr("xmlns"), Some("http://opcfoundation.org/UA/2008/02/Types.xsd"));
+        assert_eq!(v.children().count(), 2);
+        assert_eq!(v.children().nth(1).unwrap().text(), "2");
+        let tree = v.to_xml();
+        assert_eq!(tree.children[1].text, "2");
+        assert_eq!(&xml[tree.children[1].span.start as usize..tree.children[1].span.end as usize], "<Int32>");
+    }
+
+    /// Moves every span of a tree by `delta` bytes.
+    fn shifted(mut el: XmlElement, delta: i64) -> XmlElement {
+        el.span.start = (el.span.start as i64 + delta) as u32;
+        el.span.end = (el.span.end as i64 + delta) as u32;
+        el.children = el.children.into_iter().map(|c| shifted(c, delta)).collect();
+        el
+    }
+
+    #[test]
+    fn values_read_in_place_build_the_trees_extensions_build() {
+        // Entities in text and attributes, CR LF, text in pieces around a comment and CDATA, white space
+        // only, mixed content (dropped), prefixes, an empty element.
+        let inner = "<x:Outer xmlns:x=\"urn:x\" a=\"1 &amp; 2\" b='\u{e9}'>\r\n  <x:A>t &lt; u</x:A>\r\n  <B>line1\r\nline2\rline3</B>\
+            <C>one<!-- c -->two<![CDATA[<three>]]></C><D>   </D><E/><F> mixed <G>g</G> text </F><H>plain</H></x:Outer>";
+        let xml = format!(
+            "<UANodeSet><UAVariable NodeId=\"i=1\" BrowseName=\"V\"><Value>{inner}</Value>\
+             <Extensions>{inner}</Extensions></UAVariable></UANodeSet>"
+        );
+        let (set, d) = parse_str(&xml);
+        assert!(d.items.is_empty(), "{d:?}");
+        let set = set.unwrap();
+        let node = &set.nodes[0];
+        let from_arena = set.values.element(node.value.unwrap(), &xml).to_xml();
+        let delta = (xml.find("<Value>").unwrap() + "<Value>".len()) as i64 - (xml.find("<Extensions>").unwrap() + "<Extensions>".len()) as i64;
+        assert_eq!(from_arena, shifted(node.extensions[0].clone(), delta));
+        assert_eq!(from_arena.attributes, [("x".to_string(), "urn:x".to_string()), ("a".into(), "1 & 2".into()), ("b".into(), "\u{e9}".into())]);
+        let texts: Vec<&str> = from_arena.children.iter().map(|c| c.text.as_str()).collect();
+        assert_eq!(texts, ["t < u", "line1\nline2\nline3", "onetwo<three>", "", "", "", "plain"]);
+        assert_eq!(&xml[from_arena.children[1].span.start as usize..from_arena.children[1].span.end as usize], "<B>");
+    }
+
+    #[test]
+    fn value_limits_hold_for_values_read_in_place() {
+        let limits = Limits { max_value_depth: 3, max_text_len: 8, ..Limits::default() };
+        let parse_with = |value: &str| {
+            let xml = format!("<UANodeSet><UAVariable NodeId=\"i=1\" BrowseName=\"V\"><Value>{value}</Value></UAVariable></UANodeSet>");
+            let mut d = Diagnostics::new();
+            let set = parse(FileId(0), &xml, &limits, &mut d);
+            (set.is_some(), d.items.iter().map(|i| (i.code, i.message.clone())).collect::<Vec<_>>())
+        };
+        assert_eq!(parse_with("<A><B>12345678</B></A>"), (true, vec![]));
+        let (ok, d) = parse_with("<A><B><C/></B></A>");
+        assert!(!ok);
+        assert_eq!(d, [(Code::TooDeep, "a value is nested more than 3 levels deep".to_string())]);
+        let (ok, d) = parse_with("<A><B>1234<!---->56789</B></A>");
+        assert!(!ok);
+        assert_eq!(d, [(Code::TooLarge, "the text of <B> is longer than 8 bytes".to_string())]);
     }
 
     #[test]

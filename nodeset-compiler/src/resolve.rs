@@ -10,7 +10,7 @@ use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::load::Loaded;
 use crate::model::*;
 use crate::nodeid::{parse_qualified_name, NodeId, QualifiedName};
-use crate::raw::NodeClass;
+use crate::raw::{NodeClass, ValueArena};
 use crate::source::Span;
 use crate::value::{BuiltinType, Variant};
 use std::collections::{BTreeMap, HashMap, HashSet};
@@ -32,6 +32,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         members: BTreeMap::new(),
         hierarchical: Vec::new(),
         ns0_type_names: FxHashMap::default(),
+        value_arenas: Vec::new(),
     };
     let total: usize = files.iter().map(|f| f.raw.nodes.len()).sum();
     model.nodes.reserve(total);
@@ -44,8 +45,10 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         .map(|f| FileContext { ns_map: std::mem::take(&mut f.ns_map), aliases: std::mem::take(&mut f.aliases) })
         .collect();
     let mut pending: Vec<(NodeIx, u32, u32)> = Vec::with_capacity(total);
+    model.value_arenas = (0..model.sources.len()).map(|_| ValueArena::default()).collect();
     for (fi, f) in files.iter_mut().enumerate() {
         let file = f.raw.file;
+        model.value_arenas[file.0 as usize] = std::mem::take(&mut f.raw.values);
         let ctx = &contexts[fi];
         for (ni, raw) in f.raw.nodes.iter_mut().enumerate() {
             let id = match crate::load::resolve_node_id_in(&ctx.ns_map, &ctx.aliases, &raw.node_id, &model.namespaces) {
@@ -102,7 +105,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 display_name: std::mem::take(&mut raw.display_names),
                 description: std::mem::take(&mut raw.descriptions),
                 attrs: Attributes::default(),
-                value_xml: None,
+                value: None,
                 definition: None,
                 extensions: Vec::new(),
                 references: Vec::new(),
@@ -283,7 +286,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         }
         let node = &mut model.nodes[ix.index()];
         node.attrs = attrs;
-        node.value_xml = raw.value.take();
+        node.value = raw.value;
         node.definition = raw.definition.take();
         node.extensions = std::mem::take(&mut raw.extensions);
     }
@@ -797,13 +800,14 @@ fn value_fits(model: &Model, dt: NodeIx, have: BuiltinType) -> bool {
 fn check_values(model: &Model, diags: &mut Diagnostics) {
     for (i, node) in model.nodes.iter().enumerate() {
         let ix = NodeIx(i as u32);
-        let Some(xml) = &node.value_xml else { continue };
-        let v = match model.value(ix) {
+        // The check needs the type and shape of the value only, not copies of ExtensionObject bodies.
+        let Some(xml) = model.value_element(ix) else { continue };
+        let v = match model.decode_value(ix, false) {
             Some(Ok(v)) => v,
             Some(Err(why)) => {
                 diags.push(
                     Diagnostic::new(Code::BadValue, format!("the value of `{}` cannot be decoded: {why}", node.browse_name.name))
-                        .at(xml.span)
+                        .at(xml.span())
                         .help("see OPC UA Part 6, 5.3 for the XML encoding of values"),
                 );
                 continue;
@@ -819,11 +823,11 @@ fn check_values(model: &Model, diags: &mut Diagnostics) {
                     format!(
                         "the value of `{}` is a {}, but its DataType is {}",
                         node.browse_name.name,
-                        xml.name,
+                        xml.name(),
                         model.node(dt).browse_name.name
                     ),
                 )
-                .at(xml.span)
+                .at(xml.span())
                 .with_span_label(format!("a {}", have.type_name()))
                 .help("a server would reject this value; write it in the DataType's encoding"),
             );
@@ -840,7 +844,7 @@ fn check_values(model: &Model, diags: &mut Diagnostics) {
                         if v.is_array() { "an array" } else { "a scalar" }
                     ),
                 )
-                .at(xml.span)
+                .at(xml.span())
                 .help("ValueRank -1 is a scalar, 1 an array, 0 one or more dimensions, -2 any, -3 scalar or array"),
             );
         }
