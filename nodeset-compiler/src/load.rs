@@ -72,15 +72,26 @@ pub fn resolve_node_id_in(
     text: &Spanned<String>,
     namespaces: &[String],
 ) -> Result<NodeId, Diagnostic> {
+    resolve_node_id_str(ns_map, aliases, &text.value, text.span, namespaces)
+}
+
+/// [`resolve_node_id_in`] for a string read at `span`.
+pub fn resolve_node_id_str(
+    ns_map: &[u16],
+    aliases: &FxHashMap<String, Spanned<String>>,
+    text: &str,
+    span: Span,
+    namespaces: &[String],
+) -> Result<NodeId, Diagnostic> {
     {
-        let s = text.value.trim();
+        let s = text.trim();
         let (id_text, via_alias) = match aliases.get(s) {
             Some(t) => (t.value.as_str(), Some(t)),
             None => (s, None),
         };
         if via_alias.is_none() && !looks_like_node_id(id_text) {
             let mut d = Diagnostic::new(Code::UnknownAlias, format!("`{s}` is neither a declared alias nor a NodeId"))
-                .at(text.span)
+                .at(span)
                 .with_span_label("unknown alias");
             let near = nearest(s, aliases.keys().map(String::as_str));
             d = match near {
@@ -92,9 +103,9 @@ pub fn resolve_node_id_in(
         let raw = parse_node_id(id_text).map_err(|why| {
             let mut d = Diagnostic::new(Code::MalformedNodeId, format!("malformed NodeId `{id_text}`: {why}"));
             if let Some(t) = via_alias {
-                d = d.at(t.span).label(text.span, format!("used through alias `{s}` here"));
+                d = d.at(t.span).label(span, format!("used through alias `{s}` here"));
             } else {
-                d = d.at(text.span);
+                d = d.at(span);
             }
             d.help("NodeIds are written i=123, s=Name, g=GUID or b=Base64, with an optional ns=N; or nsu=URI; prefix")
         })?;
@@ -106,7 +117,7 @@ pub fn resolve_node_id_in(
                         Code::UnknownNamespaceIndex,
                         format!("namespace index {i} is not declared in this file's NamespaceUris"),
                     )
-                    .at(via_alias.map(|t| t.span).unwrap_or(text.span))
+                    .at(via_alias.map(|t| t.span).unwrap_or(span))
                     .with_span_label(format!("ns={i}"))
                     .note(format!("this file declares {} namespace URI(s)", ns_map.len() - 1))
                     .help("add the namespace's URI to <NamespaceUris> at that position"))
@@ -119,7 +130,7 @@ pub fn resolve_node_id_in(
                         Code::UnknownNamespaceUri,
                         format!("namespace `{u}` is not a loaded model or declared namespace"),
                     )
-                    .at(text.span)
+                    .at(span)
                     .help("load the model that defines this namespace (see --models)"))
                 }
             },

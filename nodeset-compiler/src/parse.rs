@@ -122,6 +122,9 @@ struct Parser<'a, 'd> {
     diags: &'d mut Diagnostics,
     /// Open elements: name and start offset, for truncation messages.
     open: Vec<(&'a str, usize)>,
+    /// One attribute list, lent out by [`Parser::attrs`] and given back by [`Parser::recycle`], so that
+    /// reading an element's attributes allocates nothing.
+    attr_buf: Vec<Attr<'a>>,
     /// The open elements of the tree [`Parser::tree`] is reading: local name, start tag, text length so far.
     tree_stack: Vec<(&'a str, Span, usize)>,
     /// The elements of the file's values.
@@ -145,6 +148,7 @@ impl<'a, 'd> Parser<'a, 'd> {
             limits,
             diags,
             open: Vec::new(),
+            attr_buf: Vec::new(),
             tree_stack: Vec::new(),
             values: ValueArena::default(),
             value_stack: Vec::new(),
@@ -287,8 +291,36 @@ impl<'a, 'd> Parser<'a, 'd> {
         self.text.get(p - base..p - base + s.len()).unwrap_or("?")
     }
 
+    /// A string read at `span`, kept as a span where it is the input text there.
+    fn raw_str(&self, value: &str, span: Span) -> RawStr {
+        RawStr::new(value, span, self.text)
+    }
+
+    /// The attributes of a start tag, in a list lent out by the parser: give it back with
+    /// [`Parser::recycle`]. A malformed attribute or value stops the file.
+    ///
+    /// quick-xml's own duplicate check keeps a list of the keys it has seen, allocated per element; this
+    /// reads without it and compares the keys itself. Any problem (an error, or two attributes with one
+    /// local name) hands the tag to [`Parser::attrs_checked`], the reading with quick-xml's checks, which
+    /// decides what is reported, so the diagnostics are quick-xml's whatever the path.
     fn attrs(&mut self, e: &BytesStart<'a>, tag: Span) -> PResult<Vec<Attr<'a>>> {
-        let mut out = Vec::new();
+        let mut out = std::mem::take(&mut self.attr_buf);
+        out.clear();
+        for a in e.attributes().with_checks(false) {
+            let Ok(a) = a else { return self.attrs_checked(e, tag, out) };
+            let key = self.str_at(local(a.key.into_inner()));
+            if out.iter().any(|o| o.key == key) {
+                return self.attrs_checked(e, tag, out);
+            }
+            let attr = self.attr(key, &a)?;
+            out.push(attr);
+        }
+        Ok(out)
+    }
+
+    /// [`Parser::attrs`] with quick-xml's duplicate check.
+    fn attrs_checked(&mut self, e: &BytesStart<'a>, tag: Span, mut out: Vec<Attr<'a>>) -> PResult<Vec<Attr<'a>>> {
+        out.clear();
         for a in e.attributes().with_checks(true) {
             let a = match a {
                 Ok(a) => a,
@@ -298,25 +330,36 @@ impl<'a, 'd> Parser<'a, 'd> {
                 }
             };
             let key = self.str_at(local(a.key.into_inner()));
-            let start = self.offset_of(&a.value);
-            let span = self.span(start, start + a.value.len());
-            let raw = self.str_at(&a.value);
-            let value: Cow<'a, str> = if !raw.contains('&') {
-                Cow::Borrowed(raw)
-            } else {
-                match a.unescape_value() {
-                    Ok(v) => Cow::Owned(v.into_owned()),
-                    Err(err) => {
-                        let d = Diagnostic::new(Code::XmlSyntax, format!("malformed attribute value: {err}"))
-                            .at(span)
-                            .help("only the predefined entities (&amp; &lt; &gt; &quot; &apos;) and character references are allowed");
-                        return Err(self.fatal(d));
-                    }
-                }
-            };
-            out.push(Attr { key, value, span });
+            let attr = self.attr(key, &a)?;
+            out.push(attr);
         }
         Ok(out)
+    }
+
+    /// One attribute: its value is borrowed from the input unless it holds references to expand.
+    fn attr(&mut self, key: &'a str, a: &quick_xml::events::attributes::Attribute<'_>) -> PResult<Attr<'a>> {
+        let start = self.offset_of(&a.value);
+        let span = self.span(start, start + a.value.len());
+        let raw = self.str_at(&a.value);
+        let value: Cow<'a, str> = if !raw.contains('&') {
+            Cow::Borrowed(raw)
+        } else {
+            match a.unescape_value() {
+                Ok(v) => Cow::Owned(v.into_owned()),
+                Err(err) => {
+                    let d = Diagnostic::new(Code::XmlSyntax, format!("malformed attribute value: {err}"))
+                        .at(span)
+                        .help("only the predefined entities (&amp; &lt; &gt; &quot; &apos;) and character references are allowed");
+                    return Err(self.fatal(d));
+                }
+            }
+        };
+        Ok(Attr { key, value, span })
+    }
+
+    /// Gives back the list [`Parser::attrs`] lent out.
+    fn recycle(&mut self, attrs: Vec<Attr<'a>>) {
+        self.attr_buf = attrs;
     }
 
     /// Consumes the rest of an element whose start has been read.
@@ -347,9 +390,10 @@ impl<'a, 'd> Parser<'a, 'd> {
         self.skip()
     }
 
-    /// Reads the text content of an element whose start has been read; child elements are reported.
-    fn text_content(&mut self, within: &str) -> PResult<String> {
-        let mut s = String::new();
+    /// Reads the text content of an element whose start has been read; child elements are reported. The
+    /// text is borrowed from the input when it is one piece without references or carriage returns.
+    fn text_content(&mut self, within: &str) -> PResult<Cow<'a, str>> {
+        let mut s: Cow<'a, str> = Cow::Borrowed("");
         let element_start = self.open.last().map(|(_, start)| *start).unwrap_or(0);
         loop {
             match self.next()? {
@@ -364,19 +408,24 @@ impl<'a, 'd> Parser<'a, 'd> {
                         .help("no NodeSet2 text needs this much; raise the limit in parse::Limits if the file is trusted");
                         return Err(self.fatal(d));
                     }
-                    s.push_str(&t)
+                    if s.is_empty() {
+                        s = t;
+                    } else {
+                        s.to_mut().push_str(&t);
+                    }
                 }
                 Ev::Start(e, span) => self.unknown(&e, span, within)?,
                 Ev::End => break,
                 Ev::Eof => unreachable!(),
             }
         }
-        Ok(normalize_newlines(Cow::Owned(s)).into_owned())
+        Ok(normalize_newlines(s))
     }
 
     fn localized(&mut self, e: &BytesStart<'a>, span: Span, name: &str) -> PResult<LocalizedText> {
         let attrs = self.attrs(e, span)?;
         let locale = attrs.iter().find(|a| a.key == "Locale").map(|a| a.value.to_string()).filter(|l| !l.is_empty());
+        self.recycle(attrs);
         let text = self.text_content(name)?;
         Ok(LocalizedText { locale, text: text.trim().to_string() })
     }
@@ -424,6 +473,7 @@ impl<'a, 'd> Parser<'a, 'd> {
             last_modified: attrs.iter().find(|a| a.key == "LastModified").map(|a| a.value.to_string()),
             values: ValueArena::default(),
         };
+        self.recycle(attrs);
         loop {
             match self.next()? {
                 Ev::Start(e, span) => {
@@ -523,6 +573,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                     if let Some(a) = attrs.iter().find(|a| a.key == "AccessRestrictions") {
                         model.access_restrictions = self.number(a);
                     }
+                    self.recycle(attrs);
                     loop {
                         match self.next()? {
                             Ev::Start(e, span) => match local(e.name().into_inner()) {
@@ -542,6 +593,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                                         xml_schema_uri: get("XmlSchemaUri"),
                                         span,
                                     });
+                                    self.recycle(attrs);
                                     self.skip()?;
                                 }
                                 b"RolePermissions" => model.role_permissions = self.role_permissions()?,
@@ -579,6 +631,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                     }
                     let attrs = self.attrs(&e, span)?;
                     let alias = attrs.iter().find(|a| a.key == "Alias").map(|a| a.value.to_string());
+                    self.recycle(attrs);
                     let text_start = self.pos();
                     let target = self.text_content("Alias")?;
                     let trimmed = target.trim();
@@ -611,6 +664,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                     }
                     let attrs = self.attrs(&e, span)?;
                     let permissions = attrs.iter().find(|a| a.key == "Permissions").and_then(|a| self.number(a));
+                    self.recycle(attrs);
                     let text_start = self.pos();
                     let role = self.text_content("RolePermission")?;
                     let lead = role.len() - role.trim_start().len();
@@ -673,13 +727,14 @@ impl<'a, 'd> Parser<'a, 'd> {
         let mut have_bn = false;
         for a in &attrs {
             let spanned = || Spanned { value: a.value.to_string(), span: a.span };
+            let raw = || self.raw_str(&a.value, a.span);
             match a.key {
                 "NodeId" => {
-                    node.node_id = spanned();
+                    node.node_id = raw();
                     have_id = true
                 }
                 "BrowseName" => {
-                    node.browse_name = spanned();
+                    node.browse_name = raw();
                     have_bn = true
                 }
                 "SymbolicName" => node.symbolic_name = Some(a.value.to_string()),
@@ -688,8 +743,8 @@ impl<'a, 'd> Parser<'a, 'd> {
                 "AccessRestrictions" => node.access_restrictions = self.number(a),
                 "HasNoPermissions" => node.has_no_permissions = self.boolean(a),
                 "ReleaseStatus" => node.release_status = Some(a.value.to_string()),
-                "ParentNodeId" => node.parent_node_id = Some(spanned()),
-                "DataType" => node.data_type = Some(spanned()),
+                "ParentNodeId" => node.parent_node_id = Some(raw()),
+                "DataType" => node.data_type = Some(raw()),
                 "ValueRank" => node.value_rank = self.number(a),
                 "ArrayDimensions" => node.array_dimensions = Some(spanned()),
                 "AccessLevel" => node.access_level = self.number(a),
@@ -699,7 +754,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                 "Historizing" => node.historizing = self.boolean(a),
                 "Executable" => node.executable = self.boolean(a),
                 "UserExecutable" => node.user_executable = self.boolean(a),
-                "MethodDeclarationId" => node.method_declaration_id = Some(spanned()),
+                "MethodDeclarationId" => node.method_declaration_id = Some(raw()),
                 "EventNotifier" => node.event_notifier = self.number(a),
                 "ContainsNoLoops" => node.contains_no_loops = self.boolean(a),
                 "IsAbstract" => node.is_abstract = self.boolean(a),
@@ -708,6 +763,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                 _ => {}
             }
         }
+        self.recycle(attrs);
         if !have_id {
             self.missing(span, class.element(), "NodeId");
         }
@@ -735,7 +791,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                             let t = self.text_content("Category")?;
                             node.category.push(t.trim().to_string())
                         }
-                        b"Documentation" => node.documentation = Some(self.text_content("Documentation")?),
+                        b"Documentation" => node.documentation = Some(self.text_content("Documentation")?.into_owned()),
                         b"References" => self.references(&mut node.references)?,
                         b"RolePermissions" => node.role_permissions = self.role_permissions()?,
                         b"Extensions" => {
@@ -772,11 +828,12 @@ impl<'a, 'd> Parser<'a, 'd> {
                     let mut rt = None;
                     for a in &attrs {
                         match a.key {
-                            "ReferenceType" => rt = Some(Spanned { value: a.value.trim().to_string(), span: a.span }),
+                            "ReferenceType" => rt = Some(self.raw_str(a.value.trim(), a.span)),
                             "IsForward" => is_forward = self.boolean(a).unwrap_or(true),
                             _ => {}
                         }
                     }
+                    self.recycle(attrs);
                     let text_start = self.pos();
                     let target = self.text_content("Reference")?;
                     let lead = target.len() - target.trim_start().len();
@@ -785,12 +842,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                         self.missing(span, "Reference", "ReferenceType");
                         continue;
                     };
-                    out.push(RawReference {
-                        reference_type,
-                        target: Spanned { value: target.trim().to_string(), span: tspan },
-                        is_forward,
-                        span,
-                    });
+                    out.push(RawReference { reference_type, target: self.raw_str(target.trim(), tspan), is_forward, span });
                 }
                 Ev::Text(..) => {}
                 Ev::End => return Ok(()),
@@ -820,6 +872,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                 _ => {}
             }
         }
+        self.recycle(attrs);
         loop {
             match self.next()? {
                 Ev::Start(e, fspan) => {
@@ -860,6 +913,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                             _ => {}
                         }
                     }
+                    self.recycle(attrs);
                     if !have_name {
                         self.missing(fspan, "Field", "Name");
                     }
@@ -912,6 +966,7 @@ impl<'a, 'd> Parser<'a, 'd> {
         let name = self.str_at(local(e.name().into_inner()));
         let attrs = self.attrs(e, span)?;
         sink.start(self, name, &attrs, span);
+        self.recycle(attrs);
         stack.push((name, span, 0));
         loop {
             match self.next()? {
@@ -928,6 +983,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                     let name = self.str_at(local(e.name().into_inner()));
                     let attrs = self.attrs(&e, s)?;
                     sink.start(self, name, &attrs, s);
+                    self.recycle(attrs);
                     stack.push((name, s, 0));
                 }
                 Ev::Text(t, _) => {
@@ -1212,6 +1268,51 @@ mod tests {
         let (ok, d) = parse_with("<A><B>1234<!---->56789</B></A>");
         assert!(!ok);
         assert_eq!(d, [(Code::TooLarge, "the text of <B> is longer than 8 bytes".to_string())]);
+    }
+
+    #[test]
+    fn attribute_problems_are_reported_as_quick_xml_reports_them() {
+        let node = |attrs: &str| format!("<UANodeSet><UAObject {attrs}><DisplayName>A</DisplayName></UAObject></UANodeSet>");
+        let first = |xml: &str| {
+            let (set, d) = parse_str(xml);
+            (set.is_some(), d.items.first().map(|i| (i.code, i.message.clone(), i.span.map(|s| s.start))))
+        };
+        // Keys with one local name but different prefixes are distinct attributes.
+        let (set, d) = parse_str(&node("NodeId=\"i=1\" BrowseName=\"A\" a:x=\"1\" b:x=\"2\""));
+        assert!(d.items.is_empty(), "{d:?}");
+        assert_eq!(set.unwrap().nodes[0].node_id.span.start, 29);
+        let dup = first(&node("NodeId=\"i=1\" BrowseName=\"A\" NodeId=\"i=2\""));
+        assert_eq!(
+            dup,
+            (false, Some((Code::XmlSyntax, "malformed attribute: position 37: duplicated attribute, previous declaration at position 9".into(), Some(11))))
+        );
+        // A bad value before a duplicate is reported first, as in document order.
+        let (ok, d) = first(&node("NodeId=\"&bogus;\" NodeId=\"i=2\""));
+        assert!(!ok);
+        assert_eq!(d.unwrap().1, "malformed attribute value: at 1..6: unrecognized entity `bogus`");
+        let (ok, d) = first(&node("NodeId=i=1 BrowseName=\"A\""));
+        assert!(!ok);
+        assert!(d.unwrap().1.starts_with("malformed attribute: "));
+    }
+
+    #[test]
+    fn node_ids_and_references_borrow_from_the_text_unless_it_differs() {
+        let xml = "<UANodeSet><UAObject NodeId=\"ns=1;s=a&amp;b\" BrowseName=\"1:A\"><References>\
+            <Reference ReferenceType=\" HasComponent \">\r\n  ns=1;i=5\r\n</Reference>\
+            <Reference ReferenceType=\"Organizes\" IsForward=\"false\">i=85</Reference></References></UAObject></UANodeSet>";
+        let (set, d) = parse_str(xml);
+        assert!(d.items.is_empty(), "{d:?}");
+        let n = &set.unwrap().nodes[0];
+        assert_eq!(n.node_id.get(xml), "ns=1;s=a&b");
+        assert_eq!(&xml[n.node_id.span.start as usize..n.node_id.span.end as usize], "ns=1;s=a&amp;b");
+        assert_eq!(n.browse_name.get(xml), "1:A");
+        let r = &n.references;
+        assert_eq!((r[0].reference_type.get(xml), r[0].target.get(xml)), ("HasComponent", "ns=1;i=5"));
+        assert_eq!(&xml[r[0].reference_type.span.start as usize..r[0].reference_type.span.end as usize], " HasComponent ");
+        // The target's span is computed on the text after line-break normalisation, as it always was.
+        let t = r[0].target.span;
+        assert_eq!(&xml[t.start as usize..t.end as usize], " ns=1;i=");
+        assert_eq!((r[1].reference_type.get(xml), r[1].target.get(xml), r[1].is_forward), ("Organizes", "i=85", false));
     }
 
     #[test]

@@ -1,8 +1,10 @@
 //! The raw model of one NodeSet2 file: what the file says, nothing resolved.
 //!
 //! Strings are kept as written (NodeIds and aliases are not yet expanded) together with their spans, so
-//! that later stages can point at the exact attribute a problem comes from. The elements of `<Value>`s are
-//! kept as spans into the file's text, in one [`ValueArena`] per file.
+//! that later stages can point at the exact attribute a problem comes from. The strings the resolver only
+//! looks up (NodeIds, reference types and targets) are [`RawStr`]s: spans into the file's text, with a copy
+//! only where the string differs from the text it was read from. The elements of `<Value>`s are kept the
+//! same way, in one [`ValueArena`] per file.
 
 use crate::source::{FileId, Span, Spanned};
 
@@ -113,10 +115,40 @@ pub struct RawAlias {
     pub span: Span,
 }
 
+/// A string read from a file (an attribute value or an element's text), kept as its span in the file's
+/// text. The string is stored only where it differs from what the span covers: after entity or character
+/// references (`&amp;`, `&#160;`) were expanded, line breaks normalised or white space trimmed.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct RawStr {
+    pub span: Span,
+    owned: Option<Box<str>>,
+}
+
+impl RawStr {
+    /// `value` as read at `span` of `source`: borrowed from the source when it is exactly the text there.
+    pub fn new(value: &str, span: Span, source: &str) -> RawStr {
+        let same = source.get(span.start as usize..span.end as usize) == Some(value);
+        RawStr { span, owned: if same { None } else { Some(value.into()) } }
+    }
+
+    /// A string that is not the text at its span (such as the empty NodeId of a node that has none).
+    pub fn owned(value: &str, span: Span) -> RawStr {
+        RawStr { span, owned: Some(value.into()) }
+    }
+
+    /// The string, given the text of the file it was read from.
+    pub fn get<'s>(&'s self, source: &'s str) -> &'s str {
+        match &self.owned {
+            Some(s) => s,
+            None => source.get(self.span.start as usize..self.span.end as usize).unwrap_or(""),
+        }
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct RawReference {
-    pub reference_type: Spanned<String>,
-    pub target: Spanned<String>,
+    pub reference_type: RawStr,
+    pub target: RawStr,
     pub is_forward: bool,
     pub span: Span,
 }
@@ -190,8 +222,8 @@ pub struct RawNode {
     pub class: NodeClass,
     /// The span of the start tag.
     pub span: Span,
-    pub node_id: Spanned<String>,
-    pub browse_name: Spanned<String>,
+    pub node_id: RawStr,
+    pub browse_name: RawStr,
     pub symbolic_name: Option<String>,
     pub write_mask: Option<u32>,
     pub user_write_mask: Option<u32>,
@@ -206,9 +238,9 @@ pub struct RawNode {
     pub role_permissions: Vec<RawRolePermission>,
     pub extensions: Vec<XmlElement>,
     // Instance attributes.
-    pub parent_node_id: Option<Spanned<String>>,
+    pub parent_node_id: Option<RawStr>,
     // Variable and VariableType attributes.
-    pub data_type: Option<Spanned<String>>,
+    pub data_type: Option<RawStr>,
     pub value_rank: Option<i32>,
     pub array_dimensions: Option<Spanned<String>>,
     pub access_level: Option<u8>,
@@ -221,7 +253,7 @@ pub struct RawNode {
     // Method attributes.
     pub executable: Option<bool>,
     pub user_executable: Option<bool>,
-    pub method_declaration_id: Option<Spanned<String>>,
+    pub method_declaration_id: Option<RawStr>,
     // Object and View attributes.
     pub event_notifier: Option<u8>,
     pub contains_no_loops: Option<bool>,
@@ -235,7 +267,8 @@ pub struct RawNode {
 
 impl RawNode {
     pub fn new(class: NodeClass, span: Span) -> RawNode {
-        let empty = Spanned { value: String::new(), span };
+        // Until the attributes are read: empty strings spanning the start tag.
+        let empty = RawStr::owned("", span);
         RawNode {
             class,
             span,

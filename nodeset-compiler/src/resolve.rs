@@ -11,7 +11,7 @@ use crate::load::Loaded;
 use crate::model::*;
 use crate::nodeid::{parse_qualified_name, NodeId, QualifiedName};
 use crate::raw::{NodeClass, ValueArena};
-use crate::source::Span;
+use crate::source::{SourceMap, Span};
 use crate::value::{BuiltinType, Variant};
 use std::collections::{BTreeMap, HashMap, HashSet};
 
@@ -19,8 +19,10 @@ use std::collections::{BTreeMap, HashMap, HashSet};
 /// offending parts left out, so that later checks can still report what they find.
 pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
     let Loaded { sources, files, namespaces, models } = loaded;
+    let mut value_arenas: Vec<ValueArena> = (0..sources.len()).map(|_| ValueArena::default()).collect();
     let mut model = Model {
-        sources,
+        // The sources join the model after pass 2; until then the raw strings borrow from them.
+        sources: SourceMap::new(),
         namespaces,
         models,
         nodes: Vec::new(),
@@ -38,27 +40,30 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
     model.nodes.reserve(total);
     model.index.reserve(total);
 
-    // Pass 1: every node gets its index. Raw nodes stay where the loader put them; `pending` says where.
+    // Pass 1: every node gets its index and what it owns of its raw node. Raw nodes stay where the loader
+    // put them; `pending` says where.
     let mut files = files;
     let contexts: Vec<FileContext> = files
         .iter_mut()
         .map(|f| FileContext { ns_map: std::mem::take(&mut f.ns_map), aliases: std::mem::take(&mut f.aliases) })
         .collect();
     let mut pending: Vec<(NodeIx, u32, u32)> = Vec::with_capacity(total);
-    model.value_arenas = (0..model.sources.len()).map(|_| ValueArena::default()).collect();
     for (fi, f) in files.iter_mut().enumerate() {
         let file = f.raw.file;
-        model.value_arenas[file.0 as usize] = std::mem::take(&mut f.raw.values);
+        let text = sources.get(file).text.as_str();
         let ctx = &contexts[fi];
+        value_arenas[file.0 as usize] = std::mem::take(&mut f.raw.values);
         for (ni, raw) in f.raw.nodes.iter_mut().enumerate() {
-            let id = match crate::load::resolve_node_id_in(&ctx.ns_map, &ctx.aliases, &raw.node_id, &model.namespaces) {
+            let node_id = raw.node_id.get(text);
+            let id = match crate::load::resolve_node_id_str(&ctx.ns_map, &ctx.aliases, node_id, raw.node_id.span, &model.namespaces) {
                 Ok(id) => id,
                 Err(d) => {
                     diags.push(d);
                     continue;
                 }
             };
-            let browse_name = match parse_qualified_name(&raw.browse_name.value) {
+            let browse_name_text = raw.browse_name.get(text);
+            let browse_name = match parse_qualified_name(browse_name_text) {
                 Ok(q) => match ctx.ns_map.get(q.ns as usize) {
                     Some(&ns) => QualifiedName { ns, name: q.name },
                     None => {
@@ -74,14 +79,14 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                     }
                 },
                 Err(why) => {
-                    if !raw.browse_name.value.is_empty() || raw.browse_name.span != raw.span {
+                    if !browse_name_text.is_empty() || raw.browse_name.span != raw.span {
                         diags.push(
                             Diagnostic::new(Code::MalformedQualifiedName, format!("malformed BrowseName: {why}"))
                                 .at(raw.browse_name.span)
                                 .help("write N:Name, N being the namespace index"),
                         );
                     }
-                    QualifiedName { ns: 0, name: raw.browse_name.value.clone() }
+                    QualifiedName { ns: 0, name: browse_name_text.to_string() }
                 }
             };
             if let Some(&prev) = model.index.get(&id) {
@@ -97,6 +102,31 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
             }
             let ix = NodeIx(model.nodes.len() as u32);
             model.index.insert(id.clone(), ix);
+            let attrs = Attributes {
+                write_mask: raw.write_mask,
+                user_write_mask: raw.user_write_mask,
+                access_restrictions: raw.access_restrictions,
+                release_status: raw.release_status.take(),
+                data_type: None,
+                value_rank: raw.value_rank,
+                array_dimensions: Vec::new(),
+                access_level: raw.access_level,
+                user_access_level: raw.user_access_level,
+                access_level_ex: raw.access_level_ex,
+                minimum_sampling_interval: raw.minimum_sampling_interval,
+                historizing: raw.historizing,
+                executable: raw.executable,
+                user_executable: raw.user_executable,
+                event_notifier: raw.event_notifier,
+                contains_no_loops: raw.contains_no_loops,
+                is_abstract: raw.is_abstract,
+                symmetric: raw.symmetric,
+                inverse_name: std::mem::take(&mut raw.inverse_names),
+                role_permissions: std::mem::take(&mut raw.role_permissions),
+                category: std::mem::take(&mut raw.category),
+                documentation: raw.documentation.take(),
+                method_declaration: None,
+            };
             model.nodes.push(Node {
                 id,
                 class: raw.class,
@@ -104,11 +134,11 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 symbolic_name: raw.symbolic_name.take(),
                 display_name: std::mem::take(&mut raw.display_names),
                 description: std::mem::take(&mut raw.descriptions),
-                attrs: Attributes::default(),
-                value: None,
-                definition: None,
-                extensions: Vec::new(),
-                references: Vec::new(),
+                attrs,
+                value: raw.value,
+                definition: raw.definition.take(),
+                extensions: std::mem::take(&mut raw.extensions),
+                references: Vec::with_capacity(raw.references.len()),
                 super_type: None,
                 type_definition: None,
                 modelling_rule: None,
@@ -128,71 +158,25 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         }
     }
 
-    // Pass 2: attributes and references.
+    // Pass 2: attributes that name nodes, and references. The raw nodes are only read from here on.
+    let files = files;
     let mut seen_refs: FxHashSet<(NodeIx, NodeIx, NodeIx)> = FxHashSet::with_capacity_and_hasher(total * 3, Default::default());
     let mut incoming: Vec<(NodeIx, Reference)> = Vec::with_capacity(total * 3);
     // Nodes with a reference that could not be resolved (already reported): no follow-on warnings.
     let mut broken: HashSet<NodeIx> = HashSet::new();
-    // Per file: NodeId strings already resolved (reference types and common targets repeat thousands of times).
-    let mut caches: Vec<FxHashMap<String, NodeIx>> = contexts.iter().map(|_| FxHashMap::default()).collect();
+    // Per file: NodeId strings already resolved (reference types and common targets repeat thousands of
+    // times), keyed by the strings as the file writes them.
+    let mut caches: Vec<FxHashMap<&str, NodeIx>> = contexts.iter().map(|_| FxHashMap::default()).collect();
     for &(ix, fi, ni) in &pending {
-        let raw = &mut files[fi as usize].raw.nodes[ni as usize];
+        let raw = &files[fi as usize].raw.nodes[ni as usize];
+        let text = sources.get(files[fi as usize].raw.file).text.as_str();
         let ctx = &contexts[fi as usize];
         let cache = &mut caches[fi as usize];
-        let resolve_ref = |cache: &mut FxHashMap<String, NodeIx>,
-                           model: &Model,
-                           s: &crate::source::Spanned<String>,
-                           diags: &mut Diagnostics|
-         -> Option<NodeIx> {
-            if let Some(&t) = cache.get(s.value.as_str()) {
-                return Some(t);
-            }
-            match resolve_in(ctx, model, s, diags) {
-                Ok(id) => match model.lookup(&id) {
-                    Some(t) => {
-                        cache.insert(s.value.clone(), t);
-                        Some(t)
-                    }
-                    None => {
-                        diags.push(dangling(model, ix, &id, s.span));
-                        None
-                    }
-                },
-                Err(d) => {
-                    diags.push(d);
-                    None
-                }
-            }
-        };
-        let mut attrs = Attributes {
-            write_mask: raw.write_mask,
-            user_write_mask: raw.user_write_mask,
-            access_restrictions: raw.access_restrictions,
-            release_status: raw.release_status.take(),
-            data_type: None,
-            value_rank: raw.value_rank,
-            array_dimensions: Vec::new(),
-            access_level: raw.access_level,
-            user_access_level: raw.user_access_level,
-            access_level_ex: raw.access_level_ex,
-            minimum_sampling_interval: raw.minimum_sampling_interval,
-            historizing: raw.historizing,
-            executable: raw.executable,
-            user_executable: raw.user_executable,
-            event_notifier: raw.event_notifier,
-            contains_no_loops: raw.contains_no_loops,
-            is_abstract: raw.is_abstract,
-            symmetric: raw.symmetric,
-            inverse_name: std::mem::take(&mut raw.inverse_names),
-            role_permissions: std::mem::take(&mut raw.role_permissions),
-            category: std::mem::take(&mut raw.category),
-            documentation: raw.documentation.take(),
-            method_declaration: None,
-        };
+        let mut array_dimensions = Vec::new();
         if let Some(ad) = &raw.array_dimensions {
             for part in ad.value.split(',').map(str::trim).filter(|p| !p.is_empty()) {
                 match part.parse::<u32>() {
-                    Ok(v) => attrs.array_dimensions.push(v),
+                    Ok(v) => array_dimensions.push(v),
                     Err(_) => diags.push(
                         Diagnostic::new(Code::BadAttribute, format!("ArrayDimensions=\"{}\" is not a list of numbers", ad.value))
                             .at(ad.span)
@@ -202,33 +186,40 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 }
             }
         }
+        let mut data_type = None;
         if let Some(dt) = &raw.data_type {
-            if let Some(t) = resolve_ref(cache, &model, dt, diags) {
+            let dt_text = dt.get(text);
+            if let Some(t) = resolve_cached(cache, ctx, &model, ix, dt_text, dt.span, diags) {
                 if model.nodes[t.index()].class != NodeClass::DataType {
                     let class = model.nodes[t.index()].class.name();
                     diags.push(
                         Diagnostic::new(
                             Code::BadDataType,
-                            format!("DataType `{}` is {} {class}, not a DataType", dt.value, article(class)),
+                            format!("DataType `{dt_text}` is {} {class}, not a DataType", article(class)),
                         )
                         .at(dt.span)
                         .help("name a DataType node (an alias such as Int32, or its NodeId)"),
                     );
                 } else {
-                    attrs.data_type = Some(t);
+                    data_type = Some(t);
                 }
             }
         }
-        if let Some(m) = &raw.method_declaration_id {
-            attrs.method_declaration = resolve_ref(cache, &model, m, diags);
+        let method_declaration = raw.method_declaration_id.as_ref().and_then(|m| resolve_cached(cache, ctx, &model, ix, m.get(text), m.span, diags));
+        {
+            let attrs = &mut model.nodes[ix.index()].attrs;
+            attrs.array_dimensions = array_dimensions;
+            attrs.data_type = data_type;
+            attrs.method_declaration = method_declaration;
         }
         for r in &raw.references {
-            let cached = cache.get(r.reference_type.value.as_str()).copied();
-            let rt = match cached.map(|t| Ok(model.nodes[t.index()].id.clone())).unwrap_or_else(|| resolve_in(ctx, &model, &r.reference_type, diags)) {
+            let rt_text = r.reference_type.get(text);
+            let cached = cache.get(rt_text).copied();
+            let rt = match cached.map(|t| Ok(model.nodes[t.index()].id.clone())).unwrap_or_else(|| resolve_in(ctx, &model, rt_text, r.reference_type.span, diags)) {
                 Ok(id) => match cached.or_else(|| model.lookup(&id)) {
                     Some(t) if model.nodes[t.index()].class == NodeClass::ReferenceType => {
                         if cached.is_none() {
-                            cache.insert(r.reference_type.value.clone(), t);
+                            cache.insert(rt_text, t);
                         }
                         t
                     }
@@ -237,7 +228,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                         diags.push(
                             Diagnostic::new(
                                 Code::BadReferenceType,
-                                format!("ReferenceType `{}` is {} {class}, not a ReferenceType", r.reference_type.value, article(class)),
+                                format!("ReferenceType `{rt_text}` is {} {class}, not a ReferenceType", article(class)),
                             )
                             .at(r.reference_type.span)
                             .help("use a ReferenceType such as HasComponent (i=47)"),
@@ -248,7 +239,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                         diags.push(
                             Diagnostic::new(
                                 Code::BadReferenceType,
-                                format!("ReferenceType `{}` names no loaded node", r.reference_type.value),
+                                format!("ReferenceType `{rt_text}` names no loaded node"),
                             )
                             .at(r.reference_type.span)
                             .help("load the model that defines the reference type"),
@@ -262,7 +253,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                     continue;
                 }
             };
-            let Some(target) = resolve_ref(cache, &model, &r.target, diags) else {
+            let Some(target) = resolve_cached(cache, ctx, &model, ix, r.target.get(text), r.target.span, diags) else {
                 broken.insert(ix);
                 continue;
             };
@@ -280,18 +271,17 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
             incoming.push((target, Reference { reference_type: rt, target: ix, forward: !r.is_forward, declared: false, span: r.span }));
         }
         if let Some(p) = &raw.parent_node_id {
-            if let Ok(id) = resolve_in(ctx, &model, p, diags) {
+            if let Ok(id) = resolve_in(ctx, &model, p.get(text), p.span, diags) {
                 model.nodes[ix.index()].parent = model.lookup(&id);
             }
         }
-        let node = &mut model.nodes[ix.index()];
-        node.attrs = attrs;
-        node.value = raw.value;
-        node.definition = raw.definition.take();
-        node.extensions = std::mem::take(&mut raw.extensions);
     }
+    drop(caches);
     model.files = files.iter().map(|f| f.raw.file).zip(contexts).collect();
+    model.sources = sources;
+    model.value_arenas = value_arenas;
     drop(pending);
+    drop(files);
     for (target, r) in incoming {
         model.nodes[target.index()].references.push(r);
     }
@@ -318,23 +308,56 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
 pub(crate) fn resolve_in(
     ctx: &FileContext,
     model: &Model,
-    s: &crate::source::Spanned<String>,
+    s: &str,
+    span: Span,
     diags: &mut Diagnostics,
 ) -> Result<NodeId, Diagnostic> {
-    match crate::load::resolve_node_id_in(&ctx.ns_map, &ctx.aliases, s, &model.namespaces) {
-        Err(d) if d.code == Code::UnknownAlias => match model.ns0_type_names.get(s.value.trim()) {
+    match crate::load::resolve_node_id_str(&ctx.ns_map, &ctx.aliases, s, span, &model.namespaces) {
+        Err(d) if d.code == Code::UnknownAlias => match model.ns0_type_names.get(s.trim()) {
             Some(&ix) => {
                 let id = model.node(ix).id.clone();
                 diags.push(
-                    Diagnostic::new(Code::AliasByBrowseName, format!("alias `{}` is not declared; using the base type `{}` ({id})", s.value.trim(), s.value.trim()))
-                        .at(s.span)
-                        .help(format!("declare it: <Alias Alias=\"{}\">{id}</Alias>", s.value.trim())),
+                    Diagnostic::new(Code::AliasByBrowseName, format!("alias `{}` is not declared; using the base type `{}` ({id})", s.trim(), s.trim()))
+                        .at(span)
+                        .help(format!("declare it: <Alias Alias=\"{}\">{id}</Alias>", s.trim())),
                 );
                 Ok(id)
             }
             None => Err(d),
         },
         other => other,
+    }
+}
+
+/// Resolves a NodeId or alias written in a file to a node, through the file's cache of strings already
+/// resolved. Problems are reported (a dangling one as coming from node `from`) and give `None`.
+fn resolve_cached<'s>(
+    cache: &mut FxHashMap<&'s str, NodeIx>,
+    ctx: &FileContext,
+    model: &Model,
+    from: NodeIx,
+    s: &'s str,
+    span: Span,
+    diags: &mut Diagnostics,
+) -> Option<NodeIx> {
+    if let Some(&t) = cache.get(s) {
+        return Some(t);
+    }
+    match resolve_in(ctx, model, s, span, diags) {
+        Ok(id) => match model.lookup(&id) {
+            Some(t) => {
+                cache.insert(s, t);
+                Some(t)
+            }
+            None => {
+                diags.push(dangling(model, from, &id, span));
+                None
+            }
+        },
+        Err(d) => {
+            diags.push(d);
+            None
+        }
     }
 }
 
