@@ -109,6 +109,21 @@ pub fn parse_node_id(text: &str) -> Result<RawNodeId, String> {
     Ok(RawNodeId { ns, id })
 }
 
+/// The common numeric NodeIds, `i=N` and `ns=I;i=N`, as `(I, N)` (`I` is 0 without `ns=`): what
+/// [`parse_node_id`] makes of such a string, without allocating; `None` for any other string, including
+/// every malformed one (which [`parse_node_id`] then explains).
+pub fn parse_numeric_node_id(text: &str) -> Option<(u16, u32)> {
+    let s = text.trim();
+    let (ns, rest) = match s.strip_prefix("ns=") {
+        Some(r) => {
+            let semi = r.find(';')?;
+            (r[..semi].parse().ok()?, &r[semi + 1..])
+        }
+        None => (0, s),
+    };
+    Some((ns, rest.strip_prefix("i=")?.parse().ok()?))
+}
+
 fn parse_identifier(s: &str) -> Result<Identifier, String> {
     if let Some(n) = s.strip_prefix("i=") {
         return n
@@ -265,6 +280,22 @@ impl fmt::Display for QualifiedName {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numeric_fast_path_agrees_with_the_general_parser() {
+        let cases = [
+            "i=85", " ns=1;i=5001 ", "ns=65535;i=4294967295", "i=+7", "ns=01;i=007", "ns=1; i=5", "ns=70000;i=1", "i=4294967296",
+            "i=", "ns=1;", "ns=;i=1", "nsu=http://x/;i=1", "s=i=1", "g=09087e75-8e5e-499b-954f-f2a9603db28a", "b=AQID", "", "i=1x",
+            "I=1", "ns=1;s=Name",
+        ];
+        for c in cases {
+            let general = parse_node_id(c).ok().and_then(|r| match (r.ns, r.id) {
+                (NsRef::Index(ns), Identifier::Numeric(n)) => Some((ns, n)),
+                _ => None,
+            });
+            assert_eq!(parse_numeric_node_id(c), general, "{c:?}");
+        }
+    }
 
     #[test]
     fn parses_every_node_id_form() {

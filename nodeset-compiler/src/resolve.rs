@@ -47,6 +47,10 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         .iter_mut()
         .map(|f| FileContext { ns_map: std::mem::take(&mut f.ns_map), aliases: std::mem::take(&mut f.aliases) })
         .collect();
+    // Files whose alias names look like NodeIds (an alias `i=5` would shadow the NodeId) take the general
+    // path for every NodeId string; the others resolve numeric NodeIds on the fast path.
+    let numeric_fast: Vec<bool> =
+        contexts.iter().map(|c| !c.aliases.keys().any(|a| crate::nodeid::looks_like_node_id(a))).collect();
     let mut pending: Vec<(NodeIx, u32, u32)> = Vec::with_capacity(total);
     for (fi, f) in files.iter_mut().enumerate() {
         let file = f.raw.file;
@@ -55,7 +59,13 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         value_arenas[file.0 as usize] = std::mem::take(&mut f.raw.values);
         for (ni, raw) in f.raw.nodes.iter_mut().enumerate() {
             let node_id = raw.node_id.get(text);
-            let id = match crate::load::resolve_node_id_str(&ctx.ns_map, &ctx.aliases, node_id, raw.node_id.span, &model.namespaces) {
+            let fast = numeric_fast[fi]
+                .then(|| crate::nodeid::parse_numeric_node_id(node_id))
+                .flatten()
+                .and_then(|(ns, n)| Some(NodeId::numeric(*ctx.ns_map.get(ns as usize)?, n)));
+            let id = match fast.map(Ok).unwrap_or_else(|| {
+                crate::load::resolve_node_id_str(&ctx.ns_map, &ctx.aliases, node_id, raw.node_id.span, &model.namespaces)
+            }) {
                 Ok(id) => id,
                 Err(d) => {
                     diags.push(d);
@@ -171,6 +181,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         let raw = &files[fi as usize].raw.nodes[ni as usize];
         let text = sources.get(files[fi as usize].raw.file).text.as_str();
         let ctx = &contexts[fi as usize];
+        let fast = numeric_fast[fi as usize];
         let cache = &mut caches[fi as usize];
         let mut array_dimensions = Vec::new();
         if let Some(ad) = &raw.array_dimensions {
@@ -189,7 +200,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         let mut data_type = None;
         if let Some(dt) = &raw.data_type {
             let dt_text = dt.get(text);
-            if let Some(t) = resolve_cached(cache, ctx, &model, ix, dt_text, dt.span, diags) {
+            if let Some(t) = resolve_cached(cache, ctx, fast, &model, ix, dt_text, dt.span, diags) {
                 if model.nodes[t.index()].class != NodeClass::DataType {
                     let class = model.nodes[t.index()].class.name();
                     diags.push(
@@ -205,7 +216,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 }
             }
         }
-        let method_declaration = raw.method_declaration_id.as_ref().and_then(|m| resolve_cached(cache, ctx, &model, ix, m.get(text), m.span, diags));
+        let method_declaration = raw.method_declaration_id.as_ref().and_then(|m| resolve_cached(cache, ctx, fast, &model, ix, m.get(text), m.span, diags));
         {
             let attrs = &mut model.nodes[ix.index()].attrs;
             attrs.array_dimensions = array_dimensions;
@@ -215,45 +226,45 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         for r in &raw.references {
             let rt_text = r.reference_type.get(text);
             let cached = cache.get(rt_text).copied();
-            let rt = match cached.map(|t| Ok(model.nodes[t.index()].id.clone())).unwrap_or_else(|| resolve_in(ctx, &model, rt_text, r.reference_type.span, diags)) {
-                Ok(id) => match cached.or_else(|| model.lookup(&id)) {
-                    Some(t) if model.nodes[t.index()].class == NodeClass::ReferenceType => {
-                        if cached.is_none() {
-                            cache.insert(rt_text, t);
-                        }
-                        t
+            let known = cached.or_else(|| fast.then(|| numeric_node(&model, ctx, rt_text)).flatten());
+            let found = match known {
+                Some(t) => Ok(Some(t)),
+                None => resolve_in(ctx, &model, rt_text, r.reference_type.span, diags).map(|id| model.lookup(&id)),
+            };
+            let rt = match found {
+                Ok(Some(t)) if model.nodes[t.index()].class == NodeClass::ReferenceType => {
+                    if cached.is_none() {
+                        cache.insert(rt_text, t);
                     }
-                    Some(t) => {
-                        let class = model.nodes[t.index()].class.name();
-                        diags.push(
-                            Diagnostic::new(
-                                Code::BadReferenceType,
-                                format!("ReferenceType `{rt_text}` is {} {class}, not a ReferenceType", article(class)),
-                            )
-                            .at(r.reference_type.span)
-                            .help("use a ReferenceType such as HasComponent (i=47)"),
-                        );
-                        continue;
-                    }
-                    None => {
-                        diags.push(
-                            Diagnostic::new(
-                                Code::BadReferenceType,
-                                format!("ReferenceType `{rt_text}` names no loaded node"),
-                            )
+                    t
+                }
+                Ok(Some(t)) => {
+                    let class = model.nodes[t.index()].class.name();
+                    diags.push(
+                        Diagnostic::new(
+                            Code::BadReferenceType,
+                            format!("ReferenceType `{rt_text}` is {} {class}, not a ReferenceType", article(class)),
+                        )
+                        .at(r.reference_type.span)
+                        .help("use a ReferenceType such as HasComponent (i=47)"),
+                    );
+                    continue;
+                }
+                Ok(None) => {
+                    diags.push(
+                        Diagnostic::new(Code::BadReferenceType, format!("ReferenceType `{rt_text}` names no loaded node"))
                             .at(r.reference_type.span)
                             .help("load the model that defines the reference type"),
-                        );
-                        continue;
-                    }
-                },
+                    );
+                    continue;
+                }
                 Err(d) => {
                     diags.push(d);
                     broken.insert(ix);
                     continue;
                 }
             };
-            let Some(target) = resolve_cached(cache, ctx, &model, ix, r.target.get(text), r.target.span, diags) else {
+            let Some(target) = resolve_cached(cache, ctx, fast, &model, ix, r.target.get(text), r.target.span, diags) else {
                 broken.insert(ix);
                 continue;
             };
@@ -282,11 +293,19 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
     model.value_arenas = value_arenas;
     drop(pending);
     drop(files);
+    // Each node's inverse references go after its own, in the order they were found; room for them is
+    // made once per node.
+    let mut extra = vec![0u32; model.nodes.len()];
+    for (target, _) in &incoming {
+        extra[target.index()] += 1;
+    }
+    for (node, n) in model.nodes.iter_mut().zip(extra) {
+        node.references.reserve_exact(n as usize);
+    }
     for (target, r) in incoming {
         model.nodes[target.index()].references.push(r);
     }
 
-    // Pass 3: hierarchy flags, supertypes, type definitions, modelling rules, parents.
     link_types(&mut model, &broken, diags);
 
     // Pass 4: instance declarations.
@@ -329,17 +348,31 @@ pub(crate) fn resolve_in(
     }
 }
 
-/// Resolves a NodeId or alias written in a file to a node, through the file's cache of strings already
-/// resolved. Problems are reported (a dangling one as coming from node `from`) and give `None`.
+/// The node a numeric NodeId string (`i=N`, `ns=I;i=N`) of a file names, found without the alias table,
+/// the cache or an allocation. `None` for any other string and for a NodeId that names no node: the general
+/// path then resolves it and reports what is wrong. Only for files where no alias looks like a NodeId.
+fn numeric_node(model: &Model, ctx: &FileContext, s: &str) -> Option<NodeIx> {
+    let (ns, n) = crate::nodeid::parse_numeric_node_id(s)?;
+    model.lookup(&NodeId::numeric(*ctx.ns_map.get(ns as usize)?, n))
+}
+
+/// Resolves a NodeId or alias written in a file to a node: numeric NodeIds on the fast path where `fast`
+/// allows it, other strings through the file's cache of strings already resolved. Problems are reported
+/// (a dangling one as coming from node `from`) and give `None`.
+#[allow(clippy::too_many_arguments)]
 fn resolve_cached<'s>(
     cache: &mut FxHashMap<&'s str, NodeIx>,
     ctx: &FileContext,
+    fast: bool,
     model: &Model,
     from: NodeIx,
     s: &'s str,
     span: Span,
     diags: &mut Diagnostics,
 ) -> Option<NodeIx> {
+    if let Some(t) = fast.then(|| numeric_node(model, ctx, s)).flatten() {
+        return Some(t);
+    }
     if let Some(&t) = cache.get(s) {
         return Some(t);
     }
