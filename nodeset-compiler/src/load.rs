@@ -176,25 +176,41 @@ pub enum Input {
 /// Loads the named inputs and the models they require.
 pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> Loaded {
     let mut sources = SourceMap::new();
-    let mut parsed: Vec<RawNodeSet> = Vec::new();
+    // The named files are read one after the other, then parsed all at once (on all cores); what is said
+    // about each goes into the diagnostics in the order the files were named.
+    let mut said: Vec<Diagnostics> = Vec::new();
+    let mut texts: Vec<(usize, FileId)> = Vec::new();
     for input in inputs {
+        let mut d = Diagnostics::new();
         let (path, display, bytes) = match input {
             Input::Path(p) => match std::fs::read(&p) {
                 Ok(b) => (p.clone(), p.display().to_string(), b),
                 Err(e) => {
-                    diags.push(
+                    d.push(
                         Diagnostic::new(Code::Io, format!("cannot read {}: {}", p.display(), io_reason(&e)))
                             .help("check the path; folders of required models go after --models"),
                     );
+                    said.push(d);
                     continue;
                 }
             },
             Input::Text { name, text } => (PathBuf::from(&name), name, text.into_bytes()),
         };
-        if let Some(set) = read_and_parse(&mut sources, path, display, bytes, true, &opts.limits, diags) {
-            parsed.push(set);
+        if let Some(id) = add_source(&mut sources, path, display, bytes, true, &mut d) {
+            texts.push((said.len(), id));
         }
+        said.push(d);
     }
+    let jobs: Vec<(FileId, &str)> = texts.iter().map(|&(_, id)| (id, sources.get(id).text.as_str())).collect();
+    let mut parsed_at: Vec<Option<RawNodeSet>> = (0..said.len()).map(|_| None).collect();
+    for (&(i, _), (set, d)) in texts.iter().zip(parse::parse_files(&jobs, &opts.limits)) {
+        said[i].extend(d);
+        parsed_at[i] = set;
+    }
+    for d in said {
+        diags.extend(d);
+    }
+    let mut parsed: Vec<RawNodeSet> = parsed_at.into_iter().flatten().collect();
 
     // Models provided by the named files.
     let mut provided: BTreeMap<String, FileId> = BTreeMap::new();
@@ -430,12 +446,17 @@ fn read_and_parse(
     limits: &Limits,
     diags: &mut Diagnostics,
 ) -> Option<RawNodeSet> {
+    let id = add_source(sources, path, display, bytes, named, diags)?;
+    let (set, d) = parse::parse_files(&[(id, sources.get(id).text.as_str())], limits).pop().expect("one file, one result");
+    diags.extend(d);
+    set
+}
+
+/// Adds a file to the sources: its text if it is UTF-8 (and returns its id), or else a lossy copy for
+/// showing its lines, with the diagnostic.
+fn add_source(sources: &mut SourceMap, path: PathBuf, display: String, bytes: Vec<u8>, named: bool, diags: &mut Diagnostics) -> Option<FileId> {
     match parse::decode_text_keeping(bytes) {
-        Ok(text) => {
-            let id = sources.add(SourceFile::new(path, display, text, named));
-            let text = &sources.get(id).text;
-            parse::parse(id, text, limits, diags)
-        }
+        Ok(text) => Some(sources.add(SourceFile::new(path, display, text, named))),
         Err((d, at, bytes)) => {
             let id = sources.add(SourceFile::new(path, display, displayable(&bytes), named));
             diags.push(d.at(Span::new(id, at, at + 1)));

@@ -86,13 +86,15 @@ pub fn decode_text(bytes: Vec<u8>) -> Result<String, (Diagnostic, usize)> {
     decode_text_keeping(bytes).map_err(|(d, at, _)| (d, at))
 }
 
-/// Parses one file. Returns `None` when the file is not usable at all (its errors are in `diags`).
+mod pieces;
+
+pub use pieces::parse_files;
+
+/// Parses one file on the calling thread. Returns `None` when the file is not usable at all (its errors
+/// are in `diags`). [`parse_files`] parses several files, and large files in pieces, on all cores.
 pub fn parse(file: FileId, text: &str, limits: &Limits, diags: &mut Diagnostics) -> Option<RawNodeSet> {
-    let mut p = Parser::new(file, text, limits, diags);
-    match p.document() {
-        Ok(set) => Some(set),
-        Err(Fatal) => None,
-    }
+    let mut p = Parser::new(file, text, 0..text.len(), limits, diags);
+    p.document().ok().map(|part| part.set)
 }
 
 /// Marker for an error that stops the file; its diagnostic has been pushed.
@@ -114,10 +116,46 @@ struct Attr<'a> {
     span: Span,
 }
 
+/// The root element as seen from a piece of a file that starts inside it (see [`pieces`]).
+#[derive(Clone, Copy, Debug)]
+struct OuterRoot<'a> {
+    /// The name as written, with any prefix.
+    qname: &'a str,
+    /// The local name.
+    name: &'a str,
+    /// Where its start tag begins.
+    start: usize,
+}
+
+/// How the reading of a file, or of a piece of it, ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum PartEnd {
+    /// At the end of the document.
+    Document,
+    /// At the end of a piece that stops before the file does, with only the root element open.
+    Boundary,
+}
+
+/// What reading a file, or a piece of it, gave.
+struct Part {
+    set: RawNodeSet,
+    /// Whether `<NamespaceUris>` and `<ServerUris>` were read (a later one replaces an earlier one).
+    namespace_uris_seen: bool,
+    server_uris_seen: bool,
+    end: PartEnd,
+}
+
 struct Parser<'a, 'd> {
     file: FileId,
     text: &'a str,
+    /// Reads `text[base..]` up to the end of the part being read.
     reader: Reader<&'a [u8]>,
+    base: usize,
+    /// For a piece that starts inside the root element: the root, whose start tag quick-xml did not see, so
+    /// the parser checks the end tags that close it (or that there is nothing to close) itself.
+    outer_root: Option<OuterRoot<'a>>,
+    /// Whether the part ends before the file does (a piece that is not the last).
+    ends_early: bool,
     limits: &'a Limits,
     diags: &'d mut Diagnostics,
     /// Open elements: name and start offset, for truncation messages.
@@ -134,8 +172,11 @@ struct Parser<'a, 'd> {
 }
 
 impl<'a, 'd> Parser<'a, 'd> {
-    fn new(file: FileId, text: &'a str, limits: &'a Limits, diags: &'d mut Diagnostics) -> Self {
-        let mut reader = Reader::from_str(text);
+    /// A parser of `text[range]`, with spans in `text`.
+    fn new(file: FileId, text: &'a str, range: std::ops::Range<usize>, limits: &'a Limits, diags: &'d mut Diagnostics) -> Self {
+        let ends_early = range.end < text.len();
+        let base = range.start;
+        let mut reader = Reader::from_str(&text[range]);
         let cfg = reader.config_mut();
         cfg.expand_empty_elements = true;
         cfg.check_end_names = true;
@@ -145,6 +186,9 @@ impl<'a, 'd> Parser<'a, 'd> {
             file,
             text,
             reader,
+            base,
+            outer_root: None,
+            ends_early,
             limits,
             diags,
             open: Vec::new(),
@@ -157,7 +201,7 @@ impl<'a, 'd> Parser<'a, 'd> {
 
     /// The reader's position in the input.
     fn pos(&self) -> usize {
-        self.reader.buffer_position() as usize
+        self.base + self.reader.buffer_position() as usize
     }
 
     fn span(&self, start: usize, end: usize) -> Span {
@@ -179,21 +223,27 @@ impl<'a, 'd> Parser<'a, 'd> {
         Fatal
     }
 
+    /// Reports a quick-xml error at byte `at`, inside the innermost open element.
+    fn xml_error(&mut self, e: &quick_xml::Error, at: usize) -> Fatal {
+        let at = at.min(self.text.len());
+        let open = self.open.last().map(|(n, _)| *n);
+        let d = xml_error_diag(e, self.span(at, at + 1), open);
+        self.fatal(d)
+    }
+
     /// The next event that matters: element starts and ends, text. Comments, PIs and the declaration are
     /// skipped (the declaration after its encoding is checked).
     fn next(&mut self) -> PResult<Ev<'a>> {
         loop {
-            let before = self.reader.buffer_position() as usize;
+            let before = self.pos();
             let ev = match self.reader.read_event() {
                 Ok(ev) => ev,
                 Err(e) => {
-                    let at = (self.reader.error_position() as usize).min(self.text.len());
-                    let open = self.open.last().map(|(n, _)| *n);
-                    let d = xml_error_diag(&e, self.span(at, at + 1), open);
-                    return Err(self.fatal(d));
+                    let at = self.base + self.reader.error_position() as usize;
+                    return Err(self.xml_error(&e, at));
                 }
             };
-            let after = self.reader.buffer_position() as usize;
+            let after = self.pos();
             match ev {
                 Event::Start(e) => {
                     let name = self.str_at(local(e.name().into_inner()));
@@ -210,7 +260,20 @@ impl<'a, 'd> Parser<'a, 'd> {
                     }
                     return Ok(Ev::Start(e, self.span(before, after)));
                 }
-                Event::End(_) => {
+                Event::End(e) => {
+                    if let Some(root) = self.outer_root.filter(|_| self.open.len() <= 1) {
+                        // quick-xml saw no start tag for this end tag; check it as quick-xml would have.
+                        use quick_xml::errors::{Error, IllFormedError};
+                        let found = std::str::from_utf8(e.name().into_inner()).map(str::to_string).unwrap_or_default();
+                        let wrong = match self.open.last() {
+                            Some(_) if found == root.qname => None,
+                            Some(_) => Some(IllFormedError::MismatchedEndTag { expected: root.qname.to_string(), found }),
+                            None => Some(IllFormedError::UnmatchedEndTag(found)),
+                        };
+                        if let Some(wrong) = wrong {
+                            return Err(self.xml_error(&Error::IllFormed(wrong), before));
+                        }
+                    }
                     self.open.pop();
                     return Ok(Ev::End);
                 }
@@ -262,6 +325,10 @@ impl<'a, 'd> Parser<'a, 'd> {
                     return Err(self.fatal(d));
                 }
                 Event::Eof => {
+                    if self.ends_early && self.open.len() == 1 {
+                        // A piece that ends before the file does, between two top-level elements.
+                        return Ok(Ev::Eof);
+                    }
                     if let Some(&(name, start)) = self.open.last() {
                         let d = Diagnostic::new(
                             Code::Truncated,
@@ -430,7 +497,8 @@ impl<'a, 'd> Parser<'a, 'd> {
         Ok(LocalizedText { locale, text: text.trim().to_string() })
     }
 
-    fn document(&mut self) -> PResult<RawNodeSet> {
+    /// Reads a file from its start: the root element, and its content up to the end of the part.
+    fn document(&mut self) -> PResult<Part> {
         // Find the root element.
         let (root, root_span) = loop {
             match self.next()? {
@@ -462,25 +530,56 @@ impl<'a, 'd> Parser<'a, 'd> {
             return Err(self.fatal(d));
         }
         let attrs = self.attrs(&root, root_span)?;
-        let mut set = RawNodeSet {
+        let last_modified = attrs.iter().find(|a| a.key == "LastModified").map(|a| a.value.to_string());
+        self.recycle(attrs);
+        let mut part = self.empty_part(root_span);
+        part.set.last_modified = last_modified;
+        self.root_content(&mut part)?;
+        Ok(part)
+    }
+
+    /// Reads a piece of a file that starts inside the root element, between two of its children.
+    fn piece(&mut self, root: OuterRoot<'a>, root_span: Span) -> PResult<Part> {
+        self.outer_root = Some(root);
+        // The end tags of the root and after it are checked in `next`.
+        self.reader.config_mut().allow_unmatched_ends = true;
+        self.open.push((root.name, root.start));
+        let mut part = self.empty_part(root_span);
+        self.root_content(&mut part)?;
+        Ok(part)
+    }
+
+    fn empty_part(&self, root_span: Span) -> Part {
+        let set = RawNodeSet {
             file: self.file,
             root_span,
             namespace_uris: Vec::new(),
             server_uris: Vec::new(),
             models: Vec::new(),
             aliases: Vec::new(),
-            nodes: Vec::with_capacity(self.text.len() / 800),
-            last_modified: attrs.iter().find(|a| a.key == "LastModified").map(|a| a.value.to_string()),
+            nodes: Vec::with_capacity(self.reader.get_ref().len() / 800),
+            last_modified: None,
             values: ValueArena::default(),
         };
-        self.recycle(attrs);
+        Part { set, namespace_uris_seen: false, server_uris_seen: false, end: PartEnd::Document }
+    }
+
+    /// Reads the children of the root element, and what follows the root, up to the end of the part.
+    fn root_content(&mut self, part: &mut Part) -> PResult<()> {
+        let set = &mut part.set;
         loop {
             match self.next()? {
                 Ev::Start(e, span) => {
                     let name = self.str_at(local(e.name().into_inner()));
                     match name {
-                        "NamespaceUris" => set.namespace_uris = self.uri_list("NamespaceUris")?,
-                        "ServerUris" => set.server_uris = self.uri_list("ServerUris")?,
+                        "NamespaceUris" => {
+                            set.namespace_uris = self.uri_list("NamespaceUris")?;
+                            part.namespace_uris_seen = true;
+                        }
+                        "ServerUris" => {
+                            set.server_uris = self.uri_list("ServerUris")?;
+                            part.server_uris_seen = true;
+                        }
                         "Models" => self.models(&mut set.models)?,
                         "Aliases" => self.aliases(&mut set.aliases)?,
                         "Extensions" => self.skip()?,
@@ -495,7 +594,12 @@ impl<'a, 'd> Parser<'a, 'd> {
                 }
                 Ev::Text(..) => {}
                 Ev::End => break,
-                Ev::Eof => unreachable!(),
+                Ev::Eof => {
+                    // Only a piece that ends before the file does stops here (see `next`).
+                    set.values = std::mem::take(&mut self.values);
+                    part.end = PartEnd::Boundary;
+                    return Ok(());
+                }
             }
         }
         // Anything after the root other than comments and white space is malformed.
@@ -520,7 +624,8 @@ impl<'a, 'd> Parser<'a, 'd> {
             }
         }
         set.values = std::mem::take(&mut self.values);
-        Ok(set)
+        part.end = PartEnd::Document;
+        Ok(())
     }
 
     fn uri_list(&mut self, within: &str) -> PResult<Vec<Spanned<String>>> {

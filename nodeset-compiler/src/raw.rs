@@ -475,6 +475,25 @@ impl ValueArena {
         }
     }
 
+    /// Appends the elements of another arena of the same file (read from a later piece of it) and returns
+    /// the index its first element now has: [`ValueRef`]s into `other` move by that much.
+    pub(crate) fn append(&mut self, other: ValueArena) -> u32 {
+        let (elements, attributes, owned) = (self.elements.len() as u32, self.attributes.len() as u32, self.owned.len() as u32);
+        let text = |t: ArenaText| match t {
+            ArenaText::Owned(i) => ArenaText::Owned(i + owned),
+            slice => slice,
+        };
+        self.elements.extend(other.elements.into_iter().map(|e| ArenaElement {
+            text: text(e.text),
+            attributes: (e.attributes.0 + attributes, e.attributes.1 + attributes),
+            end: e.end + elements,
+            ..e
+        }));
+        self.attributes.extend(other.attributes.into_iter().map(|a| ArenaAttribute { value: text(a.value), ..a }));
+        self.owned.extend(other.owned);
+        elements
+    }
+
     /// The element `ix`, read against the text of the file the arena belongs to.
     pub fn element<'a>(&'a self, value: ValueRef, source: &'a str) -> ValueElement<'a> {
         ValueElement { arena: self, source, ix: value.0 }
