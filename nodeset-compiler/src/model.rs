@@ -9,7 +9,7 @@ use crate::load::{ModelInfo, NS0_URI};
 use crate::nodeid::{NodeId, QualifiedName};
 use crate::raw::{LocalizedText, NodeClass, RawDefinition, RawRolePermission, ValueArena, ValueElement, ValueRef, XmlElement};
 use crate::source::{FileId, SourceMap, Span, Spanned};
-use crate::value::{BuiltinType, Variant};
+use crate::value::{BuiltinType, Content, Variant};
 use std::collections::BTreeMap;
 
 /// "a" or "an" before a node class or type name, for messages.
@@ -459,29 +459,28 @@ impl Model {
 
     /// Decodes a node's value, mapping the NodeIds in it through its file's namespace table.
     pub fn value(&self, ix: NodeIx) -> Option<Result<Variant, String>> {
-        self.decode_value(ix, true)
+        self.decode_value(ix, Content::All)
     }
 
-    /// [`Model::value`]; without `bodies`, ExtensionObjects come without their body (for checks that only
-    /// need the type and shape of a value).
-    pub(crate) fn decode_value(&self, ix: NodeIx, bodies: bool) -> Option<Result<Variant, String>> {
+    /// [`Model::value`], copying as much as `content` says.
+    pub(crate) fn decode_value(&self, ix: NodeIx, content: Content) -> Option<Result<Variant, String>> {
         let el = self.value_element(ix)?;
-        Some(self.decode_node_in_file(self.node(ix).file, el, bodies))
+        Some(self.decode_node_in_file(self.node(ix).file, el, content))
     }
 
     /// Decodes an XML value written in `file`.
     pub fn decode_in_file(&self, file: FileId, xml: &XmlElement) -> Result<Variant, String> {
-        self.decode_node_in_file(file, xml, true)
+        self.decode_node_in_file(file, xml, Content::All)
     }
 
-    fn decode_node_in_file<'a, E: crate::value::XmlNode<'a>>(&self, file: FileId, el: E, bodies: bool) -> Result<Variant, String> {
+    fn decode_node_in_file<'a, E: crate::value::XmlNode<'a>>(&self, file: FileId, el: E, content: Content) -> Result<Variant, String> {
         let ctx = self.files.get(&file);
         let ids = |s: &str| -> Result<NodeId, String> {
             let ctx = ctx.ok_or("unknown file")?;
             self.map_node_id(ctx, s)
         };
         let ns = |i: u16| ctx.and_then(|c| c.ns_map.get(i as usize).copied());
-        crate::value::decode_node(el, &ids, &ns, bodies)
+        crate::value::decode_node(el, &ids, &ns, content)
     }
 
     pub(crate) fn map_node_id(&self, ctx: &FileContext, s: &str) -> Result<NodeId, String> {

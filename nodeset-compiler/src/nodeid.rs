@@ -184,6 +184,17 @@ const B64_INV: [u8; 256] = {
 /// Decodes standard base64, ignoring white space (NodeSet2 files wrap long ByteStrings).
 pub fn base64_decode(s: &str) -> Option<Vec<u8>> {
     let mut out = Vec::with_capacity(s.len() * 3 / 4);
+    base64_each(s, |b| out.push(b)).then_some(out)
+}
+
+/// Whether [`base64_decode`] accepts `s`, without decoding it.
+pub fn base64_valid(s: &str) -> bool {
+    base64_each(s, |_| {})
+}
+
+/// Decodes base64 (white space ignored, padding optional), handing each byte to `out`; false if `s` is not
+/// base64.
+fn base64_each(s: &str, mut out: impl FnMut(u8)) -> bool {
     let mut acc = 0u32;
     let mut bits = 0;
     let mut padding = 0;
@@ -197,23 +208,20 @@ pub fn base64_decode(s: &str) -> Option<Vec<u8>> {
                 padding += 1;
                 continue;
             }
-            return None;
+            return false;
         }
         if padding > 0 {
-            return None;
+            return false;
         }
         acc = (acc << 6) | u32::from(v);
         bits += 6;
         if bits >= 8 {
             bits -= 8;
-            out.push((acc >> bits) as u8);
+            out((acc >> bits) as u8);
             acc &= (1 << bits) - 1;
         }
     }
-    if padding > 2 {
-        return None;
-    }
-    Some(out)
+    padding <= 2
 }
 
 pub fn base64_encode(data: &[u8]) -> String {

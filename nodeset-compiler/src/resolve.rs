@@ -10,9 +10,9 @@ use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::load::Loaded;
 use crate::model::*;
 use crate::nodeid::{parse_qualified_name, NodeId, QualifiedName};
-use crate::raw::{NodeClass, ValueArena};
+use crate::raw::{NodeClass, ValueArena, ValueElement};
 use crate::source::{SourceMap, Span};
-use crate::value::{BuiltinType, Variant};
+use crate::value::{BuiltinType, Content, Variant};
 use std::collections::{BTreeMap, HashMap, HashSet};
 
 /// Builds the model. Problems go to `diags`; the model is returned even when there are errors, with the
@@ -702,8 +702,9 @@ fn methods(model: &mut Model, diags: &mut Diagnostics) {
                 (0, "OutputArguments") => 1,
                 _ => continue,
             };
-            let Some(value) = model.value(child) else { continue };
-            let args = match value.and_then(|v| decode_arguments(model, c.file, v)) {
+            // The value is checked by decoding it without copies; the arguments are then read in place.
+            let (Some(value), Some(el)) = (model.decode_value(child, Content::Shape), model.value_element(child)) else { continue };
+            let args = match value.and_then(|v| decode_arguments(model, c.file, v, el)) {
                 Ok(a) => a,
                 Err(why) => {
                     diags.push(
@@ -725,16 +726,19 @@ fn methods(model: &mut Model, diags: &mut Diagnostics) {
     model.methods = out;
 }
 
-fn decode_arguments(model: &Model, file: crate::source::FileId, v: Variant) -> Result<Vec<Argument>, String> {
-    let items = match v {
-        Variant::Array(_, items) => items,
-        other => vec![other],
+/// The arguments in a decoded InputArguments or OutputArguments value; `el` is the value's element, from
+/// which the Argument structures are read.
+fn decode_arguments(model: &Model, file: crate::source::FileId, v: Variant, el: ValueElement<'_>) -> Result<Vec<Argument>, String> {
+    // An array's items are its element's children, one for one.
+    let items: Vec<(Variant, ValueElement<'_>)> = match v {
+        Variant::Array(_, items) => items.into_iter().zip(el.children()).collect(),
+        other => vec![(other, el)],
     };
     let ctx = &model.files[&file];
     let mut out = Vec::new();
-    for it in items {
-        let Variant::ExtensionObject(eo) = it else { return Err("an element is not an ExtensionObject".into()) };
-        let body = eo.body.ok_or("an Argument has no body")?;
+    for (it, item) in items {
+        let Variant::ExtensionObject(_) = it else { return Err("an element is not an ExtensionObject".into()) };
+        let body = item.child("Body").and_then(|b| b.children().next()).ok_or("an Argument has no body")?;
         let name = body.child_text("Name").unwrap_or("").trim().to_string();
         let data_type = match body.child("DataType").and_then(|d| d.child_text("Identifier")) {
             Some(t) => {
@@ -749,7 +753,7 @@ fn decode_arguments(model: &Model, file: crate::source::FileId, v: Variant) -> R
         };
         let array_dimensions = body
             .child("ArrayDimensions")
-            .map(|a| a.children.iter().filter_map(|c| c.text.trim().parse().ok()).collect())
+            .map(|a| a.children().filter_map(|c| c.text().trim().parse().ok()).collect())
             .unwrap_or_default();
         let description = body.child("Description").and_then(|d| d.child_text("Text")).map(|s| s.to_string()).filter(|s| !s.is_empty());
         out.push(Argument { name, data_type, value_rank, array_dimensions, description });
@@ -856,9 +860,9 @@ fn value_fits(model: &Model, dt: NodeIx, have: BuiltinType) -> bool {
 fn check_values(model: &Model, diags: &mut Diagnostics) {
     for (i, node) in model.nodes.iter().enumerate() {
         let ix = NodeIx(i as u32);
-        // The check needs the type and shape of the value only, not copies of ExtensionObject bodies.
+        // The check needs the type and shape of the value only, not copies of what it holds.
         let Some(xml) = model.value_element(ix) else { continue };
-        let v = match model.decode_value(ix, false) {
+        let v = match model.decode_value(ix, Content::Shape) {
             Some(Ok(v)) => v,
             Some(Err(why)) => {
                 diags.push(

@@ -6,7 +6,7 @@
 //! decoded against the DataType's definition by whoever needs them). NodeIds inside values are written with
 //! file-local namespace indices, so decoding takes a function that maps them.
 
-use crate::nodeid::{base64_decode, parse_guid, NodeId, QualifiedName};
+use crate::nodeid::{base64_decode, base64_valid, parse_guid, NodeId, QualifiedName};
 use crate::raw::{LocalizedText, ValueElement, XmlElement};
 
 /// An element as the decoder reads it: an owned [`XmlElement`] or a [`ValueElement`] read in place.
@@ -293,23 +293,33 @@ pub type NodeIdMapper<'a> = dyn Fn(&str) -> Result<NodeId, String> + 'a;
 /// Maps a file-local namespace index (of a QualifiedName) to a global one.
 pub type NsMapper<'a> = dyn Fn(u16) -> Option<u16> + 'a;
 
+/// How much of a value decoding copies out of the file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Content {
+    /// Everything: the value [`decode`] returns.
+    All,
+    /// What a check of the value against its DataType needs. The value decodes, or fails with the same
+    /// error, as with `All`, with the same type and shape, but nothing it holds is copied: strings,
+    /// localized texts and byte strings (checked, not decoded) are empty, ExtensionObjects have no body.
+    Shape,
+}
+
 /// Decodes one value element. Errors name the element and what is wrong with it.
 pub fn decode(el: &XmlElement, ids: &NodeIdMapper, ns: &NsMapper) -> Result<Variant, String> {
-    decode_node(el, ids, ns, true)
+    decode_node(el, ids, ns, Content::All)
 }
 
 /// Decodes one value element read in place from its file's value arena.
 pub fn decode_element(el: ValueElement<'_>, ids: &NodeIdMapper, ns: &NsMapper) -> Result<Variant, String> {
-    decode_node(el, ids, ns, true)
+    decode_node(el, ids, ns, Content::All)
 }
 
-/// Decodes an element. Without `bodies`, ExtensionObjects are decoded without their body (`body: None`):
-/// checks that only look at the type and shape of a value need not copy it.
-pub(crate) fn decode_node<'a, E: XmlNode<'a>>(el: E, ids: &NodeIdMapper, ns: &NsMapper, bodies: bool) -> Result<Variant, String> {
-    decode_depth(el, ids, ns, 0, bodies)
+/// Decodes an element, copying as much as `content` says.
+pub(crate) fn decode_node<'a, E: XmlNode<'a>>(el: E, ids: &NodeIdMapper, ns: &NsMapper, content: Content) -> Result<Variant, String> {
+    decode_depth(el, ids, ns, 0, content)
 }
 
-fn decode_depth<'a, E: XmlNode<'a>>(el: E, ids: &NodeIdMapper, ns: &NsMapper, depth: usize, bodies: bool) -> Result<Variant, String> {
+fn decode_depth<'a, E: XmlNode<'a>>(el: E, ids: &NodeIdMapper, ns: &NsMapper, depth: usize, content: Content) -> Result<Variant, String> {
     if depth > 64 {
         return Err("the value is nested more than 64 levels deep".into());
     }
@@ -321,12 +331,12 @@ fn decode_depth<'a, E: XmlNode<'a>>(el: E, ids: &NodeIdMapper, ns: &NsMapper, de
             if c.name() != item {
                 return Err(format!("<{}> inside <{name}>: expected <{item}>", c.name()));
             }
-            items.push(scalar(b, c, ids, ns, depth, bodies)?);
+            items.push(scalar(b, c, ids, ns, depth, content)?);
         }
         return Ok(Variant::Array(b, items));
     }
     let b = BuiltinType::from_xml_name(name).ok_or_else(|| format!("<{name}> is not a built-in type"))?;
-    scalar(b, el, ids, ns, depth, bodies)
+    scalar(b, el, ids, ns, depth, content)
 }
 
 fn num<'a, T: std::str::FromStr, E: XmlNode<'a>>(el: E) -> Result<T, String> {
@@ -355,7 +365,7 @@ pub fn decode_scalar(
     ns: &NsMapper,
     depth: usize,
 ) -> Result<Variant, String> {
-    scalar(b, el, ids, ns, depth, true)
+    scalar(b, el, ids, ns, depth, Content::All)
 }
 
 fn scalar<'a, E: XmlNode<'a>>(
@@ -364,8 +374,11 @@ fn scalar<'a, E: XmlNode<'a>>(
     ids: &NodeIdMapper,
     ns: &NsMapper,
     depth: usize,
-    bodies: bool,
+    content: Content,
 ) -> Result<Variant, String> {
+    let all = content == Content::All;
+    // The text of `el` if everything is copied, else an empty string.
+    let copy = |s: &str| if all { s.to_string() } else { String::new() };
     Ok(match b {
         BuiltinType::Boolean => match el.text().trim() {
             "true" | "1" => Variant::Boolean(true),
@@ -382,14 +395,15 @@ fn scalar<'a, E: XmlNode<'a>>(
         BuiltinType::UInt64 => Variant::UInt64(num(el)?),
         BuiltinType::Float => Variant::Float(float(el)?),
         BuiltinType::Double => Variant::Double(float(el)?),
-        BuiltinType::String => Variant::String(el.text().to_string()),
-        BuiltinType::DateTime => Variant::DateTime(el.text().trim().to_string()),
+        BuiltinType::String => Variant::String(copy(el.text())),
+        BuiltinType::DateTime => Variant::DateTime(copy(el.text().trim())),
         BuiltinType::Guid => {
             let t = el.child_text("String").unwrap_or(el.text());
             Variant::Guid(parse_guid(t).ok_or_else(|| format!("`{}` is not a GUID", t.trim()))?)
         }
         BuiltinType::ByteString => {
-            Variant::ByteString(base64_decode(el.text()).ok_or_else(|| "the ByteString is not base64".to_string())?)
+            let bytes = if all { base64_decode(el.text()) } else { base64_valid(el.text()).then(Vec::new) };
+            Variant::ByteString(bytes.ok_or_else(|| "the ByteString is not base64".to_string())?)
         }
         BuiltinType::XmlElement => Variant::XmlElement(el.to_xml()),
         BuiltinType::NodeId | BuiltinType::ExpandedNodeId => {
@@ -420,8 +434,9 @@ fn scalar<'a, E: XmlNode<'a>>(
                 None => 0,
             };
             let g = ns(idx).ok_or_else(|| format!("namespace index {idx} of a QualifiedName is not declared"))?;
-            Variant::QualifiedName(QualifiedName { ns: g, name: el.child_text("Name").unwrap_or("").trim().to_string() })
+            Variant::QualifiedName(QualifiedName { ns: g, name: copy(el.child_text("Name").unwrap_or("").trim()) })
         }
+        BuiltinType::LocalizedText if !all => Variant::LocalizedText(LocalizedText::default()),
         BuiltinType::LocalizedText => Variant::LocalizedText(LocalizedText {
             locale: el.child_text("Locale").map(|s| s.trim().to_string()).filter(|s| !s.is_empty()),
             text: el.child_text("Text").unwrap_or("").to_string(),
@@ -431,7 +446,7 @@ fn scalar<'a, E: XmlNode<'a>>(
                 Some(t) if !t.trim().is_empty() => Some(ids(t.trim())?),
                 _ => None,
             };
-            let body = if bodies { el.child("Body").and_then(|b| b.children().next()).map(XmlNode::to_xml) } else { None };
+            let body = if all { el.child("Body").and_then(|b| b.children().next()).map(XmlNode::to_xml) } else { None };
             Variant::ExtensionObject(Box::new(ExtensionObject { type_id, body }))
         }
         BuiltinType::Variant => {
@@ -441,7 +456,7 @@ fn scalar<'a, E: XmlNode<'a>>(
             } else {
                 inner
             };
-            Variant::Variant(Box::new(decode_depth(inner, ids, ns, depth + 1, bodies)?))
+            Variant::Variant(Box::new(decode_depth(inner, ids, ns, depth + 1, content)?))
         }
         BuiltinType::DataValue | BuiltinType::DiagnosticInfo => Variant::XmlElement(el.to_xml()),
     })
@@ -467,6 +482,44 @@ mod tests {
         match r.ns {
             crate::nodeid::NsRef::Index(i) => Ok(NodeId { ns: i + 10, id: r.id }),
             crate::nodeid::NsRef::Uri(_) => Err("uri".into()),
+        }
+    }
+
+    #[test]
+    fn shape_decoding_fails_and_succeeds_as_full_decoding_does() {
+        let ns = |i: u16| (i < 3).then_some(i + 10);
+        let leaf = |name: &str, text: &str| el(name, text, vec![]);
+        let cases = vec![
+            leaf("String", " a b "),
+            leaf("DateTime", " 2020-01-01 "),
+            leaf("ByteString", "AQID\n BA=="),
+            leaf("ByteString", "AQ*D"),
+            leaf("ByteString", "AQ==A"),
+            leaf("ByteString", "A==="),
+            leaf("Int32", "x"),
+            el("LocalizedText", "", vec![leaf("Locale", "de"), leaf("Text", "t")]),
+            el("QualifiedName", "", vec![leaf("NamespaceIndex", "2"), leaf("Name", "n")]),
+            el("QualifiedName", "", vec![leaf("NamespaceIndex", "5"), leaf("Name", "n")]),
+            el("QualifiedName", "", vec![leaf("NamespaceIndex", "x")]),
+            el("ListOfString", "", vec![leaf("String", "a"), leaf("String", "b")]),
+            el("ListOfString", "", vec![leaf("String", "a"), leaf("Int32", "1")]),
+            el("ListOfLocalizedText", "", vec![el("LocalizedText", "", vec![leaf("Text", "t")])]),
+            el("ExtensionObject", "", vec![el("TypeId", "", vec![leaf("Identifier", "i=5")]), el("Body", "", vec![leaf("X", "")])]),
+            el("ExtensionObject", "", vec![el("TypeId", "", vec![leaf("Identifier", "q=5")])]),
+            el("Variant", "", vec![el("Value", "", vec![leaf("String", "s")])]),
+            el("Variant", "", vec![]),
+        ];
+        for c in &cases {
+            let all = decode_node(c, &ids, &ns, Content::All);
+            let shape = decode_node(c, &ids, &ns, Content::Shape);
+            match (&all, &shape) {
+                (Ok(a), Ok(s)) => assert_eq!((a.builtin(), a.is_array()), (s.builtin(), s.is_array()), "{c:?}"),
+                (Err(a), Err(s)) => assert_eq!(a, s),
+                _ => panic!("{c:?}: {all:?} but {shape:?}"),
+            }
+        }
+        for s in ["", "AQID", "AQ ID\r\n", "AQ=", "AQ==", "AQ===", "A=Q", "*", "\u{e9}"] {
+            assert_eq!(base64_valid(s), base64_decode(s).is_some(), "{s:?}");
         }
     }
 
