@@ -113,6 +113,12 @@ pub fn parse_node_id(text: &str) -> Result<RawNodeId, String> {
 /// [`parse_node_id`] makes of such a string, without allocating; `None` for any other string, including
 /// every malformed one (which [`parse_node_id`] then explains).
 pub fn parse_numeric_node_id(text: &str) -> Option<(u16, u32)> {
+    // Most strings asked about are not numeric NodeIds (BrowseNames, aliases): turn them away at the first
+    // byte unless it is `i`, `n` or possibly white space.
+    let first = *text.as_bytes().first()?;
+    if !matches!(first, b'i' | b'n') && first < 0x80 && !(first as char).is_whitespace() {
+        return None;
+    }
     let s = text.trim();
     let (ns, rest) = match s.strip_prefix("ns=") {
         Some(r) => {
@@ -294,7 +300,7 @@ mod tests {
         let cases = [
             "i=85", " ns=1;i=5001 ", "ns=65535;i=4294967295", "i=+7", "ns=01;i=007", "ns=1; i=5", "ns=70000;i=1", "i=4294967296",
             "i=", "ns=1;", "ns=;i=1", "nsu=http://x/;i=1", "s=i=1", "g=09087e75-8e5e-499b-954f-f2a9603db28a", "b=AQID", "", "i=1x",
-            "I=1", "ns=1;s=Name",
+            "I=1", "ns=1;s=Name", "1:Name", "Name", "\u{a0}i=5", "\u{b}i=5", "\u{3000}ns=1;i=2", "nsx",
         ];
         for c in cases {
             let general = parse_node_id(c).ok().and_then(|r| match (r.ns, r.id) {

@@ -118,22 +118,36 @@ pub struct RawAlias {
 /// A string read from a file (an attribute value or an element's text), kept as its span in the file's
 /// text. The string is stored only where it differs from what the span covers: after entity or character
 /// references (`&amp;`, `&#160;`) were expanded, line breaks normalised or white space trimmed.
+///
+/// Most such strings are NodeIds, and almost all NodeIds are numeric: their numbers are read with the
+/// string, while the parser has the text at hand, so that the resolver need not read the text again.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct RawStr {
     pub span: Span,
     owned: Option<Box<str>>,
+    numeric: Option<(u16, u32)>,
 }
 
 impl RawStr {
     /// `value` as read at `span` of `source`: borrowed from the source when it is exactly the text there.
     pub fn new(value: &str, span: Span, source: &str) -> RawStr {
-        let same = source.get(span.start as usize..span.end as usize) == Some(value);
-        RawStr { span, owned: if same { None } else { Some(value.into()) } }
+        // A value borrowed from the source is the text at its span; only copies need comparing.
+        let same = source
+            .get(span.start as usize..span.end as usize)
+            .is_some_and(|at| std::ptr::eq(at.as_ptr(), value.as_ptr()) && at.len() == value.len() || at == value);
+        let numeric = crate::nodeid::parse_numeric_node_id(value);
+        RawStr { span, owned: if same { None } else { Some(value.into()) }, numeric }
     }
 
     /// A string that is not the text at its span (such as the empty NodeId of a node that has none).
     pub fn owned(value: &str, span: Span) -> RawStr {
-        RawStr { span, owned: Some(value.into()) }
+        RawStr { span, owned: Some(value.into()), numeric: crate::nodeid::parse_numeric_node_id(value) }
+    }
+
+    /// The string as a numeric NodeId (`i=N` or `ns=I;i=N`): what
+    /// [`parse_numeric_node_id`](crate::nodeid::parse_numeric_node_id) gives for it.
+    pub fn numeric_node_id(&self) -> Option<(u16, u32)> {
+        self.numeric
     }
 
     /// The string, given the text of the file it was read from.

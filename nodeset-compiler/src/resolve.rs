@@ -10,7 +10,7 @@ use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::load::Loaded;
 use crate::model::*;
 use crate::nodeid::{parse_qualified_name, NodeId, QualifiedName};
-use crate::raw::{NodeClass, ValueArena, ValueElement};
+use crate::raw::{NodeClass, RawStr, ValueArena, ValueElement};
 use crate::source::{SourceMap, Span};
 use crate::value::{BuiltinType, Content, Variant};
 use std::collections::{BTreeMap, HashMap, HashSet};
@@ -58,12 +58,12 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         let ctx = &contexts[fi];
         value_arenas[file.0 as usize] = std::mem::take(&mut f.raw.values);
         for (ni, raw) in f.raw.nodes.iter_mut().enumerate() {
-            let node_id = raw.node_id.get(text);
             let fast = numeric_fast[fi]
-                .then(|| crate::nodeid::parse_numeric_node_id(node_id))
+                .then(|| raw.node_id.numeric_node_id())
                 .flatten()
                 .and_then(|(ns, n)| Some(NodeId::numeric(*ctx.ns_map.get(ns as usize)?, n)));
             let id = match fast.map(Ok).unwrap_or_else(|| {
+                let node_id = raw.node_id.get(text);
                 crate::load::resolve_node_id_str(&ctx.ns_map, &ctx.aliases, node_id, raw.node_id.span, &model.namespaces)
             }) {
                 Ok(id) => id,
@@ -199,14 +199,13 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         }
         let mut data_type = None;
         if let Some(dt) = &raw.data_type {
-            let dt_text = dt.get(text);
-            if let Some(t) = resolve_cached(cache, ctx, fast, &model, ix, dt_text, dt.span, diags) {
+            if let Some(t) = resolve_cached(cache, ctx, fast, &model, ix, dt, text, diags) {
                 if model.nodes[t.index()].class != NodeClass::DataType {
                     let class = model.nodes[t.index()].class.name();
                     diags.push(
                         Diagnostic::new(
                             Code::BadDataType,
-                            format!("DataType `{dt_text}` is {} {class}, not a DataType", article(class)),
+                            format!("DataType `{}` is {} {class}, not a DataType", dt.get(text), article(class)),
                         )
                         .at(dt.span)
                         .help("name a DataType node (an alias such as Int32, or its NodeId)"),
@@ -216,7 +215,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 }
             }
         }
-        let method_declaration = raw.method_declaration_id.as_ref().and_then(|m| resolve_cached(cache, ctx, fast, &model, ix, m.get(text), m.span, diags));
+        let method_declaration = raw.method_declaration_id.as_ref().and_then(|m| resolve_cached(cache, ctx, fast, &model, ix, m, text, diags));
         {
             let attrs = &mut model.nodes[ix.index()].attrs;
             attrs.array_dimensions = array_dimensions;
@@ -224,47 +223,54 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
             attrs.method_declaration = method_declaration;
         }
         for r in &raw.references {
-            let rt_text = r.reference_type.get(text);
-            let cached = cache.get(rt_text).copied();
-            let known = cached.or_else(|| fast.then(|| numeric_node(&model, ctx, rt_text)).flatten());
-            let found = match known {
-                Some(t) => Ok(Some(t)),
-                None => resolve_in(ctx, &model, rt_text, r.reference_type.span, diags).map(|id| model.lookup(&id)),
-            };
-            let rt = match found {
-                Ok(Some(t)) if model.nodes[t.index()].class == NodeClass::ReferenceType => {
-                    if cached.is_none() {
-                        cache.insert(rt_text, t);
+            // Numeric NodeIds need neither the text nor the cache; everything else, and every problem, takes
+            // the general path.
+            let numeric = fast.then(|| numeric_node(&model, ctx, &r.reference_type)).flatten();
+            let rt = match numeric {
+                Some(t) if model.nodes[t.index()].class == NodeClass::ReferenceType => t,
+                _ => {
+                    let rt_text = r.reference_type.get(text);
+                    let cached = numeric.or_else(|| cache.get(rt_text).copied());
+                    let found = match cached {
+                        Some(t) => Ok(Some(t)),
+                        None => resolve_in(ctx, &model, rt_text, r.reference_type.span, diags).map(|id| model.lookup(&id)),
+                    };
+                    match found {
+                        Ok(Some(t)) if model.nodes[t.index()].class == NodeClass::ReferenceType => {
+                            if cached.is_none() {
+                                cache.insert(rt_text, t);
+                            }
+                            t
+                        }
+                        Ok(Some(t)) => {
+                            let class = model.nodes[t.index()].class.name();
+                            diags.push(
+                                Diagnostic::new(
+                                    Code::BadReferenceType,
+                                    format!("ReferenceType `{rt_text}` is {} {class}, not a ReferenceType", article(class)),
+                                )
+                                .at(r.reference_type.span)
+                                .help("use a ReferenceType such as HasComponent (i=47)"),
+                            );
+                            continue;
+                        }
+                        Ok(None) => {
+                            diags.push(
+                                Diagnostic::new(Code::BadReferenceType, format!("ReferenceType `{rt_text}` names no loaded node"))
+                                    .at(r.reference_type.span)
+                                    .help("load the model that defines the reference type"),
+                            );
+                            continue;
+                        }
+                        Err(d) => {
+                            diags.push(d);
+                            broken.insert(ix);
+                            continue;
+                        }
                     }
-                    t
-                }
-                Ok(Some(t)) => {
-                    let class = model.nodes[t.index()].class.name();
-                    diags.push(
-                        Diagnostic::new(
-                            Code::BadReferenceType,
-                            format!("ReferenceType `{rt_text}` is {} {class}, not a ReferenceType", article(class)),
-                        )
-                        .at(r.reference_type.span)
-                        .help("use a ReferenceType such as HasComponent (i=47)"),
-                    );
-                    continue;
-                }
-                Ok(None) => {
-                    diags.push(
-                        Diagnostic::new(Code::BadReferenceType, format!("ReferenceType `{rt_text}` names no loaded node"))
-                            .at(r.reference_type.span)
-                            .help("load the model that defines the reference type"),
-                    );
-                    continue;
-                }
-                Err(d) => {
-                    diags.push(d);
-                    broken.insert(ix);
-                    continue;
                 }
             };
-            let Some(target) = resolve_cached(cache, ctx, fast, &model, ix, r.target.get(text), r.target.span, diags) else {
+            let Some(target) = resolve_cached(cache, ctx, fast, &model, ix, &r.target, text, diags) else {
                 broken.insert(ix);
                 continue;
             };
@@ -306,6 +312,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         model.nodes[target.index()].references.push(r);
     }
 
+    // Pass 3: hierarchy flags, supertypes, type definitions, modelling rules, parents.
     link_types(&mut model, &broken, diags);
 
     // Pass 4: instance declarations.
@@ -349,10 +356,11 @@ pub(crate) fn resolve_in(
 }
 
 /// The node a numeric NodeId string (`i=N`, `ns=I;i=N`) of a file names, found without the alias table,
-/// the cache or an allocation. `None` for any other string and for a NodeId that names no node: the general
-/// path then resolves it and reports what is wrong. Only for files where no alias looks like a NodeId.
-fn numeric_node(model: &Model, ctx: &FileContext, s: &str) -> Option<NodeIx> {
-    let (ns, n) = crate::nodeid::parse_numeric_node_id(s)?;
+/// the cache, the text or an allocation. `None` for any other string and for a NodeId that names no node:
+/// the general path then resolves it and reports what is wrong. Only for files where no alias looks like a
+/// NodeId.
+fn numeric_node(model: &Model, ctx: &FileContext, s: &RawStr) -> Option<NodeIx> {
+    let (ns, n) = s.numeric_node_id()?;
     model.lookup(&NodeId::numeric(*ctx.ns_map.get(ns as usize)?, n))
 }
 
@@ -366,13 +374,14 @@ fn resolve_cached<'s>(
     fast: bool,
     model: &Model,
     from: NodeIx,
-    s: &'s str,
-    span: Span,
+    raw: &'s RawStr,
+    text: &'s str,
     diags: &mut Diagnostics,
 ) -> Option<NodeIx> {
-    if let Some(t) = fast.then(|| numeric_node(model, ctx, s)).flatten() {
+    if let Some(t) = fast.then(|| numeric_node(model, ctx, raw)).flatten() {
         return Some(t);
     }
+    let (s, span) = (raw.get(text), raw.span);
     if let Some(&t) = cache.get(s) {
         return Some(t);
     }
