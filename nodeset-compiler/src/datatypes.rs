@@ -8,7 +8,8 @@ use crate::value::{BuiltinType, Variant};
 use crate::source::Span;
 use std::collections::{BTreeMap, HashMap};
 
-pub(crate) fn classify(model: &mut Model, diags: &mut Diagnostics) {
+/// The DataTypes of the model, classified.
+pub(crate) fn classify(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeIx, DataTypeInfo> {
     let types: Vec<NodeIx> =
         (0..model.nodes.len() as u32).map(NodeIx).filter(|&ix| model.node(ix).class == NodeClass::DataType).collect();
     // Supertypes first, so inherited fields are known.
@@ -81,7 +82,7 @@ pub(crate) fn classify(model: &mut Model, diags: &mut Diagnostics) {
         };
         out.insert(t, DataTypeInfo { node: t, kind, encoding, is_abstract, encodings });
     }
-    model.data_types = out;
+    out
 }
 
 fn structure(model: &Model, t: NodeIx, done: &BTreeMap<NodeIx, DataTypeInfo>, diags: &mut Diagnostics) -> DataTypeKind {

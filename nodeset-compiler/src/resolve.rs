@@ -298,7 +298,13 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
     model.sources = sources;
     model.value_arenas = value_arenas;
     drop(pending);
-    drop(files);
+    // The raw files are not needed any more: another thread frees them while this one goes on.
+    crate::join(move || drop(files), || link(&mut model, incoming, &broken, diags));
+    model
+}
+
+/// Passes 3 to 8, on the model with its references resolved.
+fn link(model: &mut Model, incoming: Vec<(NodeIx, Reference)>, broken: &HashSet<NodeIx>, diags: &mut Diagnostics) {
     // Each node's inverse references go after its own, in the order they were found; room for them is
     // made once per node.
     let mut extra = vec![0u32; model.nodes.len()];
@@ -313,19 +319,35 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
     }
 
     // Pass 3: hierarchy flags, supertypes, type definitions, modelling rules, parents.
-    link_types(&mut model, &broken, diags);
+    link_types(model, broken, diags);
 
-    // Pass 4: instance declarations.
-    build_members(&mut model, diags);
-
-    // Pass 5-7: data types, methods, state machines.
-    crate::datatypes::classify(&mut model, diags);
-    methods(&mut model, diags);
-    state_machines(&mut model, diags);
-
-    // Pass 8: values against DataTypes.
-    check_values(&model, diags);
-    model
+    // Passes 4 to 6 and 8 only read the model and do not depend on one another, except the value check on
+    // the data types: instance declarations and method arguments on one thread, data types and values on
+    // this one. Each pass keeps its diagnostics, which are added in pass order.
+    let m = &*model;
+    let ((members, members_said, methods, methods_said), (data_types, data_types_said, values_said)) = crate::join(
+        || {
+            let (mut members_said, mut methods_said) = (Diagnostics::new(), Diagnostics::new());
+            let members = build_members(m, &mut members_said);
+            let methods = methods(m, &mut methods_said);
+            (members, members_said, methods, methods_said)
+        },
+        || {
+            let (mut data_types_said, mut values_said) = (Diagnostics::new(), Diagnostics::new());
+            let data_types = crate::datatypes::classify(m, &mut data_types_said);
+            check_values(m, &data_types, &mut values_said);
+            (data_types, data_types_said, values_said)
+        },
+    );
+    model.members = members;
+    model.data_types = data_types;
+    model.methods = methods;
+    diags.extend(members_said);
+    diags.extend(data_types_said);
+    diags.extend(methods_said);
+    // Pass 7: state machines, from the instance declarations.
+    state_machines(model, diags);
+    diags.extend(values_said);
 }
 
 /// Resolves a NodeId or alias written in a file. An alias the file forgot to declare that is the BrowseName
@@ -617,7 +639,8 @@ fn link_types(model: &mut Model, broken: &HashSet<NodeIx>, diags: &mut Diagnosti
     }
 }
 
-fn build_members(model: &mut Model, diags: &mut Diagnostics) {
+/// Pass 4: the instance declarations of every ObjectType and VariableType.
+fn build_members(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeIx, Vec<Member>> {
     // Types in an order where supertypes come first.
     let types: Vec<NodeIx> = (0..model.nodes.len() as u32)
         .map(NodeIx)
@@ -672,7 +695,7 @@ fn build_members(model: &mut Model, diags: &mut Diagnostics) {
             collision(model, ix, a, b, diags);
         }
     }
-    model.members = members;
+    members
 }
 
 fn collision(model: &Model, parent: NodeIx, a: NodeIx, b: NodeIx, diags: &mut Diagnostics) {
@@ -696,7 +719,8 @@ fn collision(model: &Model, parent: NodeIx, a: NodeIx, b: NodeIx, diags: &mut Di
     );
 }
 
-fn methods(model: &mut Model, diags: &mut Diagnostics) {
+/// Pass 6: the arguments of every method.
+fn methods(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeIx, MethodInfo> {
     let mut out = BTreeMap::new();
     for i in 0..model.nodes.len() {
         let ix = NodeIx(i as u32);
@@ -732,7 +756,7 @@ fn methods(model: &mut Model, diags: &mut Diagnostics) {
         }
         out.insert(ix, info);
     }
-    model.methods = out;
+    out
 }
 
 /// The arguments in a decoded InputArguments or OutputArguments value; `el` is the value's element, from
@@ -847,8 +871,8 @@ fn state_machines(model: &mut Model, diags: &mut Diagnostics) {
 }
 
 /// Whether a value of built-in type `have` may stand for DataType `dt`.
-fn value_fits(model: &Model, dt: NodeIx, have: BuiltinType) -> bool {
-    let Some(info) = model.data_types.get(&dt) else { return true };
+fn value_fits(model: &Model, data_types: &BTreeMap<NodeIx, DataTypeInfo>, dt: NodeIx, have: BuiltinType) -> bool {
+    let Some(info) = data_types.get(&dt) else { return true };
     match &info.kind {
         DataTypeKind::AbstractBuiltin => {
             let n = model.node(dt).id.ns0();
@@ -866,7 +890,8 @@ fn value_fits(model: &Model, dt: NodeIx, have: BuiltinType) -> bool {
     }
 }
 
-fn check_values(model: &Model, diags: &mut Diagnostics) {
+/// Pass 8: every value against its node's DataType (given before they join the model) and ValueRank.
+fn check_values(model: &Model, data_types: &BTreeMap<NodeIx, DataTypeInfo>, diags: &mut Diagnostics) {
     for (i, node) in model.nodes.iter().enumerate() {
         let ix = NodeIx(i as u32);
         // The check needs the type and shape of the value only, not copies of what it holds.
@@ -885,7 +910,7 @@ fn check_values(model: &Model, diags: &mut Diagnostics) {
         };
         let Some(dt) = node.attrs.data_type else { continue };
         let Some(have) = v.builtin() else { continue };
-        if !value_fits(model, dt, have) {
+        if !value_fits(model, data_types, dt, have) {
             diags.push(
                 Diagnostic::new(
                     Code::ValueTypeMismatch,

@@ -16,21 +16,14 @@ use crate::raw::{NodeClass, RawNodeSet, ValueRef};
 use crate::source::{FileId, Span};
 use std::ops::Range;
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::OnceLock;
 
 /// Pieces are at least this long: below it, a thread costs more than it saves.
 const MIN_PIECE: usize = 256 * 1024;
 
-/// The number of threads parsing uses: the cores this process may run on.
-fn threads() -> usize {
-    static THREADS: OnceLock<usize> = OnceLock::new();
-    *THREADS.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
-}
-
 /// Parses files, each with its diagnostics, on all cores; the results are those of [`super::parse`] on
 /// each file, in the order of `files`.
 pub fn parse_files(files: &[(FileId, &str)], limits: &Limits) -> Vec<(Option<RawNodeSet>, Diagnostics)> {
-    let threads = threads();
+    let threads = crate::cores();
     let total: usize = files.iter().map(|(_, t)| t.len()).sum();
     // About two pieces per thread, so that pieces of different sizes even out across the threads.
     let piece_len = (total / (threads * 2)).max(MIN_PIECE);
