@@ -49,7 +49,7 @@ pub fn decode_text_keeping(bytes: Vec<u8>) -> Result<String, (Diagnostic, usize,
             bytes,
         ));
     }
-    if let Some(at) = bytes.contains(&0).then(|| bytes.iter().position(|&b| b == 0)).flatten() {
+    if let Some(at) = memchr::memchr(0, &bytes) {
         return Err((
             Diagnostic::new(Code::Encoding, format!("the file contains a NUL byte at byte {at}; it is not a text file"))
                 .help("NodeSet2 files are UTF-8 text; check that the right file was given"),
@@ -284,7 +284,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                     if raw.iter().all(u8::is_ascii_whitespace) {
                         return Ok(Ev::Text(Cow::Borrowed(""), before));
                     }
-                    if !raw.contains(&b'&') {
+                    if memchr::memchr(b'&', raw).is_none() {
                         let start = self.offset_of(raw);
                         if start + raw.len() <= self.text.len() && self.text.is_char_boundary(start) && self.text.is_char_boundary(start + raw.len()) {
                             return Ok(Ev::Text(Cow::Borrowed(&self.text[start..start + raw.len()]), before));
@@ -366,23 +366,30 @@ impl<'a, 'd> Parser<'a, 'd> {
     /// The attributes of a start tag, in a list lent out by the parser: give it back with
     /// [`Parser::recycle`]. A malformed attribute or value stops the file.
     ///
-    /// quick-xml's own duplicate check keeps a list of the keys it has seen, allocated per element; this
-    /// reads without it and compares the keys itself. Any problem (an error, or two attributes with one
-    /// local name) hands the tag to [`Parser::attrs_checked`], the reading with quick-xml's checks, which
-    /// decides what is reported, so the diagnostics are quick-xml's whatever the path.
+    /// Attributes are read by [`scan_attributes`], which reads the common form (`key="value"`, each after
+    /// white space) in one pass and gives up on anything else, and without quick-xml's duplicate check
+    /// (it keeps a list of keys, allocated per element): the keys are compared here. Any problem (a tag the
+    /// scan gives up on, or two attributes with one local name) hands the tag to
+    /// [`Parser::attrs_checked`], quick-xml's reading with its checks, which decides what is reported: the
+    /// attributes and diagnostics are quick-xml's whatever the path.
     fn attrs(&mut self, e: &BytesStart<'a>, tag: Span) -> PResult<Vec<Attr<'a>>> {
         let mut out = std::mem::take(&mut self.attr_buf);
         out.clear();
-        for a in e.attributes().with_checks(false) {
-            let Ok(a) = a else { return self.attrs_checked(e, tag, out) };
-            let key = self.str_at(local(a.key.into_inner()));
+        let content: &[u8] = e;
+        let mut scan = AttributeScan { content, at: e.name().into_inner().len() };
+        loop {
+            let (key, value) = match scan.next() {
+                Some(Ok(kv)) => kv,
+                Some(Err(GaveUp)) => return self.attrs_checked(e, tag, out),
+                None => return Ok(out),
+            };
+            let key = self.str_at(local(key));
             if out.iter().any(|o| o.key == key) {
                 return self.attrs_checked(e, tag, out);
             }
-            let attr = self.attr(key, &a)?;
+            let attr = self.attr(key, value)?;
             out.push(attr);
         }
-        Ok(out)
     }
 
     /// [`Parser::attrs`] with quick-xml's duplicate check.
@@ -397,21 +404,22 @@ impl<'a, 'd> Parser<'a, 'd> {
                 }
             };
             let key = self.str_at(local(a.key.into_inner()));
-            let attr = self.attr(key, &a)?;
+            let attr = self.attr(key, &a.value)?;
             out.push(attr);
         }
         Ok(out)
     }
 
-    /// One attribute: its value is borrowed from the input unless it holds references to expand.
-    fn attr(&mut self, key: &'a str, a: &quick_xml::events::attributes::Attribute<'_>) -> PResult<Attr<'a>> {
-        let start = self.offset_of(&a.value);
-        let span = self.span(start, start + a.value.len());
-        let raw = self.str_at(&a.value);
+    /// One attribute, given its raw value (a slice of the input): the value is borrowed from the input
+    /// unless it holds references to expand.
+    fn attr(&mut self, key: &'a str, value: &[u8]) -> PResult<Attr<'a>> {
+        let start = self.offset_of(value);
+        let span = self.span(start, start + value.len());
+        let raw = self.str_at(value);
         let value: Cow<'a, str> = if !raw.contains('&') {
             Cow::Borrowed(raw)
         } else {
-            match a.unescape_value() {
+            match quick_xml::escape::unescape(raw) {
                 Ok(v) => Cow::Owned(v.into_owned()),
                 Err(err) => {
                     let d = Diagnostic::new(Code::XmlSyntax, format!("malformed attribute value: {err}"))
@@ -1237,6 +1245,53 @@ fn escape_error_diag(esc: &quick_xml::escape::EscapeError, text_start: usize, sp
     }
 }
 
+/// The scan of a start tag's attributes gave up: the tag is not in the common form.
+struct GaveUp;
+
+/// Reads the attributes of a start tag in the form nearly every tag has: white space, a key, `=`, a value
+/// in quotes. The key and value ranges are those quick-xml's attribute reader gives for such a tag; for
+/// anything else (white space around `=`, a value without quotes or closing quote, a key without value) the
+/// scan gives up and quick-xml reads the tag.
+struct AttributeScan<'t> {
+    /// The tag between `<` and `>` (and any `/` of an empty element), as quick-xml hands it out.
+    content: &'t [u8],
+    /// Where the scan is: after the element name, then after each value's closing quote.
+    at: usize,
+}
+
+impl<'t> Iterator for AttributeScan<'t> {
+    type Item = Result<(&'t [u8], &'t [u8]), GaveUp>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        // quick-xml's white space: space, tab, CR, LF.
+        let ws = |b: u8| matches!(b, b' ' | b'\t' | b'\r' | b'\n');
+        let c = self.content;
+        let mut i = self.at;
+        while i < c.len() && ws(c[i]) {
+            i += 1;
+        }
+        if i == c.len() {
+            self.at = i;
+            return None;
+        }
+        // Keys and values are short: plain loops beat a vectorised search here.
+        let key_start = i;
+        let Some(eq) = c[i..].iter().position(|&b| b == b'=' || ws(b)).map(|n| i + n) else { return Some(Err(GaveUp)) };
+        if c[eq] != b'=' || eq == key_start || eq + 1 >= c.len() {
+            return Some(Err(GaveUp));
+        }
+        let key = &c[key_start..eq];
+        let quote = c[eq + 1];
+        if quote != b'"' && quote != b'\'' {
+            return Some(Err(GaveUp));
+        }
+        let value_start = eq + 2;
+        let Some(len) = c[value_start..].iter().position(|&b| b == quote) else { return Some(Err(GaveUp)) };
+        self.at = value_start + len + 1;
+        Some(Ok((key, &c[value_start..value_start + len])))
+    }
+}
+
 /// The local part of a possibly prefixed XML name.
 fn local(name: &[u8]) -> &[u8] {
     match name.iter().position(|&b| b == b':') {
@@ -1398,6 +1453,25 @@ mod tests {
         let (ok, d) = first(&node("NodeId=i=1 BrowseName=\"A\""));
         assert!(!ok);
         assert!(d.unwrap().1.starts_with("malformed attribute: "));
+    }
+
+    #[test]
+    fn the_attribute_scan_reads_what_quick_xml_reads_or_gives_up() {
+        let tags = [
+            "a", "a b=\"1\"", "a  b='1'\tc=\"x y\"\r\n d=\"\"", "a b=\"1\"c=\"2\"", "a x:b=\"&amp;\" y:b='\"'", "a b = \"1\"",
+            "a b=1", "a b=\"1", "a b", "a =\"1\"", "a b=", "a b=\"1\" c", "a b=\"1\" ", "a b=\"<\"", "a b\"c=\"1\"",
+        ];
+        for tag in tags {
+            let e = BytesStart::from_content(tag, tag.find(' ').or_else(|| tag.find('\t')).unwrap_or(tag.len()));
+            let content: &[u8] = &e;
+            let scan: Result<Vec<_>, GaveUp> = AttributeScan { content, at: e.name().into_inner().len() }.collect();
+            let quick: Result<Vec<(Vec<u8>, Vec<u8>)>, _> =
+                e.attributes().with_checks(false).map(|a| a.map(|a| (a.key.into_inner().to_vec(), a.value.to_vec()))).collect();
+            if let Ok(scan) = scan {
+                let scan: Vec<(Vec<u8>, Vec<u8>)> = scan.into_iter().map(|(k, v)| (k.to_vec(), v.to_vec())).collect();
+                assert_eq!(Ok(scan), quick.map_err(|_| ()), "{tag}");
+            }
+        }
     }
 
     #[test]
