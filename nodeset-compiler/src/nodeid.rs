@@ -193,9 +193,35 @@ pub fn base64_decode(s: &str) -> Option<Vec<u8>> {
     base64_each(s, |b| out.push(b)).then_some(out)
 }
 
-/// Whether [`base64_decode`] accepts `s`, without decoding it.
+/// Whether [`base64_decode`] accepts `s`, without decoding it: letters of the alphabet (none after a `=`),
+/// white space, and at most two `=`.
 pub fn base64_valid(s: &str) -> bool {
-    base64_each(s, |_| {})
+    let b = s.as_bytes();
+    let mut i = 0;
+    let mut padding = 0;
+    while i < b.len() {
+        // Runs of letters, the common case, take one test per byte.
+        if padding == 0 {
+            while i < b.len() && B64_INV[b[i] as usize] != 255 {
+                i += 1;
+            }
+            if i == b.len() {
+                break;
+            }
+        }
+        let c = b[i];
+        if B64_INV[c as usize] != 255 {
+            // A letter after a `=`.
+            return false;
+        }
+        if c == b'=' {
+            padding += 1;
+        } else if !c.is_ascii_whitespace() {
+            return false;
+        }
+        i += 1;
+    }
+    padding <= 2
 }
 
 /// Decodes base64 (white space ignored, padding optional), handing each byte to `out`; false if `s` is not

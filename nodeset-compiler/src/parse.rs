@@ -949,13 +949,14 @@ impl<'a, 'd> Parser<'a, 'd> {
                     self.recycle(attrs);
                     let text_start = self.pos();
                     let target = self.text_content("Reference")?;
-                    let lead = target.len() - target.trim_start().len();
-                    let tspan = self.span(text_start + lead, text_start + lead + target.trim().len());
+                    let trimmed = target.trim();
+                    let lead = trimmed.as_ptr() as usize - target.as_ptr() as usize;
+                    let tspan = self.span(text_start + lead, text_start + lead + trimmed.len());
                     let Some(reference_type) = rt else {
                         self.missing(span, "Reference", "ReferenceType");
                         continue;
                     };
-                    out.push(RawReference { reference_type, target: self.raw_str(target.trim(), tspan), is_forward, span });
+                    out.push(RawReference { reference_type, target: self.raw_str(trimmed, tspan), is_forward, span });
                 }
                 Ev::Text(..) => {}
                 Ev::End => return Ok(()),

@@ -13,7 +13,7 @@ use crate::nodeid::{parse_qualified_name, NodeId, QualifiedName};
 use crate::raw::{NodeClass, RawStr, ValueArena, ValueElement};
 use crate::source::{SourceMap, Span};
 use crate::value::{BuiltinType, Content, Variant};
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::{BTreeMap, HashSet};
 
 /// Builds the model. Problems go to `diags`; the model is returned even when there are errors, with the
 /// offending parts left out, so that later checks can still report what they find.
@@ -288,8 +288,13 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
             incoming.push((target, Reference { reference_type: rt, target: ix, forward: !r.is_forward, declared: false, span: r.span }));
         }
         if let Some(p) = &raw.parent_node_id {
-            if let Ok(id) = resolve_in(ctx, &model, p.get(text), p.span, diags) {
-                model.nodes[ix.index()].parent = model.lookup(&id);
+            match fast.then(|| numeric_node(&model, ctx, p)).flatten() {
+                Some(parent) => model.nodes[ix.index()].parent = Some(parent),
+                None => {
+                    if let Ok(id) = resolve_in(ctx, &model, p.get(text), p.span, diags) {
+                        model.nodes[ix.index()].parent = model.lookup(&id);
+                    }
+                }
             }
         }
     }
@@ -649,38 +654,40 @@ fn build_members(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeIx, Vec
     let mut depth: Vec<(usize, NodeIx)> = types.iter().map(|&t| (model.super_chain(t).len(), t)).collect();
     depth.sort();
     let mut members: BTreeMap<NodeIx, Vec<Member>> = BTreeMap::new();
+    // A type's own children by BrowseName (reused from type to type).
+    let mut own: FxHashMap<&QualifiedName, NodeIx> = FxHashMap::default();
     for (_, t) in depth {
         let mut list: Vec<Member> = model.node(t).super_type.and_then(|s| members.get(&s)).cloned().unwrap_or_default();
-        let mut own: HashMap<QualifiedName, NodeIx> = HashMap::new();
-        for (rt, child) in model.children(t).collect::<Vec<_>>() {
-            let bn = model.node(child).browse_name.clone();
-            if let Some(&prev) = own.get(&bn) {
+        own.clear();
+        for (rt, child) in model.children(t) {
+            let bn = &model.node(child).browse_name;
+            if let Some(&prev) = own.get(bn) {
                 if prev != child {
                     collision(model, t, prev, child, diags);
                 }
                 continue;
             }
-            own.insert(bn.clone(), child);
-            match list.iter_mut().find(|m| m.browse_name == bn) {
+            own.insert(bn, child);
+            match list.iter_mut().find(|m| m.browse_name == *bn) {
                 Some(m) => {
                     m.overrides = Some(m.node);
                     m.node = child;
                     m.declared_in = t;
                     m.reference_type = rt;
                 }
-                None => list.push(Member { browse_name: bn, node: child, declared_in: t, reference_type: rt, overrides: None }),
+                None => list.push(Member { browse_name: bn.clone(), node: child, declared_in: t, reference_type: rt, overrides: None }),
             }
         }
         members.insert(t, list);
     }
     // Collisions among the children of instances and instance declarations too.
+    let mut found = Vec::new();
     for i in 0..model.nodes.len() {
         let ix = NodeIx(i as u32);
         if model.node(ix).class.is_type() {
             continue;
         }
-        let mut own: HashMap<&QualifiedName, NodeIx> = HashMap::new();
-        let mut found = Vec::new();
+        own.clear();
         for (_, child) in model.children(ix) {
             let bn = &model.node(child).browse_name;
             match own.get(bn) {
@@ -691,7 +698,7 @@ fn build_members(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeIx, Vec
                 }
             }
         }
-        for (a, b) in found {
+        for (a, b) in found.drain(..) {
             collision(model, ix, a, b, diags);
         }
     }
