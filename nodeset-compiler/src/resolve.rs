@@ -168,137 +168,50 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         }
     }
 
-    // Pass 2: attributes that name nodes, and references. The raw nodes are only read from here on.
+    // Pass 2: attributes that name nodes, and references. The raw nodes are only read from here on. Two
+    // threads resolve the two halves of the nodes, reading the model only; what they found is then entered
+    // in node order, duplicate references dropped as they come, with their diagnostics in that order: the
+    // outcome of one pass over the nodes in order.
     let files = files;
+    let pass = Pass2 { model: &model, files: &files, sources: &sources, contexts: &contexts, numeric_fast: &numeric_fast };
+    let half = {
+        let total_refs: usize = pending.iter().map(|&(_, fi, ni)| files[fi as usize].raw.nodes[ni as usize].references.len()).sum();
+        let mut seen = 0;
+        pending
+            .iter()
+            .position(|&(_, fi, ni)| {
+                seen += files[fi as usize].raw.nodes[ni as usize].references.len() + 1;
+                seen > total_refs.div_ceil(2)
+            })
+            .unwrap_or(pending.len())
+    };
+    let (first, second) = pending.split_at(half);
+    let (later, earlier) = crate::join(|| pass.links(second), || pass.links(first));
     let mut seen_refs: FxHashSet<(NodeIx, NodeIx, NodeIx)> = FxHashSet::with_capacity_and_hasher(total * 3, Default::default());
     let mut incoming: Vec<(NodeIx, Reference)> = Vec::with_capacity(total * 3);
     // Nodes with a reference that could not be resolved (already reported): no follow-on warnings.
     let mut broken: HashSet<NodeIx> = HashSet::new();
-    // Per file: NodeId strings already resolved (reference types and common targets repeat thousands of
-    // times), keyed by the strings as the file writes them.
-    let mut caches: Vec<FxHashMap<&str, NodeIx>> = contexts.iter().map(|_| FxHashMap::default()).collect();
-    for &(ix, fi, ni) in &pending {
-        let raw = &files[fi as usize].raw.nodes[ni as usize];
-        let text = sources.get(files[fi as usize].raw.file).text.as_str();
-        let ctx = &contexts[fi as usize];
-        let fast = numeric_fast[fi as usize];
-        let cache = &mut caches[fi as usize];
-        let mut array_dimensions = Vec::new();
-        if let Some(ad) = &raw.array_dimensions {
-            for part in ad.value.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-                match part.parse::<u32>() {
-                    Ok(v) => array_dimensions.push(v),
-                    Err(_) => diags.push(
-                        Diagnostic::new(Code::BadAttribute, format!("ArrayDimensions=\"{}\" is not a list of numbers", ad.value))
-                            .at(ad.span)
-                            .with_span_label(format!("`{part}` is not a UInt32"))
-                            .help("write a comma-separated list such as 3,3 (0 for an unknown length)"),
-                    ),
+    for (part, links) in [(first, earlier), (second, later)] {
+        diags.extend(links.diags);
+        broken.extend(links.broken);
+        let mut from = 0;
+        for (&(ix, _, _), found) in part.iter().zip(links.nodes) {
+            let node = &mut model.nodes[ix.index()];
+            node.attrs.array_dimensions = found.array_dimensions;
+            node.attrs.data_type = found.data_type;
+            node.attrs.method_declaration = found.method_declaration;
+            node.parent = found.parent;
+            for &(reference_type, target, forward, span) in &links.references[from..found.references_end as usize] {
+                let (src, dst) = if forward { (ix, target) } else { (target, ix) };
+                if !seen_refs.insert((src, reference_type, dst)) {
+                    continue;
                 }
+                model.nodes[ix.index()].references.push(Reference { reference_type, target, forward, declared: true, span });
+                incoming.push((target, Reference { reference_type, target: ix, forward: !forward, declared: false, span }));
             }
-        }
-        let mut data_type = None;
-        if let Some(dt) = &raw.data_type {
-            if let Some(t) = resolve_cached(cache, ctx, fast, &model, ix, dt, text, diags) {
-                if model.nodes[t.index()].class != NodeClass::DataType {
-                    let class = model.nodes[t.index()].class.name();
-                    diags.push(
-                        Diagnostic::new(
-                            Code::BadDataType,
-                            format!("DataType `{}` is {} {class}, not a DataType", dt.get(text), article(class)),
-                        )
-                        .at(dt.span)
-                        .help("name a DataType node (an alias such as Int32, or its NodeId)"),
-                    );
-                } else {
-                    data_type = Some(t);
-                }
-            }
-        }
-        let method_declaration = raw.method_declaration_id.as_ref().and_then(|m| resolve_cached(cache, ctx, fast, &model, ix, m, text, diags));
-        {
-            let attrs = &mut model.nodes[ix.index()].attrs;
-            attrs.array_dimensions = array_dimensions;
-            attrs.data_type = data_type;
-            attrs.method_declaration = method_declaration;
-        }
-        for r in &raw.references {
-            // Numeric NodeIds need neither the text nor the cache; everything else, and every problem, takes
-            // the general path.
-            let numeric = fast.then(|| numeric_node(&model, ctx, &r.reference_type)).flatten();
-            let rt = match numeric {
-                Some(t) if model.nodes[t.index()].class == NodeClass::ReferenceType => t,
-                _ => {
-                    let rt_text = r.reference_type.get(text);
-                    let cached = numeric.or_else(|| cache.get(rt_text).copied());
-                    let found = match cached {
-                        Some(t) => Ok(Some(t)),
-                        None => resolve_in(ctx, &model, rt_text, r.reference_type.span, diags).map(|id| model.lookup(&id)),
-                    };
-                    match found {
-                        Ok(Some(t)) if model.nodes[t.index()].class == NodeClass::ReferenceType => {
-                            if cached.is_none() {
-                                cache.insert(rt_text, t);
-                            }
-                            t
-                        }
-                        Ok(Some(t)) => {
-                            let class = model.nodes[t.index()].class.name();
-                            diags.push(
-                                Diagnostic::new(
-                                    Code::BadReferenceType,
-                                    format!("ReferenceType `{rt_text}` is {} {class}, not a ReferenceType", article(class)),
-                                )
-                                .at(r.reference_type.span)
-                                .help("use a ReferenceType such as HasComponent (i=47)"),
-                            );
-                            continue;
-                        }
-                        Ok(None) => {
-                            diags.push(
-                                Diagnostic::new(Code::BadReferenceType, format!("ReferenceType `{rt_text}` names no loaded node"))
-                                    .at(r.reference_type.span)
-                                    .help("load the model that defines the reference type"),
-                            );
-                            continue;
-                        }
-                        Err(d) => {
-                            diags.push(d);
-                            broken.insert(ix);
-                            continue;
-                        }
-                    }
-                }
-            };
-            let Some(target) = resolve_cached(cache, ctx, fast, &model, ix, &r.target, text, diags) else {
-                broken.insert(ix);
-                continue;
-            };
-            let (src, dst) = if r.is_forward { (ix, target) } else { (target, ix) };
-            if !seen_refs.insert((src, rt, dst)) {
-                continue;
-            }
-            model.nodes[ix.index()].references.push(Reference {
-                reference_type: rt,
-                target,
-                forward: r.is_forward,
-                declared: true,
-                span: r.span,
-            });
-            incoming.push((target, Reference { reference_type: rt, target: ix, forward: !r.is_forward, declared: false, span: r.span }));
-        }
-        if let Some(p) = &raw.parent_node_id {
-            match fast.then(|| numeric_node(&model, ctx, p)).flatten() {
-                Some(parent) => model.nodes[ix.index()].parent = Some(parent),
-                None => {
-                    if let Ok(id) = resolve_in(ctx, &model, p.get(text), p.span, diags) {
-                        model.nodes[ix.index()].parent = model.lookup(&id);
-                    }
-                }
-            }
+            from = found.references_end as usize;
         }
     }
-    drop(caches);
     model.files = files.iter().map(|f| f.raw.file).zip(contexts).collect();
     model.sources = sources;
     model.value_arenas = value_arenas;
@@ -353,6 +266,151 @@ fn link(model: &mut Model, incoming: Vec<(NodeIx, Reference)>, broken: &HashSet<
     // Pass 7: state machines, from the instance declarations.
     state_machines(model, diags);
     diags.extend(values_said);
+}
+
+/// What pass 2 reads: the model with every node indexed, and the raw files it came from.
+struct Pass2<'m> {
+    model: &'m Model,
+    files: &'m [crate::load::LoadedFile],
+    sources: &'m SourceMap,
+    contexts: &'m [FileContext],
+    /// Per file: whether numeric NodeIds may take the fast path (see [`numeric_node`]).
+    numeric_fast: &'m [bool],
+}
+
+/// What pass 2 found for a run of nodes, with the diagnostics in the order it found them.
+struct Links {
+    nodes: Vec<NodeLinks>,
+    /// The references of all the nodes, resolved: type, target, direction, span.
+    references: Vec<(NodeIx, NodeIx, bool, Span)>,
+    broken: Vec<NodeIx>,
+    diags: Diagnostics,
+}
+
+/// What pass 2 found for one node.
+struct NodeLinks {
+    array_dimensions: Vec<u32>,
+    data_type: Option<NodeIx>,
+    method_declaration: Option<NodeIx>,
+    /// Where the node's references end in [`Links::references`] (they start where the previous node's end).
+    references_end: u32,
+    parent: Option<NodeIx>,
+}
+
+impl Pass2<'_> {
+    /// Resolves the attributes that name nodes and the references of the `pending` nodes.
+    fn links(&self, pending: &[(NodeIx, u32, u32)]) -> Links {
+        let model = self.model;
+        let mut out = Links { nodes: Vec::with_capacity(pending.len()), references: Vec::new(), broken: Vec::new(), diags: Diagnostics::new() };
+        let diags = &mut out.diags;
+        // Per file: NodeId strings already resolved (reference types repeat thousands of times), keyed by
+        // the strings as the file writes them.
+        let mut caches: Vec<FxHashMap<&str, NodeIx>> = self.contexts.iter().map(|_| FxHashMap::default()).collect();
+        for &(ix, fi, ni) in pending {
+            let raw = &self.files[fi as usize].raw.nodes[ni as usize];
+            let text = self.sources.get(self.files[fi as usize].raw.file).text.as_str();
+            let ctx = &self.contexts[fi as usize];
+            let fast = self.numeric_fast[fi as usize];
+            let cache = &mut caches[fi as usize];
+            let mut array_dimensions = Vec::new();
+            if let Some(ad) = &raw.array_dimensions {
+                for part in ad.value.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+                    match part.parse::<u32>() {
+                        Ok(v) => array_dimensions.push(v),
+                        Err(_) => diags.push(
+                            Diagnostic::new(Code::BadAttribute, format!("ArrayDimensions=\"{}\" is not a list of numbers", ad.value))
+                                .at(ad.span)
+                                .with_span_label(format!("`{part}` is not a UInt32"))
+                                .help("write a comma-separated list such as 3,3 (0 for an unknown length)"),
+                        ),
+                    }
+                }
+            }
+            let mut data_type = None;
+            if let Some(dt) = &raw.data_type {
+                if let Some(t) = resolve_cached(cache, ctx, fast, model, ix, dt, text, diags) {
+                    if model.nodes[t.index()].class != NodeClass::DataType {
+                        let class = model.nodes[t.index()].class.name();
+                        diags.push(
+                            Diagnostic::new(
+                                Code::BadDataType,
+                                format!("DataType `{}` is {} {class}, not a DataType", dt.get(text), article(class)),
+                            )
+                            .at(dt.span)
+                            .help("name a DataType node (an alias such as Int32, or its NodeId)"),
+                        );
+                    } else {
+                        data_type = Some(t);
+                    }
+                }
+            }
+            let method_declaration =
+                raw.method_declaration_id.as_ref().and_then(|m| resolve_cached(cache, ctx, fast, model, ix, m, text, diags));
+            for r in &raw.references {
+                // Numeric NodeIds need neither the text nor the cache; everything else, and every problem,
+                // takes the general path.
+                let numeric = fast.then(|| numeric_node(model, ctx, &r.reference_type)).flatten();
+                let rt = match numeric {
+                    Some(t) if model.nodes[t.index()].class == NodeClass::ReferenceType => t,
+                    _ => {
+                        let rt_text = r.reference_type.get(text);
+                        let cached = numeric.or_else(|| cache.get(rt_text).copied());
+                        let found = match cached {
+                            Some(t) => Ok(Some(t)),
+                            None => resolve_in(ctx, model, rt_text, r.reference_type.span, diags).map(|id| model.lookup(&id)),
+                        };
+                        match found {
+                            Ok(Some(t)) if model.nodes[t.index()].class == NodeClass::ReferenceType => {
+                                if cached.is_none() {
+                                    cache.insert(rt_text, t);
+                                }
+                                t
+                            }
+                            Ok(Some(t)) => {
+                                let class = model.nodes[t.index()].class.name();
+                                diags.push(
+                                    Diagnostic::new(
+                                        Code::BadReferenceType,
+                                        format!("ReferenceType `{rt_text}` is {} {class}, not a ReferenceType", article(class)),
+                                    )
+                                    .at(r.reference_type.span)
+                                    .help("use a ReferenceType such as HasComponent (i=47)"),
+                                );
+                                continue;
+                            }
+                            Ok(None) => {
+                                diags.push(
+                                    Diagnostic::new(Code::BadReferenceType, format!("ReferenceType `{rt_text}` names no loaded node"))
+                                        .at(r.reference_type.span)
+                                        .help("load the model that defines the reference type"),
+                                );
+                                continue;
+                            }
+                            Err(d) => {
+                                diags.push(d);
+                                out.broken.push(ix);
+                                continue;
+                            }
+                        }
+                    }
+                };
+                let Some(target) = resolve_cached(cache, ctx, fast, model, ix, &r.target, text, diags) else {
+                    out.broken.push(ix);
+                    continue;
+                };
+                out.references.push((rt, target, r.is_forward, r.span));
+            }
+            let mut parent = None;
+            if let Some(p) = &raw.parent_node_id {
+                parent = match fast.then(|| numeric_node(model, ctx, p)).flatten() {
+                    Some(p) => Some(p),
+                    None => resolve_in(ctx, model, p.get(text), p.span, diags).ok().and_then(|id| model.lookup(&id)),
+                };
+            }
+            out.nodes.push(NodeLinks { array_dimensions, data_type, method_declaration, references_end: out.references.len() as u32, parent });
+        }
+        out
+    }
 }
 
 /// Resolves a NodeId or alias written in a file. An alias the file forgot to declare that is the BrowseName

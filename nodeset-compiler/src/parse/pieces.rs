@@ -25,8 +25,8 @@ const MIN_PIECE: usize = 256 * 1024;
 pub fn parse_files(files: &[(FileId, &str)], limits: &Limits) -> Vec<(Option<RawNodeSet>, Diagnostics)> {
     let threads = crate::cores();
     let total: usize = files.iter().map(|(_, t)| t.len()).sum();
-    // About two pieces per thread, so that pieces of different sizes even out across the threads.
-    let piece_len = (total / (threads * 2)).max(MIN_PIECE);
+    // About three pieces per thread, so that pieces of different sizes even out across the threads.
+    let piece_len = (total / (threads * 3)).max(MIN_PIECE);
     let plans: Vec<Plan> =
         files.iter().map(|&(file, text)| if threads > 1 { plan(file, text, piece_len) } else { Plan::whole(text) }).collect();
 
@@ -113,6 +113,8 @@ fn read_from(file: FileId, text: &str, plan: &Plan, range: Range<usize>, limits:
 /// Joins the pieces of a file, reading on from the last right cut where a piece does not fit.
 fn join(file: FileId, text: &str, plan: &Plan, reads: Vec<Read>, limits: &Limits) -> (Option<RawNodeSet>, Diagnostics) {
     let last = reads.len() - 1;
+    // Room for all nodes in the first piece's list, so that each later piece is copied once.
+    let nodes: usize = reads.iter().map(|(r, _)| r.as_ref().map_or(0, |p| p.set.nodes.len())).sum();
     let mut joined: Option<(Part, Diagnostics)> = None;
     for (i, (result, diags)) in reads.into_iter().enumerate() {
         // A piece that is not the last fits when it ended at its cut; the last one always fits, as its
@@ -127,7 +129,10 @@ fn join(file: FileId, text: &str, plan: &Plan, reads: Vec<Read>, limits: &Limits
         };
         let (mut part, mut all) = match joined.take() {
             None => match result {
-                Ok(part) => (part, diags),
+                Ok(mut part) => {
+                    part.set.nodes.reserve(nodes.saturating_sub(part.set.nodes.len()));
+                    (part, diags)
+                }
                 Err(Fatal) => return (None, diags),
             },
             Some((mut part, mut all)) => {
