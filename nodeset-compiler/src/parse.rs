@@ -151,6 +151,11 @@ struct Parser<'a, 'd> {
     /// Reads `text[base..]` up to the end of the part being read.
     reader: Reader<&'a [u8]>,
     base: usize,
+    /// Bytes the parser read itself (see [`Parser::scan_references`]), which quick-xml's positions lack.
+    skipped: usize,
+    /// Whether quick-xml stands between two pieces of markup, so that the parser may read on itself: after
+    /// a start tag (not of an empty element) or an end tag, not after text.
+    between_tags: bool,
     /// For a piece that starts inside the root element: the root, whose start tag quick-xml did not see, so
     /// the parser checks the end tags that close it (or that there is nothing to close) itself.
     outer_root: Option<OuterRoot<'a>>,
@@ -187,6 +192,8 @@ impl<'a, 'd> Parser<'a, 'd> {
             text,
             reader,
             base,
+            skipped: 0,
+            between_tags: false,
             outer_root: None,
             ends_early,
             limits,
@@ -201,7 +208,7 @@ impl<'a, 'd> Parser<'a, 'd> {
 
     /// The reader's position in the input.
     fn pos(&self) -> usize {
-        self.base + self.reader.buffer_position() as usize
+        self.base + self.skipped + self.reader.buffer_position() as usize
     }
 
     fn span(&self, start: usize, end: usize) -> Span {
@@ -239,11 +246,12 @@ impl<'a, 'd> Parser<'a, 'd> {
             let ev = match self.reader.read_event() {
                 Ok(ev) => ev,
                 Err(e) => {
-                    let at = self.base + self.reader.error_position() as usize;
+                    let at = self.base + self.skipped + self.reader.error_position() as usize;
                     return Err(self.xml_error(&e, at));
                 }
             };
             let after = self.pos();
+            self.between_tags = false;
             match ev {
                 Event::Start(e) => {
                     let name = self.str_at(local(e.name().into_inner()));
@@ -258,6 +266,8 @@ impl<'a, 'd> Parser<'a, 'd> {
                         .help("NodeSet2 files need fewer than 20 levels; this file is malformed or hostile");
                         return Err(self.fatal(d));
                     }
+                    // quick-xml reads on from after the `>`, except that the end of an empty element comes next.
+                    self.between_tags = self.text.as_bytes().get(after.wrapping_sub(2)) != Some(&b'/');
                     return Ok(Ev::Start(e, self.span(before, after)));
                 }
                 Event::End(e) => {
@@ -275,6 +285,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                         }
                     }
                     self.open.pop();
+                    self.between_tags = true;
                     return Ok(Ev::End);
                 }
                 Event::Empty(_) => unreachable!("expand_empty_elements is set"),
@@ -930,6 +941,7 @@ impl<'a, 'd> Parser<'a, 'd> {
 
     fn references(&mut self, out: &mut Vec<RawReference>) -> PResult<()> {
         loop {
+            self.scan_references(out);
             match self.next()? {
                 Ev::Start(e, span) => {
                     if local(e.name().into_inner()) != b"Reference" {
@@ -963,6 +975,135 @@ impl<'a, 'd> Parser<'a, 'd> {
                 Ev::Eof => unreachable!(),
             }
         }
+    }
+
+    /// Reads the `<Reference>` elements that come next in their common form straight from the text, up to
+    /// the first one that is not (or the end of `<References>`), which quick-xml then reads.
+    ///
+    /// Nearly every reference of a NodeSet2 file is written `<Reference ReferenceType="..."
+    /// [IsForward="..."]>target</Reference>`, with white space between references; going through quick-xml
+    /// costs four events and an attribute reader for each. The common form is recognised exactly (see
+    /// [`Parser::common_reference`]), with the limits on depth and text length kept; such a reference gives
+    /// what the general path gives, which reports nothing for it. For anything else the general path reads
+    /// on, and it reports what it finds.
+    fn scan_references(&mut self, out: &mut Vec<RawReference>) {
+        if !self.between_tags || self.open.len() >= self.limits.max_depth {
+            return;
+        }
+        #[cfg(test)]
+        if tests::GENERAL_PATH_ONLY.with(std::cell::Cell::get) {
+            return;
+        }
+        let rest: &'a [u8] = self.reader.get_ref();
+        let at = self.pos();
+        let mut read = 0;
+        loop {
+            let white = rest[read..].iter().take_while(|b| b.is_ascii_whitespace()).count();
+            let Some((len, reference)) = self.common_reference(&rest[read + white..], at + read + white) else {
+                read += white;
+                break;
+            };
+            out.push(reference);
+            read += white + len;
+        }
+        if read > 0 {
+            *self.reader.get_mut() = &rest[read..];
+            self.skipped += read;
+        }
+    }
+
+    /// One `<Reference>` in the common form at the start of `s` (which starts at byte `at` of the text): its
+    /// length and what it gives (see [`Parser::scan_references`]).
+    fn common_reference(&self, s: &'a [u8], at: usize) -> Option<(usize, RawReference)> {
+        const NAME: &[u8] = b"<Reference";
+        // quick-xml's white space: space, tab, CR, LF.
+        let ws = |b: u8| matches!(b, b' ' | b'\t' | b'\r' | b'\n');
+        if !s.starts_with(NAME) || !s.get(NAME.len()).is_some_and(|&b| ws(b)) {
+            return None;
+        }
+        // The attributes, each `key="value"` after white space, up to the `>`. Keys are plain names (so the
+        // first `>` outside quotes is the end of the tag, as quick-xml finds it), and only ReferenceType and
+        // IsForward, once each.
+        let mut i = NAME.len();
+        let mut reference_type = None;
+        let mut is_forward = None;
+        let tag_end = loop {
+            while s.get(i).is_some_and(|&b| ws(b)) {
+                i += 1;
+            }
+            if *s.get(i)? == b'>' {
+                break i;
+            }
+            let key_start = i;
+            while s.get(i).is_some_and(|&b| b.is_ascii_alphanumeric() || matches!(b, b'_' | b'-' | b'.' | b':')) {
+                i += 1;
+            }
+            if i == key_start || s.get(i) != Some(&b'=') {
+                return None;
+            }
+            let key = local(&s[key_start..i]);
+            let quote = *s.get(i + 1)?;
+            if quote != b'"' && quote != b'\'' {
+                return None;
+            }
+            let value_start = i + 2;
+            let value = &s[value_start..value_start + s[value_start..].iter().position(|&b| b == quote)?];
+            i = value_start + value.len() + 1;
+            if value.contains(&b'&') {
+                return None;
+            }
+            match key {
+                b"ReferenceType" if reference_type.is_none() => reference_type = Some(value),
+                b"IsForward" if is_forward.is_none() => {
+                    is_forward = Some(match self.str_at(value).trim() {
+                        "true" | "1" => true,
+                        "false" | "0" => false,
+                        _ => return None,
+                    })
+                }
+                _ => return None,
+            }
+        };
+        let reference_type = reference_type?;
+        // The target: text without references or CR, not only white space (which reads as empty text with a
+        // span of its own), within the length limit.
+        let text_start = tag_end + 1;
+        let text_len = memchr::memchr(b'<', &s[text_start..])?;
+        let text = &s[text_start..text_start + text_len];
+        let mut blank = true;
+        for &b in text {
+            if b == b'&' || b == b'\r' {
+                return None;
+            }
+            blank &= b.is_ascii_whitespace();
+        }
+        if blank || text_len > self.limits.max_text_len {
+            return None;
+        }
+        // The end tag, white space allowed before its `>`.
+        let close = text_start + text_len;
+        let end_name = s[close..].strip_prefix(b"</Reference")?;
+        let white = end_name.iter().take_while(|&&b| ws(b)).count();
+        if end_name.get(white) != Some(&b'>') {
+            return None;
+        }
+        let len = close + b"</Reference".len() + white + 1;
+
+        let rt_start = self.offset_of(reference_type);
+        let rt_span = self.span(rt_start, rt_start + reference_type.len());
+        let target = self.str_at(text);
+        let trimmed = target.trim();
+        let lead = trimmed.as_ptr() as usize - target.as_ptr() as usize;
+        let target_span = self.span(at + text_start + lead, at + text_start + lead + trimmed.len());
+        Some((
+            len,
+            RawReference {
+                reference_type: self.raw_str(self.str_at(reference_type).trim(), rt_span),
+                target: self.raw_str(trimmed, target_span),
+                is_forward: is_forward.unwrap_or(true),
+                span: self.span(at, at + tag_end + 1),
+            },
+        ))
     }
 
     fn definition(&mut self, e: &BytesStart<'a>, span: Span) -> PResult<RawDefinition> {
@@ -1340,8 +1481,86 @@ fn xml_error_diag(e: &quick_xml::Error, span: Span, open: Option<&str>) -> Diagn
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    thread_local! {
+        /// Turns the parser's own reading of common forms off, so tests can compare it with quick-xml's.
+        pub(crate) static GENERAL_PATH_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    }
+
+    /// A file parsed with and without the parser's own reading of common forms: both give the same.
+    fn assert_fast_paths_agree(text: &str, limits: &Limits) {
+        let run = |general: bool| {
+            GENERAL_PATH_ONLY.with(|g| g.set(general));
+            let mut d = Diagnostics::new();
+            let set = parse(FileId(0), text, limits, &mut d);
+            GENERAL_PATH_ONLY.with(|g| g.set(false));
+            format!("{set:?}\n{d:?}")
+        };
+        let (fast, general) = (run(false), run(true));
+        assert!(fast == general, "fast and general paths differ on:\n{text}\n--- fast\n{fast}\n--- general\n{general}");
+    }
+
+    #[test]
+    fn references_in_common_form_read_as_quick_xml_reads_them() {
+        let refs = [
+            r#"<Reference ReferenceType="HasComponent">ns=1;i=5</Reference>"#,
+            r#"<Reference ReferenceType="i=40" IsForward="false"> i=85 </Reference>"#,
+            r#"<Reference  ReferenceType='HasProperty'   IsForward='1'>i=1</Reference  >"#,
+            r#"<Reference IsForward="0" ReferenceType="Organizes" Extra="x">ns=1;s=a>b</Reference>"#,
+            r#"<Reference ReferenceType="HasComponent" IsForward="no">i=1</Reference>"#,
+            r#"<Reference ReferenceType="HasComponent" IsForward="true" IsForward="false">i=1</Reference>"#,
+            r#"<Reference ReferenceType="Has&amp;Component">i=1</Reference>"#,
+            r#"<Reference ReferenceType="HasComponent">i=1&amp;</Reference>"#,
+            r#"<Reference ReferenceType="HasComponent">   </Reference>"#,
+            r#"<Reference ReferenceType="HasComponent"></Reference>"#,
+            r#"<Reference ReferenceType="HasComponent"/>"#,
+            r#"<Reference ReferenceType="HasComponent">i=1<!-- c --></Reference>"#,
+            r#"<Reference ReferenceType="HasComponent"><![CDATA[i=1]]></Reference>"#,
+            r#"<Reference ReferenceType="HasComponent">i=1</ReferenceX>"#,
+            r#"<Reference>i=1</Reference>"#,
+            r#"<Reference IsForward="false">i=1</Reference>"#,
+            r#"<Reference ReferenceType = "HasComponent">i=1</Reference>"#,
+            r#"<Reference ReferenceType="HasComponent" a="1" b="2" c="3" d="4">i=1</Reference>"#,
+            r#"<Reference a:x="1" b:x="2" ReferenceType="HasComponent">i=1</Reference>"#,
+            r#"<ua:Reference ReferenceType="HasComponent">i=1</ua:Reference>"#,
+            "<Reference ReferenceType=\"HasComponent\">i=1\r\n</Reference>",
+            r#"<Reference ReferenceType="HasComponent">x&#233;</Reference>"#,
+            "<Reference ReferenceType=\"HasComponent\">\u{a0}i=1\u{b}</Reference>",
+            "<Reference\tReferenceType=\"HasComponent\"\n>i=1</Reference>",
+            r#"<Other/>"#,
+            r#"text"#,
+            r#"<!-- a comment -->"#,
+        ];
+        let limits = Limits::default();
+        let file = |body: &str| {
+            format!("<UANodeSet><UAObject NodeId=\"i=1\" BrowseName=\"A\"><References>{body}</References></UAObject></UANodeSet>")
+        };
+        // Every reference form alone, between common ones, and in a row of all of them.
+        for r in refs {
+            for body in [r.to_string(), format!("\n  {0}\n  {r}\n  {0}\n", refs[0]), format!("{r}{}", refs[1])] {
+                assert_fast_paths_agree(&file(&body), &limits);
+            }
+        }
+        let all = refs.join("\n");
+        assert_fast_paths_agree(&file(&all), &limits);
+        // Truncated inside the references, and with tight limits.
+        assert_fast_paths_agree(&format!("<UANodeSet><UAObject NodeId=\"i=1\" BrowseName=\"A\"><References>{}", refs[0]), &limits);
+        for tight in [Limits { max_depth: 3, max_text_len: 4, ..Limits::default() }, Limits { max_depth: 4, max_text_len: 8, ..Limits::default() }] {
+            assert_fast_paths_agree(&file(&all), &tight);
+        }
+    }
+
+    #[test]
+    fn the_vendored_files_read_the_same_on_both_paths() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../nodesets/vendor");
+        let Ok(entries) = std::fs::read_dir(&dir) else { return };
+        for e in entries.flatten() {
+            let text = std::fs::read_to_string(e.path()).unwrap();
+            assert_fast_paths_agree(&text, &Limits::default());
+        }
+    }
 
     fn parse_str(text: &str) -> (Option<RawNodeSet>, Diagnostics) {
         let mut d = Diagnostics::new();
