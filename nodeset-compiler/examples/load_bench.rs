@@ -7,6 +7,7 @@
 //! ```text
 //! cargo run --release --example load_bench -p nodeset-compiler -- robotics --runs 20
 //! cargo run --release --example load_bench -p nodeset-compiler -- tree --runs 3 --tree ../shared/nodesets/ua-nodeset
+//! cargo run --release --example load_bench -p nodeset-compiler -- sets --runs 3 --tree ../shared/nodesets/ua-nodeset
 //! ```
 //!
 //! Scenarios:
@@ -16,6 +17,10 @@
 //!   repository, each with its required models resolved from the tree itself (`model_dirs = [tree]`);
 //!   one run is one pass over all files. (A single compile of every file at once is not possible: the tree
 //!   holds several versions of some models.)
+//! * `sets`: the same tree as a few compiles of many files each, the way a user with many models compiles
+//!   them: every file is named in exactly one set, and no set names two files of one ModelUri (the first
+//!   set takes the newest version of every model, the next set the next newest, and so on). Required models
+//!   that a set does not name come from the tree, as in `tree`.
 //!
 //! Output: progress and details on stderr, and on stdout one line `BENCH key=value ...` (times in ms,
 //! memory in KiB) that `cargo xtask bench` reads. Stage times come from separate runs that call
@@ -58,7 +63,7 @@ struct Cli {
 }
 
 fn usage() -> String {
-    "usage: load_bench <robotics|tree> [--runs N] [--vendor DIR] [--tree DIR] [--no-split] [--compile-only]".to_string()
+    "usage: load_bench <robotics|tree|sets> [--runs N] [--vendor DIR] [--tree DIR] [--no-split] [--compile-only]".to_string()
 }
 
 fn parse_cli() -> Result<Cli, String> {
@@ -97,12 +102,12 @@ fn parse_cli() -> Result<Cli, String> {
     }
     if cli.runs == 0 {
         cli.runs = match cli.scenario.as_str() {
-            "tree" => 3,
+            "tree" | "sets" => 3,
             _ => 20,
         };
     }
     match cli.scenario.as_str() {
-        "robotics" | "tree" => Ok(cli),
+        "robotics" | "tree" | "sets" => Ok(cli),
         "" => Err(usage()),
         s => Err(format!("unknown scenario `{s}`\n{}", usage())),
     }
@@ -144,7 +149,7 @@ fn jobs(cli: &Cli) -> Result<Vec<Job>, String> {
                 model_dirs: vec![cli.vendor.clone()],
             }])
         }
-        _ => {
+        scenario => {
             if !cli.tree.is_dir() {
                 return Err(format!(
                     "the NodeSet tree {} does not exist",
@@ -161,16 +166,100 @@ fn jobs(cli: &Cli) -> Result<Vec<Job>, String> {
             if files.is_empty() {
                 return Err(format!("no *NodeSet2*.xml file under {}", tree.display()));
             }
+            let label = |f: &Path| f.strip_prefix(&tree).unwrap_or(f).display().to_string();
+            if scenario == "sets" {
+                return Ok(model_sets(&files)
+                    .into_iter()
+                    .enumerate()
+                    .map(|(i, set)| Job {
+                        label: format!(
+                            "set {} ({} files, first {})",
+                            i + 1,
+                            set.len(),
+                            label(&set[0])
+                        ),
+                        inputs: set,
+                        model_dirs: vec![tree.clone()],
+                    })
+                    .collect());
+            }
             Ok(files
                 .into_iter()
                 .map(|f| Job {
-                    label: f.strip_prefix(&tree).unwrap_or(&f).display().to_string(),
+                    label: label(&f),
                     inputs: vec![f],
                     model_dirs: vec![tree.clone()],
                 })
                 .collect())
         }
     }
+}
+
+/// The models a file defines, from its `<Models>` header: ModelUri, Version, PublicationDate.
+fn declared_models(path: &Path) -> Vec<(String, Option<String>, Option<String>)> {
+    use quick_xml::events::Event;
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Vec::new();
+    };
+    let mut reader = quick_xml::Reader::from_str(&text);
+    let mut out = Vec::new();
+    loop {
+        match reader.read_event() {
+            Ok(Event::Start(e)) | Ok(Event::Empty(e)) if e.local_name().as_ref() == b"Model" => {
+                let get = |k: &[u8]| {
+                    e.attributes()
+                        .flatten()
+                        .find(|a| a.key.local_name().as_ref() == k)
+                        .and_then(|a| a.unescape_value().ok().map(|v| v.into_owned()))
+                };
+                if let Some(uri) = get(b"ModelUri") {
+                    out.push((uri, get(b"Version"), get(b"PublicationDate")));
+                }
+            }
+            Ok(Event::End(e)) if e.local_name().as_ref() == b"Models" => break,
+            Ok(Event::Eof) | Err(_) => break,
+            _ => {}
+        }
+    }
+    out
+}
+
+/// Splits files into sets that name every ModelUri at most once: newest versions first, so the first set
+/// holds the newest version of every model and later sets the older versions (and duplicates).
+fn model_sets(files: &[PathBuf]) -> Vec<Vec<PathBuf>> {
+    let mut by_age: Vec<(&PathBuf, Vec<(String, Option<String>, Option<String>)>)> =
+        files.iter().map(|f| (f, declared_models(f))).collect();
+    // Newest first (version, then publication date), ties by path so the plan never depends on the walk.
+    by_age.sort_by(|(pa, a), (pb, b)| {
+        let key = |m: &[(String, Option<String>, Option<String>)]| {
+            m.first().map(|x| (x.1.clone(), x.2.clone()))
+        };
+        let (ka, kb) = (key(a), key(b));
+        let (va, da) = ka.unwrap_or_default();
+        let (vb, db) = kb.unwrap_or_default();
+        load::cmp_version(vb.as_deref(), va.as_deref())
+            .then_with(|| db.cmp(&da))
+            .then_with(|| pa.cmp(pb))
+    });
+    let mut sets: Vec<(Vec<PathBuf>, Vec<String>)> = Vec::new();
+    for (file, models) in by_age {
+        let uris: Vec<String> = models.into_iter().map(|m| m.0).collect();
+        let slot = sets
+            .iter()
+            .position(|(_, taken)| !uris.iter().any(|u| taken.contains(u)));
+        let slot = slot.unwrap_or_else(|| {
+            sets.push((Vec::new(), Vec::new()));
+            sets.len() - 1
+        });
+        sets[slot].0.push(file.clone());
+        sets[slot].1.extend(uris);
+    }
+    sets.into_iter()
+        .map(|(mut files, _)| {
+            files.sort();
+            files
+        })
+        .collect()
 }
 
 fn walk(dir: &Path, out: &mut Vec<PathBuf>) {

@@ -8,7 +8,8 @@ use crate::value::{BuiltinType, Variant};
 use crate::source::Span;
 use std::collections::{BTreeMap, HashMap};
 
-pub(crate) fn classify(model: &mut Model, diags: &mut Diagnostics) {
+/// The DataTypes of the model, classified.
+pub(crate) fn classify(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeIx, DataTypeInfo> {
     let types: Vec<NodeIx> =
         (0..model.nodes.len() as u32).map(NodeIx).filter(|&ix| model.node(ix).class == NodeClass::DataType).collect();
     // Supertypes first, so inherited fields are known.
@@ -81,7 +82,7 @@ pub(crate) fn classify(model: &mut Model, diags: &mut Diagnostics) {
         };
         out.insert(t, DataTypeInfo { node: t, kind, encoding, is_abstract, encodings });
     }
-    model.data_types = out;
+    out
 }
 
 fn structure(model: &Model, t: NodeIx, done: &BTreeMap<NodeIx, DataTypeInfo>, diags: &mut Diagnostics) -> DataTypeKind {
@@ -102,7 +103,7 @@ fn structure(model: &Model, t: NodeIx, done: &BTreeMap<NodeIx, DataTypeInfo>, di
     for f in &def.fields {
         let data_type = match &f.data_type {
             None => model.ns0(ids::BASE_DATA_TYPE),
-            Some(dt) => match crate::resolve::resolve_in(ctx, model, dt, diags) {
+            Some(dt) => match crate::resolve::resolve_in(ctx, model, &dt.value, dt.span, diags) {
                 Ok(id) => match model.lookup(&id) {
                     Some(ix) if model.node(ix).class == NodeClass::DataType => Some(ix),
                     found => {
@@ -212,7 +213,7 @@ fn enumeration(model: &Model, t: NodeIx, diags: &mut Diagnostics) -> DataTypeKin
             other => vec![other],
         };
         let mut values = Vec::new();
-        let item_spans: Vec<Span> = c.value_xml.as_ref().map(|x| x.children.iter().map(|e| e.span).collect()).unwrap_or_default();
+        let item_spans: Vec<Span> = model.value_element(child).map(|x| x.children().map(|e| e.span()).collect()).unwrap_or_default();
         let mut spans = Vec::new();
         for (i, it) in items.into_iter().enumerate() {
             let before = values.len();

@@ -83,6 +83,26 @@ pub fn compile(inputs: Vec<Input>, opts: &Options) -> Compiled {
     finish(model, diags, opts)
 }
 
+/// The number of threads the compiler uses: the cores this process may run on.
+pub(crate) fn cores() -> usize {
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
+/// Runs `a` and `b` and returns both results: `a` on another thread where there is more than one core.
+/// A panic in `a` is passed on.
+pub(crate) fn join<A: Send, B>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B) -> (A, B) {
+    if cores() == 1 {
+        return (a(), b());
+    }
+    std::thread::scope(|s| {
+        let other = s.spawn(a);
+        let rb = b();
+        let ra = other.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        (ra, rb)
+    })
+}
+
 fn finish(model: model::Model, mut diags: Diagnostics, opts: &Options) -> Compiled {
     if !opts.all_warnings {
         // Warnings about files the user did not name are not the user's problem.

@@ -72,15 +72,26 @@ pub fn resolve_node_id_in(
     text: &Spanned<String>,
     namespaces: &[String],
 ) -> Result<NodeId, Diagnostic> {
+    resolve_node_id_str(ns_map, aliases, &text.value, text.span, namespaces)
+}
+
+/// [`resolve_node_id_in`] for a string read at `span`.
+pub fn resolve_node_id_str(
+    ns_map: &[u16],
+    aliases: &FxHashMap<String, Spanned<String>>,
+    text: &str,
+    span: Span,
+    namespaces: &[String],
+) -> Result<NodeId, Diagnostic> {
     {
-        let s = text.value.trim();
+        let s = text.trim();
         let (id_text, via_alias) = match aliases.get(s) {
             Some(t) => (t.value.as_str(), Some(t)),
             None => (s, None),
         };
         if via_alias.is_none() && !looks_like_node_id(id_text) {
             let mut d = Diagnostic::new(Code::UnknownAlias, format!("`{s}` is neither a declared alias nor a NodeId"))
-                .at(text.span)
+                .at(span)
                 .with_span_label("unknown alias");
             let near = nearest(s, aliases.keys().map(String::as_str));
             d = match near {
@@ -92,9 +103,9 @@ pub fn resolve_node_id_in(
         let raw = parse_node_id(id_text).map_err(|why| {
             let mut d = Diagnostic::new(Code::MalformedNodeId, format!("malformed NodeId `{id_text}`: {why}"));
             if let Some(t) = via_alias {
-                d = d.at(t.span).label(text.span, format!("used through alias `{s}` here"));
+                d = d.at(t.span).label(span, format!("used through alias `{s}` here"));
             } else {
-                d = d.at(text.span);
+                d = d.at(span);
             }
             d.help("NodeIds are written i=123, s=Name, g=GUID or b=Base64, with an optional ns=N; or nsu=URI; prefix")
         })?;
@@ -106,7 +117,7 @@ pub fn resolve_node_id_in(
                         Code::UnknownNamespaceIndex,
                         format!("namespace index {i} is not declared in this file's NamespaceUris"),
                     )
-                    .at(via_alias.map(|t| t.span).unwrap_or(text.span))
+                    .at(via_alias.map(|t| t.span).unwrap_or(span))
                     .with_span_label(format!("ns={i}"))
                     .note(format!("this file declares {} namespace URI(s)", ns_map.len() - 1))
                     .help("add the namespace's URI to <NamespaceUris> at that position"))
@@ -119,7 +130,7 @@ pub fn resolve_node_id_in(
                         Code::UnknownNamespaceUri,
                         format!("namespace `{u}` is not a loaded model or declared namespace"),
                     )
-                    .at(text.span)
+                    .at(span)
                     .help("load the model that defines this namespace (see --models)"))
                 }
             },
@@ -165,25 +176,41 @@ pub enum Input {
 /// Loads the named inputs and the models they require.
 pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> Loaded {
     let mut sources = SourceMap::new();
-    let mut parsed: Vec<RawNodeSet> = Vec::new();
+    // The named files are read one after the other, then parsed all at once (on all cores); what is said
+    // about each goes into the diagnostics in the order the files were named.
+    let mut said: Vec<Diagnostics> = Vec::new();
+    let mut texts: Vec<(usize, FileId)> = Vec::new();
     for input in inputs {
+        let mut d = Diagnostics::new();
         let (path, display, bytes) = match input {
             Input::Path(p) => match std::fs::read(&p) {
                 Ok(b) => (p.clone(), p.display().to_string(), b),
                 Err(e) => {
-                    diags.push(
+                    d.push(
                         Diagnostic::new(Code::Io, format!("cannot read {}: {}", p.display(), io_reason(&e)))
                             .help("check the path; folders of required models go after --models"),
                     );
+                    said.push(d);
                     continue;
                 }
             },
             Input::Text { name, text } => (PathBuf::from(&name), name, text.into_bytes()),
         };
-        if let Some(set) = read_and_parse(&mut sources, path, display, bytes, true, &opts.limits, diags) {
-            parsed.push(set);
+        if let Some(id) = add_source(&mut sources, path, display, bytes, true, &mut d) {
+            texts.push((said.len(), id));
         }
+        said.push(d);
     }
+    let jobs: Vec<(FileId, &str)> = texts.iter().map(|&(_, id)| (id, sources.get(id).text.as_str())).collect();
+    let mut parsed_at: Vec<Option<RawNodeSet>> = (0..said.len()).map(|_| None).collect();
+    for (&(i, _), (set, d)) in texts.iter().zip(parse::parse_files(&jobs, &opts.limits)) {
+        said[i].extend(d);
+        parsed_at[i] = set;
+    }
+    for d in said {
+        diags.extend(d);
+    }
+    let mut parsed: Vec<RawNodeSet> = parsed_at.into_iter().flatten().collect();
 
     // Models provided by the named files.
     let mut provided: BTreeMap<String, FileId> = BTreeMap::new();
@@ -419,12 +446,17 @@ fn read_and_parse(
     limits: &Limits,
     diags: &mut Diagnostics,
 ) -> Option<RawNodeSet> {
+    let id = add_source(sources, path, display, bytes, named, diags)?;
+    let (set, d) = parse::parse_files(&[(id, sources.get(id).text.as_str())], limits).pop().expect("one file, one result");
+    diags.extend(d);
+    set
+}
+
+/// Adds a file to the sources: its text if it is UTF-8 (and returns its id), or else a lossy copy for
+/// showing its lines, with the diagnostic.
+fn add_source(sources: &mut SourceMap, path: PathBuf, display: String, bytes: Vec<u8>, named: bool, diags: &mut Diagnostics) -> Option<FileId> {
     match parse::decode_text_keeping(bytes) {
-        Ok(text) => {
-            let id = sources.add(SourceFile::new(path, display, text, named));
-            let text = &sources.get(id).text;
-            parse::parse(id, text, limits, diags)
-        }
+        Ok(text) => Some(sources.add(SourceFile::new(path, display, text, named))),
         Err((d, at, bytes)) => {
             let id = sources.add(SourceFile::new(path, display, displayable(&bytes), named));
             diags.push(d.at(Span::new(id, at, at + 1)));
@@ -543,20 +575,40 @@ fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
+/// How much of a file [`scan_header`] looks at, at most. Real NodeSet2 files close `<Models>` within the
+/// first few KiB.
+const HEADER_LIMIT: usize = 256 * 1024;
+
 /// Reads the `<Models>` element of a file without parsing the rest.
+///
+/// A models folder is scanned once per compile and may hold hundreds of files, so the file is read in
+/// growing chunks and reading stops as soon as `</Models>` has been seen. The answer is the one the first
+/// [`HEADER_LIMIT`] bytes give: reading stops early only when the bytes read so far already contain
+/// everything the tests below look for (the first `<Models>` and the `</Models>` after it, and
+/// `UANodeSet`), and reading more cannot change where those are first found.
 fn scan_header(path: &Path) -> Option<Vec<(String, Option<String>, Option<String>)>> {
     use std::io::Read;
     let mut f = std::fs::File::open(path).ok()?;
-    let mut buf = vec![0u8; 256 * 1024];
-    let mut n = 0;
-    while n < buf.len() {
-        let k = f.read(&mut buf[n..]).ok()?;
-        if k == 0 {
+    let mut buf: Vec<u8> = Vec::new();
+    let mut chunk = 16 * 1024;
+    loop {
+        let want = (buf.len() + chunk).min(HEADER_LIMIT);
+        let mut n = buf.len();
+        buf.resize(want, 0);
+        while n < want {
+            let k = f.read(&mut buf[n..]).ok()?;
+            if k == 0 {
+                break;
+            }
+            n += k;
+        }
+        let at_end = n < want || n == HEADER_LIMIT;
+        buf.truncate(n);
+        if at_end || header_complete(&String::from_utf8_lossy(&buf)) {
             break;
         }
-        n += k;
+        chunk *= 2;
     }
-    buf.truncate(n);
     let text = String::from_utf8_lossy(&buf);
     if !text.contains("UANodeSet") {
         return None;
@@ -585,6 +637,11 @@ fn scan_header(path: &Path) -> Option<Vec<(String, Option<String>, Option<String
         }
     }
     Some(out)
+}
+
+/// Whether a prefix of a file already decides [`scan_header`]'s answer (see there).
+fn header_complete(text: &str) -> bool {
+    text.contains("UANodeSet") && text.find("<Models>").is_some_and(|start| text[start..].contains("</Models>"))
 }
 
 fn topo_order(parsed: &[RawNodeSet], sources: &SourceMap, diags: &mut Diagnostics) -> Vec<usize> {
@@ -721,6 +778,33 @@ mod tests {
         assert_eq!(cmp_version(Some("1.02"), Some("1.04.0")), Ordering::Less);
         assert_eq!(cmp_version(None, Some("1.0")), Ordering::Less);
         assert_eq!(cmp_version(Some("9.99.99"), Some("1.05")), Ordering::Greater);
+    }
+
+    #[test]
+    fn header_scan_stops_at_models_but_answers_as_the_full_prefix_would() {
+        let dir = std::env::temp_dir().join(format!("nodeset-header-scan-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let model = "<Model ModelUri=\"http://x/\" Version=\"1.0\" PublicationDate=\"2020-01-01\"/>";
+        // A header past the first chunk, one that straddles chunks, one past the limit, and no UANodeSet.
+        let pad = "<!--".to_string() + &"x".repeat(40_000) + "-->";
+        let cases = [
+            (format!("<UANodeSet>{pad}<Models>{model}</Models></UANodeSet>"), true),
+            (format!("<UANodeSet><Models>{pad}{model}</Models></UANodeSet>"), true),
+            (format!("<UANodeSet>{}<Models>{model}</Models></UANodeSet>", "x".repeat(HEADER_LIMIT)), false),
+            (format!("<Other><Models>{model}</Models></Other>"), false),
+        ];
+        for (i, (text, found)) in cases.iter().enumerate() {
+            let path = dir.join(format!("{i}.xml"));
+            std::fs::write(&path, text).unwrap();
+            let got = scan_header(&path);
+            if *found {
+                let models = got.unwrap_or_else(|| panic!("case {i}"));
+                assert_eq!(models, vec![("http://x/".to_string(), Some("1.0".to_string()), Some("2020-01-01".to_string()))]);
+            } else {
+                assert!(got.is_none(), "case {i}: {got:?}");
+            }
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -7,9 +7,9 @@
 use crate::fxhash::FxHashMap;
 use crate::load::{ModelInfo, NS0_URI};
 use crate::nodeid::{NodeId, QualifiedName};
-use crate::raw::{LocalizedText, NodeClass, RawDefinition, RawRolePermission, XmlElement};
+use crate::raw::{LocalizedText, NodeClass, RawDefinition, RawRolePermission, ValueArena, ValueElement, ValueRef, XmlElement};
 use crate::source::{FileId, SourceMap, Span, Spanned};
-use crate::value::{BuiltinType, Variant};
+use crate::value::{BuiltinType, Content, Variant};
 use std::collections::BTreeMap;
 
 /// "a" or "an" before a node class or type name, for messages.
@@ -166,8 +166,9 @@ pub struct Node {
     pub display_name: Vec<LocalizedText>,
     pub description: Vec<LocalizedText>,
     pub attrs: Attributes,
-    /// The value element as written; decode with [`Model::value`].
-    pub value_xml: Option<XmlElement>,
+    /// The element inside the node's `<Value>`, if any: read it with [`Model::value_element`] or
+    /// [`Model::value_xml`], decode it with [`Model::value`].
+    pub value: Option<ValueRef>,
     pub definition: Option<RawDefinition>,
     pub extensions: Vec<XmlElement>,
     pub references: Vec<Reference>,
@@ -341,6 +342,8 @@ pub struct Model {
     pub(crate) hierarchical: Vec<bool>,
     /// BrowseNames of ns0 DataTypes and ReferenceTypes, for undeclared aliases such as `IdType`.
     pub(crate) ns0_type_names: FxHashMap<String, NodeIx>,
+    /// The values of each file (indexed by [`FileId`]), read against the file's text in `sources`.
+    pub(crate) value_arenas: Vec<ValueArena>,
 }
 
 impl Model {
@@ -440,22 +443,44 @@ impl Model {
         out
     }
 
+    /// The element inside a node's `<Value>`, read in place from its file's text.
+    pub fn value_element(&self, ix: NodeIx) -> Option<ValueElement<'_>> {
+        let node = self.node(ix);
+        let value = node.value?;
+        let arena = self.value_arenas.get(node.file.0 as usize)?;
+        Some(arena.element(value, &self.sources.get(node.file).text))
+    }
+
+    /// The element inside a node's `<Value>` as an owned tree, built on each call (with the spans of the
+    /// file it was read from). To only read a value, [`Model::value_element`] needs no copy.
+    pub fn value_xml(&self, ix: NodeIx) -> Option<XmlElement> {
+        self.value_element(ix).map(|e| e.to_xml())
+    }
+
     /// Decodes a node's value, mapping the NodeIds in it through its file's namespace table.
     pub fn value(&self, ix: NodeIx) -> Option<Result<Variant, String>> {
-        let node = self.node(ix);
-        let xml = node.value_xml.as_ref()?;
-        Some(self.decode_in_file(node.file, xml))
+        self.decode_value(ix, Content::All)
+    }
+
+    /// [`Model::value`], copying as much as `content` says.
+    pub(crate) fn decode_value(&self, ix: NodeIx, content: Content) -> Option<Result<Variant, String>> {
+        let el = self.value_element(ix)?;
+        Some(self.decode_node_in_file(self.node(ix).file, el, content))
     }
 
     /// Decodes an XML value written in `file`.
     pub fn decode_in_file(&self, file: FileId, xml: &XmlElement) -> Result<Variant, String> {
+        self.decode_node_in_file(file, xml, Content::All)
+    }
+
+    fn decode_node_in_file<'a, E: crate::value::XmlNode<'a>>(&self, file: FileId, el: E, content: Content) -> Result<Variant, String> {
         let ctx = self.files.get(&file);
         let ids = |s: &str| -> Result<NodeId, String> {
             let ctx = ctx.ok_or("unknown file")?;
             self.map_node_id(ctx, s)
         };
         let ns = |i: u16| ctx.and_then(|c| c.ns_map.get(i as usize).copied());
-        crate::value::decode(xml, &ids, &ns)
+        crate::value::decode_node(el, &ids, &ns, content)
     }
 
     pub(crate) fn map_node_id(&self, ctx: &FileContext, s: &str) -> Result<NodeId, String> {

@@ -109,6 +109,27 @@ pub fn parse_node_id(text: &str) -> Result<RawNodeId, String> {
     Ok(RawNodeId { ns, id })
 }
 
+/// The common numeric NodeIds, `i=N` and `ns=I;i=N`, as `(I, N)` (`I` is 0 without `ns=`): what
+/// [`parse_node_id`] makes of such a string, without allocating; `None` for any other string, including
+/// every malformed one (which [`parse_node_id`] then explains).
+pub fn parse_numeric_node_id(text: &str) -> Option<(u16, u32)> {
+    // Most strings asked about are not numeric NodeIds (BrowseNames, aliases): turn them away at the first
+    // byte unless it is `i`, `n` or possibly white space.
+    let first = *text.as_bytes().first()?;
+    if !matches!(first, b'i' | b'n') && first < 0x80 && !(first as char).is_whitespace() {
+        return None;
+    }
+    let s = text.trim();
+    let (ns, rest) = match s.strip_prefix("ns=") {
+        Some(r) => {
+            let semi = r.find(';')?;
+            (r[..semi].parse().ok()?, &r[semi + 1..])
+        }
+        None => (0, s),
+    };
+    Some((ns, rest.strip_prefix("i=")?.parse().ok()?))
+}
+
 fn parse_identifier(s: &str) -> Result<Identifier, String> {
     if let Some(n) = s.strip_prefix("i=") {
         return n
@@ -169,6 +190,43 @@ const B64_INV: [u8; 256] = {
 /// Decodes standard base64, ignoring white space (NodeSet2 files wrap long ByteStrings).
 pub fn base64_decode(s: &str) -> Option<Vec<u8>> {
     let mut out = Vec::with_capacity(s.len() * 3 / 4);
+    base64_each(s, |b| out.push(b)).then_some(out)
+}
+
+/// Whether [`base64_decode`] accepts `s`, without decoding it: letters of the alphabet (none after a `=`),
+/// white space, and at most two `=`.
+pub fn base64_valid(s: &str) -> bool {
+    let b = s.as_bytes();
+    let mut i = 0;
+    let mut padding = 0;
+    while i < b.len() {
+        // Runs of letters, the common case, take one test per byte.
+        if padding == 0 {
+            while i < b.len() && B64_INV[b[i] as usize] != 255 {
+                i += 1;
+            }
+            if i == b.len() {
+                break;
+            }
+        }
+        let c = b[i];
+        if B64_INV[c as usize] != 255 {
+            // A letter after a `=`.
+            return false;
+        }
+        if c == b'=' {
+            padding += 1;
+        } else if !c.is_ascii_whitespace() {
+            return false;
+        }
+        i += 1;
+    }
+    padding <= 2
+}
+
+/// Decodes base64 (white space ignored, padding optional), handing each byte to `out`; false if `s` is not
+/// base64.
+fn base64_each(s: &str, mut out: impl FnMut(u8)) -> bool {
     let mut acc = 0u32;
     let mut bits = 0;
     let mut padding = 0;
@@ -182,23 +240,20 @@ pub fn base64_decode(s: &str) -> Option<Vec<u8>> {
                 padding += 1;
                 continue;
             }
-            return None;
+            return false;
         }
         if padding > 0 {
-            return None;
+            return false;
         }
         acc = (acc << 6) | u32::from(v);
         bits += 6;
         if bits >= 8 {
             bits -= 8;
-            out.push((acc >> bits) as u8);
+            out((acc >> bits) as u8);
             acc &= (1 << bits) - 1;
         }
     }
-    if padding > 2 {
-        return None;
-    }
-    Some(out)
+    padding <= 2
 }
 
 pub fn base64_encode(data: &[u8]) -> String {
@@ -265,6 +320,22 @@ impl fmt::Display for QualifiedName {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numeric_fast_path_agrees_with_the_general_parser() {
+        let cases = [
+            "i=85", " ns=1;i=5001 ", "ns=65535;i=4294967295", "i=+7", "ns=01;i=007", "ns=1; i=5", "ns=70000;i=1", "i=4294967296",
+            "i=", "ns=1;", "ns=;i=1", "nsu=http://x/;i=1", "s=i=1", "g=09087e75-8e5e-499b-954f-f2a9603db28a", "b=AQID", "", "i=1x",
+            "I=1", "ns=1;s=Name", "1:Name", "Name", "\u{a0}i=5", "\u{b}i=5", "\u{3000}ns=1;i=2", "nsx",
+        ];
+        for c in cases {
+            let general = parse_node_id(c).ok().and_then(|r| match (r.ns, r.id) {
+                (NsRef::Index(ns), Identifier::Numeric(n)) => Some((ns, n)),
+                _ => None,
+            });
+            assert_eq!(parse_numeric_node_id(c), general, "{c:?}");
+        }
+    }
 
     #[test]
     fn parses_every_node_id_form() {

@@ -49,7 +49,7 @@ pub fn decode_text_keeping(bytes: Vec<u8>) -> Result<String, (Diagnostic, usize,
             bytes,
         ));
     }
-    if let Some(at) = bytes.contains(&0).then(|| bytes.iter().position(|&b| b == 0)).flatten() {
+    if let Some(at) = memchr::memchr(0, &bytes) {
         return Err((
             Diagnostic::new(Code::Encoding, format!("the file contains a NUL byte at byte {at}; it is not a text file"))
                 .help("NodeSet2 files are UTF-8 text; check that the right file was given"),
@@ -86,13 +86,15 @@ pub fn decode_text(bytes: Vec<u8>) -> Result<String, (Diagnostic, usize)> {
     decode_text_keeping(bytes).map_err(|(d, at, _)| (d, at))
 }
 
-/// Parses one file. Returns `None` when the file is not usable at all (its errors are in `diags`).
+mod pieces;
+
+pub use pieces::parse_files;
+
+/// Parses one file on the calling thread. Returns `None` when the file is not usable at all (its errors
+/// are in `diags`). [`parse_files`] parses several files, and large files in pieces, on all cores.
 pub fn parse(file: FileId, text: &str, limits: &Limits, diags: &mut Diagnostics) -> Option<RawNodeSet> {
-    let mut p = Parser::new(file, text, limits, diags);
-    match p.document() {
-        Ok(set) => Some(set),
-        Err(Fatal) => None,
-    }
+    let mut p = Parser::new(file, text, 0..text.len(), limits, diags);
+    p.document().ok().map(|part| part.set)
 }
 
 /// Marker for an error that stops the file; its diagnostic has been pushed.
@@ -114,25 +116,99 @@ struct Attr<'a> {
     span: Span,
 }
 
+/// The root element as seen from a piece of a file that starts inside it (see [`pieces`]).
+#[derive(Clone, Copy, Debug)]
+struct OuterRoot<'a> {
+    /// The name as written, with any prefix.
+    qname: &'a str,
+    /// The local name.
+    name: &'a str,
+    /// Where its start tag begins.
+    start: usize,
+}
+
+/// How the reading of a file, or of a piece of it, ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum PartEnd {
+    /// At the end of the document.
+    Document,
+    /// At the end of a piece that stops before the file does, with only the root element open.
+    Boundary,
+}
+
+/// What reading a file, or a piece of it, gave.
+struct Part {
+    set: RawNodeSet,
+    /// Whether `<NamespaceUris>` and `<ServerUris>` were read (a later one replaces an earlier one).
+    namespace_uris_seen: bool,
+    server_uris_seen: bool,
+    end: PartEnd,
+}
+
 struct Parser<'a, 'd> {
     file: FileId,
     text: &'a str,
+    /// Reads `text[base..]` up to the end of the part being read.
     reader: Reader<&'a [u8]>,
+    base: usize,
+    /// Bytes the parser read itself (see [`Parser::scan_references`]), which quick-xml's positions lack.
+    skipped: usize,
+    /// Whether quick-xml stands between two pieces of markup, so that the parser may read on itself: after
+    /// a start tag (not of an empty element) or an end tag, not after text.
+    between_tags: bool,
+    /// For a piece that starts inside the root element: the root, whose start tag quick-xml did not see, so
+    /// the parser checks the end tags that close it (or that there is nothing to close) itself.
+    outer_root: Option<OuterRoot<'a>>,
+    /// Whether the part ends before the file does (a piece that is not the last).
+    ends_early: bool,
     limits: &'a Limits,
     diags: &'d mut Diagnostics,
     /// Open elements: name and start offset, for truncation messages.
     open: Vec<(&'a str, usize)>,
+    /// One attribute list, lent out by [`Parser::attrs`] and given back by [`Parser::recycle`], so that
+    /// reading an element's attributes allocates nothing.
+    attr_buf: Vec<Attr<'a>>,
+    /// The open elements of the tree [`Parser::tree`] is reading: local name, start tag, text length so far.
+    tree_stack: Vec<(&'a str, Span, usize)>,
+    /// The elements of the file's values.
+    values: ValueArena,
+    /// The open elements of the value being read, as indices into `values`.
+    value_stack: Vec<u32>,
 }
 
 impl<'a, 'd> Parser<'a, 'd> {
-    fn new(file: FileId, text: &'a str, limits: &'a Limits, diags: &'d mut Diagnostics) -> Self {
-        let mut reader = Reader::from_str(text);
+    /// A parser of `text[range]`, with spans in `text`.
+    fn new(file: FileId, text: &'a str, range: std::ops::Range<usize>, limits: &'a Limits, diags: &'d mut Diagnostics) -> Self {
+        let ends_early = range.end < text.len();
+        let base = range.start;
+        let mut reader = Reader::from_str(&text[range]);
         let cfg = reader.config_mut();
         cfg.expand_empty_elements = true;
         cfg.check_end_names = true;
         cfg.check_comments = false;
         cfg.trim_text(false);
-        Parser { file, text, reader, limits, diags, open: Vec::new() }
+        Parser {
+            file,
+            text,
+            reader,
+            base,
+            skipped: 0,
+            between_tags: false,
+            outer_root: None,
+            ends_early,
+            limits,
+            diags,
+            open: Vec::new(),
+            attr_buf: Vec::new(),
+            tree_stack: Vec::new(),
+            values: ValueArena::default(),
+            value_stack: Vec::new(),
+        }
+    }
+
+    /// The reader's position in the input.
+    fn pos(&self) -> usize {
+        self.base + self.skipped + self.reader.buffer_position() as usize
     }
 
     fn span(&self, start: usize, end: usize) -> Span {
@@ -154,26 +230,31 @@ impl<'a, 'd> Parser<'a, 'd> {
         Fatal
     }
 
+    /// Reports a quick-xml error at byte `at`, inside the innermost open element.
+    fn xml_error(&mut self, e: &quick_xml::Error, at: usize) -> Fatal {
+        let at = at.min(self.text.len());
+        let open = self.open.last().map(|(n, _)| *n);
+        let d = xml_error_diag(e, self.span(at, at + 1), open);
+        self.fatal(d)
+    }
+
     /// The next event that matters: element starts and ends, text. Comments, PIs and the declaration are
     /// skipped (the declaration after its encoding is checked).
     fn next(&mut self) -> PResult<Ev<'a>> {
         loop {
-            let before = self.reader.buffer_position() as usize;
+            let before = self.pos();
             let ev = match self.reader.read_event() {
                 Ok(ev) => ev,
                 Err(e) => {
-                    let at = (self.reader.error_position() as usize).min(self.text.len());
-                    let open = self.open.last().map(|(n, _)| *n);
-                    let d = xml_error_diag(&e, self.span(at, at + 1), open);
-                    return Err(self.fatal(d));
+                    let at = self.base + self.skipped + self.reader.error_position() as usize;
+                    return Err(self.xml_error(&e, at));
                 }
             };
-            let after = self.reader.buffer_position() as usize;
+            let after = self.pos();
+            self.between_tags = false;
             match ev {
                 Event::Start(e) => {
-                    let name = std::str::from_utf8(local(e.name().into_inner())).unwrap_or("?");
-                    // SAFETY of lifetimes: the name borrows from the input text, which lives for 'a.
-                    let name: &'a str = self.text_slice(name);
+                    let name = self.str_at(local(e.name().into_inner()));
                     self.open.push((name, before));
                     if self.open.len() > self.limits.max_depth {
                         let d = Diagnostic::new(
@@ -185,10 +266,26 @@ impl<'a, 'd> Parser<'a, 'd> {
                         .help("NodeSet2 files need fewer than 20 levels; this file is malformed or hostile");
                         return Err(self.fatal(d));
                     }
+                    // quick-xml reads on from after the `>`, except that the end of an empty element comes next.
+                    self.between_tags = self.text.as_bytes().get(after.wrapping_sub(2)) != Some(&b'/');
                     return Ok(Ev::Start(e, self.span(before, after)));
                 }
-                Event::End(_) => {
+                Event::End(e) => {
+                    if let Some(root) = self.outer_root.filter(|_| self.open.len() <= 1) {
+                        // quick-xml saw no start tag for this end tag; check it as quick-xml would have.
+                        use quick_xml::errors::{Error, IllFormedError};
+                        let found = std::str::from_utf8(e.name().into_inner()).map(str::to_string).unwrap_or_default();
+                        let wrong = match self.open.last() {
+                            Some(_) if found == root.qname => None,
+                            Some(_) => Some(IllFormedError::MismatchedEndTag { expected: root.qname.to_string(), found }),
+                            None => Some(IllFormedError::UnmatchedEndTag(found)),
+                        };
+                        if let Some(wrong) = wrong {
+                            return Err(self.xml_error(&Error::IllFormed(wrong), before));
+                        }
+                    }
                     self.open.pop();
+                    self.between_tags = true;
                     return Ok(Ev::End);
                 }
                 Event::Empty(_) => unreachable!("expand_empty_elements is set"),
@@ -198,7 +295,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                     if raw.iter().all(u8::is_ascii_whitespace) {
                         return Ok(Ev::Text(Cow::Borrowed(""), before));
                     }
-                    if !raw.contains(&b'&') {
+                    if memchr::memchr(b'&', raw).is_none() {
                         let start = self.offset_of(raw);
                         if start + raw.len() <= self.text.len() && self.text.is_char_boundary(start) && self.text.is_char_boundary(start + raw.len()) {
                             return Ok(Ev::Text(Cow::Borrowed(&self.text[start..start + raw.len()]), before));
@@ -239,6 +336,10 @@ impl<'a, 'd> Parser<'a, 'd> {
                     return Err(self.fatal(d));
                 }
                 Event::Eof => {
+                    if self.ends_early && self.open.len() == 1 {
+                        // A piece that ends before the file does, between two top-level elements.
+                        return Ok(Ev::Eof);
+                    }
                     if let Some(&(name, start)) = self.open.last() {
                         let d = Diagnostic::new(
                             Code::Truncated,
@@ -257,17 +358,54 @@ impl<'a, 'd> Parser<'a, 'd> {
         }
     }
 
-    fn text_slice(&self, s: &str) -> &'a str {
-        let off = self.offset_of(s.as_bytes());
-        if off + s.len() <= self.text.len() && &self.text[off..off + s.len()] == s {
-            &self.text[off..off + s.len()]
-        } else {
-            "?"
+    /// The input text at the bytes `s`, which quick-xml handed out as a slice of it: a name, a key or a
+    /// value, with the lifetime of the input ("?" if `s` is not such a slice, which does not happen).
+    fn str_at(&self, s: &[u8]) -> &'a str {
+        let base = self.text.as_ptr() as usize;
+        let p = s.as_ptr() as usize;
+        if p < base || p + s.len() > base + self.text.len() {
+            return "?";
+        }
+        self.text.get(p - base..p - base + s.len()).unwrap_or("?")
+    }
+
+    /// A string read at `span`, kept as a span where it is the input text there.
+    fn raw_str(&self, value: &str, span: Span) -> RawStr {
+        RawStr::new(value, span, self.text)
+    }
+
+    /// The attributes of a start tag, in a list lent out by the parser: give it back with
+    /// [`Parser::recycle`]. A malformed attribute or value stops the file.
+    ///
+    /// Attributes are read by [`scan_attributes`], which reads the common form (`key="value"`, each after
+    /// white space) in one pass and gives up on anything else, and without quick-xml's duplicate check
+    /// (it keeps a list of keys, allocated per element): the keys are compared here. Any problem (a tag the
+    /// scan gives up on, or two attributes with one local name) hands the tag to
+    /// [`Parser::attrs_checked`], quick-xml's reading with its checks, which decides what is reported: the
+    /// attributes and diagnostics are quick-xml's whatever the path.
+    fn attrs(&mut self, e: &BytesStart<'a>, tag: Span) -> PResult<Vec<Attr<'a>>> {
+        let mut out = std::mem::take(&mut self.attr_buf);
+        out.clear();
+        let content: &[u8] = e;
+        let mut scan = AttributeScan { content, at: e.name().into_inner().len() };
+        loop {
+            let (key, value) = match scan.next() {
+                Some(Ok(kv)) => kv,
+                Some(Err(GaveUp)) => return self.attrs_checked(e, tag, out),
+                None => return Ok(out),
+            };
+            let key = self.str_at(local(key));
+            if out.iter().any(|o| o.key == key) {
+                return self.attrs_checked(e, tag, out);
+            }
+            let attr = self.attr(key, value)?;
+            out.push(attr);
         }
     }
 
-    fn attrs(&mut self, e: &BytesStart<'a>, tag: Span) -> PResult<Vec<Attr<'a>>> {
-        let mut out = Vec::new();
+    /// [`Parser::attrs`] with quick-xml's duplicate check.
+    fn attrs_checked(&mut self, e: &BytesStart<'a>, tag: Span, mut out: Vec<Attr<'a>>) -> PResult<Vec<Attr<'a>>> {
+        out.clear();
         for a in e.attributes().with_checks(true) {
             let a = match a {
                 Ok(a) => a,
@@ -276,16 +414,23 @@ impl<'a, 'd> Parser<'a, 'd> {
                     return Err(self.fatal(d));
                 }
             };
-            let key_bytes = local(a.key.into_inner());
-            let key = std::str::from_utf8(key_bytes).unwrap_or("?");
-            let key = self.text_slice(key);
-            let start = self.offset_of(&a.value);
-            let span = self.span(start, start + a.value.len());
-            let raw_ok = start + a.value.len() <= self.text.len() && !a.value.contains(&b'&');
-            let value: Cow<'a, str> = if raw_ok {
-                Cow::Borrowed(&self.text[start..start + a.value.len()])
-            } else {
-                match a.unescape_value() {
+            let key = self.str_at(local(a.key.into_inner()));
+            let attr = self.attr(key, &a.value)?;
+            out.push(attr);
+        }
+        Ok(out)
+    }
+
+    /// One attribute, given its raw value (a slice of the input): the value is borrowed from the input
+    /// unless it holds references to expand.
+    fn attr(&mut self, key: &'a str, value: &[u8]) -> PResult<Attr<'a>> {
+        let start = self.offset_of(value);
+        let span = self.span(start, start + value.len());
+        let raw = self.str_at(value);
+        let value: Cow<'a, str> = if !raw.contains('&') {
+            Cow::Borrowed(raw)
+        } else {
+            match quick_xml::escape::unescape(raw) {
                 Ok(v) => Cow::Owned(v.into_owned()),
                 Err(err) => {
                     let d = Diagnostic::new(Code::XmlSyntax, format!("malformed attribute value: {err}"))
@@ -293,11 +438,14 @@ impl<'a, 'd> Parser<'a, 'd> {
                         .help("only the predefined entities (&amp; &lt; &gt; &quot; &apos;) and character references are allowed");
                     return Err(self.fatal(d));
                 }
-                }
-            };
-            out.push(Attr { key, value, span });
-        }
-        Ok(out)
+            }
+        };
+        Ok(Attr { key, value, span })
+    }
+
+    /// Gives back the list [`Parser::attrs`] lent out.
+    fn recycle(&mut self, attrs: Vec<Attr<'a>>) {
+        self.attr_buf = attrs;
     }
 
     /// Consumes the rest of an element whose start has been read.
@@ -328,9 +476,10 @@ impl<'a, 'd> Parser<'a, 'd> {
         self.skip()
     }
 
-    /// Reads the text content of an element whose start has been read; child elements are reported.
-    fn text_content(&mut self, within: &str) -> PResult<String> {
-        let mut s = String::new();
+    /// Reads the text content of an element whose start has been read; child elements are reported. The
+    /// text is borrowed from the input when it is one piece without references or carriage returns.
+    fn text_content(&mut self, within: &str) -> PResult<Cow<'a, str>> {
+        let mut s: Cow<'a, str> = Cow::Borrowed("");
         let element_start = self.open.last().map(|(_, start)| *start).unwrap_or(0);
         loop {
             match self.next()? {
@@ -345,7 +494,11 @@ impl<'a, 'd> Parser<'a, 'd> {
                         .help("no NodeSet2 text needs this much; raise the limit in parse::Limits if the file is trusted");
                         return Err(self.fatal(d));
                     }
-                    s.push_str(&t)
+                    if s.is_empty() {
+                        s = t;
+                    } else {
+                        s.to_mut().push_str(&t);
+                    }
                 }
                 Ev::Start(e, span) => self.unknown(&e, span, within)?,
                 Ev::End => break,
@@ -358,11 +511,13 @@ impl<'a, 'd> Parser<'a, 'd> {
     fn localized(&mut self, e: &BytesStart<'a>, span: Span, name: &str) -> PResult<LocalizedText> {
         let attrs = self.attrs(e, span)?;
         let locale = attrs.iter().find(|a| a.key == "Locale").map(|a| a.value.to_string()).filter(|l| !l.is_empty());
+        self.recycle(attrs);
         let text = self.text_content(name)?;
         Ok(LocalizedText { locale, text: text.trim().to_string() })
     }
 
-    fn document(&mut self) -> PResult<RawNodeSet> {
+    /// Reads a file from its start: the root element, and its content up to the end of the part.
+    fn document(&mut self) -> PResult<Part> {
         // Find the root element.
         let (root, root_span) = loop {
             match self.next()? {
@@ -394,27 +549,60 @@ impl<'a, 'd> Parser<'a, 'd> {
             return Err(self.fatal(d));
         }
         let attrs = self.attrs(&root, root_span)?;
-        let mut set = RawNodeSet {
+        let last_modified = attrs.iter().find(|a| a.key == "LastModified").map(|a| a.value.to_string());
+        self.recycle(attrs);
+        let mut part = self.empty_part(root_span);
+        part.set.last_modified = last_modified;
+        self.root_content(&mut part)?;
+        Ok(part)
+    }
+
+    /// Reads a piece of a file that starts inside the root element, between two of its children.
+    fn piece(&mut self, root: OuterRoot<'a>, root_span: Span) -> PResult<Part> {
+        self.outer_root = Some(root);
+        // The end tags of the root and after it are checked in `next`.
+        self.reader.config_mut().allow_unmatched_ends = true;
+        self.open.push((root.name, root.start));
+        let mut part = self.empty_part(root_span);
+        self.root_content(&mut part)?;
+        Ok(part)
+    }
+
+    fn empty_part(&self, root_span: Span) -> Part {
+        let set = RawNodeSet {
             file: self.file,
             root_span,
             namespace_uris: Vec::new(),
             server_uris: Vec::new(),
             models: Vec::new(),
             aliases: Vec::new(),
-            nodes: Vec::with_capacity(self.text.len() / 800),
-            last_modified: attrs.iter().find(|a| a.key == "LastModified").map(|a| a.value.to_string()),
+            nodes: Vec::with_capacity(self.reader.get_ref().len() / 800),
+            last_modified: None,
+            values: ValueArena::default(),
         };
+        Part { set, namespace_uris_seen: false, server_uris_seen: false, end: PartEnd::Document }
+    }
+
+    /// Reads the children of the root element, and what follows the root, up to the end of the part.
+    fn root_content(&mut self, part: &mut Part) -> PResult<()> {
+        let set = &mut part.set;
         loop {
             match self.next()? {
                 Ev::Start(e, span) => {
-                    let name = String::from_utf8_lossy(local(e.name().into_inner())).into_owned();
-                    match name.as_str() {
-                        "NamespaceUris" => set.namespace_uris = self.uri_list("NamespaceUris")?,
-                        "ServerUris" => set.server_uris = self.uri_list("ServerUris")?,
+                    let name = self.str_at(local(e.name().into_inner()));
+                    match name {
+                        "NamespaceUris" => {
+                            set.namespace_uris = self.uri_list("NamespaceUris")?;
+                            part.namespace_uris_seen = true;
+                        }
+                        "ServerUris" => {
+                            set.server_uris = self.uri_list("ServerUris")?;
+                            part.server_uris_seen = true;
+                        }
                         "Models" => self.models(&mut set.models)?,
                         "Aliases" => self.aliases(&mut set.aliases)?,
                         "Extensions" => self.skip()?,
-                        _ => match NodeClass::from_element(&name) {
+                        _ => match NodeClass::from_element(name) {
                             Some(class) => {
                                 let node = self.node(class, &e, span)?;
                                 set.nodes.push(node);
@@ -425,7 +613,12 @@ impl<'a, 'd> Parser<'a, 'd> {
                 }
                 Ev::Text(..) => {}
                 Ev::End => break,
-                Ev::Eof => unreachable!(),
+                Ev::Eof => {
+                    // Only a piece that ends before the file does stops here (see `next`).
+                    set.values = std::mem::take(&mut self.values);
+                    part.end = PartEnd::Boundary;
+                    return Ok(());
+                }
             }
         }
         // Anything after the root other than comments and white space is malformed.
@@ -449,7 +642,9 @@ impl<'a, 'd> Parser<'a, 'd> {
                 Ev::End => unreachable!("no element is open after the root"),
             }
         }
-        Ok(set)
+        set.values = std::mem::take(&mut self.values);
+        part.end = PartEnd::Document;
+        Ok(())
     }
 
     fn uri_list(&mut self, within: &str) -> PResult<Vec<Spanned<String>>> {
@@ -502,6 +697,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                     if let Some(a) = attrs.iter().find(|a| a.key == "AccessRestrictions") {
                         model.access_restrictions = self.number(a);
                     }
+                    self.recycle(attrs);
                     loop {
                         match self.next()? {
                             Ev::Start(e, span) => match local(e.name().into_inner()) {
@@ -521,6 +717,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                                         xml_schema_uri: get("XmlSchemaUri"),
                                         span,
                                     });
+                                    self.recycle(attrs);
                                     self.skip()?;
                                 }
                                 b"RolePermissions" => model.role_permissions = self.role_permissions()?,
@@ -558,7 +755,8 @@ impl<'a, 'd> Parser<'a, 'd> {
                     }
                     let attrs = self.attrs(&e, span)?;
                     let alias = attrs.iter().find(|a| a.key == "Alias").map(|a| a.value.to_string());
-                    let text_start = self.reader.buffer_position() as usize;
+                    self.recycle(attrs);
+                    let text_start = self.pos();
                     let target = self.text_content("Alias")?;
                     let trimmed = target.trim();
                     let lead = target.len() - target.trim_start().len();
@@ -590,7 +788,8 @@ impl<'a, 'd> Parser<'a, 'd> {
                     }
                     let attrs = self.attrs(&e, span)?;
                     let permissions = attrs.iter().find(|a| a.key == "Permissions").and_then(|a| self.number(a));
-                    let text_start = self.reader.buffer_position() as usize;
+                    self.recycle(attrs);
+                    let text_start = self.pos();
                     let role = self.text_content("RolePermission")?;
                     let lead = role.len() - role.trim_start().len();
                     let rspan = self.span(text_start + lead, text_start + lead + role.trim().len());
@@ -652,13 +851,14 @@ impl<'a, 'd> Parser<'a, 'd> {
         let mut have_bn = false;
         for a in &attrs {
             let spanned = || Spanned { value: a.value.to_string(), span: a.span };
+            let raw = || self.raw_str(&a.value, a.span);
             match a.key {
                 "NodeId" => {
-                    node.node_id = spanned();
+                    node.node_id = raw();
                     have_id = true
                 }
                 "BrowseName" => {
-                    node.browse_name = spanned();
+                    node.browse_name = raw();
                     have_bn = true
                 }
                 "SymbolicName" => node.symbolic_name = Some(a.value.to_string()),
@@ -667,8 +867,8 @@ impl<'a, 'd> Parser<'a, 'd> {
                 "AccessRestrictions" => node.access_restrictions = self.number(a),
                 "HasNoPermissions" => node.has_no_permissions = self.boolean(a),
                 "ReleaseStatus" => node.release_status = Some(a.value.to_string()),
-                "ParentNodeId" => node.parent_node_id = Some(spanned()),
-                "DataType" => node.data_type = Some(spanned()),
+                "ParentNodeId" => node.parent_node_id = Some(raw()),
+                "DataType" => node.data_type = Some(raw()),
                 "ValueRank" => node.value_rank = self.number(a),
                 "ArrayDimensions" => node.array_dimensions = Some(spanned()),
                 "AccessLevel" => node.access_level = self.number(a),
@@ -678,7 +878,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                 "Historizing" => node.historizing = self.boolean(a),
                 "Executable" => node.executable = self.boolean(a),
                 "UserExecutable" => node.user_executable = self.boolean(a),
-                "MethodDeclarationId" => node.method_declaration_id = Some(spanned()),
+                "MethodDeclarationId" => node.method_declaration_id = Some(raw()),
                 "EventNotifier" => node.event_notifier = self.number(a),
                 "ContainsNoLoops" => node.contains_no_loops = self.boolean(a),
                 "IsAbstract" => node.is_abstract = self.boolean(a),
@@ -687,6 +887,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                 _ => {}
             }
         }
+        self.recycle(attrs);
         if !have_id {
             self.missing(span, class.element(), "NodeId");
         }
@@ -714,17 +915,15 @@ impl<'a, 'd> Parser<'a, 'd> {
                             let t = self.text_content("Category")?;
                             node.category.push(t.trim().to_string())
                         }
-                        b"Documentation" => node.documentation = Some(self.text_content("Documentation")?),
+                        b"Documentation" => node.documentation = Some(self.text_content("Documentation")?.into_owned()),
                         b"References" => self.references(&mut node.references)?,
                         b"RolePermissions" => node.role_permissions = self.role_permissions()?,
                         b"Extensions" => {
-                            let tree = self.tree(&e, cspan, usize::MAX)?;
-                            node.extensions = tree.children;
+                            let mut sink = ElementSink::default();
+                            self.tree(&e, cspan, usize::MAX, &mut sink)?;
+                            node.extensions = sink.done.map(|tree| tree.children).unwrap_or_default();
                         }
-                        b"Value" => {
-                            let tree = self.tree(&e, cspan, self.limits.max_value_depth)?;
-                            node.value = tree.children.into_iter().next();
-                        }
+                        b"Value" => node.value = self.value(&e, cspan)?,
                         b"Definition" => node.definition = Some(self.definition(&e, cspan)?),
                         _ => {
                             let within = class.element();
@@ -742,6 +941,7 @@ impl<'a, 'd> Parser<'a, 'd> {
 
     fn references(&mut self, out: &mut Vec<RawReference>) -> PResult<()> {
         loop {
+            self.scan_references(out);
             match self.next()? {
                 Ev::Start(e, span) => {
                     if local(e.name().into_inner()) != b"Reference" {
@@ -753,31 +953,157 @@ impl<'a, 'd> Parser<'a, 'd> {
                     let mut rt = None;
                     for a in &attrs {
                         match a.key {
-                            "ReferenceType" => rt = Some(Spanned { value: a.value.trim().to_string(), span: a.span }),
+                            "ReferenceType" => rt = Some(self.raw_str(a.value.trim(), a.span)),
                             "IsForward" => is_forward = self.boolean(a).unwrap_or(true),
                             _ => {}
                         }
                     }
-                    let text_start = self.reader.buffer_position() as usize;
+                    self.recycle(attrs);
+                    let text_start = self.pos();
                     let target = self.text_content("Reference")?;
-                    let lead = target.len() - target.trim_start().len();
-                    let tspan = self.span(text_start + lead, text_start + lead + target.trim().len());
+                    let trimmed = target.trim();
+                    let lead = trimmed.as_ptr() as usize - target.as_ptr() as usize;
+                    let tspan = self.span(text_start + lead, text_start + lead + trimmed.len());
                     let Some(reference_type) = rt else {
                         self.missing(span, "Reference", "ReferenceType");
                         continue;
                     };
-                    out.push(RawReference {
-                        reference_type,
-                        target: Spanned { value: target.trim().to_string(), span: tspan },
-                        is_forward,
-                        span,
-                    });
+                    out.push(RawReference { reference_type, target: self.raw_str(trimmed, tspan), is_forward, span });
                 }
                 Ev::Text(..) => {}
                 Ev::End => return Ok(()),
                 Ev::Eof => unreachable!(),
             }
         }
+    }
+
+    /// Reads the `<Reference>` elements that come next in their common form straight from the text, up to
+    /// the first one that is not (or the end of `<References>`), which quick-xml then reads.
+    ///
+    /// Nearly every reference of a NodeSet2 file is written `<Reference ReferenceType="..."
+    /// [IsForward="..."]>target</Reference>`, with white space between references; going through quick-xml
+    /// costs four events and an attribute reader for each. The common form is recognised exactly (see
+    /// [`Parser::common_reference`]), with the limits on depth and text length kept; such a reference gives
+    /// what the general path gives, which reports nothing for it. For anything else the general path reads
+    /// on, and it reports what it finds.
+    fn scan_references(&mut self, out: &mut Vec<RawReference>) {
+        if !self.between_tags || self.open.len() >= self.limits.max_depth {
+            return;
+        }
+        #[cfg(test)]
+        if tests::GENERAL_PATH_ONLY.with(std::cell::Cell::get) {
+            return;
+        }
+        let rest: &'a [u8] = self.reader.get_ref();
+        let at = self.pos();
+        let mut read = 0;
+        loop {
+            let white = rest[read..].iter().take_while(|b| b.is_ascii_whitespace()).count();
+            let Some((len, reference)) = self.common_reference(&rest[read + white..], at + read + white) else {
+                read += white;
+                break;
+            };
+            out.push(reference);
+            read += white + len;
+        }
+        if read > 0 {
+            *self.reader.get_mut() = &rest[read..];
+            self.skipped += read;
+        }
+    }
+
+    /// One `<Reference>` in the common form at the start of `s` (which starts at byte `at` of the text): its
+    /// length and what it gives (see [`Parser::scan_references`]).
+    fn common_reference(&self, s: &'a [u8], at: usize) -> Option<(usize, RawReference)> {
+        const NAME: &[u8] = b"<Reference";
+        // quick-xml's white space: space, tab, CR, LF.
+        let ws = |b: u8| matches!(b, b' ' | b'\t' | b'\r' | b'\n');
+        if !s.starts_with(NAME) || !s.get(NAME.len()).is_some_and(|&b| ws(b)) {
+            return None;
+        }
+        // The attributes, each `key="value"` after white space, up to the `>`. Keys are plain names (so the
+        // first `>` outside quotes is the end of the tag, as quick-xml finds it), and only ReferenceType and
+        // IsForward, once each.
+        let mut i = NAME.len();
+        let mut reference_type = None;
+        let mut is_forward = None;
+        let tag_end = loop {
+            while s.get(i).is_some_and(|&b| ws(b)) {
+                i += 1;
+            }
+            if *s.get(i)? == b'>' {
+                break i;
+            }
+            let key_start = i;
+            while s.get(i).is_some_and(|&b| b.is_ascii_alphanumeric() || matches!(b, b'_' | b'-' | b'.' | b':')) {
+                i += 1;
+            }
+            if i == key_start || s.get(i) != Some(&b'=') {
+                return None;
+            }
+            let key = local(&s[key_start..i]);
+            let quote = *s.get(i + 1)?;
+            if quote != b'"' && quote != b'\'' {
+                return None;
+            }
+            let value_start = i + 2;
+            let value = &s[value_start..value_start + s[value_start..].iter().position(|&b| b == quote)?];
+            i = value_start + value.len() + 1;
+            if value.contains(&b'&') {
+                return None;
+            }
+            match key {
+                b"ReferenceType" if reference_type.is_none() => reference_type = Some(value),
+                b"IsForward" if is_forward.is_none() => {
+                    is_forward = Some(match self.str_at(value).trim() {
+                        "true" | "1" => true,
+                        "false" | "0" => false,
+                        _ => return None,
+                    })
+                }
+                _ => return None,
+            }
+        };
+        let reference_type = reference_type?;
+        // The target: text without references or CR, not only white space (which reads as empty text with a
+        // span of its own), within the length limit.
+        let text_start = tag_end + 1;
+        let text_len = memchr::memchr(b'<', &s[text_start..])?;
+        let text = &s[text_start..text_start + text_len];
+        let mut blank = true;
+        for &b in text {
+            if b == b'&' || b == b'\r' {
+                return None;
+            }
+            blank &= b.is_ascii_whitespace();
+        }
+        if blank || text_len > self.limits.max_text_len {
+            return None;
+        }
+        // The end tag, white space allowed before its `>`.
+        let close = text_start + text_len;
+        let end_name = s[close..].strip_prefix(b"</Reference")?;
+        let white = end_name.iter().take_while(|&&b| ws(b)).count();
+        if end_name.get(white) != Some(&b'>') {
+            return None;
+        }
+        let len = close + b"</Reference".len() + white + 1;
+
+        let rt_start = self.offset_of(reference_type);
+        let rt_span = self.span(rt_start, rt_start + reference_type.len());
+        let target = self.str_at(text);
+        let trimmed = target.trim();
+        let lead = trimmed.as_ptr() as usize - target.as_ptr() as usize;
+        let target_span = self.span(at + text_start + lead, at + text_start + lead + trimmed.len());
+        Some((
+            len,
+            RawReference {
+                reference_type: self.raw_str(self.str_at(reference_type).trim(), rt_span),
+                target: self.raw_str(trimmed, target_span),
+                is_forward: is_forward.unwrap_or(true),
+                span: self.span(at, at + tag_end + 1),
+            },
+        ))
     }
 
     fn definition(&mut self, e: &BytesStart<'a>, span: Span) -> PResult<RawDefinition> {
@@ -801,6 +1127,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                 _ => {}
             }
         }
+        self.recycle(attrs);
         loop {
             match self.next()? {
                 Ev::Start(e, fspan) => {
@@ -841,6 +1168,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                             _ => {}
                         }
                     }
+                    self.recycle(attrs);
                     if !have_name {
                         self.missing(fspan, "Field", "Name");
                     }
@@ -871,10 +1199,30 @@ impl<'a, 'd> Parser<'a, 'd> {
         }
     }
 
-    /// Reads an element and everything inside it as a tree, iteratively, bounded to `max_depth` levels.
-    fn tree(&mut self, e: &BytesStart<'a>, span: Span, max_depth: usize) -> PResult<XmlElement> {
-        let root = self.element_of(e, span)?;
-        let mut stack = vec![root];
+    /// Reads an element whose start has been read and everything inside it, iteratively, bounded to
+    /// `max_depth` levels, handing each element and piece of text to `sink`. The limits are checked here,
+    /// whatever the sink builds.
+    fn tree<S: TreeSink<'a>>(&mut self, e: &BytesStart<'a>, span: Span, max_depth: usize, sink: &mut S) -> PResult<()> {
+        let mut stack = std::mem::take(&mut self.tree_stack);
+        stack.clear();
+        let result = self.tree_with(e, span, max_depth, sink, &mut stack);
+        self.tree_stack = stack;
+        result
+    }
+
+    fn tree_with<S: TreeSink<'a>>(
+        &mut self,
+        e: &BytesStart<'a>,
+        span: Span,
+        max_depth: usize,
+        sink: &mut S,
+        stack: &mut Vec<(&'a str, Span, usize)>,
+    ) -> PResult<()> {
+        let name = self.str_at(local(e.name().into_inner()));
+        let attrs = self.attrs(e, span)?;
+        sink.start(self, name, &attrs, span);
+        self.recycle(attrs);
+        stack.push((name, span, 0));
         loop {
             match self.next()? {
                 Ev::Start(e, s) => {
@@ -887,33 +1235,31 @@ impl<'a, 'd> Parser<'a, 'd> {
                         .help("values in NodeSet2 files are a few levels deep; this one is malformed or hostile");
                         return Err(self.fatal(d));
                     }
-                    let el = self.element_of(&e, s)?;
-                    stack.push(el);
+                    let name = self.str_at(local(e.name().into_inner()));
+                    let attrs = self.attrs(&e, s)?;
+                    sink.start(self, name, &attrs, s);
+                    self.recycle(attrs);
+                    stack.push((name, s, 0));
                 }
                 Ev::Text(t, _) => {
                     let top = stack.last_mut().expect("stack holds the root");
-                    if top.text.len() + t.len() > self.limits.max_text_len {
+                    if top.2 + t.len() > self.limits.max_text_len {
                         let d = Diagnostic::new(
                             Code::TooLarge,
-                            format!("the text of <{}> is longer than {} bytes", top.name, self.limits.max_text_len),
+                            format!("the text of <{}> is longer than {} bytes", top.0, self.limits.max_text_len),
                         )
-                        .at(top.span)
+                        .at(top.1)
                         .help("no NodeSet2 value needs this much; raise the limit in parse::Limits if the file is trusted");
                         return Err(self.fatal(d));
                     }
-                    top.text.push_str(&t);
+                    top.2 += t.len();
+                    sink.text(self, t);
                 }
                 Ev::End => {
-                    let mut done = stack.pop().expect("stack holds the root");
-                    if done.children.is_empty() {
-                        done.text = normalize_newlines(std::mem::take(&mut done.text));
-                    } else {
-                        // Elements with children carry only formatting white space.
-                        done.text.clear();
-                    }
-                    match stack.last_mut() {
-                        Some(parent) => parent.children.push(done),
-                        None => return Ok(done),
+                    stack.pop();
+                    sink.end(self);
+                    if stack.is_empty() {
+                        return Ok(());
                     }
                 }
                 Ev::Eof => unreachable!(),
@@ -921,15 +1267,88 @@ impl<'a, 'd> Parser<'a, 'd> {
         }
     }
 
-    fn element_of(&mut self, e: &BytesStart<'a>, span: Span) -> PResult<XmlElement> {
-        let attrs = self.attrs(e, span)?;
-        Ok(XmlElement {
-            name: String::from_utf8_lossy(local(e.name().into_inner())).into_owned(),
-            attributes: attrs.into_iter().map(|a| (a.key.to_string(), a.value.into_owned())).collect(),
+    /// Reads a `<Value>` whose start has been read into the file's value arena and returns the element
+    /// inside it, if any.
+    fn value(&mut self, e: &BytesStart<'a>, span: Span) -> PResult<Option<ValueRef>> {
+        let mut sink = ArenaSink { stack: std::mem::take(&mut self.value_stack), root: None };
+        sink.stack.clear();
+        let result = self.tree(e, span, self.limits.max_value_depth, &mut sink);
+        self.value_stack = sink.stack;
+        result?;
+        let root = sink.root.expect("the tree has a root");
+        Ok(self.values.element(ValueRef(root), self.text).children().next().map(|c| ValueRef(c.index())))
+    }
+}
+
+/// What [`Parser::tree`] builds from the elements it reads.
+trait TreeSink<'a> {
+    /// An element starts; its attributes have been read.
+    fn start(&mut self, p: &mut Parser<'a, '_>, name: &'a str, attrs: &[Attr<'a>], span: Span);
+    /// A piece of the innermost open element's text.
+    fn text(&mut self, p: &mut Parser<'a, '_>, text: Cow<'a, str>);
+    /// The innermost open element ends.
+    fn end(&mut self, p: &mut Parser<'a, '_>);
+}
+
+/// Builds an owned [`XmlElement`] tree (for `<Extensions>`).
+#[derive(Default)]
+struct ElementSink {
+    stack: Vec<XmlElement>,
+    done: Option<XmlElement>,
+}
+
+impl<'a> TreeSink<'a> for ElementSink {
+    fn start(&mut self, _: &mut Parser<'a, '_>, name: &'a str, attrs: &[Attr<'a>], span: Span) {
+        self.stack.push(XmlElement {
+            name: name.to_string(),
+            attributes: attrs.iter().map(|a| (a.key.to_string(), a.value.to_string())).collect(),
             children: Vec::new(),
             text: String::new(),
             span,
-        })
+        });
+    }
+
+    fn text(&mut self, _: &mut Parser<'a, '_>, text: Cow<'a, str>) {
+        self.stack.last_mut().expect("an element is open").text.push_str(&text);
+    }
+
+    fn end(&mut self, _: &mut Parser<'a, '_>) {
+        let mut done = self.stack.pop().expect("an element is open");
+        if done.children.is_empty() {
+            done.text = normalize_newlines(Cow::Owned(std::mem::take(&mut done.text))).into_owned();
+        } else {
+            // Elements with children carry only formatting white space.
+            done.text.clear();
+        }
+        match self.stack.last_mut() {
+            Some(parent) => parent.children.push(done),
+            None => self.done = Some(done),
+        }
+    }
+}
+
+/// Records the elements into the parser's [`ValueArena`] (for `<Value>`).
+struct ArenaSink {
+    /// The open elements, as arena indices.
+    stack: Vec<u32>,
+    root: Option<u32>,
+}
+
+impl<'a> TreeSink<'a> for ArenaSink {
+    fn start(&mut self, p: &mut Parser<'a, '_>, name: &'a str, attrs: &[Attr<'a>], span: Span) {
+        let ix = p.values.open(span, name, attrs.iter().map(|a| (a.key, &*a.value)), p.text);
+        self.root.get_or_insert(ix);
+        self.stack.push(ix);
+    }
+
+    fn text(&mut self, p: &mut Parser<'a, '_>, text: Cow<'a, str>) {
+        let ix = *self.stack.last().expect("an element is open");
+        p.values.push_text(ix, &text, p.text);
+    }
+
+    fn end(&mut self, p: &mut Parser<'a, '_>) {
+        let ix = self.stack.pop().expect("an element is open");
+        p.values.close(ix, p.text);
     }
 }
 
@@ -968,6 +1387,53 @@ fn escape_error_diag(esc: &quick_xml::escape::EscapeError, text_start: usize, sp
     }
 }
 
+/// The scan of a start tag's attributes gave up: the tag is not in the common form.
+struct GaveUp;
+
+/// Reads the attributes of a start tag in the form nearly every tag has: white space, a key, `=`, a value
+/// in quotes. The key and value ranges are those quick-xml's attribute reader gives for such a tag; for
+/// anything else (white space around `=`, a value without quotes or closing quote, a key without value) the
+/// scan gives up and quick-xml reads the tag.
+struct AttributeScan<'t> {
+    /// The tag between `<` and `>` (and any `/` of an empty element), as quick-xml hands it out.
+    content: &'t [u8],
+    /// Where the scan is: after the element name, then after each value's closing quote.
+    at: usize,
+}
+
+impl<'t> Iterator for AttributeScan<'t> {
+    type Item = Result<(&'t [u8], &'t [u8]), GaveUp>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        // quick-xml's white space: space, tab, CR, LF.
+        let ws = |b: u8| matches!(b, b' ' | b'\t' | b'\r' | b'\n');
+        let c = self.content;
+        let mut i = self.at;
+        while i < c.len() && ws(c[i]) {
+            i += 1;
+        }
+        if i == c.len() {
+            self.at = i;
+            return None;
+        }
+        // Keys and values are short: plain loops beat a vectorised search here.
+        let key_start = i;
+        let Some(eq) = c[i..].iter().position(|&b| b == b'=' || ws(b)).map(|n| i + n) else { return Some(Err(GaveUp)) };
+        if c[eq] != b'=' || eq == key_start || eq + 1 >= c.len() {
+            return Some(Err(GaveUp));
+        }
+        let key = &c[key_start..eq];
+        let quote = c[eq + 1];
+        if quote != b'"' && quote != b'\'' {
+            return Some(Err(GaveUp));
+        }
+        let value_start = eq + 2;
+        let Some(len) = c[value_start..].iter().position(|&b| b == quote) else { return Some(Err(GaveUp)) };
+        self.at = value_start + len + 1;
+        Some(Ok((key, &c[value_start..value_start + len])))
+    }
+}
+
 /// The local part of a possibly prefixed XML name.
 fn local(name: &[u8]) -> &[u8] {
     match name.iter().position(|&b| b == b':') {
@@ -976,9 +1442,9 @@ fn local(name: &[u8]) -> &[u8] {
     }
 }
 
-fn normalize_newlines(s: String) -> String {
+fn normalize_newlines(s: Cow<'_, str>) -> Cow<'_, str> {
     if s.contains('\r') {
-        s.replace("\r\n", "\n").replace('\r', "\n")
+        Cow::Owned(s.replace("\r\n", "\n").replace('\r', "\n"))
     } else {
         s
     }
@@ -1015,8 +1481,86 @@ fn xml_error_diag(e: &quick_xml::Error, span: Span, open: Option<&str>) -> Diagn
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
+
+    thread_local! {
+        /// Turns the parser's own reading of common forms off, so tests can compare it with quick-xml's.
+        pub(crate) static GENERAL_PATH_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    }
+
+    /// A file parsed with and without the parser's own reading of common forms: both give the same.
+    fn assert_fast_paths_agree(text: &str, limits: &Limits) {
+        let run = |general: bool| {
+            GENERAL_PATH_ONLY.with(|g| g.set(general));
+            let mut d = Diagnostics::new();
+            let set = parse(FileId(0), text, limits, &mut d);
+            GENERAL_PATH_ONLY.with(|g| g.set(false));
+            format!("{set:?}\n{d:?}")
+        };
+        let (fast, general) = (run(false), run(true));
+        assert!(fast == general, "fast and general paths differ on:\n{text}\n--- fast\n{fast}\n--- general\n{general}");
+    }
+
+    #[test]
+    fn references_in_common_form_read_as_quick_xml_reads_them() {
+        let refs = [
+            r#"<Reference ReferenceType="HasComponent">ns=1;i=5</Reference>"#,
+            r#"<Reference ReferenceType="i=40" IsForward="false"> i=85 </Reference>"#,
+            r#"<Reference  ReferenceType='HasProperty'   IsForward='1'>i=1</Reference  >"#,
+            r#"<Reference IsForward="0" ReferenceType="Organizes" Extra="x">ns=1;s=a>b</Reference>"#,
+            r#"<Reference ReferenceType="HasComponent" IsForward="no">i=1</Reference>"#,
+            r#"<Reference ReferenceType="HasComponent" IsForward="true" IsForward="false">i=1</Reference>"#,
+            r#"<Reference ReferenceType="Has&amp;Component">i=1</Reference>"#,
+            r#"<Reference ReferenceType="HasComponent">i=1&amp;</Reference>"#,
+            r#"<Reference ReferenceType="HasComponent">   </Reference>"#,
+            r#"<Reference ReferenceType="HasComponent"></Reference>"#,
+            r#"<Reference ReferenceType="HasComponent"/>"#,
+            r#"<Reference ReferenceType="HasComponent">i=1<!-- c --></Reference>"#,
+            r#"<Reference ReferenceType="HasComponent"><![CDATA[i=1]]></Reference>"#,
+            r#"<Reference ReferenceType="HasComponent">i=1</ReferenceX>"#,
+            r#"<Reference>i=1</Reference>"#,
+            r#"<Reference IsForward="false">i=1</Reference>"#,
+            r#"<Reference ReferenceType = "HasComponent">i=1</Reference>"#,
+            r#"<Reference ReferenceType="HasComponent" a="1" b="2" c="3" d="4">i=1</Reference>"#,
+            r#"<Reference a:x="1" b:x="2" ReferenceType="HasComponent">i=1</Reference>"#,
+            r#"<ua:Reference ReferenceType="HasComponent">i=1</ua:Reference>"#,
+            "<Reference ReferenceType=\"HasComponent\">i=1\r\n</Reference>",
+            r#"<Reference ReferenceType="HasComponent">x&#233;</Reference>"#,
+            "<Reference ReferenceType=\"HasComponent\">\u{a0}i=1\u{b}</Reference>",
+            "<Reference\tReferenceType=\"HasComponent\"\n>i=1</Reference>",
+            r#"<Other/>"#,
+            r#"text"#,
+            r#"<!-- a comment -->"#,
+        ];
+        let limits = Limits::default();
+        let file = |body: &str| {
+            format!("<UANodeSet><UAObject NodeId=\"i=1\" BrowseName=\"A\"><References>{body}</References></UAObject></UANodeSet>")
+        };
+        // Every reference form alone, between common ones, and in a row of all of them.
+        for r in refs {
+            for body in [r.to_string(), format!("\n  {0}\n  {r}\n  {0}\n", refs[0]), format!("{r}{}", refs[1])] {
+                assert_fast_paths_agree(&file(&body), &limits);
+            }
+        }
+        let all = refs.join("\n");
+        assert_fast_paths_agree(&file(&all), &limits);
+        // Truncated inside the references, and with tight limits.
+        assert_fast_paths_agree(&format!("<UANodeSet><UAObject NodeId=\"i=1\" BrowseName=\"A\"><References>{}", refs[0]), &limits);
+        for tight in [Limits { max_depth: 3, max_text_len: 4, ..Limits::default() }, Limits { max_depth: 4, max_text_len: 8, ..Limits::default() }] {
+            assert_fast_paths_agree(&file(&all), &tight);
+        }
+    }
+
+    #[test]
+    fn the_vendored_files_read_the_same_on_both_paths() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../nodesets/vendor");
+        let Ok(entries) = std::fs::read_dir(&dir) else { return };
+        for e in entries.flatten() {
+            let text = std::fs::read_to_string(e.path()).unwrap();
+            assert_fast_paths_agree(&text, &Limits::default());
+        }
+    }
 
     fn parse_str(text: &str) -> (Option<RawNodeSet>, Diagnostics) {
         let mut d = Diagnostics::new();
@@ -1047,10 +1591,127 @@ mod tests {
         assert_eq!(a.descriptions[0].text, "line1\nline2");
         assert!(!a.references[0].is_forward);
         assert_eq!(&xml[a.node_id.span.start as usize..a.node_id.span.end as usize], "ns=1;i=1");
-        let v = set.nodes[1].value.as_ref().unwrap();
-        assert_eq!(v.name, "ListOfInt32");
-        assert_eq!(v.children.len(), 2);
-        assert_eq!(v.children[1].text, "2");
+        let v = set.values.element(set.nodes[1].value.unwrap(), xml);
+        assert_eq!(v.name(), "ListOfInt32");
+        assert_eq!(v.attr("xmlns"), Some("http://opcfoundation.org/UA/2008/02/Types.xsd"));
+        assert_eq!(v.children().count(), 2);
+        assert_eq!(v.children().nth(1).unwrap().text(), "2");
+        let tree = v.to_xml();
+        assert_eq!(tree.children[1].text, "2");
+        assert_eq!(&xml[tree.children[1].span.start as usize..tree.children[1].span.end as usize], "<Int32>");
+    }
+
+    /// Moves every span of a tree by `delta` bytes.
+    fn shifted(mut el: XmlElement, delta: i64) -> XmlElement {
+        el.span.start = (el.span.start as i64 + delta) as u32;
+        el.span.end = (el.span.end as i64 + delta) as u32;
+        el.children = el.children.into_iter().map(|c| shifted(c, delta)).collect();
+        el
+    }
+
+    #[test]
+    fn values_read_in_place_build_the_trees_extensions_build() {
+        // Entities in text and attributes, CR LF, text in pieces around a comment and CDATA, white space
+        // only, mixed content (dropped), prefixes, an empty element.
+        let inner = "<x:Outer xmlns:x=\"urn:x\" a=\"1 &amp; 2\" b='\u{e9}'>\r\n  <x:A>t &lt; u</x:A>\r\n  <B>line1\r\nline2\rline3</B>\
+            <C>one<!-- c -->two<![CDATA[<three>]]></C><D>   </D><E/><F> mixed <G>g</G> text </F><H>plain</H></x:Outer>";
+        let xml = format!(
+            "<UANodeSet><UAVariable NodeId=\"i=1\" BrowseName=\"V\"><Value>{inner}</Value>\
+             <Extensions>{inner}</Extensions></UAVariable></UANodeSet>"
+        );
+        let (set, d) = parse_str(&xml);
+        assert!(d.items.is_empty(), "{d:?}");
+        let set = set.unwrap();
+        let node = &set.nodes[0];
+        let from_arena = set.values.element(node.value.unwrap(), &xml).to_xml();
+        let delta = (xml.find("<Value>").unwrap() + "<Value>".len()) as i64 - (xml.find("<Extensions>").unwrap() + "<Extensions>".len()) as i64;
+        assert_eq!(from_arena, shifted(node.extensions[0].clone(), delta));
+        assert_eq!(from_arena.attributes, [("x".to_string(), "urn:x".to_string()), ("a".into(), "1 & 2".into()), ("b".into(), "\u{e9}".into())]);
+        let texts: Vec<&str> = from_arena.children.iter().map(|c| c.text.as_str()).collect();
+        assert_eq!(texts, ["t < u", "line1\nline2\nline3", "onetwo<three>", "", "", "", "plain"]);
+        assert_eq!(&xml[from_arena.children[1].span.start as usize..from_arena.children[1].span.end as usize], "<B>");
+    }
+
+    #[test]
+    fn value_limits_hold_for_values_read_in_place() {
+        let limits = Limits { max_value_depth: 3, max_text_len: 8, ..Limits::default() };
+        let parse_with = |value: &str| {
+            let xml = format!("<UANodeSet><UAVariable NodeId=\"i=1\" BrowseName=\"V\"><Value>{value}</Value></UAVariable></UANodeSet>");
+            let mut d = Diagnostics::new();
+            let set = parse(FileId(0), &xml, &limits, &mut d);
+            (set.is_some(), d.items.iter().map(|i| (i.code, i.message.clone())).collect::<Vec<_>>())
+        };
+        assert_eq!(parse_with("<A><B>12345678</B></A>"), (true, vec![]));
+        let (ok, d) = parse_with("<A><B><C/></B></A>");
+        assert!(!ok);
+        assert_eq!(d, [(Code::TooDeep, "a value is nested more than 3 levels deep".to_string())]);
+        let (ok, d) = parse_with("<A><B>1234<!---->56789</B></A>");
+        assert!(!ok);
+        assert_eq!(d, [(Code::TooLarge, "the text of <B> is longer than 8 bytes".to_string())]);
+    }
+
+    #[test]
+    fn attribute_problems_are_reported_as_quick_xml_reports_them() {
+        let node = |attrs: &str| format!("<UANodeSet><UAObject {attrs}><DisplayName>A</DisplayName></UAObject></UANodeSet>");
+        let first = |xml: &str| {
+            let (set, d) = parse_str(xml);
+            (set.is_some(), d.items.first().map(|i| (i.code, i.message.clone(), i.span.map(|s| s.start))))
+        };
+        // Keys with one local name but different prefixes are distinct attributes.
+        let (set, d) = parse_str(&node("NodeId=\"i=1\" BrowseName=\"A\" a:x=\"1\" b:x=\"2\""));
+        assert!(d.items.is_empty(), "{d:?}");
+        assert_eq!(set.unwrap().nodes[0].node_id.span.start, 29);
+        let dup = first(&node("NodeId=\"i=1\" BrowseName=\"A\" NodeId=\"i=2\""));
+        assert_eq!(
+            dup,
+            (false, Some((Code::XmlSyntax, "malformed attribute: position 37: duplicated attribute, previous declaration at position 9".into(), Some(11))))
+        );
+        // A bad value before a duplicate is reported first, as in document order.
+        let (ok, d) = first(&node("NodeId=\"&bogus;\" NodeId=\"i=2\""));
+        assert!(!ok);
+        assert_eq!(d.unwrap().1, "malformed attribute value: at 1..6: unrecognized entity `bogus`");
+        let (ok, d) = first(&node("NodeId=i=1 BrowseName=\"A\""));
+        assert!(!ok);
+        assert!(d.unwrap().1.starts_with("malformed attribute: "));
+    }
+
+    #[test]
+    fn the_attribute_scan_reads_what_quick_xml_reads_or_gives_up() {
+        let tags = [
+            "a", "a b=\"1\"", "a  b='1'\tc=\"x y\"\r\n d=\"\"", "a b=\"1\"c=\"2\"", "a x:b=\"&amp;\" y:b='\"'", "a b = \"1\"",
+            "a b=1", "a b=\"1", "a b", "a =\"1\"", "a b=", "a b=\"1\" c", "a b=\"1\" ", "a b=\"<\"", "a b\"c=\"1\"",
+        ];
+        for tag in tags {
+            let e = BytesStart::from_content(tag, tag.find(' ').or_else(|| tag.find('\t')).unwrap_or(tag.len()));
+            let content: &[u8] = &e;
+            let scan: Result<Vec<_>, GaveUp> = AttributeScan { content, at: e.name().into_inner().len() }.collect();
+            let quick: Result<Vec<(Vec<u8>, Vec<u8>)>, _> =
+                e.attributes().with_checks(false).map(|a| a.map(|a| (a.key.into_inner().to_vec(), a.value.to_vec()))).collect();
+            if let Ok(scan) = scan {
+                let scan: Vec<(Vec<u8>, Vec<u8>)> = scan.into_iter().map(|(k, v)| (k.to_vec(), v.to_vec())).collect();
+                assert_eq!(Ok(scan), quick.map_err(|_| ()), "{tag}");
+            }
+        }
+    }
+
+    #[test]
+    fn node_ids_and_references_borrow_from_the_text_unless_it_differs() {
+        let xml = "<UANodeSet><UAObject NodeId=\"ns=1;s=a&amp;b\" BrowseName=\"1:A\"><References>\
+            <Reference ReferenceType=\" HasComponent \">\r\n  ns=1;i=5\r\n</Reference>\
+            <Reference ReferenceType=\"Organizes\" IsForward=\"false\">i=85</Reference></References></UAObject></UANodeSet>";
+        let (set, d) = parse_str(xml);
+        assert!(d.items.is_empty(), "{d:?}");
+        let n = &set.unwrap().nodes[0];
+        assert_eq!(n.node_id.get(xml), "ns=1;s=a&b");
+        assert_eq!(&xml[n.node_id.span.start as usize..n.node_id.span.end as usize], "ns=1;s=a&amp;b");
+        assert_eq!(n.browse_name.get(xml), "1:A");
+        let r = &n.references;
+        assert_eq!((r[0].reference_type.get(xml), r[0].target.get(xml)), ("HasComponent", "ns=1;i=5"));
+        assert_eq!(&xml[r[0].reference_type.span.start as usize..r[0].reference_type.span.end as usize], " HasComponent ");
+        // The target's span is computed on the text after line-break normalisation, as it always was.
+        let t = r[0].target.span;
+        assert_eq!(&xml[t.start as usize..t.end as usize], " ns=1;i=");
+        assert_eq!((r[1].reference_type.get(xml), r[1].target.get(xml), r[1].is_forward), ("Organizes", "i=85", false));
     }
 
     #[test]

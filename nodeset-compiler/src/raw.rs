@@ -1,7 +1,10 @@
 //! The raw model of one NodeSet2 file: what the file says, nothing resolved.
 //!
 //! Strings are kept as written (NodeIds and aliases are not yet expanded) together with their spans, so
-//! that later stages can point at the exact attribute a problem comes from.
+//! that later stages can point at the exact attribute a problem comes from. The strings the resolver only
+//! looks up (NodeIds, reference types and targets) are [`RawStr`]s: spans into the file's text, with a copy
+//! only where the string differs from the text it was read from. The elements of `<Value>`s are kept the
+//! same way, in one [`ValueArena`] per file.
 
 use crate::source::{FileId, Span, Spanned};
 
@@ -112,10 +115,54 @@ pub struct RawAlias {
     pub span: Span,
 }
 
+/// A string read from a file (an attribute value or an element's text), kept as its span in the file's
+/// text. The string is stored only where it differs from what the span covers: after entity or character
+/// references (`&amp;`, `&#160;`) were expanded, line breaks normalised or white space trimmed.
+///
+/// Most such strings are NodeIds, and almost all NodeIds are numeric: their numbers are read with the
+/// string, while the parser has the text at hand, so that the resolver need not read the text again.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub struct RawStr {
+    pub span: Span,
+    owned: Option<Box<str>>,
+    numeric: Option<(u16, u32)>,
+}
+
+impl RawStr {
+    /// `value` as read at `span` of `source`: borrowed from the source when it is exactly the text there.
+    pub fn new(value: &str, span: Span, source: &str) -> RawStr {
+        // A value borrowed from the source is the text at its span; only copies need comparing.
+        let same = source
+            .get(span.start as usize..span.end as usize)
+            .is_some_and(|at| std::ptr::eq(at.as_ptr(), value.as_ptr()) && at.len() == value.len() || at == value);
+        let numeric = crate::nodeid::parse_numeric_node_id(value);
+        RawStr { span, owned: if same { None } else { Some(value.into()) }, numeric }
+    }
+
+    /// A string that is not the text at its span (such as the empty NodeId of a node that has none).
+    pub fn owned(value: &str, span: Span) -> RawStr {
+        RawStr { span, owned: Some(value.into()), numeric: crate::nodeid::parse_numeric_node_id(value) }
+    }
+
+    /// The string as a numeric NodeId (`i=N` or `ns=I;i=N`): what
+    /// [`parse_numeric_node_id`](crate::nodeid::parse_numeric_node_id) gives for it.
+    pub fn numeric_node_id(&self) -> Option<(u16, u32)> {
+        self.numeric
+    }
+
+    /// The string, given the text of the file it was read from.
+    pub fn get<'s>(&'s self, source: &'s str) -> &'s str {
+        match &self.owned {
+            Some(s) => s,
+            None => source.get(self.span.start as usize..self.span.end as usize).unwrap_or(""),
+        }
+    }
+}
+
 #[derive(Clone, Debug)]
 pub struct RawReference {
-    pub reference_type: Spanned<String>,
-    pub target: Spanned<String>,
+    pub reference_type: RawStr,
+    pub target: RawStr,
     pub is_forward: bool,
     pub span: Span,
 }
@@ -155,7 +202,8 @@ pub struct RawDefinition {
     pub span: Span,
 }
 
-/// An XML element of a `<Value>` (or of `<Extensions>`), kept as a tree to be decoded against the model.
+/// An XML element of a `<Extensions>` (or of a `<Value>`, built from its [`ValueElement`] on request), kept as
+/// an owned tree.
 #[derive(Clone, Debug, PartialEq)]
 pub struct XmlElement {
     /// Local name, without namespace prefix.
@@ -188,8 +236,8 @@ pub struct RawNode {
     pub class: NodeClass,
     /// The span of the start tag.
     pub span: Span,
-    pub node_id: Spanned<String>,
-    pub browse_name: Spanned<String>,
+    pub node_id: RawStr,
+    pub browse_name: RawStr,
     pub symbolic_name: Option<String>,
     pub write_mask: Option<u32>,
     pub user_write_mask: Option<u32>,
@@ -204,9 +252,9 @@ pub struct RawNode {
     pub role_permissions: Vec<RawRolePermission>,
     pub extensions: Vec<XmlElement>,
     // Instance attributes.
-    pub parent_node_id: Option<Spanned<String>>,
+    pub parent_node_id: Option<RawStr>,
     // Variable and VariableType attributes.
-    pub data_type: Option<Spanned<String>>,
+    pub data_type: Option<RawStr>,
     pub value_rank: Option<i32>,
     pub array_dimensions: Option<Spanned<String>>,
     pub access_level: Option<u8>,
@@ -214,12 +262,12 @@ pub struct RawNode {
     pub access_level_ex: Option<u32>,
     pub minimum_sampling_interval: Option<f64>,
     pub historizing: Option<bool>,
-    /// The element inside `<Value>`, if any.
-    pub value: Option<XmlElement>,
+    /// The element inside `<Value>`, if any, in the file's [`ValueArena`].
+    pub value: Option<ValueRef>,
     // Method attributes.
     pub executable: Option<bool>,
     pub user_executable: Option<bool>,
-    pub method_declaration_id: Option<Spanned<String>>,
+    pub method_declaration_id: Option<RawStr>,
     // Object and View attributes.
     pub event_notifier: Option<u8>,
     pub contains_no_loops: Option<bool>,
@@ -233,7 +281,8 @@ pub struct RawNode {
 
 impl RawNode {
     pub fn new(class: NodeClass, span: Span) -> RawNode {
-        let empty = Spanned { value: String::new(), span };
+        // Until the attributes are read: empty strings spanning the start tag.
+        let empty = RawStr::owned("", span);
         RawNode {
             class,
             span,
@@ -287,4 +336,301 @@ pub struct RawNodeSet {
     pub aliases: Vec<RawAlias>,
     pub nodes: Vec<RawNode>,
     pub last_modified: Option<String>,
+    /// The elements of every `<Value>` of the file.
+    pub values: ValueArena,
+}
+
+/// A node's value: the element inside its `<Value>`, as an index into its file's [`ValueArena`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ValueRef(pub(crate) u32);
+
+/// The elements of the `<Value>`s of one file, as one tree of spans into the file's text.
+///
+/// Values make up a large share of the elements of a NodeSet2 file (some 13,000 elements in the base
+/// namespace), and most of them are only ever checked against their DataType. The parser reads each value
+/// once and records every element here, without a string of its own where the name, attribute or text is
+/// a slice of the file; [`ValueElement`] reads the tree in place and [`ValueElement::to_xml`] builds an
+/// owned [`XmlElement`] where one is wanted.
+///
+/// Elements are stored in document order; an element's descendants follow it, up to its `end`.
+#[derive(Clone, Debug, Default)]
+pub struct ValueArena {
+    elements: Vec<ArenaElement>,
+    attributes: Vec<ArenaAttribute>,
+    /// Texts and attribute values that are not a slice of the file.
+    owned: Vec<Box<str>>,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct ArenaElement {
+    /// The start tag.
+    span: Span,
+    /// The local name, as a byte range of the file.
+    name: (u32, u32),
+    text: ArenaText,
+    /// The element's range of [`ValueArena::attributes`].
+    attributes: (u32, u32),
+    /// The index after the element's last descendant.
+    end: u32,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct ArenaAttribute {
+    /// The local name, as a byte range of the file.
+    key: (u32, u32),
+    value: ArenaText,
+}
+
+/// A string of the arena: a byte range of the file, or an index into [`ValueArena::owned`].
+#[derive(Clone, Copy, Debug)]
+enum ArenaText {
+    Slice(u32, u32),
+    Owned(u32),
+}
+
+const EMPTY: ArenaText = ArenaText::Slice(0, 0);
+
+/// Where a string lies in `source`, if it is a slice of it.
+fn range_in(source: &str, s: &str) -> Option<(u32, u32)> {
+    let base = source.as_ptr() as usize;
+    let p = s.as_ptr() as usize;
+    (p >= base && p + s.len() <= base + source.len()).then(|| ((p - base) as u32, (p - base + s.len()) as u32))
+}
+
+impl ValueArena {
+    fn text<'a>(&'a self, t: ArenaText, source: &'a str) -> &'a str {
+        match t {
+            ArenaText::Slice(a, b) => source.get(a as usize..b as usize).unwrap_or(""),
+            ArenaText::Owned(i) => &self.owned[i as usize],
+        }
+    }
+
+    /// Stores a string read from `source`: as a range if it is a slice of it, else as a copy.
+    fn store(&mut self, s: &str, source: &str) -> ArenaText {
+        if s.is_empty() {
+            return EMPTY;
+        }
+        match range_in(source, s) {
+            Some((a, b)) => ArenaText::Slice(a, b),
+            None => {
+                self.owned.push(s.into());
+                ArenaText::Owned(self.owned.len() as u32 - 1)
+            }
+        }
+    }
+
+    /// Opens an element (the parser calls this with the element's start tag, local name and attributes,
+    /// all read from `source`) and returns its index.
+    pub(crate) fn open<'s>(
+        &mut self,
+        span: Span,
+        name: &'s str,
+        attributes: impl Iterator<Item = (&'s str, &'s str)>,
+        source: &'s str,
+    ) -> u32 {
+        let first = self.attributes.len() as u32;
+        for (k, v) in attributes {
+            let key = range_in(source, k).unwrap_or((0, 0));
+            let value = self.store(v, source);
+            self.attributes.push(ArenaAttribute { key, value });
+        }
+        let name = range_in(source, name).unwrap_or((0, 0));
+        self.elements.push(ArenaElement {
+            span,
+            name,
+            text: EMPTY,
+            attributes: (first, self.attributes.len() as u32),
+            end: u32::MAX,
+        });
+        self.elements.len() as u32 - 1
+    }
+
+    /// Appends a piece of text to an open element's text.
+    pub(crate) fn push_text(&mut self, ix: u32, piece: &str, source: &str) {
+        if piece.is_empty() {
+            return;
+        }
+        let el = self.elements[ix as usize];
+        let current = self.text(el.text, source);
+        let text = if current.is_empty() {
+            self.store(piece, source)
+        } else {
+            let joined: Box<str> = [current, piece].concat().into();
+            match el.text {
+                ArenaText::Owned(i) => {
+                    self.owned[i as usize] = joined;
+                    el.text
+                }
+                ArenaText::Slice(..) => {
+                    self.owned.push(joined);
+                    ArenaText::Owned(self.owned.len() as u32 - 1)
+                }
+            }
+        };
+        self.elements[ix as usize].text = text;
+    }
+
+    /// Closes an element: an element with children keeps no text (it is only formatting white space
+    /// between them); the text of a leaf has its line breaks normalised to `\n`.
+    pub(crate) fn close(&mut self, ix: u32, source: &str) {
+        let end = self.elements.len() as u32;
+        let el = &mut self.elements[ix as usize];
+        el.end = end;
+        if end > ix + 1 {
+            el.text = EMPTY;
+            return;
+        }
+        let text = el.text;
+        let current = self.text(text, source);
+        if current.contains('\r') {
+            let normalized: Box<str> = current.replace("\r\n", "\n").replace('\r', "\n").into();
+            self.owned.push(normalized);
+            self.elements[ix as usize].text = ArenaText::Owned(self.owned.len() as u32 - 1);
+        }
+    }
+
+    /// Appends the elements of another arena of the same file (read from a later piece of it) and returns
+    /// the index its first element now has: [`ValueRef`]s into `other` move by that much.
+    pub(crate) fn append(&mut self, other: ValueArena) -> u32 {
+        let (elements, attributes, owned) = (self.elements.len() as u32, self.attributes.len() as u32, self.owned.len() as u32);
+        let text = |t: ArenaText| match t {
+            ArenaText::Owned(i) => ArenaText::Owned(i + owned),
+            slice => slice,
+        };
+        self.elements.extend(other.elements.into_iter().map(|e| ArenaElement {
+            text: text(e.text),
+            attributes: (e.attributes.0 + attributes, e.attributes.1 + attributes),
+            end: e.end + elements,
+            ..e
+        }));
+        self.attributes.extend(other.attributes.into_iter().map(|a| ArenaAttribute { value: text(a.value), ..a }));
+        self.owned.extend(other.owned);
+        elements
+    }
+
+    /// The element `ix`, read against the text of the file the arena belongs to.
+    pub fn element<'a>(&'a self, value: ValueRef, source: &'a str) -> ValueElement<'a> {
+        ValueElement { arena: self, source, ix: value.0 }
+    }
+
+    /// The number of elements (for capacity planning and statistics).
+    pub fn len(&self) -> usize {
+        self.elements.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.elements.is_empty()
+    }
+}
+
+/// An element of a value, read in place from its file's [`ValueArena`]; it reads as an [`XmlElement`] does.
+#[derive(Clone, Copy)]
+pub struct ValueElement<'a> {
+    arena: &'a ValueArena,
+    source: &'a str,
+    ix: u32,
+}
+
+impl std::fmt::Debug for ValueElement<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        std::fmt::Debug::fmt(&self.to_xml(), f)
+    }
+}
+
+impl<'a> ValueElement<'a> {
+    /// The element's index in its arena.
+    pub(crate) fn index(&self) -> u32 {
+        self.ix
+    }
+
+    fn data(&self) -> &'a ArenaElement {
+        &self.arena.elements[self.ix as usize]
+    }
+
+    /// Local name, without namespace prefix.
+    pub fn name(&self) -> &'a str {
+        let (a, b) = self.data().name;
+        self.source.get(a as usize..b as usize).unwrap_or("")
+    }
+
+    /// The text content of a leaf element (line endings normalised to `\n`); empty for an element with
+    /// children.
+    pub fn text(&self) -> &'a str {
+        self.arena.text(self.data().text, self.source)
+    }
+
+    /// The start tag.
+    pub fn span(&self) -> Span {
+        self.data().span
+    }
+
+    /// The attributes, local name and value, in document order.
+    pub fn attributes(&self) -> impl Iterator<Item = (&'a str, &'a str)> + 'a {
+        let (arena, source) = (self.arena, self.source);
+        let (first, last) = self.data().attributes;
+        arena.attributes[first as usize..last as usize].iter().map(move |a| {
+            let key = source.get(a.key.0 as usize..a.key.1 as usize).unwrap_or("");
+            (key, arena.text(a.value, source))
+        })
+    }
+
+    pub fn attr(&self, name: &str) -> Option<&'a str> {
+        self.attributes().find(|(k, _)| *k == name).map(|(_, v)| v)
+    }
+
+    /// The child elements, in document order.
+    pub fn children(&self) -> impl Iterator<Item = ValueElement<'a>> + 'a {
+        let (arena, source) = (self.arena, self.source);
+        let end = self.data().end;
+        let mut next = self.ix + 1;
+        std::iter::from_fn(move || {
+            if next >= end {
+                return None;
+            }
+            let child = ValueElement { arena, source, ix: next };
+            next = arena.elements[next as usize].end;
+            Some(child)
+        })
+    }
+
+    pub fn child(&self, name: &str) -> Option<ValueElement<'a>> {
+        self.children().find(|c| c.name() == name)
+    }
+
+    /// Text of a child element, if present.
+    pub fn child_text(&self, name: &str) -> Option<&'a str> {
+        self.child(name).map(|c| c.text())
+    }
+
+    /// The element alone, without its children, as an owned [`XmlElement`].
+    fn shallow(&self) -> XmlElement {
+        XmlElement {
+            name: self.name().to_string(),
+            attributes: self.attributes().map(|(k, v)| (k.to_string(), v.to_string())).collect(),
+            children: Vec::new(),
+            text: self.text().to_string(),
+            span: self.span(),
+        }
+    }
+
+    /// The element and everything inside it as an owned tree (built without recursion, as values may nest
+    /// as deeply as the parser's limits allow).
+    pub fn to_xml(&self) -> XmlElement {
+        // Each frame: the element being built, and the index of its next child.
+        let mut stack: Vec<(XmlElement, u32, u32)> = vec![(self.shallow(), self.data().end, self.ix + 1)];
+        loop {
+            let top = stack.last_mut().expect("the stack holds the root until it is returned");
+            if top.2 < top.1 {
+                let child = ValueElement { arena: self.arena, source: self.source, ix: top.2 };
+                top.2 = child.data().end;
+                stack.push((child.shallow(), child.data().end, child.ix + 1));
+                continue;
+            }
+            let (done, _, _) = stack.pop().expect("checked above");
+            match stack.last_mut() {
+                Some(parent) => parent.0.children.push(done),
+                None => return done,
+            }
+        }
+    }
 }

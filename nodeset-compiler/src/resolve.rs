@@ -10,17 +10,19 @@ use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::load::Loaded;
 use crate::model::*;
 use crate::nodeid::{parse_qualified_name, NodeId, QualifiedName};
-use crate::raw::NodeClass;
-use crate::source::Span;
-use crate::value::{BuiltinType, Variant};
-use std::collections::{BTreeMap, HashMap, HashSet};
+use crate::raw::{NodeClass, RawStr, ValueArena, ValueElement};
+use crate::source::{SourceMap, Span};
+use crate::value::{BuiltinType, Content, Variant};
+use std::collections::{BTreeMap, HashSet};
 
 /// Builds the model. Problems go to `diags`; the model is returned even when there are errors, with the
 /// offending parts left out, so that later checks can still report what they find.
 pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
     let Loaded { sources, files, namespaces, models } = loaded;
+    let mut value_arenas: Vec<ValueArena> = (0..sources.len()).map(|_| ValueArena::default()).collect();
     let mut model = Model {
-        sources,
+        // The sources join the model after pass 2; until then the raw strings borrow from them.
+        sources: SourceMap::new(),
         namespaces,
         models,
         nodes: Vec::new(),
@@ -32,30 +34,46 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         members: BTreeMap::new(),
         hierarchical: Vec::new(),
         ns0_type_names: FxHashMap::default(),
+        value_arenas: Vec::new(),
     };
     let total: usize = files.iter().map(|f| f.raw.nodes.len()).sum();
     model.nodes.reserve(total);
     model.index.reserve(total);
 
-    // Pass 1: every node gets its index. Raw nodes stay where the loader put them; `pending` says where.
+    // Pass 1: every node gets its index and what it owns of its raw node. Raw nodes stay where the loader
+    // put them; `pending` says where.
     let mut files = files;
     let contexts: Vec<FileContext> = files
         .iter_mut()
         .map(|f| FileContext { ns_map: std::mem::take(&mut f.ns_map), aliases: std::mem::take(&mut f.aliases) })
         .collect();
+    // Files whose alias names look like NodeIds (an alias `i=5` would shadow the NodeId) take the general
+    // path for every NodeId string; the others resolve numeric NodeIds on the fast path.
+    let numeric_fast: Vec<bool> =
+        contexts.iter().map(|c| !c.aliases.keys().any(|a| crate::nodeid::looks_like_node_id(a))).collect();
     let mut pending: Vec<(NodeIx, u32, u32)> = Vec::with_capacity(total);
     for (fi, f) in files.iter_mut().enumerate() {
         let file = f.raw.file;
+        let text = sources.get(file).text.as_str();
         let ctx = &contexts[fi];
+        value_arenas[file.0 as usize] = std::mem::take(&mut f.raw.values);
         for (ni, raw) in f.raw.nodes.iter_mut().enumerate() {
-            let id = match crate::load::resolve_node_id_in(&ctx.ns_map, &ctx.aliases, &raw.node_id, &model.namespaces) {
+            let fast = numeric_fast[fi]
+                .then(|| raw.node_id.numeric_node_id())
+                .flatten()
+                .and_then(|(ns, n)| Some(NodeId::numeric(*ctx.ns_map.get(ns as usize)?, n)));
+            let id = match fast.map(Ok).unwrap_or_else(|| {
+                let node_id = raw.node_id.get(text);
+                crate::load::resolve_node_id_str(&ctx.ns_map, &ctx.aliases, node_id, raw.node_id.span, &model.namespaces)
+            }) {
                 Ok(id) => id,
                 Err(d) => {
                     diags.push(d);
                     continue;
                 }
             };
-            let browse_name = match parse_qualified_name(&raw.browse_name.value) {
+            let browse_name_text = raw.browse_name.get(text);
+            let browse_name = match parse_qualified_name(browse_name_text) {
                 Ok(q) => match ctx.ns_map.get(q.ns as usize) {
                     Some(&ns) => QualifiedName { ns, name: q.name },
                     None => {
@@ -71,14 +89,14 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                     }
                 },
                 Err(why) => {
-                    if !raw.browse_name.value.is_empty() || raw.browse_name.span != raw.span {
+                    if !browse_name_text.is_empty() || raw.browse_name.span != raw.span {
                         diags.push(
                             Diagnostic::new(Code::MalformedQualifiedName, format!("malformed BrowseName: {why}"))
                                 .at(raw.browse_name.span)
                                 .help("write N:Name, N being the namespace index"),
                         );
                     }
-                    QualifiedName { ns: 0, name: raw.browse_name.value.clone() }
+                    QualifiedName { ns: 0, name: browse_name_text.to_string() }
                 }
             };
             if let Some(&prev) = model.index.get(&id) {
@@ -94,6 +112,31 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
             }
             let ix = NodeIx(model.nodes.len() as u32);
             model.index.insert(id.clone(), ix);
+            let attrs = Attributes {
+                write_mask: raw.write_mask,
+                user_write_mask: raw.user_write_mask,
+                access_restrictions: raw.access_restrictions,
+                release_status: raw.release_status.take(),
+                data_type: None,
+                value_rank: raw.value_rank,
+                array_dimensions: Vec::new(),
+                access_level: raw.access_level,
+                user_access_level: raw.user_access_level,
+                access_level_ex: raw.access_level_ex,
+                minimum_sampling_interval: raw.minimum_sampling_interval,
+                historizing: raw.historizing,
+                executable: raw.executable,
+                user_executable: raw.user_executable,
+                event_notifier: raw.event_notifier,
+                contains_no_loops: raw.contains_no_loops,
+                is_abstract: raw.is_abstract,
+                symmetric: raw.symmetric,
+                inverse_name: std::mem::take(&mut raw.inverse_names),
+                role_permissions: std::mem::take(&mut raw.role_permissions),
+                category: std::mem::take(&mut raw.category),
+                documentation: raw.documentation.take(),
+                method_declaration: None,
+            };
             model.nodes.push(Node {
                 id,
                 class: raw.class,
@@ -101,11 +144,11 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 symbolic_name: raw.symbolic_name.take(),
                 display_name: std::mem::take(&mut raw.display_names),
                 description: std::mem::take(&mut raw.descriptions),
-                attrs: Attributes::default(),
-                value_xml: None,
-                definition: None,
-                extensions: Vec::new(),
-                references: Vec::new(),
+                attrs,
+                value: raw.value,
+                definition: raw.definition.take(),
+                extensions: std::mem::take(&mut raw.extensions),
+                references: Vec::with_capacity(raw.references.len()),
                 super_type: None,
                 type_definition: None,
                 modelling_rule: None,
@@ -125,188 +168,249 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         }
     }
 
-    // Pass 2: attributes and references.
+    // Pass 2: attributes that name nodes, and references. The raw nodes are only read from here on. Two
+    // threads resolve the two halves of the nodes, reading the model only; what they found is then entered
+    // in node order, duplicate references dropped as they come, with their diagnostics in that order: the
+    // outcome of one pass over the nodes in order.
+    let files = files;
+    let pass = Pass2 { model: &model, files: &files, sources: &sources, contexts: &contexts, numeric_fast: &numeric_fast };
+    let half = {
+        let total_refs: usize = pending.iter().map(|&(_, fi, ni)| files[fi as usize].raw.nodes[ni as usize].references.len()).sum();
+        let mut seen = 0;
+        pending
+            .iter()
+            .position(|&(_, fi, ni)| {
+                seen += files[fi as usize].raw.nodes[ni as usize].references.len() + 1;
+                seen > total_refs.div_ceil(2)
+            })
+            .unwrap_or(pending.len())
+    };
+    let (first, second) = pending.split_at(half);
+    let (later, earlier) = crate::join(|| pass.links(second), || pass.links(first));
     let mut seen_refs: FxHashSet<(NodeIx, NodeIx, NodeIx)> = FxHashSet::with_capacity_and_hasher(total * 3, Default::default());
     let mut incoming: Vec<(NodeIx, Reference)> = Vec::with_capacity(total * 3);
     // Nodes with a reference that could not be resolved (already reported): no follow-on warnings.
     let mut broken: HashSet<NodeIx> = HashSet::new();
-    // Per file: NodeId strings already resolved (reference types and common targets repeat thousands of times).
-    let mut caches: Vec<FxHashMap<String, NodeIx>> = contexts.iter().map(|_| FxHashMap::default()).collect();
-    for &(ix, fi, ni) in &pending {
-        let raw = &mut files[fi as usize].raw.nodes[ni as usize];
-        let ctx = &contexts[fi as usize];
-        let cache = &mut caches[fi as usize];
-        let resolve_ref = |cache: &mut FxHashMap<String, NodeIx>,
-                           model: &Model,
-                           s: &crate::source::Spanned<String>,
-                           diags: &mut Diagnostics|
-         -> Option<NodeIx> {
-            if let Some(&t) = cache.get(s.value.as_str()) {
-                return Some(t);
-            }
-            match resolve_in(ctx, model, s, diags) {
-                Ok(id) => match model.lookup(&id) {
-                    Some(t) => {
-                        cache.insert(s.value.clone(), t);
-                        Some(t)
-                    }
-                    None => {
-                        diags.push(dangling(model, ix, &id, s.span));
-                        None
-                    }
-                },
-                Err(d) => {
-                    diags.push(d);
-                    None
-                }
-            }
-        };
-        let mut attrs = Attributes {
-            write_mask: raw.write_mask,
-            user_write_mask: raw.user_write_mask,
-            access_restrictions: raw.access_restrictions,
-            release_status: raw.release_status.take(),
-            data_type: None,
-            value_rank: raw.value_rank,
-            array_dimensions: Vec::new(),
-            access_level: raw.access_level,
-            user_access_level: raw.user_access_level,
-            access_level_ex: raw.access_level_ex,
-            minimum_sampling_interval: raw.minimum_sampling_interval,
-            historizing: raw.historizing,
-            executable: raw.executable,
-            user_executable: raw.user_executable,
-            event_notifier: raw.event_notifier,
-            contains_no_loops: raw.contains_no_loops,
-            is_abstract: raw.is_abstract,
-            symmetric: raw.symmetric,
-            inverse_name: std::mem::take(&mut raw.inverse_names),
-            role_permissions: std::mem::take(&mut raw.role_permissions),
-            category: std::mem::take(&mut raw.category),
-            documentation: raw.documentation.take(),
-            method_declaration: None,
-        };
-        if let Some(ad) = &raw.array_dimensions {
-            for part in ad.value.split(',').map(str::trim).filter(|p| !p.is_empty()) {
-                match part.parse::<u32>() {
-                    Ok(v) => attrs.array_dimensions.push(v),
-                    Err(_) => diags.push(
-                        Diagnostic::new(Code::BadAttribute, format!("ArrayDimensions=\"{}\" is not a list of numbers", ad.value))
-                            .at(ad.span)
-                            .with_span_label(format!("`{part}` is not a UInt32"))
-                            .help("write a comma-separated list such as 3,3 (0 for an unknown length)"),
-                    ),
-                }
-            }
-        }
-        if let Some(dt) = &raw.data_type {
-            if let Some(t) = resolve_ref(cache, &model, dt, diags) {
-                if model.nodes[t.index()].class != NodeClass::DataType {
-                    let class = model.nodes[t.index()].class.name();
-                    diags.push(
-                        Diagnostic::new(
-                            Code::BadDataType,
-                            format!("DataType `{}` is {} {class}, not a DataType", dt.value, article(class)),
-                        )
-                        .at(dt.span)
-                        .help("name a DataType node (an alias such as Int32, or its NodeId)"),
-                    );
-                } else {
-                    attrs.data_type = Some(t);
-                }
-            }
-        }
-        if let Some(m) = &raw.method_declaration_id {
-            attrs.method_declaration = resolve_ref(cache, &model, m, diags);
-        }
-        for r in &raw.references {
-            let cached = cache.get(r.reference_type.value.as_str()).copied();
-            let rt = match cached.map(|t| Ok(model.nodes[t.index()].id.clone())).unwrap_or_else(|| resolve_in(ctx, &model, &r.reference_type, diags)) {
-                Ok(id) => match cached.or_else(|| model.lookup(&id)) {
-                    Some(t) if model.nodes[t.index()].class == NodeClass::ReferenceType => {
-                        if cached.is_none() {
-                            cache.insert(r.reference_type.value.clone(), t);
-                        }
-                        t
-                    }
-                    Some(t) => {
-                        let class = model.nodes[t.index()].class.name();
-                        diags.push(
-                            Diagnostic::new(
-                                Code::BadReferenceType,
-                                format!("ReferenceType `{}` is {} {class}, not a ReferenceType", r.reference_type.value, article(class)),
-                            )
-                            .at(r.reference_type.span)
-                            .help("use a ReferenceType such as HasComponent (i=47)"),
-                        );
-                        continue;
-                    }
-                    None => {
-                        diags.push(
-                            Diagnostic::new(
-                                Code::BadReferenceType,
-                                format!("ReferenceType `{}` names no loaded node", r.reference_type.value),
-                            )
-                            .at(r.reference_type.span)
-                            .help("load the model that defines the reference type"),
-                        );
-                        continue;
-                    }
-                },
-                Err(d) => {
-                    diags.push(d);
-                    broken.insert(ix);
+    for (part, links) in [(first, earlier), (second, later)] {
+        diags.extend(links.diags);
+        broken.extend(links.broken);
+        let mut from = 0;
+        for (&(ix, _, _), found) in part.iter().zip(links.nodes) {
+            let node = &mut model.nodes[ix.index()];
+            node.attrs.array_dimensions = found.array_dimensions;
+            node.attrs.data_type = found.data_type;
+            node.attrs.method_declaration = found.method_declaration;
+            node.parent = found.parent;
+            for &(reference_type, target, forward, span) in &links.references[from..found.references_end as usize] {
+                let (src, dst) = if forward { (ix, target) } else { (target, ix) };
+                if !seen_refs.insert((src, reference_type, dst)) {
                     continue;
                 }
-            };
-            let Some(target) = resolve_ref(cache, &model, &r.target, diags) else {
-                broken.insert(ix);
-                continue;
-            };
-            let (src, dst) = if r.is_forward { (ix, target) } else { (target, ix) };
-            if !seen_refs.insert((src, rt, dst)) {
-                continue;
+                model.nodes[ix.index()].references.push(Reference { reference_type, target, forward, declared: true, span });
+                incoming.push((target, Reference { reference_type, target: ix, forward: !forward, declared: false, span }));
             }
-            model.nodes[ix.index()].references.push(Reference {
-                reference_type: rt,
-                target,
-                forward: r.is_forward,
-                declared: true,
-                span: r.span,
-            });
-            incoming.push((target, Reference { reference_type: rt, target: ix, forward: !r.is_forward, declared: false, span: r.span }));
+            from = found.references_end as usize;
         }
-        if let Some(p) = &raw.parent_node_id {
-            if let Ok(id) = resolve_in(ctx, &model, p, diags) {
-                model.nodes[ix.index()].parent = model.lookup(&id);
-            }
-        }
-        let node = &mut model.nodes[ix.index()];
-        node.attrs = attrs;
-        node.value_xml = raw.value.take();
-        node.definition = raw.definition.take();
-        node.extensions = std::mem::take(&mut raw.extensions);
     }
     model.files = files.iter().map(|f| f.raw.file).zip(contexts).collect();
+    model.sources = sources;
+    model.value_arenas = value_arenas;
     drop(pending);
+    // The raw files are not needed any more: another thread frees them while this one goes on.
+    crate::join(move || drop(files), || link(&mut model, incoming, &broken, diags));
+    model
+}
+
+/// Passes 3 to 8, on the model with its references resolved.
+fn link(model: &mut Model, incoming: Vec<(NodeIx, Reference)>, broken: &HashSet<NodeIx>, diags: &mut Diagnostics) {
+    // Each node's inverse references go after its own, in the order they were found; room for them is
+    // made once per node.
+    let mut extra = vec![0u32; model.nodes.len()];
+    for (target, _) in &incoming {
+        extra[target.index()] += 1;
+    }
+    for (node, n) in model.nodes.iter_mut().zip(extra) {
+        node.references.reserve_exact(n as usize);
+    }
     for (target, r) in incoming {
         model.nodes[target.index()].references.push(r);
     }
 
     // Pass 3: hierarchy flags, supertypes, type definitions, modelling rules, parents.
-    link_types(&mut model, &broken, diags);
+    link_types(model, broken, diags);
 
-    // Pass 4: instance declarations.
-    build_members(&mut model, diags);
+    // Passes 4 to 6 and 8 only read the model and do not depend on one another, except the value check on
+    // the data types: instance declarations and method arguments on one thread, data types and values on
+    // this one. Each pass keeps its diagnostics, which are added in pass order.
+    let m = &*model;
+    let ((members, members_said, methods, methods_said), (data_types, data_types_said, values_said)) = crate::join(
+        || {
+            let (mut members_said, mut methods_said) = (Diagnostics::new(), Diagnostics::new());
+            let members = build_members(m, &mut members_said);
+            let methods = methods(m, &mut methods_said);
+            (members, members_said, methods, methods_said)
+        },
+        || {
+            let (mut data_types_said, mut values_said) = (Diagnostics::new(), Diagnostics::new());
+            let data_types = crate::datatypes::classify(m, &mut data_types_said);
+            check_values(m, &data_types, &mut values_said);
+            (data_types, data_types_said, values_said)
+        },
+    );
+    model.members = members;
+    model.data_types = data_types;
+    model.methods = methods;
+    diags.extend(members_said);
+    diags.extend(data_types_said);
+    diags.extend(methods_said);
+    // Pass 7: state machines, from the instance declarations.
+    state_machines(model, diags);
+    diags.extend(values_said);
+}
 
-    // Pass 5-7: data types, methods, state machines.
-    crate::datatypes::classify(&mut model, diags);
-    methods(&mut model, diags);
-    state_machines(&mut model, diags);
+/// What pass 2 reads: the model with every node indexed, and the raw files it came from.
+struct Pass2<'m> {
+    model: &'m Model,
+    files: &'m [crate::load::LoadedFile],
+    sources: &'m SourceMap,
+    contexts: &'m [FileContext],
+    /// Per file: whether numeric NodeIds may take the fast path (see [`numeric_node`]).
+    numeric_fast: &'m [bool],
+}
 
-    // Pass 8: values against DataTypes.
-    check_values(&model, diags);
-    model
+/// What pass 2 found for a run of nodes, with the diagnostics in the order it found them.
+struct Links {
+    nodes: Vec<NodeLinks>,
+    /// The references of all the nodes, resolved: type, target, direction, span.
+    references: Vec<(NodeIx, NodeIx, bool, Span)>,
+    broken: Vec<NodeIx>,
+    diags: Diagnostics,
+}
+
+/// What pass 2 found for one node.
+struct NodeLinks {
+    array_dimensions: Vec<u32>,
+    data_type: Option<NodeIx>,
+    method_declaration: Option<NodeIx>,
+    /// Where the node's references end in [`Links::references`] (they start where the previous node's end).
+    references_end: u32,
+    parent: Option<NodeIx>,
+}
+
+impl Pass2<'_> {
+    /// Resolves the attributes that name nodes and the references of the `pending` nodes.
+    fn links(&self, pending: &[(NodeIx, u32, u32)]) -> Links {
+        let model = self.model;
+        let mut out = Links { nodes: Vec::with_capacity(pending.len()), references: Vec::new(), broken: Vec::new(), diags: Diagnostics::new() };
+        let diags = &mut out.diags;
+        // Per file: NodeId strings already resolved (reference types repeat thousands of times), keyed by
+        // the strings as the file writes them.
+        let mut caches: Vec<FxHashMap<&str, NodeIx>> = self.contexts.iter().map(|_| FxHashMap::default()).collect();
+        for &(ix, fi, ni) in pending {
+            let raw = &self.files[fi as usize].raw.nodes[ni as usize];
+            let text = self.sources.get(self.files[fi as usize].raw.file).text.as_str();
+            let ctx = &self.contexts[fi as usize];
+            let fast = self.numeric_fast[fi as usize];
+            let cache = &mut caches[fi as usize];
+            let mut array_dimensions = Vec::new();
+            if let Some(ad) = &raw.array_dimensions {
+                for part in ad.value.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+                    match part.parse::<u32>() {
+                        Ok(v) => array_dimensions.push(v),
+                        Err(_) => diags.push(
+                            Diagnostic::new(Code::BadAttribute, format!("ArrayDimensions=\"{}\" is not a list of numbers", ad.value))
+                                .at(ad.span)
+                                .with_span_label(format!("`{part}` is not a UInt32"))
+                                .help("write a comma-separated list such as 3,3 (0 for an unknown length)"),
+                        ),
+                    }
+                }
+            }
+            let mut data_type = None;
+            if let Some(dt) = &raw.data_type {
+                if let Some(t) = resolve_cached(cache, ctx, fast, model, ix, dt, text, diags) {
+                    if model.nodes[t.index()].class != NodeClass::DataType {
+                        let class = model.nodes[t.index()].class.name();
+                        diags.push(
+                            Diagnostic::new(
+                                Code::BadDataType,
+                                format!("DataType `{}` is {} {class}, not a DataType", dt.get(text), article(class)),
+                            )
+                            .at(dt.span)
+                            .help("name a DataType node (an alias such as Int32, or its NodeId)"),
+                        );
+                    } else {
+                        data_type = Some(t);
+                    }
+                }
+            }
+            let method_declaration =
+                raw.method_declaration_id.as_ref().and_then(|m| resolve_cached(cache, ctx, fast, model, ix, m, text, diags));
+            for r in &raw.references {
+                // Numeric NodeIds need neither the text nor the cache; everything else, and every problem,
+                // takes the general path.
+                let numeric = fast.then(|| numeric_node(model, ctx, &r.reference_type)).flatten();
+                let rt = match numeric {
+                    Some(t) if model.nodes[t.index()].class == NodeClass::ReferenceType => t,
+                    _ => {
+                        let rt_text = r.reference_type.get(text);
+                        let cached = numeric.or_else(|| cache.get(rt_text).copied());
+                        let found = match cached {
+                            Some(t) => Ok(Some(t)),
+                            None => resolve_in(ctx, model, rt_text, r.reference_type.span, diags).map(|id| model.lookup(&id)),
+                        };
+                        match found {
+                            Ok(Some(t)) if model.nodes[t.index()].class == NodeClass::ReferenceType => {
+                                if cached.is_none() {
+                                    cache.insert(rt_text, t);
+                                }
+                                t
+                            }
+                            Ok(Some(t)) => {
+                                let class = model.nodes[t.index()].class.name();
+                                diags.push(
+                                    Diagnostic::new(
+                                        Code::BadReferenceType,
+                                        format!("ReferenceType `{rt_text}` is {} {class}, not a ReferenceType", article(class)),
+                                    )
+                                    .at(r.reference_type.span)
+                                    .help("use a ReferenceType such as HasComponent (i=47)"),
+                                );
+                                continue;
+                            }
+                            Ok(None) => {
+                                diags.push(
+                                    Diagnostic::new(Code::BadReferenceType, format!("ReferenceType `{rt_text}` names no loaded node"))
+                                        .at(r.reference_type.span)
+                                        .help("load the model that defines the reference type"),
+                                );
+                                continue;
+                            }
+                            Err(d) => {
+                                diags.push(d);
+                                out.broken.push(ix);
+                                continue;
+                            }
+                        }
+                    }
+                };
+                let Some(target) = resolve_cached(cache, ctx, fast, model, ix, &r.target, text, diags) else {
+                    out.broken.push(ix);
+                    continue;
+                };
+                out.references.push((rt, target, r.is_forward, r.span));
+            }
+            let mut parent = None;
+            if let Some(p) = &raw.parent_node_id {
+                parent = match fast.then(|| numeric_node(model, ctx, p)).flatten() {
+                    Some(p) => Some(p),
+                    None => resolve_in(ctx, model, p.get(text), p.span, diags).ok().and_then(|id| model.lookup(&id)),
+                };
+            }
+            out.nodes.push(NodeLinks { array_dimensions, data_type, method_declaration, references_end: out.references.len() as u32, parent });
+        }
+        out
+    }
 }
 
 /// Resolves a NodeId or alias written in a file. An alias the file forgot to declare that is the BrowseName
@@ -315,23 +419,72 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
 pub(crate) fn resolve_in(
     ctx: &FileContext,
     model: &Model,
-    s: &crate::source::Spanned<String>,
+    s: &str,
+    span: Span,
     diags: &mut Diagnostics,
 ) -> Result<NodeId, Diagnostic> {
-    match crate::load::resolve_node_id_in(&ctx.ns_map, &ctx.aliases, s, &model.namespaces) {
-        Err(d) if d.code == Code::UnknownAlias => match model.ns0_type_names.get(s.value.trim()) {
+    match crate::load::resolve_node_id_str(&ctx.ns_map, &ctx.aliases, s, span, &model.namespaces) {
+        Err(d) if d.code == Code::UnknownAlias => match model.ns0_type_names.get(s.trim()) {
             Some(&ix) => {
                 let id = model.node(ix).id.clone();
                 diags.push(
-                    Diagnostic::new(Code::AliasByBrowseName, format!("alias `{}` is not declared; using the base type `{}` ({id})", s.value.trim(), s.value.trim()))
-                        .at(s.span)
-                        .help(format!("declare it: <Alias Alias=\"{}\">{id}</Alias>", s.value.trim())),
+                    Diagnostic::new(Code::AliasByBrowseName, format!("alias `{}` is not declared; using the base type `{}` ({id})", s.trim(), s.trim()))
+                        .at(span)
+                        .help(format!("declare it: <Alias Alias=\"{}\">{id}</Alias>", s.trim())),
                 );
                 Ok(id)
             }
             None => Err(d),
         },
         other => other,
+    }
+}
+
+/// The node a numeric NodeId string (`i=N`, `ns=I;i=N`) of a file names, found without the alias table,
+/// the cache, the text or an allocation. `None` for any other string and for a NodeId that names no node:
+/// the general path then resolves it and reports what is wrong. Only for files where no alias looks like a
+/// NodeId.
+fn numeric_node(model: &Model, ctx: &FileContext, s: &RawStr) -> Option<NodeIx> {
+    let (ns, n) = s.numeric_node_id()?;
+    model.lookup(&NodeId::numeric(*ctx.ns_map.get(ns as usize)?, n))
+}
+
+/// Resolves a NodeId or alias written in a file to a node: numeric NodeIds on the fast path where `fast`
+/// allows it, other strings through the file's cache of strings already resolved. Problems are reported
+/// (a dangling one as coming from node `from`) and give `None`.
+#[allow(clippy::too_many_arguments)]
+fn resolve_cached<'s>(
+    cache: &mut FxHashMap<&'s str, NodeIx>,
+    ctx: &FileContext,
+    fast: bool,
+    model: &Model,
+    from: NodeIx,
+    raw: &'s RawStr,
+    text: &'s str,
+    diags: &mut Diagnostics,
+) -> Option<NodeIx> {
+    if let Some(t) = fast.then(|| numeric_node(model, ctx, raw)).flatten() {
+        return Some(t);
+    }
+    let (s, span) = (raw.get(text), raw.span);
+    if let Some(&t) = cache.get(s) {
+        return Some(t);
+    }
+    match resolve_in(ctx, model, s, span, diags) {
+        Ok(id) => match model.lookup(&id) {
+            Some(t) => {
+                cache.insert(s, t);
+                Some(t)
+            }
+            None => {
+                diags.push(dangling(model, from, &id, span));
+                None
+            }
+        },
+        Err(d) => {
+            diags.push(d);
+            None
+        }
     }
 }
 
@@ -549,7 +702,8 @@ fn link_types(model: &mut Model, broken: &HashSet<NodeIx>, diags: &mut Diagnosti
     }
 }
 
-fn build_members(model: &mut Model, diags: &mut Diagnostics) {
+/// Pass 4: the instance declarations of every ObjectType and VariableType.
+fn build_members(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeIx, Vec<Member>> {
     // Types in an order where supertypes come first.
     let types: Vec<NodeIx> = (0..model.nodes.len() as u32)
         .map(NodeIx)
@@ -558,38 +712,40 @@ fn build_members(model: &mut Model, diags: &mut Diagnostics) {
     let mut depth: Vec<(usize, NodeIx)> = types.iter().map(|&t| (model.super_chain(t).len(), t)).collect();
     depth.sort();
     let mut members: BTreeMap<NodeIx, Vec<Member>> = BTreeMap::new();
+    // A type's own children by BrowseName (reused from type to type).
+    let mut own: FxHashMap<&QualifiedName, NodeIx> = FxHashMap::default();
     for (_, t) in depth {
         let mut list: Vec<Member> = model.node(t).super_type.and_then(|s| members.get(&s)).cloned().unwrap_or_default();
-        let mut own: HashMap<QualifiedName, NodeIx> = HashMap::new();
-        for (rt, child) in model.children(t).collect::<Vec<_>>() {
-            let bn = model.node(child).browse_name.clone();
-            if let Some(&prev) = own.get(&bn) {
+        own.clear();
+        for (rt, child) in model.children(t) {
+            let bn = &model.node(child).browse_name;
+            if let Some(&prev) = own.get(bn) {
                 if prev != child {
                     collision(model, t, prev, child, diags);
                 }
                 continue;
             }
-            own.insert(bn.clone(), child);
-            match list.iter_mut().find(|m| m.browse_name == bn) {
+            own.insert(bn, child);
+            match list.iter_mut().find(|m| m.browse_name == *bn) {
                 Some(m) => {
                     m.overrides = Some(m.node);
                     m.node = child;
                     m.declared_in = t;
                     m.reference_type = rt;
                 }
-                None => list.push(Member { browse_name: bn, node: child, declared_in: t, reference_type: rt, overrides: None }),
+                None => list.push(Member { browse_name: bn.clone(), node: child, declared_in: t, reference_type: rt, overrides: None }),
             }
         }
         members.insert(t, list);
     }
     // Collisions among the children of instances and instance declarations too.
+    let mut found = Vec::new();
     for i in 0..model.nodes.len() {
         let ix = NodeIx(i as u32);
         if model.node(ix).class.is_type() {
             continue;
         }
-        let mut own: HashMap<&QualifiedName, NodeIx> = HashMap::new();
-        let mut found = Vec::new();
+        own.clear();
         for (_, child) in model.children(ix) {
             let bn = &model.node(child).browse_name;
             match own.get(bn) {
@@ -600,11 +756,11 @@ fn build_members(model: &mut Model, diags: &mut Diagnostics) {
                 }
             }
         }
-        for (a, b) in found {
+        for (a, b) in found.drain(..) {
             collision(model, ix, a, b, diags);
         }
     }
-    model.members = members;
+    members
 }
 
 fn collision(model: &Model, parent: NodeIx, a: NodeIx, b: NodeIx, diags: &mut Diagnostics) {
@@ -628,7 +784,8 @@ fn collision(model: &Model, parent: NodeIx, a: NodeIx, b: NodeIx, diags: &mut Di
     );
 }
 
-fn methods(model: &mut Model, diags: &mut Diagnostics) {
+/// Pass 6: the arguments of every method.
+fn methods(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeIx, MethodInfo> {
     let mut out = BTreeMap::new();
     for i in 0..model.nodes.len() {
         let ix = NodeIx(i as u32);
@@ -643,8 +800,9 @@ fn methods(model: &mut Model, diags: &mut Diagnostics) {
                 (0, "OutputArguments") => 1,
                 _ => continue,
             };
-            let Some(value) = model.value(child) else { continue };
-            let args = match value.and_then(|v| decode_arguments(model, c.file, v)) {
+            // The value is checked by decoding it without copies; the arguments are then read in place.
+            let (Some(value), Some(el)) = (model.decode_value(child, Content::Shape), model.value_element(child)) else { continue };
+            let args = match value.and_then(|v| decode_arguments(model, c.file, v, el)) {
                 Ok(a) => a,
                 Err(why) => {
                     diags.push(
@@ -663,19 +821,22 @@ fn methods(model: &mut Model, diags: &mut Diagnostics) {
         }
         out.insert(ix, info);
     }
-    model.methods = out;
+    out
 }
 
-fn decode_arguments(model: &Model, file: crate::source::FileId, v: Variant) -> Result<Vec<Argument>, String> {
-    let items = match v {
-        Variant::Array(_, items) => items,
-        other => vec![other],
+/// The arguments in a decoded InputArguments or OutputArguments value; `el` is the value's element, from
+/// which the Argument structures are read.
+fn decode_arguments(model: &Model, file: crate::source::FileId, v: Variant, el: ValueElement<'_>) -> Result<Vec<Argument>, String> {
+    // An array's items are its element's children, one for one.
+    let items: Vec<(Variant, ValueElement<'_>)> = match v {
+        Variant::Array(_, items) => items.into_iter().zip(el.children()).collect(),
+        other => vec![(other, el)],
     };
     let ctx = &model.files[&file];
     let mut out = Vec::new();
-    for it in items {
-        let Variant::ExtensionObject(eo) = it else { return Err("an element is not an ExtensionObject".into()) };
-        let body = eo.body.ok_or("an Argument has no body")?;
+    for (it, item) in items {
+        let Variant::ExtensionObject(_) = it else { return Err("an element is not an ExtensionObject".into()) };
+        let body = item.child("Body").and_then(|b| b.children().next()).ok_or("an Argument has no body")?;
         let name = body.child_text("Name").unwrap_or("").trim().to_string();
         let data_type = match body.child("DataType").and_then(|d| d.child_text("Identifier")) {
             Some(t) => {
@@ -690,7 +851,7 @@ fn decode_arguments(model: &Model, file: crate::source::FileId, v: Variant) -> R
         };
         let array_dimensions = body
             .child("ArrayDimensions")
-            .map(|a| a.children.iter().filter_map(|c| c.text.trim().parse().ok()).collect())
+            .map(|a| a.children().filter_map(|c| c.text().trim().parse().ok()).collect())
             .unwrap_or_default();
         let description = body.child("Description").and_then(|d| d.child_text("Text")).map(|s| s.to_string()).filter(|s| !s.is_empty());
         out.push(Argument { name, data_type, value_rank, array_dimensions, description });
@@ -775,8 +936,8 @@ fn state_machines(model: &mut Model, diags: &mut Diagnostics) {
 }
 
 /// Whether a value of built-in type `have` may stand for DataType `dt`.
-fn value_fits(model: &Model, dt: NodeIx, have: BuiltinType) -> bool {
-    let Some(info) = model.data_types.get(&dt) else { return true };
+fn value_fits(model: &Model, data_types: &BTreeMap<NodeIx, DataTypeInfo>, dt: NodeIx, have: BuiltinType) -> bool {
+    let Some(info) = data_types.get(&dt) else { return true };
     match &info.kind {
         DataTypeKind::AbstractBuiltin => {
             let n = model.node(dt).id.ns0();
@@ -794,16 +955,18 @@ fn value_fits(model: &Model, dt: NodeIx, have: BuiltinType) -> bool {
     }
 }
 
-fn check_values(model: &Model, diags: &mut Diagnostics) {
+/// Pass 8: every value against its node's DataType (given before they join the model) and ValueRank.
+fn check_values(model: &Model, data_types: &BTreeMap<NodeIx, DataTypeInfo>, diags: &mut Diagnostics) {
     for (i, node) in model.nodes.iter().enumerate() {
         let ix = NodeIx(i as u32);
-        let Some(xml) = &node.value_xml else { continue };
-        let v = match model.value(ix) {
+        // The check needs the type and shape of the value only, not copies of what it holds.
+        let Some(xml) = model.value_element(ix) else { continue };
+        let v = match model.decode_value(ix, Content::Shape) {
             Some(Ok(v)) => v,
             Some(Err(why)) => {
                 diags.push(
                     Diagnostic::new(Code::BadValue, format!("the value of `{}` cannot be decoded: {why}", node.browse_name.name))
-                        .at(xml.span)
+                        .at(xml.span())
                         .help("see OPC UA Part 6, 5.3 for the XML encoding of values"),
                 );
                 continue;
@@ -812,18 +975,18 @@ fn check_values(model: &Model, diags: &mut Diagnostics) {
         };
         let Some(dt) = node.attrs.data_type else { continue };
         let Some(have) = v.builtin() else { continue };
-        if !value_fits(model, dt, have) {
+        if !value_fits(model, data_types, dt, have) {
             diags.push(
                 Diagnostic::new(
                     Code::ValueTypeMismatch,
                     format!(
                         "the value of `{}` is a {}, but its DataType is {}",
                         node.browse_name.name,
-                        xml.name,
+                        xml.name(),
                         model.node(dt).browse_name.name
                     ),
                 )
-                .at(xml.span)
+                .at(xml.span())
                 .with_span_label(format!("a {}", have.type_name()))
                 .help("a server would reject this value; write it in the DataType's encoding"),
             );
@@ -840,7 +1003,7 @@ fn check_values(model: &Model, diags: &mut Diagnostics) {
                         if v.is_array() { "an array" } else { "a scalar" }
                     ),
                 )
-                .at(xml.span)
+                .at(xml.span())
                 .help("ValueRank -1 is a scalar, 1 an array, 0 one or more dimensions, -2 any, -3 scalar or array"),
             );
         }

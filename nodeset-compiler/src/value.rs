@@ -1,12 +1,65 @@
 //! Decoding `<Value>` trees into typed values.
 //!
-//! The parser keeps a value as an [`XmlElement`] tree. This module turns it into a [`Variant`]: every
-//! built-in scalar, `ListOf…` arrays, and ExtensionObjects whose TypeId is resolved and whose body is kept as a
-//! tree (its fields are decoded against the DataType's definition by whoever needs them). NodeIds inside
-//! values are written with file-local namespace indices, so decoding takes a function that maps them.
+//! The parser keeps a value in its file's [`ValueArena`](crate::raw::ValueArena); a value can also be an
+//! owned [`XmlElement`] tree. This module turns either into a [`Variant`]: every built-in scalar, `ListOf…`
+//! arrays, and ExtensionObjects whose TypeId is resolved and whose body is kept as a tree (its fields are
+//! decoded against the DataType's definition by whoever needs them). NodeIds inside values are written with
+//! file-local namespace indices, so decoding takes a function that maps them.
 
-use crate::nodeid::{base64_decode, parse_guid, NodeId, QualifiedName};
-use crate::raw::{LocalizedText, XmlElement};
+use crate::nodeid::{base64_decode, base64_valid, parse_guid, NodeId, QualifiedName};
+use crate::raw::{LocalizedText, ValueElement, XmlElement};
+
+/// An element as the decoder reads it: an owned [`XmlElement`] or a [`ValueElement`] read in place.
+pub(crate) trait XmlNode<'a>: Copy {
+    fn name(self) -> &'a str;
+    fn text(self) -> &'a str;
+    fn children(self) -> impl Iterator<Item = Self>;
+    fn to_xml(self) -> XmlElement;
+
+    fn child(self, name: &str) -> Option<Self> {
+        self.children().find(|c| c.name() == name)
+    }
+
+    fn child_text(self, name: &str) -> Option<&'a str> {
+        self.child(name).map(|c| c.text())
+    }
+}
+
+impl<'a> XmlNode<'a> for &'a XmlElement {
+    fn name(self) -> &'a str {
+        &self.name
+    }
+
+    fn text(self) -> &'a str {
+        &self.text
+    }
+
+    fn children(self) -> impl Iterator<Item = Self> {
+        self.children.iter()
+    }
+
+    fn to_xml(self) -> XmlElement {
+        self.clone()
+    }
+}
+
+impl<'a> XmlNode<'a> for ValueElement<'a> {
+    fn name(self) -> &'a str {
+        ValueElement::name(&self)
+    }
+
+    fn text(self) -> &'a str {
+        ValueElement::text(&self)
+    }
+
+    fn children(self) -> impl Iterator<Item = Self> {
+        ValueElement::children(&self)
+    }
+
+    fn to_xml(self) -> XmlElement {
+        ValueElement::to_xml(&self)
+    }
+}
 
 /// The built-in types of OPC UA Part 6, by their ns0 numeric id.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -240,44 +293,68 @@ pub type NodeIdMapper<'a> = dyn Fn(&str) -> Result<NodeId, String> + 'a;
 /// Maps a file-local namespace index (of a QualifiedName) to a global one.
 pub type NsMapper<'a> = dyn Fn(u16) -> Option<u16> + 'a;
 
-/// Decodes one value element. Errors name the element and what is wrong with it.
-pub fn decode(el: &XmlElement, ids: &NodeIdMapper, ns: &NsMapper) -> Result<Variant, String> {
-    decode_depth(el, ids, ns, 0)
+/// How much of a value decoding copies out of the file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Content {
+    /// Everything: the value [`decode`] returns.
+    All,
+    /// What a check of the value against its DataType needs. The value decodes, or fails with the same
+    /// error, as with `All`, with the same type and shape, but nothing it holds is copied: strings,
+    /// localized texts and byte strings (checked, not decoded) are empty, ExtensionObjects have no body.
+    Shape,
 }
 
-fn decode_depth(el: &XmlElement, ids: &NodeIdMapper, ns: &NsMapper, depth: usize) -> Result<Variant, String> {
+/// Decodes one value element. Errors name the element and what is wrong with it.
+pub fn decode(el: &XmlElement, ids: &NodeIdMapper, ns: &NsMapper) -> Result<Variant, String> {
+    decode_node(el, ids, ns, Content::All)
+}
+
+/// Decodes one value element read in place from its file's value arena.
+pub fn decode_element(el: ValueElement<'_>, ids: &NodeIdMapper, ns: &NsMapper) -> Result<Variant, String> {
+    decode_node(el, ids, ns, Content::All)
+}
+
+/// Decodes an element, copying as much as `content` says.
+pub(crate) fn decode_node<'a, E: XmlNode<'a>>(el: E, ids: &NodeIdMapper, ns: &NsMapper, content: Content) -> Result<Variant, String> {
+    decode_depth(el, ids, ns, 0, content)
+}
+
+fn decode_depth<'a, E: XmlNode<'a>>(el: E, ids: &NodeIdMapper, ns: &NsMapper, depth: usize, content: Content) -> Result<Variant, String> {
     if depth > 64 {
         return Err("the value is nested more than 64 levels deep".into());
     }
-    if let Some(item) = el.name.strip_prefix("ListOf") {
-        let b = BuiltinType::from_xml_name(item).ok_or_else(|| format!("<{}> is not a known array type", el.name))?;
-        let mut items = Vec::with_capacity(el.children.len());
-        for c in &el.children {
-            if c.name != item {
-                return Err(format!("<{}> inside <{}>: expected <{item}>", c.name, el.name));
+    let name = el.name();
+    if let Some(item) = name.strip_prefix("ListOf") {
+        let b = BuiltinType::from_xml_name(item).ok_or_else(|| format!("<{name}> is not a known array type"))?;
+        let mut items = Vec::new();
+        for c in el.children() {
+            if c.name() != item {
+                return Err(format!("<{}> inside <{name}>: expected <{item}>", c.name()));
             }
-            items.push(decode_scalar(b, c, ids, ns, depth)?);
+            items.push(scalar(b, c, ids, ns, depth, content)?);
         }
         return Ok(Variant::Array(b, items));
     }
-    let b = BuiltinType::from_xml_name(&el.name).ok_or_else(|| format!("<{}> is not a built-in type", el.name))?;
-    decode_scalar(b, el, ids, ns, depth)
+    let b = BuiltinType::from_xml_name(name).ok_or_else(|| format!("<{name}> is not a built-in type"))?;
+    scalar(b, el, ids, ns, depth, content)
 }
 
-fn num<T: std::str::FromStr>(el: &XmlElement) -> Result<T, String> {
-    let t = el.text.trim();
-    t.parse::<T>().map_err(|_| format!("<{}>{t}</{}> is not a valid {}", el.name, el.name, el.name))
+fn num<'a, T: std::str::FromStr, E: XmlNode<'a>>(el: E) -> Result<T, String> {
+    let t = el.text().trim();
+    let name = el.name();
+    t.parse::<T>().map_err(|_| format!("<{name}>{t}</{name}> is not a valid {name}"))
 }
 
-fn float<T: std::str::FromStr>(el: &XmlElement) -> Result<T, String> {
-    let t = el.text.trim();
+fn float<'a, T: std::str::FromStr, E: XmlNode<'a>>(el: E) -> Result<T, String> {
+    let t = el.text().trim();
     let t = match t {
         "INF" => "inf",
         "-INF" => "-inf",
         "NaN" => "NaN",
         other => other,
     };
-    t.parse::<T>().map_err(|_| format!("<{}>{}</{}> is not a valid {}", el.name, el.text.trim(), el.name, el.name))
+    let name = el.name();
+    t.parse::<T>().map_err(|_| format!("<{name}>{}</{name}> is not a valid {name}", el.text().trim()))
 }
 
 /// Decodes an element known to hold a scalar of type `b`.
@@ -288,8 +365,22 @@ pub fn decode_scalar(
     ns: &NsMapper,
     depth: usize,
 ) -> Result<Variant, String> {
+    scalar(b, el, ids, ns, depth, Content::All)
+}
+
+fn scalar<'a, E: XmlNode<'a>>(
+    b: BuiltinType,
+    el: E,
+    ids: &NodeIdMapper,
+    ns: &NsMapper,
+    depth: usize,
+    content: Content,
+) -> Result<Variant, String> {
+    let all = content == Content::All;
+    // The text of `el` if everything is copied, else an empty string.
+    let copy = |s: &str| if all { s.to_string() } else { String::new() };
     Ok(match b {
-        BuiltinType::Boolean => match el.text.trim() {
+        BuiltinType::Boolean => match el.text().trim() {
             "true" | "1" => Variant::Boolean(true),
             "false" | "0" => Variant::Boolean(false),
             t => return Err(format!("<Boolean>{t}</Boolean> is not true or false")),
@@ -304,16 +395,17 @@ pub fn decode_scalar(
         BuiltinType::UInt64 => Variant::UInt64(num(el)?),
         BuiltinType::Float => Variant::Float(float(el)?),
         BuiltinType::Double => Variant::Double(float(el)?),
-        BuiltinType::String => Variant::String(el.text.clone()),
-        BuiltinType::DateTime => Variant::DateTime(el.text.trim().to_string()),
+        BuiltinType::String => Variant::String(copy(el.text())),
+        BuiltinType::DateTime => Variant::DateTime(copy(el.text().trim())),
         BuiltinType::Guid => {
-            let t = el.child_text("String").unwrap_or(&el.text);
+            let t = el.child_text("String").unwrap_or(el.text());
             Variant::Guid(parse_guid(t).ok_or_else(|| format!("`{}` is not a GUID", t.trim()))?)
         }
         BuiltinType::ByteString => {
-            Variant::ByteString(base64_decode(&el.text).ok_or_else(|| "the ByteString is not base64".to_string())?)
+            let bytes = if all { base64_decode(el.text()) } else { base64_valid(el.text()).then(Vec::new) };
+            Variant::ByteString(bytes.ok_or_else(|| "the ByteString is not base64".to_string())?)
         }
-        BuiltinType::XmlElement => Variant::XmlElement(el.clone()),
+        BuiltinType::XmlElement => Variant::XmlElement(el.to_xml()),
         BuiltinType::NodeId | BuiltinType::ExpandedNodeId => {
             let t = el.child_text("Identifier").unwrap_or("").trim();
             if t.is_empty() {
@@ -328,7 +420,7 @@ pub fn decode_scalar(
             }
         }
         BuiltinType::StatusCode => {
-            let t = el.child_text("Code").unwrap_or(&el.text).trim();
+            let t = el.child_text("Code").unwrap_or(el.text()).trim();
             let code = if let Some(h) = t.strip_prefix("0x").or_else(|| t.strip_prefix("0X")) {
                 u32::from_str_radix(h, 16).ok()
             } else {
@@ -342,8 +434,9 @@ pub fn decode_scalar(
                 None => 0,
             };
             let g = ns(idx).ok_or_else(|| format!("namespace index {idx} of a QualifiedName is not declared"))?;
-            Variant::QualifiedName(QualifiedName { ns: g, name: el.child_text("Name").unwrap_or("").trim().to_string() })
+            Variant::QualifiedName(QualifiedName { ns: g, name: copy(el.child_text("Name").unwrap_or("").trim()) })
         }
+        BuiltinType::LocalizedText if !all => Variant::LocalizedText(LocalizedText::default()),
         BuiltinType::LocalizedText => Variant::LocalizedText(LocalizedText {
             locale: el.child_text("Locale").map(|s| s.trim().to_string()).filter(|s| !s.is_empty()),
             text: el.child_text("Text").unwrap_or("").to_string(),
@@ -353,19 +446,19 @@ pub fn decode_scalar(
                 Some(t) if !t.trim().is_empty() => Some(ids(t.trim())?),
                 _ => None,
             };
-            let body = el.child("Body").and_then(|b| b.children.first().cloned());
+            let body = if all { el.child("Body").and_then(|b| b.children().next()).map(XmlNode::to_xml) } else { None };
             Variant::ExtensionObject(Box::new(ExtensionObject { type_id, body }))
         }
         BuiltinType::Variant => {
-            let inner = el.children.first().ok_or_else(|| "<Variant> is empty".to_string())?;
-            let inner = if inner.name == "Value" {
-                inner.children.first().ok_or_else(|| "<Variant><Value> is empty".to_string())?
+            let inner = el.children().next().ok_or_else(|| "<Variant> is empty".to_string())?;
+            let inner = if inner.name() == "Value" {
+                inner.children().next().ok_or_else(|| "<Variant><Value> is empty".to_string())?
             } else {
                 inner
             };
-            Variant::Variant(Box::new(decode_depth(inner, ids, ns, depth + 1)?))
+            Variant::Variant(Box::new(decode_depth(inner, ids, ns, depth + 1, content)?))
         }
-        BuiltinType::DataValue | BuiltinType::DiagnosticInfo => Variant::XmlElement(el.clone()),
+        BuiltinType::DataValue | BuiltinType::DiagnosticInfo => Variant::XmlElement(el.to_xml()),
     })
 }
 
@@ -389,6 +482,44 @@ mod tests {
         match r.ns {
             crate::nodeid::NsRef::Index(i) => Ok(NodeId { ns: i + 10, id: r.id }),
             crate::nodeid::NsRef::Uri(_) => Err("uri".into()),
+        }
+    }
+
+    #[test]
+    fn shape_decoding_fails_and_succeeds_as_full_decoding_does() {
+        let ns = |i: u16| (i < 3).then_some(i + 10);
+        let leaf = |name: &str, text: &str| el(name, text, vec![]);
+        let cases = vec![
+            leaf("String", " a b "),
+            leaf("DateTime", " 2020-01-01 "),
+            leaf("ByteString", "AQID\n BA=="),
+            leaf("ByteString", "AQ*D"),
+            leaf("ByteString", "AQ==A"),
+            leaf("ByteString", "A==="),
+            leaf("Int32", "x"),
+            el("LocalizedText", "", vec![leaf("Locale", "de"), leaf("Text", "t")]),
+            el("QualifiedName", "", vec![leaf("NamespaceIndex", "2"), leaf("Name", "n")]),
+            el("QualifiedName", "", vec![leaf("NamespaceIndex", "5"), leaf("Name", "n")]),
+            el("QualifiedName", "", vec![leaf("NamespaceIndex", "x")]),
+            el("ListOfString", "", vec![leaf("String", "a"), leaf("String", "b")]),
+            el("ListOfString", "", vec![leaf("String", "a"), leaf("Int32", "1")]),
+            el("ListOfLocalizedText", "", vec![el("LocalizedText", "", vec![leaf("Text", "t")])]),
+            el("ExtensionObject", "", vec![el("TypeId", "", vec![leaf("Identifier", "i=5")]), el("Body", "", vec![leaf("X", "")])]),
+            el("ExtensionObject", "", vec![el("TypeId", "", vec![leaf("Identifier", "q=5")])]),
+            el("Variant", "", vec![el("Value", "", vec![leaf("String", "s")])]),
+            el("Variant", "", vec![]),
+        ];
+        for c in &cases {
+            let all = decode_node(c, &ids, &ns, Content::All);
+            let shape = decode_node(c, &ids, &ns, Content::Shape);
+            match (&all, &shape) {
+                (Ok(a), Ok(s)) => assert_eq!((a.builtin(), a.is_array()), (s.builtin(), s.is_array()), "{c:?}"),
+                (Err(a), Err(s)) => assert_eq!(a, s),
+                _ => panic!("{c:?}: {all:?} but {shape:?}"),
+            }
+        }
+        for s in ["", "AQID", "AQ ID\r\n", "AQ=", "AQ==", "AQ===", "A=Q", "*", "\u{e9}"] {
+            assert_eq!(base64_valid(s), base64_decode(s).is_some(), "{s:?}");
         }
     }
 

@@ -393,7 +393,7 @@ fn arrays() {
         (m.node(calibration).attrs.value_rank, m.node(calibration).attrs.array_dimensions.as_slice()),
         (Some(2), &[2, 3][..])
     );
-    assert!(m.node(calibration).value_xml.is_none());
+    assert!(m.value_xml(calibration).is_none());
     let names = member(m, t, "ChannelNames").node;
     assert_eq!(
         value(m, names),
