@@ -71,7 +71,21 @@ pub fn plan(deny_warnings: bool) -> Result<Vec<(PathBuf, Vec<OutFile>)>, String>
     let modules: Vec<(String, String)> = namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
     rust.files.push(rust_emit::models_mod(&modules, COMMAND));
     rust.files.push(rust_emit::rustfmt_toml());
-    Ok(vec![(root.join("generated/src/models"), rust.files)])
+    // Modelica: one package per namespace (and the used part of ns0, and the support package).
+    let mcfg = namespaces
+        .iter()
+        .fold(nodeset_compiler::emit::modelica::ModelicaConfig::new(), |c, n| c.namespace(n.uri.clone()));
+    let modelica = nodeset_compiler::emit::modelica::generate_with_diagnostics(model, &mcfg);
+    let mut mdiags = modelica.diagnostics;
+    if deny_warnings {
+        mdiags.deny_warnings();
+    }
+    mdiags.sort(&model.sources);
+    eprint!("{}", mdiags.render(&model.sources));
+    if mdiags.has_errors() {
+        return Err("Modelica generation failed; generated/ is left as it was".into());
+    }
+    Ok(vec![(root.join("generated/src/models"), rust.files), (root.join("generated/modelica"), modelica.files)])
 }
 
 pub fn run(args: Args) -> Result<(), String> {

@@ -1,1 +1,2 @@
+pub mod modelica;
 pub mod rust;

@@ -30,6 +30,8 @@ pub fn one_line(s: &str) -> String {
 /// The description string of an element: the original BrowseName first (so the one-to-one mapping stays
 /// visible), then the Description of the nodeset.
 pub fn description(original: &str, doc: Option<&str>) -> String {
+    // Some nodesets start a Description with the separator themselves (": The ...").
+    let doc = doc.map(|d| d.trim_start_matches(|c: char| c == ':' || c.is_whitespace()));
     match doc.map(one_line).filter(|d| !d.is_empty()) {
         Some(d) => string_literal(&format!("{original}: {d}")),
         None => string_literal(original),

@@ -1,0 +1,330 @@
+//! Instances: the objects and variables a nodeset puts into the address space (below the ObjectsFolder,
+//! without a ModellingRule).
+//!
+//! Every top-level instance (one whose parent belongs to another namespace, such as the ObjectsFolder or DI's
+//! DeviceSet) becomes a class `<Pkg>.Instances.<Name>` that extends the class of its type with the values
+//! of the nodeset; children that fill a placeholder become named components. `<Pkg>.Instances.Objects`
+//! holds one component per top-level instance and the DLR-style `OpcUaSupport.Nodes` record that lists every
+//! variable of the instances with its NodeId, DataType and initial value.
+
+use super::ctx::{identifier_text, node_id_text, node_id_type, Ctx, Owner};
+use super::objects::{escape_browse_name, ClassPlan, Mode, TypeRef};
+use super::text::{self, string_literal};
+use crate::model::{ids, Model, NodeIx};
+use crate::raw::NodeClass;
+use crate::value::{BuiltinType, Variant};
+use std::collections::BTreeSet;
+
+/// The NodeId of the ObjectsFolder.
+const OBJECTS_FOLDER: u32 = 85;
+
+/// The Server object: what hangs below it (NamespaceMetadata, diagnostics) describes the server, not the
+/// plant, and is not an instance of the information model.
+const SERVER: u32 = 2253;
+
+/// Whether a node hangs below the ObjectsFolder through instances only (no type, no instance declaration, not
+/// below the Server object).
+fn below_objects(m: &Model, ix: NodeIx) -> bool {
+    let mut cur = m.node(ix).parent;
+    let mut steps = 0;
+    while let Some(p) = cur {
+        let n = m.node(p);
+        if n.id.ns0() == Some(OBJECTS_FOLDER) {
+            return true;
+        }
+        if n.id.ns0() == Some(SERVER) {
+            return false;
+        }
+        if n.class.is_type() || n.modelling_rule.is_some() {
+            return false;
+        }
+        steps += 1;
+        if steps > 64 {
+            return false;
+        }
+        cur = n.parent;
+    }
+    false
+}
+
+/// The entry points of a namespace's instances: objects and variables of the namespace below the
+/// ObjectsFolder whose parent belongs to another namespace (or is the ObjectsFolder), in node order.
+pub fn top_level(m: &Model, ns: u16) -> Vec<NodeIx> {
+    (0..m.nodes.len() as u32)
+        .map(NodeIx)
+        .filter(|&ix| {
+            let n = m.node(ix);
+            n.id.ns == ns
+                && matches!(n.class, NodeClass::Object | NodeClass::Variable)
+                && n.modelling_rule.is_none()
+                && n.parent.is_some_and(|p| m.node(p).id.ns != ns)
+                && below_objects(m, ix)
+        })
+        .collect()
+}
+
+/// The BrowseNames from the ObjectsFolder to a node, '/'-separated.
+pub fn path_from_objects(m: &Model, ix: NodeIx) -> String {
+    let mut names = vec![escape_browse_name(&m.node(ix).browse_name.name)];
+    let mut cur = m.node(ix).parent;
+    let mut steps = 0;
+    while let Some(p) = cur {
+        if m.node(p).id.ns0() == Some(OBJECTS_FOLDER) || steps > 64 {
+            break;
+        }
+        names.push(escape_browse_name(&m.node(p).browse_name.name));
+        cur = m.node(p).parent;
+        steps += 1;
+    }
+    names.reverse();
+    names.join("/")
+}
+
+impl Ctx<'_> {
+    /// Plans the class of a top-level instance object.
+    pub fn plan_instance(&mut self, ix: NodeIx) {
+        let m = self.m;
+        let node = m.node(ix);
+        let owner = Owner::Instance(ix);
+        if self.plans.contains_key(&owner) {
+            return;
+        }
+        let td = node
+            .type_definition
+            .filter(|&t| m.node(t).class == NodeClass::ObjectType && !self.is_event_type(t))
+            .or_else(|| m.ns0(ids::BASE_OBJECT_TYPE))
+            .expect("namespace 0 has BaseObjectType");
+        self.plans.insert(owner, Default::default());
+        let base = self.type_class(td);
+        let own = self.own_children(ix, Mode::Instance);
+        let mut body = self.plan_body(owner, "", base.as_ref(), &own, Mode::Instance, true);
+        let doc = format!(
+            "{}<p>The instance {} of {} ({}).</p>",
+            node.doc().map(text::html_paragraphs).unwrap_or_default(),
+            text::html_escape(&path_from_objects(m, ix)),
+            text::html_escape(&m.qualified(td)),
+            text::html_escape(&node_id_text(m, &node.id))
+        );
+        let plan = ClassPlan {
+            keyword: "model",
+            desc: text::description(&node.browse_name.name, node.doc()),
+            doc_html: doc,
+            extends: base.as_ref().map(|b| (TypeRef::Class(b.key.clone()), std::mem::take(&mut body.mods))),
+            items: std::mem::take(&mut body.items),
+            equations: std::mem::take(&mut body.equations),
+            opcua: format!(
+                "__OPCUA(nodeId={}, browseName={}, browsePath={})",
+                string_literal(&node_id_text(m, &node.id)),
+                string_literal(&node.browse_name.name),
+                string_literal(&path_from_objects(m, ix))
+            ),
+        };
+        self.plans.entry(owner).or_default().main = Some(plan);
+        self.name_decls(owner);
+        self.run_deferred();
+    }
+
+    /// The `Instances.Objects` model of a namespace.
+    pub fn objects_model(&mut self, ns: u16) -> String {
+        let m = self.m;
+        let names = self.names(ns);
+        let pkg = self.pkg[ns as usize].clone();
+        let mut s = format!(
+            "model Objects {}\n",
+            string_literal(&format!("The instances of {} below the ObjectsFolder", m.namespace_uri(ns)))
+        );
+        // The Nodes record: every variable below the top-level instances.
+        let mut vars: Vec<NodeIx> = Vec::new();
+        let mut seen = BTreeSet::new();
+        for &top in &names.top_instances {
+            collect_variables(m, top, &mut vars, &mut seen);
+        }
+        let mut uris: Vec<u16> = vars.iter().map(|&v| m.node(v).id.ns).filter(|&n| n != 0).collect();
+        uris.sort();
+        uris.dedup();
+        let ns_list: Vec<String> = uris.iter().map(|&n| string_literal(m.namespace_uri(n))).collect();
+        let mut entries = Vec::new();
+        for &v in &vars {
+            entries.push(self.variable_node(v, &uris));
+        }
+        let sup = super::support::PACKAGE;
+        s.push_str(&format!("  parameter {sup}.Nodes nodes = {sup}.Nodes(\n    nsUri={{{}}}", ns_list.join(", ")));
+        if !entries.is_empty() {
+            s.push_str(&format!(
+                ",\n    nVars={},\n    vars={{\n      {}}})",
+                entries.len(),
+                entries.join(",\n      ")
+            ));
+        } else {
+            s.push(')');
+        }
+        s.push_str(&format!(
+            "\n    {}\n    annotation (Dialog(group=\"Configuration\"));\n",
+            string_literal(
+                "Every variable of the instances, as the configuration record of an OPC UA server or client block"
+            )
+        ));
+        let mut scope = self.scope::<NodeIx>();
+        scope.reserve("nodes");
+        for &top in &names.top_instances {
+            scope.add(&super::ctx::component_original(&m.node(top).browse_name.name), top);
+        }
+        let (idents, collisions) = scope.finish();
+        self.report(&format!("{pkg}.Instances.Objects"), "components", collisions, |k| {
+            (*k, Some(m.node(*k).browse_name.name.clone()))
+        });
+        for &top in &names.top_instances {
+            let n = m.node(top);
+            let ident = idents[&top].clone();
+            let annotation = format!(
+                "__OPCUA(browsePath={}, nodeId={})",
+                string_literal(&path_from_objects(m, top)),
+                string_literal(&node_id_text(m, &n.id))
+            );
+            let desc = text::description(&n.browse_name.name, n.doc());
+            match n.class {
+                NodeClass::Object => {
+                    let class = format!("{pkg}.Instances.{}", names.instances[&top]);
+                    s.push_str(&format!("  {class} {ident} {desc}\n    annotation ({annotation});\n"));
+                }
+                NodeClass::Variable => {
+                    let ty = n.attrs.data_type.map(|d| self.mtype(d));
+                    match ty {
+                        Some(ty) if !matches!(ty, super::types::MType::Unmapped(_)) => {
+                            let dims = Self::dims(n.attrs.value_rank.unwrap_or(-1), &n.attrs.array_dimensions);
+                            let value = self.value_of(top, &ty, dims.as_deref());
+                            let writable = n.attrs.access_level.unwrap_or(1) & 0x02 != 0;
+                            let dims_s = dims.as_deref().map(super::types::dims_text).unwrap_or_default();
+                            let (prefix, tyname) = match &ty {
+                                super::types::MType::Scalar { base, .. } => (
+                                    String::new(),
+                                    format!("{sup}.{}{}", base.name(), if writable { "Input" } else { "Output" }),
+                                ),
+                                other => (
+                                    (if writable { "input " } else { "output " }).to_string(),
+                                    other.type_name().to_string(),
+                                ),
+                            };
+                            s.push_str(&format!(
+                                "  {prefix}{tyname} {ident}{dims_s} = {value} {desc}\n    annotation ({annotation});\n"
+                            ));
+                        }
+                        Some(super::types::MType::Unmapped(why)) => {
+                            s.push_str(&format!("  // {} is left out: {why}.\n", n.browse_name.name));
+                        }
+                        _ => s.push_str(&format!("  // {} is left out: it has no DataType.\n", n.browse_name.name)),
+                    }
+                }
+                _ => {}
+            }
+        }
+        s.push_str(&format!(
+            "  annotation ({});\nend Objects;\n",
+            text::documentation(&format!(
+                "<p>The instances of {} in the address space, one component per instance whose parent belongs to \
+                 another namespace, and <code>nodes</code>, the variables of all of them with their NodeIds.</p>",
+                text::html_escape(m.namespace_uri(ns))
+            ))
+        ));
+        s
+    }
+
+    /// One `OpcUaSupport.VariableNode(...)` entry.
+    fn variable_node(&mut self, v: NodeIx, uris: &[u16]) -> String {
+        let m = self.m;
+        let n = m.node(v);
+        let ns_index =
+            if n.id.ns == 0 { 0 } else { uris.iter().position(|&u| u == n.id.ns).map(|p| p + 1).unwrap_or(0) };
+        let sup = super::support::PACKAGE;
+        let dt = n.attrs.data_type;
+        let builtin = dt.and_then(|d| m.data_types.get(&d)).map(|i| i.encoding).unwrap_or(BuiltinType::Variant);
+        let rank = n.attrs.value_rank.unwrap_or(-1);
+        let dims = if rank >= 0 {
+            if n.attrs.array_dimensions.is_empty() {
+                vec!["0".to_string(); rank.max(1) as usize].join(",")
+            } else {
+                n.attrs.array_dimensions.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(",")
+            }
+        } else {
+            String::new()
+        };
+        let init = match m.value(v) {
+            Some(Ok(val)) => self.value_text(&val).unwrap_or_default(),
+            _ => String::new(),
+        };
+        let mut args = vec![
+            format!("nsIndex={ns_index}"),
+            format!("nodeIdType={sup}.NodeIdType.{}", node_id_type(&n.id.id)),
+            format!("id={}", string_literal(&identifier_text(&n.id.id))),
+            format!("displayName={}", string_literal(n.display())),
+        ];
+        if let Some(d) = n.doc() {
+            args.push(format!("description={}", string_literal(&text::one_line(d))));
+        }
+        args.push(format!("dataType={sup}.BuiltinType.{}", builtin_literal(builtin)));
+        if let Some(d) = dt {
+            args.push(format!("dataTypeId={}", string_literal(&node_id_text(m, &m.node(d).id))));
+        }
+        if !dims.is_empty() {
+            args.push(format!("arrayDimensions={}", string_literal(&dims)));
+        }
+        if !init.is_empty() {
+            args.push(format!("initValue={}", string_literal(&init)));
+        }
+        args.push(format!("browsePath={}", string_literal(&path_from_objects(m, v))));
+        format!("{sup}.VariableNode({})", args.join(", "))
+    }
+
+    /// A value as the text of `VariableNode.initValue`: scalars as written, arrays as `{a, b}`; structures have
+    /// no text form.
+    fn value_text(&self, v: &Variant) -> Option<String> {
+        Some(match v {
+            Variant::Boolean(b) => b.to_string(),
+            Variant::SByte(x) => x.to_string(),
+            Variant::Byte(x) => x.to_string(),
+            Variant::Int16(x) => x.to_string(),
+            Variant::UInt16(x) => x.to_string(),
+            Variant::Int32(x) => x.to_string(),
+            Variant::UInt32(x) => x.to_string(),
+            Variant::Int64(x) => x.to_string(),
+            Variant::UInt64(x) => x.to_string(),
+            Variant::Float(x) => x.to_string(),
+            Variant::Double(x) => x.to_string(),
+            Variant::StatusCode(x) => x.to_string(),
+            Variant::Variant(inner) => return self.value_text(inner),
+            Variant::Array(_, items) => {
+                let parts: Option<Vec<String>> = items.iter().map(|i| self.value_text(i)).collect();
+                format!("{{{}}}", parts?.join(", "))
+            }
+            Variant::ExtensionObject(_) | Variant::ByteString(_) | Variant::XmlElement(_) | Variant::Null => {
+                return None
+            }
+            other => self.string_value(other)?,
+        })
+    }
+}
+
+fn collect_variables(m: &Model, ix: NodeIx, out: &mut Vec<NodeIx>, seen: &mut BTreeSet<NodeIx>) {
+    if !seen.insert(ix) || seen.len() > 200_000 {
+        return;
+    }
+    if m.node(ix).class == NodeClass::Variable {
+        out.push(ix);
+    }
+    let kids: Vec<NodeIx> = m.children(ix).map(|(_, c)| c).collect();
+    for c in kids {
+        // The arguments of a method are not variables a server block reads or writes.
+        if m.node(c).modelling_rule.is_none() && m.node(c).class != NodeClass::Method {
+            collect_variables(m, c, out, seen);
+        }
+    }
+}
+
+/// The `OpcUaSupport.BuiltinType` literal of a built-in type.
+fn builtin_literal(b: BuiltinType) -> &'static str {
+    match b {
+        BuiltinType::ExtensionObject => "ExtensionObject",
+        BuiltinType::Variant => "Variant",
+        other => other.type_name(),
+    }
+}

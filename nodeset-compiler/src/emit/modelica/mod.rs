@@ -1,0 +1,723 @@
+//! The Modelica back end: one Modelica package per OPC UA namespace, plus `OpcUaSupport`.
+//!
+//! [`generate`] is a pure function of the resolved [`Model`] and a [`ModelicaConfig`]; it returns the files
+//! (paths relative to one output root that holds every package, as Modelica tools expect a library root)
+//! and writes nothing. The output follows the conventions of the Modelica Standard Library and does not
+//! depend on it: one class per file, `package.mo` and `package.order` in every package folder, `within`
+//! clauses, description strings, `Documentation(info=...)` from the nodeset's Descriptions, and `version` and
+//! `uses` annotations from the Model and RequiredModel elements.
+//!
+//! ```no_run
+//! use nodeset_compiler::emit::modelica::{generate, ModelicaConfig};
+//! use nodeset_compiler::{compile, load::Input, Options};
+//! let dir = std::path::PathBuf::from("nodesets/vendor");
+//! let out = compile(vec![Input::Path(dir.join("Opc.Ua.Robotics.NodeSet2.xml"))], &Options { model_dirs: vec![dir], ..Options::default() });
+//! let cfg = ModelicaConfig::new()
+//!     .namespace("http://opcfoundation.org/UA/DI/")
+//!     .namespace("http://opcfoundation.org/UA/IA/")
+//!     .namespace("http://opcfoundation.org/UA/Robotics/");
+//! let files = generate(&out.model, &cfg).expect("no emitter errors");
+//! nodeset_compiler::write::write_tree("modelica".as_ref(), &files, nodeset_compiler::write::Mode::Write).unwrap();
+//! ```
+//!
+//! # Layout
+//!
+//! ```text
+//! OpcUaSupport/              connectors RealInput ... StringOutput, NodeId, BrowsePath, VariableNode, Nodes
+//! OpcUa/                     the part of the base namespace the other packages use (or all of it)
+//! OpcUaRobotics/
+//!   package.mo               version, uses, the namespace URI
+//!   Types/                   one class per DataType (enumeration, record, type)
+//!   EnumerationValues.mo     the OPC UA values of the enumeration literals
+//!   ObjectTypes/             one model per ObjectType (partial when abstract), one record per event type
+//!   Declarations/            classes of instance declarations that add children to their type, named
+//!                            <Owner>_<BrowsePath> (AxisType_ParameterSet)
+//!   Instances/               one model per top-level instance and `Objects` with the `Nodes` record
+//! ```
+//!
+//! Package names derive from the namespace URI (`http://opcfoundation.org/UA/Robotics/` -> `OpcUaRobotics`,
+//! `http://opcfoundation.org/UA/DI/` -> `OpcUaDI`, the base namespace -> `OpcUa`; other hosts give their
+//! first label and path, `http://example.com/fixtures/union/` -> `ExampleFixturesUnion`) and can be set per
+//! URI. A namespace that is not emitted is referred to by its package name, so the package must exist
+//! already, except for the base namespace, of which the needed subset is emitted unless
+//! [`ModelicaConfig::base_subset`] is off.
+//!
+//! # DataTypes
+//!
+//! | OPC UA | Modelica | Note |
+//! |---|---|---|
+//! | Boolean | `Boolean` | |
+//! | SByte, Byte, Int16, UInt16 | `OpcUa.Types.<T>` = `Integer(min=..., max=...)` | exact |
+//! | Int32 | `Integer` | exact |
+//! | UInt32 | `OpcUa.Types.UInt32` = `Integer(min=0)` | values above 2147483647 do not fit a Modelica Integer |
+//! | Int64, UInt64 | `OpcUa.Types.<T>` = `Real` | exact up to 2^53 |
+//! | Float, Double, Number, Decimal | `Real` | Decimal beyond double precision is rounded |
+//! | Integer, UInteger (abstract) | `Integer` | 32 bits |
+//! | String | `String` | |
+//! | LocalizedText | `OpcUa.Types.LocalizedText` = `String` | the text of the default locale |
+//! | QualifiedName | `String` | `nsu=<URI>;<Name>`, or `<Name>` in the base namespace |
+//! | NodeId, ExpandedNodeId | `String` | `nsu=<URI>;i=5`, or `i=5` in the base namespace |
+//! | Guid | `String` | text form |
+//! | DateTime | `OpcUa.Types.DateTime` = `Real(unit="s")` | seconds since 1970 UTC; below a microsecond is lost |
+//! | StatusCode | `Integer` | the same 32 bits, signed: Bad codes are negative |
+//! | ByteString, XmlElement, DataValue, DiagnosticInfo, BaseDataType (Variant), abstract Structure | none | left out with a comment and a warning |
+//! | simple subtype (Duration, ...) | `type Duration = Real` | |
+//! | enumeration | `type E = enumeration(...)` | literals in nodeset order; `EnumerationValues.E[Integer(x)]` is the OPC UA value |
+//! | OptionSet | `record` of one `Boolean` per bit | a Modelica Integer cannot hold a UInt32/UInt64 mask and has no bit operators |
+//! | structure | `record`, `extends` its supertype's record | optional fields get `Boolean has_<field>`; a union gets `Integer switchField` (0 = none, i = i-th field) and all alternatives; a field whose type contains the structure again is left out |
+//!
+//! Arrays: ValueRank n >= 1 gives n dimensions, fixed where ArrayDimensions gives a length, else `:` with
+//! the value (or `fill(..., 0)`) deciding; ValueRank 0 is one dimension; -2 (any) and -3 (scalar or one
+//! dimension) are declared as scalars. Inside a record, and for arrays of records anywhere, a dimension of
+//! unknown length is sized by a parameter of its own (`parameter Integer nX = 0; T x[nX]`): a record
+//! constructor cannot infer `:`.
+//!
+//! # ObjectTypes
+//!
+//! * An ObjectType becomes a `model` that `extends` the class of its supertype (across packages); an abstract
+//!   one becomes a `partial model`; an event type (subtype of BaseEventType) becomes a `record` of its
+//!   fields. Every generated model is balanced as it stands (outputs carry a binding, like
+//!   `Modelica.Blocks.Sources.RealExpression`): extend it and bind what the model computes with modifiers
+//!   (`extends AxisType(parameterSet(actualPosition=q))`).
+//! * A property becomes a `parameter`; a data variable becomes an `OpcUaSupport` output connector, or an
+//!   input connector when its AccessLevel has CurrentWrite (0x02); enumerations and records use `output` /
+//!   `input` components. The value in the nodeset is the binding, else zero, false, "" or the record's
+//!   defaults. The unit comes from the EngineeringUnits value (UNECE code, see `units.rs`).
+//! * An object becomes a component whose class is a replaceable alias (`replaceable model Axes =
+//!   OpcUaRobotics.Declarations.MotionDeviceType_Axes; Axes axes;`). An instance declaration that adds or
+//!   changes children gets a class of its own in `Declarations`; a subtype that overrides an inherited
+//!   object redeclares the alias (`redeclare model ParameterSet = ...AxisType_ParameterSet`), and a user
+//!   plugs in a model of their own the same way.
+//! * Optional: `parameter Boolean use_x = false` and `X x if use_x`; a subtype that makes it Mandatory writes
+//!   `final use_x = true`. Placeholder `<X>`: `parameter Integer nX(min=0) = 0`, `replaceable model X = ...`
+//!   and `X x[nX]`.
+//! * Methods appear as comments (call them through an OPC UA client), except as the triggers of a state
+//!   machine (see `statemachine.rs`).
+//! * Every component carries `annotation(__OPCUA(browsePath="...", nodeId="...", dataType="..."))`; the
+//!   browse path is relative to the object the enclosing class stands for.
+//!
+//! # Names
+//!
+//! Every identifier comes from [`crate::names::Scope`] with `Target::Modelica` and `Case::Preserve`: class
+//! names keep the BrowseName (`3DFrameType` -> `N3DFrameType`), component names start with their first word
+//! in lower case (`ActualPosition` -> `actualPosition`, `Model` -> `model_`), reserved words get a trailing
+//! underscore, and names that collide in one scope get `_2`, `_3`, ... in the sorted order of the originals
+//! (with a warning). Each scope reserves the names of the top-level packages and every name a base class
+//! uses. The original BrowseName is the first thing in every description string.
+//!
+//! # rumoca
+//!
+//! The tests check every generated class with rumoca 0.10.2 (`tests/modelica/check.py`). Some choices keep
+//! clear of what that compiler gets wrong, without leaving the Modelica language: classes are redeclared as
+//! aliases (a component redeclaration two `extends` levels up is dropped); a declaration class is never named
+//! like the alias it replaces (`redeclare model X = P.X` is ignored); a redeclaration's class has local
+//! replaceable elements only when its constraining class has some (rumoca's reading of MLS 6.4); no
+//! `redeclare model extends` (it crashes rumoca); record arrays get explicit sizes and array literals rather
+//! than `fill` (`expression shape mismatch`).
+//!
+//! # Limits
+//!
+//! VariableTypes have no classes: a variable is a connector of its value, and of the properties of a
+//! variable only EngineeringUnits (as `unit`) is kept; the instance `Nodes` record lists all of them.
+//! Children that an instance declaration adds to an inherited component that is not replaceable are left
+//! out with a warning.
+
+mod ctx;
+mod instances;
+mod objects;
+mod statemachine;
+pub mod support;
+mod text;
+mod types;
+pub mod units;
+
+use crate::diag::{Code, Diagnostic, Diagnostics, Severity};
+use crate::load::NS0_URI;
+use crate::model::{Model, NodeIx};
+use crate::names::{is_valid, Case, Scope, Target};
+use crate::raw::NodeClass;
+use crate::write::OutFile;
+use ctx::{Ctx, Need, Owner};
+use objects::{ClassPlan, Item, Mod, TypeRef};
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::PathBuf;
+use text::string_literal;
+
+/// What [`generate`] emits.
+#[derive(Clone, Debug)]
+pub struct ModelicaConfig {
+    /// The namespaces (by URI) to emit completely, one top-level package each. Empty: the models of the files
+    /// the user named.
+    pub namespaces: Vec<String>,
+    /// Package names per namespace URI, instead of the name derived from the URI.
+    pub package_names: BTreeMap<String, String>,
+    /// Emit the part of the base namespace that the emitted packages use as package `OpcUa`, unless the base
+    /// namespace is emitted completely. Off: a complete `OpcUa` package must exist beside the output.
+    pub base_subset: bool,
+    /// Emit the `OpcUaSupport` package.
+    pub support_package: bool,
+}
+
+impl Default for ModelicaConfig {
+    fn default() -> ModelicaConfig {
+        ModelicaConfig {
+            namespaces: Vec::new(),
+            package_names: BTreeMap::new(),
+            base_subset: true,
+            support_package: true,
+        }
+    }
+}
+
+impl ModelicaConfig {
+    pub fn new() -> ModelicaConfig {
+        ModelicaConfig::default()
+    }
+
+    /// Adds a namespace to emit.
+    pub fn namespace(mut self, uri: impl Into<String>) -> ModelicaConfig {
+        self.namespaces.push(uri.into());
+        self
+    }
+
+    /// Sets the package name of a namespace.
+    pub fn package_name(mut self, uri: impl Into<String>, name: impl Into<String>) -> ModelicaConfig {
+        self.package_names.insert(uri.into(), name.into());
+        self
+    }
+
+    pub fn base_subset(mut self, on: bool) -> ModelicaConfig {
+        self.base_subset = on;
+        self
+    }
+
+    pub fn support_package(mut self, on: bool) -> ModelicaConfig {
+        self.support_package = on;
+        self
+    }
+}
+
+/// The files and everything said about them.
+#[derive(Debug)]
+pub struct Generated {
+    pub files: Vec<OutFile>,
+    pub diagnostics: Diagnostics,
+}
+
+/// Generates the Modelica packages; `Err` with the diagnostics when one of them is an error (a namespace the
+/// model does not have, an invalid package name). Warnings (name collisions, types without a faithful
+/// mapping) are returned by [`generate_with_diagnostics`].
+pub fn generate(model: &Model, cfg: &ModelicaConfig) -> Result<Vec<OutFile>, Diagnostics> {
+    let g = generate_with_diagnostics(model, cfg);
+    if g.diagnostics.has_errors() {
+        Err(g.diagnostics)
+    } else {
+        Ok(g.files)
+    }
+}
+
+/// The word list of a package name derived from a namespace URI.
+fn package_words(uri: &str) -> String {
+    let rest = uri.split_once("://").map(|(_, r)| r).or_else(|| uri.strip_prefix("urn:")).unwrap_or(uri);
+    let mut segs: Vec<&str> = rest.split(['/', ':']).filter(|s| !s.is_empty()).collect();
+    let mut words: Vec<String> = Vec::new();
+    if let Some(host) = segs.first().copied() {
+        let host = host.trim_start_matches("www.");
+        if host == "opcfoundation.org" {
+            words.push("Opc Ua".into());
+        } else {
+            words.push(host.split('.').next().unwrap_or(host).to_string());
+        }
+        segs.remove(0);
+    }
+    if segs.first().is_some_and(|s| s.eq_ignore_ascii_case("UA")) {
+        segs.remove(0);
+    }
+    for s in segs {
+        // Version segments (`1.0.0`) do not belong in a name.
+        if s.chars().all(|c| c.is_ascii_digit() || c == '.') {
+            continue;
+        }
+        words.push(s.to_string());
+    }
+    words.join(" ")
+}
+
+/// Generates the packages and reports everything found.
+pub fn generate_with_diagnostics(model: &Model, cfg: &ModelicaConfig) -> Generated {
+    let mut diags = Diagnostics::new();
+    // Which namespaces to emit.
+    let mut uris: Vec<String> = cfg.namespaces.clone();
+    if uris.is_empty() {
+        uris = model.models.iter().filter(|mi| model.sources.get(mi.file).named).map(|mi| mi.uri.clone()).collect();
+    }
+    let mut full: BTreeSet<u16> = BTreeSet::new();
+    for uri in &uris {
+        match model.namespaces.iter().position(|n| n == uri) {
+            Some(i) => {
+                full.insert(i as u16);
+            }
+            None => diags.push(
+                Diagnostic::new(
+                    Code::UnknownNamespaceUri,
+                    format!("the Modelica configuration names namespace `{uri}`, which no loaded model defines"),
+                )
+                .help("load the NodeSet2 file of that model, or remove the namespace from the configuration"),
+            ),
+        }
+    }
+    // Package names: overrides as given, the others derived in one scope.
+    let mut names: Vec<Option<String>> = vec![None; model.namespaces.len()];
+    let mut scope: Scope<usize> = Scope::new(Target::Modelica, Case::UpperCamel);
+    scope.reserve(support::PACKAGE);
+    for (uri, name) in &cfg.package_names {
+        if !is_valid(name, Target::Modelica) {
+            // A configured package name is the user's input, like an attribute value: BadAttribute fits.
+            diags.push(
+                Diagnostic::new(
+                    Code::BadAttribute,
+                    format!("the package name `{name}` given for `{uri}` is not a Modelica identifier"),
+                )
+                .help("use letters, digits and `_`, starting with a letter, and no reserved word"),
+            );
+        }
+        scope.reserve(name);
+        if let Some(i) = model.namespaces.iter().position(|n| n == uri) {
+            names[i] = Some(name.clone());
+        }
+    }
+    for (i, uri) in model.namespaces.iter().enumerate() {
+        if names[i].is_none() {
+            scope.add(&package_words(uri), i);
+        }
+    }
+    let (derived, collisions) = scope.finish();
+    let pkg: Vec<String> =
+        (0..model.namespaces.len()).map(|i| names[i].clone().unwrap_or_else(|| derived[&i].clone())).collect();
+    {
+        let mut seen = BTreeMap::new();
+        for (i, p) in pkg.iter().enumerate() {
+            if let Some(j) = seen.insert(p.clone(), i) {
+                diags.push(Diagnostic::new(
+                    Code::BadAttribute,
+                    format!(
+                        "namespaces `{}` and `{}` would both be package `{p}`",
+                        model.namespaces[j], model.namespaces[i]
+                    ),
+                ));
+            }
+        }
+    }
+    if diags.has_errors() {
+        return Generated { files: Vec::new(), diagnostics: diags };
+    }
+    let ns0 = model.namespaces.iter().position(|n| n == NS0_URI).map(|i| i as u16);
+    let subset = if cfg.base_subset && ns0.is_some_and(|n| !full.contains(&n)) { ns0 } else { None };
+    let mut ctx = Ctx::new(model, pkg, full.clone(), subset);
+    for c in collisions {
+        let list: Vec<String> = c.members.iter().map(|(o, i)| format!("`{}` ({o})", model.namespaces[*i])).collect();
+        let mut d = Diagnostic::new(
+            Code::NameCollision,
+            format!(
+                "namespaces {} map to one package name `{}`; they are told apart by `_2`, ...",
+                list.join(", "),
+                c.ident
+            ),
+        );
+        d.severity = Severity::Warning;
+        ctx.diags.push(d);
+    }
+    // Plan every class of the emitted namespaces, then write them; writing finds what the base-namespace
+    // subset needs, which is planned and written in turn until nothing new is needed.
+    for &ns in &full {
+        plan_namespace(&mut ctx, ns);
+    }
+    let mut out = Output::default();
+    let mut done_needs: BTreeSet<Need> = BTreeSet::new();
+    for &ns in &full {
+        emit_namespace(&mut ctx, ns, &mut out);
+    }
+    loop {
+        let pending: Vec<Need> = ctx.needs.iter().filter(|n| !done_needs.contains(n)).copied().collect();
+        if pending.is_empty() {
+            break;
+        }
+        for need in pending {
+            done_needs.insert(need);
+            match need {
+                Need::DataType(dt) => emit_datatype(&mut ctx, dt, &mut out),
+                Need::ObjectType(t) => {
+                    if ctx.type_class(t).is_some() {
+                        emit_owner(&mut ctx, Owner::Type(t), &mut out);
+                    }
+                }
+            }
+        }
+    }
+    if let Some(ns) = subset {
+        if out.classes.keys().any(|(n, _)| *n == ns) {
+            emit_enumeration_values(&mut ctx, ns, &mut out);
+        }
+    }
+    let mut files = out.finish(&mut ctx, &full, subset);
+    if cfg.support_package {
+        files.extend(support::files());
+    }
+    files.sort_by(|a, b| a.path.cmp(&b.path));
+    let mut diagnostics = diags;
+    diagnostics.extend(ctx.diags);
+    diagnostics.sort(&model.sources);
+    Generated { files, diagnostics }
+}
+
+/// Classes by (namespace, sub-package path) and identifier.
+#[derive(Default)]
+struct Output {
+    classes: BTreeMap<(u16, String), BTreeMap<String, String>>,
+    /// Enumerations emitted per namespace, for `EnumerationValues`.
+    enums: BTreeMap<u16, Vec<NodeIx>>,
+    emitted_types: BTreeSet<NodeIx>,
+    emitted_owners: BTreeSet<Owner>,
+    /// Single-file classes directly in the namespace package (EnumerationValues).
+    top_files: BTreeMap<u16, BTreeMap<String, String>>,
+}
+
+impl Output {
+    fn add(&mut self, ns: u16, sub: &str, ident: &str, body: String) {
+        self.classes.entry((ns, sub.to_string())).or_default().insert(ident.to_string(), body);
+    }
+
+    /// The package skeleton (package.mo and package.order of every folder) around the classes.
+    fn finish(mut self, ctx: &mut Ctx, full: &BTreeSet<u16>, subset: Option<u16>) -> Vec<OutFile> {
+        let m = ctx.m;
+        let mut files = Vec::new();
+        let mut namespaces: BTreeSet<u16> = full.clone();
+        if let Some(s) = subset {
+            if self.classes.keys().any(|(n, _)| *n == s) {
+                namespaces.insert(s);
+            }
+        }
+        for ns in namespaces {
+            let pkg = ctx.pkg[ns as usize].clone();
+            let info = m.models.iter().find(|mi| mi.ns == ns);
+            let header = text::header(info);
+            let root = PathBuf::from(&pkg);
+            // Sub-packages, each with its classes.
+            let mut subs: BTreeMap<String, Vec<String>> = BTreeMap::new();
+            for ((n, sub), classes) in &self.classes {
+                if *n != ns {
+                    continue;
+                }
+                let dir = root.join(sub.replace('.', "/"));
+                for (ident, body) in classes {
+                    files.push(OutFile {
+                        path: dir.join(format!("{ident}.mo")),
+                        contents: format!("{header}within {pkg}.{sub};\n{body}"),
+                    });
+                }
+                let mut order: Vec<String> = classes.keys().cloned().collect();
+                order.sort_by_key(|a| (a.to_ascii_lowercase(), a.clone()));
+                subs.insert(sub.clone(), order);
+            }
+            let mut top_order: Vec<String> = Vec::new();
+            for (sub, what) in [
+                ("Types", "DataTypes"),
+                ("ObjectTypes", "ObjectTypes"),
+                ("Declarations", "Classes of instance declarations"),
+                ("Instances", "Instances"),
+            ] {
+                let order: Vec<String> = subs.get(sub).cloned().unwrap_or_default();
+                if order.is_empty() {
+                    continue;
+                }
+                top_order.push(sub.to_string());
+                if sub == "Types" && self.top_files.get(&ns).is_some_and(|t| t.contains_key("EnumerationValues")) {
+                    top_order.push("EnumerationValues".into());
+                }
+                let dir = root.join(sub);
+                files.push(OutFile {
+                    path: dir.join("package.mo"),
+                    contents: format!(
+                        "{header}within {pkg};\npackage {sub} {}\n  annotation ({});\nend {sub};\n",
+                        string_literal(&format!("{what} of {}", m.namespace_uri(ns))),
+                        text::documentation(&format!(
+                            "<p>{what} of the OPC UA namespace {}.</p>",
+                            text::html_escape(m.namespace_uri(ns))
+                        ))
+                    ),
+                });
+                files.push(OutFile { path: dir.join("package.order"), contents: lines(&order) });
+            }
+            for (ident, body) in self.top_files.remove(&ns).unwrap_or_default() {
+                if !top_order.contains(&ident) {
+                    top_order.push(ident.clone());
+                }
+                files.push(OutFile {
+                    path: root.join(format!("{ident}.mo")),
+                    contents: format!("{header}within {pkg};\n{body}"),
+                });
+            }
+            files.push(OutFile { path: root.join("package.order"), contents: lines(&top_order) });
+            files.push(OutFile {
+                path: root.join("package.mo"),
+                contents: format!("{header}{}", package_mo(ctx, ns, subset == Some(ns))),
+            });
+        }
+        files
+    }
+}
+
+fn lines(v: &[String]) -> String {
+    let mut s = v.join("\n");
+    s.push('\n');
+    s
+}
+
+/// The `package.mo` of a namespace package.
+fn package_mo(ctx: &Ctx, ns: u16, subset: bool) -> String {
+    let m = ctx.m;
+    let pkg = &ctx.pkg[ns as usize];
+    let uri = m.namespace_uri(ns);
+    let info = m.models.iter().find(|mi| mi.ns == ns);
+    let mut ann = Vec::new();
+    if let Some(v) = info.and_then(|i| i.version.as_deref()) {
+        ann.push(format!("version={}", string_literal(v)));
+    }
+    let mut uses: Vec<String> = Vec::new();
+    if let Some(i) = info {
+        for r in &i.required {
+            let Some(rns) = m.namespaces.iter().position(|n| *n == r.uri) else { continue };
+            if rns as u16 == ns {
+                continue;
+            }
+            let version =
+                m.models.iter().find(|x| x.uri == r.uri).and_then(|x| x.version.clone()).or_else(|| r.version.clone());
+            let entry = match version {
+                Some(v) => format!("{}(version={})", ctx.pkg[rns], string_literal(&v)),
+                None => ctx.pkg[rns].clone(),
+            };
+            if !uses.contains(&entry) {
+                uses.push(entry);
+            }
+        }
+    }
+    uses.push(format!("{}(version={})", support::PACKAGE, string_literal(support::VERSION)));
+    ann.push(format!("uses({})", uses.join(", ")));
+    let mut doc = format!("<p>Generated from the OPC UA information model <code>{}</code>", text::html_escape(uri));
+    if let Some(i) = info {
+        if let Some(v) = &i.version {
+            doc.push_str(&format!(", version {}", text::html_escape(v)));
+        }
+        if let Some(d) = &i.publication_date {
+            doc.push_str(&format!(", published {}", text::html_escape(d)));
+        }
+    }
+    doc.push_str(".</p>");
+    if subset {
+        doc.push_str("<p>This package holds only the part of the namespace that the other generated packages use.</p>");
+    }
+    ann.push(text::documentation(&doc));
+    ann.push(format!("__OPCUA(namespaceUri={})", string_literal(uri)));
+    let desc = if subset {
+        format!("OPC UA namespace {uri} (the part the generated packages use)")
+    } else {
+        format!("OPC UA namespace {uri}")
+    };
+    format!(
+        "within;\npackage {pkg} {}\n  annotation (\n    {});\nend {pkg};\n",
+        string_literal(&desc),
+        ann.join(",\n    ")
+    )
+}
+
+/// Plans the classes of a namespace: every ObjectType and every top-level instance object.
+fn plan_namespace(ctx: &mut Ctx, ns: u16) {
+    let m = ctx.m;
+    for ix in (0..m.nodes.len() as u32).map(NodeIx) {
+        if m.node(ix).id.ns == ns && m.node(ix).class == NodeClass::ObjectType {
+            ctx.type_class(ix);
+        }
+    }
+    let names = ctx.names(ns);
+    for &top in &names.top_instances {
+        if m.node(top).class == NodeClass::Object {
+            ctx.plan_instance(top);
+        }
+    }
+}
+
+fn emit_namespace(ctx: &mut Ctx, ns: u16, out: &mut Output) {
+    let m = ctx.m;
+    let nodes: Vec<NodeIx> = (0..m.nodes.len() as u32).map(NodeIx).filter(|&ix| m.node(ix).id.ns == ns).collect();
+    for &ix in &nodes {
+        if m.node(ix).class == NodeClass::DataType {
+            emit_datatype(ctx, ix, out);
+        }
+    }
+    for &ix in &nodes {
+        if m.node(ix).class == NodeClass::ObjectType && ctx.class_infos.contains_key(&ctx::ClassKey::Type(ix)) {
+            emit_owner(ctx, Owner::Type(ix), out);
+        }
+    }
+    let names = ctx.names(ns);
+    for &top in &names.top_instances {
+        if m.node(top).class == NodeClass::Object {
+            emit_owner(ctx, Owner::Instance(top), out);
+        }
+    }
+    if !names.top_instances.is_empty() {
+        let body = ctx.objects_model(ns);
+        out.add(ns, "Instances", "Objects", body);
+    }
+    emit_enumeration_values(ctx, ns, out);
+}
+
+fn emit_enumeration_values(ctx: &mut Ctx, ns: u16, out: &mut Output) {
+    let enums = out.enums.get(&ns).cloned().unwrap_or_default();
+    if !enums.is_empty() {
+        let body = ctx.enumeration_values(ns, &enums);
+        out.top_files.entry(ns).or_default().insert("EnumerationValues".into(), body);
+    }
+}
+
+fn emit_datatype(ctx: &mut Ctx, dt: NodeIx, out: &mut Output) {
+    if !out.emitted_types.insert(dt) {
+        return;
+    }
+    let ns = ctx.m.node(dt).id.ns;
+    if let Some((ident, body)) = ctx.datatype_class(dt) {
+        if matches!(ctx.m.data_types.get(&dt).map(|i| &i.kind), Some(crate::model::DataTypeKind::Enumeration { .. })) {
+            out.enums.entry(ns).or_default().push(dt);
+        }
+        out.add(ns, "Types", &ident, body);
+    }
+}
+
+/// Writes the classes of an owner: its main class and its declaration classes.
+fn emit_owner(ctx: &mut Ctx, owner: Owner, out: &mut Output) {
+    if !out.emitted_owners.insert(owner) {
+        return;
+    }
+    let ns = ctx.m.node(owner.node()).id.ns;
+    let Some(plan) = ctx.plans.remove(&owner) else { return };
+    let names = ctx.names(ns);
+    let owner_ident = names.owners[&owner].clone();
+    if let Some(main) = &plan.main {
+        let (sub, ident) = match owner {
+            Owner::Type(t) => ("ObjectTypes".to_string(), names.object_types[&t].clone()),
+            Owner::Instance(i) => ("Instances".to_string(), names.instances[&i].clone()),
+        };
+        let body = render_class(ctx, main, &ident);
+        out.add(ns, &sub, &ident, body);
+    }
+    for (path, decl) in &plan.decls {
+        // `<Owner>_<Path>`: unique in the namespace (neither part contains a `_` the other could complete), and
+        // never the name of the class alias it is redeclared for (rumoca ignores `redeclare model X = P.X`).
+        let ident = format!("{owner_ident}_{}", ctx.decl_names[&(owner, path.clone())]);
+        let body = render_class(ctx, decl, &ident);
+        out.add(ns, "Declarations", &ident, body);
+    }
+    ctx.plans.insert(owner, plan);
+}
+
+fn type_ref(ctx: &mut Ctx, t: &TypeRef) -> String {
+    match t {
+        TypeRef::Path(p) => p.clone(),
+        TypeRef::Class(k) => ctx.class_path(k),
+    }
+}
+
+fn render_mod(ctx: &mut Ctx, m: &Mod) -> String {
+    match m {
+        Mod::Value { ident, is_final, attrs, value } => {
+            let mut s = String::new();
+            if *is_final {
+                s.push_str("final ");
+            }
+            s.push_str(ident);
+            if !attrs.is_empty() {
+                s.push_str(&format!("({})", attrs.join(", ")));
+            }
+            if let Some(v) = value {
+                s.push_str(&format!("={v}"));
+            }
+            s
+        }
+        Mod::Nested { ident, mods } => {
+            let inner: Vec<String> = mods.iter().map(|x| render_mod(ctx, x)).collect();
+            format!("{ident}({})", inner.join(", "))
+        }
+        Mod::Redeclare { ident, class } => format!("redeclare model {ident} = {}", type_ref(ctx, class)),
+    }
+}
+
+/// A modification list: inline when short, else one modifier per line.
+fn render_mods(ctx: &mut Ctx, mods: &[Mod], indent: usize) -> String {
+    if mods.is_empty() {
+        return String::new();
+    }
+    let parts: Vec<String> = mods.iter().map(|x| render_mod(ctx, x)).collect();
+    let inline = parts.join(", ");
+    if inline.len() + indent <= 90 && !inline.contains('\n') {
+        format!("({inline})")
+    } else {
+        let pad = " ".repeat(indent + 2);
+        format!("(\n{pad}{})", parts.join(&format!(",\n{pad}")))
+    }
+}
+
+fn render_class(ctx: &mut Ctx, plan: &ClassPlan, ident: &str) -> String {
+    let mut s = format!("{} {ident} {}\n", plan.keyword, plan.desc);
+    if let Some((base, mods)) = &plan.extends {
+        let base = type_ref(ctx, base);
+        let mods = render_mods(ctx, mods, 2);
+        s.push_str(&format!("  extends {base}{mods};\n"));
+    }
+    for item in &plan.items {
+        match item {
+            Item::Comment(c) => s.push_str(&format!("  // {c}\n")),
+            Item::Alias { ident, class, desc } => {
+                let class = type_ref(ctx, class);
+                s.push_str(&format!("  replaceable model {ident} = {class}\n    {desc};\n"));
+            }
+            Item::Decl { prefix, ty, ident, dims, mods, value, cond, desc, annotation } => {
+                let ty = type_ref(ctx, ty);
+                let mut line = String::from("  ");
+                if !prefix.is_empty() {
+                    line.push_str(prefix);
+                    line.push(' ');
+                }
+                line.push_str(&format!("{ty} {ident}{dims}"));
+                line.push_str(&render_mods(ctx, mods, 4));
+                if let Some(v) = value {
+                    line.push_str(&format!(" = {v}"));
+                }
+                if let Some(c) = cond {
+                    line.push_str(&format!(" if {c}"));
+                }
+                line.push_str(&format!("\n    {desc}"));
+                if !annotation.is_empty() {
+                    line.push_str(&format!("\n    annotation ({annotation})"));
+                }
+                line.push_str(";\n");
+                s.push_str(&line);
+            }
+        }
+    }
+    if !plan.equations.is_empty() {
+        s.push_str("equation\n");
+        for e in &plan.equations {
+            s.push_str(&text::indent(e, 2));
+        }
+    }
+    let mut ann = Vec::new();
+    if !plan.doc_html.is_empty() {
+        ann.push(text::documentation(&plan.doc_html));
+    }
+    ann.push(plan.opcua.clone());
+    s.push_str(&format!("  annotation (\n    {});\nend {ident};\n", ann.join(",\n    ")));
+    s
+}
+
+#[cfg(test)]
+mod tests;

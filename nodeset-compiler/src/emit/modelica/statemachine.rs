@@ -1,0 +1,366 @@
+//! State machines: an Integer state with the nodeset's state numbers, one Boolean trigger input per cause
+//! (the methods Start, Suspend, ... of a program, or the transition itself when the nodeset names no cause),
+//! and one `when` equation that moves between the states along the transitions of the nodeset.
+//!
+//! ```modelica
+//!   parameter Integer stateMachineLevel = 1 "Which class drives the state machine";
+//!   constant Integer Ready = 2 "Ready (StateNumber 2)";
+//!   discrete Integer currentStateNumber(start=Ready, fixed=true) "Number of the current state";
+//!   OpcUaSupport.BooleanInput start = false "Start: a rising edge stands for a call of the method Start";
+//! equation
+//!   if stateMachineLevel == 1 then
+//!     when start then
+//!       currentStateNumber = if pre(currentStateNumber) == Ready then Running else pre(currentStateNumber);
+//!     elsewhen ...
+//!     end when;
+//!   end if;
+//! ```
+//!
+//! A subtype that adds states or transitions keeps the constants and triggers it inherits, declares the new
+//! ones, sets `stateMachineLevel` to its own level and writes the `when` equation of the whole machine under
+//! `if stateMachineLevel == <its level>`, which switches the inherited equation off. Triggers are checked in
+//! the order of the `elsewhen` branches, so of two triggers that rise at the same instant the first wins.
+
+use super::ctx::{component_original, Ctx};
+use super::objects::{Body, ClassInfo, ElemKind, Item, Mod, TypeRef};
+use super::text::string_literal;
+use super::types::{Base, MType};
+use crate::model::NodeIx;
+use crate::nodeid::QualifiedName;
+use std::collections::BTreeSet;
+use std::rc::Rc;
+
+/// The state machine a class drives: the names its subclasses reuse.
+#[derive(Debug, Clone)]
+pub struct SmInfo {
+    pub level: u32,
+    pub level_param: String,
+    pub var: String,
+    /// State node -> constant.
+    pub states: Vec<(NodeIx, String)>,
+    /// Cause (method or transition) node -> trigger input.
+    pub triggers: Vec<(NodeIx, String)>,
+    /// The BrowseNames of the states and transitions covered.
+    pub nodes: BTreeSet<QualifiedName>,
+}
+
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+enum Key {
+    State(usize),
+    Var,
+    Level,
+    Trigger(usize),
+}
+
+impl Ctx<'_> {
+    /// Adds the machinery of a state machine type to its class body.
+    pub fn plan_state_machine(&mut self, t: NodeIx, base: Option<&Rc<ClassInfo>>, body: &mut Body) -> Option<SmInfo> {
+        let m = self.m;
+        let info = m.state_machines.get(&t)?.clone();
+        if info.states.is_empty() {
+            return None;
+        }
+        // States and transitions are the same when their BrowseNames are: a subtype may declare an inherited
+        // state again (to add a sub-state machine, for instance) without changing the machine.
+        let nodes: BTreeSet<QualifiedName> = info
+            .states
+            .iter()
+            .map(|s| s.node)
+            .chain(info.transitions.iter().map(|x| x.node))
+            .map(|n| m.node(n).browse_name.clone())
+            .collect();
+        let inherited = base.and_then(|b| b.state_machine.clone());
+        if inherited.as_ref().is_some_and(|b| b.nodes == nodes) {
+            return None;
+        }
+        let level = inherited.as_ref().map(|b| b.level + 1).unwrap_or(1);
+
+        // State numbers: the nodeset's, or the next free numbers for states without one.
+        let mut numbers: Vec<u32> = Vec::new();
+        let mut next = info.states.iter().filter_map(|s| s.number).max().unwrap_or(0) + 1;
+        let mut numbered_here = BTreeSet::new();
+        for (i, s) in info.states.iter().enumerate() {
+            match s.number {
+                Some(n) => numbers.push(n),
+                None => {
+                    numbers.push(next);
+                    numbered_here.insert(i);
+                    next += 1;
+                }
+            }
+        }
+        // Triggers: for each transition its cause methods, else the transition itself.
+        let mut trig_nodes: Vec<NodeIx> = Vec::new();
+        let mut transition_trigs: Vec<Vec<usize>> = Vec::new();
+        let same_method = |a: NodeIx, b: NodeIx| a == b || m.node(a).browse_name == m.node(b).browse_name;
+        for tr in &info.transitions {
+            let causes: Vec<NodeIx> = if tr.causes.is_empty() { vec![tr.node] } else { tr.causes.clone() };
+            let mut mine = Vec::new();
+            for c in causes {
+                let i = match trig_nodes.iter().position(|&x| same_method(x, c)) {
+                    Some(i) => i,
+                    None => {
+                        trig_nodes.push(c);
+                        trig_nodes.len() - 1
+                    }
+                };
+                if !mine.contains(&i) {
+                    mine.push(i);
+                }
+            }
+            transition_trigs.push(mine);
+        }
+        // Names: inherited ones are reused; a method keeps the name its element has; the rest are new.
+        let inherited_state = |n: NodeIx| {
+            inherited.as_ref().and_then(|b| {
+                b.states.iter().find(|(s, _)| m.node(*s).browse_name == m.node(n).browse_name).map(|(_, i)| i.clone())
+            })
+        };
+        let inherited_trig = |n: NodeIx| {
+            inherited.as_ref().and_then(|b| b.triggers.iter().find(|(s, _)| same_method(*s, n)).map(|(_, i)| i.clone()))
+        };
+        let method_element = |n: NodeIx| {
+            body.elements
+                .iter()
+                .find(|e| matches!(e.kind, ElemKind::Method) && (e.node == n || e.bn == m.node(n).browse_name))
+                .map(|e| e.ident.clone())
+        };
+        let mut scope = self.scope::<Key>();
+        for n in &body.taken {
+            scope.reserve(n);
+        }
+        for (i, s) in info.states.iter().enumerate() {
+            if inherited_state(s.node).is_none() {
+                scope.add(&s.name, Key::State(i));
+            }
+        }
+        if inherited.is_none() {
+            scope.add(&component_original("CurrentStateNumber"), Key::Var);
+            scope.add(&component_original("StateMachineLevel"), Key::Level);
+        }
+        let mut fixed_trig: Vec<Option<String>> = Vec::new();
+        for (i, &n) in trig_nodes.iter().enumerate() {
+            let known = inherited_trig(n).or_else(|| method_element(n));
+            if known.is_none() {
+                scope.add(&component_original(&m.node(n).browse_name.name), Key::Trigger(i));
+            }
+            fixed_trig.push(known);
+        }
+        let (names, collisions) = scope.finish();
+        self.report(&format!("state machine {}", m.qualified(t)), "states and triggers", collisions, |_| (t, None));
+        for n in names.values() {
+            body.taken.insert(n.clone());
+        }
+        let states: Vec<String> = info
+            .states
+            .iter()
+            .enumerate()
+            .map(|(i, s)| inherited_state(s.node).unwrap_or_else(|| names[&Key::State(i)].clone()))
+            .collect();
+        let triggers: Vec<String> = (0..trig_nodes.len())
+            .map(|i| fixed_trig[i].clone().unwrap_or_else(|| names[&Key::Trigger(i)].clone()))
+            .collect();
+        let (var, level_param) = match &inherited {
+            Some(b) => (b.var.clone(), b.level_param.clone()),
+            None => (names[&Key::Var].clone(), names[&Key::Level].clone()),
+        };
+        let declared_triggers: BTreeSet<String> =
+            inherited.iter().flat_map(|b| b.triggers.iter().map(|(_, i)| i.clone())).collect();
+        let declared_states: BTreeSet<String> =
+            inherited.iter().flat_map(|b| b.states.iter().map(|(_, i)| i.clone())).collect();
+
+        body.adds = true;
+        body.items.push(Item::Comment(match &inherited {
+            None => format!(
+                "State machine of {}: its states, and transitions driven by the trigger inputs.",
+                m.node(t).browse_name.name
+            ),
+            Some(_) => format!(
+                "{} adds states or transitions to the inherited state machine and drives it from here.",
+                m.node(t).browse_name.name
+            ),
+        }));
+        if inherited.is_none() {
+            body.items.push(Item::Decl {
+                prefix: "parameter".into(),
+                ty: TypeRef::Path("Integer".into()),
+                ident: level_param.clone(),
+                dims: String::new(),
+                mods: Vec::new(),
+                value: Some(level.to_string()),
+                cond: None,
+                desc: string_literal(
+                    "Which class drives the state machine: a subclass that adds states sets its own level",
+                ),
+                annotation: "Evaluate=true".into(),
+            });
+        } else {
+            body.mods.push(Mod::Value {
+                ident: level_param.clone(),
+                is_final: false,
+                attrs: Vec::new(),
+                value: Some(level.to_string()),
+            });
+        }
+        for (i, s) in info.states.iter().enumerate() {
+            if declared_states.contains(&states[i]) {
+                continue;
+            }
+            let mut d = if numbered_here.contains(&i) {
+                format!("{} (the nodeset gives no StateNumber; numbered here)", s.name)
+            } else {
+                format!("{} (StateNumber {})", s.name, numbers[i])
+            };
+            if s.initial {
+                d.push_str(", the initial state");
+            }
+            body.items.push(Item::Decl {
+                prefix: "constant".into(),
+                ty: TypeRef::Path("Integer".into()),
+                ident: states[i].clone(),
+                dims: String::new(),
+                mods: Vec::new(),
+                value: Some(numbers[i].to_string()),
+                cond: None,
+                desc: string_literal(&d),
+                annotation: self.opcua_annotation(s.node),
+            });
+        }
+        if inherited.is_none() {
+            let marked = info.states.iter().position(|s| s.initial);
+            let initial = marked.unwrap_or(0);
+            let desc = if marked.is_some() {
+                "Number of the current state (CurrentState/Number)".to_string()
+            } else {
+                format!("Number of the current state (CurrentState/Number); the nodeset marks no initial state, so it starts in {}", info.states[0].name)
+            };
+            body.items.push(Item::Decl {
+                prefix: "discrete".into(),
+                ty: TypeRef::Path("Integer".into()),
+                ident: var.clone(),
+                dims: String::new(),
+                mods: vec![
+                    Mod::Value {
+                        ident: "start".into(),
+                        is_final: false,
+                        attrs: Vec::new(),
+                        value: Some(states[initial].clone()),
+                    },
+                    Mod::Value {
+                        ident: "fixed".into(),
+                        is_final: false,
+                        attrs: Vec::new(),
+                        value: Some("true".into()),
+                    },
+                ],
+                value: None,
+                cond: None,
+                desc: string_literal(&desc),
+                annotation: String::new(),
+            });
+        }
+        for (i, &n) in trig_nodes.iter().enumerate() {
+            if declared_triggers.contains(&triggers[i]) {
+                continue;
+            }
+            let name = &m.node(n).browse_name.name;
+            let d = if m.node(n).class == crate::raw::NodeClass::Method {
+                format!("{name}: a rising edge stands for a call of the method {name}")
+            } else {
+                format!("{name}: a rising edge takes this transition, for which the nodeset gives no cause")
+            };
+            body.items.push(Item::Decl {
+                prefix: String::new(),
+                ty: TypeRef::Path(format!("{}.BooleanInput", super::support::PACKAGE)),
+                ident: triggers[i].clone(),
+                dims: String::new(),
+                mods: Vec::new(),
+                value: Some("false".into()),
+                cond: None,
+                desc: string_literal(&d),
+                annotation: self.opcua_annotation(n),
+            });
+        }
+        // One branch per trigger, in the order triggers first appear.
+        let state_index = |node: Option<NodeIx>| node.and_then(|n| info.states.iter().position(|s| s.node == n));
+        let mut branches: Vec<(usize, Vec<(usize, usize)>)> = Vec::new();
+        for (ti, tr) in info.transitions.iter().enumerate() {
+            let (Some(from), Some(to)) = (state_index(tr.from), state_index(tr.to)) else {
+                body.items.push(Item::Comment(format!(
+                    "Transition {} is left out: it does not lead from one state of this machine to another.",
+                    tr.name
+                )));
+                continue;
+            };
+            for &g in &transition_trigs[ti] {
+                match branches.iter_mut().find(|(x, _)| *x == g) {
+                    Some((_, list)) => match list.iter().find(|(f, _)| *f == from) {
+                        Some(&(_, first_to)) => {
+                            let msg = format!(
+                                "{} leads from {} both to {} and, through {}, to {}; the first transition is taken",
+                                m.node(trig_nodes[g]).browse_name.name,
+                                info.states[from].name,
+                                info.states[first_to].name,
+                                tr.name,
+                                info.states[to].name
+                            );
+                            body.items.push(Item::Comment(format!("{msg}.")));
+                            self.lossy(tr.node, format!("in state machine `{}`, {msg}", m.qualified(t)));
+                        }
+                        None => list.push((from, to)),
+                    },
+                    None => branches.push((g, vec![(from, to)])),
+                }
+            }
+        }
+        let mut eq = format!("if {level_param} == {level} then\n");
+        if branches.is_empty() {
+            eq.push_str(&format!("  {var} = pre({var});\n"));
+        } else {
+            for (k, (g, moves)) in branches.iter().enumerate() {
+                let kw = if k == 0 { "when" } else { "elsewhen" };
+                eq.push_str(&format!("  {kw} {} then\n", triggers[*g]));
+                let mut expr = String::new();
+                for (j, (from, to)) in moves.iter().enumerate() {
+                    let kw = if j == 0 { "if" } else { " elseif" };
+                    expr.push_str(&format!("{kw} pre({var}) == {} then {}", states[*from], states[*to]));
+                }
+                expr.push_str(&format!(" else pre({var})"));
+                eq.push_str(&format!("    {var} = {expr};\n"));
+            }
+            eq.push_str("  end when;\n");
+        }
+        eq.push_str("end if;");
+        body.equations.push(eq);
+        // CurrentState shows the DisplayName of the current state.
+        let current = body
+            .elements
+            .iter()
+            .find(|e| e.bn.ns == 0 && e.bn.name == "CurrentState" && e.use_flag.is_none())
+            .filter(|e| {
+                matches!(&e.kind, ElemKind::Signal { ty: MType::Scalar { base: Base::String, .. }, dims: None, .. })
+            })
+            .map(|e| e.ident.clone());
+        if let Some(cur) = current {
+            let mut expr = String::new();
+            for (i, s) in info.states.iter().enumerate() {
+                let kw = if i == 0 { "if" } else { " elseif" };
+                expr.push_str(&format!(
+                    "{kw} {var} == {} then {}",
+                    states[i],
+                    string_literal(m.node(s.node).display())
+                ));
+            }
+            expr.push_str(" else \"\"");
+            body.mods.push(Mod::Value { ident: cur, is_final: false, attrs: Vec::new(), value: Some(expr) });
+        }
+        Some(SmInfo {
+            level,
+            level_param,
+            var,
+            states: info.states.iter().enumerate().map(|(i, s)| (s.node, states[i].clone())).collect(),
+            triggers: trig_nodes.iter().enumerate().map(|(i, &n)| (n, triggers[i].clone())).collect(),
+            nodes,
+        })
+    }
+}

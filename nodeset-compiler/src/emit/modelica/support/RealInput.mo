@@ -1,0 +1,8 @@
+within OpcUaSupport;
+connector RealInput = input Real "'input Real' as connector"
+  annotation (
+    defaultComponentName="u",
+    Icon(coordinateSystem(preserveAspectRatio=true, extent={{-100,-100},{100,100}}),
+      graphics={Polygon(lineColor={0,0,127}, fillColor={0,0,127}, fillPattern=FillPattern.Solid, points={{-100,100},{100,0},{-100,-100},{-100,100}})}),
+    Documentation(info="<html><p>Connector with one input signal of type Real, shaped like the connectors of
+Modelica.Blocks.Interfaces so that blocks of both libraries connect.</p></html>"));

@@ -1,0 +1,233 @@
+//! Unit tests of the Modelica back end over the pinned companion specifications and the fixtures.
+//!
+//! rumoca accepts duplicate enumeration literals and does not complain about a modifier of an element that
+//! does not exist, so these properties are checked here, on the generator's own tables.
+
+use super::ctx::{ClassKey, Ctx};
+use super::objects::ElemKind;
+use super::*;
+use crate::load::Input;
+use crate::model::DataTypeKind;
+use crate::{compile, Options};
+use std::collections::BTreeSet;
+use std::path::PathBuf;
+
+fn workspace() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
+}
+
+fn load(files: &[PathBuf], dirs: Vec<PathBuf>) -> crate::Compiled {
+    let out = compile(
+        files.iter().map(|f| Input::Path(f.clone())).collect(),
+        &Options { model_dirs: dirs, ..Options::default() },
+    );
+    assert!(out.ok(), "{}", out.render_diagnostics());
+    out
+}
+
+fn robotics() -> crate::Compiled {
+    let v = workspace().join("nodesets/vendor");
+    load(&[v.join("Opc.Ua.Robotics.NodeSet2.xml")], vec![v])
+}
+
+fn fixture(case: &str) -> crate::Compiled {
+    let dir = workspace().join("tests/fixtures").join(case);
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.extension().is_some_and(|x| x == "xml"))
+        .collect();
+    files.sort();
+    load(&files, vec![dir, workspace().join("nodesets/vendor")])
+}
+
+/// Plans every ObjectType and instance of every namespace of the model (ns0 included) and checks that the
+/// identifiers of each class are unique: elements, their `use_` flags, counts and class aliases.
+fn assert_unique_names(model: &crate::model::Model) {
+    let pkg: Vec<String> = (0..model.namespaces.len()).map(|i| format!("P{i}")).collect();
+    let all: BTreeSet<u16> = (0..model.namespaces.len() as u16).collect();
+    let mut ctx = Ctx::new(model, pkg, all.clone(), None);
+    for ns in all {
+        for ix in (0..model.nodes.len() as u32).map(crate::model::NodeIx) {
+            let n = model.node(ix);
+            if n.id.ns != ns {
+                continue;
+            }
+            if n.class == crate::raw::NodeClass::ObjectType {
+                ctx.type_class(ix);
+            }
+            if let Some(DataTypeKind::Enumeration { .. }) = model.data_types.get(&ix).map(|i| &i.kind) {
+                let lits = ctx.enum_literals(ix);
+                let set: BTreeSet<&String> = lits.iter().map(|(_, l)| l).collect();
+                assert_eq!(set.len(), lits.len(), "duplicate literals in {}", model.qualified(ix));
+                for (_, l) in &lits {
+                    assert!(crate::names::is_valid(l, crate::names::Target::Modelica), "{l}");
+                }
+            }
+            if matches!(
+                model.data_types.get(&ix).map(|i| &i.kind),
+                Some(DataTypeKind::Structure { .. } | DataTypeKind::OptionSet { .. })
+            ) {
+                let r = ctx.record_info(ix);
+                let mut names: Vec<&String> = r.fields.iter().map(|f| &f.ident).collect();
+                names.extend(r.fields.iter().filter_map(|f| f.has_flag.as_ref()));
+                names.extend(r.fields.iter().filter_map(|f| f.count.as_ref()));
+                let set: BTreeSet<&String> = names.iter().copied().collect();
+                assert_eq!(set.len(), names.len(), "duplicate fields in {}: {names:?}", model.qualified(ix));
+            }
+        }
+        let names = ctx.names(ns);
+        for &top in &names.top_instances {
+            if model.node(top).class == crate::raw::NodeClass::Object {
+                ctx.plan_instance(top);
+            }
+        }
+    }
+    assert!(!ctx.class_infos.is_empty());
+    for (key, info) in &ctx.class_infos {
+        let mut names: Vec<&String> = Vec::new();
+        for e in &info.elements {
+            names.push(&e.ident);
+            names.extend(e.use_flag.iter());
+            names.extend(e.count.iter());
+            names.extend(e.alias.iter());
+        }
+        let set: BTreeSet<&String> = names.iter().copied().collect();
+        assert_eq!(set.len(), names.len(), "duplicate identifiers in {key:?}: {names:?}");
+        for n in &names {
+            assert!(crate::names::is_valid(n, crate::names::Target::Modelica), "{n} in {key:?}");
+            assert!(info.taken.contains(*n), "{n} of {key:?} is not recorded as taken");
+        }
+        // An element that refers to a class refers to one that was planned.
+        for e in &info.elements {
+            if let ElemKind::Object { class } = &e.kind {
+                match class {
+                    ClassKey::Type(t) => assert_eq!(model.node(*t).class, crate::raw::NodeClass::ObjectType),
+                    other => assert!(ctx.class_infos.contains_key(other), "{other:?} of {key:?} was never planned"),
+                }
+            }
+        }
+    }
+    // Every declaration class has a name.
+    for (owner, plan) in &ctx.plans {
+        for (path, _) in &plan.decls {
+            assert!(ctx.decl_names.contains_key(&(*owner, path.clone())), "{path} of {owner:?} has no name");
+        }
+    }
+}
+
+#[test]
+fn names_are_unique_in_every_scope_of_the_companion_specs() {
+    assert_unique_names(&robotics().model);
+}
+
+#[test]
+fn names_are_unique_in_every_scope_of_the_fixtures() {
+    for case in ["names", "instances", "state_machine", "two_namespaces", "optional_fields", "union", "enum_gaps"] {
+        assert_unique_names(&fixture(case).model);
+    }
+}
+
+#[test]
+fn colliding_names_are_renamed_and_reported() {
+    let out = fixture("names");
+    let g =
+        generate_with_diagnostics(&out.model, &ModelicaConfig::new().namespace("http://example.com/fixtures/names/"));
+    let class =
+        g.files.iter().find(|f| f.path.ends_with("ObjectTypes/N3DFrameType.mo")).expect("3DFrameType is generated");
+    for decl in [
+        "String type_ =",
+        "parameter String model_ =",
+        "OpcUaSupport.RealOutput input_ =",
+        "modeA =",
+        "modeA_2 =",
+        "self_2 =",
+        "ios(min=0)",
+    ] {
+        assert!(class.contents.contains(decl), "`{decl}` missing in\n{}", class.contents);
+    }
+    let collisions: Vec<&str> = g
+        .diagnostics
+        .items
+        .iter()
+        .filter(|d| d.code == crate::diag::Code::NameCollision)
+        .map(|d| d.message.as_str())
+        .collect();
+    assert!(collisions.iter().any(|m| m.contains("`modeA`") && m.contains("Mode-A")), "{collisions:?}");
+}
+
+#[test]
+fn package_names_derive_from_uris() {
+    assert_eq!(package_words("http://opcfoundation.org/UA/Robotics/"), "Opc Ua Robotics");
+    let cases = [
+        ("http://opcfoundation.org/UA/", "OpcUa"),
+        ("http://opcfoundation.org/UA/DI/", "OpcUaDI"),
+        ("http://opcfoundation.org/UA/Robotics/", "OpcUaRobotics"),
+        ("http://opcfoundation.org/UA/Mining/General/1.0.0/", "OpcUaMiningGeneral"),
+        ("http://example.com/fixtures/union/", "ExampleFixturesUnion"),
+        ("urn:vendor:models:press", "VendorModelsPress"),
+    ];
+    for (uri, want) in cases {
+        assert_eq!(
+            crate::names::sanitize(&package_words(uri), crate::names::Case::UpperCamel, crate::names::Target::Modelica),
+            want,
+            "{uri}"
+        );
+    }
+}
+
+#[test]
+fn configuration_errors_are_diagnostics() {
+    let out = fixture("structure");
+    let bad_ns = generate(&out.model, &ModelicaConfig::new().namespace("http://nowhere.invalid/"));
+    let d = bad_ns.expect_err("an unknown namespace is an error");
+    assert!(d.items.iter().any(|x| x.code == crate::diag::Code::UnknownNamespaceUri));
+    let bad_name = generate(
+        &out.model,
+        &ModelicaConfig::new()
+            .namespace("http://example.com/fixtures/structure/")
+            .package_name("http://example.com/fixtures/structure/", "model"),
+    );
+    assert!(bad_name.is_err(), "`model` is no package name");
+    let renamed = generate(
+        &out.model,
+        &ModelicaConfig::new()
+            .namespace("http://example.com/fixtures/structure/")
+            .package_name("http://example.com/fixtures/structure/", "Plant"),
+    )
+    .unwrap();
+    assert!(renamed.iter().any(|f| f.path.as_path() == std::path::Path::new("Plant/Types/Position.mo")));
+}
+
+#[test]
+fn enumerations_keep_their_opc_ua_values() {
+    let out = fixture("enum_gaps");
+    let files =
+        generate(&out.model, &ModelicaConfig::new().namespace("http://example.com/fixtures/enum_gaps/")).unwrap();
+    let values = files.iter().find(|f| f.path.ends_with("EnumerationValues.mo")).unwrap();
+    assert!(
+        values.contents.contains("constant Integer AlarmSeverityLevel[5] = {-1, 1, 2, 5, 10}"),
+        "{}",
+        values.contents
+    );
+}
+
+#[test]
+fn a_subtype_makes_an_optional_member_mandatory_and_redeclares_its_class() {
+    let files = generate(
+        &robotics().model,
+        &ModelicaConfig::new()
+            .namespace("http://opcfoundation.org/UA/Robotics/")
+            .namespace("http://opcfoundation.org/UA/DI/")
+            .namespace("http://opcfoundation.org/UA/IA/"),
+    )
+    .unwrap();
+    let axis = files.iter().find(|f| f.path.ends_with("OpcUaRobotics/ObjectTypes/AxisType.mo")).unwrap();
+    assert!(axis.contents.contains("final use_parameterSet=true"), "{}", axis.contents);
+    assert!(
+        axis.contents.contains("redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet"),
+        "{}",
+        axis.contents
+    );
+}

@@ -1,0 +1,439 @@
+//! The Modelica back end: snapshots of the fixtures, and real inputs checked by a real Modelica compiler.
+//!
+//! * one insta snapshot per fixture: every generated file of the fixture's own packages and of the ns0 subset,
+//!   concatenated with `// file: <path>` separators, then the rendered diagnostics;
+//! * DI + IA + Robotics (with the ns0 subset) and the hand-written example on top of them, checked class by
+//!   class by rumoca (`tests/modelica/check.py`), and the example simulated;
+//! * every resolvable file of the ua-nodeset corpus and the skill reference models, checked by rumoca one
+//!   aggregate model per nodeset;
+//! * determinism: same input, byte-identical output, whatever the input order.
+//!
+//! rumoca runs in the venv that `cargo xtask venv` creates; a missing venv fails the tests with that command.
+
+use nodeset_compiler::emit::modelica::{generate, generate_with_diagnostics, ModelicaConfig};
+use nodeset_compiler::load::{Input, NS0_URI};
+use nodeset_compiler::model::Model;
+use nodeset_compiler::write::{write_tree, Mode, OutFile};
+use nodeset_compiler::{compile, Compiled, Options};
+use nodeset_tests::{corpus, nodeset_files, root, vendor};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+/// The fixtures with a snapshot; `every_fixture_has_a_snapshot` keeps the list complete.
+const CASES: &[&str] = &[
+    "abstract_base",
+    "arrays",
+    "enum_gaps",
+    "event_type",
+    "instances",
+    "method",
+    "names",
+    "option_set",
+    "optional_fields",
+    "state_machine",
+    "structure",
+    "two_namespaces",
+    "union",
+    "variable_type",
+];
+
+fn python() -> PathBuf {
+    let py = root().join(".venv/bin/python");
+    assert!(
+        py.is_file(),
+        "{} is missing: run `cargo xtask venv` (it installs rumoca from tests/requirements.txt)",
+        py.display()
+    );
+    py
+}
+
+fn compile_files(files: &[PathBuf], dirs: Vec<PathBuf>) -> Compiled {
+    let out = compile(
+        files.iter().map(|f| Input::Path(f.clone())).collect(),
+        &Options { model_dirs: dirs, ..Options::default() },
+    );
+    assert!(out.ok(), "{}", out.render_diagnostics());
+    out
+}
+
+/// The namespaces a set of files defines (their own models, not the ones they require).
+fn own_models(model: &Model) -> Vec<String> {
+    let mut uris: Vec<String> = model
+        .models
+        .iter()
+        .filter(|m| model.sources.get(m.file).named && m.uri != NS0_URI)
+        .map(|m| m.uri.clone())
+        .collect();
+    uris.sort();
+    uris
+}
+
+fn fixture(case: &str) -> Compiled {
+    let dir = root().join("tests/fixtures").join(case);
+    let files = nodeset_files(&dir);
+    assert!(!files.is_empty(), "no NodeSet2 files in {}", dir.display());
+    compile_files(&files, vec![dir, vendor()])
+}
+
+fn concatenate(files: &[OutFile]) -> String {
+    let mut s = String::new();
+    for f in files {
+        s.push_str(&format!("// file: {}\n", f.path.display()));
+        s.push_str(&f.contents);
+    }
+    s
+}
+
+fn snapshot(case: &str) {
+    let out = fixture(case);
+    let mut cfg = ModelicaConfig::new().support_package(false);
+    for uri in own_models(&out.model) {
+        cfg = cfg.namespace(uri);
+    }
+    let g = generate_with_diagnostics(&out.model, &cfg);
+    assert!(!g.diagnostics.has_errors(), "{}", g.diagnostics.render(&out.model.sources));
+    let mut text = concatenate(&g.files);
+    text.push_str("// diagnostics:\n");
+    // Paths relative to the workspace root, so the snapshot does not depend on where the checkout is.
+    text.push_str(&g.diagnostics.render(&out.model.sources).replace(&format!("{}/", root().display()), ""));
+    insta::assert_snapshot!(case, text);
+}
+
+macro_rules! snapshots {
+    ($($case:ident),* $(,)?) => { $( #[test] fn $case() { snapshot(stringify!($case)); } )* };
+}
+
+snapshots!(
+    abstract_base,
+    arrays,
+    enum_gaps,
+    event_type,
+    instances,
+    method,
+    names,
+    option_set,
+    optional_fields,
+    state_machine,
+    structure,
+    two_namespaces,
+    union,
+    variable_type,
+);
+
+#[test]
+fn every_fixture_has_a_snapshot() {
+    let mut dirs: Vec<String> = std::fs::read_dir(root().join("tests/fixtures"))
+        .unwrap()
+        .flatten()
+        .filter(|e| e.path().is_dir())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n != "bad")
+        .collect();
+    dirs.sort();
+    assert_eq!(dirs, CASES, "add the new fixture to CASES and to the snapshots! list");
+}
+
+/// Writes generated files below `dir`, replacing what was there.
+fn write(dir: &Path, files: &[OutFile]) {
+    let _ = std::fs::remove_dir_all(dir);
+    write_tree(dir, files, Mode::Write).unwrap_or_else(|e| panic!("cannot write {}: {e}", dir.display()));
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            copy_dir(&p, &to.join(e.file_name()));
+        } else {
+            std::fs::copy(&p, to.join(e.file_name())).unwrap();
+        }
+    }
+}
+
+/// Runs the checker; returns (passed, failed) and the output.
+fn check(dir: &Path, aggregate: bool) -> (usize, usize, String) {
+    let mut cmd = Command::new(python());
+    cmd.arg(root().join("tests/modelica/check.py")).arg(dir).arg("--quiet");
+    if aggregate {
+        cmd.arg("--aggregate").args(["--jobs", "1"]);
+    }
+    let out = cmd.output().expect("cannot run tests/modelica/check.py");
+    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    let last = text
+        .lines()
+        .rev()
+        .find(|l| l.ends_with(" failed"))
+        .unwrap_or_else(|| panic!("no summary line from check.py:\n{text}"));
+    let nums: Vec<usize> = last.split_whitespace().filter_map(|w| w.parse().ok()).collect();
+    assert_eq!(nums.len(), 2, "unexpected summary `{last}`");
+    (nums[0], nums[1], text)
+}
+
+fn tmp(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("modelica").join(name)
+}
+
+#[test]
+fn companion_specs_and_the_example_pass_rumoca_and_the_example_simulates() {
+    let dir = vendor();
+    let out = compile_files(&[dir.join("Opc.Ua.Robotics.NodeSet2.xml")], vec![dir]);
+    let cfg = ModelicaConfig::new()
+        .namespace("http://opcfoundation.org/UA/DI/")
+        .namespace("http://opcfoundation.org/UA/IA/")
+        .namespace("http://opcfoundation.org/UA/Robotics/");
+    let files = generate(&out.model, &cfg).unwrap_or_else(|d| panic!("{}", d.render(&out.model.sources)));
+    let classes = files
+        .iter()
+        .filter(|f| f.path.extension().is_some_and(|x| x == "mo") && !f.path.ends_with("package.mo"))
+        .count();
+    let target = tmp("robotics");
+    write(&target, &files);
+    let example = root().join("tests/modelica/RoboticsExample");
+    copy_dir(&example, &target.join("RoboticsExample"));
+    let example_classes = std::fs::read_dir(&example)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name() != "package.mo" && e.path().extension().is_some_and(|x| x == "mo"))
+        .count();
+
+    let t = Instant::now();
+    let (passed, failed, text) = check(&target, false);
+    println!(
+        "DI + IA + Robotics + ns0 subset + OpcUaSupport + RoboticsExample: {passed} passed, {failed} failed in {:.1} s",
+        t.elapsed().as_secs_f64()
+    );
+    assert_eq!(failed, 0, "{text}");
+    assert_eq!(passed, classes + example_classes, "every generated class and the example are checked\n{text}");
+
+    // The example: the axis follows its target with a first-order lag, and the generated OPC UA variable
+    // ParameterSet/ActualPosition carries the position.
+    let sim = |model: &str, at: &str| -> Vec<(String, f64, f64)> {
+        let out = Command::new(python())
+            .arg(root().join("tests/modelica/simulate.py"))
+            .arg(&target)
+            .arg(model)
+            .arg(at)
+            .output()
+            .expect("cannot run tests/modelica/simulate.py");
+        let text = String::from_utf8_lossy(&out.stdout).into_owned();
+        assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+        assert!(text.contains(&format!("simulated {model}")), "{text}");
+        text.lines()
+            .filter_map(|l| {
+                let mut parts = l.split_whitespace();
+                let name = parts.next()?.to_string();
+                let at: f64 = parts.next()?.split('@').next()?.parse().ok()?;
+                let end: f64 = parts.next()?.split('@').next()?.parse().ok()?;
+                Some((name, at, end))
+            })
+            .collect()
+    };
+    let value = |vars: &[(String, f64, f64)], name: &str| -> (f64, f64) {
+        vars.iter()
+            .find(|v| v.0 == name)
+            .map(|v| (v.1, v.2))
+            .unwrap_or_else(|| panic!("no variable {name} in {vars:?}"))
+    };
+    let axis = sim("RoboticsExample.AxisDemo", "0.2");
+    let (at_t, end) = value(&axis, "axis.parameterSet.actualPosition");
+    let expected = 1.0 - (-1.0f64).exp();
+    assert!((at_t - expected).abs() < 1e-3, "ActualPosition at t = T is {at_t}, expected {expected}");
+    assert!((end - 1.0).abs() < 1e-3, "ActualPosition at the end is {end}");
+    let robot = sim("RoboticsExample.RobotDemo", "0.1");
+    let (_, a1) = value(&robot, "robot.axes.axisIdentifier[1].position");
+    let (_, a2) = value(&robot, "robot.axes.axisIdentifier[2].position");
+    assert!((a1 - 1.0).abs() < 1e-2 && (a2 + 0.5).abs() < 1e-2, "the robot's axes end at {a1} and {a2}");
+}
+
+/// Generates the models of each file (with everything it requires, ns0 as a subset) and checks each output
+/// with one aggregate rumoca model, two nodesets at a time.
+fn check_tree(label: &str, tree: &Path, files: &[PathBuf], absent_ok: bool) {
+    let t0 = Instant::now();
+    let mut jobs: Vec<(PathBuf, PathBuf, usize)> = Vec::new();
+    let mut unresolvable = Vec::new();
+    let mut generated_classes = 0;
+    let mut gen_time = 0.0;
+    for (i, f) in files.iter().enumerate() {
+        let out = compile(
+            vec![Input::Path(f.clone())],
+            &Options { model_dirs: vec![tree.to_path_buf()], ..Options::default() },
+        );
+        if !out.ok() {
+            unresolvable.push(f.clone());
+            continue;
+        }
+        // Every non-base namespace that was loaded, so the output is complete on its own.
+        let mut cfg = ModelicaConfig::new();
+        for m in &out.model.models {
+            if m.uri != NS0_URI {
+                cfg = cfg.namespace(m.uri.clone());
+            }
+        }
+        let t = Instant::now();
+        let files =
+            generate(&out.model, &cfg).unwrap_or_else(|d| panic!("{}: {}", f.display(), d.render(&out.model.sources)));
+        gen_time += t.elapsed().as_secs_f64();
+        let classes = files
+            .iter()
+            .filter(|x| x.path.extension().is_some_and(|e| e == "mo") && !x.path.ends_with("package.mo"))
+            .count();
+        generated_classes += classes;
+        let dir = tmp(&format!("{label}/{i:03}"));
+        write(&dir, &files);
+        jobs.push((f.clone(), dir, classes));
+    }
+    if !absent_ok {
+        assert!(unresolvable.is_empty(), "{unresolvable:?} do not resolve");
+    }
+    let gen_elapsed = t0.elapsed().as_secs_f64();
+    // Two workers: the CI machine has two cores.
+    let t1 = Instant::now();
+    let results: Vec<(PathBuf, usize, usize, String)> = std::thread::scope(|s| {
+        let chunks: Vec<Vec<&(PathBuf, PathBuf, usize)>> =
+            (0..2).map(|w| jobs.iter().skip(w).step_by(2).collect()).collect();
+        let handles: Vec<_> = chunks
+            .into_iter()
+            .map(|chunk| {
+                s.spawn(move || {
+                    chunk
+                        .into_iter()
+                        .map(|(f, dir, _)| {
+                            let (p, fl, text) = check(dir, true);
+                            (f.clone(), p, fl, text)
+                        })
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        handles.into_iter().flat_map(|h| h.join().expect("a checker thread panicked")).collect()
+    });
+    let mut passed = 0;
+    let mut failed = 0;
+    let mut failures = String::new();
+    for (f, p, fl, text) in &results {
+        passed += p;
+        failed += fl;
+        if *fl > 0 {
+            failures.push_str(&format!("{}:\n{text}\n", f.display()));
+        }
+    }
+    println!(
+        "{label}: {} files, {} generated ({generated_classes} classes, generation {gen_time:.2} s, {gen_elapsed:.1} s with loading), {} unresolvable (missing models); rumoca: {passed} passed, {failed} failed in {:.1} s",
+        files.len(),
+        jobs.len(),
+        unresolvable.len(),
+        t1.elapsed().as_secs_f64()
+    );
+    for u in &unresolvable {
+        println!("  unresolvable: {}", u.strip_prefix(tree).unwrap_or(u).display());
+    }
+    assert_eq!(failed, 0, "{failures}");
+    assert_eq!(passed, jobs.iter().map(|j| j.2).sum::<usize>(), "every generated class is checked");
+}
+
+#[test]
+fn every_resolvable_corpus_file_passes_rumoca() {
+    let tree = corpus();
+    let files = nodeset_files(&tree);
+    assert!(files.len() >= 117, "expected the 117+ NodeSet2 files of the corpus, found {}", files.len());
+    check_tree("corpus", &tree, &files, true);
+}
+
+#[test]
+fn skill_reference_models_pass_rumoca() {
+    let tree = root().join("../shared/nodesets/skills-reference");
+    let mut files = nodeset_files(&tree);
+    assert_eq!(files.len(), 2, "the two skill reference models are expected in {}", tree.display());
+    // The skills need DI, which the reference folder does not hold; the corpus has it.
+    let dir = tmp("skills-models");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    for f in &files {
+        std::fs::copy(f, dir.join(f.file_name().unwrap())).unwrap();
+    }
+    let di = corpus().join("DI/Opc.Ua.Di.NodeSet2.xml");
+    std::fs::copy(&di, dir.join("Opc.Ua.Di.NodeSet2.xml")).unwrap();
+    std::fs::copy(corpus().join("Schema/Opc.Ua.NodeSet2.xml"), dir.join("Opc.Ua.NodeSet2.xml")).unwrap();
+    files = files.iter().map(|f| dir.join(f.file_name().unwrap())).collect();
+    check_tree("skills", &dir, &files, false);
+}
+
+#[test]
+fn output_does_not_depend_on_input_order_or_run() {
+    let dir = vendor();
+    let names = ["Opc.Ua.Di.NodeSet2.xml", "Opc.Ua.IA.NodeSet2.xml", "Opc.Ua.Robotics.NodeSet2.xml"];
+    let forward: Vec<PathBuf> = names.iter().map(|n| dir.join(n)).collect();
+    let backward: Vec<PathBuf> = forward.iter().rev().cloned().collect();
+    let cfg = ModelicaConfig::new()
+        .namespace("http://opcfoundation.org/UA/Robotics/")
+        .namespace("http://opcfoundation.org/UA/DI/")
+        .namespace("http://opcfoundation.org/UA/IA/");
+    let a = generate(&compile_files(&forward, vec![dir.clone()]).model, &cfg).unwrap();
+    let b = generate(&compile_files(&forward, vec![dir.clone()]).model, &cfg).unwrap();
+    let c = generate(&compile_files(&backward, vec![dir.clone()]).model, &cfg).unwrap();
+    assert_eq!(a, b, "two runs differ");
+    assert_eq!(a, c, "the input order changes the output");
+}
+
+#[test]
+fn files_are_utf8_without_bom_with_header_and_within() {
+    let dir = vendor();
+    let out = compile_files(&[dir.join("Opc.Ua.Robotics.NodeSet2.xml")], vec![dir]);
+    let files = generate(
+        &out.model,
+        &ModelicaConfig::new()
+            .namespace("http://opcfoundation.org/UA/Robotics/")
+            .namespace("http://opcfoundation.org/UA/DI/")
+            .namespace("http://opcfoundation.org/UA/IA/"),
+    )
+    .unwrap();
+    for f in &files {
+        assert!(!f.contents.starts_with('\u{feff}'), "{} starts with a BOM", f.path.display());
+        let name = f.path.file_name().unwrap().to_string_lossy();
+        if name == "package.order" {
+            assert!(
+                f.contents
+                    .lines()
+                    .all(|l| nodeset_compiler::names::is_valid(l, nodeset_compiler::names::Target::Modelica)),
+                "{}",
+                f.path.display()
+            );
+            continue;
+        }
+        assert!(f.contents.starts_with("// Generated by nodeset-compiler"), "{} has no header", f.path.display());
+        assert!(
+            f.contents.contains("`cargo xtask generate`"),
+            "{} does not say how to regenerate it",
+            f.path.display()
+        );
+        let parent: Vec<String> =
+            f.path.parent().unwrap().components().map(|c| c.as_os_str().to_string_lossy().into_owned()).collect();
+        let class = name.strip_suffix(".mo").unwrap();
+        let within = if class == "package" { parent[..parent.len() - 1].join(".") } else { parent.join(".") };
+        let expected = if within.is_empty() { "within;".to_string() } else { format!("within {within};") };
+        assert!(f.contents.contains(&format!("\n{expected}\n")), "{} lacks `{expected}`", f.path.display());
+    }
+    // Every class of a folder is listed in its package.order.
+    let mut dirs = std::collections::BTreeMap::<PathBuf, Vec<String>>::new();
+    for f in &files {
+        if let Some(c) = f.path.file_name().unwrap().to_string_lossy().strip_suffix(".mo") {
+            if c != "package" {
+                dirs.entry(f.path.parent().unwrap().to_path_buf()).or_default().push(c.to_string());
+            }
+        }
+    }
+    for (dir, mut classes) in dirs {
+        let order = files
+            .iter()
+            .find(|f| f.path == dir.join("package.order"))
+            .unwrap_or_else(|| panic!("{} has no package.order", dir.display()));
+        let mut listed: Vec<String> = order.contents.lines().map(str::to_string).collect();
+        // Sub-packages are listed too.
+        listed.retain(|l| !files.iter().any(|f| f.path == dir.join(l).join("package.mo")));
+        listed.sort();
+        classes.sort();
+        assert_eq!(listed, classes, "{}", dir.display());
+    }
+}
