@@ -7,6 +7,7 @@ pub mod demo;
 pub mod import;
 pub mod server;
 pub mod table;
+pub mod typed;
 
 use opcua::types::NodeId;
 pub use table::{Id, IdKind};

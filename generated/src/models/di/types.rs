@@ -19,6 +19,7 @@ pub enum DeviceHealthEnumeration {
     /// `MAINTENANCE_REQUIRED` = 4: This element is working, but a maintenance operation is required.
     MaintenanceRequired = 4,
 }
+crate::runtime::typed::ua_enum!(DeviceHealthEnumeration);
 /// `TransferResultErrorDataType` (nsu=http://opcfoundation.org/UA/DI/;i=15888).
 #[opcua::types::ua_encodable]
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -30,6 +31,7 @@ pub struct TransferResultErrorDataType {
     #[opcua(rename = "Diagnostics")]
     pub diagnostics: opcua::types::DiagnosticInfo,
 }
+crate::runtime::typed::ua_struct!(TransferResultErrorDataType);
 impl opcua::types::ExpandedMessageInfo for TransferResultErrorDataType {
     fn full_type_id(&self) -> opcua::types::ExpandedNodeId {
         opcua::types::ExpandedNodeId::from((15891u32, super::NAMESPACE_URI))
@@ -58,6 +60,7 @@ pub struct TransferResultDataDataType {
     #[opcua(rename = "ParameterDefs")]
     pub parameter_defs: Option<Vec<ParameterResultDataType>>,
 }
+crate::runtime::typed::ua_struct!(TransferResultDataDataType);
 impl opcua::types::ExpandedMessageInfo for TransferResultDataDataType {
     fn full_type_id(&self) -> opcua::types::ExpandedNodeId {
         opcua::types::ExpandedNodeId::from((15892u32, super::NAMESPACE_URI))
@@ -86,6 +89,7 @@ pub struct ParameterResultDataType {
     #[opcua(rename = "Diagnostics")]
     pub diagnostics: opcua::types::DiagnosticInfo,
 }
+crate::runtime::typed::ua_struct!(ParameterResultDataType);
 impl opcua::types::ExpandedMessageInfo for ParameterResultDataType {
     fn full_type_id(&self) -> opcua::types::ExpandedNodeId {
         opcua::types::ExpandedNodeId::from((6554u32, super::NAMESPACE_URI))
@@ -115,6 +119,7 @@ pub enum SoftwareClass {
     /// `Solution` = 3: The software update is used to install a solution with several software package to several components.
     Solution = 3,
 }
+crate::runtime::typed::ua_enum!(SoftwareClass);
 bitflags::bitflags! {
     #[doc = " `LocationIndicationType` (nsu=http://opcfoundation.org/UA/DI/;i=410)."]
     #[derive(Debug, Copy, Clone, PartialEq, Eq, Hash, Default)] pub struct
@@ -139,6 +144,7 @@ impl opcua::types::IntoVariant for LocationIndicationType {
         opcua::types::IntoVariant::into_variant(self.bits())
     }
 }
+crate::runtime::typed::ua_option_set!(LocationIndicationType, u16, UInt16);
 #[cfg(feature = "xml")]
 impl opcua::types::xml::XmlType for LocationIndicationType {
     const TAG: &'static str = stringify!(LocationIndicationType);
@@ -156,6 +162,7 @@ pub enum SoftwareVersionFileType {
     /// `Fallback` = 2: The fallback version of the software identified by the FallbackVersion Object.
     Fallback = 2,
 }
+crate::runtime::typed::ua_enum!(SoftwareVersionFileType);
 bitflags::bitflags! {
     #[doc = " `UpdateBehavior` (nsu=http://opcfoundation.org/UA/DI/;i=333)."]
     #[derive(Debug, Copy, Clone, PartialEq, Eq, Hash, Default)] pub struct UpdateBehavior
@@ -186,6 +193,7 @@ impl opcua::types::IntoVariant for UpdateBehavior {
         opcua::types::IntoVariant::into_variant(self.bits())
     }
 }
+crate::runtime::typed::ua_option_set!(UpdateBehavior, u32, UInt32);
 #[cfg(feature = "xml")]
 impl opcua::types::xml::XmlType for UpdateBehavior {
     const TAG: &'static str = stringify!(UpdateBehavior);

@@ -5,6 +5,7 @@
 #![allow(clippy::all)]
 pub mod ids;
 pub mod nodes;
+pub mod objects;
 pub mod types;
 /// The namespace URI of this model.
 pub const NAMESPACE_URI: &str = "http://opcfoundation.org/UA/IA/";

@@ -17,6 +17,7 @@ pub enum LevelDisplayMode {
     /// `Other` = 2: Display fractions in a way not defined in this version of the specification.
     Other = 2,
 }
+crate::runtime::typed::ua_enum!(LevelDisplayMode);
 /// `SignalColor` (nsu=http://opcfoundation.org/UA/IA/;i=3004).
 ///
 /// Holds the possible colour values for stacklight lamps.
@@ -42,6 +43,7 @@ pub enum SignalColor {
     /// `White` = 7: This value indicates a white lamp colour (R+G+B).
     White = 7,
 }
+crate::runtime::typed::ua_enum!(SignalColor);
 /// `SignalModeLight` (nsu=http://opcfoundation.org/UA/IA/;i=3005).
 ///
 /// Contains the values used to indicate in what way a lamp behaves when switched on.
@@ -59,6 +61,7 @@ pub enum SignalModeLight {
     /// `Other` = 3: The light is handled in a way not defined in this version of the specification.
     Other = 3,
 }
+crate::runtime::typed::ua_enum!(SignalModeLight);
 /// `StacklightOperationMode` (nsu=http://opcfoundation.org/UA/IA/;i=3002).
 ///
 /// Contains the values used to indicate how a stacklight (as a whole unit) is used.
@@ -76,6 +79,7 @@ pub enum StacklightOperationMode {
     /// `Other` = 3: Stacklight is used in a way not defined in this version of the specification
     Other = 3,
 }
+crate::runtime::typed::ua_enum!(StacklightOperationMode);
 /// `RGBWDataType` (nsu=http://opcfoundation.org/UA/IA/;i=3007).
 #[opcua::types::ua_encodable]
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -93,6 +97,7 @@ pub struct RgbwDataType {
     #[opcua(optional, rename = "White")]
     pub white: Option<u8>,
 }
+crate::runtime::typed::ua_struct!(RgbwDataType);
 impl opcua::types::ExpandedMessageInfo for RgbwDataType {
     fn full_type_id(&self) -> opcua::types::ExpandedNodeId {
         opcua::types::ExpandedNodeId::from((5009u32, super::NAMESPACE_URI))

@@ -19,6 +19,7 @@ pub enum AxisMotionProfileEnumeration {
     /// `LINEAR_ENDLESS` = 4: Linear motion is a one dimensional motion along a straight line with no limits. Motion movement is going endless in the same direction. Control unit is mainly mm.
     LinearEndless = 4,
 }
+crate::runtime::typed::ua_enum!(AxisMotionProfileEnumeration);
 /// `ExecutionModeEnumeration` (nsu=http://opcfoundation.org/UA/Robotics/;i=18191).
 #[opcua::types::ua_encodable]
 #[derive(Debug, Copy, Clone, PartialEq, Eq, Hash)]
@@ -32,6 +33,7 @@ pub enum ExecutionModeEnumeration {
     /// `STEP` = 2: Task program is executed in steps.
     Step = 2,
 }
+crate::runtime::typed::ua_enum!(ExecutionModeEnumeration);
 /// `MotionDeviceCategoryEnumeration` (nsu=http://opcfoundation.org/UA/Robotics/;i=18193).
 #[opcua::types::ua_encodable]
 #[derive(Debug, Copy, Clone, PartialEq, Eq, Hash)]
@@ -53,6 +55,7 @@ pub enum MotionDeviceCategoryEnumeration {
     /// `CYLINDRICAL_ROBOT` = 6: The robot has at least one rotary joint at the base and at least one prismatic joint to connect the links. The rotary joint uses a rotational motion along the joint axis, while the prismatic joint moves in a linear motion. Cylindrical robots operate within a cylindrical-shaped work envelope.
     CylindricalRobot = 6,
 }
+crate::runtime::typed::ua_enum!(MotionDeviceCategoryEnumeration);
 /// `OperationalModeEnumeration` (nsu=http://opcfoundation.org/UA/Robotics/;i=3006).
 #[opcua::types::ua_encodable]
 #[derive(Debug, Copy, Clone, PartialEq, Eq, Hash)]
@@ -70,6 +73,7 @@ pub enum OperationalModeEnumeration {
     /// `AUTOMATIC_EXTERNAL` = 4: "Automatic external" - Same as "Automatic" but with external control, e.g. by a PLC.
     AutomaticExternal = 4,
 }
+crate::runtime::typed::ua_enum!(OperationalModeEnumeration);
 static TYPES: std::sync::LazyLock<opcua::types::TypeLoaderInstance> = std::sync::LazyLock::new(||
 {
     #[allow(unused_mut)]

@@ -8,7 +8,9 @@ use async_trait::async_trait;
 use opcua::nodes::{DefaultTypeTree, NodeType};
 use opcua::server::address_space::{validate_node_write, write_node_value, AccessLevel, AddressSpace};
 use opcua::server::diagnostics::NamespaceMetadata;
-use opcua::server::node_manager::memory::{InMemoryNodeManager, InMemoryNodeManagerBuilder, InMemoryNodeManagerImpl};
+use opcua::server::node_manager::memory::{
+    CoreNodeManager, InMemoryNodeManager, InMemoryNodeManagerBuilder, InMemoryNodeManagerImpl,
+};
 use opcua::server::node_manager::{
     MethodCall, NodeManagerBuilder, NodeManagersRef, ParsedWriteValue, RequestContext, ServerContext, WriteNode,
 };
@@ -23,6 +25,8 @@ use tracing::warn;
 use super::check::Types;
 use crate::runtime::import::{build_map, parse_date_time, TableImport, OPC_UA_NAMESPACE, UNMAPPED};
 use crate::runtime::table::NodeSetTable;
+use crate::runtime::typed::instance::{Planner, Spaces};
+use crate::runtime::typed::{BindError, Binder, Handle, Instantiate, InstantiateError};
 use crate::runtime::{NamespaceMap, NsNodeId};
 
 /// ns0 HasProperty.
@@ -111,6 +115,7 @@ struct ServedTable {
 pub struct ModelNodes {
     tables: Vec<ServedTable>,
     namespaces: Vec<NamespaceMetadata>,
+    instance_ns: u16,
     node_managers: NodeManagersRef,
     subscriptions: Arc<SubscriptionCache>,
     type_tree: Arc<RwLock<DefaultTypeTree>>,
@@ -128,14 +133,32 @@ pub type ModelNodeManager = InMemoryNodeManager<ModelNodes>;
 /// namespace index is 0, is skipped with a warning. [`super::ServerConfig`] does all of this for you; use this function to add generated namespaces
 /// to a server you configure yourself.
 pub fn model_node_manager(tables: impl IntoIterator<Item = &'static NodeSetTable>) -> impl NodeManagerBuilder {
+    model_node_manager_with_instances(tables, DEFAULT_INSTANCE_NAMESPACE)
+}
+
+/// The namespace of instances created with [`ModelManager::instantiate`] unless the server names one.
+pub const DEFAULT_INSTANCE_NAMESPACE: &str = "urn:nodeset-models:instances";
+
+/// [`model_node_manager`] with the namespace URI that instances created at run time get their NodeIds and
+/// BrowseNames in.
+pub fn model_node_manager_with_instances(
+    tables: impl IntoIterator<Item = &'static NodeSetTable>,
+    instance_namespace: &str,
+) -> impl NodeManagerBuilder {
     let tables: Vec<&'static NodeSetTable> = tables.into_iter().collect();
+    let instance_namespace = instance_namespace.to_owned();
     InMemoryNodeManagerBuilder::new(move |context: ServerContext, space: &mut AddressSpace| {
-        ModelNodes::import(tables, context, space)
+        ModelNodes::import(tables, &instance_namespace, context, space)
     })
 }
 
 impl ModelNodes {
-    fn import(tables: Vec<&'static NodeSetTable>, context: ServerContext, space: &mut AddressSpace) -> ModelNodes {
+    fn import(
+        tables: Vec<&'static NodeSetTable>,
+        instance_namespace: &str,
+        context: ServerContext,
+        space: &mut AddressSpace,
+    ) -> ModelNodes {
         let mut seen = HashSet::new();
         let tables: Vec<_> = tables
             .into_iter()
@@ -152,6 +175,7 @@ impl ModelNodes {
             })
             .collect();
         let mut served = Vec::new();
+        let instance_ns;
         {
             let mut tree = context.type_tree.write();
             for t in &tables {
@@ -162,14 +186,25 @@ impl ModelNodes {
                 let known = tree.namespaces();
                 served.push(ServedTable { table: t, map: build_map(t, |_, uri| known.get_index(uri)) });
             }
+            instance_ns = tree.namespaces_mut().add_namespace(instance_namespace);
+            space.add_namespace(instance_namespace, instance_ns);
             // async-opcua loads the types when the server starts running; loading them now as well lets
             // `ModelManager::set_value` check values against them before that.
             space.load_into_type_tree(&mut tree);
         }
-        let namespaces = namespace_metadata(&served);
+        let mut namespaces = namespace_metadata(&served);
+        if !namespaces.iter().any(|m| m.namespace_index == instance_ns) {
+            namespaces.push(NamespaceMetadata {
+                namespace_uri: instance_namespace.to_owned(),
+                namespace_index: instance_ns,
+                is_namespace_subset: Some(false),
+                ..Default::default()
+            });
+        }
         ModelNodes {
             tables: served,
             namespaces,
+            instance_ns,
             node_managers: context.node_managers.clone(),
             subscriptions: context.subscriptions.clone(),
             type_tree: context.type_tree.clone(),
@@ -524,6 +559,65 @@ impl ModelManager {
             Types { tree: &tree, space: None }.check(&value, &data_type, value_rank, false)?;
         }
         self.set_data_value(node, DataValue::new_now(value))
+    }
+
+    /// The namespace index of instances created with [`ModelManager::instantiate`].
+    pub fn instance_namespace(&self) -> u16 {
+        self.nodes().instance_ns
+    }
+
+    /// The server's type tree (types of ns0 and of every table).
+    pub fn type_tree(&self) -> &Arc<RwLock<DefaultTypeTree>> {
+        &self.nodes().type_tree
+    }
+
+    /// Binds a typed handle (a generated ObjectType handle, `Variable<T>`, ...) to an existing node.
+    pub fn bind<H: Handle>(&self, node: &NodeId) -> Result<H, BindError> {
+        Binder::bind(self, node)
+    }
+
+    /// Runs `f` with a [`Binder`] (one read lock for a whole tree of handles).
+    pub fn bind_with<H>(&self, f: impl FnOnce(&Binder<'_>) -> Result<H, BindError>) -> Result<H, BindError> {
+        let space = self.node_manager.address_space().read();
+        let tree = self.nodes().type_tree.read();
+        f(&Binder::new(self, &space, &tree))
+    }
+
+    /// Creates an instance of an ObjectType or VariableType under `parent` as the type prescribes (see
+    /// [`crate::runtime::typed::instance`]) and returns its NodeId. Nothing is created if anything fails.
+    pub fn instantiate(
+        &self,
+        type_id: &NodeId,
+        parent: &NodeId,
+        browse_name: QualifiedName,
+        options: &Instantiate,
+    ) -> Result<NodeId, InstantiateError> {
+        let core = self.nodes().node_managers.get_of_type::<CoreNodeManager>();
+        let planned = {
+            let core_space = core.as_ref().map(|c| c.address_space().read());
+            let space = self.node_manager.address_space().read();
+            let tree = self.nodes().type_tree.read();
+            let spaces = Spaces { core: core_space.as_deref(), model: &space, tree: &tree };
+            let id = options.node_id_or(self.instance_namespace(), browse_name.name.as_ref());
+            let mut planner = Planner { spaces, options, used: Default::default(), out: Vec::new() };
+            planner.root(type_id, parent, browse_name, id)?;
+            if let Some(path) = planner.unused() {
+                return Err(InstantiateError::UnknownPath(path));
+            }
+            planner.out
+        };
+        let mut space = self.node_manager.address_space().write();
+        if let Some(p) = planned.iter().find(|p| space.node_exists(p.node.as_node().node_id())) {
+            return Err(InstantiateError::NodeExists(p.node.as_node().node_id().clone()));
+        }
+        let root = planned.first().map(|p| p.node.as_node().node_id().clone()).unwrap_or_else(NodeId::null);
+        for p in planned {
+            space.insert::<NodeType, NodeId>(p.node, None);
+            for (source, target, rt) in p.references {
+                space.insert_reference(&source, &target, rt);
+            }
+        }
+        Ok(root)
     }
 
     /// Sets a variable's whole DataValue (value, status, timestamps) unchecked, and reports it to

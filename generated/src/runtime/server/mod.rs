@@ -39,7 +39,7 @@ use opcua::server::{Server, ServerBuilder, ServerHandle};
 use opcua::types::TypeLoader;
 
 pub use manager::{
-    model_node_manager, MethodError, MethodHandler, MethodInvocation, MethodResult, ModelManager, ModelNodeManager,
+    model_node_manager, model_node_manager_with_instances, MethodError, DEFAULT_INSTANCE_NAMESPACE, MethodHandler, MethodInvocation, MethodResult, ModelManager, ModelNodeManager,
     ModelNodes, WriteHandler,
 };
 
@@ -62,6 +62,9 @@ pub struct ServerConfig {
     /// Type loaders of the generated data types, so that structures written by clients or passed to
     /// methods arrive decoded.
     pub type_loaders: Vec<Arc<dyn TypeLoader>>,
+    /// The namespace URI of instances created at run time ([`ModelManager::instantiate`]). Defaults to
+    /// `<application URI>:instances`.
+    pub instance_namespace: Option<String>,
     /// Where async-opcua keeps certificates. The endpoint needs none; the default is a folder in the
     /// system's temporary directory, so that nothing is written beside the program.
     pub pki_dir: PathBuf,
@@ -82,6 +85,7 @@ impl ServerConfig {
             application_name,
             tables: Vec::new(),
             type_loaders: Vec::new(),
+            instance_namespace: None,
             pki_dir: std::env::temp_dir().join("nodeset-models-pki"),
         }
     }
@@ -104,6 +108,12 @@ impl ServerConfig {
         self
     }
 
+    /// Sets the namespace URI of instances created at run time.
+    pub fn instance_namespace(mut self, uri: impl Into<String>) -> ServerConfig {
+        self.instance_namespace = Some(uri.into());
+        self
+    }
+
     /// Adds a type loader.
     pub fn type_loader(mut self, loader: impl TypeLoader + 'static) -> ServerConfig {
         self.type_loaders.push(Arc::new(loader));
@@ -116,6 +126,8 @@ impl ServerConfig {
     pub fn build(self) -> Result<ModelServer, String> {
         let listener = TcpListener::bind((self.host.as_str(), self.port))
             .map_err(|e| format!("cannot listen on {}:{}: {e}", self.host, self.port))?;
+        let instance_namespace =
+            self.instance_namespace.clone().unwrap_or_else(|| format!("{}:instances", self.application_uri));
         let port = listener.local_addr().map_err(|e| format!("cannot read the bound address: {e}"))?.port();
         let mut builder = ServerBuilder::new_anonymous(self.application_name)
             .application_uri(&self.application_uri)
@@ -124,7 +136,7 @@ impl ServerConfig {
             .port(port)
             .pki_dir(self.pki_dir)
             .create_sample_keypair(false)
-            .with_node_manager(model_node_manager(self.tables));
+            .with_node_manager(model_node_manager_with_instances(self.tables, &instance_namespace));
         for loader in self.type_loaders {
             builder = builder.with_type_loader(loader);
         }

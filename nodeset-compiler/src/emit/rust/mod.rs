@@ -17,6 +17,9 @@
 //! [`NodeSetTable`]: https://docs.rs/nodeset-models (runtime::table::NodeSetTable)
 
 mod async_opcua_ns0;
+mod objects;
+
+pub use objects::marker_name;
 
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::model::{ids, DataTypeKind, Model, NodeIx, StructureKind};
@@ -195,6 +198,7 @@ impl<'m> Gen<'m> {
         let ids = self.ids_file();
         let types = self.types_file();
         let nodes = self.nodes_file();
+        let objects = self.objects_file();
         let m = self.model.model_of_namespace(self.ns);
         let uri = lit(self.uri());
         let version = lit(m.and_then(|m| m.version.as_deref()).unwrap_or(""));
@@ -205,6 +209,7 @@ impl<'m> Gen<'m> {
             #![allow(clippy::all)]
             pub mod ids;
             pub mod nodes;
+            pub mod objects;
             pub mod types;
             /// The namespace URI of this model.
             pub const NAMESPACE_URI: &str = #uri;
@@ -215,7 +220,7 @@ impl<'m> Gen<'m> {
             pub use nodes::TABLE;
             pub use types::TypeLoader;
         };
-        vec![self.file("mod.rs", "Module", mod_rs), ids, types, nodes]
+        vec![self.file("mod.rs", "Module", mod_rs), ids, types, nodes, objects]
     }
 
     // ----- NodeId constants -------------------------------------------------------------------------
@@ -468,10 +473,17 @@ impl<'m> Gen<'m> {
                         #[derive(Debug, Copy, Clone, PartialEq, Eq, Hash)]
                         #[repr(i32)]
                         pub enum #name_id { #(#variants),* }
+                        #runtime::typed::ua_enum!(#name_id);
                     });
                 }
                 DataTypeKind::OptionSet { base, bits } => {
                     let width = builtin_type(*base);
+                    let variant = ident(match base {
+                        BuiltinType::Byte => "Byte",
+                        BuiltinType::UInt16 => "UInt16",
+                        BuiltinType::UInt32 => "UInt32",
+                        _ => "UInt64",
+                    });
                     let mut scope: Scope<usize> = Scope::new(Target::Rust, Case::ShoutySnake);
                     for (i, v) in bits.iter().enumerate() {
                         scope.add(&v.name, i);
@@ -514,6 +526,7 @@ impl<'m> Gen<'m> {
                                 opcua::types::IntoVariant::into_variant(self.bits())
                             }
                         }
+                        #runtime::typed::ua_option_set!(#name_id, #width, #variant);
                         #[cfg(feature = "xml")]
                         impl opcua::types::xml::XmlType for #name_id {
                             const TAG: &'static str = stringify!(#name_id);
@@ -596,6 +609,7 @@ impl<'m> Gen<'m> {
                         }
                     };
                     items.push(body);
+                    items.push(quote! { #runtime::typed::ua_struct!(#name_id); });
                     // Encoding ids and the type loader.
                     let enc = |which: &str| info.encodings.iter().find(|(n, _)| n == which).map(|(_, ix)| *ix);
                     let binary = enc("Default Binary");
@@ -634,7 +648,6 @@ impl<'m> Gen<'m> {
                 _ => {}
             }
         }
-        let _ = &runtime;
         let tokens = quote! {
             //! Data types of this namespace, encodable with async-opcua.
             #(#items)*
@@ -1230,13 +1243,13 @@ pub fn inline(files: &[OutFile], namespaces: &[RustNamespace]) -> String {
         };
         out.push_str(&format!("pub mod {} {{\n", ns.module));
         for line in get("mod.rs").lines() {
-            if matches!(line.trim(), "pub mod ids;" | "pub mod nodes;" | "pub mod types;") {
+            if matches!(line.trim(), "pub mod ids;" | "pub mod nodes;" | "pub mod objects;" | "pub mod types;") {
                 continue;
             }
             out.push_str(line);
             out.push('\n');
         }
-        for sub in ["ids", "nodes", "types"] {
+        for sub in ["ids", "nodes", "objects", "types"] {
             out.push_str(&format!("pub mod {sub} {{\n{}}}\n", get(&format!("{sub}.rs"))));
         }
         out.push_str("}\n");

@@ -1,0 +1,436 @@
+//! Instantiation of ObjectTypes and VariableTypes: the nodes an instance needs, created as its type
+//! prescribes.
+//!
+//! The type's members are read from the server's address spaces (ns0's and the generated tables'), so any
+//! type works, generated or not: the members of the type and its supertypes (a subtype's declaration
+//! overrides its supertype's of the same BrowseName), and for each member, recursively, the members of its
+//! own TypeDefinition overridden by the children the declaration adds. Mandatory members are always
+//! created, Optional ones on request, placeholders (`<AxisIdentifier>`) once per name the caller gives.
+//! Every new node gets the declaration's attributes (DisplayName, Description, DataType, ValueRank,
+//! ArrayDimensions, AccessLevel, initial value, Executable), a HasTypeDefinition reference to its type and
+//! the declaration's reference from its parent; instances carry no ModellingRule. Methods are copied per
+//! instance with their argument properties, so each instance can have its own implementation.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt;
+
+use opcua::nodes::{Base, DefaultTypeTree, Method as MethodNode, NodeType, Object, TypeTree, Variable as VariableNode};
+use opcua::server::address_space::AddressSpace;
+use opcua::types::{
+    BrowseDirection, DataEncoding, DataValue, DateTime, LocalizedText, NodeClass, NodeId, NumericRange, ObjectId,
+    ObjectTypeId, QualifiedName, ReferenceTypeId, TimestampsToReturn,
+};
+
+use super::handle::BindError;
+
+/// How deep instance declarations may nest (a guard against types that contain themselves).
+const MAX_DEPTH: usize = 32;
+
+/// What to create besides the mandatory members, and where.
+///
+/// Paths name members below the new instance by BrowseName, `/`-separated: `ParameterSet/ActualSpeed`;
+/// a placeholder is named by its declaration (`Axes/<AxisIdentifier>`), and members below a placeholder
+/// instance by the name given to it (`MotionDevices/Arm/Axes/<AxisIdentifier>`).
+#[derive(Clone, Debug, Default)]
+pub struct Instantiate {
+    optional: BTreeSet<String>,
+    all_optional: bool,
+    placeholders: BTreeMap<String, Vec<(String, Option<NodeId>)>>,
+    reference_type: Option<NodeId>,
+    node_id: Option<NodeId>,
+}
+
+impl Instantiate {
+    /// Mandatory members only.
+    pub fn new() -> Instantiate {
+        Instantiate::default()
+    }
+
+    /// Also create the Optional member at `path`.
+    pub fn optional(mut self, path: impl Into<String>) -> Instantiate {
+        self.optional.insert(path.into());
+        self
+    }
+
+    /// Create every Optional member (at every depth).
+    pub fn all_optional(mut self) -> Instantiate {
+        self.all_optional = true;
+        self
+    }
+
+    /// Create one instance of the placeholder at `path` per name, of the placeholder's TypeDefinition.
+    pub fn placeholder<S: Into<String>>(mut self, path: impl Into<String>, names: impl IntoIterator<Item = S>) -> Instantiate {
+        let entry = self.placeholders.entry(path.into()).or_default();
+        entry.extend(names.into_iter().map(|n| (n.into(), None)));
+        self
+    }
+
+    /// Create one instance of the placeholder at `path`, of `type_id` (a subtype of the placeholder's
+    /// TypeDefinition).
+    pub fn placeholder_of_type(mut self, path: impl Into<String>, name: impl Into<String>, type_id: NodeId) -> Instantiate {
+        self.placeholders.entry(path.into()).or_default().push((name.into(), Some(type_id)));
+        self
+    }
+
+    /// The reference from the parent to the new instance (default: Organizes under a folder, HasComponent
+    /// otherwise).
+    pub fn reference_type(mut self, reference_type: impl Into<NodeId>) -> Instantiate {
+        self.reference_type = Some(reference_type.into());
+        self
+    }
+
+    pub(crate) fn node_id_or(&self, namespace: u16, name: &str) -> NodeId {
+        self.node_id.clone().unwrap_or_else(|| NodeId::new(namespace, name))
+    }
+
+    /// The NodeId of the new instance (default: a string NodeId in the server's instance namespace, the
+    /// BrowseName; its members get `<parent id>/<BrowseName>`).
+    pub fn node_id(mut self, node_id: NodeId) -> Instantiate {
+        self.node_id = Some(node_id);
+        self
+    }
+}
+
+/// Why an instance could not be created.
+#[derive(Clone, Debug, PartialEq)]
+pub enum InstantiateError {
+    /// The type is not an ObjectType or VariableType the server knows.
+    UnknownType(NodeId),
+    /// The parent node does not exist.
+    UnknownParent(NodeId),
+    /// A node the instance needs already exists.
+    NodeExists(NodeId),
+    /// A MandatoryPlaceholder got no names (`Instantiate::placeholder`).
+    MissingPlaceholder(String),
+    /// An option names a path the type does not have (or that is not Optional, or not a placeholder).
+    UnknownPath(String),
+    /// A type's members nest deeper than the instantiation allows (a type that contains itself).
+    TooDeep(String),
+    /// The instance was created but a typed handle could not be bound to it.
+    Bind(BindError),
+}
+
+impl fmt::Display for InstantiateError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            InstantiateError::UnknownType(id) => write!(f, "{id} is not an ObjectType or VariableType of this server"),
+            InstantiateError::UnknownParent(id) => write!(f, "the parent {id} does not exist"),
+            InstantiateError::NodeExists(id) => write!(f, "node {id} already exists"),
+            InstantiateError::MissingPlaceholder(p) => {
+                write!(f, "`{p}` is a MandatoryPlaceholder: give at least one name with Instantiate::placeholder")
+            }
+            InstantiateError::UnknownPath(p) => {
+                write!(f, "`{p}` is not an Optional member or a placeholder of the type (paths are BrowseNames joined by `/`)")
+            }
+            InstantiateError::TooDeep(p) => write!(f, "instance declarations nest too deep at `{p}`"),
+            InstantiateError::Bind(e) => write!(f, "the instance was created, but: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for InstantiateError {}
+
+impl From<BindError> for InstantiateError {
+    fn from(e: BindError) -> Self {
+        InstantiateError::Bind(e)
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Rule {
+    Mandatory,
+    Optional,
+    MandatoryPlaceholder,
+    OptionalPlaceholder,
+    /// ExposesItsArray, or a rule this runtime does not know: not instantiated.
+    Other,
+}
+
+/// An instance declaration, as a member of a type or of another declaration.
+#[derive(Clone, Debug)]
+struct Decl {
+    id: NodeId,
+    browse_name: QualifiedName,
+    reference_type: NodeId,
+    rule: Rule,
+}
+
+/// The address spaces the type information is read from.
+pub(crate) struct Spaces<'a> {
+    /// ns0 (async-opcua's core node manager), if the server has it.
+    pub core: Option<&'a AddressSpace>,
+    /// The generated tables and the instances.
+    pub model: &'a AddressSpace,
+    pub tree: &'a DefaultTypeTree,
+}
+
+/// A node to insert, with its references (source, target, type).
+pub(crate) struct Planned {
+    pub node: NodeType,
+    pub references: Vec<(NodeId, NodeId, NodeId)>,
+}
+
+impl<'a> Spaces<'a> {
+    fn space_of(&self, id: &NodeId) -> Option<&'a AddressSpace> {
+        if id.namespace == 0 {
+            if let Some(core) = self.core {
+                if core.node_exists(id) {
+                    return Some(core);
+                }
+            }
+        }
+        Some(self.model).filter(|m| m.node_exists(id)).or(self.core.filter(|c| c.node_exists(id)))
+    }
+
+    fn find(&self, id: &NodeId) -> Option<&'a NodeType> {
+        self.space_of(id)?.find(id)
+    }
+
+    /// Forward references of `node` of type `rt` or a subtype, as (reference type, target).
+    fn refs(&self, node: &NodeId, rt: ReferenceTypeId) -> Vec<(NodeId, NodeId)> {
+        let mut out: Vec<(NodeId, NodeId)> = Vec::new();
+        // A reference may be stored in either space (ns0 nodes refer to generated ones and back).
+        for space in [Some(self.model), self.core].into_iter().flatten() {
+            for r in space.find_references(node, Some((NodeId::from(rt), true)), self.tree, BrowseDirection::Forward) {
+                let item = (r.reference_type.clone(), r.target_node.clone());
+                if !out.contains(&item) {
+                    out.push(item);
+                }
+            }
+        }
+        out
+    }
+
+    fn type_definition(&self, node: &NodeId) -> Option<NodeId> {
+        self.refs(node, ReferenceTypeId::HasTypeDefinition).into_iter().map(|(_, t)| t).next()
+    }
+
+    fn rule(&self, node: &NodeId) -> Option<Rule> {
+        let (_, rule) = self.refs(node, ReferenceTypeId::HasModellingRule).into_iter().next()?;
+        Some(match rule {
+            r if r == NodeId::from(ObjectId::ModellingRule_Mandatory) => Rule::Mandatory,
+            r if r == NodeId::from(ObjectId::ModellingRule_Optional) => Rule::Optional,
+            r if r == NodeId::from(ObjectId::ModellingRule_MandatoryPlaceholder) => Rule::MandatoryPlaceholder,
+            r if r == NodeId::from(ObjectId::ModellingRule_OptionalPlaceholder) => Rule::OptionalPlaceholder,
+            _ => Rule::Other,
+        })
+    }
+
+    /// The children of `node` that have a ModellingRule (a method's argument properties count even without).
+    fn declared_children(&self, node: &NodeId) -> Vec<Decl> {
+        let is_method = matches!(self.find(node), Some(NodeType::Method(_)));
+        let has_subtype: NodeId = ReferenceTypeId::HasSubtype.into();
+        let mut out = Vec::new();
+        for (rt, target) in self.refs(node, ReferenceTypeId::HierarchicalReferences) {
+            if rt == has_subtype {
+                continue;
+            }
+            let Some(child) = self.find(&target) else { continue };
+            let rule = match self.rule(&target) {
+                Some(rule) => rule,
+                None if is_method && rt == NodeId::from(ReferenceTypeId::HasProperty) => Rule::Mandatory,
+                None => continue,
+            };
+            out.push(Decl { id: target.clone(), browse_name: child.as_node().browse_name().clone(), reference_type: rt, rule });
+        }
+        out
+    }
+
+    /// The members of a type: its own declarations and its supertypes', the most derived first.
+    fn type_members(&self, type_id: &NodeId) -> Vec<Decl> {
+        let mut out: Vec<Decl> = Vec::new();
+        let mut current = Some(type_id.clone());
+        let mut depth = 0;
+        while let Some(t) = current {
+            for d in self.declared_children(&t) {
+                if !out.iter().any(|m| m.browse_name == d.browse_name) {
+                    out.push(d);
+                }
+            }
+            depth += 1;
+            current = if depth < MAX_DEPTH { self.tree.get_supertype(&t).cloned() } else { None };
+        }
+        out
+    }
+
+    /// The members of an instance of declaration `decl` whose TypeDefinition is `type_id`.
+    fn decl_members(&self, decl: Option<&NodeId>, type_id: Option<&NodeId>) -> Vec<Decl> {
+        let mut out = type_id.map(|t| self.type_members(t)).unwrap_or_default();
+        if let Some(decl) = decl {
+            for d in self.declared_children(decl) {
+                match out.iter_mut().find(|m| m.browse_name == d.browse_name) {
+                    Some(m) => *m = d,
+                    None => out.push(d),
+                }
+            }
+        }
+        out
+    }
+}
+
+/// Plans the nodes of a new instance.
+pub(crate) struct Planner<'a> {
+    pub spaces: Spaces<'a>,
+    pub options: &'a Instantiate,
+    pub used: BTreeSet<String>,
+    pub out: Vec<Planned>,
+}
+
+/// What a new node copies its attributes from.
+struct Source<'a> {
+    /// The instance declaration, or the type itself for the root.
+    template: Option<&'a NodeType>,
+    type_id: Option<NodeId>,
+}
+
+impl<'a> Planner<'a> {
+    /// Plans an instance of `type_id` named `browse_name`, under `parent`.
+    pub fn root(&mut self, type_id: &NodeId, parent: &NodeId, browse_name: QualifiedName, id: NodeId) -> Result<NodeClass, InstantiateError> {
+        let class = match self.spaces.find(type_id) {
+            Some(NodeType::ObjectType(_)) => NodeClass::Object,
+            Some(NodeType::VariableType(_)) => NodeClass::Variable,
+            _ => return Err(InstantiateError::UnknownType(type_id.clone())),
+        };
+        if self.spaces.find(parent).is_none() {
+            return Err(InstantiateError::UnknownParent(parent.clone()));
+        }
+        let folder: NodeId = ObjectId::ObjectsFolder.into();
+        let is_folder = self.spaces.type_definition(parent).is_some_and(|t| {
+            let folder_type = NodeId::from(ObjectTypeId::FolderType);
+            t == folder_type || self.spaces.tree.is_subtype_of(&t, &folder_type)
+        }) || *parent == folder;
+        let rt = self.options.reference_type.clone().unwrap_or_else(|| {
+            if is_folder { ReferenceTypeId::Organizes.into() } else { ReferenceTypeId::HasComponent.into() }
+        });
+        let members = self.spaces.decl_members(None, Some(type_id));
+        let template = self.spaces.find(type_id);
+        self.node(Source { template, type_id: Some(type_id.clone()) }, class, &id, browse_name, parent, rt)?;
+        self.members(&id, members, "", 0)?;
+        Ok(class)
+    }
+
+    fn node(
+        &mut self,
+        source: Source<'_>,
+        class: NodeClass,
+        id: &NodeId,
+        browse_name: QualifiedName,
+        parent: &NodeId,
+        reference_type: NodeId,
+    ) -> Result<(), InstantiateError> {
+        if self.spaces.model.node_exists(id) || self.out.iter().any(|p| p.node.as_node().node_id() == id) {
+            return Err(InstantiateError::NodeExists(id.clone()));
+        }
+        let is_declaration = matches!(source.template, Some(NodeType::Object(_) | NodeType::Variable(_) | NodeType::Method(_)));
+        let display_name = match source.template {
+            Some(t) if is_declaration && !browse_name.name.as_ref().is_empty() && *t.as_node().browse_name() == browse_name => {
+                t.as_node().display_name().clone()
+            }
+            _ => LocalizedText::new("", browse_name.name.as_ref()),
+        };
+        let description = source.template.filter(|_| is_declaration).and_then(|t| t.as_node().description().cloned());
+        let base = Base::new_full(id.clone(), class, browse_name, display_name, description, None, None);
+        let node: NodeType = match (class, source.template) {
+            (NodeClass::Variable, Some(NodeType::Variable(v))) => {
+                let value = v.value(TimestampsToReturn::Neither, &NumericRange::None, &DataEncoding::Binary, 0.0);
+                let now = DateTime::now();
+                let value = DataValue { source_timestamp: Some(now), server_timestamp: Some(now), ..value };
+                VariableNode::new_full(
+                    base,
+                    v.data_type(),
+                    v.historizing(),
+                    v.value_rank(),
+                    value,
+                    v.access_level().bits(),
+                    v.user_access_level().bits(),
+                    v.array_dimensions(),
+                    v.minimum_sampling_interval(),
+                )
+                .into()
+            }
+            (NodeClass::Variable, Some(NodeType::VariableType(vt))) => {
+                let value = vt.value().cloned().unwrap_or_default();
+                VariableNode::new_full(base, vt.data_type().clone(), false, vt.value_rank(), value, 1, 1, vt.array_dimensions(), None)
+                    .into()
+            }
+            (NodeClass::Object, Some(NodeType::Object(o))) => Object::new_full(base, o.event_notifier()).into(),
+            (NodeClass::Object, _) => Object::new_full(base, Default::default()).into(),
+            (NodeClass::Method, Some(NodeType::Method(m))) => MethodNode::new_full(base, m.executable(), m.user_executable()).into(),
+            _ => return Err(InstantiateError::UnknownType(source.type_id.unwrap_or_else(NodeId::null))),
+        };
+        let mut references = vec![(parent.clone(), id.clone(), reference_type)];
+        if let Some(t) = source.type_id {
+            references.push((id.clone(), t, ReferenceTypeId::HasTypeDefinition.into()));
+        }
+        self.out.push(Planned { node, references });
+        Ok(())
+    }
+
+    fn members(&mut self, parent: &NodeId, members: Vec<Decl>, path: &str, depth: usize) -> Result<(), InstantiateError> {
+        if depth >= MAX_DEPTH {
+            return Err(InstantiateError::TooDeep(path.to_owned()));
+        }
+        for decl in members {
+            let name = decl.browse_name.name.as_ref().to_owned();
+            let member_path = format!("{path}{name}");
+            let instances: Vec<(QualifiedName, Option<NodeId>, String)> = match decl.rule {
+                Rule::Mandatory => vec![(decl.browse_name.clone(), None, member_path.clone())],
+                Rule::Optional => {
+                    let wanted = self.options.optional.contains(&member_path);
+                    if wanted {
+                        self.used.insert(format!("o:{member_path}"));
+                    }
+                    if wanted || self.options.all_optional {
+                        vec![(decl.browse_name.clone(), None, member_path.clone())]
+                    } else {
+                        continue;
+                    }
+                }
+                Rule::MandatoryPlaceholder | Rule::OptionalPlaceholder => {
+                    let names = self.options.placeholders.get(&member_path).cloned().unwrap_or_default();
+                    if names.is_empty() && decl.rule == Rule::MandatoryPlaceholder {
+                        return Err(InstantiateError::MissingPlaceholder(member_path));
+                    }
+                    if !names.is_empty() {
+                        self.used.insert(format!("p:{member_path}"));
+                    }
+                    names
+                        .into_iter()
+                        .map(|(n, t)| (QualifiedName::new(decl.browse_name.namespace_index, n.as_str()), t, format!("{path}{n}")))
+                        .collect()
+                }
+                Rule::Other => continue,
+            };
+            let Some(template) = self.spaces.find(&decl.id) else { continue };
+            let class = template.node_class();
+            for (browse_name, type_override, instance_path) in instances {
+                let id = child_id(parent, browse_name.name.as_ref());
+                let type_id = type_override.clone().or_else(|| self.spaces.type_definition(&decl.id));
+                let members = match class {
+                    NodeClass::Method => self.spaces.declared_children(&decl.id),
+                    _ => self.spaces.decl_members(Some(&decl.id), type_id.as_ref()),
+                };
+                let source = Source { template: Some(template), type_id: if class == NodeClass::Method { None } else { type_id } };
+                self.node(source, class, &id, browse_name, parent, decl.reference_type.clone())?;
+                self.members(&id, members, &format!("{instance_path}/"), depth + 1)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Options that named nothing the type has.
+    pub fn unused(&self) -> Option<String> {
+        let optional = self.options.optional.iter().find(|p| !self.used.contains(&format!("o:{p}")));
+        let placeholder = self.options.placeholders.keys().find(|p| !self.used.contains(&format!("p:{p}")));
+        optional.or(placeholder).cloned()
+    }
+}
+
+/// The NodeId of a member: `<parent id>/<name>` for string parents, otherwise `<parent id as text>/<name>`.
+pub(crate) fn child_id(parent: &NodeId, name: &str) -> NodeId {
+    let base = match &parent.identifier {
+        opcua::types::Identifier::String(s) => s.as_ref().to_owned(),
+        other => other.to_string(),
+    };
+    NodeId::new(parent.namespace, format!("{base}/{name}"))
+}

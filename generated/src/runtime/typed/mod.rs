@@ -1,0 +1,244 @@
+//! The typed API generated handles are built on: Rust value types for OPC UA DataTypes ([`UaValue`]),
+//! handles to the nodes of an instance ([`Variable<T>`], [`Method<I, O>`], [`ObjectNode`],
+//! [`Placeholders<H>`]), instantiation of types as they prescribe ([`Instantiate`]), and the traits that
+//! generated code implements for every ObjectType ([`ObjectType`]) and that `nodeset-derive` checks bindings
+//! against ([`Member`], [`VariableMember`]).
+
+pub mod handle;
+pub mod instance;
+pub mod value;
+
+pub use handle::{Arguments, BindError, Binder, CallContext, Handle, Method, ObjectNode, Placeholders, Variable};
+pub use instance::{Instantiate, InstantiateError};
+pub use value::{UaStruct, UaValue};
+
+use opcua::types::{NodeId, QualifiedName};
+
+use crate::runtime::server::ModelManager;
+use crate::runtime::NsNodeId;
+
+/// A generated handle of an ObjectType: its instances can be created ([`ObjectType::instantiate`]) and bound
+/// ([`ModelManager::bind`]).
+#[diagnostic::on_unimplemented(
+    message = "`{Self}` is not an ObjectType handle",
+    label = "name a struct of a generated `objects` module that stands for an ObjectType",
+    note = "generated ObjectType handles are in `models::<namespace>::objects`; VariableTypes and data types cannot be bound"
+)]
+pub trait ObjectType: Handle {
+    /// The ObjectType's NodeId.
+    const TYPE_ID: NsNodeId;
+    /// The ObjectType's BrowseName (its name; the namespace is `TYPE_ID`'s).
+    const BROWSE_NAME: &'static str;
+
+    /// Creates an instance named `name` under `parent` (mandatory members, and what `options` asks for) and
+    /// binds a handle to it. Its BrowseName is in the server's instance namespace.
+    fn instantiate(manager: &ModelManager, parent: &NodeId, name: &str, options: &Instantiate) -> Result<Self, InstantiateError> {
+        let type_id = manager.resolve(Self::TYPE_ID).ok_or(InstantiateError::Bind(BindError::UnknownNamespace(
+            Self::TYPE_ID.namespace_uri.to_owned(),
+        )))?;
+        let browse_name = QualifiedName::new(manager.instance_namespace(), name);
+        let id = manager.instantiate(&type_id, parent, browse_name, options)?;
+        Ok(manager.bind(&id)?)
+    }
+}
+
+/// A generated handle of a VariableType.
+pub trait VariableType: Handle {
+    /// The VariableType's NodeId.
+    const TYPE_ID: NsNodeId;
+    /// The VariableType's BrowseName.
+    const BROWSE_NAME: &'static str;
+}
+
+/// What kind of node a member is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MemberKind {
+    Object,
+    Variable,
+    Method,
+}
+
+/// An instance declaration of an ObjectType, as a zero-sized marker type that generated code declares per
+/// member path (`<type module>::members::ParameterSet__ActualPosition`). `nodeset-derive` names these
+/// markers to check a binding at compile time.
+pub trait Member {
+    /// The ObjectType handle the member belongs to.
+    type Owner;
+    /// BrowseNames from the instance down to the member, each with its namespace URI.
+    const PATH: &'static [(&'static str, &'static str)];
+    /// The member's NodeClass.
+    const KIND: MemberKind;
+    /// Whether every instance has it (Mandatory, all the way down).
+    const MANDATORY: bool;
+}
+
+/// A member that is a variable.
+pub trait VariableMember: Member {
+    /// The Rust type of one value of the variable's DataType.
+    type Scalar;
+    /// The variable's ValueRank.
+    const VALUE_RANK: i32;
+    /// Whether the nodeset gives the declaration an initial value.
+    const HAS_DEFAULT: bool;
+    /// Whether clients may write it (CurrentWrite in its AccessLevel).
+    const WRITABLE: bool;
+}
+
+/// Checks, for `nodeset-derive`, that a field's Rust type holds the values of a variable member: the same
+/// scalar type. (The ValueRank is checked separately, with [`value::rank_fits`].)
+#[diagnostic::on_unimplemented(
+    message = "the field's type `{Self}` does not hold values of this variable's DataType (`{S}`)",
+    label = "expected `{S}` (or `Vec<{S}>` for an array)"
+)]
+pub trait Holds<S> {}
+
+impl<S: UaValue<Scalar = S>> Holds<S> for S {}
+impl<S: UaValue<Scalar = S>> Holds<S> for Vec<S> {}
+impl Holds<String> for opcua::types::UAString {}
+
+/// Implements [`UaValue`] for a generated enumeration (`#[repr(i32)]`, with `TryFrom<i32>`).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __nodeset_ua_enum {
+    ($($t:ty),* $(,)?) => {$(
+        impl $crate::runtime::typed::UaValue for $t {
+            type Scalar = $t;
+            const VALUE_RANK: i32 = -1;
+            const VARIANT_TYPE: opcua::types::VariantScalarTypeId = opcua::types::VariantScalarTypeId::Int32;
+            fn to_variant(&self) -> opcua::types::Variant {
+                opcua::types::Variant::Int32(*self as i32)
+            }
+            fn from_variant(value: &opcua::types::Variant) -> Option<Self> {
+                let i = $crate::runtime::typed::value::enum_value(value)?;
+                <$t>::try_from(i32::try_from(i).ok()?).ok()
+            }
+        }
+    )*};
+}
+pub use crate::__nodeset_ua_enum as ua_enum;
+
+/// Implements [`UaValue`] for a generated OptionSet (bit flags over an unsigned integer).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __nodeset_ua_option_set {
+    ($t:ty, $bits:ty, $variant:ident) => {
+        impl $crate::runtime::typed::UaValue for $t {
+            type Scalar = $t;
+            const VALUE_RANK: i32 = -1;
+            const VARIANT_TYPE: opcua::types::VariantScalarTypeId = opcua::types::VariantScalarTypeId::$variant;
+            fn to_variant(&self) -> opcua::types::Variant {
+                opcua::types::Variant::$variant(self.bits())
+            }
+            fn from_variant(value: &opcua::types::Variant) -> Option<Self> {
+                let bits = $crate::runtime::typed::value::option_set_bits(value)?;
+                Some(<$t>::from_bits_retain(<$bits>::try_from(bits).ok()?))
+            }
+        }
+    };
+}
+pub use crate::__nodeset_ua_option_set as ua_option_set;
+
+/// Marks generated structures as [`UaStruct`]s.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __nodeset_ua_struct {
+    ($($t:ty),* $(,)?) => {$( impl $crate::runtime::typed::UaStruct for $t {} )*};
+}
+pub use crate::__nodeset_ua_struct as ua_struct;
+
+/// Declares the member markers of an ObjectType (generated `members` modules use it): a module named
+/// after the handle with, for each variable member, the marker name, the Rust scalar type, the ValueRank,
+/// the browse path as (index into `NS`, name) pairs, and whether it is mandatory, has a default value, and
+/// is writable; and `REQUIRED`, the mandatory variables without a default, with the message for a derive
+/// that leaves one unbound.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __nodeset_object_members {
+    ($owner:ident; required: [$(($rp:literal, $rm:literal)),*]; $($m:ident: $scalar:ty, $rank:literal, [$($k:literal $name:literal),*], $mandatory:literal $default:literal $writable:literal;)*) => {
+        #[doc = concat!(" Member markers of [`", stringify!($owner), "`](super::", stringify!($owner), ") for `nodeset-derive`.")]
+        pub mod $owner {
+            #[allow(unused_imports)]
+            use super::super::{t, ua, NS};
+            $(
+                #[doc = concat!(" The variable `", $($name, "/",)* "`.")]
+                pub struct $m;
+                impl $crate::runtime::typed::Member for $m {
+                    type Owner = super::super::$owner;
+                    const PATH: &'static [(&'static str, &'static str)] = &[$((NS[$k], $name)),*];
+                    const KIND: $crate::runtime::typed::MemberKind = $crate::runtime::typed::MemberKind::Variable;
+                    const MANDATORY: bool = $mandatory;
+                }
+                impl $crate::runtime::typed::VariableMember for $m {
+                    type Scalar = $scalar;
+                    const VALUE_RANK: i32 = $rank;
+                    const HAS_DEFAULT: bool = $default;
+                    const WRITABLE: bool = $writable;
+                }
+            )*
+            /// Mandatory variables without a default value, with the message for an unbound one.
+            pub const REQUIRED: &[(&str, &str)] = &[$(($rp, $rm)),*];
+        }
+    };
+}
+pub use crate::__nodeset_object_members as object_members;
+
+/// `Deref` from a generated handle to the handle of its supertype.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __nodeset_deref_base {
+    ($t:ident => $base:ty) => {
+        impl std::ops::Deref for $t {
+            type Target = $base;
+            fn deref(&self) -> &$base {
+                &self.base
+            }
+        }
+    };
+}
+pub use crate::__nodeset_deref_base as deref_base;
+
+/// The [`ObjectType`] impl of a generated handle.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __nodeset_object_type {
+    ($t:ident, $id:expr, $name:literal) => {
+        impl $crate::runtime::typed::ObjectType for $t {
+            const TYPE_ID: $crate::runtime::NsNodeId = $id;
+            const BROWSE_NAME: &'static str = $name;
+        }
+    };
+}
+pub use crate::__nodeset_object_type as object_type;
+
+/// The [`VariableType`] impl of a generated handle.
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __nodeset_variable_type {
+    ($t:ident, $id:expr, $name:literal) => {
+        impl $crate::runtime::typed::VariableType for $t {
+            const TYPE_ID: $crate::runtime::NsNodeId = $id;
+            const BROWSE_NAME: &'static str = $name;
+        }
+    };
+}
+pub use crate::__nodeset_variable_type as variable_type;
+
+ua_struct!(
+    opcua::types::Argument,
+    opcua::types::AxisInformation,
+    opcua::types::BuildInfo,
+    opcua::types::ComplexNumberType,
+    opcua::types::DoubleComplexNumberType,
+    opcua::types::EUInformation,
+    opcua::types::EnumValueType,
+    opcua::types::KeyValuePair,
+    opcua::types::Range,
+    opcua::types::RationalNumber,
+    opcua::types::ServerStatusDataType,
+    opcua::types::ThreeDCartesianCoordinates,
+    opcua::types::ThreeDFrame,
+    opcua::types::ThreeDOrientation,
+    opcua::types::ThreeDVector,
+    opcua::types::TimeZoneDataType,
+    opcua::types::XVType,
+);

@@ -1,0 +1,531 @@
+//! `objects.rs`: typed handles of a namespace's ObjectTypes and VariableTypes, and member markers.
+//!
+//! For every ObjectType a struct whose fields are typed handles of its members (`Variable<T>` with `T` from
+//! the DataType and ValueRank, `Method<(inputs), (outputs)>` from the Argument definitions, nested structs
+//! for object members whose declaration adds children, `Option<_>` for Optional members, `Placeholders<_>`
+//! for `<Placeholder>` members); the members of the nearest supertype that has a handle of its own are in
+//! its `base` field, reached through `Deref`, so a subtype's handle reaches what it inherits. Supertypes
+//! without a handle (ns0's) have their members folded into the first generated subtype.
+//!
+//! `members::<Type>` holds one zero-sized marker per variable reachable from an instance without crossing
+//! a placeholder, named from the browse path (`ParameterSet__ActualPosition`), with the DataType's Rust
+//! scalar type, ValueRank, whether it is mandatory, has a default, is writable; plus `REQUIRED`, the
+//! mandatory variables without a default value. `nodeset-derive` checks bindings against these at compile
+//! time (it never reads XML).
+
+use std::collections::{BTreeMap, BTreeSet};
+
+use proc_macro2::{Literal, TokenStream};
+use quote::quote;
+
+use super::{doc, ident, lit, path, Gen};
+use crate::model::{DataTypeKind, ModellingRule, NodeIx};
+use crate::nodeid::Identifier;
+use crate::names::{Case, Scope, Target};
+use crate::raw::NodeClass;
+use crate::value::BuiltinType;
+use crate::write::OutFile;
+
+/// ns0 structures for which the runtime implements `UaValue` (async-opcua's own types); other ns0
+/// structures are handled as ExtensionObjects.
+const NS0_VALUE_STRUCTS: &[&str] = &[
+    "Argument", "AxisInformation", "BuildInfo", "ComplexNumberType", "DoubleComplexNumberType", "EUInformation",
+    "EnumValueType", "KeyValuePair", "Range", "RationalNumber", "ServerStatusDataType", "ThreeDCartesianCoordinates",
+    "ThreeDFrame", "ThreeDOrientation", "ThreeDVector", "TimeZoneDataType", "XVType",
+];
+
+/// How deep markers follow object members.
+const MAX_DEPTH: usize = 6;
+
+/// How deep nested handle structs go (below, members are typed by their TypeDefinition's handle).
+const NESTED_DEPTH: usize = 2;
+
+/// The marker name of a browse path, as `nodeset-derive` computes it from a `path = "A/B"` attribute:
+/// every character that cannot be in an identifier becomes `_`, a leading digit gets a `_` before it,
+/// segments are joined by `__`, and a Rust keyword gets a trailing `_`.
+pub fn marker_name(segments: &[&str]) -> String {
+    let mut parts = Vec::new();
+    for s in segments {
+        let mut p: String = s.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' }).collect();
+        if p.is_empty() || p.starts_with(|c: char| c.is_ascii_digit()) {
+            p.insert(0, '_');
+        }
+        parts.push(p);
+    }
+    let mut name = parts.join("__");
+    if syn::parse_str::<syn::Ident>(&name).is_err() {
+        name.push('_');
+    }
+    name
+}
+
+/// One member as a field of a handle struct.
+struct Field {
+    name: String,
+    ty: TokenStream,
+    bind: TokenStream,
+    doc: String,
+}
+
+/// A variable reachable from an instance, for the markers.
+struct Reach {
+    path: Vec<String>,
+    /// (namespace index into NS, name) per segment.
+    qpath: Vec<(usize, String)>,
+    node: NodeIx,
+    mandatory: bool,
+}
+
+impl Gen<'_> {
+    /// Whether a type gets a handle struct.
+    fn has_handle(&self, t: NodeIx) -> bool {
+        matches!(self.model.node(t).class, NodeClass::ObjectType | NodeClass::VariableType)
+    }
+
+    /// Handle struct names of a namespace's types.
+    fn handle_names(&self, ns: u16) -> BTreeMap<NodeIx, String> {
+        let mut scope: Scope<NodeIx> = Scope::new(Target::Rust, Case::UpperCamel);
+        for r in ["NS", "Members"] {
+            scope.reserve(r);
+        }
+        for (i, n) in self.model.nodes.iter().enumerate() {
+            let ix = NodeIx(i as u32);
+            if n.id.ns == ns && self.has_handle(ix) {
+                scope.add(n.symbolic_name.as_deref().unwrap_or(&n.browse_name.name), ix);
+            }
+        }
+        scope.finish().0
+    }
+
+    /// The Rust path of a type's handle, if it has one reachable from this module.
+    fn handle_path(&self, t: NodeIx, names: &BTreeMap<NodeIx, String>) -> Option<TokenStream> {
+        let n = self.model.node(t);
+        if n.id.ns == self.ns {
+            let name = ident(names.get(&t)?);
+            return Some(quote! { #name });
+        }
+        if n.id.ns == 0 || !self.has_handle(t) {
+            return None;
+        }
+        let uri = self.model.namespace_uri(n.id.ns);
+        let module = if let Some(p) = self.cfg.extern_paths.get(uri) {
+            path(p)
+        } else if let Some(m) = self.cfg.namespaces.iter().find(|m| m.uri == uri) {
+            let m = ident(&m.module);
+            quote! { super::super::#m }
+        } else {
+            return None;
+        };
+        let name = ident(self.handle_names(n.id.ns).get(&t)?);
+        Some(quote! { #module::objects::#name })
+    }
+
+    /// The Rust value type of a DataType and ValueRank, as typed handles use it.
+    fn value_type(&self, dt: Option<NodeIx>, value_rank: i32) -> TokenStream {
+        let variant = quote! { opcua::types::Variant };
+        let Some(dt) = dt else { return variant };
+        let scalar = self.scalar_value_type(dt);
+        if scalar.to_string() == variant.to_string() {
+            return variant;
+        }
+        match value_rank {
+            -1 => scalar,
+            0 | 1 => quote! { Vec<#scalar> },
+            _ => variant,
+        }
+    }
+
+    fn scalar_value_type(&self, dt: NodeIx) -> TokenStream {
+        let model = self.model;
+        let Some(info) = model.data_types.get(&dt) else { return quote! { opcua::types::Variant } };
+        let n = model.node(dt);
+        let t = match &info.kind {
+            DataTypeKind::Builtin(BuiltinType::String) => quote! { String },
+            DataTypeKind::Builtin(BuiltinType::Variant | BuiltinType::DataValue | BuiltinType::DiagnosticInfo)
+            | DataTypeKind::AbstractBuiltin => quote! { opcua::types::Variant },
+            DataTypeKind::Builtin(b) => super::builtin_type(*b),
+            DataTypeKind::Simple(BuiltinType::String) if n.id.ns == 0 => quote! { String },
+            _ if n.id.ns == 0 => match &info.kind {
+                DataTypeKind::Simple(b) => super::builtin_type(*b),
+                DataTypeKind::Enumeration { .. } => quote! { i32 },
+                DataTypeKind::OptionSet { base, .. } => super::builtin_type(*base),
+                DataTypeKind::Structure { .. } => {
+                    let name = n.browse_name.name.replace("3D", "ThreeD");
+                    if NS0_VALUE_STRUCTS.contains(&name.as_str()) && !info.is_abstract {
+                        let name = ident(&name);
+                        quote! { opcua::types::#name }
+                    } else {
+                        quote! { opcua::types::ExtensionObject }
+                    }
+                }
+                _ => quote! { opcua::types::Variant },
+            },
+            DataTypeKind::Structure { .. } if info.is_abstract => quote! { opcua::types::ExtensionObject },
+            DataTypeKind::Structure { .. } | DataTypeKind::Enumeration { .. } | DataTypeKind::OptionSet { .. } => {
+                let t = self.rust_type(dt);
+                if t.to_string().contains("Variant") { quote! { opcua::types::Variant } } else { t }
+            }
+            DataTypeKind::Simple(_) => self.rust_type(dt),
+        };
+        // Types of this namespace are named bare in types.rs; objects.rs reaches them through `super`.
+        if n.id.ns == self.ns && !t.to_string().contains("::") {
+            return quote! { super::types::#t };
+        }
+        t
+    }
+
+    /// The modelling rule of a member, if it is instantiated at all.
+    fn rule(&self, node: NodeIx) -> Option<ModellingRule> {
+        match self.model.node(node).modelling_rule? {
+            r @ (ModellingRule::Mandatory
+            | ModellingRule::Optional
+            | ModellingRule::MandatoryPlaceholder
+            | ModellingRule::OptionalPlaceholder) => Some(r),
+            _ => None,
+        }
+    }
+
+    /// The members of a declaration (or of an instance): `instance_members` with a rule.
+    fn decl_members(&self, decl: NodeIx) -> Vec<(NodeIx, NodeIx)> {
+        self.model
+            .instance_members(decl)
+            .into_iter()
+            .filter(|m| self.rule(m.node).is_some())
+            .map(|m| (m.node, m.reference_type))
+            .collect()
+    }
+
+    /// Whether a declaration has children of its own with a rule (then it gets a nested handle struct).
+    fn adds_children(&self, decl: NodeIx) -> bool {
+        self.model.children(decl).any(|(_, c)| self.rule(c).is_some())
+    }
+
+    fn method_type(&self, decl: NodeIx) -> TokenStream {
+        let info = self.model.methods.get(&decl).cloned().unwrap_or_default();
+        let tuple = |args: &[crate::model::Argument]| -> TokenStream {
+            let items: Vec<TokenStream> = args.iter().map(|a| self.value_type(a.data_type, a.value_rank)).collect();
+            if items.len() > 12 {
+                quote! { Vec<opcua::types::Variant> }
+            } else {
+                quote! { (#(#items,)*) }
+            }
+        };
+        let (i, o) = (tuple(&info.inputs), tuple(&info.outputs));
+        quote! { t::Method<#i, #o> }
+    }
+
+    /// Index of a namespace URI in the file's `NS` table.
+    fn ns_index(&self, uris: &mut BTreeMap<String, usize>, ns: u16) -> usize {
+        let uri = self.model.namespace_uri(ns).to_owned();
+        let next = uris.len();
+        *uris.entry(uri).or_insert(next)
+    }
+
+    fn ns_node_id(&self, uris: &mut BTreeMap<String, usize>, t: NodeIx) -> TokenStream {
+        let id = &self.model.node(t).id;
+        let k = Literal::usize_unsuffixed(self.ns_index(uris, id.ns));
+        if let Identifier::Numeric(v) = &id.id {
+            let v = Literal::u32_unsuffixed(*v);
+            return quote! { rt::NsNodeId::numeric(NS[#k], #v) };
+        }
+        let kind = self.id_kind(&id.id);
+        quote! { rt::NsNodeId { namespace_uri: NS[#k], id: #kind } }
+    }
+
+    /// The fields of a handle for `members`; nested handle structs go to `nested` (named in `scope_prefix`).
+    fn fields(
+        &mut self,
+        members: &[(NodeIx, NodeIx)],
+        names: &BTreeMap<NodeIx, String>,
+        uris: &mut BTreeMap<String, usize>,
+        prefix: &str,
+        nested: &mut Vec<TokenStream>,
+        depth: usize,
+    ) -> Vec<Field> {
+        let model = self.model;
+        let mut scope: Scope<NodeIx> = Scope::new(Target::Rust, Case::Snake);
+        scope.reserve("node");
+        scope.reserve("base");
+        for &(m, _) in members {
+            scope.add(&model.node(m).browse_name.name, m);
+        }
+        let (fnames, _) = scope.finish();
+        let mut out = Vec::new();
+        for &(m, _) in members {
+            let n = model.node(m);
+            let Some(rule) = self.rule(m) else { continue };
+            let k = Literal::usize_unsuffixed(self.ns_index(uris, n.browse_name.ns));
+            let bname = lit(&n.browse_name.name);
+            let handle = match n.class {
+                NodeClass::Variable => {
+                    let vt = self.value_type(n.attrs.data_type, n.attrs.value_rank.unwrap_or(-1));
+                    quote! { t::Variable<#vt> }
+                }
+                NodeClass::Method => self.method_type(m),
+                NodeClass::Object if depth < NESTED_DEPTH && !rule.is_placeholder() && self.adds_children(m) => {
+                    let sname = format!("{prefix}{}", crate::names::sanitize(&n.browse_name.name, Case::UpperCamel, Target::Rust).trim_start_matches("r#"));
+                    let sub = self.decl_members(m);
+                    let text = format!("`{}`, a member of `{}` with children of its own.", n.browse_name.name, prefix.trim_end_matches('_'));
+                    nested.push(self.handle_struct(&sname, &text, None, None, &sub, names, uris, nested_prefix(&sname), depth + 1));
+                    let s = ident(&sname);
+                    quote! { #s }
+                }
+                NodeClass::Object => n
+                    .type_definition
+                    .and_then(|t| self.handle_path(t, names))
+                    .unwrap_or_else(|| quote! { t::ObjectNode }),
+                _ => continue,
+            };
+            let (ty, bind) = match rule {
+                ModellingRule::Mandatory => (handle, quote! { b.child(id, NS[#k], #bname)? }),
+                ModellingRule::Optional => (quote! { Option<#handle> }, quote! { b.optional(id, NS[#k], #bname)? }),
+                _ => {
+                    let Some(td) = n.type_definition else { continue };
+                    let tid = self.ns_node_id(uris, td);
+                    (quote! { t::Placeholders<#handle> }, quote! { b.placeholders(id, #tid)? })
+                }
+            };
+            let mut text = format!("`{}` ({}).", n.browse_name.name, rule.name());
+            if let Some(d) = n.doc() {
+                text.push_str(" ");
+                text.push_str(d);
+            }
+            out.push(Field { name: fnames[&m].clone(), ty, bind, doc: text });
+        }
+        out
+    }
+
+    /// A handle struct with its `Handle` impl (and `Deref` to its base).
+    #[allow(clippy::too_many_arguments)]
+    fn handle_struct(
+        &mut self,
+        name: &str,
+        text: &str,
+        node_ty: Option<TokenStream>,
+        base: Option<TokenStream>,
+        members: &[(NodeIx, NodeIx)],
+        names: &BTreeMap<NodeIx, String>,
+        uris: &mut BTreeMap<String, usize>,
+        prefix: String,
+        depth: usize,
+    ) -> TokenStream {
+        let mut nested = Vec::new();
+        let fields = self.fields(members, names, uris, &prefix, &mut nested, depth);
+        let sname = ident(name);
+        let docs = doc(text);
+        let node_ty = node_ty.unwrap_or_else(|| quote! { t::ObjectNode });
+        // Field names keep a collision's resolution visible (`self__2`), which the snake-case lint dislikes.
+        let allow = if depth > 0 {
+            quote! { #[allow(non_camel_case_types, non_snake_case)] }
+        } else {
+            quote! { #[allow(non_snake_case)] }
+        };
+        let mut decls = vec![quote! { #[doc = " The instance."] pub node: #node_ty }];
+        let mut binds = vec![quote! { node: b.this(id)? }];
+        let mut deref = quote! {};
+        if let Some(base) = &base {
+            decls.push(quote! { #[doc = " The members inherited from the supertype (also reached through `Deref`)."] pub base: #base });
+            binds.push(quote! { base: b.this(id)? });
+            deref = quote! { t::deref_base!(#sname => #base); };
+        }
+        for f in &fields {
+            let (fname, ty, bind) = (ident(&f.name), &f.ty, &f.bind);
+            let d = doc(&f.doc);
+            decls.push(quote! { #d pub #fname: #ty });
+            binds.push(quote! { #fname: #bind });
+        }
+        quote! {
+            #docs
+            #[derive(Clone, Debug)]
+            #allow
+            pub struct #sname { #(#decls),* }
+            impl t::Handle for #sname {
+                fn bind(b: &t::Binder<'_>, id: &opcua::types::NodeId) -> Result<Self, t::BindError> {
+                    Ok(Self { #(#binds),* })
+                }
+            }
+            #deref
+            #(#nested)*
+        }
+    }
+
+    /// Variables reachable from an instance of `members`' owner, not crossing placeholders.
+    fn reach(&self, members: &[(NodeIx, NodeIx)], path: &mut Vec<(NodeIx, bool)>, out: &mut Vec<(Vec<NodeIx>, NodeIx, bool)>) {
+        if path.len() >= MAX_DEPTH {
+            return;
+        }
+        for &(m, _) in members {
+            let n = self.model.node(m);
+            let Some(rule) = self.rule(m) else { continue };
+            if rule.is_placeholder() {
+                continue;
+            }
+            let mandatory = rule == ModellingRule::Mandatory && path.iter().all(|(_, mand)| *mand);
+            match n.class {
+                NodeClass::Variable => {
+                    let p: Vec<NodeIx> = path.iter().map(|(p, _)| *p).chain([m]).collect();
+                    out.push((p, m, mandatory));
+                }
+                NodeClass::Object => {
+                    path.push((m, rule == ModellingRule::Mandatory));
+                    let sub = self.decl_members(m);
+                    self.reach(&sub, path, out);
+                    path.pop();
+                }
+                _ => {}
+            }
+        }
+    }
+
+    fn markers(&self, type_name: &str, members: &[(NodeIx, NodeIx)], uris: &mut BTreeMap<String, usize>) -> TokenStream {
+        let model = self.model;
+        let mut found = Vec::new();
+        self.reach(members, &mut Vec::new(), &mut found);
+        let reach: Vec<Reach> = found
+            .into_iter()
+            .map(|(p, node, mandatory)| Reach {
+                path: p.iter().map(|&s| model.node(s).browse_name.name.clone()).collect(),
+                qpath: p
+                    .iter()
+                    .map(|&s| (self.ns_index(uris, model.node(s).browse_name.ns), model.node(s).browse_name.name.clone()))
+                    .collect(),
+                node,
+                mandatory,
+            })
+            .collect();
+        // A marker name two paths map to is left out (the derive cannot name either): order-independent.
+        let mut count: BTreeMap<String, usize> = BTreeMap::new();
+        for r in &reach {
+            let segs: Vec<&str> = r.path.iter().map(String::as_str).collect();
+            *count.entry(marker_name(&segs)).or_default() += 1;
+        }
+        let owner = ident(type_name);
+        let mut items = Vec::new();
+        let mut required = Vec::new();
+        let mut seen = BTreeSet::new();
+        for r in &reach {
+            let segs: Vec<&str> = r.path.iter().map(String::as_str).collect();
+            let mname = marker_name(&segs);
+            if count[&mname] > 1 || !seen.insert(mname.clone()) {
+                continue;
+            }
+            let n = model.node(r.node);
+            let rank = n.attrs.value_rank.unwrap_or(-1);
+            let scalar = match self.value_type(n.attrs.data_type, -1) {
+                t if t.to_string().contains("Variant") => quote! { opcua::types::Variant },
+                // Paths relative to objects.rs, seen from `members::<Owner>` two modules down.
+                t if t.to_string().starts_with("super ::") => quote! { super::super::#t },
+                t => t,
+            };
+            let has_default = n.value.is_some();
+            let writable = n.attrs.access_level.unwrap_or(1) & 2 != 0;
+            let path_items = r.qpath.iter().map(|(k, s)| {
+                let k = Literal::usize_unsuffixed(*k);
+                let s = lit(s);
+                quote! { #k #s }
+            });
+            let m = ident(&mname);
+            let rank = Literal::i32_unsuffixed(rank);
+            let (mandatory, has_default_t, writable_t) = (r.mandatory, has_default, writable);
+            items.push(quote! { #m: #scalar, #rank, [#(#path_items),*], #mandatory #has_default_t #writable_t; });
+            if r.mandatory && !has_default {
+                let msg = lit(&format!(
+                    "the mandatory variable `{}` of {type_name} has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"{}\")]",
+                    r.path.join("/"),
+                    r.path.join("/")
+                ));
+                let p = lit(&r.path.join("/"));
+                required.push(quote! { (#p, #msg) });
+            }
+        }
+        quote! {
+            t::object_members! { #owner; required: [#(#required),*]; #(#items)* }
+        }
+    }
+
+    pub(super) fn objects_file(&mut self) -> OutFile {
+        let model = self.model;
+        let names = self.handle_names(self.ns);
+        let mut uris: BTreeMap<String, usize> = BTreeMap::new();
+        self.ns_index(&mut uris, self.ns);
+        let mut ordered: Vec<(&String, NodeIx)> = names.iter().map(|(k, v)| (v, *k)).collect();
+        ordered.sort();
+        let mut items = Vec::new();
+        let mut markers = Vec::new();
+        for (name, t) in ordered {
+            let n = model.node(t);
+            let all: Vec<(NodeIx, NodeIx)> = model
+                .members
+                .get(&t)
+                .map(|ms| ms.iter().filter(|m| self.rule(m.node).is_some()).map(|m| (m.node, m.reference_type)).collect())
+                .unwrap_or_default();
+            let mut text = format!("Handle of an instance of `{}` ({}).", n.browse_name.name, crate::resolve::display_id(model, &n.id));
+            if let Some(d) = n.doc() {
+                text.push_str("\n\n");
+                text.push_str(d);
+            }
+            let tid = self.ns_node_id(&mut uris, t);
+            let bname = lit(&n.browse_name.name);
+            let sname = ident(name);
+            if n.class == NodeClass::ObjectType {
+                // The nearest supertype with a handle carries the members it declares.
+                let base = model.super_chain(t).into_iter().skip(1).find_map(|s| Some((s, self.handle_path(s, &names)?)));
+                let own: Vec<(NodeIx, NodeIx)> = match &base {
+                    Some((s, _)) => {
+                        let inherited: BTreeSet<NodeIx> = model.members.get(s).map(|ms| ms.iter().map(|m| m.node).collect()).unwrap_or_default();
+                        all.iter().copied().filter(|(m, _)| !inherited.contains(m)).collect()
+                    }
+                    None => all.clone(),
+                };
+                let body = self.handle_struct(name, &text, None, base.map(|(_, p)| p), &own, &names, &mut uris, nested_prefix(name), 0);
+                items.push(quote! {
+                    #body
+                    t::object_type!(#sname, #tid, #bname);
+                });
+                markers.push(self.markers(name, &all, &mut uris));
+            } else {
+                let vt = self.value_type(n.attrs.data_type, n.attrs.value_rank.unwrap_or(-2));
+                let body = self.handle_struct(name, &text, Some(quote! { t::Variable<#vt> }), None, &all, &names, &mut uris, nested_prefix(name), 0);
+                items.push(quote! {
+                    #body
+                    t::variable_type!(#sname, #tid, #bname);
+                });
+            }
+        }
+        let runtime = path(&self.cfg.runtime_path);
+        let mut ns_list: Vec<(&String, &usize)> = uris.iter().collect();
+        ns_list.sort_by_key(|(_, i)| **i);
+        let ns_items = ns_list.iter().map(|(u, _)| lit(u));
+        let tokens = quote! {
+            //! Typed handles of this namespace's ObjectTypes and VariableTypes (bind them to instances with
+            //! `ModelManager::bind`, create instances with `ObjectType::instantiate`), and member markers for
+            //! `nodeset-derive`.
+            #[allow(unused_imports)]
+            use #runtime as rt;
+            #[allow(unused_imports)]
+            use #runtime::typed as t;
+            #[allow(unused_imports)]
+            use opcua::types as ua;
+            /// Namespace URIs of the BrowseNames and types named below.
+            #[allow(dead_code)]
+            const NS: &[&str] = &[#(#ns_items),*];
+            #(#items)*
+            /// Member markers of each ObjectType, named from browse paths (`ParameterSet__ActualPosition`).
+            #[allow(non_snake_case, non_camel_case_types)]
+            pub mod members {
+                #[allow(unused_imports)]
+                use super::t;
+                #(#markers)*
+            }
+        };
+        // async-opcua's types are named through a short alias in this file.
+        let text = tokens.to_string().replace("opcua :: types ::", "ua ::");
+        let tokens: TokenStream = text.parse().unwrap_or_else(|e| panic!("internal error: objects.rs of {}: {e}", self.uri()));
+        self.file("objects.rs", "Typed handles", tokens)
+    }
+}
+
+/// The prefix of nested handle struct names of a type (`AxisType` -> `AxisType_`).
+fn nested_prefix(name: &str) -> String {
+    format!("{name}_")
+}
