@@ -7,3 +7,8 @@
 
 pub mod models;
 pub mod runtime;
+
+pub use nodeset_derive::ObjectModel;
+
+// The derive names `::nodeset_models`; inside this crate (its tests and examples) that is this crate.
+extern crate self as nodeset_models;

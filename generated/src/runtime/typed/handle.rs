@@ -107,11 +107,10 @@ impl<'a> Binder<'a> {
 
     /// The targets of `node`'s forward hierarchical references (HasSubtype excluded), in the order stored.
     pub fn children(&self, node: &NodeId) -> Vec<NodeId> {
-        let hierarchical: NodeId = ReferenceTypeId::HierarchicalReferences.into();
         let has_subtype: NodeId = ReferenceTypeId::HasSubtype.into();
         self.space
-            .find_references(node, Some((hierarchical, true)), self.tree, BrowseDirection::Forward)
-            .filter(|r| *r.reference_type != has_subtype)
+            .find_references(node, None::<(NodeId, bool)>, self.tree, BrowseDirection::Forward)
+            .filter(|r| *r.reference_type != has_subtype && super::instance::is_hierarchical(self.tree, r.reference_type))
             .map(|r| r.target_node.clone())
             .collect()
     }
@@ -138,9 +137,9 @@ impl<'a> Binder<'a> {
         for child in self.children(node) {
             let definition = self
                 .space
-                .find_references(&child, Some((has_type_definition.clone(), false)), self.tree, BrowseDirection::Forward)
-                .map(|r| r.target_node.clone())
-                .next();
+                .find_references(&child, None::<(NodeId, bool)>, self.tree, BrowseDirection::Forward)
+                .find(|r| *r.reference_type == has_type_definition)
+                .map(|r| r.target_node.clone());
             if definition.is_some_and(|d| d == ty || self.tree.is_subtype_of(&d, &ty)) {
                 let name = self.space.find(&child).map(|n| n.as_node().browse_name().name.as_ref().to_owned());
                 out.insert(name.unwrap_or_default(), H::bind(self, &child)?);

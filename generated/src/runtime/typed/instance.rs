@@ -34,6 +34,7 @@ const MAX_DEPTH: usize = 32;
 #[derive(Clone, Debug, Default)]
 pub struct Instantiate {
     optional: BTreeSet<String>,
+    ensure: BTreeSet<String>,
     all_optional: bool,
     placeholders: BTreeMap<String, Vec<(String, Option<NodeId>)>>,
     reference_type: Option<NodeId>,
@@ -49,6 +50,13 @@ impl Instantiate {
     /// Also create the Optional member at `path`.
     pub fn optional(mut self, path: impl Into<String>) -> Instantiate {
         self.optional.insert(path.into());
+        self
+    }
+
+    /// Create the member at `path` if it is Optional; unlike [`Instantiate::optional`], a path that is
+    /// Mandatory or not a member is no error (the derive asks for every prefix of the paths it binds).
+    pub fn ensure(mut self, path: impl Into<String>) -> Instantiate {
+        self.ensure.insert(path.into());
         self
     }
 
@@ -186,14 +194,18 @@ impl<'a> Spaces<'a> {
         self.space_of(id)?.find(id)
     }
 
-    /// Forward references of `node` of type `rt` or a subtype, as (reference type, target).
+    /// Forward references of `node` of type `rt` (or, for HierarchicalReferences, any hierarchical type),
+    /// as (reference type, target).
     fn refs(&self, node: &NodeId, rt: ReferenceTypeId) -> Vec<(NodeId, NodeId)> {
+        let wanted = NodeId::from(rt);
+        let hierarchical = rt == ReferenceTypeId::HierarchicalReferences;
         let mut out: Vec<(NodeId, NodeId)> = Vec::new();
         // A reference may be stored in either space (ns0 nodes refer to generated ones and back).
         for space in [Some(self.model), self.core].into_iter().flatten() {
-            for r in space.find_references(node, Some((NodeId::from(rt), true)), self.tree, BrowseDirection::Forward) {
+            for r in space.find_references(node, None::<(NodeId, bool)>, self.tree, BrowseDirection::Forward) {
+                let fits = if hierarchical { is_hierarchical(self.tree, r.reference_type) } else { *r.reference_type == wanted };
                 let item = (r.reference_type.clone(), r.target_node.clone());
-                if !out.contains(&item) {
+                if fits && !out.contains(&item) {
                     out.push(item);
                 }
             }
@@ -380,7 +392,7 @@ impl<'a> Planner<'a> {
                     if wanted {
                         self.used.insert(format!("o:{member_path}"));
                     }
-                    if wanted || self.options.all_optional {
+                    if wanted || self.options.all_optional || self.options.ensure.contains(&member_path) {
                         vec![(decl.browse_name.clone(), None, member_path.clone())]
                     } else {
                         continue;
@@ -433,4 +445,16 @@ pub(crate) fn child_id(parent: &NodeId, name: &str) -> NodeId {
         other => other.to_string(),
     };
     NodeId::new(parent.namespace, format!("{base}/{name}"))
+}
+
+/// Whether a reference type is hierarchical: one of ns0's (known without the type tree, which holds ns0's
+/// reference types only once the server runs) or a subtype of HierarchicalReferences in the type tree.
+pub(crate) fn is_hierarchical(tree: &DefaultTypeTree, rt: &NodeId) -> bool {
+    const NS0: [u32; 11] = [33, 34, 35, 36, 44, 45, 46, 47, 48, 49, 17604];
+    if let (0, opcua::types::Identifier::Numeric(n)) = (rt.namespace, &rt.identifier) {
+        if NS0.contains(n) {
+            return true;
+        }
+    }
+    tree.is_subtype_of(rt, &ReferenceTypeId::HierarchicalReferences.into())
 }

@@ -6,10 +6,12 @@
 
 pub mod handle;
 pub mod instance;
+pub mod model;
 pub mod value;
 
 pub use handle::{Arguments, BindError, Binder, CallContext, Handle, Method, ObjectNode, Placeholders, Variable};
 pub use instance::{Instantiate, InstantiateError};
+pub use model::{Bound, ObjectModel};
 pub use value::{UaStruct, UaValue};
 
 use opcua::types::{NodeId, QualifiedName};

@@ -1,0 +1,219 @@
+//! A simulated six-axis robot, served over OPC UA with the typed API and `#[derive(ObjectModel)]`.
+//!
+//! ```text
+//! cargo run -p nodeset-models --example robot -- [--port 4856] [--seconds N]
+//! ```
+//!
+//! It instantiates a Robotics `MotionDeviceSystemType` named `Robot` under the Objects folder: one
+//! MotionDevice `Arm` with six Axes `A1`..`A6` and their PowerTrains `PT1`..`PT6` (each with a Motor and a
+//! Gear), a Controller and a SafetyState, every mandatory child as the types prescribe. The arm's DI
+//! identification (Manufacturer, Model, ProductCode, SerialNumber, ...) comes from a struct bound with the
+//! derive; a client's write of the arm's `AssetId` lands in that struct (and is printed). Joint positions
+//! (`Axes/<axis>/ParameterSet/ActualPosition`) move along sine curves, updated at 100 Hz through the typed
+//! handles. The arm's `Lock` object (DI LockingServicesType) has typed methods: `InitLock(Context)` locks
+//! for a client, `ExitLock` unlocks.
+//!
+//! The first line on stdout is `listening on <url>`; the server stops on SIGINT, SIGTERM or after
+//! `--seconds N`, printing `server stopped cleanly`.
+
+use std::io::Write;
+use std::process::ExitCode;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use nodeset_models::models::robotics::objects::MotionDeviceSystemType;
+use nodeset_models::models::robotics::types::MotionDeviceCategoryEnumeration;
+use nodeset_models::models::{di, ia, robotics};
+use nodeset_models::runtime::server::{MethodError, ServerConfig};
+use nodeset_models::runtime::typed::{Bound, Instantiate, ObjectType};
+use nodeset_models::ObjectModel;
+use opcua::types::{LocalizedText, NodeId, ObjectId, StatusCode};
+
+/// The arm's identification, bound to the Robotics MotionDeviceType (and the DI members it inherits).
+#[derive(Clone, Debug, ObjectModel)]
+#[opcua(object_type = robotics::objects::MotionDeviceType)]
+struct ArmIdentity {
+    manufacturer: LocalizedText,
+    model: LocalizedText,
+    product_code: String,
+    serial_number: String,
+    motion_device_category: MotionDeviceCategoryEnumeration,
+    /// Writable by clients (DI AssetId).
+    asset_id: String,
+    #[opcua(path = "ParameterSet/SpeedOverride")]
+    speed_override: f64,
+    #[opcua(skip)]
+    writes_seen: u32,
+}
+
+/// The axes and their simulated motion.
+const AXES: [&str; 6] = ["A1", "A2", "A3", "A4", "A5", "A6"];
+
+fn options() -> Result<(u16, Option<u64>), String> {
+    let (mut port, mut seconds) = (4856, None);
+    let mut args = std::env::args().skip(1);
+    while let Some(arg) = args.next() {
+        let mut value = |name: &str| args.next().ok_or(format!("{name} needs a value"));
+        match arg.as_str() {
+            "--port" => port = value("--port")?.parse().map_err(|e| format!("--port: {e}"))?,
+            "--seconds" => seconds = Some(value("--seconds")?.parse().map_err(|e| format!("--seconds: {e}"))?),
+            other => return Err(format!("unknown argument {other:?} (usage: robot [--port 4856] [--seconds N])")),
+        }
+    }
+    Ok((port, seconds))
+}
+
+/// What `Instantiate` needs for the robot: the names of every placeholder instance.
+fn robot_options() -> Instantiate {
+    let mut o = Instantiate::new()
+        .placeholder("MotionDevices/<MotionDeviceIdentifier>", ["Arm"])
+        .placeholder("MotionDevices/Arm/Axes/<AxisIdentifier>", AXES)
+        .placeholder("MotionDevices/Arm/PowerTrains/<PowerTrainIdentifier>", AXES.map(|a| format!("PT{}", &a[1..])))
+        .placeholder("Controllers/<ControllerIdentifier>", ["Controller"])
+        .placeholder("SafetyStates/<SafetyStateIdentifier>", ["SafetyState"])
+        .placeholder("Controllers/Controller/TaskControls/<TaskControlIdentifier>", ["Task"])
+        .placeholder("Controllers/Controller/Software/<SoftwareIdentifier>", ["Software"])
+        .optional("MotionDevices/Arm/Lock")
+        .optional("MotionDevices/Arm/AssetId");
+    for a in AXES {
+        let pt = format!("MotionDevices/Arm/PowerTrains/PT{}", &a[1..]);
+        o = o.placeholder(format!("{pt}/<MotorIdentifier>"), ["Motor"]).placeholder(format!("{pt}/<GearIdentifier>"), ["Gear"]);
+    }
+    o
+}
+
+async fn run(port: u16, seconds: Option<u64>) -> Result<(), String> {
+    let server = ServerConfig::new("Six-axis robot")
+        .port(port)
+        .table(&di::TABLE)
+        .type_loader(di::TypeLoader)
+        .table(&ia::TABLE)
+        .type_loader(ia::TypeLoader)
+        .table(&robotics::TABLE)
+        .type_loader(robotics::TypeLoader)
+        .build()?;
+    let manager = server.manager().clone();
+    let objects: NodeId = ObjectId::ObjectsFolder.into();
+    let robot = MotionDeviceSystemType::instantiate(&manager, &objects, "Robot", &robot_options()).map_err(|e| e.to_string())?;
+    let arm = robot.motion_devices.motion_device_identifier.get("Arm").ok_or("the robot has no arm")?.clone();
+
+    let identity = ArmIdentity {
+        manufacturer: LocalizedText::new("en", "nodeset-compiler robotics"),
+        model: LocalizedText::new("en", "SIX-1"),
+        product_code: "SIX-1-850".into(),
+        serial_number: "0001".into(),
+        motion_device_category: MotionDeviceCategoryEnumeration::ArticulatedRobot,
+        asset_id: "cell-1/robot".into(),
+        speed_override: 1.0,
+        writes_seen: 0,
+    };
+    let identity = Arc::new(Bound::bind(&manager, arm.node.id(), identity).map_err(|e| e.to_string())?);
+
+    // The Lock methods, typed: InitLock(Context: String) -> InitLockStatus: Int32.
+    if let Some(lock) = &arm.lock {
+        let holder = Arc::new(Mutex::new(None::<String>));
+        let h = holder.clone();
+        lock.init_lock.implement(move |_ctx, (context,): (String,)| {
+            let h = h.clone();
+            async move {
+                if context.is_empty() {
+                    return Err(MethodError::Status(StatusCode::BadInvalidArgument));
+                }
+                let mut held = h.lock().unwrap_or_else(|e| e.into_inner());
+                // DI: 0 = OK, -1 = E_AlreadyLocked.
+                Ok((if held.is_some() { -1 } else { *held = Some(context); 0 },))
+            }
+        });
+        let h = holder.clone();
+        lock.exit_lock.implement(move |_ctx, ()| {
+            let h = h.clone();
+            async move { Ok((if h.lock().unwrap_or_else(|e| e.into_inner()).take().is_some() { 0 } else { -1 },)) }
+        });
+        lock.locked.set(false).map_err(|s| s.to_string())?;
+    }
+
+    let axes: Vec<_> = arm.axes.axis_identifier.values().map(|a| a.parameter_set.actual_position.clone()).collect();
+    let handle = server.handle().clone();
+    println!("listening on {}", server.endpoint_url());
+    let _ = std::io::stdout().flush();
+    let task = tokio::spawn(server.run());
+
+    // Joint motion at 100 Hz.
+    let started = Instant::now();
+    let mut tick = tokio::time::interval(Duration::from_millis(10));
+    tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
+    let stop = async {
+        match seconds {
+            Some(s) => tokio::time::sleep(Duration::from_secs(s)).await,
+            None => shutdown_signal().await,
+        }
+    };
+    tokio::pin!(stop);
+    let mut last_asset = identity.read(|i| i.asset_id.clone());
+    loop {
+        tokio::select! {
+            _ = &mut stop => break,
+            _ = tick.tick() => {
+                let t = started.elapsed().as_secs_f64();
+                for (i, position) in axes.iter().enumerate() {
+                    let amplitude = 90.0 - 10.0 * i as f64;
+                    let _ = position.set(amplitude * (t * (0.2 + 0.05 * i as f64)).sin());
+                }
+                let asset = identity.read(|i| i.asset_id.clone());
+                if asset != last_asset {
+                    identity.update(|i| i.writes_seen += 1);
+                    println!("AssetId written by a client: {asset:?}");
+                    let _ = std::io::stdout().flush();
+                    last_asset = asset;
+                }
+            }
+        }
+    }
+    handle.cancel();
+    task.await.map_err(|e| e.to_string())??;
+    println!("server stopped cleanly");
+    Ok(())
+}
+
+async fn shutdown_signal() {
+    #[cfg(unix)]
+    {
+        use tokio::signal::unix::{signal, SignalKind};
+        match signal(SignalKind::terminate()) {
+            Ok(mut term) => {
+                tokio::select! { _ = tokio::signal::ctrl_c() => {}, _ = term.recv() => {} }
+            }
+            Err(_) => {
+                let _ = tokio::signal::ctrl_c().await;
+            }
+        }
+    }
+    #[cfg(not(unix))]
+    let _ = tokio::signal::ctrl_c().await;
+}
+
+fn main() -> ExitCode {
+    let filter = std::env::var("RUST_LOG").unwrap_or_else(|_| "warn,opcua_server=error,opcua_nodes=error,opcua_crypto=off,opcua_core=error".into());
+    let _ = tracing_subscriber::fmt().with_env_filter(filter).with_writer(std::io::stderr).try_init();
+    let (port, seconds) = match options() {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let runtime = match tokio::runtime::Runtime::new() {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: cannot start tokio: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    match runtime.block_on(run(port, seconds)) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
