@@ -27,22 +27,22 @@ fn python() -> PathBuf {
     python
 }
 
-/// Builds the example server and returns the path of its executable.
-fn build_server() -> PathBuf {
+/// Builds an example of nodeset-models and returns the path of its executable.
+fn build_server(example: &str) -> PathBuf {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
     let output = Command::new(cargo)
         .current_dir(root())
         // --workspace resolves features as `cargo test --workspace` does, so no dependency is built twice.
-        .args(["build", "--workspace", "--example", "server", "--message-format=json-render-diagnostics"])
+        .args(["build", "--workspace", "--example", example, "--message-format=json-render-diagnostics"])
         .stderr(Stdio::inherit())
         .output()
         .expect("cargo runs");
-    assert!(output.status.success(), "cargo build --workspace --example server failed");
+    assert!(output.status.success(), "cargo build --workspace --example {example} failed");
     let stdout = String::from_utf8_lossy(&output.stdout);
     let line = stdout
         .lines()
         .filter(|l| l.contains("\"reason\":\"compiler-artifact\"") && l.contains("\"executable\":\""))
-        .find(|l| l.contains("\"name\":\"server\""))
+        .find(|l| l.contains(&format!("\"name\":\"{example}\"")))
         .expect("cargo reports the example's executable");
     let start = line.find("\"executable\":\"").unwrap() + "\"executable\":\"".len();
     let end = start + line[start..].find('"').unwrap();
@@ -63,9 +63,10 @@ impl Drop for Server {
 }
 
 impl Server {
-    fn start(exe: &PathBuf) -> (Server, String) {
+    fn start(exe: &PathBuf, args: &[&str]) -> (Server, String) {
         let mut child = Command::new(exe)
-            .args(["--port", "0", "--demo"])
+            .args(["--port", "0"])
+            .args(args)
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit())
             .spawn()
@@ -103,14 +104,34 @@ impl Server {
 #[test]
 fn asyncua_client_against_the_example_server() {
     let python = python();
-    let exe = build_server();
-    let (server, url) = Server::start(&exe);
+    let exe = build_server("server");
+    let (server, url) = Server::start(&exe, &["--demo"]);
     let script = root().join("tests/interop/robotics_check.py");
     let mut check = Command::new(&python);
     check.arg(&script).args(["--url", &url]).args(["--nodesets"]).arg(root().join("nodesets/vendor"));
     for suite in SUITES {
         check.args(["--suite", suite]);
     }
+    run_check(check);
+    server.stop();
+}
+
+/// The six-axis robot example (typed handles, instantiation, the derive) against `robot_check.py`: the
+/// instance against its types' instance declarations, a subscription to a joint position, writes to
+/// read-only variables, the derived identification, typed methods with correct and wrong arguments.
+#[test]
+fn asyncua_client_against_the_robot_example() {
+    let python = python();
+    let exe = build_server("robot");
+    let (server, url) = Server::start(&exe, &[]);
+    let mut check = Command::new(&python);
+    check.arg(root().join("tests/interop/robot_check.py")).args(["--url", &url]);
+    run_check(check);
+    server.stop();
+}
+
+/// Runs a check script; fails unless it ends with `N passed, 0 failed`.
+fn run_check(mut check: Command) {
     let mut child = check.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("python runs");
     let mut stdout = String::new();
     let mut stderr = String::new();
@@ -122,7 +143,6 @@ fn asyncua_client_against_the_example_server() {
     let summary = stdout.lines().last().unwrap_or_default();
     assert!(
         status.success() && summary.ends_with(" passed, 0 failed"),
-        "robotics_check.py failed ({status}): {summary}"
+        "the check failed ({status}): {summary}"
     );
-    server.stop();
 }
