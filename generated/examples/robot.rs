@@ -8,7 +8,9 @@
 //! MotionDevice `Arm` with six Axes `A1`..`A6` and their PowerTrains `PT1`..`PT6` (each with a Motor and a
 //! Gear), a Controller and a SafetyState, every mandatory child as the types prescribe. The arm's DI
 //! identification (Manufacturer, Model, ProductCode, SerialNumber, ...) comes from a struct bound with the
-//! derive; a client's write of the arm's `AssetId` lands in that struct (and is printed). Joint positions
+//! derive. The controller is bound to a second struct whose `default_stop_mode` field is the writable
+//! `SystemOperation/SystemOperationStateMachine/ConfiguredDefaultStopMode`: a client's write lands in that
+//! struct and is printed (`ConfiguredDefaultStopMode written by a client: <value>`). Joint positions
 //! (`Axes/<axis>/ParameterSet/ActualPosition`) move along sine curves, updated at 100 Hz through the typed
 //! handles. The arm's `Lock` object (DI LockingServicesType) has typed methods: `InitLock(Context)` locks
 //! for a client, `ExitLock` unlocks.
@@ -46,6 +48,21 @@ struct ArmIdentity {
     writes_seen: u32,
 }
 
+/// The controller's identification and its one client-writable setting.
+#[derive(Clone, Debug, ObjectModel)]
+#[opcua(object_type = robotics::objects::ControllerType)]
+struct ControllerSettings {
+    manufacturer: LocalizedText,
+    model: LocalizedText,
+    product_code: String,
+    serial_number: String,
+    #[opcua(path = "CurrentUser/Level")]
+    user_level: String,
+    /// Writable by clients (AccessLevel CurrentRead | CurrentWrite in Robotics).
+    #[opcua(path = "SystemOperation/SystemOperationStateMachine/ConfiguredDefaultStopMode")]
+    default_stop_mode: i16,
+}
+
 /// The axes and their simulated motion.
 const AXES: [&str; 6] = ["A1", "A2", "A3", "A4", "A5", "A6"];
 
@@ -74,7 +91,9 @@ fn robot_options() -> Instantiate {
         .placeholder("Controllers/Controller/TaskControls/<TaskControlIdentifier>", ["Task"])
         .placeholder("Controllers/Controller/Software/<SoftwareIdentifier>", ["Software"])
         .optional("MotionDevices/Arm/Lock")
-        .optional("MotionDevices/Arm/AssetId");
+        .optional("MotionDevices/Arm/AssetId")
+        .optional("Controllers/Controller/SystemOperation")
+        .optional("Controllers/Controller/SystemOperation/SystemOperationStateMachine/ConfiguredDefaultStopMode");
     for a in AXES {
         let pt = format!("MotionDevices/Arm/PowerTrains/PT{}", &a[1..]);
         o = o.placeholder(format!("{pt}/<MotorIdentifier>"), ["Motor"]).placeholder(format!("{pt}/<GearIdentifier>"), ["Gear"]);
@@ -108,6 +127,16 @@ async fn run(port: u16, seconds: Option<u64>) -> Result<(), String> {
         writes_seen: 0,
     };
     let identity = Arc::new(Bound::bind(&manager, arm.node.id(), identity).map_err(|e| e.to_string())?);
+    let controller = robot.controllers.controller_identifier.get("Controller").ok_or("the robot has no controller")?;
+    let settings = ControllerSettings {
+        manufacturer: LocalizedText::new("en", "nodeset-compiler robotics"),
+        model: LocalizedText::new("en", "SIX-C"),
+        product_code: "SIX-C-1".into(),
+        serial_number: "C-0001".into(),
+        user_level: "operator".into(),
+        default_stop_mode: 0,
+    };
+    let settings = Bound::bind(&manager, controller.node.id(), settings).map_err(|e| e.to_string())?;
 
     // The Lock methods, typed: InitLock(Context: String) -> InitLockStatus: Int32.
     if let Some(lock) = &arm.lock {
@@ -150,6 +179,7 @@ async fn run(port: u16, seconds: Option<u64>) -> Result<(), String> {
     };
     tokio::pin!(stop);
     let mut last_asset = identity.read(|i| i.asset_id.clone());
+    let mut last_stop_mode = settings.read(|s| s.default_stop_mode);
     loop {
         tokio::select! {
             _ = &mut stop => break,
@@ -165,6 +195,12 @@ async fn run(port: u16, seconds: Option<u64>) -> Result<(), String> {
                     println!("AssetId written by a client: {asset:?}");
                     let _ = std::io::stdout().flush();
                     last_asset = asset;
+                }
+                let stop_mode = settings.read(|s| s.default_stop_mode);
+                if stop_mode != last_stop_mode {
+                    println!("ConfiguredDefaultStopMode written by a client: {stop_mode}");
+                    let _ = std::io::stdout().flush();
+                    last_stop_mode = stop_mode;
                 }
             }
         }
@@ -193,7 +229,7 @@ async fn shutdown_signal() {
 }
 
 fn main() -> ExitCode {
-    let filter = std::env::var("RUST_LOG").unwrap_or_else(|_| "warn,opcua_server=error,opcua_nodes=error,opcua_crypto=off,opcua_core=error".into());
+    let filter = std::env::var("RUST_LOG").unwrap_or_else(|_| "warn,opcua_server=error,opcua_nodes=error,opcua_crypto=off,opcua_core=error,opcua_core::comms::secure_channel=off".into());
     let _ = tracing_subscriber::fmt().with_env_filter(filter).with_writer(std::io::stderr).try_init();
     let (port, seconds) = match options() {
         Ok(o) => o,

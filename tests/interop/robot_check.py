@@ -199,6 +199,22 @@ async def run(url: str) -> Report:
         except ua.UaStatusCodeError as e:
             report.check("write to AssetId (read-only in Robotics) is BadNotWritable", e.code == ua.StatusCodes.BadNotWritable, str(e))
 
+        # A writable variable: the controller's ConfiguredDefaultStopMode (Int16, CurrentWrite in Robotics) is
+        # bound to a derived struct; the write is stored, and the server prints it from the struct (the Rust
+        # test checks that line). A value of the wrong type is refused.
+        controller = await (await robot.get_child([f"{rob}:Controllers"])).get_child([f"{rob}:Controller"])
+        stop_mode = await controller.get_child(
+            [f"{rob}:SystemOperation", f"{rob}:SystemOperationStateMachine", f"{rob}:ConfiguredDefaultStopMode"]
+        )
+        report.check("ConfiguredDefaultStopMode starts at 0 (the struct's value)", await stop_mode.read_value() == 0)
+        await stop_mode.write_value(ua.DataValue(ua.Variant(2, ua.VariantType.Int16)))
+        report.check("write to writable ConfiguredDefaultStopMode is stored", await stop_mode.read_value() == 2)
+        try:
+            await stop_mode.write_value(ua.DataValue(ua.Variant("two", ua.VariantType.String)))
+            report.check("write of a String to Int16 ConfiguredDefaultStopMode is refused", False, "accepted")
+        except ua.UaStatusCodeError as e:
+            report.check("write of a String to Int16 ConfiguredDefaultStopMode is BadTypeMismatch", e.code == ua.StatusCodes.BadTypeMismatch, str(e))
+
         # Typed methods of the arm's Lock, correct and wrong arguments.
         lock = await arm.get_child([f"{di}:Lock"])
         init_lock = await lock.get_child([f"{di}:InitLock"])

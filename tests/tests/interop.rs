@@ -86,8 +86,8 @@ impl Server {
         (server, url.to_owned())
     }
 
-    /// Sends SIGTERM and checks that the server ends cleanly.
-    fn stop(mut self) {
+    /// Sends SIGTERM, checks that the server ends cleanly, and returns what it printed after its URL.
+    fn stop(mut self) -> Vec<String> {
         let pid = self.child.id().to_string();
         let sent = Command::new("kill").args(["-TERM", &pid]).status().is_ok_and(|s| s.success());
         assert!(sent, "cannot send SIGTERM to the server");
@@ -98,6 +98,7 @@ impl Server {
         let status = self.child.wait().expect("the server ends");
         assert!(status.success(), "the server exited with {status}; its output: {rest:?}");
         assert!(rest.iter().any(|l| l == "server stopped cleanly"), "the server did not stop cleanly: {rest:?}");
+        rest
     }
 }
 
@@ -118,7 +119,8 @@ fn asyncua_client_against_the_example_server() {
 
 /// The six-axis robot example (typed handles, instantiation, the derive) against `robot_check.py`: the
 /// instance against its types' instance declarations, a subscription to a joint position, writes to
-/// read-only variables, the derived identification, typed methods with correct and wrong arguments.
+/// read-only variables, the derived identification, a client write that must reach the derived struct (the
+/// example prints the struct's field when it changes), typed methods with correct and wrong arguments.
 #[test]
 fn asyncua_client_against_the_robot_example() {
     let python = python();
@@ -127,7 +129,11 @@ fn asyncua_client_against_the_robot_example() {
     let mut check = Command::new(&python);
     check.arg(root().join("tests/interop/robot_check.py")).args(["--url", &url]);
     run_check(check);
-    server.stop();
+    let printed = server.stop();
+    assert!(
+        printed.iter().any(|l| l == "ConfiguredDefaultStopMode written by a client: 2"),
+        "the client's write of ConfiguredDefaultStopMode did not reach the derived struct; the server printed {printed:?}"
+    );
 }
 
 /// Runs a check script; fails unless it ends with `N passed, 0 failed`.
