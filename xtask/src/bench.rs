@@ -18,6 +18,9 @@
 //! * `rust`: the Rust back end, end to end (module [`rust`] below says how each figure is taken):
 //!   generation time and memory for DI + IA + Robotics, generated lines, build time of the generated crate
 //!   alone, address-space import time, and the same figures for async-opcua-codegen 0.19 on the same inputs.
+//! * `robots`: the typed API at scale ([`robots`]): N six-axis robots instantiated in one server, every joint
+//!   position updated at 100 Hz; time per update cycle and memory per robot. Not part of `all` (it runs for
+//!   `--robots-seconds` and builds the server stack in release mode).
 
 use std::collections::BTreeMap;
 use std::env;
@@ -25,6 +28,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use crate::util::{display_path, workspace_root};
+
+mod robots;
 
 /// The files of the `robotics` scenario, in `nodesets/vendor/`.
 const VENDOR_FILES: &[&str] = &[
@@ -47,7 +52,7 @@ const TREE_TIME_MS: f64 = 1000.0;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Which scenario(s) to run.
-    #[arg(long, value_parser = ["all", "robotics", "tree", "sets", "rust"], default_value = "all")]
+    #[arg(long, value_parser = ["all", "robotics", "tree", "sets", "rust", "robots"], default_value = "all")]
     scenario: String,
 
     /// Runs of the robotics scenario (ns0 + DI + IA + Robotics).
@@ -91,6 +96,18 @@ pub struct Args {
     /// Rust scenario: skip the release builds (the import bench is still built in release).
     #[arg(long)]
     no_release: bool,
+
+    /// Robots scenario: how many six-axis robots.
+    #[arg(long, value_name = "N", default_value_t = 100)]
+    robots: usize,
+
+    /// Robots scenario: the update rate of every joint position.
+    #[arg(long, value_name = "HZ", default_value_t = 100)]
+    robots_hz: u32,
+
+    /// Robots scenario: how long the updates run.
+    #[arg(long, value_name = "S", default_value_t = 10)]
+    robots_seconds: u64,
 
     /// Skip the stage-split runs (halves the run time; the table then shows totals only).
     #[arg(long)]
@@ -169,6 +186,9 @@ pub fn run(args: Args) -> Result<(), String> {
     }
     if want("rust") {
         rust::run(&args, &root, &tree)?;
+    }
+    if args.scenario == "robots" {
+        robots::run(&root, args.robots, args.robots_hz, args.robots_seconds)?;
     }
     Ok(())
 }

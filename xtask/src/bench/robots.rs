@@ -1,0 +1,58 @@
+//! The `robots` scenario: the typed API at scale (issue "Typed ObjectTypes"): `generated/examples/robot_bench.rs`
+//! instantiates N six-axis Robotics robots in one running server and updates every joint position at a fixed
+//! rate through typed handles; this task builds it in release mode, runs it once and shows its figures.
+
+use std::env;
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+use super::{parse_report, release_dir};
+
+/// Builds and runs the robot bench with `robots` robots for `seconds` seconds at `hz`, and prints its report.
+pub(super) fn run(root: &Path, robots: usize, hz: u32, seconds: u64) -> Result<(), String> {
+    eprintln!("robots: building the robot_bench example (release) ...");
+    let cargo = env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let status = Command::new(cargo)
+        .current_dir(root)
+        .args(["build", "--quiet", "--release", "-p", "nodeset-models", "--example", "robot_bench"])
+        .status()
+        .map_err(|e| format!("cannot run cargo: {e}"))?;
+    if !status.success() {
+        return Err(format!("building the robot_bench example failed ({status})"));
+    }
+    let exe = release_dir(root).join("examples").join(format!("robot_bench{}", env::consts::EXE_SUFFIX));
+    eprintln!("robots: {robots} robots, every joint set at {hz} Hz for {seconds} s ...");
+    let out = Command::new(&exe)
+        .args(["--robots", &robots.to_string(), "--hz", &hz.to_string(), "--seconds", &seconds.to_string()])
+        .stderr(Stdio::inherit())
+        .output()
+        .map_err(|e| format!("cannot run {}: {e}", exe.display()))?;
+    if !out.status.success() {
+        return Err(format!("the robot bench failed ({})", out.status));
+    }
+    let r = parse_report(&String::from_utf8_lossy(&out.stdout)).ok_or("the robot bench printed no BENCH line")?;
+    let period_us = 1e6 / f64::from(hz);
+    println!();
+    println!("Typed API at scale: {} robots x 6 axes ({} joints) in one server, release build.", r.s("robots"), r.s("joints"));
+    println!("  nodes per robot                 {:>10}", r.s("nodes_per_robot"));
+    println!("  instantiate + bind, all robots  {:>10.1} ms  ({:.2} ms per robot)", r.f("instantiate_ms"), r.f("instantiate_per_robot_ms"));
+    println!("  resident memory before robots   {:>10.1} MiB", r.f("rss_base_kib") / 1024.0);
+    println!("  resident memory with robots     {:>10.1} MiB", r.f("rss_robots_kib") / 1024.0);
+    println!("  memory per robot                {:>10.1} KiB", r.f("kib_per_robot"));
+    println!(
+        "  update cycle ({} joints set)   median {:.1} us, p99 {:.1} us, max {:.1} us  ({:.1}% of the {:.0} us period at the median)",
+        r.s("joints"),
+        r.f("cycle_median_us"),
+        r.f("cycle_p99_us"),
+        r.f("cycle_max_us"),
+        100.0 * r.f("cycle_median_us") / period_us,
+        period_us
+    );
+    println!(
+        "  cycles                          {:>10}  ({} late, {:.1} Hz achieved of {hz} Hz)",
+        r.s("cycles"),
+        r.s("late_cycles"),
+        r.f("achieved_hz")
+    );
+    Ok(())
+}
