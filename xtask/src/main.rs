@@ -14,6 +14,7 @@ mod bench;
 mod corpus;
 mod fetch;
 mod generate;
+mod load;
 mod test;
 mod util;
 mod venv;
@@ -41,6 +42,8 @@ enum Command {
     Corpus(corpus::Args),
     /// Regenerate generated/ from the pinned companion specifications (`--check`: fail if stale).
     Generate(generate::Args),
+    /// The generated robot server under client load: sessions subscribed to every axis variable, a writer.
+    Load(load::Args),
     /// Everything a fresh machine needs (pinned nodesets, Python test peers), then every test.
     Test(test::Args),
     /// Create or update the Python venv `.venv` with the test peers of `tests/requirements.txt`.
@@ -54,6 +57,7 @@ fn main() -> ExitCode {
         Command::Bench(args) => bench::run(args),
         Command::Corpus(args) => corpus::run(args),
         Command::Generate(args) => generate::run(args),
+        Command::Load(args) => load::run(args),
         Command::Test(args) => test::run(args),
         Command::Venv(args) => venv::run(args),
     };

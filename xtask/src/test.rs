@@ -4,6 +4,7 @@
 //! 2. The Python venv with the test peers (`.venv`, from `tests/requirements.txt`).
 //! 3. `cargo test --workspace --locked`, whose summary lines CI reads.
 //! 4. `cargo xtask corpus`: Rust for every resolvable ua-nodeset file, compiled.
+//! 5. `cargo xtask load --seconds 20`: the robot example under 50 subscribed client sessions and a writer.
 
 use crate::util::workspace_root;
 use std::process::Command;
@@ -37,5 +38,7 @@ pub fn run(args: Args) -> Result<(), String> {
         return Err(format!("cargo test failed ({status})"));
     }
     // The whole corpus as Rust, compiled: too long for a #[test] among others, so it runs after them.
-    crate::corpus::run(crate::corpus::Args::default())
+    crate::corpus::run(crate::corpus::Args::default())?;
+    // The robot server under 50 client sessions, briefly (`cargo xtask load` runs five minutes).
+    crate::load::run(crate::load::Args { sessions: 50, seconds: 20, publishing_ms: 100, release: false })
 }

@@ -68,7 +68,14 @@ pub struct ServerConfig {
     /// Where async-opcua keeps certificates. The endpoint needs none; the default is a folder in the
     /// system's temporary directory, so that nothing is written beside the program.
     pub pki_dir: PathBuf,
+    /// How many client sessions the server accepts at once; more get `BadTooManySessions`. Defaults to
+    /// [`DEFAULT_MAX_SESSIONS`] (async-opcua's own default, 20, is too few for a cell whose devices are
+    /// watched by dashboards, HMIs and the composite skills of other servers at the same time).
+    pub max_sessions: usize,
 }
+
+/// The default of [`ServerConfig::max_sessions`].
+pub const DEFAULT_MAX_SESSIONS: usize = 100;
 
 impl ServerConfig {
     /// A configuration with the defaults above and no tables.
@@ -87,6 +94,7 @@ impl ServerConfig {
             type_loaders: Vec::new(),
             instance_namespace: None,
             pki_dir: std::env::temp_dir().join("nodeset-models-pki"),
+            max_sessions: DEFAULT_MAX_SESSIONS,
         }
     }
 
@@ -99,6 +107,12 @@ impl ServerConfig {
     /// Sets the port (0 picks a free one).
     pub fn port(mut self, port: u16) -> ServerConfig {
         self.port = port;
+        self
+    }
+
+    /// Sets how many client sessions the server accepts at once.
+    pub fn max_sessions(mut self, max_sessions: usize) -> ServerConfig {
+        self.max_sessions = max_sessions;
         self
     }
 
@@ -136,6 +150,7 @@ impl ServerConfig {
             .port(port)
             .pki_dir(self.pki_dir)
             .create_sample_keypair(false)
+            .max_sessions(self.max_sessions)
             .with_node_manager(model_node_manager_with_instances(self.tables, &instance_namespace));
         for loader in self.type_loaders {
             builder = builder.with_type_loader(loader);
