@@ -13,6 +13,7 @@ use clap::{Parser, Subcommand};
 mod bench;
 mod corpus;
 mod fetch;
+mod fuzz;
 mod generate;
 mod test;
 mod util;
@@ -39,6 +40,8 @@ enum Command {
     Bench(bench::Args),
     /// Generate Rust for every resolvable ua-nodeset file into one crate and `cargo check` it.
     Corpus(corpus::Args),
+    /// Run one cargo-fuzz target of fuzz/ for a number of seconds (installs cargo-fuzz, builds the seeds).
+    Fuzz(fuzz::Args),
     /// Regenerate generated/ from the pinned companion specifications (`--check`: fail if stale).
     Generate(generate::Args),
     /// Everything a fresh machine needs (pinned nodesets, Python test peers), then every test.
@@ -53,6 +56,7 @@ fn main() -> ExitCode {
         Command::FetchNodesets(args) => fetch::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Corpus(args) => corpus::run(args),
+        Command::Fuzz(args) => fuzz::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Test(args) => test::run(args),
         Command::Venv(args) => venv::run(args),
