@@ -74,27 +74,6 @@ fn in_process(files: &[PathBuf]) -> Output {
     files
 }
 
-/// Builds the `nodeset-compiler` command (the workspace's own build) and returns its path.
-fn command_binary() -> PathBuf {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-    let output = Command::new(cargo)
-        .current_dir(nodeset_tests::root())
-        .args(["build", "-p", "nodeset-compiler", "--bin", "nodeset-compiler", "--message-format=json-render-diagnostics"])
-        .stderr(Stdio::inherit())
-        .output()
-        .expect("cargo runs");
-    assert!(output.status.success(), "cargo build -p nodeset-compiler --bin nodeset-compiler failed");
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    let line = stdout
-        .lines()
-        .filter(|l| l.contains("\"reason\":\"compiler-artifact\"") && l.contains("\"executable\":\""))
-        .find(|l| l.contains("\"name\":\"nodeset-compiler\""))
-        .expect("cargo reports the command's executable");
-    let start = line.find("\"executable\":\"").unwrap() + "\"executable\":\"".len();
-    let end = start + line[start..].find('"').unwrap();
-    PathBuf::from(&line[start..end])
-}
-
 /// Runs the command's `rust` and `modelica` subcommands in `cwd` with `files` and `models` as given (relative
 /// to `cwd` or absolute), writing below `out`, and reads back what they wrote.
 fn by_command(exe: &Path, cwd: &Path, files: &[PathBuf], models: &Path, out: &Path) -> Output {
@@ -167,7 +146,7 @@ fn generation_is_byte_identical_across_runs_orders_and_directories() {
     assert_same("the inputs in reverse order", &first, &in_process(&reversed));
 
     // The command, started in nodesets/vendor with paths relative to it.
-    let exe = command_binary();
+    let exe = nodeset_tests::command_binary();
     let tmp = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("determinism");
     let vendor = nodeset_tests::vendor();
     let relative: Vec<PathBuf> = files
