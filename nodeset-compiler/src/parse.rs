@@ -1059,7 +1059,8 @@ impl<'a, 'd> Parser<'a, 'd> {
             let value_start = i + 2;
             let value = &s[value_start..value_start + s[value_start..].iter().position(|&b| b == quote)?];
             i = value_start + value.len() + 1;
-            if value.contains(&b'&') {
+            // Values with references to expand, or too long (the general path reports it), are not common.
+            if value.contains(&b'&') || value.len() > self.limits.max_text_len {
                 return None;
             }
             match key {
