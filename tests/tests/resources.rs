@@ -74,3 +74,47 @@ fn fifty_megabytes_load_within_a_memory_bound() {
     eprintln!("50 MB model ({} bytes, {nodes} nodes): peak RSS {peak_mib} MiB", text.len());
     assert!(peak_mib <= PEAK_RSS_MIB_50MB, "peak RSS {peak_mib} MiB exceeds the bound of {PEAK_RSS_MIB_50MB} MiB");
 }
+
+/// Generates Rust and Modelica for a synthetic model, returning the files and the rendered diagnostics.
+fn generate_both(text: String) -> (Vec<nodeset_compiler::write::OutFile>, nodeset_compiler::diag::Diagnostics) {
+    use nodeset_compiler::emit::{modelica, rust};
+    let opts = Options { model_dirs: vec![nodeset_tests::vendor()], ..Options::default() };
+    let out = compile(vec![Input::Text { name: "synth.xml".into(), text }], &opts);
+    assert!(out.ok(), "{}", out.render_diagnostics());
+    let cfg = rust::RustConfig {
+        namespaces: vec![rust::RustNamespace { uri: synth::URI.into(), module: "synth".into() }],
+        extern_paths: Default::default(),
+        runtime_path: "nodeset_models::runtime".into(),
+        command: "test".into(),
+    };
+    let r = rust::generate(&out.model, &cfg);
+    let m = modelica::generate_with_diagnostics(&out.model, &modelica::ModelicaConfig::new().namespace(synth::URI));
+    let mut diags = r.diagnostics;
+    diags.extend(m.diagnostics);
+    let mut files = r.files;
+    files.extend(m.files);
+    (files, diags)
+}
+
+/// A 2,000-level object hierarchy (it overflowed the Modelica emitter's stack) and 300-character
+/// BrowseNames (they made class files whose names the file system refuses) generate both back ends: the
+/// hierarchy is cut at 64 levels with an NS0302 warning, and every file name stays within the limit.
+#[test]
+fn deep_hierarchies_and_long_names_generate() {
+    let (files, diags) = generate_both(synth::nodeset(Shape::DeepInstances, 2000));
+    assert!(!diags.has_errors());
+    let cut: Vec<_> = diags.items.iter().filter(|d| d.code.as_str() == "NS0302" && d.message.contains("nested more than 64 levels")).collect();
+    assert_eq!(cut.len(), 1, "one warning where the hierarchy is cut: {:?}", diags.items.iter().map(|d| &d.message).collect::<Vec<_>>());
+
+    let long = "Very".repeat(75);
+    let text = synth::nodeset(Shape::Mixed, 20).replace("1:DeviceType0\"", &format!("1:{long}\"")).replace("1:Device0\"", &format!("1:{long}X\""));
+    let (files_long, diags) = generate_both(text);
+    assert!(!diags.has_errors());
+    for f in files.iter().chain(&files_long) {
+        for part in f.path.iter() {
+            let len = part.len();
+            assert!(len <= nodeset_compiler::names::MAX_IDENT_LEN + 3, "{}: a path component of {len} bytes", f.path.display());
+        }
+    }
+    assert!(files_long.iter().any(|f| f.contents.contains(&long)), "the original BrowseName is kept in the output");
+}
