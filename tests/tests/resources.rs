@@ -35,6 +35,8 @@ fn synthetic_models_resolve_cleanly() {
 }
 
 /// Runs `exe args` to its end and returns (exit success, stdout, peak resident memory in KiB).
+// The child is reaped by wait4 (which also gives its rusage), not by `Child::wait`.
+#[allow(clippy::zombie_processes)]
 fn run_measured(exe: &std::path::Path, args: &[&std::ffi::OsStr]) -> (bool, String, u64) {
     let child = Command::new(exe).args(args).stdout(Stdio::piped()).stderr(Stdio::null()).spawn().expect("the command starts");
     let pid = child.id() as libc::pid_t;
