@@ -31,6 +31,12 @@ fn synthetic_models_resolve_cleanly() {
         let ns = out.model.namespaces.iter().position(|u| u == synth::URI).expect("the synthetic namespace is loaded") as u16;
         let nodes = out.model.nodes.iter().filter(|n| n.id.ns == ns).count();
         assert!((300..=303).contains(&nodes), "{}: {nodes} nodes", shape.name());
+        // The depths computed in one pass are those of the chains.
+        let depths = out.model.type_depths();
+        for i in 0..out.model.nodes.len() {
+            let ix = nodeset_compiler::model::NodeIx(i as u32);
+            assert_eq!(depths[i] as usize + 1, out.model.super_chain(ix).len(), "{}: type depth of {}", shape.name(), out.model.qualified(ix));
+        }
     }
 }
 
