@@ -37,12 +37,7 @@ pub const NAMESPACES: &[(&str, &str)] = &[
 
 pub const COMMAND: &str = "cargo xtask generate";
 
-/// Everything `generate` would write, by output folder.
-pub fn plan(deny_warnings: bool) -> Result<Vec<(PathBuf, Vec<OutFile>)>, String> {
-    plan_into(&workspace_root().join("generated"), &[], deny_warnings)
-}
-
-/// Everything `generate` would write into the crate folder `crate_dir` (normally `generated/`), with further
+/// Everything `generate` would write, by output folder, into the crate folder `crate_dir` (normally `generated/`), with further
 /// input files compiled beside the pinned ones.
 pub fn plan_into(crate_dir: &Path, extra_inputs: &[PathBuf], deny_warnings: bool) -> Result<Vec<(PathBuf, Vec<OutFile>)>, String> {
     let root = workspace_root();
@@ -146,6 +141,11 @@ fn write_plan(plan: &[(PathBuf, Vec<OutFile>)], check: bool) -> Result<(), Strin
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Everything `generate` would write into generated/.
+    fn plan(deny_warnings: bool) -> Result<Vec<(PathBuf, Vec<OutFile>)>, String> {
+        plan_into(&workspace_root().join("generated"), &[], deny_warnings)
+    }
 
     /// generated/ must be what the compiler produces from the pinned specs today.
     #[test]
