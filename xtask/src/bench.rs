@@ -18,6 +18,8 @@
 //! * `rust`: the Rust back end, end to end (module [`rust`] below says how each figure is taken):
 //!   generation time and memory for DI + IA + Robotics, generated lines, build time of the generated crate
 //!   alone, address-space import time, and the same figures for async-opcua-codegen 0.19 on the same inputs.
+//! * `scale`: synthetic models of n and 4n nodes in several shapes, timed in this process, with the ratio
+//!   per stage (module [`scale`]); looks for quadratic behaviour.
 
 use std::collections::BTreeMap;
 use std::env;
@@ -25,6 +27,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 
 use crate::util::{display_path, workspace_root};
+
+mod scale;
 
 /// The files of the `robotics` scenario, in `nodesets/vendor/`.
 const VENDOR_FILES: &[&str] = &[
@@ -47,7 +51,7 @@ const TREE_TIME_MS: f64 = 1000.0;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Which scenario(s) to run.
-    #[arg(long, value_parser = ["all", "robotics", "tree", "sets", "rust"], default_value = "all")]
+    #[arg(long, value_parser = ["all", "robotics", "tree", "sets", "rust", "scale"], default_value = "all")]
     scenario: String,
 
     /// Runs of the robotics scenario (ns0 + DI + IA + Robotics).
@@ -92,6 +96,14 @@ pub struct Args {
     #[arg(long)]
     no_release: bool,
 
+    /// Nodes of the smaller model of each shape in the scale scenario (the larger has four times as many).
+    #[arg(long, value_name = "N", default_value_t = 10_000)]
+    scale_n: usize,
+
+    /// Runs of each model in the scale scenario (the median is shown).
+    #[arg(long, value_name = "N", default_value_t = 3)]
+    runs_scale: usize,
+
     /// Skip the stage-split runs (halves the run time; the table then shows totals only).
     #[arg(long)]
     no_split: bool,
@@ -119,7 +131,7 @@ pub fn run(args: Args) -> Result<(), String> {
     let want = |s: &str| args.scenario == "all" || args.scenario == s;
     let tree = args.tree.clone().unwrap_or_else(|| root.join(DEFAULT_TREE));
 
-    if want("robotics") || want("rust") {
+    if want("robotics") || want("rust") || want("scale") {
         ensure_vendor(&root.join("nodesets/vendor"))?;
     }
     let tree_scenarios: Vec<&str> = ["tree", "sets"].into_iter().filter(|s| want(s)).collect();
@@ -169,6 +181,9 @@ pub fn run(args: Args) -> Result<(), String> {
     }
     if want("rust") {
         rust::run(&args, &root, &tree)?;
+    }
+    if want("scale") {
+        scale::run(&root.join("nodesets/vendor"), args.scale_n, args.runs_scale)?;
     }
     Ok(())
 }
