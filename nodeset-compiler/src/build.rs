@@ -18,7 +18,8 @@
 //! ```
 //!
 //! Every file the compiler reads is printed as `cargo:rerun-if-changed`, warnings as `cargo:warning`. The
-//! output file is replaced atomically; on any error nothing is written and the error lists the diagnostics.
+//! output file is replaced atomically (written as `.<file>.tmp-<pid>` beside it, then renamed over it); on
+//! any error the previous output stays as it was and the error lists the diagnostics.
 
 use crate::emit::rust::{self as rust_emit, RustConfig, RustNamespace};
 use crate::load::Input;
@@ -151,11 +152,17 @@ impl Builder {
         }
         let text = rust_emit::inline(&gen.files, &namespaces);
         let name = self.out_file.clone().unwrap_or_else(|| "nodesets.rs".into());
-        let path = out_dir.join(name);
+        let path = out_dir.join(&name);
         std::fs::create_dir_all(&out_dir).map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
-        let tmp = path.with_extension("rs.tmp");
-        std::fs::write(&tmp, text).map_err(|e| format!("cannot write {}: {e}", tmp.display()))?;
-        std::fs::rename(&tmp, &path).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-        Ok(path)
+        // The text goes to a temporary file beside the output, which is then renamed over it: readers see
+        // the old file or the new one, and a failure leaves the old one and no temporary file.
+        let tmp = out_dir.join(format!(".{name}.tmp-{}", std::process::id()));
+        let written = std::fs::write(&tmp, text)
+            .map_err(|e| format!("cannot write {}: {e}", tmp.display()))
+            .and_then(|()| std::fs::rename(&tmp, &path).map_err(|e| format!("cannot write {}: {e}", path.display())));
+        if written.is_err() {
+            let _ = std::fs::remove_file(&tmp);
+        }
+        written.map(|()| path)
     }
 }

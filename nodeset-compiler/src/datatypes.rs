@@ -13,7 +13,8 @@ pub(crate) fn classify(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeI
     let types: Vec<NodeIx> =
         (0..model.nodes.len() as u32).map(NodeIx).filter(|&ix| model.node(ix).class == NodeClass::DataType).collect();
     // Supertypes first, so inherited fields are known.
-    let mut order: Vec<(usize, NodeIx)> = types.iter().map(|&t| (model.super_chain(t).len(), t)).collect();
+    let depths = model.type_depths();
+    let mut order: Vec<(u32, NodeIx)> = types.iter().map(|&t| (depths[t.index()], t)).collect();
     order.sort();
     let has_encoding = model.ns0(ids::HAS_ENCODING);
     let mut out: BTreeMap<NodeIx, DataTypeInfo> = BTreeMap::new();

@@ -93,7 +93,9 @@ pub fn resolve_node_id_str(
             let mut d = Diagnostic::new(Code::UnknownAlias, format!("`{s}` is neither a declared alias nor a NodeId"))
                 .at(span)
                 .with_span_label("unknown alias");
-            let near = nearest(s, aliases.keys().map(String::as_str));
+            // A file with very many aliases gets no suggestion: the search is per unknown name, and over
+            // thousands of aliases it made thousands of unknown names quadratic (8,000 took 48 s).
+            let near = if aliases.len() <= MAX_SUGGESTION_CANDIDATES { nearest(s, aliases.keys().map(String::as_str)) } else { None };
             d = match near {
                 Some(n) => d.help(format!("did you mean the alias `{n}`? Otherwise declare it in <Aliases>")),
                 None => d.help("declare it in <Aliases> (<Alias Alias=\"Name\">i=...</Alias>) or write the NodeId"),
@@ -738,13 +740,35 @@ fn topo_order(parsed: &[RawNodeSet], sources: &SourceMap, diags: &mut Diagnostic
     order
 }
 
+/// The most candidates [`nearest`] is asked to search by the loader (the aliases of one file; ns0 has 30).
+pub const MAX_SUGGESTION_CANDIDATES: usize = 1000;
+
+/// The longest name [`nearest`] looks for: suggestions are for typos in names of identifier size.
+const MAX_SUGGESTION_NAME: usize = 100;
+
 /// The candidate closest to `name` by edit distance, if close enough to be a likely typo.
+///
+/// Each comparison costs at most the product of the two lengths and stops as soon as the distance exceeds
+/// what would count as a typo; names longer than 100 bytes get no suggestion.
 pub fn nearest<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Option<&'a str> {
+    if name.len() > MAX_SUGGESTION_NAME {
+        return None;
+    }
+    let name_l = name.to_lowercase();
+    let name_chars = name_l.chars().count();
     let mut best: Option<(usize, &str)> = None;
     for c in candidates {
-        let d = edit_distance(&name.to_lowercase(), &c.to_lowercase());
         let limit = (name.len().max(c.len()) / 3).max(1);
-        if d <= limit && best.is_none_or(|(bd, bc)| (d, c) < (bd, bc)) {
+        if c.len() > MAX_SUGGESTION_NAME {
+            continue;
+        }
+        let c_l = c.to_lowercase();
+        // The distance is at least the difference in length.
+        if name_chars.abs_diff(c_l.chars().count()) > limit {
+            continue;
+        }
+        let Some(d) = edit_distance_within(&name_l, &c_l, limit) else { continue };
+        if best.is_none_or(|(bd, bc)| (d, c) < (bd, bc)) {
             best = Some((d, c));
         }
     }
@@ -752,6 +776,11 @@ pub fn nearest<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Opt
 }
 
 pub fn edit_distance(a: &str, b: &str) -> usize {
+    edit_distance_within(a, b, usize::MAX).unwrap_or(usize::MAX)
+}
+
+/// The edit distance of `a` and `b` if it is at most `limit`.
+pub fn edit_distance_within(a: &str, b: &str, limit: usize) -> Option<usize> {
     let a: Vec<char> = a.chars().collect();
     let b: Vec<char> = b.chars().collect();
     let mut prev: Vec<usize> = (0..=b.len()).collect();
@@ -763,8 +792,12 @@ pub fn edit_distance(a: &str, b: &str) -> usize {
             cur[j] = (prev[j] + 1).min(cur[j - 1] + 1).min(prev[j - 1] + cost);
         }
         std::mem::swap(&mut prev, &mut cur);
+        // A row's minimum never decreases further down: past the limit, the distance is too.
+        if prev.iter().min().is_some_and(|&m| m > limit) {
+            return None;
+        }
     }
-    prev[b.len()]
+    Some(prev[b.len()]).filter(|&d| d <= limit)
 }
 
 #[cfg(test)]
@@ -812,5 +845,9 @@ mod tests {
         let c = ["HasComponent", "HasProperty", "Organizes"];
         assert_eq!(nearest("HasComponnet", c.iter().copied()), Some("HasComponent"));
         assert_eq!(nearest("Zebra", c.iter().copied()), None);
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance_within("kitten", "sitting", 2), None);
+        assert_eq!(edit_distance_within("kitten", "sitting", 3), Some(3));
+        assert_eq!(nearest(&"x".repeat(101), ["x".repeat(101).as_str()].into_iter()), None, "long names get no suggestion");
     }
 }

@@ -63,6 +63,25 @@ enum Command {
         #[arg(long, value_name = "WHAT", value_parser = ["warnings"])]
         deny: Option<String>,
     },
+    /// Generate Modelica component skeletons from NodeSet2 files: one package per namespace, the used part
+    /// of the base namespace (`OpcUa`) and `OpcUaSupport`.
+    Modelica {
+        /// NodeSet2 files whose models are generated.
+        #[arg(required = true)]
+        files: Vec<PathBuf>,
+        /// Folders searched recursively for the models the files require.
+        #[arg(long = "models", value_name = "DIR")]
+        models: Vec<PathBuf>,
+        /// Output folder (replaced atomically; it must hold only generated files).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Compare with the output folder instead of writing; fail if it differs.
+        #[arg(long)]
+        check: bool,
+        /// `--deny warnings` turns warnings into errors.
+        #[arg(long, value_name = "WHAT", value_parser = ["warnings"])]
+        deny: Option<String>,
+    },
 }
 
 fn pairs(items: &[String], what: &str) -> Result<Vec<(String, String)>, String> {
@@ -141,6 +160,41 @@ fn rust_command(
     Ok(())
 }
 
+fn modelica_command(files: Vec<PathBuf>, models: Vec<PathBuf>, out: PathBuf, check: bool, deny: bool) -> Result<(), String> {
+    use nodeset_compiler::emit::modelica::{generate_with_diagnostics, ModelicaConfig};
+    use nodeset_compiler::write::{write_tree, Mode};
+    let opts = Options { model_dirs: models, deny_warnings: deny, ..Options::default() };
+    let compiled = compile(files.into_iter().map(Input::Path).collect(), &opts);
+    eprint!("{}", compiled.render_diagnostics());
+    if !compiled.ok() {
+        return Err("the NodeSet2 files do not compile; nothing was written".into());
+    }
+    let model = &compiled.model;
+    let mut gen = generate_with_diagnostics(model, &ModelicaConfig::new());
+    if deny {
+        gen.diagnostics.deny_warnings();
+    }
+    gen.diagnostics.sort(&model.sources);
+    eprint!("{}", gen.diagnostics.render(&model.sources));
+    if gen.diagnostics.has_errors() {
+        return Err("generation failed; nothing was written".into());
+    }
+    let report = write_tree(&out, &gen.files, if check { Mode::Check } else { Mode::Write })?;
+    if check && !report.is_clean() {
+        return Err(format!("{} is stale:\n{}", out.display(), report.describe(&out)));
+    }
+    eprintln!(
+        "{}: {} file(s), {} new, {} changed, {} removed, {} unchanged",
+        out.display(),
+        gen.files.len(),
+        report.added.len(),
+        report.changed.len(),
+        report.removed.len(),
+        report.unchanged
+    );
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
@@ -153,6 +207,13 @@ fn main() -> ExitCode {
                 }
             }
         }
+        Command::Modelica { files, models, out, check, deny } => match modelica_command(files, models, out, check, deny.is_some()) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::FAILURE
+            }
+        },
         Command::Check { files, models, deny, all_warnings, show, depth } => {
             let opts = Options {
                 model_dirs: models,

@@ -340,6 +340,9 @@ pub struct Model {
     /// Instance declarations of every ObjectType and VariableType, inherited ones included.
     pub members: BTreeMap<NodeIx, Vec<Member>>,
     pub(crate) hierarchical: Vec<bool>,
+    /// Each node's entry and exit time in a depth-first walk of the supertype forest, so that
+    /// [`Model::is_subtype_of`] is one comparison (see [`Model::index_subtypes`]); empty until then.
+    pub(crate) subtype_spans: Vec<(u32, u32)>,
     /// BrowseNames of ns0 DataTypes and ReferenceTypes, for undeclared aliases such as `IdType`.
     pub(crate) ns0_type_names: FxHashMap<String, NodeIx>,
     /// The values of each file (indexed by [`FileId`]), read against the file's text in `sources`.
@@ -373,6 +376,9 @@ impl Model {
 
     /// Whether `ix` is `ancestor` or one of its subtypes.
     pub fn is_subtype_of(&self, ix: NodeIx, ancestor: NodeIx) -> bool {
+        if let (Some(a), Some(b)) = (self.subtype_spans.get(ix.index()), self.subtype_spans.get(ancestor.index())) {
+            return b.0 <= a.0 && a.1 <= b.1;
+        }
         let mut cur = Some(ix);
         let mut steps = 0;
         while let Some(c) = cur {
@@ -394,17 +400,108 @@ impl Model {
     }
 
     /// The chain from `ix` up to its root type, `ix` first.
+    ///
+    /// The resolver breaks subtype cycles, so the chain ends at a root; a cycle met anyway ends the chain
+    /// where it closes. Linear in the length of the chain (a set of the nodes seen is kept once the chain
+    /// is longer than a real type hierarchy).
     pub fn super_chain(&self, ix: NodeIx) -> Vec<NodeIx> {
         let mut out = vec![ix];
+        let mut seen: crate::fxhash::FxHashSet<NodeIx> = Default::default();
         let mut cur = self.node(ix).super_type;
         while let Some(c) = cur {
-            if out.contains(&c) {
+            if out.len() == 32 {
+                seen.extend(out.iter().copied());
+            }
+            let repeated = if out.len() < 32 { out.contains(&c) } else { !seen.insert(c) };
+            if repeated {
                 break;
             }
             out.push(c);
             cur = self.node(c).super_type;
         }
         out
+    }
+
+    /// Numbers the supertype forest for [`Model::is_subtype_of`], which otherwise walks up the chain (once
+    /// per question: quadratic over a deep hierarchy). Called by the resolver once the supertypes are final
+    /// (cycles broken); if a cycle remains anyway, the numbering is left out and the walk is used.
+    pub(crate) fn index_subtypes(&mut self) {
+        const NONE: u32 = u32::MAX;
+        let n = self.nodes.len();
+        let (mut first_child, mut next_sibling) = (vec![NONE; n], vec![NONE; n]);
+        for i in (0..n).rev() {
+            if let Some(s) = self.nodes[i].super_type {
+                next_sibling[i] = first_child[s.index()];
+                first_child[s.index()] = i as u32;
+            }
+        }
+        let mut spans = vec![(0u32, 0u32); n];
+        let (mut clock, mut visited) = (0u32, 0usize);
+        let mut stack: Vec<(u32, u32)> = Vec::new();
+        for root in (0..n).filter(|&i| self.nodes[i].super_type.is_none()) {
+            spans[root].0 = clock;
+            clock += 1;
+            visited += 1;
+            stack.push((root as u32, first_child[root]));
+            while let Some(top) = stack.last_mut() {
+                let child = top.1;
+                if child == NONE {
+                    let node = top.0 as usize;
+                    stack.pop();
+                    spans[node].1 = clock;
+                    clock += 1;
+                } else {
+                    top.1 = next_sibling[child as usize];
+                    spans[child as usize].0 = clock;
+                    clock += 1;
+                    visited += 1;
+                    stack.push((child, first_child[child as usize]));
+                }
+            }
+        }
+        self.subtype_spans = if visited == n { spans } else { Vec::new() };
+    }
+
+    /// The supertypes of `ix`, nearest first, read lazily (a caller looking for the nearest one with some
+    /// property pays for the types it looks at, not for the whole chain). Ends after as many steps as the
+    /// model has nodes, so a cycle met anyway cannot make it endless.
+    pub fn supertypes(&self, ix: NodeIx) -> impl Iterator<Item = NodeIx> + '_ {
+        std::iter::successors(self.node(ix).super_type, move |&s| self.node(s).super_type).take(self.nodes.len())
+    }
+
+    /// For every node, how many supertypes are above it (0 for a node without one), in one pass over the
+    /// model: what `super_chain(ix).len() - 1` gives for each node, without walking every chain (which is
+    /// quadratic in the depth of a hierarchy). A cycle met anyway counts as ending where it closes.
+    pub fn type_depths(&self) -> Vec<u32> {
+        const UNKNOWN: u32 = u32::MAX;
+        const VISITING: u32 = u32::MAX - 1;
+        let mut depth = vec![UNKNOWN; self.nodes.len()];
+        let mut path: Vec<usize> = Vec::new();
+        for start in 0..self.nodes.len() {
+            // Up from `start` to a node whose depth is known, a root, or a node of this path (a cycle).
+            let mut cur = start;
+            let above = loop {
+                match depth[cur] {
+                    UNKNOWN => {
+                        depth[cur] = VISITING;
+                        path.push(cur);
+                        match self.nodes[cur].super_type {
+                            Some(s) => cur = s.index(),
+                            None => break None,
+                        }
+                    }
+                    VISITING => break None,
+                    d => break Some(d),
+                }
+            };
+            let mut next = above.map_or(0, |d| d + 1);
+            for &p in path.iter().rev() {
+                depth[p] = next;
+                next += 1;
+            }
+            path.clear();
+        }
+        depth
     }
 
     pub fn is_hierarchical(&self, reference_type: NodeIx) -> bool {

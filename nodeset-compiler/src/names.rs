@@ -17,6 +17,9 @@
 //!    name (`model`, `input`, `Real`, `time`, ...) gets a trailing underscore.
 //! 6. An empty result (a name of punctuation only) becomes `_` followed by the code points (`Precise+` is
 //!    fine, `+` alone becomes `u002b`).
+//! 7. An identifier longer than [`MAX_IDENT_LEN`] bytes keeps its first 103 bytes and ends in 16 hex digits
+//!    of a hash (FNV-1a, 64 bit) of the whole identifier, after `_` (`H` in UpperCamel case, which allows
+//!    no underscore): identifiers become file and folder names, which file systems limit to 255 bytes.
 //!
 //! Two originals that map to one identifier in one scope are resolved by [`Scope::finish`]: the originals
 //! are sorted, the first keeps the identifier, the others get `_2`, `_3`, ... in that sorted order, and a
@@ -145,6 +148,28 @@ fn join(words: &[String], case: Case) -> String {
     }
 }
 
+/// The longest identifier [`sanitize`] returns, in bytes (rule 7).
+pub const MAX_IDENT_LEN: usize = 120;
+
+/// Rule 7: shortens an identifier longer than [`MAX_IDENT_LEN`] to exactly that length, keeping its start
+/// and ending in a hash of the whole. Shorter identifiers are returned as they are.
+pub fn cap_len(name: String, case: Case) -> String {
+    if name.len() <= MAX_IDENT_LEN {
+        return name;
+    }
+    let hash = name.bytes().fold(0xcbf2_9ce4_8422_2325_u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3));
+    let suffix = match case {
+        Case::UpperCamel => format!("H{hash:016X}"),
+        Case::ShoutySnake => format!("_{hash:016X}"),
+        Case::Snake | Case::Preserve => format!("_{hash:016x}"),
+    };
+    // Sanitized identifiers are ASCII, so any byte index is a character boundary.
+    let keep = MAX_IDENT_LEN - suffix.len();
+    let mut out: String = name.chars().take(keep).collect();
+    out.push_str(&suffix);
+    out
+}
+
 /// The identifier for `original` in `case` for `target`. Always a valid identifier of the target language.
 pub fn sanitize(original: &str, case: Case, target: Target) -> String {
     let ws = words(original);
@@ -173,7 +198,7 @@ pub fn sanitize(original: &str, case: Case, target: Target) -> String {
             }
         }
     }
-    name
+    cap_len(name, case)
 }
 
 /// Whether `s` is a valid identifier of the target (used by tests and debug assertions).
@@ -329,6 +354,23 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn long_identifiers_are_capped_distinct_and_valid() {
+        let long = "VeryLongBrowseName".repeat(20);
+        for target in [Target::Rust, Target::Modelica] {
+            for case in [Case::UpperCamel, Case::Snake, Case::ShoutySnake, Case::Preserve] {
+                let a = sanitize(&format!("{long}A"), case, target);
+                let b = sanitize(&format!("{long}B"), case, target);
+                assert_eq!(a.len(), MAX_IDENT_LEN, "{a}");
+                assert!(is_valid(&a, target) && is_valid(&b, target), "{a} / {b}");
+                assert_ne!(a, b, "two long names that differ only at the end stay distinct");
+                assert_eq!(a, sanitize(&format!("{long}A"), case, target), "the hash is stable");
+            }
+        }
+        assert_eq!(sanitize(&"x".repeat(MAX_IDENT_LEN), Case::Snake, Target::Rust).len(), MAX_IDENT_LEN);
+        assert!(!sanitize(&"ab".repeat(100), Case::UpperCamel, Target::Rust).contains('_'));
     }
 
     #[test]

@@ -18,7 +18,7 @@ pub struct Limits {
     pub max_depth: usize,
     /// Deepest nesting inside one `<Value>` (ExtensionObjects within arrays within structures ...).
     pub max_value_depth: usize,
-    /// Longest text content of one element, in bytes.
+    /// Longest text content of one element, and longest attribute value, in bytes.
     pub max_text_len: usize,
 }
 
@@ -426,6 +426,16 @@ impl<'a, 'd> Parser<'a, 'd> {
     fn attr(&mut self, key: &'a str, value: &[u8]) -> PResult<Attr<'a>> {
         let start = self.offset_of(value);
         let span = self.span(start, start + value.len());
+        if value.len() > self.limits.max_text_len {
+            let d = Diagnostic::new(
+                Code::TooLarge,
+                format!("the value of attribute `{key}` is longer than {} bytes", self.limits.max_text_len),
+            )
+            .at(self.span(start, start))
+            .with_span_label("this attribute's value is too long")
+            .help("no NodeSet2 attribute needs this much; raise the limit in parse::Limits if the file is trusted");
+            return Err(self.fatal(d));
+        }
         let raw = self.str_at(value);
         let value: Cow<'a, str> = if !raw.contains('&') {
             Cow::Borrowed(raw)
@@ -1049,7 +1059,8 @@ impl<'a, 'd> Parser<'a, 'd> {
             let value_start = i + 2;
             let value = &s[value_start..value_start + s[value_start..].iter().position(|&b| b == quote)?];
             i = value_start + value.len() + 1;
-            if value.contains(&b'&') {
+            // Values with references to expand, or too long (the general path reports it), are not common.
+            if value.contains(&b'&') || value.len() > self.limits.max_text_len {
                 return None;
             }
             match key {

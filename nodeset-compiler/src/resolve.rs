@@ -33,6 +33,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         state_machines: BTreeMap::new(),
         members: BTreeMap::new(),
         hierarchical: Vec::new(),
+        subtype_spans: Vec::new(),
         ns0_type_names: FxHashMap::default(),
         value_arenas: Vec::new(),
     };
@@ -606,6 +607,7 @@ fn link_types(model: &mut Model, broken: &HashSet<NodeIx>, diags: &mut Diagnosti
             state[p] = 2;
         }
     }
+    model.index_subtypes();
     let hier = model.ns0(ids::HIERARCHICAL_REFERENCES);
     model.hierarchical = (0..n)
         .map(|i| {
@@ -709,7 +711,8 @@ fn build_members(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeIx, Vec
         .map(NodeIx)
         .filter(|&ix| matches!(model.node(ix).class, NodeClass::ObjectType | NodeClass::VariableType))
         .collect();
-    let mut depth: Vec<(usize, NodeIx)> = types.iter().map(|&t| (model.super_chain(t).len(), t)).collect();
+    let depths = model.type_depths();
+    let mut depth: Vec<(u32, NodeIx)> = types.iter().map(|&t| (depths[t.index()], t)).collect();
     depth.sort();
     let mut members: BTreeMap<NodeIx, Vec<Member>> = BTreeMap::new();
     // A type's own children by BrowseName (reused from type to type).

@@ -401,6 +401,41 @@ fn text_too_long() {
 }
 
 #[test]
+fn value_text_too_long() {
+    // A string value beyond the (lowered) text limit: the value reader enforces the limit as well.
+    let limits = nodeset_compiler::parse::Limits { max_text_len: 1 << 20, ..Default::default() };
+    let text = deep("", "", 0, true).replace(
+        "\n    </Value>",
+        &format!("<String xmlns=\"http://opcfoundation.org/UA/2008/02/Types.xsd\">{}</String>\n    </Value>", "x".repeat(2 << 20)),
+    );
+    let r = run_with("value_text_too_long", vec![Input::Text { name: "generated/value_text_too_long.xml".into(), text }], Options { limits, ..options() });
+    let d = r.error("NS0011");
+    r.has_help(d).no_model();
+    let (_, line, _) = r.position(d);
+    assert_eq!(line, 7, "the caret belongs on <String>\n{}", r.rendered);
+    r.snapshot();
+}
+
+#[test]
+fn attribute_too_long() {
+    // An attribute value beyond the (lowered) text limit: a 2 MiB BrowseName.
+    let limits = nodeset_compiler::parse::Limits { max_text_len: 1 << 20, ..Default::default() };
+    let text = deep("", "", 0, false).replace(
+        "\n</UANodeSet>",
+        &format!("<UAObject NodeId=\"ns=1;i=1\" BrowseName=\"1:{}\">\n  </UAObject>\n</UANodeSet>", "x".repeat(2 << 20)),
+    );
+    let r = run_with("attribute_too_long", vec![Input::Text { name: "generated/attribute_too_long.xml".into(), text }], Options { limits, ..options() });
+    let d = r.error("NS0011");
+    r.has_help(d).no_model();
+    if !d.message.contains("BrowseName") {
+        r.fail("the message should name the attribute");
+    }
+    let (_, line, _) = r.position(d);
+    assert_eq!(line, 5, "the caret belongs on the attribute\n{}", r.rendered);
+    r.snapshot();
+}
+
+#[test]
 fn not_nodeset_root() {
     let r = file("not_nodeset_root");
     let d = r.error("NS0006");

@@ -21,6 +21,8 @@
 //! * `robots`: the typed API at scale ([`robots`]): N six-axis robots instantiated in one server, every joint
 //!   position updated at 100 Hz; time per update cycle and memory per robot. Not part of `all` (it runs for
 //!   `--robots-seconds` and builds the server stack in release mode).
+//! * `scale`: synthetic models of n and 4n nodes in several shapes, timed in this process, with the ratio
+//!   per stage (module [`scale`]); looks for quadratic behaviour.
 
 use std::collections::BTreeMap;
 use std::env;
@@ -30,6 +32,7 @@ use std::process::{Command, Stdio};
 use crate::util::{display_path, workspace_root};
 
 mod robots;
+mod scale;
 
 /// The files of the `robotics` scenario, in `nodesets/vendor/`.
 const VENDOR_FILES: &[&str] = &[
@@ -52,7 +55,7 @@ const TREE_TIME_MS: f64 = 1000.0;
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Which scenario(s) to run.
-    #[arg(long, value_parser = ["all", "robotics", "tree", "sets", "rust", "robots"], default_value = "all")]
+    #[arg(long, value_parser = ["all", "robotics", "tree", "sets", "rust", "scale", "robots"], default_value = "all")]
     scenario: String,
 
     /// Runs of the robotics scenario (ns0 + DI + IA + Robotics).
@@ -108,6 +111,13 @@ pub struct Args {
     /// Robots scenario: how long the updates run.
     #[arg(long, value_name = "S", default_value_t = 10)]
     robots_seconds: u64,
+    /// Nodes of the smaller model of each shape in the scale scenario (the larger has four times as many).
+    #[arg(long, value_name = "N", default_value_t = 10_000)]
+    scale_n: usize,
+
+    /// Runs of each model in the scale scenario (the median is shown).
+    #[arg(long, value_name = "N", default_value_t = 3)]
+    runs_scale: usize,
 
     /// Skip the stage-split runs (halves the run time; the table then shows totals only).
     #[arg(long)]
@@ -136,7 +146,7 @@ pub fn run(args: Args) -> Result<(), String> {
     let want = |s: &str| args.scenario == "all" || args.scenario == s;
     let tree = args.tree.clone().unwrap_or_else(|| root.join(DEFAULT_TREE));
 
-    if want("robotics") || want("rust") {
+    if want("robotics") || want("rust") || want("scale") {
         ensure_vendor(&root.join("nodesets/vendor"))?;
     }
     let tree_scenarios: Vec<&str> = ["tree", "sets"].into_iter().filter(|s| want(s)).collect();
@@ -186,6 +196,9 @@ pub fn run(args: Args) -> Result<(), String> {
     }
     if want("rust") {
         rust::run(&args, &root, &tree)?;
+    }
+    if want("scale") {
+        scale::run(&root.join("nodesets/vendor"), args.scale_n, args.runs_scale)?;
     }
     if args.scenario == "robots" {
         robots::run(&root, args.robots, args.robots_hz, args.robots_seconds)?;

@@ -13,6 +13,7 @@ use clap::{Parser, Subcommand};
 mod bench;
 mod corpus;
 mod fetch;
+mod fuzz;
 mod generate;
 mod load;
 mod test;
@@ -40,6 +41,8 @@ enum Command {
     Bench(bench::Args),
     /// Generate Rust for every resolvable ua-nodeset file into one crate and `cargo check` it.
     Corpus(corpus::Args),
+    /// Run one cargo-fuzz target of fuzz/ for a number of seconds (installs cargo-fuzz, builds the seeds).
+    Fuzz(fuzz::Args),
     /// Regenerate generated/ from the pinned companion specifications (`--check`: fail if stale).
     Generate(generate::Args),
     /// The generated robot server under client load: sessions subscribed to every axis variable, a writer.
@@ -56,6 +59,7 @@ fn main() -> ExitCode {
         Command::FetchNodesets(args) => fetch::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Corpus(args) => corpus::run(args),
+        Command::Fuzz(args) => fuzz::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Load(args) => load::run(args),
         Command::Test(args) => test::run(args),

@@ -5,6 +5,8 @@
 //! 3. `cargo test --workspace --locked`, whose summary lines CI reads.
 //! 4. `cargo xtask corpus`: Rust for every resolvable ua-nodeset file, compiled.
 //! 5. `cargo xtask load --seconds 20`: the robot example under 50 subscribed client sessions and a writer.
+//! 6. Each fuzz target of `fuzz/` for [`FUZZ_SECS`] seconds (`cargo xtask fuzz`): CI exercises the targets
+//!    and replays the corpus they grew on this machine before; a crash fails the run.
 
 use crate::util::workspace_root;
 use std::process::Command;
@@ -40,5 +42,13 @@ pub fn run(args: Args) -> Result<(), String> {
     // The whole corpus as Rust, compiled: too long for a #[test] among others, so it runs after them.
     crate::corpus::run(crate::corpus::Args::default())?;
     // The robot server under 50 client sessions, briefly (`cargo xtask load` runs five minutes).
-    crate::load::run(crate::load::Args { sessions: 50, seconds: 20, publishing_ms: 100, release: false })
+    crate::load::run(crate::load::Args { sessions: 50, seconds: 20, publishing_ms: 100, release: false })?;
+    for target in crate::fuzz::Target::ALL {
+        crate::fuzz::run(crate::fuzz::Args { target, secs: FUZZ_SECS, libfuzzer_args: Vec::new() })?;
+    }
+    Ok(())
 }
+
+/// How long CI fuzzes each target: long enough to replay the seeds and mutate for a while, short enough
+/// that the three targets with cargo-fuzz's installation and the instrumented build add a few minutes.
+pub const FUZZ_SECS: u64 = 25;

@@ -11,6 +11,19 @@ use crate::raw::NodeClass;
 use std::collections::{BTreeMap, BTreeSet};
 use std::rc::Rc;
 
+/// The class of an owner's declaration in `Declarations`: `<Owner>_<Path>`, unique in the namespace (neither
+/// part contains a `_` the other could complete), and never the name of the class alias it is redeclared
+/// for (rumoca ignores `redeclare model X = P.X`). Long results are capped like every identifier
+/// (`names` rule 7), as the class is also a file name.
+pub fn decl_class_ident(owner_ident: &str, decl: &str) -> String {
+    crate::names::cap_len(format!("{owner_ident}_{decl}"), Case::Preserve)
+}
+
+/// The deepest nesting of instance declarations or instance children represented in Modelica, one nested
+/// class per level. Companion specifications nest fewer than twenty; a model nested deeper (thousands of
+/// levels overflowed the stack) is cut here with an NS0302 warning.
+pub const MAX_NESTING: usize = 64;
+
 /// Who owns a set of instance-declaration classes: an ObjectType or a top-level instance.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Owner {
@@ -73,6 +86,8 @@ pub struct Ctx<'a> {
     pub reserved: Vec<String>,
     /// Guards against runaway recursion through malformed type graphs.
     pub depth: usize,
+    /// How many class bodies are being planned inside each other (see [`MAX_NESTING`]).
+    pub nesting: usize,
     pub deferred: Vec<Deferred>,
 }
 
@@ -96,6 +111,7 @@ impl<'a> Ctx<'a> {
             records: BTreeMap::new(),
             reserved,
             depth: 0,
+            nesting: 0,
             deferred: Vec::new(),
         }
     }
@@ -238,7 +254,7 @@ impl<'a> Ctx<'a> {
                 // Every declaration class is named when its owner is planned; the fallback only guards
                 // against a type graph too deep to plan.
                 let decl = self.decl_names.get(&(*owner, path.clone())).cloned().unwrap_or_else(|| class_ident(path));
-                format!("{}.Declarations.{}_{decl}", self.pkg[ns as usize], names.owners[owner])
+                format!("{}.Declarations.{}", self.pkg[ns as usize], decl_class_ident(&names.owners[owner], &decl))
             }
         }
     }

@@ -611,9 +611,7 @@ fn emit_owner(ctx: &mut Ctx, owner: Owner, out: &mut Output) {
         out.add(ns, &sub, &ident, body);
     }
     for (path, decl) in &plan.decls {
-        // `<Owner>_<Path>`: unique in the namespace (neither part contains a `_` the other could complete), and
-        // never the name of the class alias it is redeclared for (rumoca ignores `redeclare model X = P.X`).
-        let ident = format!("{owner_ident}_{}", ctx.decl_names[&(owner, path.clone())]);
+        let ident = ctx::decl_class_ident(&owner_ident, &ctx.decl_names[&(owner, path.clone())]);
         let body = render_class(ctx, decl, &ident);
         out.add(ns, "Declarations", &ident, body);
     }

@@ -7,7 +7,7 @@
 //! element. Every element keeps its origin in an `__OPCUA(browsePath, nodeId, dataType)` annotation; the
 //! browse path is relative to the object the enclosing class stands for.
 
-use super::ctx::{component_original, count_name, node_id_text, ClassKey, Ctx, Owner};
+use super::ctx::{component_original, count_name, node_id_text, ClassKey, Ctx, Owner, MAX_NESTING};
 use super::text::{self, string_literal};
 use super::types::{dims_text, Base, MType};
 use crate::model::{ids, ModellingRule, NodeIx};
@@ -517,6 +517,35 @@ impl Ctx<'_> {
     /// Plans the body of a class: overrides of `base` and new elements for `own`. `allow_replaceable` is false
     /// for the class of a redeclaration whose constraining class has no replaceable elements of its own.
     pub fn plan_body(
+        &mut self,
+        owner: Owner,
+        path: &str,
+        base: Option<&Rc<ClassInfo>>,
+        own: &[Own],
+        mode: Mode,
+        allow_replaceable: bool,
+    ) -> Body {
+        // Each level of an object hierarchy is a nested class (and a few stack frames here); below
+        // MAX_NESTING levels the children are left out, with a warning, rather than overflowing the stack.
+        let own = if self.nesting >= MAX_NESTING && !own.is_empty() {
+            let at = own[0].node;
+            self.lossy(
+                at,
+                format!(
+                    "the children of `{path}` are nested more than {MAX_NESTING} levels deep; they are not represented in Modelica"
+                ),
+            );
+            &[][..]
+        } else {
+            own
+        };
+        self.nesting += 1;
+        let body = self.plan_body_at(owner, path, base, own, mode, allow_replaceable);
+        self.nesting -= 1;
+        body
+    }
+
+    fn plan_body_at(
         &mut self,
         owner: Owner,
         path: &str,

@@ -469,7 +469,7 @@ impl Gen<'_> {
             let sname = ident(name);
             if n.class == NodeClass::ObjectType {
                 // The nearest supertype with a handle carries the members it declares.
-                let base = model.super_chain(t).into_iter().skip(1).find_map(|s| Some((s, self.handle_path(s, &names)?)));
+                let base = model.supertypes(t).find_map(|s| Some((s, self.handle_path(s, &names)?)));
                 let own: Vec<(NodeIx, NodeIx)> = match &base {
                     Some((s, _)) => {
                         let inherited: BTreeSet<NodeIx> = model.members.get(s).map(|ms| ms.iter().map(|m| m.node).collect()).unwrap_or_default();
