@@ -344,7 +344,10 @@ async fn namespaces_follow_the_order_of_the_tables() {
     };
     assert_eq!(uris[0], "http://opcfoundation.org/UA/");
     assert_eq!(uris[1], "urn:nodeset-models:order-test");
-    assert_eq!(&uris[2..], ["urn:test:b", "urn:test:a", "urn:test:missing"]);
+    assert_eq!(&uris[2..5], ["urn:test:b", "urn:test:a", "urn:test:missing"]);
+    // The namespace of instances created at run time comes after every table's namespaces.
+    assert_eq!(&uris[5..], ["urn:nodeset-models:order-test:instances"]);
+    assert_eq!(m.instance_namespace(), 5);
     common::disconnect(session, event_loop).await;
     running.stop().await;
 }
