@@ -1,15 +1,15 @@
 //! `cargo xtask generate`: regenerates `generated/` from the pinned companion specifications.
 //!
-//! The model is compiled once (ns0, DI, IA and Robotics from `nodesets/vendor/`); each back end returns its
-//! files in memory; only when everything succeeded are the output folders replaced, each atomically
-//! (`write_tree`). `--check` writes nothing and fails when a file is stale.
+//! The model is compiled once (ns0, DI, IA and Robotics from `nodesets/vendor/`, our skill models from
+//! `nodesets/`); each back end returns its files in memory; only when everything succeeded are the output
+//! folders replaced, each atomically (`write_tree`). `--check` writes nothing and fails when a file is stale.
 
 use crate::util::workspace_root;
 use nodeset_compiler::emit::rust::{self as rust_emit, RustConfig, RustNamespace};
 use nodeset_compiler::load::Input;
 use nodeset_compiler::write::{write_tree, Mode, OutFile};
 use nodeset_compiler::{compile, Options};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -21,11 +21,15 @@ pub struct Args {
     deny_warnings: bool,
 }
 
-/// The namespaces of `generated/`: (file in nodesets/vendor, module name).
+/// The namespaces of `generated/`: (file under `nodesets/`, module name). The official specifications are
+/// fetched into `nodesets/vendor/`; our skill models are committed in `nodesets/` itself.
 pub const NAMESPACES: &[(&str, &str)] = &[
-    ("Opc.Ua.Di.NodeSet2.xml", "di"),
-    ("Opc.Ua.IA.NodeSet2.xml", "ia"),
-    ("Opc.Ua.Robotics.NodeSet2.xml", "robotics"),
+    ("vendor/Opc.Ua.Di.NodeSet2.xml", "di"),
+    ("vendor/Opc.Ua.IA.NodeSet2.xml", "ia"),
+    ("vendor/Opc.Ua.Robotics.NodeSet2.xml", "robotics"),
+    ("CommonSkills.NodeSet2.xml", "common_skills"),
+    ("RobotCell.NodeSet2.xml", "robot_cell"),
+    ("DrillingProcess.NodeSet2.xml", "drilling_process"),
 ];
 
 pub const COMMAND: &str = "cargo xtask generate";
@@ -34,7 +38,7 @@ pub const COMMAND: &str = "cargo xtask generate";
 pub fn plan(deny_warnings: bool) -> Result<Vec<(PathBuf, Vec<OutFile>)>, String> {
     let root = workspace_root();
     let vendor = root.join("nodesets/vendor");
-    let inputs = NAMESPACES.iter().map(|(f, _)| Input::Path(vendor.join(f))).collect();
+    let inputs = NAMESPACES.iter().map(|(f, _)| Input::Path(root.join("nodesets").join(f))).collect();
     let out = compile(inputs, &Options { model_dirs: vec![vendor.clone()], deny_warnings, ..Options::default() });
     let rendered = out.render_diagnostics();
     if !out.ok() {
@@ -48,7 +52,7 @@ pub fn plan(deny_warnings: bool) -> Result<Vec<(PathBuf, Vec<OutFile>)>, String>
         let m = model
             .models
             .iter()
-            .find(|m| model.sources.get(m.file).path.file_name().is_some_and(|n| n == *file))
+            .find(|m| model.sources.get(m.file).path.file_name() == Path::new(file).file_name())
             .ok_or_else(|| format!("{file} defines no model"))?;
         namespaces.push(RustNamespace { uri: m.uri.clone(), module: (*module).to_string() });
     }
