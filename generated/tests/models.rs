@@ -1,9 +1,10 @@
-//! The generated DI, IA and Robotics tables import completely into a server: every row becomes a node,
-//! the namespaces get the indices of the order they are given in, and the types join the type tree.
+//! The generated DI, IA and Robotics tables, and our skill models on them, import completely into a server:
+//! every row becomes a node, the namespaces get the indices of the order they are given in, and the types
+//! join the type tree.
 
 mod common;
 
-use nodeset_models::models::{di, ia, robotics};
+use nodeset_models::models::{common_skills, di, drilling_process, ia, robot_cell, robotics};
 use nodeset_models::runtime::server::ServerConfig;
 use nodeset_models::runtime::table::NodeSetTable;
 use opcua::nodes::TypeTree;
@@ -51,6 +52,51 @@ async fn generated_tables_import_completely() {
         let tree = running.handle.type_tree().read();
         assert!(tree.is_subtype_of(&NodeId::new(4, 1002u32), &NodeId::new(2, 15063u32)));
         assert!(tree.is_subtype_of(&NodeId::new(4, 1002u32), &NodeId::new(0, 58u32)));
+    }
+    running.stop().await;
+}
+
+const SKILL_TABLES: [&NodeSetTable; 6] =
+    [&di::TABLE, &ia::TABLE, &robotics::TABLE, &common_skills::TABLE, &robot_cell::TABLE, &drilling_process::TABLE];
+
+#[tokio::test]
+async fn skill_tables_import_completely() {
+    let running = common::serve(
+        ServerConfig::new("skills test")
+            .table(&di::TABLE)
+            .type_loader(di::TypeLoader)
+            .table(&ia::TABLE)
+            .type_loader(ia::TypeLoader)
+            .table(&robotics::TABLE)
+            .type_loader(robotics::TypeLoader)
+            .table(&common_skills::TABLE)
+            .type_loader(common_skills::TypeLoader)
+            .table(&robot_cell::TABLE)
+            .type_loader(robot_cell::TypeLoader)
+            .table(&drilling_process::TABLE)
+            .type_loader(drilling_process::TypeLoader),
+    )
+    .await;
+    let m = &running.manager;
+    for (i, table) in SKILL_TABLES.iter().enumerate() {
+        assert_eq!(m.namespace_index(table.namespace_uri), Some(i as u16 + 2), "{}", table.namespace_uri);
+        let map = m.namespace_map(table.namespace_uri).expect("the table is served");
+        let missing: Vec<_> = table
+            .nodes
+            .iter()
+            .map(|row| map.try_id(row.id).expect("every row's namespace is registered"))
+            .filter(|id| running.attribute(id, AttributeId::NodeClass).is_none())
+            .collect();
+        assert!(missing.is_empty(), "{}: rows missing from the address space: {missing:?}", table.namespace_uri);
+    }
+    // DrillHoleSkillType (DrillingProcess) -> CompositeSkillType -> ProgramSkillStateMachineType (CommonSkills)
+    // -> ProgramStateMachineType (ns0 i=2391).
+    {
+        let tree = running.handle.type_tree().read();
+        let drill_hole = m.resolve(drilling_process::ids::object_types::DRILL_HOLE_SKILL_TYPE).unwrap();
+        let composite = m.resolve(common_skills::ids::object_types::COMPOSITE_SKILL_TYPE).unwrap();
+        assert!(tree.is_subtype_of(&drill_hole, &composite));
+        assert!(tree.is_subtype_of(&drill_hole, &NodeId::new(0, 2391u32)));
     }
     running.stop().await;
 }

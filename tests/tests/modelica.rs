@@ -6,6 +6,7 @@
 //!   class by rumoca (`tests/modelica/check.py`), and the example simulated;
 //! * every resolvable file of the ua-nodeset corpus and the skill reference models, checked by rumoca one
 //!   aggregate model per nodeset;
+//! * the checked-in `generated/modelica` (with our skill models), checked class by class by rumoca;
 //! * determinism: same input, byte-identical output, whatever the input order.
 //!
 //! rumoca runs in the venv that `cargo xtask venv` creates; a missing venv fails the tests with that command.
@@ -339,6 +340,33 @@ fn every_resolvable_corpus_file_passes_rumoca() {
     let files = nodeset_files(&tree);
     assert!(files.len() >= 117, "expected the 117+ NodeSet2 files of the corpus, found {}", files.len());
     check_tree("corpus", &tree, &files, true);
+}
+
+/// The checked-in tree of `cargo xtask generate` (DI, IA, Robotics and our three skill models with the ns0
+/// subset they use) passes rumoca class by class, as it is committed.
+#[test]
+fn generated_tree_passes_rumoca() {
+    let tree = root().join("generated/modelica");
+    for package in ["NodesetCompilerCommonSkills", "NodesetCompilerRobotCell", "NodesetCompilerDrillingProcess"] {
+        assert!(tree.join(package).join("package.mo").is_file(), "{package} is missing: run `cargo xtask generate`");
+    }
+    let mut classes = 0;
+    let mut dirs = vec![tree.clone()];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap().flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                dirs.push(path);
+            } else if path.extension().is_some_and(|x| x == "mo") && !path.ends_with("package.mo") {
+                classes += 1;
+            }
+        }
+    }
+    let t = Instant::now();
+    let (passed, failed, text) = check(&tree, false);
+    println!("generated/modelica: {passed} passed, {failed} failed in {:.1} s", t.elapsed().as_secs_f64());
+    assert_eq!(failed, 0, "{text}");
+    assert_eq!(passed, classes, "every class of generated/modelica is checked\n{text}");
 }
 
 #[test]

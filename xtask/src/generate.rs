@@ -1,9 +1,10 @@
 //! `cargo xtask generate`: regenerates `generated/` from the pinned companion specifications.
 //!
-//! The model is compiled once (ns0, DI, IA and Robotics from `nodesets/vendor/`); each back end returns its
-//! files in memory; only when everything succeeded are the output folders replaced, together and atomically
-//! (`write_trees`: both new trees are built before either folder is replaced, and a failure puts back what
-//! was replaced). `--check` writes nothing and fails when a file is stale.
+//! The model is compiled once (ns0, DI, IA and Robotics from `nodesets/vendor/`, our skill models from
+//! `nodesets/`); each back end returns its files in memory; only when everything succeeded are the output
+//! folders replaced, together and atomically (`write_trees`: both new trees are built before either folder
+//! is replaced, and a failure puts back what was replaced). `--check` writes nothing and fails when a file is
+//! stale.
 
 use crate::util::workspace_root;
 use nodeset_compiler::emit::rust::{self as rust_emit, RustConfig, RustNamespace};
@@ -28,11 +29,15 @@ pub struct Args {
     out: Option<PathBuf>,
 }
 
-/// The namespaces of `generated/`: (file in nodesets/vendor, module name).
+/// The namespaces of `generated/`: (file under `nodesets/`, module name). The official specifications are
+/// fetched into `nodesets/vendor/`; our skill models are committed in `nodesets/` itself.
 pub const NAMESPACES: &[(&str, &str)] = &[
-    ("Opc.Ua.Di.NodeSet2.xml", "di"),
-    ("Opc.Ua.IA.NodeSet2.xml", "ia"),
-    ("Opc.Ua.Robotics.NodeSet2.xml", "robotics"),
+    ("vendor/Opc.Ua.Di.NodeSet2.xml", "di"),
+    ("vendor/Opc.Ua.IA.NodeSet2.xml", "ia"),
+    ("vendor/Opc.Ua.Robotics.NodeSet2.xml", "robotics"),
+    ("CommonSkills.NodeSet2.xml", "common_skills"),
+    ("RobotCell.NodeSet2.xml", "robot_cell"),
+    ("DrillingProcess.NodeSet2.xml", "drilling_process"),
 ];
 
 pub const COMMAND: &str = "cargo xtask generate";
@@ -44,7 +49,7 @@ pub fn plan_into(crate_dir: &Path, extra_inputs: &[PathBuf], deny_warnings: bool
     let vendor = root.join("nodesets/vendor");
     let inputs = NAMESPACES
         .iter()
-        .map(|(f, _)| Input::Path(vendor.join(f)))
+        .map(|(f, _)| Input::Path(root.join("nodesets").join(f)))
         .chain(extra_inputs.iter().cloned().map(Input::Path))
         .collect();
     let out = compile(inputs, &Options { model_dirs: vec![vendor.clone()], deny_warnings, ..Options::default() });
@@ -60,7 +65,7 @@ pub fn plan_into(crate_dir: &Path, extra_inputs: &[PathBuf], deny_warnings: bool
         let m = model
             .models
             .iter()
-            .find(|m| model.sources.get(m.file).path.file_name().is_some_and(|n| n == *file))
+            .find(|m| model.sources.get(m.file).path.file_name() == Path::new(file).file_name())
             .ok_or_else(|| format!("{file} defines no model"))?;
         namespaces.push(RustNamespace { uri: m.uri.clone(), module: (*module).to_string() });
     }

@@ -6,3 +6,9 @@ pub mod di;
 pub mod ia;
 /// `http://opcfoundation.org/UA/Robotics/`
 pub mod robotics;
+/// `http://nodeset-compiler.dev/CommonSkills/`
+pub mod common_skills;
+/// `http://nodeset-compiler.dev/RobotCell/`
+pub mod robot_cell;
+/// `http://nodeset-compiler.dev/DrillingProcess/`
+pub mod drilling_process;

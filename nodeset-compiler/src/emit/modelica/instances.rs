@@ -313,8 +313,9 @@ fn collect_variables(m: &Model, ix: NodeIx, out: &mut Vec<NodeIx>, seen: &mut BT
     }
     let kids: Vec<NodeIx> = m.children(ix).map(|(_, c)| c).collect();
     for c in kids {
-        // The arguments of a method are not variables a server block reads or writes.
-        if m.node(c).modelling_rule.is_none() && m.node(c).class != NodeClass::Method {
+        // The arguments of a method are not variables a server block reads or writes; another namespace's
+        // instances below this one are listed by that namespace.
+        if m.node(c).modelling_rule.is_none() && m.node(c).class != NodeClass::Method && m.node(c).id.ns == m.node(ix).id.ns {
             collect_variables(m, c, out, seen);
         }
     }

@@ -182,9 +182,13 @@ impl Ctx<'_> {
 
     /// The children that count for a class: those with a ModellingRule (types), or all (instances).
     pub fn own_children(&self, node: NodeIx, mode: Mode) -> Vec<Own> {
+        let ns = self.m.node(node).id.ns;
         self.m
             .children(node)
             .filter(|&(_, c)| mode == Mode::Instance || self.m.node(c).modelling_rule.is_some())
+            // Another namespace's instance below this one (our models' cell below DI's DeviceSet) is a top-level
+            // instance of that namespace, with its class in that namespace's package.
+            .filter(|&(_, c)| !(mode == Mode::Instance && self.m.node(c).modelling_rule.is_none() && self.m.node(c).id.ns != ns))
             .filter(|&(_, c)| {
                 matches!(self.m.node(c).class, NodeClass::Object | NodeClass::Variable | NodeClass::Method)
             })

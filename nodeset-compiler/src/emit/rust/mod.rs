@@ -705,7 +705,8 @@ impl<'m> Gen<'m> {
         for &ix in &mine {
             let n = model.node(ix);
             used.insert(n.browse_name.ns);
-            for r in &n.references {
+            // Only the references a row carries (those its file declares, not the resolver's inverses).
+            for r in n.references.iter().filter(|r| r.declared) {
                 used.insert(model.node(r.reference_type).id.ns);
                 used.insert(model.node(r.target).id.ns);
             }
