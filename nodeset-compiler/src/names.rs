@@ -17,9 +17,12 @@
 //!    name (`model`, `input`, `Real`, `time`, ...) gets a trailing underscore.
 //! 6. An empty result (a name of punctuation only) becomes `_` followed by the code points (`Precise+` is
 //!    fine, `+` alone becomes `u002b`).
-//! 7. An identifier longer than [`MAX_IDENT_LEN`] bytes keeps its first 103 bytes and ends in 16 hex digits
-//!    of a hash (FNV-1a, 64 bit) of the whole identifier, after `_` (`H` in UpperCamel case, which allows
-//!    no underscore): identifiers become file and folder names, which file systems limit to 255 bytes.
+//! 7. A Modelica identifier longer than [`MAX_IDENT_LEN`] bytes keeps its first 103 bytes and ends in 16 hex
+//!    digits of a hash (FNV-1a, 64 bit) of the whole identifier, after `_` (`H` in UpperCamel case, which
+//!    allows no underscore): Modelica classes become file and folder names, which file systems limit to 255
+//!    bytes. Rust identifiers are not capped: no generated Rust file is named after a BrowseName (modules are
+//!    the configured namespace names), and a cut name would hide the end of a long path, which is what tells
+//!    two long NodeId constants apart for a reader.
 //!
 //! Two originals that map to one identifier in one scope are resolved by [`Scope::finish`]: the originals
 //! are sorted, the first keeps the identifier, the others get `_2`, `_3`, ... in that sorted order, and a
@@ -198,7 +201,10 @@ pub fn sanitize(original: &str, case: Case, target: Target) -> String {
             }
         }
     }
-    cap_len(name, case)
+    match target {
+        Target::Modelica => cap_len(name, case),
+        Target::Rust => name,
+    }
 }
 
 /// Whether `s` is a valid identifier of the target (used by tests and debug assertions).
@@ -363,14 +369,18 @@ mod tests {
             for case in [Case::UpperCamel, Case::Snake, Case::ShoutySnake, Case::Preserve] {
                 let a = sanitize(&format!("{long}A"), case, target);
                 let b = sanitize(&format!("{long}B"), case, target);
-                assert_eq!(a.len(), MAX_IDENT_LEN, "{a}");
+                match target {
+                    Target::Modelica => assert_eq!(a.len(), MAX_IDENT_LEN, "{a}"),
+                    // Rust keeps the whole name, end included.
+                    Target::Rust => assert!(a.len() > MAX_IDENT_LEN && a.to_ascii_lowercase().ends_with('a'), "{a}"),
+                }
                 assert!(is_valid(&a, target) && is_valid(&b, target), "{a} / {b}");
                 assert_ne!(a, b, "two long names that differ only at the end stay distinct");
                 assert_eq!(a, sanitize(&format!("{long}A"), case, target), "the hash is stable");
             }
         }
-        assert_eq!(sanitize(&"x".repeat(MAX_IDENT_LEN), Case::Snake, Target::Rust).len(), MAX_IDENT_LEN);
-        assert!(!sanitize(&"ab".repeat(100), Case::UpperCamel, Target::Rust).contains('_'));
+        assert_eq!(sanitize(&"x".repeat(MAX_IDENT_LEN), Case::Snake, Target::Modelica).len(), MAX_IDENT_LEN);
+        assert!(!sanitize(&"ab".repeat(100), Case::UpperCamel, Target::Modelica).contains('_'));
     }
 
     #[test]
