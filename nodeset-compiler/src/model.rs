@@ -494,10 +494,8 @@ impl Model {
                     d => break Some(d),
                 }
             };
-            let mut next = above.map_or(0, |d| d + 1);
-            for &p in path.iter().rev() {
-                depth[p] = next;
-                next += 1;
+            for (d, &p) in (above.map_or(0, |d| d + 1)..).zip(path.iter().rev()) {
+                depth[p] = d;
             }
             path.clear();
         }

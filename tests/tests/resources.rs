@@ -33,9 +33,10 @@ fn synthetic_models_resolve_cleanly() {
         assert!((300..=303).contains(&nodes), "{}: {nodes} nodes", shape.name());
         // The depths computed in one pass are those of the chains.
         let depths = out.model.type_depths();
-        for i in 0..out.model.nodes.len() {
+        assert_eq!(depths.len(), out.model.nodes.len());
+        for (i, &depth) in depths.iter().enumerate() {
             let ix = nodeset_compiler::model::NodeIx(i as u32);
-            assert_eq!(depths[i] as usize + 1, out.model.super_chain(ix).len(), "{}: type depth of {}", shape.name(), out.model.qualified(ix));
+            assert_eq!(depth as usize + 1, out.model.super_chain(ix).len(), "{}: type depth of {}", shape.name(), out.model.qualified(ix));
         }
     }
 }
