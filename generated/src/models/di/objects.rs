@@ -324,7 +324,7 @@ pub struct ConnectionPointType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: TopologyElementType,
     /// `NetworkAddress` (Mandatory).
-    pub network_address: FunctionalGroupType,
+    pub network_address: Box<FunctionalGroupType>,
     /// `<ProfileIdentifier>` (MandatoryPlaceholder).
     pub profile_identifier: t::Placeholders<ProtocolType>,
 }
@@ -1758,7 +1758,7 @@ pub struct SoftwareUpdateType {
     /// The instance.
     pub node: t::ObjectNode,
     /// `Loading` (Optional).
-    pub loading: Option<SoftwareLoadingType>,
+    pub loading: Option<Box<SoftwareLoadingType>>,
     /// `PrepareForUpdate` (Optional).
     pub prepare_for_update: Option<SoftwareUpdateType_PrepareForUpdate>,
     /// `Installation` (Optional).
@@ -2076,7 +2076,7 @@ pub struct TopologyElementType {
     /// `<GroupIdentifier>` (OptionalPlaceholder).
     pub group_identifier: t::Placeholders<FunctionalGroupType>,
     /// `Identification` (Optional).
-    pub identification: Option<FunctionalGroupType>,
+    pub identification: Option<Box<FunctionalGroupType>>,
     /// `Lock` (Optional).
     pub lock: Option<TopologyElementType_Lock>,
 }

@@ -77,7 +77,7 @@ pub struct BasicStacklightType {
     /// `StacklightMode` (Mandatory). Shows in what way (stack of individual lights, level meter, running light) the stacklight unit is used.
     pub stacklight_mode: t::Variable<super::types::StacklightOperationMode>,
     /// `StackRunning` (Optional). Valid if the stacklight is used in “Running_Light” StacklightMode.
-    pub stack_running: Option<StackRunningType>,
+    pub stack_running: Option<Box<StackRunningType>>,
 }
 impl t::Handle for BasicStacklightType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
@@ -123,7 +123,7 @@ pub struct CalibrationTargetType {
     /// The instance.
     pub node: t::ObjectNode,
     /// `CalibrationTargetCategory` (Mandatory). Defines what category the calibration target is of.
-    pub calibration_target_category: BaseCalibrationTargetCategoryType,
+    pub calibration_target_category: Box<BaseCalibrationTargetCategoryType>,
     /// `CalibrationTargetFeatures` (Mandatory). A folder containing information about the features of a calibration target, that is, what can be calibrated with the calibration target.
     pub calibration_target_features: CalibrationTargetType_CalibrationTargetFeatures,
     /// `CertificateUri` (Optional). Contains the Uri of a certificate of the calibration target, in case the calibration target is certified and the information available. Otherwise, the Property should be omitted.

@@ -175,7 +175,7 @@ pub struct LwrSystemType_MotionDeviceSystem {
         super::super::di::objects::FunctionalGroupType,
     >,
     /// `Identification` (Optional).
-    pub identification: Option<super::super::di::objects::FunctionalGroupType>,
+    pub identification: Option<Box<super::super::di::objects::FunctionalGroupType>>,
     /// `Lock` (Optional).
     pub lock: Option<LwrSystemType_MotionDeviceSystem_Lock>,
     /// `Manufacturer` (Optional).
@@ -338,7 +338,7 @@ pub struct TemplateDrillingLwrSystemType_DrillingEndEffector {
         super::super::di::objects::FunctionalGroupType,
     >,
     /// `Identification` (Optional).
-    pub identification: Option<super::super::di::objects::FunctionalGroupType>,
+    pub identification: Option<Box<super::super::di::objects::FunctionalGroupType>>,
     /// `Lock` (Optional).
     pub lock: Option<TemplateDrillingLwrSystemType_DrillingEndEffector_Lock>,
     /// `Manufacturer` (Mandatory). Manufacturer of the end effector.
@@ -461,7 +461,7 @@ pub struct TemplateDrillingLwrSystemType_DrillingEndEffector_SkillSet {
     /// The instance.
     pub node: t::ObjectNode,
     /// `TemplateDrilling` (Mandatory). Drills one hole through the drill bush the end effector sits in.
-    pub template_drilling: TemplateDrillingSkillType,
+    pub template_drilling: Box<TemplateDrillingSkillType>,
 }
 impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector_SkillSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
@@ -597,9 +597,9 @@ pub struct Ur10eSystemType_Controllers_URController {
         super::super::di::objects::FunctionalGroupType,
     >,
     /// `Identification` (Optional).
-    pub identification: Option<super::super::di::objects::FunctionalGroupType>,
+    pub identification: Option<Box<super::super::di::objects::FunctionalGroupType>>,
     /// `Lock` (Optional).
-    pub lock: Option<super::super::di::objects::LockingServicesType>,
+    pub lock: Option<Box<super::super::di::objects::LockingServicesType>>,
     /// `Manufacturer` (Mandatory). Manufacturer of the controller.
     pub manufacturer: t::Variable<ua::LocalizedText>,
     /// `ManufacturerUri` (Optional).
@@ -639,13 +639,15 @@ pub struct Ur10eSystemType_Controllers_URController {
     /// `Components` (Optional). Components is a container for one or more instances of subtypes of ComponentType defined in OPC UA DI. The listed components are installed in the motion device system, e.g. a processing-unit, a power-supply, an IO-board or a drive, and have an electrical interface to the controller.
     pub components: Option<t::ObjectNode>,
     /// `CurrentUser` (Mandatory). The user logged in at the URController.
-    pub current_user: super::super::robotics::objects::UserType,
+    pub current_user: Box<super::super::robotics::objects::UserType>,
     /// `Programs` (Optional).
     pub programs: Option<t::ObjectNode>,
     /// `Software` (Mandatory). The software running on the controller.
     pub software: t::ObjectNode,
     /// `SystemOperation` (Optional).
-    pub system_operation: Option<super::super::robotics::objects::SystemOperationType>,
+    pub system_operation: Option<
+        Box<super::super::robotics::objects::SystemOperationType>,
+    >,
     /// `TaskControls` (Mandatory). The program task of the controller.
     pub task_controls: t::ObjectNode,
     /// `SkillSet` (Mandatory). The basic move skills of the UR10e (ISkillSetType): AbsoluteJointPTPMove, RelativeCartesianLinearMove and AbsoluteCartesianLinearMove.
@@ -720,9 +722,9 @@ pub struct Ur10eSystemType_MotionDevices_Manipulator {
         super::super::di::objects::FunctionalGroupType,
     >,
     /// `Identification` (Optional).
-    pub identification: Option<super::super::di::objects::FunctionalGroupType>,
+    pub identification: Option<Box<super::super::di::objects::FunctionalGroupType>>,
     /// `Lock` (Optional).
-    pub lock: Option<super::super::di::objects::LockingServicesType>,
+    pub lock: Option<Box<super::super::di::objects::LockingServicesType>>,
     /// `Manufacturer` (Mandatory). Manufacturer of the arm.
     pub manufacturer: t::Variable<ua::LocalizedText>,
     /// `ManufacturerUri` (Optional).
@@ -756,7 +758,7 @@ pub struct Ur10eSystemType_MotionDevices_Manipulator {
     /// `Axes` (Mandatory). The six joints of the arm.
     pub axes: t::ObjectNode,
     /// `FlangeLoad` (Optional). The FlangeLoad is the load on the flange or at the mounting point of the MotionDevice. This can be the maximum load of the MotionDevice.
-    pub flange_load: Option<super::super::robotics::objects::LoadType>,
+    pub flange_load: Option<Box<super::super::robotics::objects::LoadType>>,
     /// `MotionDeviceCategory` (Mandatory). Kinematic category of the arm: an articulated robot.
     pub motion_device_category: t::Variable<
         super::super::robotics::types::MotionDeviceCategoryEnumeration,
@@ -830,9 +832,9 @@ pub struct Ur10eSystemType_SafetyStates_SafetyState {
         super::super::di::objects::FunctionalGroupType,
     >,
     /// `Identification` (Optional).
-    pub identification: Option<super::super::di::objects::FunctionalGroupType>,
+    pub identification: Option<Box<super::super::di::objects::FunctionalGroupType>>,
     /// `Lock` (Optional).
-    pub lock: Option<super::super::di::objects::LockingServicesType>,
+    pub lock: Option<Box<super::super::di::objects::LockingServicesType>>,
     /// `Manufacturer` (Optional).
     pub manufacturer: Option<t::Variable<ua::LocalizedText>>,
     /// `ManufacturerUri` (Optional).

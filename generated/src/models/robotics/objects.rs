@@ -389,11 +389,11 @@ pub struct ControllerType_SystemOperation_SystemOperationStateMachine {
     /// `Stop` (Optional).
     pub stop: Option<t::Method<(i64,), (i32,)>>,
     /// `ExecutingSubstateMachine` (Optional).
-    pub executing_substate_machine: Option<ExecutingSubstateMachineType>,
+    pub executing_substate_machine: Option<Box<ExecutingSubstateMachineType>>,
     /// `GetReady` (Optional).
     pub get_ready: Option<t::Method<(), (i32,)>>,
     /// `IdleSubstateMachine` (Optional).
-    pub idle_substate_machine: Option<IdleSubstateMachineType>,
+    pub idle_substate_machine: Option<Box<IdleSubstateMachineType>>,
     /// `StandDown` (Optional).
     pub stand_down: Option<t::Method<(), (i32,)>>,
 }
@@ -1886,7 +1886,7 @@ pub struct TaskControlType_TaskControlOperation_TaskControlStateMachine {
     /// `LoadByNodeId` (Optional).
     pub load_by_node_id: Option<t::Method<(ua::ExpandedNodeId,), (i32,)>>,
     /// `ReadySubstateMachine` (Optional).
-    pub ready_substate_machine: Option<ReadySubstateMachineType>,
+    pub ready_substate_machine: Option<Box<ReadySubstateMachineType>>,
     /// `UnloadByName` (Optional).
     pub unload_by_name: Option<t::Method<(String,), (i32,)>>,
     /// `UnloadByNodeId` (Optional).

@@ -275,6 +275,16 @@ impl<T: UaValue> Variable<T> {
     }
 }
 
+/// A handle behind a `Box`: generated handles hold the handles of members typed by other ObjectTypes boxed,
+/// because such a member may be of its owner's own type (PROFINET's `EthernetPortType` has an
+/// `<EthernetPort>` of type `EthernetPortType`), or of a subtype of a type that contains it, which by value
+/// would be a struct of infinite size. Field access and method calls reach through the `Box` as before.
+impl<H: Handle> Handle for Box<H> {
+    fn bind(binder: &Binder<'_>, node: &NodeId) -> Result<Self, BindError> {
+        H::bind(binder, node).map(Box::new)
+    }
+}
+
 impl<T: UaValue> Handle for Variable<T> {
     fn bind(binder: &Binder<'_>, node: &NodeId) -> Result<Self, BindError> {
         let value_rank = binder.variable_rank(node)?;

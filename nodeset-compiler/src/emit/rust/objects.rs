@@ -2,7 +2,8 @@
 //!
 //! For every ObjectType a struct whose fields are typed handles of its members (`Variable<T>` with `T` from
 //! the DataType and ValueRank, `Method<(inputs), (outputs)>` from the Argument definitions, nested structs
-//! for object members whose declaration adds children, `Option<_>` for Optional members, `Placeholders<_>`
+//! for object members whose declaration adds children, `Box<_>` around the handle of a member typed by another
+//! ObjectType, `Option<_>` for Optional members, `Placeholders<_>`
 //! for `<Placeholder>` members); the members of the nearest supertype that has a handle of its own are in
 //! its `base` field, reached through `Deref`, so a subtype's handle reaches what it inherits. Supertypes
 //! without a handle (ns0's) have their members folded into the first generated subtype.
@@ -256,6 +257,7 @@ impl Gen<'_> {
             let Some(rule) = self.rule(m) else { continue };
             let k = Literal::usize_unsuffixed(self.ns_index(uris, n.browse_name.ns));
             let bname = lit(&n.browse_name.name);
+            let mut boxed = false;
             let handle = match n.class {
                 NodeClass::Variable => {
                     let vt = self.value_type(n.attrs.data_type, n.attrs.value_rank.unwrap_or(-1));
@@ -270,15 +272,22 @@ impl Gen<'_> {
                     let s = ident(&sname);
                     quote! { #s }
                 }
-                NodeClass::Object => n
-                    .type_definition
-                    .and_then(|t| self.handle_path(t, names))
-                    .unwrap_or_else(|| quote! { t::ObjectNode }),
+                // Another type's handle is boxed: the member may be of the owner's type or of a subtype of a
+                // type that contains the owner, and by value that struct would have no finite size.
+                NodeClass::Object => match n.type_definition.and_then(|t| self.handle_path(t, names)) {
+                    Some(h) => {
+                        boxed = true;
+                        h
+                    }
+                    None => quote! { t::ObjectNode },
+                },
                 _ => continue,
             };
+            // Placeholders are kept in a map, on the heap already.
+            let single = if boxed { quote! { Box<#handle> } } else { handle.clone() };
             let (ty, bind) = match rule {
-                ModellingRule::Mandatory => (handle, quote! { b.child(id, NS[#k], #bname)? }),
-                ModellingRule::Optional => (quote! { Option<#handle> }, quote! { b.optional(id, NS[#k], #bname)? }),
+                ModellingRule::Mandatory => (single, quote! { b.child(id, NS[#k], #bname)? }),
+                ModellingRule::Optional => (quote! { Option<#single> }, quote! { b.optional(id, NS[#k], #bname)? }),
                 _ => {
                     let Some(td) = n.type_definition else { continue };
                     let tid = self.ns_node_id(uris, td);
