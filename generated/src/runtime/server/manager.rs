@@ -5,7 +5,7 @@ use std::future::Future;
 use std::sync::Arc;
 
 use async_trait::async_trait;
-use opcua::nodes::{DefaultTypeTree, NodeType};
+use opcua::nodes::{DefaultTypeTree, Event, EventNotifier, NodeType};
 use opcua::server::address_space::{validate_node_write, write_node_value, AccessLevel, AddressSpace};
 use opcua::server::diagnostics::NamespaceMetadata;
 use opcua::server::node_manager::memory::{
@@ -618,6 +618,25 @@ impl ModelManager {
             }
         }
         Ok(root)
+    }
+
+    /// Reports an event to the clients that monitor any of `notifiers` for events (the event's source, the
+    /// Server object, ...). async-opcua evaluates each monitored item's EventFilter against the event.
+    pub fn notify_event(&self, event: &dyn Event, notifiers: &[NodeId]) {
+        self.nodes().subscriptions.notify_events(notifiers.iter().map(|n| (event, n)));
+    }
+
+    /// Sets the EventNotifier attribute of an object (`SUBSCRIBE_TO_EVENTS` lets clients monitor it for
+    /// events). `BadNodeIdUnknown` if there is no such node, `BadAttributeIdInvalid` if it is not an object.
+    pub fn set_event_notifier(&self, node: &NodeId, notifier: EventNotifier) -> Result<(), StatusCode> {
+        match self.node_manager.address_space().write().find_mut(node) {
+            Some(NodeType::Object(object)) => {
+                object.set_event_notifier(notifier);
+                Ok(())
+            }
+            Some(_) => Err(StatusCode::BadAttributeIdInvalid),
+            None => Err(StatusCode::BadNodeIdUnknown),
+        }
     }
 
     /// Sets a variable's whole DataValue (value, status, timestamps) unchecked, and reports it to
