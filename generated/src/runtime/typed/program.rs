@@ -221,6 +221,8 @@ pub enum ProgramError {
     MissingState(&'static str),
     /// The table has no states at all, or none to start in.
     NoInitialState,
+    /// The table has no state with this BrowseName.
+    UnknownState(String),
     /// A namespace of the table is not registered in the server.
     UnknownNamespace(&'static str),
 }
@@ -231,6 +233,7 @@ impl std::fmt::Display for ProgramError {
             ProgramError::Bind(e) => write!(f, "{e}"),
             ProgramError::MissingState(s) => write!(f, "the state machine has no state `{s}`, which a program needs"),
             ProgramError::NoInitialState => write!(f, "the state machine has no initial state"),
+            ProgramError::UnknownState(s) => write!(f, "the state machine has no state `{s}`"),
             ProgramError::UnknownNamespace(uri) => write!(f, "the server has no namespace `{uri}`"),
         }
     }
@@ -889,9 +892,19 @@ impl Machine {
     /// Serves the state machine instance `machine` is bound to, starting in the table's initial state
     /// (`NoInitialState` if it has none).
     pub fn serve<M: StateMachine>(machine: &M) -> Result<Machine, ProgramError> {
-        let table = &M::TABLE;
-        let initial = table.states.iter().position(|s| s.initial).ok_or(ProgramError::NoInitialState)?;
-        let core = Core::new(table, machine.state_machine_node())?;
+        let initial = M::TABLE.states.iter().position(|s| s.initial).ok_or(ProgramError::NoInitialState)?;
+        Machine::serve_table(&M::TABLE, machine.state_machine_node(), initial)
+    }
+
+    /// Serves the state machine instance `machine` is bound to, starting in the state with BrowseName
+    /// `state` (for machines whose nodeset marks no initial state).
+    pub fn serve_from<M: StateMachine>(machine: &M, state: &str) -> Result<Machine, ProgramError> {
+        let initial = M::TABLE.state(state).ok_or_else(|| ProgramError::UnknownState(state.to_owned()))?;
+        Machine::serve_table(&M::TABLE, machine.state_machine_node(), initial)
+    }
+
+    fn serve_table(table: &'static StateTable, instance: &ObjectNode, initial: usize) -> Result<Machine, ProgramError> {
+        let core = Core::new(table, instance)?;
         core.show_state(initial);
         let inner = Arc::new(MachineInner { core, current: Mutex::new(initial) });
         let out = Machine { inner };
