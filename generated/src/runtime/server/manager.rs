@@ -578,8 +578,11 @@ impl ModelManager {
 
     /// Runs `f` with a [`Binder`] (one read lock for a whole tree of handles).
     pub fn bind_with<H>(&self, f: impl FnOnce(&Binder<'_>) -> Result<H, BindError>) -> Result<H, BindError> {
-        let space = self.node_manager.address_space().read();
+        // The type tree first, then the address space: async-opcua initialises node managers holding the
+        // type tree and then taking the address space, so the other order deadlocks a bind that runs while a
+        // server on another thread starts.
         let tree = self.nodes().type_tree.read();
+        let space = self.node_manager.address_space().read();
         f(&Binder::new(self, &space, &tree))
     }
 
@@ -594,9 +597,10 @@ impl ModelManager {
     ) -> Result<NodeId, InstantiateError> {
         let core = self.nodes().node_managers.get_of_type::<CoreNodeManager>();
         let planned = {
+            // The type tree first (see `bind_with`).
+            let tree = self.nodes().type_tree.read();
             let core_space = core.as_ref().map(|c| c.address_space().read());
             let space = self.node_manager.address_space().read();
-            let tree = self.nodes().type_tree.read();
             let spaces = Spaces { core: core_space.as_deref(), model: &space, tree: &tree };
             let id = options.node_id_or(self.instance_namespace(), browse_name.name.as_ref());
             let mut planner = Planner { spaces, options, used: Default::default(), out: Vec::new() };

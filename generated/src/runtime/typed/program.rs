@@ -577,6 +577,18 @@ impl Control {
         *self.rx.borrow()
     }
 
+    /// A receiver that sees every state the program enters.
+    pub fn watch(&self) -> watch::Receiver<ProgramState> {
+        self.rx.clone()
+    }
+
+    /// Suspends the program from its own body (a composite skill whose basic skill paused or cannot be
+    /// reached): the transition a Suspend call takes; `BadInvalidState` if there is none from the current
+    /// state. The body parks at its next checkpoint until a client resumes the program.
+    pub fn suspend(&self) -> Result<(), StatusCode> {
+        self.program.call("Suspend")
+    }
+
     /// Whether a Suspend waits for the body's next checkpoint.
     pub fn suspend_requested(&self) -> bool {
         self.state() == ProgramState::Suspended
