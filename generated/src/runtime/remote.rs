@@ -28,6 +28,9 @@
 //!   halted;
 //! - the server of the basic skill cannot be reached when the run starts (a transport error, not a status
 //!   of the skill): the composite suspends itself and tries again when a client resumes it.
+//!
+//! Not handled yet: a server that goes away while its skill runs. The run then waits for events that do not
+//! come, and the composite stays Running until a client halts it.
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
