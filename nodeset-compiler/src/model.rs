@@ -28,6 +28,7 @@ pub mod ids {
     pub const HAS_CHILD: u32 = 34;
     pub const ORGANIZES: u32 = 35;
     pub const HAS_MODELLING_RULE: u32 = 37;
+    pub const GENERATES_EVENT: u32 = 41;
     pub const HAS_ENCODING: u32 = 38;
     pub const HAS_TYPE_DEFINITION: u32 = 40;
     pub const AGGREGATES: u32 = 44;
@@ -67,6 +68,7 @@ pub mod ids {
     pub const INITIAL_STATE_TYPE: u32 = 2309;
     pub const TRANSITION_TYPE: u32 = 2310;
     pub const PROGRAM_STATE_MACHINE_TYPE: u32 = 2391;
+    pub const TRANSITION_EVENT_TYPE: u32 = 2311;
 
     pub const MANDATORY: u32 = 78;
     pub const OPTIONAL: u32 = 80;
@@ -316,6 +318,11 @@ pub struct Transition {
 pub struct StateMachineInfo {
     pub states: Vec<State>,
     pub transitions: Vec<Transition>,
+    /// The concrete event type a transition raises: the first TransitionEventType subtype the machine
+    /// type (or a supertype, nearest first) names with GeneratesEvent; else the effect its transitions
+    /// name (HasEffect), or that effect's nearest concrete supertype when it is abstract (ns0 1.05 makes
+    /// ProgramTransitionEventType abstract); `None` if the model has no TransitionEventType.
+    pub event_type: Option<NodeIx>,
 }
 
 /// How a loaded file maps its local namespace indices and aliases (needed to decode its values).

@@ -932,10 +932,41 @@ fn state_machines(model: &mut Model, diags: &mut Diagnostics) {
             }
         }
         if !info.states.is_empty() || !info.transitions.is_empty() {
+            info.event_type = transition_event_type(model, t, &info);
             out.insert(t, info);
         }
     }
     model.state_machines = out;
+}
+
+/// The event type a transition of state machine type `t` raises (see [`StateMachineInfo::event_type`]).
+fn transition_event_type(model: &Model, t: NodeIx, info: &StateMachineInfo) -> Option<NodeIx> {
+    let base = model.ns0(ids::TRANSITION_EVENT_TYPE)?;
+    let generates = model.ns0(ids::GENERATES_EVENT);
+    let concrete = |e: NodeIx| model.is_subtype_of(e, base) && !model.node(e).is_abstract();
+    for s in model.super_chain(t) {
+        let mut named: Vec<NodeIx> = model
+            .node(s)
+            .references
+            .iter()
+            .filter(|r| r.forward && Some(r.reference_type) == generates && concrete(r.target))
+            .map(|r| r.target)
+            .collect();
+        named.sort_by(|a, b| model.node(*a).id.cmp(&model.node(*b).id));
+        if let Some(&e) = named.first() {
+            return Some(e);
+        }
+    }
+    // The effects the transitions name; of several, the one most transitions name, then the lowest NodeId.
+    let mut effects: BTreeMap<NodeIx, usize> = BTreeMap::new();
+    for tr in &info.transitions {
+        for &e in tr.effects.iter().filter(|&&e| model.is_subtype_of(e, base)) {
+            *effects.entry(e).or_default() += 1;
+        }
+    }
+    let effect = effects.iter().max_by(|a, b| a.1.cmp(b.1).then(model.node(*b.0).id.cmp(&model.node(*a.0).id))).map(|(&e, _)| e);
+    let chain = effect.map(|e| model.super_chain(e)).unwrap_or_default();
+    Some(chain.into_iter().find(|&e| concrete(e)).unwrap_or(base))
 }
 
 /// Whether a value of built-in type `have` may stand for DataType `dt`.

@@ -203,6 +203,9 @@ pub fn dump(model: &Model) -> String {
                     t.causes.iter().map(|c| model.node(*c).browse_name.name.clone()).collect::<Vec<_>>().join("|")
                 );
             }
+            if let Some(e) = sm.event_type {
+                let _ = writeln!(s, "    transition event {}", model.node(e).browse_name.name);
+            }
         }
         if let Some(members) = model.members.get(&ix) {
             for m in members {

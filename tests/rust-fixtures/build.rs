@@ -1,4 +1,5 @@
-//! Generates every one-feature fixture of tests/fixtures through the build.rs API (bad inputs excepted).
+//! Generates every one-feature fixture of tests/fixtures through the build.rs API (bad inputs excepted), and
+//! the two public skill reference models of ../shared/nodesets/skills-reference.
 
 fn main() {
     let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures");
@@ -17,6 +18,26 @@ fn main() {
         for f in files.into_iter().filter(|f| f.extension().is_some_and(|x| x == "xml")) {
             builder = builder.file(f);
         }
+    }
+    builder.generate().unwrap_or_else(|e| panic!("{e}"));
+
+    // The two public skill reference models (../shared/nodesets/skills-reference), on DI from nodeset-models.
+    let reference = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/nodesets/skills-reference");
+    let mut files: Vec<_> = std::fs::read_dir(&reference)
+        .unwrap_or_else(|e| panic!("{} is needed beside the repository: {e}", reference.display()))
+        .flatten()
+        .map(|e| e.path())
+        .filter(|f| f.extension().is_some_and(|x| x == "xml"))
+        .collect();
+    files.sort();
+    assert_eq!(files.len(), 2, "the two skill reference models are expected in {}", reference.display());
+    let mut builder = nodeset_compiler::build::Builder::new()
+        .models_dir(&vendor)
+        .models_dir(&reference)
+        .extern_namespace("http://opcfoundation.org/UA/DI/", "nodeset_models::models::di")
+        .out_file("skills_reference.rs");
+    for f in files {
+        builder = builder.file(f);
     }
     builder.generate().unwrap_or_else(|e| panic!("{e}"));
 }

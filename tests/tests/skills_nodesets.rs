@@ -119,6 +119,9 @@ fn skills_are_programs_with_the_methods_they_promise() {
     assert_eq!(states, ["Halted", "Ready", "Running", "Suspended"]);
     assert!(sm.states.iter().all(|s| m.node(s.node).id.ns == 0), "the states are ns0's");
     assert_eq!(sm.transitions.len(), 9);
+    // A transition raises the event ProgramSkillStateMachineType names with GeneratesEvent (ns0 names the
+    // abstract ProgramTransitionEventType as the transitions' effect).
+    assert_eq!(sm.event_type, Some(find(m, CS, "SkillTransitionEventType")));
     for tr in &sm.transitions {
         for &cause in &tr.causes {
             let name = &m.node(cause).browse_name.name;

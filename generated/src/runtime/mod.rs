@@ -1,10 +1,11 @@
 //! The hand-written runtime the generated namespaces need: static tables ([`table`]), NodeIds that carry
 //! their namespace URI ([`NsNodeId`]), the mapping of table-local namespace indices to the server's, the
-//! import of a table into an async-opcua address space ([`import`]) and a server that serves tables
-//! ([`server`]).
+//! import of a table into an async-opcua address space ([`import`]), a server that serves tables
+//! ([`server`]), and the client side of composite skills ([`remote`]).
 
 pub mod demo;
 pub mod import;
+pub mod remote;
 pub mod server;
 pub mod table;
 pub mod typed;

@@ -2,3 +2,8 @@
 #![deny(warnings)]
 
 include!(concat!(env!("OUT_DIR"), "/nodesets.rs"));
+
+/// The skill reference models of ../shared/nodesets/skills-reference (`skills`, `linear_axis_with_gripper`).
+pub mod skills_reference {
+    include!(concat!(env!("OUT_DIR"), "/skills_reference.rs"));
+}

@@ -66,6 +66,33 @@ t::object_type!(
     AbsoluteCartesianLinearMoveSkillType, rt::NsNodeId::numeric(NS[0], 1800),
     "AbsoluteCartesianLinearMoveSkillType"
 );
+/// The state machine of `AbsoluteCartesianLinearMoveSkillType`: states Halted (11), Ready (12), Running (13), Suspended (14); 9 transitions.
+impl t::StateMachine for AbsoluteCartesianLinearMoveSkillType {
+    const TABLE: t::StateTable = <MoveSkillType as t::StateMachine>::TABLE;
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
+t::program_type!(
+    AbsoluteCartesianLinearMoveSkillType, AbsoluteCartesianLinearMoveSkillTypeInputs,
+    ProgramSkillStateMachineTypeOutputs
+);
+/// Inputs of the program `AbsoluteCartesianLinearMoveSkillType`: the variables of its `InputParameterSet`, read from the instance when Start is called.
+///
+/// The inputs of the absolute motion: TargetPose, Speed and Acceleration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AbsoluteCartesianLinearMoveSkillTypeInputs {
+    /// `Speed` (Mandatory). Maximum speed of the tool centre point along the path, in millimetres per second.
+    pub speed: f64,
+    /// `Acceleration` (Mandatory). Maximum acceleration of the tool centre point along the path, in millimetres per second squared.
+    pub acceleration: f64,
+    /// `TargetPose` (Mandatory). Pose the tool centre point moves to, in the base frame of the robot; millimetres and degrees.
+    pub target_pose: ua::ThreeDFrame,
+}
+t::parameters!(
+    AbsoluteCartesianLinearMoveSkillTypeInputs; set : 0 "InputParameterSet"; fields :
+    [speed : 0 "Speed", acceleration : 0 "Acceleration", target_pose : 0 "TargetPose"]
+);
 /// Handle of an instance of `AbsoluteJointPTPMoveSkillType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1600).
 ///
 /// Point-to-point motion in joint space: every joint moves to its target angle, all joints start and stop together; the path of the tool between is not a straight line.
@@ -116,6 +143,34 @@ t::object_type!(
     AbsoluteJointPtpMoveSkillType, rt::NsNodeId::numeric(NS[0], 1600),
     "AbsoluteJointPTPMoveSkillType"
 );
+/// The state machine of `AbsoluteJointPTPMoveSkillType`: states Halted (11), Ready (12), Running (13), Suspended (14); 9 transitions.
+impl t::StateMachine for AbsoluteJointPtpMoveSkillType {
+    const TABLE: t::StateTable = <MoveSkillType as t::StateMachine>::TABLE;
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
+t::program_type!(
+    AbsoluteJointPtpMoveSkillType, AbsoluteJointPtpMoveSkillTypeInputs,
+    ProgramSkillStateMachineTypeOutputs
+);
+/// Inputs of the program `AbsoluteJointPTPMoveSkillType`: the variables of its `InputParameterSet`, read from the instance when Start is called.
+///
+/// The inputs of the joint motion: TargetJointPositions, Speed and Acceleration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct AbsoluteJointPtpMoveSkillTypeInputs {
+    /// `Speed` (Mandatory). Maximum joint speed of the leading joint, in degrees per second.
+    pub speed: f64,
+    /// `Acceleration` (Mandatory). Maximum joint acceleration of the leading joint, in degrees per second squared.
+    pub acceleration: f64,
+    /// `TargetJointPositions` (Mandatory). Target angle of every joint, in degrees, in the order of the joints from the base to the flange. The array has one element per joint of the robot.
+    pub target_joint_positions: Vec<f64>,
+}
+t::parameters!(
+    AbsoluteJointPtpMoveSkillTypeInputs; set : 0 "InputParameterSet"; fields : [speed : 0
+    "Speed", acceleration : 0 "Acceleration", target_joint_positions : 0
+    "TargetJointPositions"]
+);
 /// Handle of an instance of `CompositeSkillType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1400).
 ///
 /// A skill that runs other skills one after another, possibly of other devices and servers (for example move, drill, move). If a skill it uses is unavailable it suspends, if one halts it halts, so the state of the innermost skill reaches the outermost; Suspend and Resume are therefore Mandatory.
@@ -144,6 +199,17 @@ impl t::Handle for CompositeSkillType {
 t::deref_base!(CompositeSkillType => ProgramSkillStateMachineType);
 t::object_type!(
     CompositeSkillType, rt::NsNodeId::numeric(NS[0], 1400), "CompositeSkillType"
+);
+/// The state machine of `CompositeSkillType`: states Halted (11), Ready (12), Running (13), Suspended (14); 9 transitions.
+impl t::StateMachine for CompositeSkillType {
+    const TABLE: t::StateTable = <ProgramSkillStateMachineType as t::StateMachine>::TABLE;
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
+t::program_type!(
+    CompositeSkillType, ProgramSkillStateMachineTypeInputs,
+    ProgramSkillStateMachineTypeOutputs
 );
 /// Handle of an instance of `GrippingSkillType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1900).
 ///
@@ -190,6 +256,30 @@ impl t::Handle for GrippingSkillType_InputParameterSet {
 }
 t::object_type!(
     GrippingSkillType, rt::NsNodeId::numeric(NS[0], 1900), "GrippingSkillType"
+);
+/// The state machine of `GrippingSkillType`: states Halted (11), Ready (12), Running (13), Suspended (14); 9 transitions.
+impl t::StateMachine for GrippingSkillType {
+    const TABLE: t::StateTable = <ProgramSkillStateMachineType as t::StateMachine>::TABLE;
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
+t::program_type!(
+    GrippingSkillType, GrippingSkillTypeInputs, ProgramSkillStateMachineTypeOutputs
+);
+/// Inputs of the program `GrippingSkillType`: the variables of its `InputParameterSet`, read from the instance when Start is called.
+///
+/// The inputs of the gripping: Action and GripForce.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GrippingSkillTypeInputs {
+    /// `Action` (Mandatory). Whether the run opens or closes the gripper.
+    pub action: super::types::GripperActionEnumeration,
+    /// `GripForce` (Mandatory). Force the jaws hold the part with when closing, in newtons; ignored when opening.
+    pub grip_force: f64,
+}
+t::parameters!(
+    GrippingSkillTypeInputs; set : 0 "InputParameterSet"; fields : [action : 0 "Action",
+    grip_force : 0 "GripForce"]
 );
 /// Handle of an instance of `ISkillSetType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1200).
 ///
@@ -255,6 +345,30 @@ impl t::Handle for MoveSkillType_InputParameterSet {
     }
 }
 t::object_type!(MoveSkillType, rt::NsNodeId::numeric(NS[0], 1500), "MoveSkillType");
+/// The state machine of `MoveSkillType`: states Halted (11), Ready (12), Running (13), Suspended (14); 9 transitions.
+impl t::StateMachine for MoveSkillType {
+    const TABLE: t::StateTable = <ProgramSkillStateMachineType as t::StateMachine>::TABLE;
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
+t::program_type!(
+    MoveSkillType, MoveSkillTypeInputs, ProgramSkillStateMachineTypeOutputs
+);
+/// Inputs of the program `MoveSkillType`: the variables of its `InputParameterSet`, read from the instance when Start is called.
+///
+/// The inputs of the motion: Speed and Acceleration, and the target the concrete move skill adds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MoveSkillTypeInputs {
+    /// `Speed` (Mandatory). Maximum speed of the motion, in the unit its EngineeringUnits name.
+    pub speed: f64,
+    /// `Acceleration` (Mandatory). Maximum acceleration of the motion, in the unit its EngineeringUnits name.
+    pub acceleration: f64,
+}
+t::parameters!(
+    MoveSkillTypeInputs; set : 0 "InputParameterSet"; fields : [speed : 0 "Speed",
+    acceleration : 0 "Acceleration"]
+);
 /// Handle of an instance of `ProgramSkillStateMachineType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1300).
 ///
 /// A skill: a capability of a device or cell that a client parameterises and runs. It is an OPC UA Program (ProgramStateMachineType) and keeps its states Ready, Running, Suspended and Halted, its transitions and their causes: a client writes the variables of InputParameterSet, calls Start, and the skill runs until it is back in Ready (success, results in OutputParameterSet) or in Halted (failure or Halt, Reset to go on). Start, Halt and Reset are Mandatory; Suspend and Resume are Optional and made Mandatory by subtypes that can pause. Every transition raises a SkillTransitionEventType.
@@ -340,6 +454,149 @@ t::object_type!(
     ProgramSkillStateMachineType, rt::NsNodeId::numeric(NS[0], 1300),
     "ProgramSkillStateMachineType"
 );
+/// The state machine of `ProgramSkillStateMachineType`: states Halted (11), Ready (12), Running (13), Suspended (14); 9 transitions.
+impl t::StateMachine for ProgramSkillStateMachineType {
+    const TABLE: t::StateTable = t::StateTable {
+        states: &[
+            t::StateRow {
+                name: "Halted",
+                display_name: "Halted",
+                number: Some(11),
+                node: rt::NsNodeId::numeric(NS[1], 2406),
+                initial: false,
+            },
+            t::StateRow {
+                name: "Ready",
+                display_name: "Ready",
+                number: Some(12),
+                node: rt::NsNodeId::numeric(NS[1], 2400),
+                initial: false,
+            },
+            t::StateRow {
+                name: "Running",
+                display_name: "Running",
+                number: Some(13),
+                node: rt::NsNodeId::numeric(NS[1], 2402),
+                initial: false,
+            },
+            t::StateRow {
+                name: "Suspended",
+                display_name: "Suspended",
+                number: Some(14),
+                node: rt::NsNodeId::numeric(NS[1], 2404),
+                initial: false,
+            },
+        ],
+        transitions: &[
+            t::TransitionRow {
+                name: "HaltedToReady",
+                display_name: "HaltedToReady",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[1], 2408),
+                from: 0,
+                to: 1,
+                causes: &[(NS[1], "Reset")],
+            },
+            t::TransitionRow {
+                name: "ReadyToRunning",
+                display_name: "ReadyToRunning",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[1], 2410),
+                from: 1,
+                to: 2,
+                causes: &[(NS[1], "Start")],
+            },
+            t::TransitionRow {
+                name: "RunningToHalted",
+                display_name: "RunningToHalted",
+                number: Some(3),
+                node: rt::NsNodeId::numeric(NS[1], 2412),
+                from: 2,
+                to: 0,
+                causes: &[(NS[1], "Halt")],
+            },
+            t::TransitionRow {
+                name: "RunningToReady",
+                display_name: "RunningToReady",
+                number: Some(4),
+                node: rt::NsNodeId::numeric(NS[1], 2414),
+                from: 2,
+                to: 1,
+                causes: &[],
+            },
+            t::TransitionRow {
+                name: "RunningToSuspended",
+                display_name: "RunningToSuspended",
+                number: Some(5),
+                node: rt::NsNodeId::numeric(NS[1], 2416),
+                from: 2,
+                to: 3,
+                causes: &[(NS[1], "Suspend")],
+            },
+            t::TransitionRow {
+                name: "SuspendedToRunning",
+                display_name: "SuspendedToRunning",
+                number: Some(6),
+                node: rt::NsNodeId::numeric(NS[1], 2418),
+                from: 3,
+                to: 2,
+                causes: &[(NS[1], "Resume")],
+            },
+            t::TransitionRow {
+                name: "SuspendedToHalted",
+                display_name: "SuspendedToHalted",
+                number: Some(7),
+                node: rt::NsNodeId::numeric(NS[1], 2420),
+                from: 3,
+                to: 0,
+                causes: &[(NS[1], "Halt"), (NS[1], "Reset")],
+            },
+            t::TransitionRow {
+                name: "SuspendedToReady",
+                display_name: "SuspendedToReady",
+                number: Some(8),
+                node: rt::NsNodeId::numeric(NS[1], 2422),
+                from: 3,
+                to: 1,
+                causes: &[(NS[1], "Reset")],
+            },
+            t::TransitionRow {
+                name: "ReadyToHalted",
+                display_name: "ReadyToHalted",
+                number: Some(9),
+                node: rt::NsNodeId::numeric(NS[1], 2424),
+                from: 1,
+                to: 0,
+                causes: &[(NS[1], "Halt")],
+            },
+        ],
+        event_type: Some(rt::NsNodeId::numeric(NS[0], 1100)),
+    };
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
+t::program_type!(
+    ProgramSkillStateMachineType, ProgramSkillStateMachineTypeInputs,
+    ProgramSkillStateMachineTypeOutputs
+);
+/// Inputs of the program `ProgramSkillStateMachineType`: the variables of its `InputParameterSet`, read from the instance when Start is called.
+///
+/// The inputs of the skill: one writable variable per parameter, declared Mandatory by each skill type. Written before Start; read by the skill when it starts.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProgramSkillStateMachineTypeInputs {}
+t::parameters!(
+    ProgramSkillStateMachineTypeInputs; set : 0 "InputParameterSet"; fields : []
+);
+/// Outputs of the program `ProgramSkillStateMachineType`: the variables of its `OutputParameterSet`, written to the instance when a run ends in Ready.
+///
+/// The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProgramSkillStateMachineTypeOutputs {}
+t::parameters!(
+    ProgramSkillStateMachineTypeOutputs; set : 0 "OutputParameterSet"; outcome : 0
+    "Result"; fields : []
+);
 /// Handle of an instance of `RelativeCartesianLinearMoveSkillType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1700).
 ///
 /// Linear Cartesian motion relative to where the tool is: the tool centre point moves on a straight line by PoseOffset, expressed in the tool frame (the frame of the tool centre point when the motion starts). Used for short approach and retreat motions, such as moving a drill nose into a drill bush along tool Z.
@@ -389,6 +646,33 @@ impl t::Handle for RelativeCartesianLinearMoveSkillType_InputParameterSet {
 t::object_type!(
     RelativeCartesianLinearMoveSkillType, rt::NsNodeId::numeric(NS[0], 1700),
     "RelativeCartesianLinearMoveSkillType"
+);
+/// The state machine of `RelativeCartesianLinearMoveSkillType`: states Halted (11), Ready (12), Running (13), Suspended (14); 9 transitions.
+impl t::StateMachine for RelativeCartesianLinearMoveSkillType {
+    const TABLE: t::StateTable = <MoveSkillType as t::StateMachine>::TABLE;
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
+t::program_type!(
+    RelativeCartesianLinearMoveSkillType, RelativeCartesianLinearMoveSkillTypeInputs,
+    ProgramSkillStateMachineTypeOutputs
+);
+/// Inputs of the program `RelativeCartesianLinearMoveSkillType`: the variables of its `InputParameterSet`, read from the instance when Start is called.
+///
+/// The inputs of the relative motion: PoseOffset, Speed and Acceleration.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RelativeCartesianLinearMoveSkillTypeInputs {
+    /// `Speed` (Mandatory). Maximum speed of the tool centre point along the path, in millimetres per second.
+    pub speed: f64,
+    /// `Acceleration` (Mandatory). Maximum acceleration of the tool centre point along the path, in millimetres per second squared.
+    pub acceleration: f64,
+    /// `PoseOffset` (Mandatory). Displacement and rotation of the tool centre point, in the tool frame at the start of the motion; millimetres and degrees.
+    pub pose_offset: ua::ThreeDFrame,
+}
+t::parameters!(
+    RelativeCartesianLinearMoveSkillTypeInputs; set : 0 "InputParameterSet"; fields :
+    [speed : 0 "Speed", acceleration : 0 "Acceleration", pose_offset : 0 "PoseOffset"]
 );
 /// Handle of an instance of `SkillTransitionEventType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1100).
 ///

@@ -315,6 +315,51 @@ t::object_type!(
     ConfirmationStateMachineType, rt::NsNodeId::numeric(NS[0], 307),
     "ConfirmationStateMachineType"
 );
+/// The state machine of `ConfirmationStateMachineType`: states NotWaitingForConfirm (1), WaitingForConfirm (2); 2 transitions.
+impl t::StateMachine for ConfirmationStateMachineType {
+    const TABLE: t::StateTable = t::StateTable {
+        states: &[
+            t::StateRow {
+                name: "NotWaitingForConfirm",
+                display_name: "NotWaitingForConfirm",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 323),
+                initial: true,
+            },
+            t::StateRow {
+                name: "WaitingForConfirm",
+                display_name: "WaitingForConfirm",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[0], 325),
+                initial: false,
+            },
+        ],
+        transitions: &[
+            t::TransitionRow {
+                name: "NotWaitingForConfirmToWaitingForConfirm",
+                display_name: "NotWaitingForConfirmToWaitingForConfirm",
+                number: Some(12),
+                node: rt::NsNodeId::numeric(NS[0], 327),
+                from: 0,
+                to: 1,
+                causes: &[],
+            },
+            t::TransitionRow {
+                name: "WaitingForConfirmToNotWaitingForConfirm",
+                display_name: "WaitingForConfirmToNotWaitingForConfirm",
+                number: Some(21),
+                node: rt::NsNodeId::numeric(NS[0], 329),
+                from: 1,
+                to: 0,
+                causes: &[(NS[0], "Confirm")],
+            },
+        ],
+        event_type: Some(rt::NsNodeId::numeric(NS[1], 2311)),
+    };
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
 /// Handle of an instance of `ConnectionPointType` (nsu=http://opcfoundation.org/UA/DI/;i=6308).
 #[derive(Clone, Debug)]
 #[allow(non_snake_case)]
@@ -1226,6 +1271,80 @@ t::object_type!(
     InstallationStateMachineType, rt::NsNodeId::numeric(NS[0], 249),
     "InstallationStateMachineType"
 );
+/// The state machine of `InstallationStateMachineType`: states Idle (1), Installing (2), Error (3); 4 transitions.
+impl t::StateMachine for InstallationStateMachineType {
+    const TABLE: t::StateTable = t::StateTable {
+        states: &[
+            t::StateRow {
+                name: "Idle",
+                display_name: "Idle",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 271),
+                initial: true,
+            },
+            t::StateRow {
+                name: "Installing",
+                display_name: "Installing",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[0], 273),
+                initial: false,
+            },
+            t::StateRow {
+                name: "Error",
+                display_name: "Error",
+                number: Some(3),
+                node: rt::NsNodeId::numeric(NS[0], 275),
+                initial: false,
+            },
+        ],
+        transitions: &[
+            t::TransitionRow {
+                name: "IdleToInstalling",
+                display_name: "IdleToInstalling",
+                number: Some(12),
+                node: rt::NsNodeId::numeric(NS[0], 277),
+                from: 0,
+                to: 1,
+                causes: &[
+                    (NS[0], "InstallFiles"),
+                    (NS[0], "InstallSoftwarePackage"),
+                    (NS[0], "Uninstall"),
+                ],
+            },
+            t::TransitionRow {
+                name: "InstallingToIdle",
+                display_name: "InstallingToIdle",
+                number: Some(21),
+                node: rt::NsNodeId::numeric(NS[0], 279),
+                from: 1,
+                to: 0,
+                causes: &[],
+            },
+            t::TransitionRow {
+                name: "InstallingToError",
+                display_name: "InstallingToError",
+                number: Some(23),
+                node: rt::NsNodeId::numeric(NS[0], 281),
+                from: 1,
+                to: 2,
+                causes: &[],
+            },
+            t::TransitionRow {
+                name: "ErrorToIdle",
+                display_name: "ErrorToIdle",
+                number: Some(31),
+                node: rt::NsNodeId::numeric(NS[0], 283),
+                from: 2,
+                to: 0,
+                causes: &[(NS[0], "Resume")],
+            },
+        ],
+        event_type: Some(rt::NsNodeId::numeric(NS[1], 2311)),
+    };
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
 /// Handle of an instance of `LengthIndicationType` (nsu=http://opcfoundation.org/UA/DI/;i=477).
 ///
 /// Indicates the abraded length, for example of a drill.
@@ -1622,6 +1741,51 @@ t::object_type!(
     PowerCycleStateMachineType, rt::NsNodeId::numeric(NS[0], 285),
     "PowerCycleStateMachineType"
 );
+/// The state machine of `PowerCycleStateMachineType`: states NotWaitingForPowerCycle (1), WaitingForPowerCycle (2); 2 transitions.
+impl t::StateMachine for PowerCycleStateMachineType {
+    const TABLE: t::StateTable = t::StateTable {
+        states: &[
+            t::StateRow {
+                name: "NotWaitingForPowerCycle",
+                display_name: "NotWaitingForPowerCycle",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 299),
+                initial: true,
+            },
+            t::StateRow {
+                name: "WaitingForPowerCycle",
+                display_name: "WaitingForPowerCycle",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[0], 301),
+                initial: false,
+            },
+        ],
+        transitions: &[
+            t::TransitionRow {
+                name: "NotWaitingForPowerCycleToWaitingForPowerCycle",
+                display_name: "NotWaitingForPowerCycleToWaitingForPowerCycle",
+                number: Some(12),
+                node: rt::NsNodeId::numeric(NS[0], 303),
+                from: 0,
+                to: 1,
+                causes: &[],
+            },
+            t::TransitionRow {
+                name: "WaitingForPowerCycleToNotWaitingForPowerCycle",
+                display_name: "WaitingForPowerCycleToNotWaitingForPowerCycle",
+                number: Some(21),
+                node: rt::NsNodeId::numeric(NS[0], 305),
+                from: 1,
+                to: 0,
+                causes: &[],
+            },
+        ],
+        event_type: Some(rt::NsNodeId::numeric(NS[1], 2311)),
+    };
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
 /// Handle of an instance of `PrepareForUpdateStateMachineType` (nsu=http://opcfoundation.org/UA/DI/;i=213).
 #[derive(Clone, Debug)]
 #[allow(non_snake_case)]
@@ -1664,6 +1828,92 @@ t::object_type!(
     PrepareForUpdateStateMachineType, rt::NsNodeId::numeric(NS[0], 213),
     "PrepareForUpdateStateMachineType"
 );
+/// The state machine of `PrepareForUpdateStateMachineType`: states Idle (1), Preparing (2), PreparedForUpdate (3), Resuming (4); 5 transitions.
+impl t::StateMachine for PrepareForUpdateStateMachineType {
+    const TABLE: t::StateTable = t::StateTable {
+        states: &[
+            t::StateRow {
+                name: "Idle",
+                display_name: "Idle",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 231),
+                initial: true,
+            },
+            t::StateRow {
+                name: "Preparing",
+                display_name: "Preparing",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[0], 233),
+                initial: false,
+            },
+            t::StateRow {
+                name: "PreparedForUpdate",
+                display_name: "PreparedForUpdate",
+                number: Some(3),
+                node: rt::NsNodeId::numeric(NS[0], 235),
+                initial: false,
+            },
+            t::StateRow {
+                name: "Resuming",
+                display_name: "Resuming",
+                number: Some(4),
+                node: rt::NsNodeId::numeric(NS[0], 237),
+                initial: false,
+            },
+        ],
+        transitions: &[
+            t::TransitionRow {
+                name: "IdleToPreparing",
+                display_name: "IdleToPreparing",
+                number: Some(12),
+                node: rt::NsNodeId::numeric(NS[0], 239),
+                from: 0,
+                to: 1,
+                causes: &[(NS[0], "Prepare")],
+            },
+            t::TransitionRow {
+                name: "PreparingToIdle",
+                display_name: "PreparingToIdle",
+                number: Some(21),
+                node: rt::NsNodeId::numeric(NS[0], 241),
+                from: 1,
+                to: 0,
+                causes: &[(NS[0], "Abort")],
+            },
+            t::TransitionRow {
+                name: "PreparingToPreparedForUpdate",
+                display_name: "PreparingToPreparedForUpdate",
+                number: Some(23),
+                node: rt::NsNodeId::numeric(NS[0], 243),
+                from: 1,
+                to: 2,
+                causes: &[],
+            },
+            t::TransitionRow {
+                name: "PreparedForUpdateToResuming",
+                display_name: "PreparedForUpdateToResuming",
+                number: Some(34),
+                node: rt::NsNodeId::numeric(NS[0], 245),
+                from: 2,
+                to: 3,
+                causes: &[(NS[0], "Resume")],
+            },
+            t::TransitionRow {
+                name: "ResumingToIdle",
+                display_name: "ResumingToIdle",
+                number: Some(41),
+                node: rt::NsNodeId::numeric(NS[0], 247),
+                from: 3,
+                to: 0,
+                causes: &[(NS[0], "Abort")],
+            },
+        ],
+        event_type: Some(rt::NsNodeId::numeric(NS[1], 2311)),
+    };
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
 /// Handle of an instance of `ProtocolType` (nsu=http://opcfoundation.org/UA/DI/;i=1006).
 #[derive(Clone, Debug)]
 #[allow(non_snake_case)]

@@ -77,6 +77,40 @@ impl t::Handle for DrillHoleSkillType_InputParameterSet {
 t::object_type!(
     DrillHoleSkillType, rt::NsNodeId::numeric(NS[0], 2000), "DrillHoleSkillType"
 );
+/// The state machine of `DrillHoleSkillType`: states Halted (11), Ready (12), Running (13), Suspended (14); 9 transitions.
+impl t::StateMachine for DrillHoleSkillType {
+    const TABLE: t::StateTable = <super::super::common_skills::objects::CompositeSkillType as t::StateMachine>::TABLE;
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
+t::program_type!(
+    DrillHoleSkillType, DrillHoleSkillTypeInputs,
+    super::super::common_skills::objects::ProgramSkillStateMachineTypeOutputs
+);
+/// Inputs of the program `DrillHoleSkillType`: the variables of its `InputParameterSet`, read from the instance when Start is called.
+///
+/// The inputs: InsertionDistance and the drilling parameters passed to TemplateDrilling.
+#[derive(Clone, Debug, PartialEq)]
+pub struct DrillHoleSkillTypeInputs {
+    /// `InsertionDistance` (Mandatory). Distance the nose moves along tool Z into the drill bush before drilling and back out after, in millimetres.
+    pub insertion_distance: f64,
+    /// `HoleDiameter` (Mandatory). Nominal diameter of the hole, in millimetres; selects and checks the drill.
+    pub hole_diameter: f64,
+    /// `Depth` (Mandatory). Depth to drill, in millimetres, measured from the face of the drill bush.
+    pub depth: f64,
+    /// `FeedRate` (Mandatory). Feed of the drill along its axis, in millimetres per minute.
+    pub feed_rate: f64,
+    /// `SpindleSpeed` (Mandatory). Rotational speed of the spindle, in revolutions per minute.
+    pub spindle_speed: f64,
+    /// `ClampForce` (Mandatory). Force the nose clamps the stack against the template with, in newtons.
+    pub clamp_force: f64,
+}
+t::parameters!(
+    DrillHoleSkillTypeInputs; set : 1 "InputParameterSet"; fields : [insertion_distance :
+    0 "InsertionDistance", hole_diameter : 0 "HoleDiameter", depth : 0 "Depth", feed_rate
+    : 0 "FeedRate", spindle_speed : 0 "SpindleSpeed", clamp_force : 0 "ClampForce"]
+);
 /// Handle of an instance of `DrillingCellType` (nsu=http://nodeset-compiler.dev/DrillingProcess/;i=3000).
 ///
 /// A template drilling work cell: offers the process skills ReferenceDrillBush and DrillHole, which a process controller runs once per hole, using the skills of the robot system and its end effector.
@@ -315,6 +349,43 @@ impl t::Handle for ReferenceDrillBushSkillType_OutputParameterSet {
 t::object_type!(
     ReferenceDrillBushSkillType, rt::NsNodeId::numeric(NS[0], 1000),
     "ReferenceDrillBushSkillType"
+);
+/// The state machine of `ReferenceDrillBushSkillType`: states Halted (11), Ready (12), Running (13), Suspended (14); 9 transitions.
+impl t::StateMachine for ReferenceDrillBushSkillType {
+    const TABLE: t::StateTable = <super::super::common_skills::objects::CompositeSkillType as t::StateMachine>::TABLE;
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
+t::program_type!(
+    ReferenceDrillBushSkillType, ReferenceDrillBushSkillTypeInputs,
+    ReferenceDrillBushSkillTypeOutputs
+);
+/// Inputs of the program `ReferenceDrillBushSkillType`: the variables of its `InputParameterSet`, read from the instance when Start is called.
+///
+/// The inputs: HolePosition and ApproachDistance.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReferenceDrillBushSkillTypeInputs {
+    /// `HolePosition` (Mandatory). Rough pose of the drill bush in the base frame of the robot, from the template referencing camera: position of the bush face centre, Z along the bush axis into the part; millimetres and degrees.
+    pub hole_position: ua::ThreeDFrame,
+    /// `ApproachDistance` (Mandatory). Distance in front of the bush face at which the end effector stops, in millimetres.
+    pub approach_distance: f64,
+}
+t::parameters!(
+    ReferenceDrillBushSkillTypeInputs; set : 1 "InputParameterSet"; fields :
+    [hole_position : 0 "HolePosition", approach_distance : 0 "ApproachDistance"]
+);
+/// Outputs of the program `ReferenceDrillBushSkillType`: the variables of its `OutputParameterSet`, written to the instance when a run ends in Ready.
+///
+/// The results: Result and ReferencedHolePosition.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReferenceDrillBushSkillTypeOutputs {
+    /// `ReferencedHolePosition` (Mandatory). Pose of the drill bush as the hole referencing unit measured it, in the base frame of the robot; millimetres and degrees. Valid after a run that ended in Ready.
+    pub referenced_hole_position: ua::ThreeDFrame,
+}
+t::parameters!(
+    ReferenceDrillBushSkillTypeOutputs; set : 1 "OutputParameterSet"; outcome : 1
+    "Result"; fields : [referenced_hole_position : 0 "ReferencedHolePosition"]
 );
 /// Member markers of each ObjectType, named from browse paths (`ParameterSet__ActualPosition`).
 #[allow(non_snake_case, non_camel_case_types)]

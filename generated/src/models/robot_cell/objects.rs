@@ -534,6 +534,38 @@ t::object_type!(
     TemplateDrillingSkillType, rt::NsNodeId::numeric(NS[0], 1000),
     "TemplateDrillingSkillType"
 );
+/// The state machine of `TemplateDrillingSkillType`: states Halted (11), Ready (12), Running (13), Suspended (14); 9 transitions.
+impl t::StateMachine for TemplateDrillingSkillType {
+    const TABLE: t::StateTable = <super::super::common_skills::objects::ProgramSkillStateMachineType as t::StateMachine>::TABLE;
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
+t::program_type!(
+    TemplateDrillingSkillType, TemplateDrillingSkillTypeInputs,
+    super::super::common_skills::objects::ProgramSkillStateMachineTypeOutputs
+);
+/// Inputs of the program `TemplateDrillingSkillType`: the variables of its `InputParameterSet`, read from the instance when Start is called.
+///
+/// The drilling parameters: HoleDiameter, Depth, FeedRate, SpindleSpeed and ClampForce.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TemplateDrillingSkillTypeInputs {
+    /// `HoleDiameter` (Mandatory). Nominal diameter of the hole, in millimetres; selects and checks the drill.
+    pub hole_diameter: f64,
+    /// `Depth` (Mandatory). Depth to drill, in millimetres, measured from the face of the drill bush.
+    pub depth: f64,
+    /// `FeedRate` (Mandatory). Feed of the drill along its axis, in millimetres per minute.
+    pub feed_rate: f64,
+    /// `SpindleSpeed` (Mandatory). Rotational speed of the spindle, in revolutions per minute.
+    pub spindle_speed: f64,
+    /// `ClampForce` (Mandatory). Force the nose clamps the stack against the template with, in newtons.
+    pub clamp_force: f64,
+}
+t::parameters!(
+    TemplateDrillingSkillTypeInputs; set : 2 "InputParameterSet"; fields : [hole_diameter
+    : 0 "HoleDiameter", depth : 0 "Depth", feed_rate : 0 "FeedRate", spindle_speed : 0
+    "SpindleSpeed", clamp_force : 0 "ClampForce"]
+);
 /// Handle of an instance of `UR10eSystemType` (nsu=http://nodeset-compiler.dev/RobotCell/;i=4000).
 ///
 /// A Universal Robots UR10e as a Robotics motion device system: the six-joint arm (12.5 kg payload, 1300 mm reach) and its controller. The controller offers the three basic move skills of CommonSkills in its SkillSet, so composite skills can drive any robot that offers the same skills.

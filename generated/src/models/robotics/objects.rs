@@ -524,6 +524,42 @@ t::object_type!(
     ExecutingSubstateMachineType, rt::NsNodeId::numeric(NS[0], 1007),
     "ExecutingSubstateMachineType"
 );
+/// The state machine of `ExecutingSubstateMachineType`: states Running (1), Stopping (2); 1 transitions.
+impl t::StateMachine for ExecutingSubstateMachineType {
+    const TABLE: t::StateTable = t::StateTable {
+        states: &[
+            t::StateRow {
+                name: "Running",
+                display_name: "Running",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 5020),
+                initial: true,
+            },
+            t::StateRow {
+                name: "Stopping",
+                display_name: "Stopping",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[0], 5021),
+                initial: false,
+            },
+        ],
+        transitions: &[
+            t::TransitionRow {
+                name: "RunningToStopping",
+                display_name: "RunningToStopping",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 5022),
+                from: 0,
+                to: 1,
+                causes: &[],
+            },
+        ],
+        event_type: Some(rt::NsNodeId::numeric(NS[2], 2311)),
+    };
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
 /// Handle of an instance of `GearType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1022).
 ///
 /// The GearType describes a gear in a powertrain, e.g. a gear box or a spindle.
@@ -599,6 +635,51 @@ t::object_type!(
     IdleSubstateMachineType, rt::NsNodeId::numeric(NS[0], 1009),
     "IdleSubstateMachineType"
 );
+/// The state machine of `IdleSubstateMachineType`: states GettingReady (2), StandBy (1); 2 transitions.
+impl t::StateMachine for IdleSubstateMachineType {
+    const TABLE: t::StateTable = t::StateTable {
+        states: &[
+            t::StateRow {
+                name: "GettingReady",
+                display_name: "GettingReady",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[0], 5017),
+                initial: false,
+            },
+            t::StateRow {
+                name: "StandBy",
+                display_name: "StandBy",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 5015),
+                initial: true,
+            },
+        ],
+        transitions: &[
+            t::TransitionRow {
+                name: "GettingReadyToStandBy",
+                display_name: "GettingReadyToStandBy",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[0], 5018),
+                from: 0,
+                to: 1,
+                causes: &[],
+            },
+            t::TransitionRow {
+                name: "StandByToGettingReady",
+                display_name: "StandByToGettingReady",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 5019),
+                from: 1,
+                to: 0,
+                causes: &[],
+            },
+        ],
+        event_type: Some(rt::NsNodeId::numeric(NS[2], 2311)),
+    };
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
 /// Handle of an instance of `LoadType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1018).
 ///
 /// The LoadType is for describing loads mounted on the motion device typically by an integrator or a customer.
@@ -1096,6 +1177,94 @@ t::object_type!(
     OperationStateMachineType, rt::NsNodeId::numeric(NS[0], 1006),
     "OperationStateMachineType"
 );
+/// The state machine of `OperationStateMachineType`: states Executing (3), Idle (1), Ready (2); 6 transitions.
+impl t::StateMachine for OperationStateMachineType {
+    const TABLE: t::StateTable = t::StateTable {
+        states: &[
+            t::StateRow {
+                name: "Executing",
+                display_name: "Executing",
+                number: Some(3),
+                node: rt::NsNodeId::numeric(NS[0], 5007),
+                initial: false,
+            },
+            t::StateRow {
+                name: "Idle",
+                display_name: "Idle",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 5005),
+                initial: false,
+            },
+            t::StateRow {
+                name: "Ready",
+                display_name: "Ready",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[0], 5006),
+                initial: false,
+            },
+        ],
+        transitions: &[
+            t::TransitionRow {
+                name: "ExecutingToIdle",
+                display_name: "ExecutingToIdle",
+                number: Some(6),
+                node: rt::NsNodeId::numeric(NS[0], 5013),
+                from: 0,
+                to: 1,
+                causes: &[],
+            },
+            t::TransitionRow {
+                name: "ExecutingToReady",
+                display_name: "ExecutingToReady",
+                number: Some(5),
+                node: rt::NsNodeId::numeric(NS[0], 5011),
+                from: 0,
+                to: 2,
+                causes: &[(NS[0], "Stop")],
+            },
+            t::TransitionRow {
+                name: "IdleToIdle",
+                display_name: "IdleToIdle",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 5014),
+                from: 1,
+                to: 1,
+                causes: &[],
+            },
+            t::TransitionRow {
+                name: "IdleToReady",
+                display_name: "IdleToReady",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[0], 5009),
+                from: 1,
+                to: 2,
+                causes: &[],
+            },
+            t::TransitionRow {
+                name: "ReadyToExecuting",
+                display_name: "ReadyToExecuting",
+                number: Some(4),
+                node: rt::NsNodeId::numeric(NS[0], 5012),
+                from: 2,
+                to: 0,
+                causes: &[(NS[0], "Start")],
+            },
+            t::TransitionRow {
+                name: "ReadyToIdle",
+                display_name: "ReadyToIdle",
+                number: Some(3),
+                node: rt::NsNodeId::numeric(NS[0], 5008),
+                from: 2,
+                to: 1,
+                causes: &[],
+            },
+        ],
+        event_type: Some(rt::NsNodeId::numeric(NS[2], 2311)),
+    };
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
 /// Handle of an instance of `PowerTrainType` (nsu=http://opcfoundation.org/UA/Robotics/;i=16794).
 ///
 /// The PowerTrainType represents instances of powertrains of a motion device.
@@ -1198,6 +1367,51 @@ t::object_type!(
     ReadySubstateMachineType, rt::NsNodeId::numeric(NS[0], 1012),
     "ReadySubstateMachineType"
 );
+/// The state machine of `ReadySubstateMachineType`: states AtProgramStart (1), Suspended (2); 2 transitions.
+impl t::StateMachine for ReadySubstateMachineType {
+    const TABLE: t::StateTable = t::StateTable {
+        states: &[
+            t::StateRow {
+                name: "AtProgramStart",
+                display_name: "AtProgramStart",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 5023),
+                initial: false,
+            },
+            t::StateRow {
+                name: "Suspended",
+                display_name: "Suspended",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[0], 5024),
+                initial: false,
+            },
+        ],
+        transitions: &[
+            t::TransitionRow {
+                name: "ProgramStartToSuspended",
+                display_name: "ProgramStartToSuspended",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 5025),
+                from: 0,
+                to: 1,
+                causes: &[],
+            },
+            t::TransitionRow {
+                name: "SuspendedToProgramStart",
+                display_name: "SuspendedToProgramStart",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[0], 5026),
+                from: 1,
+                to: 0,
+                causes: &[(NS[0], "ResetToProgramStart")],
+            },
+        ],
+        event_type: Some(rt::NsNodeId::numeric(NS[2], 2311)),
+    };
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
 /// Handle of an instance of `SafetyStateType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1013).
 ///
 /// SafetyStateType describes the safety states of the motion devices and controllers. One motion device system is associated with one or more instances of the SafetyStateType.
@@ -1406,6 +1620,94 @@ t::object_type!(
     SystemOperationStateMachineType, rt::NsNodeId::numeric(NS[0], 1021),
     "SystemOperationStateMachineType"
 );
+/// The state machine of `SystemOperationStateMachineType`: states Executing (3), Idle (1), Ready (2); 6 transitions.
+impl t::StateMachine for SystemOperationStateMachineType {
+    const TABLE: t::StateTable = t::StateTable {
+        states: &[
+            t::StateRow {
+                name: "Executing",
+                display_name: "Executing",
+                number: Some(3),
+                node: rt::NsNodeId::numeric(NS[0], 5032),
+                initial: false,
+            },
+            t::StateRow {
+                name: "Idle",
+                display_name: "Idle",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 5030),
+                initial: false,
+            },
+            t::StateRow {
+                name: "Ready",
+                display_name: "Ready",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[0], 5031),
+                initial: false,
+            },
+        ],
+        transitions: &[
+            t::TransitionRow {
+                name: "ExecutingToIdle",
+                display_name: "ExecutingToIdle",
+                number: Some(6),
+                node: rt::NsNodeId::numeric(NS[0], 5038),
+                from: 0,
+                to: 1,
+                causes: &[],
+            },
+            t::TransitionRow {
+                name: "ExecutingToReady",
+                display_name: "ExecutingToReady",
+                number: Some(5),
+                node: rt::NsNodeId::numeric(NS[0], 5037),
+                from: 0,
+                to: 2,
+                causes: &[(NS[0], "Stop")],
+            },
+            t::TransitionRow {
+                name: "IdleToIdle",
+                display_name: "IdleToIdle",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 5033),
+                from: 1,
+                to: 1,
+                causes: &[(NS[0], "StandDown")],
+            },
+            t::TransitionRow {
+                name: "IdleToReady",
+                display_name: "IdleToReady",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[0], 5034),
+                from: 1,
+                to: 2,
+                causes: &[(NS[0], "GetReady")],
+            },
+            t::TransitionRow {
+                name: "ReadyToExecuting",
+                display_name: "ReadyToExecuting",
+                number: Some(4),
+                node: rt::NsNodeId::numeric(NS[0], 5036),
+                from: 2,
+                to: 0,
+                causes: &[(NS[0], "Start")],
+            },
+            t::TransitionRow {
+                name: "ReadyToIdle",
+                display_name: "ReadyToIdle",
+                number: Some(3),
+                node: rt::NsNodeId::numeric(NS[0], 5035),
+                from: 2,
+                to: 1,
+                causes: &[(NS[0], "StandDown")],
+            },
+        ],
+        event_type: Some(rt::NsNodeId::numeric(NS[2], 2311)),
+    };
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
 /// Handle of an instance of `SystemOperationType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1028).
 #[derive(Clone, Debug)]
 #[allow(non_snake_case)]
@@ -1777,6 +2079,98 @@ t::object_type!(
     TaskControlStateMachineType, rt::NsNodeId::numeric(NS[0], 1025),
     "TaskControlStateMachineType"
 );
+/// The state machine of `TaskControlStateMachineType`: states Executing (3), Idle (1), Ready (2); 6 transitions.
+impl t::StateMachine for TaskControlStateMachineType {
+    const TABLE: t::StateTable = t::StateTable {
+        states: &[
+            t::StateRow {
+                name: "Executing",
+                display_name: "Executing",
+                number: Some(3),
+                node: rt::NsNodeId::numeric(NS[0], 5042),
+                initial: false,
+            },
+            t::StateRow {
+                name: "Idle",
+                display_name: "Idle",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 5040),
+                initial: false,
+            },
+            t::StateRow {
+                name: "Ready",
+                display_name: "Ready",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[0], 5041),
+                initial: false,
+            },
+        ],
+        transitions: &[
+            t::TransitionRow {
+                name: "ExecutingToIdle",
+                display_name: "ExecutingToIdle",
+                number: Some(6),
+                node: rt::NsNodeId::numeric(NS[0], 5048),
+                from: 0,
+                to: 1,
+                causes: &[],
+            },
+            t::TransitionRow {
+                name: "ExecutingToReady",
+                display_name: "ExecutingToReady",
+                number: Some(5),
+                node: rt::NsNodeId::numeric(NS[0], 5047),
+                from: 0,
+                to: 2,
+                causes: &[(NS[0], "Stop")],
+            },
+            t::TransitionRow {
+                name: "IdleToIdle",
+                display_name: "IdleToIdle",
+                number: Some(1),
+                node: rt::NsNodeId::numeric(NS[0], 5043),
+                from: 1,
+                to: 1,
+                causes: &[],
+            },
+            t::TransitionRow {
+                name: "IdleToReady",
+                display_name: "IdleToReady",
+                number: Some(2),
+                node: rt::NsNodeId::numeric(NS[0], 5044),
+                from: 1,
+                to: 2,
+                causes: &[(NS[0], "LoadByName"), (NS[0], "LoadByNodeId")],
+            },
+            t::TransitionRow {
+                name: "ReadyToExecuting",
+                display_name: "ReadyToExecuting",
+                number: Some(4),
+                node: rt::NsNodeId::numeric(NS[0], 5046),
+                from: 2,
+                to: 0,
+                causes: &[(NS[0], "Start")],
+            },
+            t::TransitionRow {
+                name: "ReadyToIdle",
+                display_name: "ReadyToIdle",
+                number: Some(3),
+                node: rt::NsNodeId::numeric(NS[0], 5045),
+                from: 2,
+                to: 1,
+                causes: &[
+                    (NS[0], "UnloadByName"),
+                    (NS[0], "UnloadByNodeId"),
+                    (NS[0], "UnloadProgram"),
+                ],
+            },
+        ],
+        event_type: Some(rt::NsNodeId::numeric(NS[2], 2311)),
+    };
+    fn state_machine_node(&self) -> &t::ObjectNode {
+        &self.node
+    }
+}
 /// Handle of an instance of `TaskControlType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1011).
 ///
 /// Represents a specific task control active on the controller.

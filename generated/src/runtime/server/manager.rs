@@ -5,7 +5,7 @@ use std::future::Future;
 use std::sync::Arc;
 
 use async_trait::async_trait;
-use opcua::nodes::{DefaultTypeTree, NodeType};
+use opcua::nodes::{DefaultTypeTree, Event, EventNotifier, NodeType};
 use opcua::server::address_space::{validate_node_write, write_node_value, AccessLevel, AddressSpace};
 use opcua::server::diagnostics::NamespaceMetadata;
 use opcua::server::node_manager::memory::{
@@ -578,8 +578,11 @@ impl ModelManager {
 
     /// Runs `f` with a [`Binder`] (one read lock for a whole tree of handles).
     pub fn bind_with<H>(&self, f: impl FnOnce(&Binder<'_>) -> Result<H, BindError>) -> Result<H, BindError> {
-        let space = self.node_manager.address_space().read();
+        // The type tree first, then the address space: async-opcua initialises node managers holding the
+        // type tree and then taking the address space, so the other order deadlocks a bind that runs while a
+        // server on another thread starts.
         let tree = self.nodes().type_tree.read();
+        let space = self.node_manager.address_space().read();
         f(&Binder::new(self, &space, &tree))
     }
 
@@ -594,9 +597,10 @@ impl ModelManager {
     ) -> Result<NodeId, InstantiateError> {
         let core = self.nodes().node_managers.get_of_type::<CoreNodeManager>();
         let planned = {
+            // The type tree first (see `bind_with`).
+            let tree = self.nodes().type_tree.read();
             let core_space = core.as_ref().map(|c| c.address_space().read());
             let space = self.node_manager.address_space().read();
-            let tree = self.nodes().type_tree.read();
             let spaces = Spaces { core: core_space.as_deref(), model: &space, tree: &tree };
             let id = options.node_id_or(self.instance_namespace(), browse_name.name.as_ref());
             let mut planner = Planner { spaces, options, used: Default::default(), out: Vec::new() };
@@ -618,6 +622,25 @@ impl ModelManager {
             }
         }
         Ok(root)
+    }
+
+    /// Reports an event to the clients that monitor any of `notifiers` for events (the event's source, the
+    /// Server object, ...). async-opcua evaluates each monitored item's EventFilter against the event.
+    pub fn notify_event(&self, event: &dyn Event, notifiers: &[NodeId]) {
+        self.nodes().subscriptions.notify_events(notifiers.iter().map(|n| (event, n)));
+    }
+
+    /// Sets the EventNotifier attribute of an object (`SUBSCRIBE_TO_EVENTS` lets clients monitor it for
+    /// events). `BadNodeIdUnknown` if there is no such node, `BadAttributeIdInvalid` if it is not an object.
+    pub fn set_event_notifier(&self, node: &NodeId, notifier: EventNotifier) -> Result<(), StatusCode> {
+        match self.node_manager.address_space().write().find_mut(node) {
+            Some(NodeType::Object(object)) => {
+                object.set_event_notifier(notifier);
+                Ok(())
+            }
+            Some(_) => Err(StatusCode::BadAttributeIdInvalid),
+            None => Err(StatusCode::BadNodeIdUnknown),
+        }
     }
 
     /// Sets a variable's whole DataValue (value, status, timestamps) unchecked, and reports it to

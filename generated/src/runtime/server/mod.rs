@@ -65,6 +65,11 @@ pub struct ServerConfig {
     /// The namespace URI of instances created at run time ([`ModelManager::instantiate`]). Defaults to
     /// `<application URI>:instances`.
     pub instance_namespace: Option<String>,
+    /// The smallest sampling interval the server grants, in milliseconds. Defaults to 0: the values the
+    /// runtime sets are pushed to subscriptions when they change, so a client that asks for 0 gets every
+    /// change, each state of a program however short it lasts. (async-opcua 0.19 holds back a change that
+    /// follows another within a non-zero sampling interval until the next change of the variable.)
+    pub min_sampling_interval_ms: f64,
     /// Where async-opcua keeps certificates. The endpoint needs none; the default is a folder in the
     /// system's temporary directory, so that nothing is written beside the program.
     pub pki_dir: PathBuf,
@@ -93,6 +98,7 @@ impl ServerConfig {
             tables: Vec::new(),
             type_loaders: Vec::new(),
             instance_namespace: None,
+            min_sampling_interval_ms: 0.0,
             pki_dir: std::env::temp_dir().join("nodeset-models-pki"),
             max_sessions: DEFAULT_MAX_SESSIONS,
         }
@@ -128,6 +134,12 @@ impl ServerConfig {
         self
     }
 
+    /// Sets the smallest sampling interval the server grants.
+    pub fn min_sampling_interval_ms(mut self, ms: f64) -> ServerConfig {
+        self.min_sampling_interval_ms = ms;
+        self
+    }
+
     /// Adds a type loader.
     pub fn type_loader(mut self, loader: impl TypeLoader + 'static) -> ServerConfig {
         self.type_loaders.push(Arc::new(loader));
@@ -155,6 +167,7 @@ impl ServerConfig {
         for loader in self.type_loaders {
             builder = builder.with_type_loader(loader);
         }
+        builder.limits_mut().subscriptions.min_sampling_interval_ms = self.min_sampling_interval_ms;
         let (server, handle) = builder.build()?;
         let manager = ModelManager::from_handle(&handle).ok_or("the model node manager is missing from the server")?;
         let endpoint_url = format!("opc.tcp://{}:{port}/", self.host);

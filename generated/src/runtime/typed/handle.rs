@@ -95,6 +95,11 @@ impl<'a> Binder<'a> {
         H::bind(self, node)
     }
 
+    /// The BrowseName of a node, if there is such a node.
+    pub fn browse_name(&self, node: &NodeId) -> Option<QualifiedName> {
+        self.space.find(node).map(|n| n.as_node().browse_name().clone())
+    }
+
     /// The child of `node` with BrowseName `name` in namespace `uri`, if there is one.
     pub fn find_child(&self, node: &NodeId, uri: &str, name: &str) -> Result<Option<NodeId>, BindError> {
         let ns = self.tree.namespaces().get_index(uri).ok_or_else(|| BindError::UnknownNamespace(uri.to_owned()))?;

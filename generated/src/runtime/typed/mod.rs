@@ -7,11 +7,18 @@
 pub mod handle;
 pub mod instance;
 pub mod model;
+pub mod program;
 pub mod value;
 
 pub use handle::{Arguments, BindError, Binder, CallContext, Handle, Method, ObjectNode, Placeholders, Variable};
 pub use instance::{Instantiate, InstantiateError};
 pub use model::{Bound, ObjectModel};
+pub use program::{
+    Control, Machine, ParameterValue, Parameters, Program, ProgramError, ProgramState, ProgramType, StateMachine,
+    StateRow, StateTable, TransitionEvent, TransitionRow,
+};
+pub use crate::__nodeset_parameters as parameters;
+pub use crate::__nodeset_program_type as program_type;
 pub use value::{UaStruct, UaValue};
 
 use opcua::types::{NodeId, QualifiedName};

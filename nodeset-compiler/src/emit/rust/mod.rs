@@ -1,6 +1,6 @@
 //! The Rust back end: typed Rust for async-opcua 0.19 from the resolved model.
 //!
-//! For each namespace it emits a module with four files:
+//! For each namespace it emits a module with five files:
 //!
 //! - `mod.rs`: the namespace URI, model version, and re-exports;
 //! - `ids.rs`: a constant for every node (`NsNodeId`: the namespace by URI, resolved at run time), named from
@@ -10,7 +10,9 @@
 //!   nodeset's values, OptionSets as bit flags of the right width, simple subtypes as aliases, plus the
 //!   encoding ids and a type loader so servers and clients decode them;
 //! - `nodes.rs`: the address space as one static [`NodeSetTable`] (data, one row per node), which the
-//!   hand-written runtime imports into a server with the namespace indices of that server.
+//!   hand-written runtime imports into a server with the namespace indices of that server;
+//! - `objects.rs`: typed handles of the ObjectTypes and VariableTypes and member markers (`objects`), the
+//!   state tables of state machine types, and the typed inputs and outputs of program types (`programs`).
 //!
 //! `generate` is a pure function of the model and the configuration; it returns files in memory.
 //!
@@ -18,6 +20,7 @@
 
 mod async_opcua_ns0;
 mod objects;
+mod programs;
 
 pub use objects::marker_name;
 

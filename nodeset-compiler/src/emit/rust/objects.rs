@@ -19,6 +19,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 
+use super::programs::Item;
 use super::{doc, ident, lit, path, Gen};
 use crate::model::{DataTypeKind, ModellingRule, NodeIx};
 use crate::nodeid::Identifier;
@@ -79,27 +80,46 @@ struct Reach {
 
 impl Gen<'_> {
     /// Whether a type gets a handle struct.
-    fn has_handle(&self, t: NodeIx) -> bool {
+    pub(super) fn has_handle(&self, t: NodeIx) -> bool {
         matches!(self.model.node(t).class, NodeClass::ObjectType | NodeClass::VariableType)
     }
 
-    /// Handle struct names of a namespace's types.
-    fn handle_names(&self, ns: u16) -> BTreeMap<NodeIx, String> {
-        let mut scope: Scope<NodeIx> = Scope::new(Target::Rust, Case::UpperCamel);
+    /// Names of the items of a namespace's `objects.rs` in one scope: the handle structs of its types and
+    /// the parameter structs of its program types.
+    pub(super) fn object_item_names(&self, ns: u16) -> BTreeMap<(NodeIx, Item), String> {
+        let mut scope: Scope<(NodeIx, Item)> = Scope::new(Target::Rust, Case::UpperCamel);
         for r in ["NS", "Members"] {
             scope.reserve(r);
         }
         for (i, n) in self.model.nodes.iter().enumerate() {
             let ix = NodeIx(i as u32);
             if n.id.ns == ns && self.has_handle(ix) {
-                scope.add(n.symbolic_name.as_deref().unwrap_or(&n.browse_name.name), ix);
+                scope.add(n.symbolic_name.as_deref().unwrap_or(&n.browse_name.name), (ix, Item::Handle));
             }
         }
+        self.add_parameter_names(ns, &mut scope);
         scope.finish().0
     }
 
+    /// Handle struct names of a namespace's types.
+    pub(super) fn handle_names(&self, ns: u16) -> BTreeMap<NodeIx, String> {
+        self.object_item_names(ns).into_iter().filter(|((_, item), _)| *item == Item::Handle).map(|((t, _), n)| (t, n)).collect()
+    }
+
+    /// The Rust path of the module of another generated namespace, if this run reaches it.
+    pub(super) fn module_path(&self, ns: u16) -> Option<TokenStream> {
+        let uri = self.model.namespace_uri(ns);
+        if let Some(p) = self.cfg.extern_paths.get(uri) {
+            Some(path(p))
+        } else {
+            let m = self.cfg.namespaces.iter().find(|m| m.uri == uri)?;
+            let m = ident(&m.module);
+            Some(quote! { super::super::#m })
+        }
+    }
+
     /// The Rust path of a type's handle, if it has one reachable from this module.
-    fn handle_path(&self, t: NodeIx, names: &BTreeMap<NodeIx, String>) -> Option<TokenStream> {
+    pub(super) fn handle_path(&self, t: NodeIx, names: &BTreeMap<NodeIx, String>) -> Option<TokenStream> {
         let n = self.model.node(t);
         if n.id.ns == self.ns {
             let name = ident(names.get(&t)?);
@@ -108,21 +128,13 @@ impl Gen<'_> {
         if n.id.ns == 0 || !self.has_handle(t) {
             return None;
         }
-        let uri = self.model.namespace_uri(n.id.ns);
-        let module = if let Some(p) = self.cfg.extern_paths.get(uri) {
-            path(p)
-        } else if let Some(m) = self.cfg.namespaces.iter().find(|m| m.uri == uri) {
-            let m = ident(&m.module);
-            quote! { super::super::#m }
-        } else {
-            return None;
-        };
+        let module = self.module_path(n.id.ns)?;
         let name = ident(self.handle_names(n.id.ns).get(&t)?);
         Some(quote! { #module::objects::#name })
     }
 
     /// The Rust value type of a DataType and ValueRank, as typed handles use it.
-    fn value_type(&self, dt: Option<NodeIx>, value_rank: i32) -> TokenStream {
+    pub(super) fn value_type(&self, dt: Option<NodeIx>, value_rank: i32) -> TokenStream {
         let variant = quote! { opcua::types::Variant };
         let Some(dt) = dt else { return variant };
         let scalar = self.scalar_value_type(dt);
@@ -176,7 +188,7 @@ impl Gen<'_> {
     }
 
     /// The modelling rule of a member, if it is instantiated at all.
-    fn rule(&self, node: NodeIx) -> Option<ModellingRule> {
+    pub(super) fn rule(&self, node: NodeIx) -> Option<ModellingRule> {
         match self.model.node(node).modelling_rule? {
             r @ (ModellingRule::Mandatory
             | ModellingRule::Optional
@@ -187,7 +199,7 @@ impl Gen<'_> {
     }
 
     /// The members of a declaration (or of an instance): `instance_members` with a rule.
-    fn decl_members(&self, decl: NodeIx) -> Vec<(NodeIx, NodeIx)> {
+    pub(super) fn decl_members(&self, decl: NodeIx) -> Vec<(NodeIx, NodeIx)> {
         self.model
             .instance_members(decl)
             .into_iter()
@@ -216,13 +228,13 @@ impl Gen<'_> {
     }
 
     /// Index of a namespace URI in the file's `NS` table.
-    fn ns_index(&self, uris: &mut BTreeMap<String, usize>, ns: u16) -> usize {
+    pub(super) fn ns_index(&self, uris: &mut BTreeMap<String, usize>, ns: u16) -> usize {
         let uri = self.model.namespace_uri(ns).to_owned();
         let next = uris.len();
         *uris.entry(uri).or_insert(next)
     }
 
-    fn ns_node_id(&self, uris: &mut BTreeMap<String, usize>, t: NodeIx) -> TokenStream {
+    pub(super) fn ns_node_id(&self, uris: &mut BTreeMap<String, usize>, t: NodeIx) -> TokenStream {
         let id = &self.model.node(t).id;
         let k = Literal::usize_unsuffixed(self.ns_index(uris, id.ns));
         if let Identifier::Numeric(v) = &id.id {
@@ -454,6 +466,7 @@ impl Gen<'_> {
 
     pub(super) fn objects_file(&mut self) -> OutFile {
         let model = self.model;
+        let item_names = self.object_item_names(self.ns);
         let names = self.handle_names(self.ns);
         let mut uris: BTreeMap<String, usize> = BTreeMap::new();
         self.ns_index(&mut uris, self.ns);
@@ -487,9 +500,11 @@ impl Gen<'_> {
                     None => all.clone(),
                 };
                 let body = self.handle_struct(name, &text, None, base.map(|(_, p)| p), &own, &names, &mut uris, nested_prefix(name), 0);
+                let machine = self.state_machine_items(t, name, &names, &item_names, &mut uris);
                 items.push(quote! {
                     #body
                     t::object_type!(#sname, #tid, #bname);
+                    #machine
                 });
                 markers.push(self.markers(name, &all, &mut uris));
             } else {
