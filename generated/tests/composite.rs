@@ -48,24 +48,7 @@ fn config(name: &str) -> ServerConfig {
 
 /// Binds the skill at `path` on a server (the server side looks it up in its own address space).
 fn local<H: nodeset_models::runtime::typed::Handle>(m: &ModelManager, path: &str) -> H {
-    let objects = NodeId::from(opcua::types::ObjectId::ObjectsFolder);
-    let node = m
-        .bind_with(|b| {
-            let mut node = objects.clone();
-            for segment in path.split('/') {
-                node = b
-                    .children(&node)
-                    .into_iter()
-                    .find(|c| b.browse_name(c).is_some_and(|q| q.name.as_ref() == segment))
-                    .ok_or(nodeset_models::runtime::typed::BindError::MissingChild {
-                        parent: node.clone(),
-                        browse_name: segment.to_owned(),
-                    })?;
-            }
-            Ok(node)
-        })
-        .expect("the path exists");
-    m.bind(&node).expect("binds the skill")
+    m.bind_path(path).expect("the path leads to the skill")
 }
 
 fn offset(z: f64) -> RelativeCartesianLinearMoveSkillTypeInputs {

@@ -64,6 +64,18 @@ impl Drop for Server {
 
 impl Server {
     fn start(exe: &PathBuf, args: &[&str]) -> (Server, String) {
+        let server = Server::spawn(exe, args);
+        let first = server.line();
+        let url = first.strip_prefix("listening on ").unwrap_or_else(|| panic!("unexpected first line {first:?}"));
+        (server, url.to_owned())
+    }
+
+    /// The next line the server prints (within a minute).
+    fn line(&self) -> String {
+        self.stdout.recv_timeout(Duration::from_secs(60)).expect("the server prints a line")
+    }
+
+    fn spawn(exe: &PathBuf, args: &[&str]) -> Server {
         let mut child = Command::new(exe)
             .args(["--port", "0"])
             .args(args)
@@ -80,10 +92,7 @@ impl Server {
                 }
             }
         });
-        let server = Server { child, stdout: rx };
-        let first = server.stdout.recv_timeout(Duration::from_secs(60)).expect("the server prints its URL");
-        let url = first.strip_prefix("listening on ").unwrap_or_else(|| panic!("unexpected first line {first:?}"));
-        (server, url.to_owned())
+        Server { child, stdout: rx }
     }
 
     /// Sends SIGTERM, checks that the server ends cleanly, and returns what it printed after its URL.
@@ -134,6 +143,29 @@ fn asyncua_client_against_the_robot_example() {
         printed.iter().any(|l| l == "ConfiguredDefaultStopMode written by a client: 2"),
         "the client's write of ConfiguredDefaultStopMode did not reach the derived struct; the server printed {printed:?}"
     );
+}
+
+/// The robot cell example (three servers: the robot's move skills, the drilling unit's TemplateDrilling,
+/// the cell's composite skills) against `skills_check.py`: the SkillSets, a move skill started with inputs
+/// and followed through CurrentState and transition events, Halt, Start while Halted, Reset, and DrillHole
+/// running the basic skills of the other two servers in order and halting with them.
+#[test]
+fn asyncua_client_against_the_robot_cell() {
+    let python = python();
+    let exe = build_server("robot_cell");
+    let server = Server::spawn(&exe, &["--motion-ms", "600"]);
+    let mut urls = Vec::new();
+    for label in ["robot", "drilling unit", "cell"] {
+        let line = server.line();
+        let url = line.strip_prefix(&format!("{label} listening on ")).unwrap_or_else(|| panic!("unexpected line {line:?}"));
+        urls.push(url.to_owned());
+    }
+    assert_eq!(server.line(), "cell ready");
+    let mut check = Command::new(&python);
+    check.arg(root().join("tests/interop/skills_check.py"));
+    check.args(["--robot", &urls[0], "--unit", &urls[1], "--cell", &urls[2]]);
+    run_check(check);
+    server.stop();
 }
 
 /// Runs a check script; fails unless it ends with `N passed, 0 failed`.

@@ -576,6 +576,27 @@ impl ModelManager {
         Binder::bind(self, node)
     }
 
+    /// Binds a typed handle to the node at `path` below the Objects folder: BrowseNames (their name part)
+    /// separated by `/`, such as `DrillingCell/SkillSet/DrillHole`. A segment that matches no child, or
+    /// several, is a `MissingChild` error naming the node where the path stopped.
+    pub fn bind_path<H: Handle>(&self, path: &str) -> Result<H, BindError> {
+        self.bind_with(|b| {
+            let mut node: NodeId = opcua::types::ObjectId::ObjectsFolder.into();
+            for segment in path.split('/').filter(|s| !s.is_empty()) {
+                let hits: Vec<NodeId> = b
+                    .children(&node)
+                    .into_iter()
+                    .filter(|c| b.browse_name(c).is_some_and(|q| q.name.as_ref() == segment))
+                    .collect();
+                match <[NodeId; 1]>::try_from(hits) {
+                    Ok([one]) => node = one,
+                    Err(_) => return Err(BindError::MissingChild { parent: node, browse_name: segment.to_owned() }),
+                }
+            }
+            H::bind(b, &node)
+        })
+    }
+
     /// Runs `f` with a [`Binder`] (one read lock for a whole tree of handles).
     pub fn bind_with<H>(&self, f: impl FnOnce(&Binder<'_>) -> Result<H, BindError>) -> Result<H, BindError> {
         // The type tree first, then the address space: async-opcua initialises node managers holding the

@@ -1,0 +1,381 @@
+//! The Commands2 drilling cell as three OPC UA servers on loopback, started by one command:
+//!
+//! ```text
+//! cargo run -p nodeset-models --example robot_cell -- [--port 4861] [--motion-ms 1000] [--seconds N]
+//! ```
+//!
+//! - the **robot** (port P): the UR10e of `TemplateDrillingLwrSystem`; its controller's SkillSet serves the
+//!   basic move skills `AbsoluteJointPTPMove` (the six joints' `ActualPosition` move to the target),
+//!   `RelativeCartesianLinearMove` and `AbsoluteCartesianLinearMove`;
+//! - the **drilling unit** (port P+1): the drilling end effector's `TemplateDrilling`;
+//! - the **cell** (port P+2): `DrillingCell/SkillSet` with the composite skills `DrillHole` (move in by
+//!   `InsertionDistance`, drill, move out) and `ReferenceDrillBush` (approach the bush `ApproachDistance`
+//!   above `HolePosition`, move onto it, report the measured pose in `ReferencedHolePosition`). The cell
+//!   finds the basic skills on the other two servers by browse path and runs them through async-opcua's
+//!   client (`runtime::remote`): a basic skill that halts halts the composite, one that is suspended
+//!   suspends it, and a Halt of the composite halts the basic skill that runs.
+//!
+//! Every server loads the same models (CommonSkills, RobotCell, DrillingProcess and what they require), so
+//! each shows the whole cell; it runs only its own device's skills. The skills of the other devices stay
+//! Ready there and answer Start with `BadNotImplemented`. Each basic skill takes `--motion-ms` (in steps of
+//! at most 10 ms, each a point where a Suspend parks it).
+//!
+//! `--port 0` takes free ports. It prints `robot listening on <url>`, `drilling unit listening on <url>`,
+//! `cell listening on <url>`, then `cell ready` once the cell found the basic skills; it stops on SIGINT,
+//! SIGTERM or after `--seconds N`, printing `server stopped cleanly`.
+
+use std::io::Write;
+use std::process::ExitCode;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use nodeset_models::models::common_skills::objects::{
+    AbsoluteCartesianLinearMoveSkillType, AbsoluteCartesianLinearMoveSkillTypeInputs, AbsoluteJointPtpMoveSkillType,
+    AbsoluteJointPtpMoveSkillTypeInputs, ProgramSkillStateMachineTypeOutputs as Done,
+    RelativeCartesianLinearMoveSkillType, RelativeCartesianLinearMoveSkillTypeInputs,
+};
+use nodeset_models::models::drilling_process::objects::{
+    DrillHoleSkillType, DrillHoleSkillTypeInputs, ReferenceDrillBushSkillType, ReferenceDrillBushSkillTypeInputs,
+    ReferenceDrillBushSkillTypeOutputs,
+};
+use nodeset_models::models::robot_cell::objects::{TemplateDrillingSkillType, TemplateDrillingSkillTypeInputs};
+use nodeset_models::models::robotics::objects::AxisType;
+use nodeset_models::models::{common_skills, di, drilling_process, ia, robot_cell, robotics};
+use nodeset_models::runtime::remote::RemoteServer;
+use nodeset_models::runtime::server::{ModelServer as Server, ServerConfig};
+use nodeset_models::runtime::typed::{Control, Program};
+use opcua::server::ServerHandle;
+use opcua::types::{StatusCode, ThreeDCartesianCoordinates, ThreeDFrame, ThreeDOrientation};
+use tokio::task::JoinHandle;
+
+const SYSTEM: &str = "DeviceSet/TemplateDrillingLwrSystem";
+const CONTROLLER_SKILLS: &str = "MotionDeviceSystem/Controllers/URController/SkillSet";
+const AXES: &str = "MotionDeviceSystem/MotionDevices/Manipulator/Axes";
+const JOINTS: [&str; 6] = ["Base", "Shoulder", "Elbow", "Wrist1", "Wrist2", "Wrist3"];
+const DRILL: &str = "DrillingEndEffector/SkillSet/TemplateDrilling";
+const CELL_SKILLS: &str = "DrillingCell/SkillSet";
+
+struct Options {
+    port: u16,
+    motion: Duration,
+    seconds: Option<u64>,
+}
+
+fn options() -> Result<Options, String> {
+    let mut o = Options { port: 4861, motion: Duration::from_millis(1000), seconds: None };
+    let mut args = std::env::args().skip(1);
+    while let Some(arg) = args.next() {
+        let mut value = |name: &str| args.next().ok_or(format!("{name} needs a value"));
+        match arg.as_str() {
+            "--port" => o.port = value("--port")?.parse().map_err(|e| format!("--port: {e}"))?,
+            "--motion-ms" => {
+                o.motion = Duration::from_millis(value("--motion-ms")?.parse().map_err(|e| format!("--motion-ms: {e}"))?)
+            }
+            "--seconds" => o.seconds = Some(value("--seconds")?.parse().map_err(|e| format!("--seconds: {e}"))?),
+            other => {
+                return Err(format!(
+                    "unknown argument {other:?} (usage: robot_cell [--port 4861] [--motion-ms 1000] [--seconds N])"
+                ))
+            }
+        }
+    }
+    Ok(o)
+}
+
+fn config(name: &str, port: u16) -> ServerConfig {
+    ServerConfig::new(name)
+        .port(port)
+        .table(&di::TABLE)
+        .type_loader(di::TypeLoader)
+        .table(&ia::TABLE)
+        .type_loader(ia::TypeLoader)
+        .table(&robotics::TABLE)
+        .type_loader(robotics::TypeLoader)
+        .table(&common_skills::TABLE)
+        .type_loader(common_skills::TypeLoader)
+        .table(&robot_cell::TABLE)
+        .type_loader(robot_cell::TypeLoader)
+        .table(&drilling_process::TABLE)
+        .type_loader(drilling_process::TypeLoader)
+}
+
+/// A server that runs.
+struct Running {
+    handle: ServerHandle,
+    task: JoinHandle<Result<(), String>>,
+}
+
+fn start(label: &str, server: Server) -> Running {
+    println!("{label} listening on {}", server.endpoint_url());
+    let _ = std::io::stdout().flush();
+    Running { handle: server.handle().clone(), task: tokio::spawn(server.run()) }
+}
+
+/// Waits for `time`, in steps of at most 10 ms, calling `step` with the fraction done after each and
+/// parking while the skill is suspended.
+async fn work(ctl: &Control, time: Duration, mut step: impl FnMut(f64)) {
+    let steps = (time.as_millis() / 10).max(1) as u32;
+    for i in 1..=steps {
+        ctl.checkpoint().await;
+        tokio::time::sleep(time / steps).await;
+        step(f64::from(i) / f64::from(steps));
+    }
+}
+
+/// The robot: the three move skills of the controller's SkillSet.
+fn robot(server: &Server, motion: Duration) -> Result<Vec<Program>, String> {
+    let m = server.manager();
+    let e = |e: nodeset_models::runtime::typed::BindError| e.to_string();
+    let skills = format!("{SYSTEM}/{CONTROLLER_SKILLS}");
+    let axes: Vec<AxisType> =
+        JOINTS.iter().map(|j| m.bind_path(&format!("{SYSTEM}/{AXES}/{j}"))).collect::<Result<_, _>>().map_err(e)?;
+    let positions: Arc<Vec<_>> = Arc::new(axes.iter().map(|a| a.parameter_set.actual_position.clone()).collect());
+    for p in positions.iter() {
+        p.set(0.0).map_err(|s| s.to_string())?;
+    }
+    // The tool centre point, which the Cartesian moves change (the cell has no kinematics).
+    let tcp = Arc::new(Mutex::new(ThreeDFrame::default()));
+
+    let ptp: AbsoluteJointPtpMoveSkillType = m.bind_path(&format!("{skills}/AbsoluteJointPTPMove")).map_err(e)?;
+    let ptp = ptp
+        .serve(move |inputs: AbsoluteJointPtpMoveSkillTypeInputs, ctl| {
+            let positions = positions.clone();
+            async move {
+                if inputs.target_joint_positions.len() != positions.len() || inputs.speed <= 0.0 {
+                    return Err(StatusCode::BadInvalidArgument);
+                }
+                let from: Vec<f64> = positions.iter().map(|p| p.get().unwrap_or(0.0)).collect();
+                work(&ctl, motion, |done| {
+                    for ((p, a), b) in positions.iter().zip(&from).zip(&inputs.target_joint_positions) {
+                        let _ = p.set(a + (b - a) * done);
+                    }
+                })
+                .await;
+                Ok(Done {})
+            }
+        })
+        .map_err(|e| e.to_string())?;
+
+    let relative: RelativeCartesianLinearMoveSkillType =
+        m.bind_path(&format!("{skills}/RelativeCartesianLinearMove")).map_err(e)?;
+    let t = tcp.clone();
+    let relative = relative
+        .serve(move |inputs: RelativeCartesianLinearMoveSkillTypeInputs, ctl| {
+            let tcp = t.clone();
+            async move {
+                if inputs.speed <= 0.0 {
+                    return Err(StatusCode::BadInvalidArgument);
+                }
+                let from = tcp.lock().unwrap_or_else(|e| e.into_inner()).clone();
+                let to = add(&from, &inputs.pose_offset);
+                work(&ctl, motion, |done| *tcp.lock().unwrap_or_else(|e| e.into_inner()) = lerp(&from, &to, done)).await;
+                Ok(Done {})
+            }
+        })
+        .map_err(|e| e.to_string())?;
+
+    let absolute: AbsoluteCartesianLinearMoveSkillType =
+        m.bind_path(&format!("{skills}/AbsoluteCartesianLinearMove")).map_err(e)?;
+    let absolute = absolute
+        .serve(move |inputs: AbsoluteCartesianLinearMoveSkillTypeInputs, ctl| {
+            let tcp = tcp.clone();
+            async move {
+                if inputs.speed <= 0.0 {
+                    return Err(StatusCode::BadInvalidArgument);
+                }
+                let from = tcp.lock().unwrap_or_else(|e| e.into_inner()).clone();
+                let to = inputs.target_pose;
+                work(&ctl, motion, |done| *tcp.lock().unwrap_or_else(|e| e.into_inner()) = lerp(&from, &to, done)).await;
+                Ok(Done {})
+            }
+        })
+        .map_err(|e| e.to_string())?;
+    Ok(vec![ptp, relative, absolute])
+}
+
+fn add(a: &ThreeDFrame, b: &ThreeDFrame) -> ThreeDFrame {
+    let (p, q) = (&a.cartesian_coordinates, &b.cartesian_coordinates);
+    let (r, s) = (&a.orientation, &b.orientation);
+    ThreeDFrame {
+        cartesian_coordinates: ThreeDCartesianCoordinates { x: p.x + q.x, y: p.y + q.y, z: p.z + q.z },
+        orientation: ThreeDOrientation { a: r.a + s.a, b: r.b + s.b, c: r.c + s.c },
+    }
+}
+
+fn lerp(a: &ThreeDFrame, b: &ThreeDFrame, t: f64) -> ThreeDFrame {
+    let f = |x: f64, y: f64| x + (y - x) * t;
+    let (p, q) = (&a.cartesian_coordinates, &b.cartesian_coordinates);
+    let (r, s) = (&a.orientation, &b.orientation);
+    ThreeDFrame {
+        cartesian_coordinates: ThreeDCartesianCoordinates { x: f(p.x, q.x), y: f(p.y, q.y), z: f(p.z, q.z) },
+        orientation: ThreeDOrientation { a: f(r.a, s.a), b: f(r.b, s.b), c: f(r.c, s.c) },
+    }
+}
+
+/// The drilling unit: TemplateDrilling.
+fn drilling_unit(server: &Server, motion: Duration) -> Result<Program, String> {
+    let drill: TemplateDrillingSkillType =
+        server.manager().bind_path(&format!("{SYSTEM}/{DRILL}")).map_err(|e| e.to_string())?;
+    drill
+        .serve(move |inputs: TemplateDrillingSkillTypeInputs, ctl| async move {
+            if inputs.hole_diameter <= 0.0 || inputs.depth <= 0.0 || inputs.feed_rate <= 0.0 {
+                return Err(StatusCode::BadInvalidArgument);
+            }
+            work(&ctl, motion, |_| {}).await;
+            Ok(Done {})
+        })
+        .map_err(|e| e.to_string())
+}
+
+fn frame(x: f64, y: f64, z: f64) -> ThreeDFrame {
+    ThreeDFrame {
+        cartesian_coordinates: ThreeDCartesianCoordinates { x, y, z },
+        orientation: ThreeDOrientation { a: 0.0, b: 0.0, c: 0.0 },
+    }
+}
+
+/// The cell: DrillHole and ReferenceDrillBush, composed of the skills of the robot and the drilling unit.
+async fn cell(server: &Server, robot_url: &str, unit_url: &str) -> Result<Vec<Program>, String> {
+    let e = |e: nodeset_models::runtime::remote::RemoteError| e.to_string();
+    let robot = RemoteServer::connect(robot_url).await.map_err(e)?;
+    let unit = RemoteServer::connect(unit_url).await.map_err(e)?;
+    let skills = format!("{SYSTEM}/{CONTROLLER_SKILLS}");
+    let relative = Arc::new(robot.skill(&format!("{skills}/RelativeCartesianLinearMove")).await.map_err(e)?);
+    let absolute = Arc::new(robot.skill(&format!("{skills}/AbsoluteCartesianLinearMove")).await.map_err(e)?);
+    let drill = Arc::new(unit.skill(&format!("{SYSTEM}/{DRILL}")).await.map_err(e)?);
+    // The skills keep their sessions open; the servers' handles are not needed any more.
+    drop((robot, unit));
+
+    let m = server.manager();
+    let drill_hole: DrillHoleSkillType = m.bind_path(&format!("{CELL_SKILLS}/DrillHole")).map_err(|e| e.to_string())?;
+    let r = relative.clone();
+    let drill_hole = drill_hole
+        .serve(move |i: DrillHoleSkillTypeInputs, ctl| {
+            let (relative, drill) = (r.clone(), drill.clone());
+            async move {
+                let offset = |z| RelativeCartesianLinearMoveSkillTypeInputs {
+                    speed: 50.0,
+                    acceleration: 200.0,
+                    pose_offset: frame(0.0, 0.0, z),
+                };
+                relative.run(offset(i.insertion_distance), &ctl).await?;
+                let drilling = TemplateDrillingSkillTypeInputs {
+                    hole_diameter: i.hole_diameter,
+                    depth: i.depth,
+                    feed_rate: i.feed_rate,
+                    spindle_speed: i.spindle_speed,
+                    clamp_force: i.clamp_force,
+                };
+                drill.run(drilling, &ctl).await?;
+                relative.run(offset(-i.insertion_distance), &ctl).await?;
+                Ok(Done {})
+            }
+        })
+        .map_err(|e| e.to_string())?;
+
+    let reference: ReferenceDrillBushSkillType =
+        m.bind_path(&format!("{CELL_SKILLS}/ReferenceDrillBush")).map_err(|e| e.to_string())?;
+    let reference = reference
+        .serve(move |i: ReferenceDrillBushSkillTypeInputs, ctl| {
+            let (relative, absolute) = (relative.clone(), absolute.clone());
+            async move {
+                let mut approach = i.hole_position.clone();
+                approach.cartesian_coordinates.z += i.approach_distance;
+                let to_approach =
+                    AbsoluteCartesianLinearMoveSkillTypeInputs { speed: 100.0, acceleration: 400.0, target_pose: approach };
+                absolute.run(to_approach, &ctl).await?;
+                let onto = RelativeCartesianLinearMoveSkillTypeInputs {
+                    speed: 20.0,
+                    acceleration: 100.0,
+                    pose_offset: frame(0.0, 0.0, -i.approach_distance),
+                };
+                relative.run(onto, &ctl).await?;
+                // The simulated hole referencing unit measures the bush where it was expected.
+                Ok(ReferenceDrillBushSkillTypeOutputs { referenced_hole_position: i.hole_position })
+            }
+        })
+        .map_err(|e| e.to_string())?;
+    Ok(vec![drill_hole, reference])
+}
+
+async fn run(o: Options) -> Result<(), String> {
+    let next = |k: u16| if o.port == 0 { 0 } else { o.port + k };
+    let robot_server = config("UR10e robot", o.port).build()?;
+    let unit_server = config("Drilling unit", next(1)).build()?;
+    let cell_server = config("Drilling cell", next(2)).build()?;
+    let (robot_url, unit_url) = (robot_server.endpoint_url().to_owned(), unit_server.endpoint_url().to_owned());
+
+    let robot_skills = robot(&robot_server, o.motion)?;
+    let drilling = drilling_unit(&unit_server, o.motion)?;
+    let servers = vec![start("robot", robot_server), start("drilling unit", unit_server)];
+    let cell_skills = cell(&cell_server, &robot_url, &unit_url).await?;
+    let mut servers = servers;
+    servers.push(start("cell", cell_server));
+    println!("cell ready");
+    let _ = std::io::stdout().flush();
+
+    match o.seconds {
+        Some(s) => tokio::time::sleep(Duration::from_secs(s)).await,
+        None => shutdown_signal().await,
+    }
+    // The cell first: its skills hold sessions to the other two.
+    drop(cell_skills);
+    let mut failed = Vec::new();
+    for s in servers.into_iter().rev() {
+        s.handle.cancel();
+        match s.task.await {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => failed.push(e),
+            Err(e) => failed.push(e.to_string()),
+        }
+    }
+    drop((robot_skills, drilling));
+    if !failed.is_empty() {
+        return Err(failed.join("; "));
+    }
+    println!("server stopped cleanly");
+    Ok(())
+}
+
+async fn shutdown_signal() {
+    #[cfg(unix)]
+    {
+        use tokio::signal::unix::{signal, SignalKind};
+        match signal(SignalKind::terminate()) {
+            Ok(mut term) => {
+                tokio::select! { _ = tokio::signal::ctrl_c() => {}, _ = term.recv() => {} }
+            }
+            Err(_) => {
+                let _ = tokio::signal::ctrl_c().await;
+            }
+        }
+    }
+    #[cfg(not(unix))]
+    let _ = tokio::signal::ctrl_c().await;
+}
+
+fn main() -> ExitCode {
+    let filter = std::env::var("RUST_LOG").unwrap_or_else(|_| "warn,opcua_server=error,opcua_nodes=error,opcua_crypto=off,opcua_core=error,opcua_core::comms::secure_channel=off,opcua_client=off".into());
+    let _ = tracing_subscriber::fmt().with_env_filter(filter).with_writer(std::io::stderr).try_init();
+    let o = match options() {
+        Ok(o) => o,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let runtime = match tokio::runtime::Runtime::new() {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: cannot start tokio: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    match runtime.block_on(run(o)) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
