@@ -275,6 +275,40 @@ async fn drill_hole_runs_its_basic_skills_in_order_and_follows_them() {
     c.robot.stop().await;
 }
 
+/// The drilling unit goes away while it drills: DrillHole halts with BadCommunicationError instead of
+/// waiting for an event that never comes. Started again, DrillHole moves in and then suspends, since the
+/// drilling unit cannot be reached; a client's Halt ends it.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_lost_server_halts_the_composite_and_an_unreachable_one_suspends_it() {
+    let c = cell().await;
+    let (session, event_loop) = connect(&c.cell.url).await;
+    let skill = &c.drill_hole_handle;
+    write_inputs(&session, skill).await;
+
+    c.hold.store(true, Ordering::SeqCst);
+    assert_eq!(call(&session, skill, "Start").await, StatusCode::Good);
+    logged(&c.log, "drill 6 x 8").await;
+    let lost = std::time::Instant::now();
+    c.unit.stop().await;
+    wait(&c.drill_hole, ProgramState::Halted).await;
+    assert_eq!(outcome(skill), Some(StatusCode::BadCommunicationError));
+    assert!(lost.elapsed() < Duration::from_secs(8), "halted only after {:?}", lost.elapsed());
+    assert_eq!(*c.log.lock().unwrap(), ["move 12.5", "drill 6 x 8"], "no move out after the lost drilling");
+
+    c.log.lock().unwrap().clear();
+    assert_eq!(call(&session, skill, "Reset").await, StatusCode::Good);
+    assert_eq!(call(&session, skill, "Start").await, StatusCode::Good);
+    wait(&c.drill_hole, ProgramState::Suspended).await;
+    assert_eq!(*c.log.lock().unwrap(), ["move 12.5"]);
+    assert_eq!(call(&session, skill, "Halt").await, StatusCode::Good);
+    wait(&c.drill_hole, ProgramState::Halted).await;
+    assert_eq!(c.moves.state(), ProgramState::Ready);
+
+    disconnect(session, event_loop).await;
+    c.cell.stop().await;
+    c.robot.stop().await;
+}
+
 /// A path that does not lead to a skill is an error that names where it stopped.
 #[tokio::test]
 async fn a_wrong_path_names_where_it_stops() {

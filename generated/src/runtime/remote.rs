@@ -26,11 +26,13 @@
 //!   composite;
 //! - the composite is halted or reset while the basic skill runs (its body is dropped): the basic skill is
 //!   halted;
-//! - the server of the basic skill cannot be reached when the run starts (a transport error, not a status
-//!   of the skill): the composite suspends itself and tries again when a client resumes it.
-//!
-//! Not handled yet: a server that goes away while its skill runs. The run then waits for events that do not
-//! come, and the composite stays Running until a client halts it.
+//! - the server of the basic skill cannot be reached when the run starts (a transport error or no answer
+//!   within 3 s, not a status of the skill): the composite suspends itself and tries again when a client
+//!   resumes it;
+//! - the server of the basic skill goes away while the skill runs (no event for a second, and CurrentState
+//!   cannot be read within 3 s): `run` returns `BadCommunicationError`, so the composite halts; what the
+//!   basic skill did is unknown, so the composite does not go on by itself. A transition event that is lost
+//!   (the skill is Ready or Halted, but no event said so) is found by the same read.
 
 use std::collections::BTreeMap;
 use std::sync::Arc;
@@ -48,6 +50,11 @@ use tokio::sync::{mpsc, Mutex};
 use tokio::task::JoinHandle;
 
 use crate::runtime::typed::{Control, Parameters, ProgramState};
+
+/// How long a request to another server may take before its server counts as unreachable.
+const REQUEST_TIMEOUT: Duration = Duration::from_secs(3);
+/// How long a run waits for a transition event before it reads the skill's state itself.
+const LIVENESS: Duration = Duration::from_secs(1);
 
 /// Why a remote skill could not be reached or found.
 #[derive(Clone, Debug, PartialEq)]
@@ -432,8 +439,11 @@ impl RemoteSkill {
                     return Ok(written);
                 }
                 self.call("Start").await
-            }
-            .await;
+            };
+            // A server that is gone may not fail a request at once: the session waits for a reconnection.
+            let started = tokio::time::timeout(REQUEST_TIMEOUT, started)
+                .await
+                .unwrap_or(Err(RemoteError::Service("Start", StatusCode::BadTimeout)));
             match started {
                 Ok(s) if s.is_good() => break,
                 Ok(s) => return Err(s),
@@ -447,18 +457,22 @@ impl RemoteSkill {
         let guard = HaltOnDrop { skill: Some((self.session.clone(), self.node.clone(), self.methods["Halt"].clone())) };
         let mut composite = ctl.watch();
         let mut basic = ProgramState::Running;
+        // Without events for a while, CurrentState is read: it finds a server that went away (the
+        // composite halts: what the basic skill did is unknown) and a state whose event was lost.
+        let mut quiet = tokio::time::interval_at(tokio::time::Instant::now() + LIVENESS, LIVENESS);
         let outcome = loop {
             tokio::select! {
                 next = states.recv() => {
+                    quiet.reset();
                     if next.is_none() {
                         break Err(StatusCode::BadCommunicationError);
                     }
                     // An event says the skill changed state; CurrentState says to which. (An event of a
                     // transition before this run's Start can arrive after it: its state is not the skill's.)
-                    let state = match self.state().await {
-                        Ok(Some(state)) => state,
-                        Ok(None) => continue,
-                        Err(_) => break Err(StatusCode::BadCommunicationError),
+                    let state = match tokio::time::timeout(REQUEST_TIMEOUT, self.state()).await {
+                        Ok(Ok(Some(state))) => state,
+                        Ok(Ok(None)) => continue,
+                        Ok(Err(_)) | Err(_) => break Err(StatusCode::BadCommunicationError),
                     };
                     let before = std::mem::replace(&mut basic, state);
                     match state {
@@ -470,6 +484,24 @@ impl RemoteSkill {
                             let _ = ctl.suspend();
                         }
                         _ => {}
+                    }
+                }
+                _ = quiet.tick() => {
+                    match tokio::time::timeout(REQUEST_TIMEOUT, self.state()).await {
+                        Ok(Ok(Some(ProgramState::Ready))) if basic != ProgramState::Ready => {
+                            tracing::warn!("skill {} is Ready, but its transition event did not arrive", self.name);
+                            break Ok(());
+                        }
+                        Ok(Ok(Some(ProgramState::Halted))) => break Err(self.cause().await),
+                        Ok(Ok(_)) => {}
+                        Ok(Err(e)) => {
+                            tracing::warn!("skill {} cannot be read ({e}); the composite halts", self.name);
+                            break Err(StatusCode::BadCommunicationError);
+                        }
+                        Err(_) => {
+                            tracing::warn!("skill {} does not answer; the composite halts", self.name);
+                            break Err(StatusCode::BadCommunicationError);
+                        }
                     }
                 }
                 changed = composite.changed() => {
