@@ -85,6 +85,8 @@ fn options() -> Result<Options, String> {
 fn config(name: &str, port: u16) -> ServerConfig {
     ServerConfig::new(name)
         .port(port)
+        // Each step of a composite skill ends with a transition event of a basic skill: publish quickly.
+        .min_publishing_interval_ms(10)
         .table(&di::TABLE)
         .type_loader(di::TypeLoader)
         .table(&ia::TABLE)

@@ -32,59 +32,94 @@ pub struct Args {
     pub release: bool,
 }
 
-/// Builds the examples and returns the folder of their executables.
-fn build(root: &Path, release: bool) -> Result<PathBuf, String> {
+/// Builds examples of nodeset-models and returns the folder of their executables.
+pub(crate) fn build(root: &Path, release: bool, examples: &[&str]) -> Result<PathBuf, String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut cmd = Command::new(cargo);
     // --workspace resolves features as `cargo test --workspace` does, so nothing is built twice.
-    cmd.current_dir(root).args(["build", "--quiet", "--workspace", "--example", "robot", "--example", "load"]);
+    cmd.current_dir(root).args(["build", "--quiet", "--workspace"]);
+    for e in examples {
+        cmd.args(["--example", e]);
+    }
     if release {
         cmd.arg("--release");
     }
     let status = cmd.status().map_err(|e| format!("cannot run cargo: {e}"))?;
     if !status.success() {
-        return Err(format!("building the robot and load examples failed ({status})"));
+        return Err(format!("building the examples {} failed ({status})", examples.join(", ")));
     }
     let target = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| root.join("target"));
     let target = if target.is_absolute() { target } else { root.join(target) };
     Ok(target.join(if release { "release" } else { "debug" }).join("examples"))
 }
 
-struct Robot {
+/// An example server running as a child process, its stdout read line by line; killed if dropped.
+pub(crate) struct Example {
     child: Child,
     lines: mpsc::Receiver<String>,
 }
 
-impl Drop for Robot {
+impl Drop for Example {
     fn drop(&mut self) {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
 }
 
+impl Example {
+    pub(crate) fn spawn(exe: &Path, args: &[&str]) -> Result<Example, String> {
+        let mut child = Command::new(exe)
+            .args(args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .map_err(|e| format!("cannot start {}: {e}", exe.display()))?;
+        let out = child.stdout.take().ok_or("no stdout")?;
+        let (tx, lines) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(out).lines().map_while(Result::ok) {
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        Ok(Example { child, lines })
+    }
+
+    /// The next line it prints (within a minute).
+    pub(crate) fn line(&self) -> Result<String, String> {
+        self.lines.recv_timeout(Duration::from_secs(60)).map_err(|_| "the example printed nothing for a minute".into())
+    }
+
+    pub(crate) fn pid(&self) -> u32 {
+        self.child.id()
+    }
+
+    /// Sends SIGTERM; the lines printed until it ended, or why it did not end cleanly (printing
+    /// `server stopped cleanly` and exiting with 0).
+    pub(crate) fn stop(mut self) -> Result<Vec<String>, String> {
+        let killed = Command::new("kill").args(["-TERM", &self.pid().to_string()]).status().is_ok_and(|s| s.success());
+        let mut rest = Vec::new();
+        while let Ok(line) = self.lines.recv_timeout(Duration::from_secs(15)) {
+            rest.push(line);
+        }
+        let exit = self.child.wait().map_err(|e| e.to_string())?;
+        if killed && exit.success() && rest.iter().any(|l| l == "server stopped cleanly") {
+            Ok(rest)
+        } else {
+            Err(format!("the server did not stop cleanly ({exit}); last lines: {:?}", rest.iter().rev().take(5).collect::<Vec<_>>()))
+        }
+    }
+}
+
 pub fn run(args: Args) -> Result<(), String> {
     let root = workspace_root();
     crate::fetch::ensure_fetched()?;
-    let examples = build(&root, args.release)?;
-    let mut child = Command::new(examples.join("robot"))
-        .args(["--port", "0"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::inherit())
-        .spawn()
-        .map_err(|e| format!("cannot start the robot example: {e}"))?;
-    let out = child.stdout.take().ok_or("no stdout")?;
-    let (tx, lines) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in BufReader::new(out).lines().map_while(Result::ok) {
-            if tx.send(line).is_err() {
-                break;
-            }
-        }
-    });
-    let robot = Robot { child, lines };
-    let first = robot.lines.recv_timeout(Duration::from_secs(60)).map_err(|_| "the robot example printed no URL")?;
+    let examples = build(&root, args.release, &["robot", "load"])?;
+    let robot = Example::spawn(&examples.join("robot"), &["--port", "0"])?;
+    let first = robot.line()?;
     let url = first.strip_prefix("listening on ").ok_or_else(|| format!("unexpected first line {first:?}"))?.to_owned();
-    let pid = robot.child.id();
+    let pid = robot.pid();
     eprintln!("load: robot example (pid {pid}) listening on {url}");
 
     let status = Command::new(examples.join("load"))
@@ -95,22 +130,13 @@ pub fn run(args: Args) -> Result<(), String> {
         .map_err(|e| format!("cannot run the load client: {e}"))?;
 
     // Stop the robot; it must end cleanly under (and after) the load.
-    let mut robot = robot;
-    let killed = Command::new("kill").args(["-TERM", &pid.to_string()]).status().is_ok_and(|s| s.success());
-    let mut rest = Vec::new();
-    while let Ok(line) = robot.lines.recv_timeout(Duration::from_secs(15)) {
-        rest.push(line);
-    }
-    let exit = robot.child.wait().map_err(|e| e.to_string())?;
-    let clean = killed && exit.success() && rest.iter().any(|l| l == "server stopped cleanly");
-    let writes_seen = rest.iter().filter(|l| l.starts_with("ConfiguredDefaultStopMode written by a client")).count();
-    eprintln!("load: the robot printed {writes_seen} client writes received by its derived struct");
+    let stopped = robot.stop();
     if !status.success() {
         return Err(format!("the load test failed ({status})"));
     }
-    if !clean {
-        return Err(format!("the robot example did not stop cleanly after the load ({exit}); last lines: {:?}", rest.iter().rev().take(5).collect::<Vec<_>>()));
-    }
+    let rest = stopped.map_err(|e| format!("after the load, {e}"))?;
+    let writes_seen = rest.iter().filter(|l| l.starts_with("ConfiguredDefaultStopMode written by a client")).count();
+    eprintln!("load: the robot printed {writes_seen} client writes received by its derived struct");
     if writes_seen == 0 {
         return Err("no client write reached the robot's derived struct".into());
     }

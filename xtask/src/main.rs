@@ -16,6 +16,7 @@ mod fetch;
 mod fuzz;
 mod generate;
 mod load;
+mod soak;
 mod test;
 mod util;
 mod venv;
@@ -47,6 +48,8 @@ enum Command {
     Generate(generate::Args),
     /// The generated robot server under client load: sessions subscribed to every axis variable, a writer.
     Load(load::Args),
+    /// The robot cell runs DrillHole many times, a python asyncua client watching every skill's state.
+    Soak(soak::Args),
     /// Everything a fresh machine needs (pinned nodesets, Python test peers), then every test.
     Test(test::Args),
     /// Create or update the Python venv `.venv` with the test peers of `tests/requirements.txt`.
@@ -62,6 +65,7 @@ fn main() -> ExitCode {
         Command::Fuzz(args) => fuzz::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Load(args) => load::run(args),
+        Command::Soak(args) => soak::run(args),
         Command::Test(args) => test::run(args),
         Command::Venv(args) => venv::run(args),
     };

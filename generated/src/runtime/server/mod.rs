@@ -70,6 +70,11 @@ pub struct ServerConfig {
     /// change, each state of a program however short it lasts. (async-opcua 0.19 holds back a change that
     /// follows another within a non-zero sampling interval until the next change of the variable.)
     pub min_sampling_interval_ms: f64,
+    /// The smallest publishing interval the server grants, in milliseconds, which is also how often it
+    /// looks for notifications to send. Defaults to async-opcua's 100. A server whose programs are run by
+    /// the composite skills of other servers wants less: `runtime::remote` learns that a basic skill ended
+    /// from its transition event, so each step of a composite skill waits for a publish.
+    pub min_publishing_interval_ms: u64,
     /// Where async-opcua keeps certificates. The endpoint needs none; the default is a folder in the
     /// system's temporary directory, so that nothing is written beside the program.
     pub pki_dir: PathBuf,
@@ -99,6 +104,7 @@ impl ServerConfig {
             type_loaders: Vec::new(),
             instance_namespace: None,
             min_sampling_interval_ms: 0.0,
+            min_publishing_interval_ms: 100,
             pki_dir: std::env::temp_dir().join("nodeset-models-pki"),
             max_sessions: DEFAULT_MAX_SESSIONS,
         }
@@ -140,6 +146,12 @@ impl ServerConfig {
         self
     }
 
+    /// Sets the smallest publishing interval the server grants (at least 1 ms).
+    pub fn min_publishing_interval_ms(mut self, ms: u64) -> ServerConfig {
+        self.min_publishing_interval_ms = ms.max(1);
+        self
+    }
+
     /// Adds a type loader.
     pub fn type_loader(mut self, loader: impl TypeLoader + 'static) -> ServerConfig {
         self.type_loaders.push(Arc::new(loader));
@@ -168,6 +180,8 @@ impl ServerConfig {
             builder = builder.with_type_loader(loader);
         }
         builder.limits_mut().subscriptions.min_sampling_interval_ms = self.min_sampling_interval_ms;
+        builder.limits_mut().subscriptions.min_publishing_interval_ms = self.min_publishing_interval_ms as f64;
+        builder = builder.subscription_poll_interval_ms(self.min_publishing_interval_ms.min(100));
         let (server, handle) = builder.build()?;
         let manager = ModelManager::from_handle(&handle).ok_or("the model node manager is missing from the server")?;
         let endpoint_url = format!("opc.tcp://{}:{port}/", self.host);

@@ -1,0 +1,55 @@
+//! `cargo xtask soak`: the robot cell runs DrillHole many times in a row (issue "Skills", must-show 3).
+//!
+//! Builds the `robot_cell` example, starts its three servers on free loopback ports with short motions,
+//! and runs `tests/interop/skills_soak.py` (python asyncua from `.venv`) against them: one session per
+//! server subscribed to CurrentState and the transition events of every skill, DrillHole started `--runs`
+//! times, each transition event checked in order, the servers' memory sampled. Then it stops the servers,
+//! which must end cleanly. `cargo xtask test` runs it with 100 runs; the default is the full 1,000.
+
+use crate::load::{build, Example};
+use crate::util::workspace_root;
+
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// How many DrillHole runs.
+    #[arg(long, default_value_t = 1000)]
+    pub runs: usize,
+    /// How long each basic skill's simulated motion takes.
+    #[arg(long, default_value_t = 5)]
+    pub motion_ms: u64,
+    /// Build the example in release mode (the default reuses the debug build of `cargo test`).
+    #[arg(long)]
+    pub release: bool,
+}
+
+pub fn run(args: Args) -> Result<(), String> {
+    let root = workspace_root();
+    crate::fetch::ensure_fetched()?;
+    let python = crate::venv::ensure_venv()?;
+    let examples = build(&root, args.release, &["robot_cell"])?;
+    let motion = args.motion_ms.to_string();
+    let cell = Example::spawn(&examples.join("robot_cell"), &["--port", "0", "--motion-ms", &motion])?;
+    let mut urls = Vec::new();
+    for label in ["robot", "drilling unit", "cell"] {
+        let line = cell.line()?;
+        let url = line.strip_prefix(&format!("{label} listening on ")).ok_or_else(|| format!("unexpected line {line:?}"))?;
+        urls.push(url.to_owned());
+    }
+    let ready = cell.line()?;
+    if ready != "cell ready" {
+        return Err(format!("unexpected line {ready:?}"));
+    }
+    eprintln!("soak: robot cell (pid {}) at {}", cell.pid(), urls.join(", "));
+    let status = std::process::Command::new(python)
+        .current_dir(root.join("tests/interop"))
+        .arg("skills_soak.py")
+        .args(["--robot", &urls[0], "--unit", &urls[1], "--cell", &urls[2]])
+        .args(["--runs", &args.runs.to_string(), "--server-pid", &cell.pid().to_string()])
+        .status()
+        .map_err(|e| format!("cannot run the soak client: {e}"))?;
+    let stopped = cell.stop();
+    if !status.success() {
+        return Err(format!("the soak run failed ({status})"));
+    }
+    stopped.map(|_| ()).map_err(|e| format!("after the soak run, {e}"))
+}
