@@ -799,9 +799,7 @@ impl Program {
         let (from, to) = (self.kind(row.from), self.kind(row.to));
         let starts = to == Some(ProgramState::Running) && !from.is_some_and(ProgramState::active);
         let ends = from.is_some_and(ProgramState::active) && !to.is_some_and(ProgramState::active);
-        if starts {
-            self.start(&mut st, arguments)?;
-        }
+        let run = if starts { Some(self.start(&mut st, arguments)?) } else { None };
         if ends {
             self.end_run(&mut st);
         }
@@ -814,12 +812,17 @@ impl Program {
             self.inner.core.set(&self.inner.core.vars.recycle_count, st.recycle_count);
         }
         self.take(&mut st, t, 100);
+        // The body runs once the transition to Running is taken: nothing it does (such as starting the
+        // skills of other servers) can come before the program's own Running.
+        if let Some(run) = run {
+            st.task = Some(tokio::spawn(run).abort_handle());
+        }
         Ok(())
     }
 
-    /// Reads the inputs and spawns the body of a new run (before the transition to Running is taken, so
-    /// bad inputs leave the state as it is).
-    fn start(&self, st: &mut ProgramStatus, arguments: Vec<Variant>) -> Result<(), StatusCode> {
+    /// Reads the inputs and prepares the body of a new run (before the transition to Running is taken, so
+    /// bad inputs leave the state as it is); the caller spawns it after the transition.
+    fn start(&self, st: &mut ProgramStatus, arguments: Vec<Variant>) -> Result<Pin<Box<dyn Future<Output = ()> + Send>>, StatusCode> {
         let values: Vec<Option<Variant>> = self
             .inner
             .inputs
@@ -832,14 +835,12 @@ impl Program {
         let control = Control { program: self.clone(), rx: self.inner.tx.subscribe(), arguments: arguments.into() };
         let future = (self.inner.starter)(values, control)?;
         let weak = Arc::downgrade(&self.inner);
-        let task = tokio::spawn(async move {
+        Ok(Box::pin(async move {
             let result = future.await;
             if let Some(inner) = weak.upgrade() {
                 Program { inner }.finish(run, result);
             }
-        });
-        st.task = Some(task.abort_handle());
-        Ok(())
+        }))
     }
 
     /// Ends run `run` as its body returned: in Ready with the outputs, or in Halted with the error.
