@@ -35,8 +35,19 @@
 //!   (the skill is Ready or Halted, but no event said so) is found by the same read.
 
 use std::collections::BTreeMap;
+use std::future::Future;
+use std::pin::Pin;
 use std::sync::Arc;
 use std::time::Duration;
+
+use opcua::client::transport::{ConnectorBuilder, StreamConnection, StreamConnector};
+use opcua::client::ConnectionSource;
+use opcua::core::comms::tcp_codec::TcpCodec;
+use opcua::core::comms::url::hostname_port_from_url;
+use opcua::types::{DecodingOptions, EndpointDescription};
+use tokio::io::{ReadHalf, WriteHalf};
+use tokio::net::TcpStream;
+use tokio_util::codec::FramedRead;
 
 use opcua::client::{ClientBuilder, IdentityToken, MonitoredItem, Session, SubscriptionCallbacks};
 use opcua::crypto::SecurityPolicy;
@@ -85,6 +96,52 @@ impl std::fmt::Display for RemoteError {
 
 impl std::error::Error for RemoteError {}
 
+/// A connection source for async-opcua's client whose TCP connections send at once (`TCP_NODELAY`).
+///
+/// async-opcua writes a request in more than one write, and with Nagle's algorithm the second waits for
+/// the server's ACK of the first, which Linux delays by up to 40 ms: every read after a Publish request
+/// took that long, and each step of a composite skill waited for two of them. Use it with
+/// `client.session_builder()...with_connector(NoDelay)`; [`RemoteServer::connect`] does.
+pub struct NoDelay;
+
+/// The connector [`NoDelay`] builds for one endpoint.
+pub struct NoDelayUrl(String);
+
+type Halves = StreamConnection<ReadHalf<TcpStream>, WriteHalf<TcpStream>>;
+type Connecting = Pin<Box<dyn Future<Output = Result<Halves, opcua::types::Error>> + Send + Sync>>;
+
+impl ConnectionSource for NoDelay {
+    type Builder = NoDelayUrl;
+
+    fn get_connector(&self, endpoint: &EndpointDescription) -> Result<NoDelayUrl, opcua::types::Error> {
+        Ok(NoDelayUrl(endpoint.endpoint_url.as_ref().to_owned()))
+    }
+}
+
+impl ConnectorBuilder for NoDelayUrl {
+    type ConnectorType = StreamConnector<ReadHalf<TcpStream>, WriteHalf<TcpStream>, fn(String, DecodingOptions) -> Connecting, Connecting>;
+
+    fn build(self) -> Result<Self::ConnectorType, opcua::types::Error> {
+        Ok(StreamConnector::new(connect_no_delay as fn(String, DecodingOptions) -> Connecting, self.0))
+    }
+}
+
+fn connect_no_delay(url: String, options: DecodingOptions) -> Connecting {
+    Box::pin(async move {
+        let error = |status: StatusCode, what: String| opcua::types::Error::new(status, what);
+        let (host, port) = hostname_port_from_url(&url, opcua::core::constants::DEFAULT_OPC_UA_SERVER_PORT)
+            .map_err(|s| error(s, format!("cannot read host and port from {url}")))?;
+        let stream = TcpStream::connect((host.as_str(), port))
+            .await
+            .map_err(|e| error(StatusCode::BadCommunicationError, format!("cannot connect to {host}:{port}: {e}")))?;
+        stream
+            .set_nodelay(true)
+            .map_err(|e| error(StatusCode::BadCommunicationError, format!("cannot set TCP_NODELAY: {e}")))?;
+        let (reader, writer) = tokio::io::split(stream);
+        Ok(StreamConnection::new(FramedRead::new(reader, TcpCodec::new(options)), writer, url))
+    })
+}
+
 /// A session to another server.
 pub struct RemoteServer {
     session: Arc<Session>,
@@ -96,7 +153,7 @@ impl RemoteServer {
     /// Opens a session (SecurityPolicy None, anonymous) to the server at `url` and reads its namespaces.
     pub async fn connect(url: &str) -> Result<RemoteServer, RemoteError> {
         let connect_error = |s: StatusCode| RemoteError::Connect(url.to_owned(), s);
-        let mut client = ClientBuilder::new()
+        let client = ClientBuilder::new()
             .application_name("nodeset-models composite skill")
             .application_uri("urn:nodeset-models:composite-skill")
             .pki_dir(std::env::temp_dir().join("nodeset-models-pki-remote"))
@@ -105,12 +162,15 @@ impl RemoteServer {
             .session_retry_limit(3)
             .client()
             .map_err(|_| connect_error(StatusCode::BadConfigurationError))?;
+        let endpoints = client.get_server_endpoints_from_url(url).await.map_err(|e| connect_error(e.status()))?;
         let (session, event_loop) = client
-            .connect_to_matching_endpoint(
-                (url, SecurityPolicy::None.to_str(), MessageSecurityMode::None),
-                IdentityToken::Anonymous,
-            )
-            .await
+            .session_builder()
+            .with_endpoints(endpoints)
+            .connect_to_matching_endpoint((url, SecurityPolicy::None.to_str(), MessageSecurityMode::None))
+            .map_err(|e| connect_error(e.status()))?
+            .user_identity_token(IdentityToken::Anonymous)
+            .with_connector(NoDelay)
+            .build(client.certificate_store().clone())
             .map_err(|e| connect_error(e.status()))?;
         let event_loop = event_loop.spawn();
         let connected = tokio::time::timeout(Duration::from_secs(10), session.wait_for_connection()).await;
@@ -311,7 +371,7 @@ impl RemoteSkill {
             },
         );
         let subscription = session
-            .create_subscription(Duration::from_millis(20), 600, 20, 0, 0, true, callbacks)
+            .create_subscription(Duration::from_millis(10), 600, 20, 0, 0, true, callbacks)
             .await
             .map_err(|e| RemoteError::Service("CreateSubscription", e.status()))?;
         let filter = EventFilter { select_clauses: Some(to_state_clauses()), where_clause: ContentFilter::default() };

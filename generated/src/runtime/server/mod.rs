@@ -223,6 +223,9 @@ impl ModelServer {
     /// Serves clients until the handle is cancelled; must run inside a tokio runtime.
     pub async fn run(self) -> Result<(), String> {
         self.listener.set_nonblocking(true).map_err(|e| format!("cannot make the listener non-blocking: {e}"))?;
+        if let Err(e) = socket2::SockRef::from(&self.listener).set_tcp_nodelay(true) {
+            tracing::warn!("cannot set TCP_NODELAY on the listener: {e}");
+        }
         let listener = tokio::net::TcpListener::from_std(self.listener)
             .map_err(|e| format!("cannot hand the listener to tokio: {e}"))?;
         self.server.run_with(listener).await
