@@ -5,7 +5,7 @@
 //! 3. `cargo test --workspace --locked`, whose summary lines CI reads.
 //! 4. `cargo xtask corpus`: Rust for every resolvable ua-nodeset file, compiled.
 //! 5. `cargo xtask load --seconds 20`: the robot example under 50 subscribed client sessions and a writer.
-//! 6. `cargo xtask soak --runs 100`: the robot cell runs DrillHole 100 times, every skill state watched.
+//! 6. `cargo xtask soak`: the robot cell runs DrillHole 1,000 times, every skill state watched.
 //! 7. Each fuzz target of `fuzz/` for [`FUZZ_SECS`] seconds (`cargo xtask fuzz`): CI exercises the targets
 //!    and replays the corpus they grew on this machine before; a crash fails the run.
 
@@ -44,8 +44,8 @@ pub fn run(args: Args) -> Result<(), String> {
     crate::corpus::run(crate::corpus::Args::default())?;
     // The robot server under 50 client sessions, briefly (`cargo xtask load` runs five minutes).
     crate::load::run(crate::load::Args { sessions: 50, seconds: 20, publishing_ms: 100, release: false })?;
-    // The robot cell, DrillHole 100 times in a row (`cargo xtask soak` runs 1,000).
-    crate::soak::run(crate::soak::Args { runs: 100, motion_ms: 5, release: false })?;
+    // The robot cell, DrillHole 1,000 times in a row (about a minute).
+    crate::soak::run(crate::soak::Args { runs: 1000, motion_ms: 5, release: false })?;
     for target in crate::fuzz::Target::ALL {
         crate::fuzz::run(crate::fuzz::Args { target, secs: FUZZ_SECS, libfuzzer_args: Vec::new() })?;
     }
