@@ -1,7 +1,8 @@
 //! Our skill nodesets (`nodesets/CommonSkills`, `RobotCell`, `DrillingProcess`) on the pinned ns0, DI, IA and
 //! Robotics: they resolve without a single diagnostic, the skills are programs with the methods they
 //! promise, the UR10e controller offers the three move skills, every instance carries every Mandatory
-//! instance declaration of its type, and python asyncua's XML importer loads them without a warning.
+//! instance declaration of its type, python asyncua's XML importer loads them without a warning, and they
+//! are valid against UANodeSet.xsd.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -385,4 +386,43 @@ fn asyncua_imports_the_skill_nodesets_without_a_warning() {
         "tests/interop/skills_import.py failed:\n{stdout}\n{}",
         String::from_utf8_lossy(&out.stderr)
     );
+}
+
+/// Runs `tests/interop/xsd_check.py` with the OPC Foundation's UANodeSet.xsd on `files`.
+fn xsd_check(files: &[PathBuf]) -> (bool, String) {
+    let schema = root().join("../shared/nodesets/ua-nodeset/Schema/UANodeSet.xsd");
+    assert!(schema.is_file(), "UANodeSet.xsd is missing at {}; the tests need ../shared beside the project", schema.display());
+    let out = Command::new(python())
+        .arg(root().join("tests/interop/xsd_check.py"))
+        .arg(&schema)
+        .args(files)
+        .output()
+        .expect("python runs");
+    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(!text.contains("ModuleNotFoundError"), "xmlschema is not installed; run `cargo xtask venv`:\n{text}");
+    (out.status.success(), text)
+}
+
+/// Each file is valid against UANodeSet.xsd; the check itself finds an element that the schema forbids.
+#[test]
+fn skill_nodesets_are_valid_against_uanodeset_xsd() {
+    let files: Vec<PathBuf> = FILES.iter().map(|f| root().join("nodesets").join(f)).collect();
+    let (valid, report) = xsd_check(&files);
+    assert!(valid, "a skill nodeset is not valid against UANodeSet.xsd:\n{report}");
+    assert_eq!(report.matches(": 0 errors").count(), 3, "{report}");
+
+    // A UAObjectType without its NodeId, and an element UANodeSet.xsd does not know.
+    let text = std::fs::read_to_string(&files[0]).unwrap();
+    let broken = text
+        .replacen("<UAObjectType NodeId=\"ns=1;i=1100\"", "<UAObjectType", 1)
+        .replacen("</UANodeSet>", "<UAWidget NodeId=\"ns=1;i=1\"/></UANodeSet>", 1);
+    assert_ne!(broken, text);
+    let dir = std::env::temp_dir().join(format!("nodeset-xsd-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("Broken.NodeSet2.xml");
+    std::fs::write(&path, broken).unwrap();
+    let (valid, report) = xsd_check(&[path]);
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(!valid, "the broken file passed:\n{report}");
+    assert!(report.contains(": 2 errors") && report.contains("NodeId") && report.contains("UAWidget"), "{report}");
 }
