@@ -869,6 +869,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                 }
                 "BrowseName" => {
                     node.browse_name = raw();
+                    node.qualified_name = crate::nodeid::parse_qualified_name(&a.value).ok();
                     have_bn = true
                 }
                 "SymbolicName" => node.symbolic_name = Some(a.value.to_string()),

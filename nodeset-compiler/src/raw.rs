@@ -238,6 +238,10 @@ pub struct RawNode {
     pub span: Span,
     pub node_id: RawStr,
     pub browse_name: RawStr,
+    /// The BrowseName read as `N:Name` (local namespace index), when it is one: read by the parser while
+    /// the text is at hand. `None` when it is malformed or missing; the resolver then reads the text and
+    /// says what is wrong.
+    pub qualified_name: Option<crate::nodeid::RawQualifiedName>,
     pub symbolic_name: Option<String>,
     pub write_mask: Option<u32>,
     pub user_write_mask: Option<u32>,
@@ -288,6 +292,7 @@ impl RawNode {
             span,
             node_id: empty.clone(),
             browse_name: empty,
+            qualified_name: None,
             symbolic_name: None,
             write_mask: None,
             user_write_mask: None,
