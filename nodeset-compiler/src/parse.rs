@@ -614,8 +614,12 @@ impl<'a, 'd> Parser<'a, 'd> {
                         "Extensions" => self.skip()?,
                         _ => match NodeClass::from_element(name) {
                             Some(class) => {
-                                let node = self.node(class, &e, span)?;
-                                set.nodes.push(node);
+                                // Read in place: a node is large, and moving it out of `node` and into the
+                                // list cost a copy or two of it per node. A node left half read by an error
+                                // goes with the part, which the error discards.
+                                set.nodes.push(RawNode::new(class, span));
+                                let node = set.nodes.last_mut().expect("just pushed");
+                                self.node(node, &e)?;
                             }
                             None => self.unknown(&e, span, "UANodeSet")?,
                         },
@@ -854,8 +858,9 @@ impl<'a, 'd> Parser<'a, 'd> {
         }
     }
 
-    fn node(&mut self, class: NodeClass, e: &BytesStart<'a>, span: Span) -> PResult<RawNode> {
-        let mut node = RawNode::new(class, span);
+    /// Reads a node element into `node`, a fresh [`RawNode::new`] of its class and start tag.
+    fn node(&mut self, node: &mut RawNode, e: &BytesStart<'a>) -> PResult<()> {
+        let (class, span) = (node.class, node.span);
         let attrs = self.attrs(e, span)?;
         let mut have_id = false;
         let mut have_bn = false;
@@ -947,7 +952,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                 Ev::Eof => unreachable!(),
             }
         }
-        Ok(node)
+        Ok(())
     }
 
     fn references(&mut self, out: &mut Vec<RawReference>) -> PResult<()> {
