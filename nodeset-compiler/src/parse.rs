@@ -949,7 +949,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                             node.extensions = sink.done.map(|tree| tree.children).unwrap_or_default();
                         }
                         b"Value" => node.value = self.value(&e, cspan)?,
-                        b"Definition" => node.definition = Some(self.definition(&e, cspan)?),
+                        b"Definition" => node.definition = Some(Box::new(self.definition(&e, cspan)?)),
                         _ => {
                             let within = class.element();
                             self.unknown(&e, cspan, within)?

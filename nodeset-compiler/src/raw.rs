@@ -279,7 +279,8 @@ pub struct RawNode {
     pub is_abstract: Option<bool>,
     pub symmetric: Option<bool>,
     pub inverse_names: Vec<LocalizedText>,
-    pub definition: Option<RawDefinition>,
+    /// Boxed: only DataTypes have one, and every other node would carry its room.
+    pub definition: Option<Box<RawDefinition>>,
     pub purpose: Option<String>,
 }
 
