@@ -155,7 +155,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 description: std::mem::take(&mut raw.descriptions),
                 attrs,
                 value: raw.value,
-                definition: raw.definition.take().map(|d| *d),
+                definition: raw.definition.take(),
                 extensions: std::mem::take(&mut raw.extensions),
                 references: Vec::with_capacity(raw.references.len()),
                 super_type: None,
