@@ -31,7 +31,7 @@ pub(crate) fn classify(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeI
             .map(|r| (model.node(r.target).browse_name.name.clone(), r.target))
             .collect();
         let is_abstract = node.is_abstract();
-        let def = node.definition.as_ref();
+        let def = node.definition.as_deref();
         let kind = if let Some(b) = own_builtin.filter(|b| !matches!(b, BuiltinType::ExtensionObject | BuiltinType::Variant)) {
             DataTypeKind::Builtin(b)
         } else if matches!(node.id.ns0(), Some(ids::BASE_DATA_TYPE | ids::NUMBER | ids::INTEGER | ids::UINTEGER | ids::DECIMAL)) {

@@ -171,7 +171,8 @@ pub struct Node {
     /// The element inside the node's `<Value>`, if any: read it with [`Model::value_element`] or
     /// [`Model::value_xml`], decode it with [`Model::value`].
     pub value: Option<ValueRef>,
-    pub definition: Option<RawDefinition>,
+    /// Boxed, as in the raw node: only DataTypes have one.
+    pub definition: Option<Box<RawDefinition>>,
     pub extensions: Vec<XmlElement>,
     pub references: Vec<Reference>,
     pub super_type: Option<NodeIx>,

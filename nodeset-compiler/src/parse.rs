@@ -151,6 +151,8 @@ struct Parser<'a, 'd> {
     /// Reads `text[base..]` up to the end of the part being read.
     reader: Reader<&'a [u8]>,
     base: usize,
+    /// Where the part being read ends in `text`.
+    end: usize,
     /// Bytes the parser read itself (see [`Parser::scan_references`]), which quick-xml's positions lack.
     skipped: usize,
     /// Whether quick-xml stands between two pieces of markup, so that the parser may read on itself: after
@@ -180,7 +182,7 @@ impl<'a, 'd> Parser<'a, 'd> {
     /// A parser of `text[range]`, with spans in `text`.
     fn new(file: FileId, text: &'a str, range: std::ops::Range<usize>, limits: &'a Limits, diags: &'d mut Diagnostics) -> Self {
         let ends_early = range.end < text.len();
-        let base = range.start;
+        let (base, end) = (range.start, range.end);
         let mut reader = Reader::from_str(&text[range]);
         let cfg = reader.config_mut();
         cfg.expand_empty_elements = true;
@@ -192,6 +194,7 @@ impl<'a, 'd> Parser<'a, 'd> {
             text,
             reader,
             base,
+            end,
             skipped: 0,
             between_tags: false,
             outer_root: None,
@@ -596,6 +599,12 @@ impl<'a, 'd> Parser<'a, 'd> {
     /// Reads the children of the root element, and what follows the root, up to the end of the part.
     fn root_content(&mut self, part: &mut Part) -> PResult<()> {
         let set = &mut part.set;
+        // Room for the nodes up front: a node is large, and a list grown by doubling copied each one about
+        // once more. Every node element starts with `<UA`; the count may be a little high (a comment). A
+        // real node takes hundreds of bytes, so no more than one per 64 bytes is reserved for: a file full
+        // of `<UA` cannot make the room many times its own size (its list grows as it is read).
+        let rest = self.text.as_bytes().get(self.pos()..self.end).unwrap_or_default();
+        set.nodes.reserve(memchr::memmem::find_iter(rest, b"<UA").count().min(rest.len() / 64));
         loop {
             match self.next()? {
                 Ev::Start(e, span) => {
@@ -614,8 +623,12 @@ impl<'a, 'd> Parser<'a, 'd> {
                         "Extensions" => self.skip()?,
                         _ => match NodeClass::from_element(name) {
                             Some(class) => {
-                                let node = self.node(class, &e, span)?;
-                                set.nodes.push(node);
+                                // Read in place: a node is large, and moving it out of `node` and into the
+                                // list cost a copy or two of it per node. A node left half read by an error
+                                // goes with the part, which the error discards.
+                                set.nodes.push(RawNode::new(class, span));
+                                let node = set.nodes.last_mut().expect("just pushed");
+                                self.node(node, &e)?;
                             }
                             None => self.unknown(&e, span, "UANodeSet")?,
                         },
@@ -854,8 +867,9 @@ impl<'a, 'd> Parser<'a, 'd> {
         }
     }
 
-    fn node(&mut self, class: NodeClass, e: &BytesStart<'a>, span: Span) -> PResult<RawNode> {
-        let mut node = RawNode::new(class, span);
+    /// Reads a node element into `node`, a fresh [`RawNode::new`] of its class and start tag.
+    fn node(&mut self, node: &mut RawNode, e: &BytesStart<'a>) -> PResult<()> {
+        let (class, span) = (node.class, node.span);
         let attrs = self.attrs(e, span)?;
         let mut have_id = false;
         let mut have_bn = false;
@@ -869,6 +883,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                 }
                 "BrowseName" => {
                     node.browse_name = raw();
+                    node.qualified_name = crate::nodeid::parse_qualified_name(&a.value).ok();
                     have_bn = true
                 }
                 "SymbolicName" => node.symbolic_name = Some(a.value.to_string()),
@@ -934,7 +949,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                             node.extensions = sink.done.map(|tree| tree.children).unwrap_or_default();
                         }
                         b"Value" => node.value = self.value(&e, cspan)?,
-                        b"Definition" => node.definition = Some(self.definition(&e, cspan)?),
+                        b"Definition" => node.definition = Some(Box::new(self.definition(&e, cspan)?)),
                         _ => {
                             let within = class.element();
                             self.unknown(&e, cspan, within)?
@@ -946,7 +961,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                 Ev::Eof => unreachable!(),
             }
         }
-        Ok(node)
+        Ok(())
     }
 
     fn references(&mut self, out: &mut Vec<RawReference>) -> PResult<()> {

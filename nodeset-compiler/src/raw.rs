@@ -238,6 +238,10 @@ pub struct RawNode {
     pub span: Span,
     pub node_id: RawStr,
     pub browse_name: RawStr,
+    /// The BrowseName read as `N:Name` (local namespace index), when it is one: read by the parser while
+    /// the text is at hand. `None` when it is malformed or missing; the resolver then reads the text and
+    /// says what is wrong.
+    pub qualified_name: Option<crate::nodeid::RawQualifiedName>,
     pub symbolic_name: Option<String>,
     pub write_mask: Option<u32>,
     pub user_write_mask: Option<u32>,
@@ -275,7 +279,8 @@ pub struct RawNode {
     pub is_abstract: Option<bool>,
     pub symmetric: Option<bool>,
     pub inverse_names: Vec<LocalizedText>,
-    pub definition: Option<RawDefinition>,
+    /// Boxed: only DataTypes have one, and every other node would carry its room.
+    pub definition: Option<Box<RawDefinition>>,
     pub purpose: Option<String>,
 }
 
@@ -288,6 +293,7 @@ impl RawNode {
             span,
             node_id: empty.clone(),
             browse_name: empty,
+            qualified_name: None,
             symbolic_name: None,
             write_mask: None,
             user_write_mask: None,

@@ -73,8 +73,12 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                     continue;
                 }
             };
-            let browse_name_text = raw.browse_name.get(text);
-            let browse_name = match parse_qualified_name(browse_name_text) {
+            // The parser read well-formed BrowseNames; the text is read again only for the others.
+            let parsed = match raw.qualified_name.take() {
+                Some(q) => Ok(q),
+                None => parse_qualified_name(raw.browse_name.get(text)),
+            };
+            let browse_name = match parsed {
                 Ok(q) => match ctx.ns_map.get(q.ns as usize) {
                     Some(&ns) => QualifiedName { ns, name: q.name },
                     None => {
@@ -90,6 +94,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                     }
                 },
                 Err(why) => {
+                    let browse_name_text = raw.browse_name.get(text);
                     if !browse_name_text.is_empty() || raw.browse_name.span != raw.span {
                         diags.push(
                             Diagnostic::new(Code::MalformedQualifiedName, format!("malformed BrowseName: {why}"))
@@ -113,6 +118,9 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
             }
             let ix = NodeIx(model.nodes.len() as u32);
             model.index.insert(id.clone(), ix);
+            if id.ns == 0 && matches!(raw.class, NodeClass::DataType | NodeClass::ReferenceType) {
+                model.ns0_type_names.insert(browse_name.name.clone(), ix);
+            }
             let attrs = Attributes {
                 write_mask: raw.write_mask,
                 user_write_mask: raw.user_write_mask,
@@ -160,12 +168,6 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 browse_name_span: raw.browse_name.span,
             });
             pending.push((ix, fi as u32, ni as u32));
-        }
-    }
-
-    for (i, n) in model.nodes.iter().enumerate() {
-        if n.id.ns == 0 && matches!(n.class, NodeClass::DataType | NodeClass::ReferenceType) {
-            model.ns0_type_names.insert(n.browse_name.name.clone(), NodeIx(i as u32));
         }
     }
 
