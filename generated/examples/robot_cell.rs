@@ -40,7 +40,7 @@ use nodeset_models::models::drilling_process::objects::{
 };
 use nodeset_models::models::robot_cell::objects::{TemplateDrillingSkillType, TemplateDrillingSkillTypeInputs};
 use nodeset_models::models::robotics::objects::AxisType;
-use nodeset_models::models::{common_skills, di, drilling_process, ia, robot_cell, robotics};
+use nodeset_models::models;
 use nodeset_models::runtime::remote::RemoteServer;
 use nodeset_models::runtime::server::{ModelServer as Server, ServerConfig};
 use nodeset_models::runtime::typed::{Control, Program};
@@ -83,22 +83,8 @@ fn options() -> Result<Options, String> {
 }
 
 fn config(name: &str, port: u16) -> ServerConfig {
-    ServerConfig::new(name)
-        .port(port)
-        // Each step of a composite skill ends with a transition event of a basic skill: publish quickly.
-        .min_publishing_interval_ms(10)
-        .table(&di::TABLE)
-        .type_loader(di::TypeLoader)
-        .table(&ia::TABLE)
-        .type_loader(ia::TypeLoader)
-        .table(&robotics::TABLE)
-        .type_loader(robotics::TypeLoader)
-        .table(&common_skills::TABLE)
-        .type_loader(common_skills::TypeLoader)
-        .table(&robot_cell::TABLE)
-        .type_loader(robot_cell::TypeLoader)
-        .table(&drilling_process::TABLE)
-        .type_loader(drilling_process::TypeLoader)
+    // Each step of a composite skill ends with a transition event of a basic skill: publish quickly.
+    models::register(ServerConfig::new(name).port(port).min_publishing_interval_ms(10))
 }
 
 /// A server that runs.

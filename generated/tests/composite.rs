@@ -17,7 +17,7 @@ use nodeset_models::models::common_skills::objects::{
 };
 use nodeset_models::models::drilling_process::objects::{DrillHoleSkillType, DrillHoleSkillTypeInputs};
 use nodeset_models::models::robot_cell::objects::{TemplateDrillingSkillType, TemplateDrillingSkillTypeInputs};
-use nodeset_models::models::{common_skills, di, drilling_process, ia, robot_cell, robotics};
+use nodeset_models::models::{self, drilling_process};
 use nodeset_models::runtime::remote::{RemoteError, RemoteServer};
 use nodeset_models::runtime::server::{ModelManager, ServerConfig};
 use nodeset_models::runtime::typed::{Program, ProgramState};
@@ -31,19 +31,7 @@ const DRILL: &str = "DeviceSet/TemplateDrillingLwrSystem/DrillingEndEffector/Ski
 const DRILL_HOLE: &str = "DrillingCell/SkillSet/DrillHole";
 
 fn config(name: &str) -> ServerConfig {
-    ServerConfig::new(name)
-        .table(&di::TABLE)
-        .type_loader(di::TypeLoader)
-        .table(&ia::TABLE)
-        .type_loader(ia::TypeLoader)
-        .table(&robotics::TABLE)
-        .type_loader(robotics::TypeLoader)
-        .table(&common_skills::TABLE)
-        .type_loader(common_skills::TypeLoader)
-        .table(&robot_cell::TABLE)
-        .type_loader(robot_cell::TypeLoader)
-        .table(&drilling_process::TABLE)
-        .type_loader(drilling_process::TypeLoader)
+    models::register(ServerConfig::new(name))
 }
 
 /// Binds the skill at `path` on a server (the server side looks it up in its own address space).

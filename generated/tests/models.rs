@@ -4,7 +4,7 @@
 
 mod common;
 
-use nodeset_models::models::{common_skills, di, drilling_process, ia, robot_cell, robotics};
+use nodeset_models::models::{self, common_skills, di, drilling_process, ia, robot_cell, robotics};
 use nodeset_models::runtime::server::ServerConfig;
 use nodeset_models::runtime::table::NodeSetTable;
 use opcua::nodes::TypeTree;
@@ -62,19 +62,7 @@ const SKILL_TABLES: [&NodeSetTable; 6] =
 #[tokio::test]
 async fn skill_tables_import_completely() {
     let running = common::serve(
-        ServerConfig::new("skills test")
-            .table(&di::TABLE)
-            .type_loader(di::TypeLoader)
-            .table(&ia::TABLE)
-            .type_loader(ia::TypeLoader)
-            .table(&robotics::TABLE)
-            .type_loader(robotics::TypeLoader)
-            .table(&common_skills::TABLE)
-            .type_loader(common_skills::TypeLoader)
-            .table(&robot_cell::TABLE)
-            .type_loader(robot_cell::TypeLoader)
-            .table(&drilling_process::TABLE)
-            .type_loader(drilling_process::TypeLoader),
+        models::register(ServerConfig::new("skills test")),
     )
     .await;
     let m = &running.manager;

@@ -16,7 +16,7 @@ use common::{connect, disconnect, read, serve, Running};
 use nodeset_models::models::common_skills::objects::{
     AbsoluteJointPtpMoveSkillType, AbsoluteJointPtpMoveSkillTypeInputs, ProgramSkillStateMachineTypeOutputs,
 };
-use nodeset_models::models::{common_skills, di, drilling_process, ia, robot_cell, robotics};
+use nodeset_models::models::{self, common_skills, di, drilling_process};
 use nodeset_models::runtime::server::ServerConfig;
 use nodeset_models::runtime::typed::{Instantiate, Machine, ObjectType, ProgramState, StateMachine};
 use opcua::client::{MonitoredItem, Session, SubscriptionCallbacks};
@@ -226,19 +226,7 @@ fn check(e: &Seen, name: &str, transition: (u32, u32), from: (u32, u32), to: (u3
 }
 
 fn cell_config(name: &str) -> ServerConfig {
-    ServerConfig::new(name)
-        .table(&di::TABLE)
-        .type_loader(di::TypeLoader)
-        .table(&ia::TABLE)
-        .type_loader(ia::TypeLoader)
-        .table(&robotics::TABLE)
-        .type_loader(robotics::TypeLoader)
-        .table(&common_skills::TABLE)
-        .type_loader(common_skills::TypeLoader)
-        .table(&robot_cell::TABLE)
-        .type_loader(robot_cell::TypeLoader)
-        .table(&drilling_process::TABLE)
-        .type_loader(drilling_process::TypeLoader)
+    models::register(ServerConfig::new(name))
 }
 
 fn skill_event_type(running: &Running) -> Variant {

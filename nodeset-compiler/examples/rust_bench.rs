@@ -267,7 +267,7 @@ fn generate_cmd(mut args: impl Iterator<Item = String>) -> Result<(), String> {
             .iter()
             .map(|n| (n.module.clone(), n.uri.clone()))
             .collect();
-        rust.files.push(rust_emit::models_mod(&modules, COMMAND));
+        rust.files.push(rust_emit::models_mod(&modules, &cfg.runtime_path, COMMAND));
         rust.files.push(rust_emit::rustfmt_toml());
         let t_emit = ms_since(t1);
         let c2 = sys::thread_cpu_ms();

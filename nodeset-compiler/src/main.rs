@@ -142,7 +142,7 @@ fn rust_command(
         return Err("generation failed; nothing was written".into());
     }
     let list: Vec<(String, String)> = namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
-    gen.files.push(r::models_mod(&list, "nodeset-compiler rust ..."));
+    gen.files.push(r::models_mod(&list, &cfg.runtime_path, "nodeset-compiler rust ..."));
     gen.files.push(r::rustfmt_toml());
     let report = write_tree(&out, &gen.files, if check { Mode::Check } else { Mode::Write })?;
     if check && !report.is_clean() {

@@ -170,22 +170,27 @@ class Handler:
         pass
 
 
-async def watch(client: Client, server: str, skills_path: list, names: list) -> dict:
-    """Subscribes to CurrentState and the transition events of the skills `names` of a SkillSet."""
-    handler = Handler()
-    sub = await client.create_subscription(20, handler)
+async def skill_events(client: Client):
+    """SkillTransitionEventType (found by browsing) and an event filter for it: the type's select clauses and
+    an OfType where clause. async-opcua 0.19 compares only numbers and Booleans in InList, so the
+    `EventType InList [...]` that asyncua writes by default matches no event of an async-opcua server."""
     ns = await client.get_namespace_index(COMMON_SKILLS)
     event_type = await client.nodes.base_event_type.get_child(
         ["0:TransitionEventType", "0:ProgramTransitionEventType", f"{ns}:SkillTransitionEventType"]
     )
-    # The select clauses of SkillTransitionEventType, and an OfType where clause: async-opcua 0.19 compares
-    # only numbers and Booleans in InList, so the `EventType InList [...]` that asyncua writes by default
-    # matches no event of an async-opcua server.
     evfilter = await get_filter_from_event_type([event_type])
     of_type = ua.ContentFilterElement(
         FilterOperator=ua.FilterOperator.OfType, FilterOperands=[ua.LiteralOperand(Value=ua.Variant(event_type.nodeid))]
     )
     evfilter.WhereClause = ua.ContentFilter(Elements=[of_type])
+    return event_type, evfilter
+
+
+async def watch(client: Client, server: str, skills_path: list, names: list) -> dict:
+    """Subscribes to CurrentState and the transition events of the skills `names` of a SkillSet."""
+    handler = Handler()
+    sub = await client.create_subscription(20, handler)
+    event_type, evfilter = await skill_events(client)
     skill_set = await find(client, skills_path)
     out = {}
     for name in names:

@@ -27,9 +27,8 @@ import sys
 import time
 
 from asyncua import Client, ua
-from asyncua.common.events import get_filter_from_event_type
 
-from skills_check import COMMON_SKILLS, CELL_SKILLS, ROBOT_SKILLS, UNIT_SKILLS, children, double, find
+from skills_check import CELL_SKILLS, ROBOT_SKILLS, UNIT_SKILLS, children, double, find, skill_events
 
 logging.basicConfig(level=logging.ERROR)
 
@@ -79,19 +78,7 @@ class Watch:
 
 async def subscribe(client: Client, watch: Watch, path: list) -> dict:
     sub = await client.create_subscription(20, watch)
-    ns = await client.get_namespace_index(COMMON_SKILLS)
-    event_type = await client.nodes.base_event_type.get_child(
-        ["0:TransitionEventType", "0:ProgramTransitionEventType", f"{ns}:SkillTransitionEventType"]
-    )
-    evfilter = await get_filter_from_event_type([event_type])
-    evfilter.WhereClause = ua.ContentFilter(
-        Elements=[
-            ua.ContentFilterElement(
-                FilterOperator=ua.FilterOperator.OfType,
-                FilterOperands=[ua.LiteralOperand(Value=ua.Variant(event_type.nodeid))],
-            )
-        ]
-    )
+    event_type, evfilter = await skill_events(client)
     skills = await children(client, await find(client, path))
     out = {}
     for name, node in skills.items():

@@ -60,7 +60,7 @@ fn in_process(files: &[PathBuf]) -> Output {
     let mut rust = rust_emit::generate(model, &cfg);
     assert!(!rust.diagnostics.has_errors(), "{}", rust.diagnostics.render(&model.sources));
     let list: Vec<(String, String)> = namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
-    rust.files.push(rust_emit::models_mod(&list, command));
+    rust.files.push(rust_emit::models_mod(&list, &cfg.runtime_path, command));
     rust.files.push(rust_emit::rustfmt_toml());
     let modelica = generate_with_diagnostics(model, &ModelicaConfig::new());
     assert!(!modelica.diagnostics.has_errors(), "{}", modelica.diagnostics.render(&model.sources));

@@ -86,7 +86,7 @@ pub fn plan_into(crate_dir: &Path, extra_inputs: &[PathBuf], deny_warnings: bool
         return Err("Rust generation failed; generated/ is left as it was".into());
     }
     let modules: Vec<(String, String)> = namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
-    rust.files.push(rust_emit::models_mod(&modules, COMMAND));
+    rust.files.push(rust_emit::models_mod(&modules, &cfg.runtime_path, COMMAND));
     rust.files.push(rust_emit::rustfmt_toml());
     // Modelica: one package per namespace (and the used part of ns0, and the support package).
     let mcfg = namespaces

@@ -12,3 +12,22 @@ pub mod common_skills;
 pub mod robot_cell;
 /// `http://nodeset-compiler.dev/DrillingProcess/`
 pub mod drilling_process;
+/// Adds the address space and the type loader of every namespace above to a server, dependencies
+/// first.
+pub fn register(
+    config: crate::runtime::server::ServerConfig,
+) -> crate::runtime::server::ServerConfig {
+    config
+        .table(&di::TABLE)
+        .type_loader(di::TypeLoader)
+        .table(&ia::TABLE)
+        .type_loader(ia::TypeLoader)
+        .table(&robotics::TABLE)
+        .type_loader(robotics::TypeLoader)
+        .table(&common_skills::TABLE)
+        .type_loader(common_skills::TypeLoader)
+        .table(&robot_cell::TABLE)
+        .type_loader(robot_cell::TypeLoader)
+        .table(&drilling_process::TABLE)
+        .type_loader(drilling_process::TypeLoader)
+}

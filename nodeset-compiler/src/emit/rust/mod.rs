@@ -1205,8 +1205,9 @@ fn builtin_type(b: BuiltinType) -> TokenStream {
     }
 }
 
-/// The `mod.rs` of a folder holding several generated namespaces.
-pub fn models_mod(modules: &[(String, String)], command: &str) -> OutFile {
+/// The `mod.rs` of a folder holding several generated namespaces (`modules`: module name and namespace URI,
+/// dependencies first), with `register`, which adds all of them to a server configuration in that order.
+pub fn models_mod(modules: &[(String, String)], runtime_path: &str, command: &str) -> OutFile {
     let items: Vec<TokenStream> = modules
         .iter()
         .map(|(m, uri)| {
@@ -1215,7 +1216,19 @@ pub fn models_mod(modules: &[(String, String)], command: &str) -> OutFile {
             quote! { #[doc = #d] pub mod #m; }
         })
         .collect();
-    let file: syn::File = syn::parse2(quote! { #(#items)* }).expect("internal error: models mod.rs");
+    let runtime: syn::Path = syn::parse_str(runtime_path).expect("internal error: runtime path");
+    let adds = modules.iter().map(|(m, _)| {
+        let m = ident(m);
+        quote! { .table(&#m::TABLE).type_loader(#m::TypeLoader) }
+    });
+    let register = quote! {
+        /// Adds the address space and the type loader of every namespace above to a server, dependencies
+        /// first.
+        pub fn register(config: #runtime::server::ServerConfig) -> #runtime::server::ServerConfig {
+            config #(#adds)*
+        }
+    };
+    let file: syn::File = syn::parse2(quote! { #(#items)* #register }).expect("internal error: models mod.rs");
     OutFile {
         path: PathBuf::from("mod.rs"),
         contents: format!(
