@@ -22,6 +22,8 @@ import traceback
 
 from asyncua import Client, ua
 
+from report import Report
+
 ROBOTICS_NS = "http://opcfoundation.org/UA/Robotics/"
 DI_NS = "http://opcfoundation.org/UA/DI/"
 INSTANCE_NS = "urn:nodeset-models:six-axis-robot:instances"
@@ -33,20 +35,6 @@ HAS_MODELLING_RULE = ua.NodeId(37, 0)
 HIERARCHICAL = ua.NodeId(33, 0)
 
 logging.basicConfig(level=logging.ERROR)
-
-
-class Report:
-    def __init__(self) -> None:
-        self.passed = 0
-        self.failed = 0
-
-    def check(self, name: str, ok: bool, detail: str = "") -> bool:
-        if ok:
-            self.passed += 1
-        else:
-            self.failed += 1
-        print(("PASS " if ok else "FAIL ") + name + (f"  [{detail}]" if detail and not ok else ""), flush=True)
-        return ok
 
 
 def nid(x) -> ua.NodeId:

@@ -32,6 +32,8 @@ from pathlib import Path
 
 from asyncua import Client, ua
 
+from report import Report
+
 UA_NS = "http://opcfoundation.org/UA/"
 DI_NS = "http://opcfoundation.org/UA/DI/"
 IA_NS = "http://opcfoundation.org/UA/IA/"
@@ -41,34 +43,6 @@ XSD = "{http://opcfoundation.org/UA/2011/03/UANodeSet.xsd}"
 
 # asyncua warns about every ns0 enumeration it meets twice while loading definitions; that is noise here.
 logging.basicConfig(level=logging.ERROR)
-
-
-class Report:
-    """Counts and prints checks."""
-
-    def __init__(self) -> None:
-        self.passed = 0
-        self.failed = 0
-
-    def check(self, name: str, ok: bool, detail: str = "") -> bool:
-        if ok:
-            self.passed += 1
-        else:
-            self.failed += 1
-        print(("PASS " if ok else "FAIL ") + name + (f"  [{detail}]" if detail and not ok else ""), flush=True)
-        return ok
-
-    def equal(self, name: str, got, expected) -> bool:
-        return self.check(name, got == expected, f"got {got!r}, expected {expected!r}")
-
-    def all(self, name: str, problems: list[str], total: int) -> bool:
-        """One check over many items: passes if `problems` is empty; prints the first problems."""
-        ok = self.check(f"{name} ({total} checked)", not problems, f"{len(problems)} wrong")
-        for p in problems[:25]:
-            print(f"     {p}")
-        if len(problems) > 25:
-            print(f"     ... and {len(problems) - 25} more")
-        return ok
 
 
 def status_of(exc: Exception) -> str:

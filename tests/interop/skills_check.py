@@ -30,6 +30,8 @@ import time
 import traceback
 
 from asyncua import Client, ua
+
+from report import Report
 from asyncua.common.events import get_filter_from_event_type
 
 PROGRAM_STATE_MACHINE_TYPE = ua.NodeId(2391, 0)
@@ -42,23 +44,20 @@ SYSTEM = ["DeviceSet", "TemplateDrillingLwrSystem"]
 ROBOT_SKILLS = SYSTEM + ["MotionDeviceSystem", "Controllers", "URController", "SkillSet"]
 UNIT_SKILLS = SYSTEM + ["DrillingEndEffector", "SkillSet"]
 CELL_SKILLS = ["DrillingCell", "SkillSet"]
+# One DrillHole run as transition events of the three servers' skills, in Time order.
+DRILL_HOLE_EVENTS = [
+    "DrillHole Running",
+    "RelativeCartesianLinearMove Running",
+    "RelativeCartesianLinearMove Ready",
+    "TemplateDrilling Running",
+    "TemplateDrilling Ready",
+    "RelativeCartesianLinearMove Running",
+    "RelativeCartesianLinearMove Ready",
+    "DrillHole Ready",
+]
 JOINTS = ["Base", "Shoulder", "Elbow", "Wrist1", "Wrist2", "Wrist3"]
 
 logging.basicConfig(level=logging.ERROR)
-
-
-class Report:
-    def __init__(self) -> None:
-        self.passed = 0
-        self.failed = 0
-
-    def check(self, name: str, ok: bool, detail: str = "") -> bool:
-        if ok:
-            self.passed += 1
-        else:
-            self.failed += 1
-        print(("PASS " if ok else "FAIL ") + name + (f"  [{detail}]" if detail and not ok else ""), flush=True)
-        return ok
 
 
 def nid(x) -> ua.NodeId:
@@ -306,17 +305,7 @@ async def composite_skill(report: Report, robot: Client, unit: Client, cell: Cli
     order = [s for _, s in steps]
     report.check(
         "DrillHole: runs move, drill, move in this order",
-        order
-        == [
-            "DrillHole Running",
-            "RelativeCartesianLinearMove Running",
-            "RelativeCartesianLinearMove Ready",
-            "TemplateDrilling Running",
-            "TemplateDrilling Ready",
-            "RelativeCartesianLinearMove Running",
-            "RelativeCartesianLinearMove Ready",
-            "DrillHole Ready",
-        ],
+        order == DRILL_HOLE_EVENTS,
         f"{order}",
     )
     report.check("DrillHole: CurrentState Ready -> Running -> Ready", hole.states == ["Ready", "Running", "Ready"], f"{hole.states}")

@@ -22,6 +22,8 @@ from pathlib import Path
 
 from asyncua import Server, ua
 
+from report import Report
+
 CS = "http://nodeset-compiler.dev/CommonSkills/"
 RC = "http://nodeset-compiler.dev/RobotCell/"
 DP = "http://nodeset-compiler.dev/DrillingProcess/"
@@ -40,20 +42,6 @@ class Collect(logging.Handler):
 
     def emit(self, record: logging.LogRecord) -> None:
         self.records.append(record)
-
-
-class Report:
-    def __init__(self) -> None:
-        self.passed = 0
-        self.failed = 0
-
-    def check(self, name: str, ok: bool, detail: str = "") -> None:
-        if ok:
-            self.passed += 1
-            print(f"PASS {name}")
-        else:
-            self.failed += 1
-            print(f"FAIL {name}{': ' + detail if detail else ''}")
 
 
 async def child(node, path: list[tuple[str, str]], idx: dict[str, int]):

@@ -28,20 +28,20 @@ import time
 
 from asyncua import Client, ua
 
-from skills_check import CELL_SKILLS, ROBOT_SKILLS, UNIT_SKILLS, children, double, find, skill_events
+from skills_check import (
+    CELL_SKILLS,
+    DRILL_HOLE_EVENTS,
+    ROBOT_SKILLS,
+    UNIT_SKILLS,
+    children,
+    double,
+    find,
+    skill_events,
+)
 
 logging.basicConfig(level=logging.ERROR)
 
-PATTERN = [
-    "DrillHole Running",
-    "RelativeCartesianLinearMove Running",
-    "RelativeCartesianLinearMove Ready",
-    "TemplateDrilling Running",
-    "TemplateDrilling Ready",
-    "RelativeCartesianLinearMove Running",
-    "RelativeCartesianLinearMove Ready",
-    "DrillHole Ready",
-]
+PATTERN = DRILL_HOLE_EVENTS
 
 
 class Watch:
