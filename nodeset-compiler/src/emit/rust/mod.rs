@@ -72,25 +72,61 @@ pub fn default_module_name(uri: &str) -> String {
 }
 
 /// Generates Rust for the configured namespaces.
+///
+/// Each file of each namespace is generated on its own (a fresh [`Gen`] per file) and the files are spread
+/// over the cores; files and diagnostics come out in the same order whatever the number of threads.
 pub fn generate(model: &Model, cfg: &RustConfig) -> RustOutput {
     let mut out = RustOutput::default();
-    let mut modules = Vec::new();
-    for ns_cfg in &cfg.namespaces {
-        let Some(ns) = model.namespaces.iter().position(|u| *u == ns_cfg.uri).map(|i| i as u16) else {
+    let namespaces: Vec<Option<u16>> = cfg
+        .namespaces
+        .iter()
+        .map(|ns_cfg| model.namespaces.iter().position(|u| *u == ns_cfg.uri).map(|i| i as u16))
+        .collect();
+    // The largest parts first, so that the threads finish together.
+    let mut jobs: Vec<(usize, u16, Part)> = Vec::new();
+    for part in [Part::Objects, Part::Ids, Part::Nodes, Part::Types, Part::Module] {
+        for (i, ns) in namespaces.iter().enumerate() {
+            if let Some(ns) = *ns {
+                jobs.push((i, ns, part));
+            }
+        }
+    }
+    let done = crate::par_map(&jobs, |&(i, ns, part)| {
+        let mut g = Gen::new(model, cfg, ns, &cfg.namespaces[i].module);
+        let file = g.part(part);
+        (file, g.diags)
+    });
+    let mut per_ns: Vec<Vec<(Part, OutFile, Diagnostics)>> = namespaces.iter().map(|_| Vec::new()).collect();
+    for (&(i, _, part), (file, diags)) in jobs.iter().zip(done) {
+        per_ns[i].push((part, file, diags));
+    }
+    for (i, mut parts) in per_ns.into_iter().enumerate() {
+        if namespaces[i].is_none() {
             out.diagnostics.push(
-                Diagnostic::new(Code::MissingModel, format!("namespace `{}` is not in the loaded model", ns_cfg.uri))
+                Diagnostic::new(Code::MissingModel, format!("namespace `{}` is not in the loaded model", cfg.namespaces[i].uri))
                     .help("name the NodeSet2 file that defines it"),
             );
             continue;
-        };
-        let mut g = Gen::new(model, cfg, ns, &ns_cfg.module);
-        let files = g.namespace();
-        out.diagnostics.extend(std::mem::take(&mut g.diags));
-        modules.push(ns_cfg.module.clone());
-        out.files.extend(files);
+        }
+        // Diagnostics in the order the parts were always generated in.
+        parts.sort_by_key(|(part, _, _)| *part);
+        for (_, file, diags) in parts {
+            out.diagnostics.extend(diags);
+            out.files.push(file);
+        }
     }
     out.files.sort_by(|a, b| a.path.cmp(&b.path));
     out
+}
+
+/// The files of a namespace.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Part {
+    Ids,
+    Types,
+    Nodes,
+    Objects,
+    Module,
 }
 
 /// Per-namespace generation state.
@@ -192,17 +228,23 @@ impl<'m> Gen<'m> {
     }
 
     fn file(&self, name: &str, what: &str, tokens: TokenStream) -> OutFile {
-        let parsed: syn::File = syn::parse2(tokens.clone())
-            .unwrap_or_else(|e| panic!("internal error: generated {name} for {} does not parse: {e}\n{tokens}", self.uri()));
+        let parsed: syn::File = syn::parse2(tokens)
+            .unwrap_or_else(|e| panic!("internal error: generated {name} for {} does not parse: {e}", self.uri()));
         let text = prettyplease::unparse(&parsed);
         OutFile { path: PathBuf::from(&self.module).join(name), contents: format!("{}{text}", self.header(what)) }
     }
 
-    fn namespace(&mut self) -> Vec<OutFile> {
-        let ids = self.ids_file();
-        let types = self.types_file();
-        let nodes = self.nodes_file();
-        let objects = self.objects_file();
+    fn part(&mut self, part: Part) -> OutFile {
+        match part {
+            Part::Ids => self.ids_file(),
+            Part::Types => self.types_file(),
+            Part::Nodes => self.nodes_file(),
+            Part::Objects => self.objects_file(),
+            Part::Module => self.mod_file(),
+        }
+    }
+
+    fn mod_file(&self) -> OutFile {
         let m = self.model.model_of_namespace(self.ns);
         let uri = lit(self.uri());
         let version = lit(m.and_then(|m| m.version.as_deref()).unwrap_or(""));
@@ -224,7 +266,7 @@ impl<'m> Gen<'m> {
             pub use nodes::TABLE;
             pub use types::TypeLoader;
         };
-        vec![self.file("mod.rs", "Module", mod_rs), ids, types, nodes, objects]
+        self.file("mod.rs", "Module", mod_rs)
     }
 
     // ----- NodeId constants -------------------------------------------------------------------------
