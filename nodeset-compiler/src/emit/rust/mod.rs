@@ -129,6 +129,9 @@ enum Part {
     Module,
 }
 
+/// The width prettyplease fills before it breaks a line (its `MARGIN`), in bytes.
+const PRETTYPLEASE_MARGIN: usize = 89;
+
 /// Per-namespace generation state.
 struct Gen<'m> {
     model: &'m Model,
@@ -310,6 +313,7 @@ impl<'m> Gen<'m> {
         }
         let runtime = path(&self.cfg.runtime_path);
         let mut mods = Vec::new();
+        let mut bodies: Vec<String> = Vec::new();
         for (class, nodes) in groups {
             let mut scope: Scope<NodeIx> = Scope::new(Target::Rust, Case::ShoutySnake);
             for &ix in &nodes {
@@ -321,35 +325,10 @@ impl<'m> Gen<'m> {
             }
             let mut items: Vec<(NodeIx, String)> = names.into_iter().collect();
             items.sort_by(|a, b| a.1.cmp(&b.1));
-            let consts: Vec<TokenStream> = items
-                .iter()
-                .map(|(ix, name)| {
-                    let n = self.model.node(*ix);
-                    let name = ident(name);
-                    let mut text = format!("`{}` ({}).", n.browse_name.name, n.class.name());
-                    if let Some(d) = n.doc() {
-                        text.push_str("\n\n");
-                        text.push_str(d);
-                    }
-                    let docs = doc(&text);
-                    let value = match &n.id.id {
-                        Identifier::Numeric(v) => {
-                            let v = Literal::u32_unsuffixed(*v);
-                            quote! { id(#v) }
-                        }
-                        Identifier::String(s) => {
-                            let s = lit(s);
-                            quote! { NsNodeId::string(NS, #s) }
-                        }
-                        other => {
-                            let idk = self.id_kind(other);
-                            let idk = path(&idk.to_string().replacen("rt ::", &format!("{} ::", self.cfg.runtime_path), 1));
-                            quote! { NsNodeId { namespace_uri: NS, id: #idk } }
-                        }
-                    };
-                    quote! { #docs pub const #name: NsNodeId = #value; }
-                })
-                .collect();
+            // The constants are written as text (see `consts_text`); the module around them goes through
+            // prettyplease with a marker where they belong.
+            let marker = ident(&format!("NODESET_COMPILER_CONSTS_{}", bodies.len()));
+            bodies.push(self.consts_text(&items));
             let module = ident(&names::sanitize(&format!("{}s", class.name()), Case::Snake, Target::Rust));
             let mdoc = format!(" The {} nodes of this namespace.", class.name());
             mods.push(quote! {
@@ -359,7 +338,7 @@ impl<'m> Gen<'m> {
                     use #runtime::NsNodeId;
                     #[allow(dead_code)]
                     const fn id(n: u32) -> NsNodeId { NsNodeId::numeric(NS, n) }
-                    #(#consts)*
+                    const #marker: () = ();
                 }
             });
         }
@@ -367,7 +346,68 @@ impl<'m> Gen<'m> {
             //! NodeIds of every node of this namespace, resolved against a namespace table at run time.
             #(#mods)*
         };
-        self.file("ids.rs", "NodeIds", tokens)
+        let mut file = self.file("ids.rs", "NodeIds", tokens);
+        for (i, body) in bodies.iter().enumerate() {
+            let line = format!("    const NODESET_COMPILER_CONSTS_{i}: () = ();\n");
+            file.contents = file.contents.replacen(&line, body, 1);
+        }
+        file
+    }
+
+    /// The NodeId constants of one module of `ids.rs`, as prettyplease prints them (checked by the test
+    /// `ids_text_is_what_prettyplease_prints`): the doc lines, then `pub const NAME: NsNodeId = value;` on
+    /// one line if that fits in prettyplease's margin, else with the call's arguments one per line.
+    fn consts_text(&self, items: &[(NodeIx, String)]) -> String {
+        use std::fmt::Write as _;
+        let mut out = String::with_capacity(items.len() * 160);
+        for (ix, name) in items {
+            let n = self.model.node(*ix);
+            let mut text = format!("`{}` ({}).", n.browse_name.name, n.class.name());
+            if let Some(d) = n.doc() {
+                text.push_str("\n\n");
+                text.push_str(d);
+            }
+            for l in text.lines() {
+                let l = l.trim_end();
+                out.push_str(if l.is_empty() { "    ///\n" } else { "    /// " });
+                if !l.is_empty() {
+                    out.push_str(l);
+                    out.push('\n');
+                }
+            }
+            // (the callee, its arguments): `id(5)` or `NsNodeId::string(NS, "x")`.
+            let (callee, args): (&str, Vec<String>) = match &n.id.id {
+                Identifier::Numeric(v) => ("id", vec![v.to_string()]),
+                Identifier::String(s) => ("NsNodeId::string", vec!["NS".to_string(), Literal::string(s).to_string()]),
+                other => {
+                    let idk = self.id_kind(other);
+                    let idk = path(&idk.to_string().replacen("rt ::", &format!("{} ::", self.cfg.runtime_path), 1));
+                    let name = ident(name);
+                    let item = quote! { pub const #name: NsNodeId = NsNodeId { namespace_uri: NS, id: #idk }; };
+                    let file: syn::File = syn::parse2(quote! { mod m { #item } }).expect("internal error: a NodeId constant does not parse");
+                    let text = prettyplease::unparse(&file);
+                    // `mod m {` ... `}`: the item is indented by four spaces already.
+                    let inner: Vec<&str> = text.lines().collect();
+                    for l in &inner[1..inner.len() - 1] {
+                        out.push_str(l);
+                        out.push('\n');
+                    }
+                    continue;
+                }
+            };
+            let flat = format!("    pub const {name}: NsNodeId = {callee}({});", args.join(", "));
+            if flat.len() <= PRETTYPLEASE_MARGIN {
+                out.push_str(&flat);
+                out.push('\n');
+            } else {
+                let _ = writeln!(out, "    pub const {name}: NsNodeId = {callee}(");
+                for a in &args {
+                    let _ = writeln!(out, "        {a},");
+                }
+                out.push_str("    );\n");
+            }
+        }
+        out
     }
 
     fn collision_warning(&mut self, c: &names::Collision<NodeIx>, scope: &str) {
