@@ -1306,7 +1306,7 @@ mod rust {
         ] {
             let median = g.f(&format!("{key}_median_ms"));
             let cpu = cpu
-                .map(|k| format!("   CPU median {:>8.2} ms", g.f(k)))
+                .map(|k| format!("   CPU (all threads) median {:>8.2} ms", g.f(k)))
                 .unwrap_or_default();
             let judged = if key == "emit" {
                 format!("   target <= {EMIT_MS} ms  {}", verdict(median, EMIT_MS))
