@@ -109,17 +109,23 @@ fn ids_text_is_what_prettyplease_prints() {
     assert_prettyplease_layout("ids.rs of the layout model", &ids.contents);
 }
 
-/// The same for the checked-in generated code: every file but the node tables (whose rows are one line each
-/// on purpose) is exactly what prettyplease prints.
+/// The same for the checked-in generated code: every file is exactly what prettyplease prints, except the
+/// tables written one row per line on purpose (the node rows of nodes.rs, the member markers at the end of
+/// objects.rs, which prettyplease would fold into paragraphs).
 #[test]
 fn generated_code_is_in_prettyplease_layout() {
+    const MARKERS: &str = "/// Member markers of each ObjectType";
     let models = root().join("generated/src/models");
     let mut checked = 0;
     for dir in std::fs::read_dir(&models).expect("generated/src/models").flatten().map(|e| e.path()).filter(|p| p.is_dir()) {
         for name in ["mod.rs", "ids.rs", "types.rs", "objects.rs"] {
             let path = dir.join(name);
             let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-            assert_prettyplease_layout(&path.display().to_string(), &text);
+            let text = match text.find(MARKERS) {
+                Some(at) if name == "objects.rs" => &text[..at],
+                _ => &text[..],
+            };
+            assert_prettyplease_layout(&path.display().to_string(), text);
             checked += 1;
         }
     }

@@ -754,260 +754,209 @@ pub mod members {
     #[allow(unused_imports)]
     use super::t;
     t::object_members! {
-        AbsoluteCartesianLinearMoveSkillType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("Deletable",
-        "the mandatory variable `Deletable` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
-        ("AutoDelete",
-        "the mandatory variable `AutoDelete` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
-        ("RecycleCount",
-        "the mandatory variable `RecycleCount` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
-        ("InputParameterSet/Speed",
-        "the mandatory variable `InputParameterSet/Speed` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Speed\")]"),
-        ("InputParameterSet/Acceleration",
-        "the mandatory variable `InputParameterSet/Acceleration` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Acceleration\")]"),
-        ("InputParameterSet/TargetPose",
-        "the mandatory variable `InputParameterSet/TargetPose` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/TargetPose\")]"),
-        ("OutputParameterSet/Result",
-        "the mandatory variable `OutputParameterSet/Result` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]")];
-        CurrentState : ua::LocalizedText, - 1, [1 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [1 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [1 "AvailableTransitions"], false false
-        false; Deletable : bool, - 1, [1 "Deletable"], true false false; AutoDelete :
-        bool, - 1, [1 "AutoDelete"], true false false; RecycleCount : i32, - 1, [1
-        "RecycleCount"], true false false; ProgramDiagnostic : ua::ExtensionObject, - 1,
-        [1 "ProgramDiagnostic"], false false false; InputParameterSet__Speed : f64, - 1,
-        [0 "InputParameterSet", 0 "Speed"], true false true;
-        InputParameterSet__Acceleration : f64, - 1, [0 "InputParameterSet", 0
-        "Acceleration"], true false true; InputParameterSet__TargetPose :
-        ua::ThreeDFrame, - 1, [0 "InputParameterSet", 0 "TargetPose"], true false true;
-        OutputParameterSet__Result : ua::StatusCode, - 1, [0 "OutputParameterSet", 0
-        "Result"], true false false;
+        AbsoluteCartesianLinearMoveSkillType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("Deletable", "the mandatory variable `Deletable` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
+            ("AutoDelete", "the mandatory variable `AutoDelete` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
+            ("RecycleCount", "the mandatory variable `RecycleCount` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
+            ("InputParameterSet/Speed", "the mandatory variable `InputParameterSet/Speed` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Speed\")]"),
+            ("InputParameterSet/Acceleration", "the mandatory variable `InputParameterSet/Acceleration` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Acceleration\")]"),
+            ("InputParameterSet/TargetPose", "the mandatory variable `InputParameterSet/TargetPose` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/TargetPose\")]"),
+            ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
+        Deletable: bool, -1, [1 "Deletable"], true false false;
+        AutoDelete: bool, -1, [1 "AutoDelete"], true false false;
+        RecycleCount: i32, -1, [1 "RecycleCount"], true false false;
+        ProgramDiagnostic: ua::ExtensionObject, -1, [1 "ProgramDiagnostic"], false false false;
+        InputParameterSet__Speed: f64, -1, [0 "InputParameterSet", 0 "Speed"], true false true;
+        InputParameterSet__Acceleration: f64, -1, [0 "InputParameterSet", 0 "Acceleration"], true false true;
+        InputParameterSet__TargetPose: ua::ThreeDFrame, -1, [0 "InputParameterSet", 0 "TargetPose"], true false true;
+        OutputParameterSet__Result: ua::StatusCode, -1, [0 "OutputParameterSet", 0 "Result"], true false false;
     }
     t::object_members! {
-        AbsoluteJointPtpMoveSkillType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("Deletable",
-        "the mandatory variable `Deletable` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
-        ("AutoDelete",
-        "the mandatory variable `AutoDelete` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
-        ("RecycleCount",
-        "the mandatory variable `RecycleCount` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
-        ("InputParameterSet/Speed",
-        "the mandatory variable `InputParameterSet/Speed` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Speed\")]"),
-        ("InputParameterSet/Acceleration",
-        "the mandatory variable `InputParameterSet/Acceleration` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Acceleration\")]"),
-        ("InputParameterSet/TargetJointPositions",
-        "the mandatory variable `InputParameterSet/TargetJointPositions` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/TargetJointPositions\")]"),
-        ("OutputParameterSet/Result",
-        "the mandatory variable `OutputParameterSet/Result` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]")];
-        CurrentState : ua::LocalizedText, - 1, [1 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [1 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [1 "AvailableTransitions"], false false
-        false; Deletable : bool, - 1, [1 "Deletable"], true false false; AutoDelete :
-        bool, - 1, [1 "AutoDelete"], true false false; RecycleCount : i32, - 1, [1
-        "RecycleCount"], true false false; ProgramDiagnostic : ua::ExtensionObject, - 1,
-        [1 "ProgramDiagnostic"], false false false; InputParameterSet__Speed : f64, - 1,
-        [0 "InputParameterSet", 0 "Speed"], true false true;
-        InputParameterSet__Acceleration : f64, - 1, [0 "InputParameterSet", 0
-        "Acceleration"], true false true; InputParameterSet__TargetJointPositions : f64,
-        1, [0 "InputParameterSet", 0 "TargetJointPositions"], true false true;
-        OutputParameterSet__Result : ua::StatusCode, - 1, [0 "OutputParameterSet", 0
-        "Result"], true false false;
+        AbsoluteJointPtpMoveSkillType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("Deletable", "the mandatory variable `Deletable` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
+            ("AutoDelete", "the mandatory variable `AutoDelete` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
+            ("RecycleCount", "the mandatory variable `RecycleCount` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
+            ("InputParameterSet/Speed", "the mandatory variable `InputParameterSet/Speed` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Speed\")]"),
+            ("InputParameterSet/Acceleration", "the mandatory variable `InputParameterSet/Acceleration` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Acceleration\")]"),
+            ("InputParameterSet/TargetJointPositions", "the mandatory variable `InputParameterSet/TargetJointPositions` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/TargetJointPositions\")]"),
+            ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
+        Deletable: bool, -1, [1 "Deletable"], true false false;
+        AutoDelete: bool, -1, [1 "AutoDelete"], true false false;
+        RecycleCount: i32, -1, [1 "RecycleCount"], true false false;
+        ProgramDiagnostic: ua::ExtensionObject, -1, [1 "ProgramDiagnostic"], false false false;
+        InputParameterSet__Speed: f64, -1, [0 "InputParameterSet", 0 "Speed"], true false true;
+        InputParameterSet__Acceleration: f64, -1, [0 "InputParameterSet", 0 "Acceleration"], true false true;
+        InputParameterSet__TargetJointPositions: f64, 1, [0 "InputParameterSet", 0 "TargetJointPositions"], true false true;
+        OutputParameterSet__Result: ua::StatusCode, -1, [0 "OutputParameterSet", 0 "Result"], true false false;
     }
     t::object_members! {
-        CompositeSkillType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("Deletable",
-        "the mandatory variable `Deletable` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
-        ("AutoDelete",
-        "the mandatory variable `AutoDelete` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
-        ("RecycleCount",
-        "the mandatory variable `RecycleCount` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
-        ("OutputParameterSet/Result",
-        "the mandatory variable `OutputParameterSet/Result` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]")];
-        CurrentState : ua::LocalizedText, - 1, [1 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [1 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [1 "AvailableTransitions"], false false
-        false; Deletable : bool, - 1, [1 "Deletable"], true false false; AutoDelete :
-        bool, - 1, [1 "AutoDelete"], true false false; RecycleCount : i32, - 1, [1
-        "RecycleCount"], true false false; ProgramDiagnostic : ua::ExtensionObject, - 1,
-        [1 "ProgramDiagnostic"], false false false; OutputParameterSet__Result :
-        ua::StatusCode, - 1, [0 "OutputParameterSet", 0 "Result"], true false false;
+        CompositeSkillType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("Deletable", "the mandatory variable `Deletable` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
+            ("AutoDelete", "the mandatory variable `AutoDelete` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
+            ("RecycleCount", "the mandatory variable `RecycleCount` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
+            ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
+        Deletable: bool, -1, [1 "Deletable"], true false false;
+        AutoDelete: bool, -1, [1 "AutoDelete"], true false false;
+        RecycleCount: i32, -1, [1 "RecycleCount"], true false false;
+        ProgramDiagnostic: ua::ExtensionObject, -1, [1 "ProgramDiagnostic"], false false false;
+        OutputParameterSet__Result: ua::StatusCode, -1, [0 "OutputParameterSet", 0 "Result"], true false false;
     }
     t::object_members! {
-        GrippingSkillType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("Deletable",
-        "the mandatory variable `Deletable` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
-        ("AutoDelete",
-        "the mandatory variable `AutoDelete` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
-        ("RecycleCount",
-        "the mandatory variable `RecycleCount` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
-        ("InputParameterSet/Action",
-        "the mandatory variable `InputParameterSet/Action` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Action\")]"),
-        ("InputParameterSet/GripForce",
-        "the mandatory variable `InputParameterSet/GripForce` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/GripForce\")]"),
-        ("OutputParameterSet/Result",
-        "the mandatory variable `OutputParameterSet/Result` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]")];
-        CurrentState : ua::LocalizedText, - 1, [1 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [1 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [1 "AvailableTransitions"], false false
-        false; Deletable : bool, - 1, [1 "Deletable"], true false false; AutoDelete :
-        bool, - 1, [1 "AutoDelete"], true false false; RecycleCount : i32, - 1, [1
-        "RecycleCount"], true false false; ProgramDiagnostic : ua::ExtensionObject, - 1,
-        [1 "ProgramDiagnostic"], false false false; InputParameterSet__Action :
-        super::super::super::types::GripperActionEnumeration, - 1, [0
-        "InputParameterSet", 0 "Action"], true false true; InputParameterSet__GripForce :
-        f64, - 1, [0 "InputParameterSet", 0 "GripForce"], true false true;
-        OutputParameterSet__Result : ua::StatusCode, - 1, [0 "OutputParameterSet", 0
-        "Result"], true false false;
+        GrippingSkillType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("Deletable", "the mandatory variable `Deletable` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
+            ("AutoDelete", "the mandatory variable `AutoDelete` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
+            ("RecycleCount", "the mandatory variable `RecycleCount` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
+            ("InputParameterSet/Action", "the mandatory variable `InputParameterSet/Action` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Action\")]"),
+            ("InputParameterSet/GripForce", "the mandatory variable `InputParameterSet/GripForce` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/GripForce\")]"),
+            ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
+        Deletable: bool, -1, [1 "Deletable"], true false false;
+        AutoDelete: bool, -1, [1 "AutoDelete"], true false false;
+        RecycleCount: i32, -1, [1 "RecycleCount"], true false false;
+        ProgramDiagnostic: ua::ExtensionObject, -1, [1 "ProgramDiagnostic"], false false false;
+        InputParameterSet__Action: super::super::super::types::GripperActionEnumeration, -1, [0 "InputParameterSet", 0 "Action"], true false true;
+        InputParameterSet__GripForce: f64, -1, [0 "InputParameterSet", 0 "GripForce"], true false true;
+        OutputParameterSet__Result: ua::StatusCode, -1, [0 "OutputParameterSet", 0 "Result"], true false false;
     }
     t::object_members! {
-        ISkillSetType; required : [];
+        ISkillSetType;
+        required: [];
     }
     t::object_members! {
-        MoveSkillType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("Deletable",
-        "the mandatory variable `Deletable` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
-        ("AutoDelete",
-        "the mandatory variable `AutoDelete` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
-        ("RecycleCount",
-        "the mandatory variable `RecycleCount` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
-        ("InputParameterSet/Speed",
-        "the mandatory variable `InputParameterSet/Speed` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Speed\")]"),
-        ("InputParameterSet/Acceleration",
-        "the mandatory variable `InputParameterSet/Acceleration` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Acceleration\")]"),
-        ("OutputParameterSet/Result",
-        "the mandatory variable `OutputParameterSet/Result` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]")];
-        CurrentState : ua::LocalizedText, - 1, [1 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [1 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [1 "AvailableTransitions"], false false
-        false; Deletable : bool, - 1, [1 "Deletable"], true false false; AutoDelete :
-        bool, - 1, [1 "AutoDelete"], true false false; RecycleCount : i32, - 1, [1
-        "RecycleCount"], true false false; ProgramDiagnostic : ua::ExtensionObject, - 1,
-        [1 "ProgramDiagnostic"], false false false; InputParameterSet__Speed : f64, - 1,
-        [0 "InputParameterSet", 0 "Speed"], true false true;
-        InputParameterSet__Acceleration : f64, - 1, [0 "InputParameterSet", 0
-        "Acceleration"], true false true; OutputParameterSet__Result : ua::StatusCode, -
-        1, [0 "OutputParameterSet", 0 "Result"], true false false;
+        MoveSkillType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("Deletable", "the mandatory variable `Deletable` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
+            ("AutoDelete", "the mandatory variable `AutoDelete` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
+            ("RecycleCount", "the mandatory variable `RecycleCount` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
+            ("InputParameterSet/Speed", "the mandatory variable `InputParameterSet/Speed` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Speed\")]"),
+            ("InputParameterSet/Acceleration", "the mandatory variable `InputParameterSet/Acceleration` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Acceleration\")]"),
+            ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
+        Deletable: bool, -1, [1 "Deletable"], true false false;
+        AutoDelete: bool, -1, [1 "AutoDelete"], true false false;
+        RecycleCount: i32, -1, [1 "RecycleCount"], true false false;
+        ProgramDiagnostic: ua::ExtensionObject, -1, [1 "ProgramDiagnostic"], false false false;
+        InputParameterSet__Speed: f64, -1, [0 "InputParameterSet", 0 "Speed"], true false true;
+        InputParameterSet__Acceleration: f64, -1, [0 "InputParameterSet", 0 "Acceleration"], true false true;
+        OutputParameterSet__Result: ua::StatusCode, -1, [0 "OutputParameterSet", 0 "Result"], true false false;
     }
     t::object_members! {
-        ProgramSkillStateMachineType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("Deletable",
-        "the mandatory variable `Deletable` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
-        ("AutoDelete",
-        "the mandatory variable `AutoDelete` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
-        ("RecycleCount",
-        "the mandatory variable `RecycleCount` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
-        ("OutputParameterSet/Result",
-        "the mandatory variable `OutputParameterSet/Result` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]")];
-        CurrentState : ua::LocalizedText, - 1, [1 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [1 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [1 "AvailableTransitions"], false false
-        false; Deletable : bool, - 1, [1 "Deletable"], true false false; AutoDelete :
-        bool, - 1, [1 "AutoDelete"], true false false; RecycleCount : i32, - 1, [1
-        "RecycleCount"], true false false; ProgramDiagnostic : ua::ExtensionObject, - 1,
-        [1 "ProgramDiagnostic"], false false false; OutputParameterSet__Result :
-        ua::StatusCode, - 1, [0 "OutputParameterSet", 0 "Result"], true false false;
+        ProgramSkillStateMachineType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("Deletable", "the mandatory variable `Deletable` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
+            ("AutoDelete", "the mandatory variable `AutoDelete` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
+            ("RecycleCount", "the mandatory variable `RecycleCount` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
+            ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
+        Deletable: bool, -1, [1 "Deletable"], true false false;
+        AutoDelete: bool, -1, [1 "AutoDelete"], true false false;
+        RecycleCount: i32, -1, [1 "RecycleCount"], true false false;
+        ProgramDiagnostic: ua::ExtensionObject, -1, [1 "ProgramDiagnostic"], false false false;
+        OutputParameterSet__Result: ua::StatusCode, -1, [0 "OutputParameterSet", 0 "Result"], true false false;
     }
     t::object_members! {
-        RelativeCartesianLinearMoveSkillType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("Deletable",
-        "the mandatory variable `Deletable` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
-        ("AutoDelete",
-        "the mandatory variable `AutoDelete` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
-        ("RecycleCount",
-        "the mandatory variable `RecycleCount` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
-        ("InputParameterSet/Speed",
-        "the mandatory variable `InputParameterSet/Speed` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Speed\")]"),
-        ("InputParameterSet/Acceleration",
-        "the mandatory variable `InputParameterSet/Acceleration` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Acceleration\")]"),
-        ("InputParameterSet/PoseOffset",
-        "the mandatory variable `InputParameterSet/PoseOffset` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/PoseOffset\")]"),
-        ("OutputParameterSet/Result",
-        "the mandatory variable `OutputParameterSet/Result` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]")];
-        CurrentState : ua::LocalizedText, - 1, [1 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [1 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [1 "AvailableTransitions"], false false
-        false; Deletable : bool, - 1, [1 "Deletable"], true false false; AutoDelete :
-        bool, - 1, [1 "AutoDelete"], true false false; RecycleCount : i32, - 1, [1
-        "RecycleCount"], true false false; ProgramDiagnostic : ua::ExtensionObject, - 1,
-        [1 "ProgramDiagnostic"], false false false; InputParameterSet__Speed : f64, - 1,
-        [0 "InputParameterSet", 0 "Speed"], true false true;
-        InputParameterSet__Acceleration : f64, - 1, [0 "InputParameterSet", 0
-        "Acceleration"], true false true; InputParameterSet__PoseOffset :
-        ua::ThreeDFrame, - 1, [0 "InputParameterSet", 0 "PoseOffset"], true false true;
-        OutputParameterSet__Result : ua::StatusCode, - 1, [0 "OutputParameterSet", 0
-        "Result"], true false false;
+        RelativeCartesianLinearMoveSkillType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("Deletable", "the mandatory variable `Deletable` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
+            ("AutoDelete", "the mandatory variable `AutoDelete` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
+            ("RecycleCount", "the mandatory variable `RecycleCount` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
+            ("InputParameterSet/Speed", "the mandatory variable `InputParameterSet/Speed` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Speed\")]"),
+            ("InputParameterSet/Acceleration", "the mandatory variable `InputParameterSet/Acceleration` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Acceleration\")]"),
+            ("InputParameterSet/PoseOffset", "the mandatory variable `InputParameterSet/PoseOffset` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/PoseOffset\")]"),
+            ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
+        Deletable: bool, -1, [1 "Deletable"], true false false;
+        AutoDelete: bool, -1, [1 "AutoDelete"], true false false;
+        RecycleCount: i32, -1, [1 "RecycleCount"], true false false;
+        ProgramDiagnostic: ua::ExtensionObject, -1, [1 "ProgramDiagnostic"], false false false;
+        InputParameterSet__Speed: f64, -1, [0 "InputParameterSet", 0 "Speed"], true false true;
+        InputParameterSet__Acceleration: f64, -1, [0 "InputParameterSet", 0 "Acceleration"], true false true;
+        InputParameterSet__PoseOffset: ua::ThreeDFrame, -1, [0 "InputParameterSet", 0 "PoseOffset"], true false true;
+        OutputParameterSet__Result: ua::StatusCode, -1, [0 "OutputParameterSet", 0 "Result"], true false false;
     }
     t::object_members! {
-        SkillTransitionEventType; required : [("EventId",
-        "the mandatory variable `EventId` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
-        ("EventType",
-        "the mandatory variable `EventType` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
-        ("SourceNode",
-        "the mandatory variable `SourceNode` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceNode\")]"),
-        ("SourceName",
-        "the mandatory variable `SourceName` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceName\")]"),
-        ("Time",
-        "the mandatory variable `Time` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Time\")]"),
-        ("ReceiveTime",
-        "the mandatory variable `ReceiveTime` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ReceiveTime\")]"),
-        ("Message",
-        "the mandatory variable `Message` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Message\")]"),
-        ("Severity",
-        "the mandatory variable `Severity` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Severity\")]"),
-        ("Transition",
-        "the mandatory variable `Transition` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Transition\")]"),
-        ("FromState",
-        "the mandatory variable `FromState` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"FromState\")]"),
-        ("ToState",
-        "the mandatory variable `ToState` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ToState\")]"),
-        ("IntermediateResult",
-        "the mandatory variable `IntermediateResult` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"IntermediateResult\")]"),
-        ("SkillName",
-        "the mandatory variable `SkillName` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillName\")]")];
-        EventId : ua::ByteString, - 1, [1 "EventId"], true false false; EventType :
-        ua::NodeId, - 1, [1 "EventType"], true false false; SourceNode : ua::NodeId, - 1,
-        [1 "SourceNode"], true false false; SourceName : String, - 1, [1 "SourceName"],
-        true false false; Time : ua::DateTime, - 1, [1 "Time"], true false false;
-        ReceiveTime : ua::DateTime, - 1, [1 "ReceiveTime"], true false false; LocalTime :
-        ua::TimeZoneDataType, - 1, [1 "LocalTime"], false false false; Message :
-        ua::LocalizedText, - 1, [1 "Message"], true false false; Severity : u16, - 1, [1
-        "Severity"], true false false; ConditionClassId : ua::NodeId, - 1, [1
-        "ConditionClassId"], false false false; ConditionClassName : ua::LocalizedText, -
-        1, [1 "ConditionClassName"], false false false; ConditionSubClassId : ua::NodeId,
-        1, [1 "ConditionSubClassId"], false false false; ConditionSubClassName :
-        ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false; Transition
-        : ua::LocalizedText, - 1, [1 "Transition"], true false false; FromState :
-        ua::LocalizedText, - 1, [1 "FromState"], true false false; ToState :
-        ua::LocalizedText, - 1, [1 "ToState"], true false false; IntermediateResult :
-        ua::Variant, - 1, [1 "IntermediateResult"], true false false; SkillName : String,
-        - 1, [0 "SkillName"], true false false;
+        SkillTransitionEventType;
+        required: [
+            ("EventId", "the mandatory variable `EventId` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
+            ("EventType", "the mandatory variable `EventType` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
+            ("SourceNode", "the mandatory variable `SourceNode` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceNode\")]"),
+            ("SourceName", "the mandatory variable `SourceName` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceName\")]"),
+            ("Time", "the mandatory variable `Time` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Time\")]"),
+            ("ReceiveTime", "the mandatory variable `ReceiveTime` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ReceiveTime\")]"),
+            ("Message", "the mandatory variable `Message` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Message\")]"),
+            ("Severity", "the mandatory variable `Severity` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Severity\")]"),
+            ("Transition", "the mandatory variable `Transition` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Transition\")]"),
+            ("FromState", "the mandatory variable `FromState` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"FromState\")]"),
+            ("ToState", "the mandatory variable `ToState` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ToState\")]"),
+            ("IntermediateResult", "the mandatory variable `IntermediateResult` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"IntermediateResult\")]"),
+            ("SkillName", "the mandatory variable `SkillName` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillName\")]"),
+        ];
+        EventId: ua::ByteString, -1, [1 "EventId"], true false false;
+        EventType: ua::NodeId, -1, [1 "EventType"], true false false;
+        SourceNode: ua::NodeId, -1, [1 "SourceNode"], true false false;
+        SourceName: String, -1, [1 "SourceName"], true false false;
+        Time: ua::DateTime, -1, [1 "Time"], true false false;
+        ReceiveTime: ua::DateTime, -1, [1 "ReceiveTime"], true false false;
+        LocalTime: ua::TimeZoneDataType, -1, [1 "LocalTime"], false false false;
+        Message: ua::LocalizedText, -1, [1 "Message"], true false false;
+        Severity: u16, -1, [1 "Severity"], true false false;
+        ConditionClassId: ua::NodeId, -1, [1 "ConditionClassId"], false false false;
+        ConditionClassName: ua::LocalizedText, -1, [1 "ConditionClassName"], false false false;
+        ConditionSubClassId: ua::NodeId, 1, [1 "ConditionSubClassId"], false false false;
+        ConditionSubClassName: ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
+        Transition: ua::LocalizedText, -1, [1 "Transition"], true false false;
+        FromState: ua::LocalizedText, -1, [1 "FromState"], true false false;
+        ToState: ua::LocalizedText, -1, [1 "ToState"], true false false;
+        IntermediateResult: ua::Variant, -1, [1 "IntermediateResult"], true false false;
+        SkillName: String, -1, [0 "SkillName"], true false false;
     }
 }

@@ -2448,898 +2448,786 @@ pub mod members {
     #[allow(unused_imports)]
     use super::t;
     t::object_members! {
-        BaseLifetimeIndicationType; required : [];
+        BaseLifetimeIndicationType;
+        required: [];
     }
     t::object_members! {
-        BlockType; required : []; Identification__UIElement : ua::Variant, - 1, [0
-        "Identification", 0 "UIElement"], false false false; Lock__Locked : bool, - 1, [0
-        "Lock", 0 "Locked"], false false false; Lock__LockingClient : String, - 1, [0
-        "Lock", 0 "LockingClient"], false false false; Lock__LockingUser : String, - 1,
-        [0 "Lock", 0 "LockingUser"], false false false; Lock__RemainingLockTime : f64, -
-        1, [0 "Lock", 0 "RemainingLockTime"], false false false; RevisionCounter : i32, -
-        1, [0 "RevisionCounter"], false false false; ActualMode : ua::LocalizedText, - 1,
-        [0 "ActualMode"], false false false; PermittedMode : ua::LocalizedText, 1, [0
-        "PermittedMode"], false false false; NormalMode : ua::LocalizedText, 1, [0
-        "NormalMode"], false false false; TargetMode : ua::LocalizedText, 1, [0
-        "TargetMode"], false false false;
+        BlockType;
+        required: [];
+        Identification__UIElement: ua::Variant, -1, [0 "Identification", 0 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [0 "Lock", 0 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [0 "Lock", 0 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [0 "Lock", 0 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [0 "Lock", 0 "RemainingLockTime"], false false false;
+        RevisionCounter: i32, -1, [0 "RevisionCounter"], false false false;
+        ActualMode: ua::LocalizedText, -1, [0 "ActualMode"], false false false;
+        PermittedMode: ua::LocalizedText, 1, [0 "PermittedMode"], false false false;
+        NormalMode: ua::LocalizedText, 1, [0 "NormalMode"], false false false;
+        TargetMode: ua::LocalizedText, 1, [0 "TargetMode"], false false false;
     }
     t::object_members! {
-        CachedLoadingType; required : [("CurrentVersion/Manufacturer",
-        "the mandatory variable `CurrentVersion/Manufacturer` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/Manufacturer\")]"),
-        ("CurrentVersion/ManufacturerUri",
-        "the mandatory variable `CurrentVersion/ManufacturerUri` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/ManufacturerUri\")]"),
-        ("CurrentVersion/SoftwareRevision",
-        "the mandatory variable `CurrentVersion/SoftwareRevision` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/SoftwareRevision\")]"),
-        ("FileTransfer/ClientProcessingTimeout",
-        "the mandatory variable `FileTransfer/ClientProcessingTimeout` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"FileTransfer/ClientProcessingTimeout\")]"),
-        ("ErrorMessage",
-        "the mandatory variable `ErrorMessage` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ErrorMessage\")]"),
-        ("PendingVersion/Manufacturer",
-        "the mandatory variable `PendingVersion/Manufacturer` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"PendingVersion/Manufacturer\")]"),
-        ("PendingVersion/ManufacturerUri",
-        "the mandatory variable `PendingVersion/ManufacturerUri` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"PendingVersion/ManufacturerUri\")]"),
-        ("PendingVersion/SoftwareRevision",
-        "the mandatory variable `PendingVersion/SoftwareRevision` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"PendingVersion/SoftwareRevision\")]")];
-        UpdateKey : String, - 1, [0 "UpdateKey"], false false false;
-        CurrentVersion__Manufacturer : ua::LocalizedText, - 1, [0 "CurrentVersion", 0
-        "Manufacturer"], true false false; CurrentVersion__ManufacturerUri : String, - 1,
-        [0 "CurrentVersion", 0 "ManufacturerUri"], true false false;
-        CurrentVersion__SoftwareRevision : String, - 1, [0 "CurrentVersion", 0
-        "SoftwareRevision"], true false false; CurrentVersion__PatchIdentifiers : String,
-        1, [0 "CurrentVersion", 0 "PatchIdentifiers"], false false false;
-        CurrentVersion__ReleaseDate : ua::DateTime, - 1, [0 "CurrentVersion", 0
-        "ReleaseDate"], false false false; CurrentVersion__ChangeLogReference : String, -
-        1, [0 "CurrentVersion", 0 "ChangeLogReference"], false false false;
-        CurrentVersion__Hash : ua::ByteString, - 1, [0 "CurrentVersion", 0 "Hash"], false
-        false false; FileTransfer__ClientProcessingTimeout : f64, - 1, [0 "FileTransfer",
-        1 "ClientProcessingTimeout"], true false false; ErrorMessage : ua::LocalizedText,
-        - 1, [0 "ErrorMessage"], true false false; WriteBlockSize : u32, - 1, [0
-        "WriteBlockSize"], false false false; PendingVersion__Manufacturer :
-        ua::LocalizedText, - 1, [0 "PendingVersion", 0 "Manufacturer"], true false false;
-        PendingVersion__ManufacturerUri : String, - 1, [0 "PendingVersion", 0
-        "ManufacturerUri"], true false false; PendingVersion__SoftwareRevision : String,
-        - 1, [0 "PendingVersion", 0 "SoftwareRevision"], true false false;
-        PendingVersion__PatchIdentifiers : String, 1, [0 "PendingVersion", 0
-        "PatchIdentifiers"], false false false; PendingVersion__ReleaseDate :
-        ua::DateTime, - 1, [0 "PendingVersion", 0 "ReleaseDate"], false false false;
-        PendingVersion__ChangeLogReference : String, - 1, [0 "PendingVersion", 0
-        "ChangeLogReference"], false false false; PendingVersion__Hash : ua::ByteString,
-        - 1, [0 "PendingVersion", 0 "Hash"], false false false;
-        FallbackVersion__Manufacturer : ua::LocalizedText, - 1, [0 "FallbackVersion", 0
-        "Manufacturer"], false false false; FallbackVersion__ManufacturerUri : String, -
-        1, [0 "FallbackVersion", 0 "ManufacturerUri"], false false false;
-        FallbackVersion__SoftwareRevision : String, - 1, [0 "FallbackVersion", 0
-        "SoftwareRevision"], false false false; FallbackVersion__PatchIdentifiers :
-        String, 1, [0 "FallbackVersion", 0 "PatchIdentifiers"], false false false;
-        FallbackVersion__ReleaseDate : ua::DateTime, - 1, [0 "FallbackVersion", 0
-        "ReleaseDate"], false false false; FallbackVersion__ChangeLogReference : String,
-        - 1, [0 "FallbackVersion", 0 "ChangeLogReference"], false false false;
-        FallbackVersion__Hash : ua::ByteString, - 1, [0 "FallbackVersion", 0 "Hash"],
-        false false false;
+        CachedLoadingType;
+        required: [
+            ("CurrentVersion/Manufacturer", "the mandatory variable `CurrentVersion/Manufacturer` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/Manufacturer\")]"),
+            ("CurrentVersion/ManufacturerUri", "the mandatory variable `CurrentVersion/ManufacturerUri` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/ManufacturerUri\")]"),
+            ("CurrentVersion/SoftwareRevision", "the mandatory variable `CurrentVersion/SoftwareRevision` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/SoftwareRevision\")]"),
+            ("FileTransfer/ClientProcessingTimeout", "the mandatory variable `FileTransfer/ClientProcessingTimeout` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"FileTransfer/ClientProcessingTimeout\")]"),
+            ("ErrorMessage", "the mandatory variable `ErrorMessage` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ErrorMessage\")]"),
+            ("PendingVersion/Manufacturer", "the mandatory variable `PendingVersion/Manufacturer` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"PendingVersion/Manufacturer\")]"),
+            ("PendingVersion/ManufacturerUri", "the mandatory variable `PendingVersion/ManufacturerUri` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"PendingVersion/ManufacturerUri\")]"),
+            ("PendingVersion/SoftwareRevision", "the mandatory variable `PendingVersion/SoftwareRevision` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"PendingVersion/SoftwareRevision\")]"),
+        ];
+        UpdateKey: String, -1, [0 "UpdateKey"], false false false;
+        CurrentVersion__Manufacturer: ua::LocalizedText, -1, [0 "CurrentVersion", 0 "Manufacturer"], true false false;
+        CurrentVersion__ManufacturerUri: String, -1, [0 "CurrentVersion", 0 "ManufacturerUri"], true false false;
+        CurrentVersion__SoftwareRevision: String, -1, [0 "CurrentVersion", 0 "SoftwareRevision"], true false false;
+        CurrentVersion__PatchIdentifiers: String, 1, [0 "CurrentVersion", 0 "PatchIdentifiers"], false false false;
+        CurrentVersion__ReleaseDate: ua::DateTime, -1, [0 "CurrentVersion", 0 "ReleaseDate"], false false false;
+        CurrentVersion__ChangeLogReference: String, -1, [0 "CurrentVersion", 0 "ChangeLogReference"], false false false;
+        CurrentVersion__Hash: ua::ByteString, -1, [0 "CurrentVersion", 0 "Hash"], false false false;
+        FileTransfer__ClientProcessingTimeout: f64, -1, [0 "FileTransfer", 1 "ClientProcessingTimeout"], true false false;
+        ErrorMessage: ua::LocalizedText, -1, [0 "ErrorMessage"], true false false;
+        WriteBlockSize: u32, -1, [0 "WriteBlockSize"], false false false;
+        PendingVersion__Manufacturer: ua::LocalizedText, -1, [0 "PendingVersion", 0 "Manufacturer"], true false false;
+        PendingVersion__ManufacturerUri: String, -1, [0 "PendingVersion", 0 "ManufacturerUri"], true false false;
+        PendingVersion__SoftwareRevision: String, -1, [0 "PendingVersion", 0 "SoftwareRevision"], true false false;
+        PendingVersion__PatchIdentifiers: String, 1, [0 "PendingVersion", 0 "PatchIdentifiers"], false false false;
+        PendingVersion__ReleaseDate: ua::DateTime, -1, [0 "PendingVersion", 0 "ReleaseDate"], false false false;
+        PendingVersion__ChangeLogReference: String, -1, [0 "PendingVersion", 0 "ChangeLogReference"], false false false;
+        PendingVersion__Hash: ua::ByteString, -1, [0 "PendingVersion", 0 "Hash"], false false false;
+        FallbackVersion__Manufacturer: ua::LocalizedText, -1, [0 "FallbackVersion", 0 "Manufacturer"], false false false;
+        FallbackVersion__ManufacturerUri: String, -1, [0 "FallbackVersion", 0 "ManufacturerUri"], false false false;
+        FallbackVersion__SoftwareRevision: String, -1, [0 "FallbackVersion", 0 "SoftwareRevision"], false false false;
+        FallbackVersion__PatchIdentifiers: String, 1, [0 "FallbackVersion", 0 "PatchIdentifiers"], false false false;
+        FallbackVersion__ReleaseDate: ua::DateTime, -1, [0 "FallbackVersion", 0 "ReleaseDate"], false false false;
+        FallbackVersion__ChangeLogReference: String, -1, [0 "FallbackVersion", 0 "ChangeLogReference"], false false false;
+        FallbackVersion__Hash: ua::ByteString, -1, [0 "FallbackVersion", 0 "Hash"], false false false;
     }
     t::object_members! {
-        CheckFunctionAlarmType; required : [("EventId",
-        "the mandatory variable `EventId` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
-        ("EventType",
-        "the mandatory variable `EventType` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
-        ("SourceNode",
-        "the mandatory variable `SourceNode` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceNode\")]"),
-        ("SourceName",
-        "the mandatory variable `SourceName` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceName\")]"),
-        ("Time",
-        "the mandatory variable `Time` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Time\")]"),
-        ("ReceiveTime",
-        "the mandatory variable `ReceiveTime` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ReceiveTime\")]"),
-        ("Message",
-        "the mandatory variable `Message` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Message\")]"),
-        ("Severity",
-        "the mandatory variable `Severity` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Severity\")]"),
-        ("ConditionClassId",
-        "the mandatory variable `ConditionClassId` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassId\")]"),
-        ("ConditionClassName",
-        "the mandatory variable `ConditionClassName` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassName\")]"),
-        ("ConditionName",
-        "the mandatory variable `ConditionName` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionName\")]"),
-        ("BranchId",
-        "the mandatory variable `BranchId` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"BranchId\")]"),
-        ("Retain",
-        "the mandatory variable `Retain` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Retain\")]"),
-        ("EnabledState",
-        "the mandatory variable `EnabledState` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EnabledState\")]"),
-        ("Quality",
-        "the mandatory variable `Quality` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Quality\")]"),
-        ("LastSeverity",
-        "the mandatory variable `LastSeverity` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastSeverity\")]"),
-        ("Comment",
-        "the mandatory variable `Comment` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Comment\")]"),
-        ("ClientUserId",
-        "the mandatory variable `ClientUserId` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ClientUserId\")]"),
-        ("AckedState",
-        "the mandatory variable `AckedState` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AckedState\")]"),
-        ("ActiveState",
-        "the mandatory variable `ActiveState` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ActiveState\")]"),
-        ("InputNode",
-        "the mandatory variable `InputNode` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputNode\")]"),
-        ("SuppressedOrShelved",
-        "the mandatory variable `SuppressedOrShelved` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SuppressedOrShelved\")]"),
-        ("NormalState",
-        "the mandatory variable `NormalState` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NormalState\")]")];
-        EventId : ua::ByteString, - 1, [1 "EventId"], true false false; EventType :
-        ua::NodeId, - 1, [1 "EventType"], true false false; SourceNode : ua::NodeId, - 1,
-        [1 "SourceNode"], true false false; SourceName : String, - 1, [1 "SourceName"],
-        true false false; Time : ua::DateTime, - 1, [1 "Time"], true false false;
-        ReceiveTime : ua::DateTime, - 1, [1 "ReceiveTime"], true false false; LocalTime :
-        ua::TimeZoneDataType, - 1, [1 "LocalTime"], false false false; Message :
-        ua::LocalizedText, - 1, [1 "Message"], true false false; Severity : u16, - 1, [1
-        "Severity"], true false false; ConditionClassId : ua::NodeId, - 1, [1
-        "ConditionClassId"], true false false; ConditionClassName : ua::LocalizedText, -
-        1, [1 "ConditionClassName"], true false false; ConditionSubClassId : ua::NodeId,
-        1, [1 "ConditionSubClassId"], false false false; ConditionSubClassName :
-        ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
-        ConditionName : String, - 1, [1 "ConditionName"], true false false; BranchId :
-        ua::NodeId, - 1, [1 "BranchId"], true false false; Retain : bool, - 1, [1
-        "Retain"], true false false; EnabledState : ua::LocalizedText, - 1, [1
-        "EnabledState"], true false false; Quality : ua::StatusCode, - 1, [1 "Quality"],
-        true false false; LastSeverity : u16, - 1, [1 "LastSeverity"], true false false;
-        Comment : ua::LocalizedText, - 1, [1 "Comment"], true false false; ClientUserId :
-        String, - 1, [1 "ClientUserId"], true false false; AckedState :
-        ua::LocalizedText, - 1, [1 "AckedState"], true false false; ConfirmedState :
-        ua::LocalizedText, - 1, [1 "ConfirmedState"], false false false; ActiveState :
-        ua::LocalizedText, - 1, [1 "ActiveState"], true false false; InputNode :
-        ua::NodeId, - 1, [1 "InputNode"], true false false; SuppressedState :
-        ua::LocalizedText, - 1, [1 "SuppressedState"], false false false;
-        OutOfServiceState : ua::LocalizedText, - 1, [1 "OutOfServiceState"], false false
-        false; ShelvingState__CurrentState : ua::LocalizedText, - 1, [1 "ShelvingState",
-        1 "CurrentState"], false false false; ShelvingState__LastTransition :
-        ua::LocalizedText, - 1, [1 "ShelvingState", 1 "LastTransition"], false false
-        false; ShelvingState__AvailableStates : ua::NodeId, 1, [1 "ShelvingState", 1
-        "AvailableStates"], false false false; ShelvingState__AvailableTransitions :
-        ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableTransitions"], false false false;
-        ShelvingState__UnshelveTime : f64, - 1, [1 "ShelvingState", 1 "UnshelveTime"],
-        false false false; SuppressedOrShelved : bool, - 1, [1 "SuppressedOrShelved"],
-        true false false; MaxTimeShelved : f64, - 1, [1 "MaxTimeShelved"], false false
-        false; AudibleEnabled : bool, - 1, [1 "AudibleEnabled"], false false false;
-        AudibleSound : ua::ByteString, - 1, [1 "AudibleSound"], false false false;
-        SilenceState : ua::LocalizedText, - 1, [1 "SilenceState"], false false false;
-        OnDelay : f64, - 1, [1 "OnDelay"], false false false; OffDelay : f64, - 1, [1
-        "OffDelay"], false false false; FirstInGroupFlag : bool, - 1, [1
-        "FirstInGroupFlag"], false false false; LatchedState : ua::LocalizedText, - 1, [1
-        "LatchedState"], false false false; ReAlarmTime : f64, - 1, [1 "ReAlarmTime"],
-        false false false; ReAlarmRepeatCount : i16, - 1, [1 "ReAlarmRepeatCount"], false
-        false false; NormalState : ua::NodeId, - 1, [1 "NormalState"], true false false;
+        CheckFunctionAlarmType;
+        required: [
+            ("EventId", "the mandatory variable `EventId` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
+            ("EventType", "the mandatory variable `EventType` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
+            ("SourceNode", "the mandatory variable `SourceNode` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceNode\")]"),
+            ("SourceName", "the mandatory variable `SourceName` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceName\")]"),
+            ("Time", "the mandatory variable `Time` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Time\")]"),
+            ("ReceiveTime", "the mandatory variable `ReceiveTime` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ReceiveTime\")]"),
+            ("Message", "the mandatory variable `Message` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Message\")]"),
+            ("Severity", "the mandatory variable `Severity` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Severity\")]"),
+            ("ConditionClassId", "the mandatory variable `ConditionClassId` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassId\")]"),
+            ("ConditionClassName", "the mandatory variable `ConditionClassName` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassName\")]"),
+            ("ConditionName", "the mandatory variable `ConditionName` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionName\")]"),
+            ("BranchId", "the mandatory variable `BranchId` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"BranchId\")]"),
+            ("Retain", "the mandatory variable `Retain` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Retain\")]"),
+            ("EnabledState", "the mandatory variable `EnabledState` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EnabledState\")]"),
+            ("Quality", "the mandatory variable `Quality` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Quality\")]"),
+            ("LastSeverity", "the mandatory variable `LastSeverity` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastSeverity\")]"),
+            ("Comment", "the mandatory variable `Comment` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Comment\")]"),
+            ("ClientUserId", "the mandatory variable `ClientUserId` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ClientUserId\")]"),
+            ("AckedState", "the mandatory variable `AckedState` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AckedState\")]"),
+            ("ActiveState", "the mandatory variable `ActiveState` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ActiveState\")]"),
+            ("InputNode", "the mandatory variable `InputNode` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputNode\")]"),
+            ("SuppressedOrShelved", "the mandatory variable `SuppressedOrShelved` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SuppressedOrShelved\")]"),
+            ("NormalState", "the mandatory variable `NormalState` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NormalState\")]"),
+        ];
+        EventId: ua::ByteString, -1, [1 "EventId"], true false false;
+        EventType: ua::NodeId, -1, [1 "EventType"], true false false;
+        SourceNode: ua::NodeId, -1, [1 "SourceNode"], true false false;
+        SourceName: String, -1, [1 "SourceName"], true false false;
+        Time: ua::DateTime, -1, [1 "Time"], true false false;
+        ReceiveTime: ua::DateTime, -1, [1 "ReceiveTime"], true false false;
+        LocalTime: ua::TimeZoneDataType, -1, [1 "LocalTime"], false false false;
+        Message: ua::LocalizedText, -1, [1 "Message"], true false false;
+        Severity: u16, -1, [1 "Severity"], true false false;
+        ConditionClassId: ua::NodeId, -1, [1 "ConditionClassId"], true false false;
+        ConditionClassName: ua::LocalizedText, -1, [1 "ConditionClassName"], true false false;
+        ConditionSubClassId: ua::NodeId, 1, [1 "ConditionSubClassId"], false false false;
+        ConditionSubClassName: ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
+        ConditionName: String, -1, [1 "ConditionName"], true false false;
+        BranchId: ua::NodeId, -1, [1 "BranchId"], true false false;
+        Retain: bool, -1, [1 "Retain"], true false false;
+        EnabledState: ua::LocalizedText, -1, [1 "EnabledState"], true false false;
+        Quality: ua::StatusCode, -1, [1 "Quality"], true false false;
+        LastSeverity: u16, -1, [1 "LastSeverity"], true false false;
+        Comment: ua::LocalizedText, -1, [1 "Comment"], true false false;
+        ClientUserId: String, -1, [1 "ClientUserId"], true false false;
+        AckedState: ua::LocalizedText, -1, [1 "AckedState"], true false false;
+        ConfirmedState: ua::LocalizedText, -1, [1 "ConfirmedState"], false false false;
+        ActiveState: ua::LocalizedText, -1, [1 "ActiveState"], true false false;
+        InputNode: ua::NodeId, -1, [1 "InputNode"], true false false;
+        SuppressedState: ua::LocalizedText, -1, [1 "SuppressedState"], false false false;
+        OutOfServiceState: ua::LocalizedText, -1, [1 "OutOfServiceState"], false false false;
+        ShelvingState__CurrentState: ua::LocalizedText, -1, [1 "ShelvingState", 1 "CurrentState"], false false false;
+        ShelvingState__LastTransition: ua::LocalizedText, -1, [1 "ShelvingState", 1 "LastTransition"], false false false;
+        ShelvingState__AvailableStates: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableStates"], false false false;
+        ShelvingState__AvailableTransitions: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableTransitions"], false false false;
+        ShelvingState__UnshelveTime: f64, -1, [1 "ShelvingState", 1 "UnshelveTime"], false false false;
+        SuppressedOrShelved: bool, -1, [1 "SuppressedOrShelved"], true false false;
+        MaxTimeShelved: f64, -1, [1 "MaxTimeShelved"], false false false;
+        AudibleEnabled: bool, -1, [1 "AudibleEnabled"], false false false;
+        AudibleSound: ua::ByteString, -1, [1 "AudibleSound"], false false false;
+        SilenceState: ua::LocalizedText, -1, [1 "SilenceState"], false false false;
+        OnDelay: f64, -1, [1 "OnDelay"], false false false;
+        OffDelay: f64, -1, [1 "OffDelay"], false false false;
+        FirstInGroupFlag: bool, -1, [1 "FirstInGroupFlag"], false false false;
+        LatchedState: ua::LocalizedText, -1, [1 "LatchedState"], false false false;
+        ReAlarmTime: f64, -1, [1 "ReAlarmTime"], false false false;
+        ReAlarmRepeatCount: i16, -1, [1 "ReAlarmRepeatCount"], false false false;
+        NormalState: ua::NodeId, -1, [1 "NormalState"], true false false;
     }
     t::object_members! {
-        ComponentType; required : []; Identification__UIElement : ua::Variant, - 1, [0
-        "Identification", 0 "UIElement"], false false false; Lock__Locked : bool, - 1, [0
-        "Lock", 0 "Locked"], false false false; Lock__LockingClient : String, - 1, [0
-        "Lock", 0 "LockingClient"], false false false; Lock__LockingUser : String, - 1,
-        [0 "Lock", 0 "LockingUser"], false false false; Lock__RemainingLockTime : f64, -
-        1, [0 "Lock", 0 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [0 "Manufacturer"], false false false; ManufacturerUri :
-        String, - 1, [0 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [0 "Model"], false false false; HardwareRevision : String, - 1, [0
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [0
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [0
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [0
-        "ProductCode"], false false false; DeviceManual : String, - 1, [0
-        "DeviceManual"], false false false; DeviceClass : String, - 1, [0 "DeviceClass"],
-        false false false; SerialNumber : String, - 1, [0 "SerialNumber"], false false
-        false; ProductInstanceUri : String, - 1, [0 "ProductInstanceUri"], false false
-        false; RevisionCounter : i32, - 1, [0 "RevisionCounter"], false false false;
-        AssetId : String, - 1, [0 "AssetId"], false false false; ComponentName :
-        ua::LocalizedText, - 1, [0 "ComponentName"], false false false;
+        ComponentType;
+        required: [];
+        Identification__UIElement: ua::Variant, -1, [0 "Identification", 0 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [0 "Lock", 0 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [0 "Lock", 0 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [0 "Lock", 0 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [0 "Lock", 0 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [0 "Manufacturer"], false false false;
+        ManufacturerUri: String, -1, [0 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [0 "Model"], false false false;
+        HardwareRevision: String, -1, [0 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [0 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [0 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [0 "ProductCode"], false false false;
+        DeviceManual: String, -1, [0 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [0 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [0 "SerialNumber"], false false false;
+        ProductInstanceUri: String, -1, [0 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [0 "RevisionCounter"], false false false;
+        AssetId: String, -1, [0 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [0 "ComponentName"], false false false;
     }
     t::object_members! {
-        ConfigurableObjectType; required : [];
+        ConfigurableObjectType;
+        required: [];
     }
     t::object_members! {
-        ConfirmationStateMachineType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of ConfirmationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("ConfirmationTimeout",
-        "the mandatory variable `ConfirmationTimeout` of ConfirmationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConfirmationTimeout\")]")];
-        CurrentState : ua::LocalizedText, - 1, [1 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [1 "LastTransition"], false false false;
-        AvailableStates : ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [1 "AvailableTransitions"], false false
-        false; ConfirmationTimeout : f64, - 1, [0 "ConfirmationTimeout"], true false
-        false;
+        ConfirmationStateMachineType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of ConfirmationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("ConfirmationTimeout", "the mandatory variable `ConfirmationTimeout` of ConfirmationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConfirmationTimeout\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], false false false;
+        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
+        ConfirmationTimeout: f64, -1, [0 "ConfirmationTimeout"], true false false;
     }
     t::object_members! {
-        ConnectionPointType; required : []; Identification__UIElement : ua::Variant, - 1,
-        [0 "Identification", 0 "UIElement"], false false false; Lock__Locked : bool, - 1,
-        [0 "Lock", 0 "Locked"], false false false; Lock__LockingClient : String, - 1, [0
-        "Lock", 0 "LockingClient"], false false false; Lock__LockingUser : String, - 1,
-        [0 "Lock", 0 "LockingUser"], false false false; Lock__RemainingLockTime : f64, -
-        1, [0 "Lock", 0 "RemainingLockTime"], false false false;
-        NetworkAddress__UIElement : ua::Variant, - 1, [0 "NetworkAddress", 0
-        "UIElement"], false false false;
+        ConnectionPointType;
+        required: [];
+        Identification__UIElement: ua::Variant, -1, [0 "Identification", 0 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [0 "Lock", 0 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [0 "Lock", 0 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [0 "Lock", 0 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [0 "Lock", 0 "RemainingLockTime"], false false false;
+        NetworkAddress__UIElement: ua::Variant, -1, [0 "NetworkAddress", 0 "UIElement"], false false false;
     }
     t::object_members! {
-        DeviceHealthDiagnosticAlarmType; required : [("EventId",
-        "the mandatory variable `EventId` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
-        ("EventType",
-        "the mandatory variable `EventType` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
-        ("SourceNode",
-        "the mandatory variable `SourceNode` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceNode\")]"),
-        ("SourceName",
-        "the mandatory variable `SourceName` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceName\")]"),
-        ("Time",
-        "the mandatory variable `Time` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Time\")]"),
-        ("ReceiveTime",
-        "the mandatory variable `ReceiveTime` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ReceiveTime\")]"),
-        ("Message",
-        "the mandatory variable `Message` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Message\")]"),
-        ("Severity",
-        "the mandatory variable `Severity` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Severity\")]"),
-        ("ConditionClassId",
-        "the mandatory variable `ConditionClassId` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassId\")]"),
-        ("ConditionClassName",
-        "the mandatory variable `ConditionClassName` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassName\")]"),
-        ("ConditionName",
-        "the mandatory variable `ConditionName` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionName\")]"),
-        ("BranchId",
-        "the mandatory variable `BranchId` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"BranchId\")]"),
-        ("Retain",
-        "the mandatory variable `Retain` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Retain\")]"),
-        ("EnabledState",
-        "the mandatory variable `EnabledState` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EnabledState\")]"),
-        ("Quality",
-        "the mandatory variable `Quality` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Quality\")]"),
-        ("LastSeverity",
-        "the mandatory variable `LastSeverity` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastSeverity\")]"),
-        ("Comment",
-        "the mandatory variable `Comment` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Comment\")]"),
-        ("ClientUserId",
-        "the mandatory variable `ClientUserId` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ClientUserId\")]"),
-        ("AckedState",
-        "the mandatory variable `AckedState` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AckedState\")]"),
-        ("ActiveState",
-        "the mandatory variable `ActiveState` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ActiveState\")]"),
-        ("InputNode",
-        "the mandatory variable `InputNode` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputNode\")]"),
-        ("SuppressedOrShelved",
-        "the mandatory variable `SuppressedOrShelved` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SuppressedOrShelved\")]"),
-        ("NormalState",
-        "the mandatory variable `NormalState` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NormalState\")]")];
-        EventId : ua::ByteString, - 1, [1 "EventId"], true false false; EventType :
-        ua::NodeId, - 1, [1 "EventType"], true false false; SourceNode : ua::NodeId, - 1,
-        [1 "SourceNode"], true false false; SourceName : String, - 1, [1 "SourceName"],
-        true false false; Time : ua::DateTime, - 1, [1 "Time"], true false false;
-        ReceiveTime : ua::DateTime, - 1, [1 "ReceiveTime"], true false false; LocalTime :
-        ua::TimeZoneDataType, - 1, [1 "LocalTime"], false false false; Message :
-        ua::LocalizedText, - 1, [1 "Message"], true false false; Severity : u16, - 1, [1
-        "Severity"], true false false; ConditionClassId : ua::NodeId, - 1, [1
-        "ConditionClassId"], true false false; ConditionClassName : ua::LocalizedText, -
-        1, [1 "ConditionClassName"], true false false; ConditionSubClassId : ua::NodeId,
-        1, [1 "ConditionSubClassId"], false false false; ConditionSubClassName :
-        ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
-        ConditionName : String, - 1, [1 "ConditionName"], true false false; BranchId :
-        ua::NodeId, - 1, [1 "BranchId"], true false false; Retain : bool, - 1, [1
-        "Retain"], true false false; EnabledState : ua::LocalizedText, - 1, [1
-        "EnabledState"], true false false; Quality : ua::StatusCode, - 1, [1 "Quality"],
-        true false false; LastSeverity : u16, - 1, [1 "LastSeverity"], true false false;
-        Comment : ua::LocalizedText, - 1, [1 "Comment"], true false false; ClientUserId :
-        String, - 1, [1 "ClientUserId"], true false false; AckedState :
-        ua::LocalizedText, - 1, [1 "AckedState"], true false false; ConfirmedState :
-        ua::LocalizedText, - 1, [1 "ConfirmedState"], false false false; ActiveState :
-        ua::LocalizedText, - 1, [1 "ActiveState"], true false false; InputNode :
-        ua::NodeId, - 1, [1 "InputNode"], true false false; SuppressedState :
-        ua::LocalizedText, - 1, [1 "SuppressedState"], false false false;
-        OutOfServiceState : ua::LocalizedText, - 1, [1 "OutOfServiceState"], false false
-        false; ShelvingState__CurrentState : ua::LocalizedText, - 1, [1 "ShelvingState",
-        1 "CurrentState"], false false false; ShelvingState__LastTransition :
-        ua::LocalizedText, - 1, [1 "ShelvingState", 1 "LastTransition"], false false
-        false; ShelvingState__AvailableStates : ua::NodeId, 1, [1 "ShelvingState", 1
-        "AvailableStates"], false false false; ShelvingState__AvailableTransitions :
-        ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableTransitions"], false false false;
-        ShelvingState__UnshelveTime : f64, - 1, [1 "ShelvingState", 1 "UnshelveTime"],
-        false false false; SuppressedOrShelved : bool, - 1, [1 "SuppressedOrShelved"],
-        true false false; MaxTimeShelved : f64, - 1, [1 "MaxTimeShelved"], false false
-        false; AudibleEnabled : bool, - 1, [1 "AudibleEnabled"], false false false;
-        AudibleSound : ua::ByteString, - 1, [1 "AudibleSound"], false false false;
-        SilenceState : ua::LocalizedText, - 1, [1 "SilenceState"], false false false;
-        OnDelay : f64, - 1, [1 "OnDelay"], false false false; OffDelay : f64, - 1, [1
-        "OffDelay"], false false false; FirstInGroupFlag : bool, - 1, [1
-        "FirstInGroupFlag"], false false false; LatchedState : ua::LocalizedText, - 1, [1
-        "LatchedState"], false false false; ReAlarmTime : f64, - 1, [1 "ReAlarmTime"],
-        false false false; ReAlarmRepeatCount : i16, - 1, [1 "ReAlarmRepeatCount"], false
-        false false; NormalState : ua::NodeId, - 1, [1 "NormalState"], true false false;
+        DeviceHealthDiagnosticAlarmType;
+        required: [
+            ("EventId", "the mandatory variable `EventId` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
+            ("EventType", "the mandatory variable `EventType` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
+            ("SourceNode", "the mandatory variable `SourceNode` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceNode\")]"),
+            ("SourceName", "the mandatory variable `SourceName` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceName\")]"),
+            ("Time", "the mandatory variable `Time` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Time\")]"),
+            ("ReceiveTime", "the mandatory variable `ReceiveTime` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ReceiveTime\")]"),
+            ("Message", "the mandatory variable `Message` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Message\")]"),
+            ("Severity", "the mandatory variable `Severity` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Severity\")]"),
+            ("ConditionClassId", "the mandatory variable `ConditionClassId` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassId\")]"),
+            ("ConditionClassName", "the mandatory variable `ConditionClassName` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassName\")]"),
+            ("ConditionName", "the mandatory variable `ConditionName` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionName\")]"),
+            ("BranchId", "the mandatory variable `BranchId` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"BranchId\")]"),
+            ("Retain", "the mandatory variable `Retain` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Retain\")]"),
+            ("EnabledState", "the mandatory variable `EnabledState` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EnabledState\")]"),
+            ("Quality", "the mandatory variable `Quality` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Quality\")]"),
+            ("LastSeverity", "the mandatory variable `LastSeverity` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastSeverity\")]"),
+            ("Comment", "the mandatory variable `Comment` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Comment\")]"),
+            ("ClientUserId", "the mandatory variable `ClientUserId` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ClientUserId\")]"),
+            ("AckedState", "the mandatory variable `AckedState` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AckedState\")]"),
+            ("ActiveState", "the mandatory variable `ActiveState` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ActiveState\")]"),
+            ("InputNode", "the mandatory variable `InputNode` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputNode\")]"),
+            ("SuppressedOrShelved", "the mandatory variable `SuppressedOrShelved` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SuppressedOrShelved\")]"),
+            ("NormalState", "the mandatory variable `NormalState` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NormalState\")]"),
+        ];
+        EventId: ua::ByteString, -1, [1 "EventId"], true false false;
+        EventType: ua::NodeId, -1, [1 "EventType"], true false false;
+        SourceNode: ua::NodeId, -1, [1 "SourceNode"], true false false;
+        SourceName: String, -1, [1 "SourceName"], true false false;
+        Time: ua::DateTime, -1, [1 "Time"], true false false;
+        ReceiveTime: ua::DateTime, -1, [1 "ReceiveTime"], true false false;
+        LocalTime: ua::TimeZoneDataType, -1, [1 "LocalTime"], false false false;
+        Message: ua::LocalizedText, -1, [1 "Message"], true false false;
+        Severity: u16, -1, [1 "Severity"], true false false;
+        ConditionClassId: ua::NodeId, -1, [1 "ConditionClassId"], true false false;
+        ConditionClassName: ua::LocalizedText, -1, [1 "ConditionClassName"], true false false;
+        ConditionSubClassId: ua::NodeId, 1, [1 "ConditionSubClassId"], false false false;
+        ConditionSubClassName: ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
+        ConditionName: String, -1, [1 "ConditionName"], true false false;
+        BranchId: ua::NodeId, -1, [1 "BranchId"], true false false;
+        Retain: bool, -1, [1 "Retain"], true false false;
+        EnabledState: ua::LocalizedText, -1, [1 "EnabledState"], true false false;
+        Quality: ua::StatusCode, -1, [1 "Quality"], true false false;
+        LastSeverity: u16, -1, [1 "LastSeverity"], true false false;
+        Comment: ua::LocalizedText, -1, [1 "Comment"], true false false;
+        ClientUserId: String, -1, [1 "ClientUserId"], true false false;
+        AckedState: ua::LocalizedText, -1, [1 "AckedState"], true false false;
+        ConfirmedState: ua::LocalizedText, -1, [1 "ConfirmedState"], false false false;
+        ActiveState: ua::LocalizedText, -1, [1 "ActiveState"], true false false;
+        InputNode: ua::NodeId, -1, [1 "InputNode"], true false false;
+        SuppressedState: ua::LocalizedText, -1, [1 "SuppressedState"], false false false;
+        OutOfServiceState: ua::LocalizedText, -1, [1 "OutOfServiceState"], false false false;
+        ShelvingState__CurrentState: ua::LocalizedText, -1, [1 "ShelvingState", 1 "CurrentState"], false false false;
+        ShelvingState__LastTransition: ua::LocalizedText, -1, [1 "ShelvingState", 1 "LastTransition"], false false false;
+        ShelvingState__AvailableStates: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableStates"], false false false;
+        ShelvingState__AvailableTransitions: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableTransitions"], false false false;
+        ShelvingState__UnshelveTime: f64, -1, [1 "ShelvingState", 1 "UnshelveTime"], false false false;
+        SuppressedOrShelved: bool, -1, [1 "SuppressedOrShelved"], true false false;
+        MaxTimeShelved: f64, -1, [1 "MaxTimeShelved"], false false false;
+        AudibleEnabled: bool, -1, [1 "AudibleEnabled"], false false false;
+        AudibleSound: ua::ByteString, -1, [1 "AudibleSound"], false false false;
+        SilenceState: ua::LocalizedText, -1, [1 "SilenceState"], false false false;
+        OnDelay: f64, -1, [1 "OnDelay"], false false false;
+        OffDelay: f64, -1, [1 "OffDelay"], false false false;
+        FirstInGroupFlag: bool, -1, [1 "FirstInGroupFlag"], false false false;
+        LatchedState: ua::LocalizedText, -1, [1 "LatchedState"], false false false;
+        ReAlarmTime: f64, -1, [1 "ReAlarmTime"], false false false;
+        ReAlarmRepeatCount: i16, -1, [1 "ReAlarmRepeatCount"], false false false;
+        NormalState: ua::NodeId, -1, [1 "NormalState"], true false false;
     }
     t::object_members! {
-        DeviceType; required : [("Manufacturer",
-        "the mandatory variable `Manufacturer` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
-        ("Model",
-        "the mandatory variable `Model` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
-        ("HardwareRevision",
-        "the mandatory variable `HardwareRevision` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"HardwareRevision\")]"),
-        ("SoftwareRevision",
-        "the mandatory variable `SoftwareRevision` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SoftwareRevision\")]"),
-        ("DeviceRevision",
-        "the mandatory variable `DeviceRevision` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DeviceRevision\")]"),
-        ("DeviceManual",
-        "the mandatory variable `DeviceManual` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DeviceManual\")]"),
-        ("SerialNumber",
-        "the mandatory variable `SerialNumber` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
-        ("RevisionCounter",
-        "the mandatory variable `RevisionCounter` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RevisionCounter\")]")];
-        Identification__UIElement : ua::Variant, - 1, [0 "Identification", 0
-        "UIElement"], false false false; Lock__Locked : bool, - 1, [0 "Lock", 0
-        "Locked"], false false false; Lock__LockingClient : String, - 1, [0 "Lock", 0
-        "LockingClient"], false false false; Lock__LockingUser : String, - 1, [0 "Lock",
-        0 "LockingUser"], false false false; Lock__RemainingLockTime : f64, - 1, [0
-        "Lock", 0 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [0 "Manufacturer"], true false false; ManufacturerUri :
-        String, - 1, [0 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [0 "Model"], true false false; HardwareRevision : String, - 1, [0
-        "HardwareRevision"], true false false; SoftwareRevision : String, - 1, [0
-        "SoftwareRevision"], true false false; DeviceRevision : String, - 1, [0
-        "DeviceRevision"], true false false; ProductCode : String, - 1, [0
-        "ProductCode"], false false false; DeviceManual : String, - 1, [0
-        "DeviceManual"], true false false; DeviceClass : String, - 1, [0 "DeviceClass"],
-        false false false; SerialNumber : String, - 1, [0 "SerialNumber"], true false
-        false; ProductInstanceUri : String, - 1, [0 "ProductInstanceUri"], false false
-        false; RevisionCounter : i32, - 1, [0 "RevisionCounter"], true false false;
-        AssetId : String, - 1, [0 "AssetId"], false false false; ComponentName :
-        ua::LocalizedText, - 1, [0 "ComponentName"], false false false; DeviceHealth :
-        super::super::super::types::DeviceHealthEnumeration, - 1, [0 "DeviceHealth"],
-        false false false;
+        DeviceType;
+        required: [
+            ("Manufacturer", "the mandatory variable `Manufacturer` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
+            ("Model", "the mandatory variable `Model` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
+            ("HardwareRevision", "the mandatory variable `HardwareRevision` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"HardwareRevision\")]"),
+            ("SoftwareRevision", "the mandatory variable `SoftwareRevision` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SoftwareRevision\")]"),
+            ("DeviceRevision", "the mandatory variable `DeviceRevision` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DeviceRevision\")]"),
+            ("DeviceManual", "the mandatory variable `DeviceManual` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DeviceManual\")]"),
+            ("SerialNumber", "the mandatory variable `SerialNumber` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
+            ("RevisionCounter", "the mandatory variable `RevisionCounter` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RevisionCounter\")]"),
+        ];
+        Identification__UIElement: ua::Variant, -1, [0 "Identification", 0 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [0 "Lock", 0 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [0 "Lock", 0 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [0 "Lock", 0 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [0 "Lock", 0 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [0 "Manufacturer"], true false false;
+        ManufacturerUri: String, -1, [0 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [0 "Model"], true false false;
+        HardwareRevision: String, -1, [0 "HardwareRevision"], true false false;
+        SoftwareRevision: String, -1, [0 "SoftwareRevision"], true false false;
+        DeviceRevision: String, -1, [0 "DeviceRevision"], true false false;
+        ProductCode: String, -1, [0 "ProductCode"], false false false;
+        DeviceManual: String, -1, [0 "DeviceManual"], true false false;
+        DeviceClass: String, -1, [0 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [0 "SerialNumber"], true false false;
+        ProductInstanceUri: String, -1, [0 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [0 "RevisionCounter"], true false false;
+        AssetId: String, -1, [0 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [0 "ComponentName"], false false false;
+        DeviceHealth: super::super::super::types::DeviceHealthEnumeration, -1, [0 "DeviceHealth"], false false false;
     }
     t::object_members! {
-        DiameterIndicationType; required : [];
+        DiameterIndicationType;
+        required: [];
     }
     t::object_members! {
-        DirectLoadingType; required : [("CurrentVersion/Manufacturer",
-        "the mandatory variable `CurrentVersion/Manufacturer` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/Manufacturer\")]"),
-        ("CurrentVersion/ManufacturerUri",
-        "the mandatory variable `CurrentVersion/ManufacturerUri` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/ManufacturerUri\")]"),
-        ("CurrentVersion/SoftwareRevision",
-        "the mandatory variable `CurrentVersion/SoftwareRevision` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/SoftwareRevision\")]"),
-        ("FileTransfer/ClientProcessingTimeout",
-        "the mandatory variable `FileTransfer/ClientProcessingTimeout` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"FileTransfer/ClientProcessingTimeout\")]"),
-        ("ErrorMessage",
-        "the mandatory variable `ErrorMessage` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ErrorMessage\")]"),
-        ("UpdateBehavior",
-        "the mandatory variable `UpdateBehavior` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"UpdateBehavior\")]")];
-        UpdateKey : String, - 1, [0 "UpdateKey"], false false false;
-        CurrentVersion__Manufacturer : ua::LocalizedText, - 1, [0 "CurrentVersion", 0
-        "Manufacturer"], true false false; CurrentVersion__ManufacturerUri : String, - 1,
-        [0 "CurrentVersion", 0 "ManufacturerUri"], true false false;
-        CurrentVersion__SoftwareRevision : String, - 1, [0 "CurrentVersion", 0
-        "SoftwareRevision"], true false false; CurrentVersion__PatchIdentifiers : String,
-        1, [0 "CurrentVersion", 0 "PatchIdentifiers"], false false false;
-        CurrentVersion__ReleaseDate : ua::DateTime, - 1, [0 "CurrentVersion", 0
-        "ReleaseDate"], false false false; CurrentVersion__ChangeLogReference : String, -
-        1, [0 "CurrentVersion", 0 "ChangeLogReference"], false false false;
-        CurrentVersion__Hash : ua::ByteString, - 1, [0 "CurrentVersion", 0 "Hash"], false
-        false false; FileTransfer__ClientProcessingTimeout : f64, - 1, [0 "FileTransfer",
-        1 "ClientProcessingTimeout"], true false false; ErrorMessage : ua::LocalizedText,
-        - 1, [0 "ErrorMessage"], true false false; WriteBlockSize : u32, - 1, [0
-        "WriteBlockSize"], false false false; UpdateBehavior :
-        super::super::super::types::UpdateBehavior, - 1, [0 "UpdateBehavior"], true false
-        false; WriteTimeout : f64, - 1, [0 "WriteTimeout"], false false false;
+        DirectLoadingType;
+        required: [
+            ("CurrentVersion/Manufacturer", "the mandatory variable `CurrentVersion/Manufacturer` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/Manufacturer\")]"),
+            ("CurrentVersion/ManufacturerUri", "the mandatory variable `CurrentVersion/ManufacturerUri` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/ManufacturerUri\")]"),
+            ("CurrentVersion/SoftwareRevision", "the mandatory variable `CurrentVersion/SoftwareRevision` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/SoftwareRevision\")]"),
+            ("FileTransfer/ClientProcessingTimeout", "the mandatory variable `FileTransfer/ClientProcessingTimeout` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"FileTransfer/ClientProcessingTimeout\")]"),
+            ("ErrorMessage", "the mandatory variable `ErrorMessage` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ErrorMessage\")]"),
+            ("UpdateBehavior", "the mandatory variable `UpdateBehavior` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"UpdateBehavior\")]"),
+        ];
+        UpdateKey: String, -1, [0 "UpdateKey"], false false false;
+        CurrentVersion__Manufacturer: ua::LocalizedText, -1, [0 "CurrentVersion", 0 "Manufacturer"], true false false;
+        CurrentVersion__ManufacturerUri: String, -1, [0 "CurrentVersion", 0 "ManufacturerUri"], true false false;
+        CurrentVersion__SoftwareRevision: String, -1, [0 "CurrentVersion", 0 "SoftwareRevision"], true false false;
+        CurrentVersion__PatchIdentifiers: String, 1, [0 "CurrentVersion", 0 "PatchIdentifiers"], false false false;
+        CurrentVersion__ReleaseDate: ua::DateTime, -1, [0 "CurrentVersion", 0 "ReleaseDate"], false false false;
+        CurrentVersion__ChangeLogReference: String, -1, [0 "CurrentVersion", 0 "ChangeLogReference"], false false false;
+        CurrentVersion__Hash: ua::ByteString, -1, [0 "CurrentVersion", 0 "Hash"], false false false;
+        FileTransfer__ClientProcessingTimeout: f64, -1, [0 "FileTransfer", 1 "ClientProcessingTimeout"], true false false;
+        ErrorMessage: ua::LocalizedText, -1, [0 "ErrorMessage"], true false false;
+        WriteBlockSize: u32, -1, [0 "WriteBlockSize"], false false false;
+        UpdateBehavior: super::super::super::types::UpdateBehavior, -1, [0 "UpdateBehavior"], true false false;
+        WriteTimeout: f64, -1, [0 "WriteTimeout"], false false false;
     }
     t::object_members! {
-        FailureAlarmType; required : [("EventId",
-        "the mandatory variable `EventId` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
-        ("EventType",
-        "the mandatory variable `EventType` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
-        ("SourceNode",
-        "the mandatory variable `SourceNode` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceNode\")]"),
-        ("SourceName",
-        "the mandatory variable `SourceName` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceName\")]"),
-        ("Time",
-        "the mandatory variable `Time` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Time\")]"),
-        ("ReceiveTime",
-        "the mandatory variable `ReceiveTime` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ReceiveTime\")]"),
-        ("Message",
-        "the mandatory variable `Message` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Message\")]"),
-        ("Severity",
-        "the mandatory variable `Severity` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Severity\")]"),
-        ("ConditionClassId",
-        "the mandatory variable `ConditionClassId` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassId\")]"),
-        ("ConditionClassName",
-        "the mandatory variable `ConditionClassName` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassName\")]"),
-        ("ConditionName",
-        "the mandatory variable `ConditionName` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionName\")]"),
-        ("BranchId",
-        "the mandatory variable `BranchId` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"BranchId\")]"),
-        ("Retain",
-        "the mandatory variable `Retain` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Retain\")]"),
-        ("EnabledState",
-        "the mandatory variable `EnabledState` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EnabledState\")]"),
-        ("Quality",
-        "the mandatory variable `Quality` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Quality\")]"),
-        ("LastSeverity",
-        "the mandatory variable `LastSeverity` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastSeverity\")]"),
-        ("Comment",
-        "the mandatory variable `Comment` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Comment\")]"),
-        ("ClientUserId",
-        "the mandatory variable `ClientUserId` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ClientUserId\")]"),
-        ("AckedState",
-        "the mandatory variable `AckedState` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AckedState\")]"),
-        ("ActiveState",
-        "the mandatory variable `ActiveState` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ActiveState\")]"),
-        ("InputNode",
-        "the mandatory variable `InputNode` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputNode\")]"),
-        ("SuppressedOrShelved",
-        "the mandatory variable `SuppressedOrShelved` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SuppressedOrShelved\")]"),
-        ("NormalState",
-        "the mandatory variable `NormalState` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NormalState\")]")];
-        EventId : ua::ByteString, - 1, [1 "EventId"], true false false; EventType :
-        ua::NodeId, - 1, [1 "EventType"], true false false; SourceNode : ua::NodeId, - 1,
-        [1 "SourceNode"], true false false; SourceName : String, - 1, [1 "SourceName"],
-        true false false; Time : ua::DateTime, - 1, [1 "Time"], true false false;
-        ReceiveTime : ua::DateTime, - 1, [1 "ReceiveTime"], true false false; LocalTime :
-        ua::TimeZoneDataType, - 1, [1 "LocalTime"], false false false; Message :
-        ua::LocalizedText, - 1, [1 "Message"], true false false; Severity : u16, - 1, [1
-        "Severity"], true false false; ConditionClassId : ua::NodeId, - 1, [1
-        "ConditionClassId"], true false false; ConditionClassName : ua::LocalizedText, -
-        1, [1 "ConditionClassName"], true false false; ConditionSubClassId : ua::NodeId,
-        1, [1 "ConditionSubClassId"], false false false; ConditionSubClassName :
-        ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
-        ConditionName : String, - 1, [1 "ConditionName"], true false false; BranchId :
-        ua::NodeId, - 1, [1 "BranchId"], true false false; Retain : bool, - 1, [1
-        "Retain"], true false false; EnabledState : ua::LocalizedText, - 1, [1
-        "EnabledState"], true false false; Quality : ua::StatusCode, - 1, [1 "Quality"],
-        true false false; LastSeverity : u16, - 1, [1 "LastSeverity"], true false false;
-        Comment : ua::LocalizedText, - 1, [1 "Comment"], true false false; ClientUserId :
-        String, - 1, [1 "ClientUserId"], true false false; AckedState :
-        ua::LocalizedText, - 1, [1 "AckedState"], true false false; ConfirmedState :
-        ua::LocalizedText, - 1, [1 "ConfirmedState"], false false false; ActiveState :
-        ua::LocalizedText, - 1, [1 "ActiveState"], true false false; InputNode :
-        ua::NodeId, - 1, [1 "InputNode"], true false false; SuppressedState :
-        ua::LocalizedText, - 1, [1 "SuppressedState"], false false false;
-        OutOfServiceState : ua::LocalizedText, - 1, [1 "OutOfServiceState"], false false
-        false; ShelvingState__CurrentState : ua::LocalizedText, - 1, [1 "ShelvingState",
-        1 "CurrentState"], false false false; ShelvingState__LastTransition :
-        ua::LocalizedText, - 1, [1 "ShelvingState", 1 "LastTransition"], false false
-        false; ShelvingState__AvailableStates : ua::NodeId, 1, [1 "ShelvingState", 1
-        "AvailableStates"], false false false; ShelvingState__AvailableTransitions :
-        ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableTransitions"], false false false;
-        ShelvingState__UnshelveTime : f64, - 1, [1 "ShelvingState", 1 "UnshelveTime"],
-        false false false; SuppressedOrShelved : bool, - 1, [1 "SuppressedOrShelved"],
-        true false false; MaxTimeShelved : f64, - 1, [1 "MaxTimeShelved"], false false
-        false; AudibleEnabled : bool, - 1, [1 "AudibleEnabled"], false false false;
-        AudibleSound : ua::ByteString, - 1, [1 "AudibleSound"], false false false;
-        SilenceState : ua::LocalizedText, - 1, [1 "SilenceState"], false false false;
-        OnDelay : f64, - 1, [1 "OnDelay"], false false false; OffDelay : f64, - 1, [1
-        "OffDelay"], false false false; FirstInGroupFlag : bool, - 1, [1
-        "FirstInGroupFlag"], false false false; LatchedState : ua::LocalizedText, - 1, [1
-        "LatchedState"], false false false; ReAlarmTime : f64, - 1, [1 "ReAlarmTime"],
-        false false false; ReAlarmRepeatCount : i16, - 1, [1 "ReAlarmRepeatCount"], false
-        false false; NormalState : ua::NodeId, - 1, [1 "NormalState"], true false false;
+        FailureAlarmType;
+        required: [
+            ("EventId", "the mandatory variable `EventId` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
+            ("EventType", "the mandatory variable `EventType` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
+            ("SourceNode", "the mandatory variable `SourceNode` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceNode\")]"),
+            ("SourceName", "the mandatory variable `SourceName` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceName\")]"),
+            ("Time", "the mandatory variable `Time` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Time\")]"),
+            ("ReceiveTime", "the mandatory variable `ReceiveTime` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ReceiveTime\")]"),
+            ("Message", "the mandatory variable `Message` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Message\")]"),
+            ("Severity", "the mandatory variable `Severity` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Severity\")]"),
+            ("ConditionClassId", "the mandatory variable `ConditionClassId` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassId\")]"),
+            ("ConditionClassName", "the mandatory variable `ConditionClassName` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassName\")]"),
+            ("ConditionName", "the mandatory variable `ConditionName` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionName\")]"),
+            ("BranchId", "the mandatory variable `BranchId` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"BranchId\")]"),
+            ("Retain", "the mandatory variable `Retain` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Retain\")]"),
+            ("EnabledState", "the mandatory variable `EnabledState` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EnabledState\")]"),
+            ("Quality", "the mandatory variable `Quality` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Quality\")]"),
+            ("LastSeverity", "the mandatory variable `LastSeverity` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastSeverity\")]"),
+            ("Comment", "the mandatory variable `Comment` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Comment\")]"),
+            ("ClientUserId", "the mandatory variable `ClientUserId` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ClientUserId\")]"),
+            ("AckedState", "the mandatory variable `AckedState` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AckedState\")]"),
+            ("ActiveState", "the mandatory variable `ActiveState` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ActiveState\")]"),
+            ("InputNode", "the mandatory variable `InputNode` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputNode\")]"),
+            ("SuppressedOrShelved", "the mandatory variable `SuppressedOrShelved` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SuppressedOrShelved\")]"),
+            ("NormalState", "the mandatory variable `NormalState` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NormalState\")]"),
+        ];
+        EventId: ua::ByteString, -1, [1 "EventId"], true false false;
+        EventType: ua::NodeId, -1, [1 "EventType"], true false false;
+        SourceNode: ua::NodeId, -1, [1 "SourceNode"], true false false;
+        SourceName: String, -1, [1 "SourceName"], true false false;
+        Time: ua::DateTime, -1, [1 "Time"], true false false;
+        ReceiveTime: ua::DateTime, -1, [1 "ReceiveTime"], true false false;
+        LocalTime: ua::TimeZoneDataType, -1, [1 "LocalTime"], false false false;
+        Message: ua::LocalizedText, -1, [1 "Message"], true false false;
+        Severity: u16, -1, [1 "Severity"], true false false;
+        ConditionClassId: ua::NodeId, -1, [1 "ConditionClassId"], true false false;
+        ConditionClassName: ua::LocalizedText, -1, [1 "ConditionClassName"], true false false;
+        ConditionSubClassId: ua::NodeId, 1, [1 "ConditionSubClassId"], false false false;
+        ConditionSubClassName: ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
+        ConditionName: String, -1, [1 "ConditionName"], true false false;
+        BranchId: ua::NodeId, -1, [1 "BranchId"], true false false;
+        Retain: bool, -1, [1 "Retain"], true false false;
+        EnabledState: ua::LocalizedText, -1, [1 "EnabledState"], true false false;
+        Quality: ua::StatusCode, -1, [1 "Quality"], true false false;
+        LastSeverity: u16, -1, [1 "LastSeverity"], true false false;
+        Comment: ua::LocalizedText, -1, [1 "Comment"], true false false;
+        ClientUserId: String, -1, [1 "ClientUserId"], true false false;
+        AckedState: ua::LocalizedText, -1, [1 "AckedState"], true false false;
+        ConfirmedState: ua::LocalizedText, -1, [1 "ConfirmedState"], false false false;
+        ActiveState: ua::LocalizedText, -1, [1 "ActiveState"], true false false;
+        InputNode: ua::NodeId, -1, [1 "InputNode"], true false false;
+        SuppressedState: ua::LocalizedText, -1, [1 "SuppressedState"], false false false;
+        OutOfServiceState: ua::LocalizedText, -1, [1 "OutOfServiceState"], false false false;
+        ShelvingState__CurrentState: ua::LocalizedText, -1, [1 "ShelvingState", 1 "CurrentState"], false false false;
+        ShelvingState__LastTransition: ua::LocalizedText, -1, [1 "ShelvingState", 1 "LastTransition"], false false false;
+        ShelvingState__AvailableStates: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableStates"], false false false;
+        ShelvingState__AvailableTransitions: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableTransitions"], false false false;
+        ShelvingState__UnshelveTime: f64, -1, [1 "ShelvingState", 1 "UnshelveTime"], false false false;
+        SuppressedOrShelved: bool, -1, [1 "SuppressedOrShelved"], true false false;
+        MaxTimeShelved: f64, -1, [1 "MaxTimeShelved"], false false false;
+        AudibleEnabled: bool, -1, [1 "AudibleEnabled"], false false false;
+        AudibleSound: ua::ByteString, -1, [1 "AudibleSound"], false false false;
+        SilenceState: ua::LocalizedText, -1, [1 "SilenceState"], false false false;
+        OnDelay: f64, -1, [1 "OnDelay"], false false false;
+        OffDelay: f64, -1, [1 "OffDelay"], false false false;
+        FirstInGroupFlag: bool, -1, [1 "FirstInGroupFlag"], false false false;
+        LatchedState: ua::LocalizedText, -1, [1 "LatchedState"], false false false;
+        ReAlarmTime: f64, -1, [1 "ReAlarmTime"], false false false;
+        ReAlarmRepeatCount: i16, -1, [1 "ReAlarmRepeatCount"], false false false;
+        NormalState: ua::NodeId, -1, [1 "NormalState"], true false false;
     }
     t::object_members! {
-        FileSystemLoadingType; required : []; UpdateKey : String, - 1, [0 "UpdateKey"],
-        false false false;
+        FileSystemLoadingType;
+        required: [];
+        UpdateKey: String, -1, [0 "UpdateKey"], false false false;
     }
     t::object_members! {
-        FunctionalGroupType; required : []; UIElement : ua::Variant, - 1, [0
-        "UIElement"], false false false;
+        FunctionalGroupType;
+        required: [];
+        UIElement: ua::Variant, -1, [0 "UIElement"], false false false;
     }
     t::object_members! {
-        IAssetLocationIndicationType; required : [("IsIndicating",
-        "the mandatory variable `IsIndicating` of IAssetLocationIndicationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"IsIndicating\")]")];
-        IsIndicating : bool, - 1, [0 "IsIndicating"], true false false;
-        UsedIndicationType : super::super::super::types::LocationIndicationType, - 1, [0
-        "UsedIndicationType"], false false false; SupportedIndicationTypes :
-        super::super::super::types::LocationIndicationType, - 1, [0
-        "SupportedIndicationTypes"], false false false;
+        IAssetLocationIndicationType;
+        required: [
+            ("IsIndicating", "the mandatory variable `IsIndicating` of IAssetLocationIndicationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"IsIndicating\")]"),
+        ];
+        IsIndicating: bool, -1, [0 "IsIndicating"], true false false;
+        UsedIndicationType: super::super::super::types::LocationIndicationType, -1, [0 "UsedIndicationType"], false false false;
+        SupportedIndicationTypes: super::super::super::types::LocationIndicationType, -1, [0 "SupportedIndicationTypes"], false false false;
     }
     t::object_members! {
-        IDeviceHealthType; required : []; DeviceHealth :
-        super::super::super::types::DeviceHealthEnumeration, - 1, [0 "DeviceHealth"],
-        false false false;
+        IDeviceHealthType;
+        required: [];
+        DeviceHealth: super::super::super::types::DeviceHealthEnumeration, -1, [0 "DeviceHealth"], false false false;
     }
     t::object_members! {
-        IOperationCounterType; required : []; PowerOnDuration : f64, - 1, [0
-        "PowerOnDuration"], false false false; OperationDuration : f64, - 1, [0
-        "OperationDuration"], false false false; OperationCycleCounter : ua::Variant, -
-        1, [0 "OperationCycleCounter"], false false false;
+        IOperationCounterType;
+        required: [];
+        PowerOnDuration: f64, -1, [0 "PowerOnDuration"], false false false;
+        OperationDuration: f64, -1, [0 "OperationDuration"], false false false;
+        OperationCycleCounter: ua::Variant, -1, [0 "OperationCycleCounter"], false false false;
     }
     t::object_members! {
-        ISupportInfoType; required : [];
+        ISupportInfoType;
+        required: [];
     }
     t::object_members! {
-        ITagNameplateType; required : []; AssetId : String, - 1, [0 "AssetId"], false
-        false false; ComponentName : ua::LocalizedText, - 1, [0 "ComponentName"], false
-        false false;
+        ITagNameplateType;
+        required: [];
+        AssetId: String, -1, [0 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [0 "ComponentName"], false false false;
     }
     t::object_members! {
-        IVendorNameplateType; required : []; Manufacturer : ua::LocalizedText, - 1, [0
-        "Manufacturer"], false false false; ManufacturerUri : String, - 1, [0
-        "ManufacturerUri"], false false false; Model : ua::LocalizedText, - 1, [0
-        "Model"], false false false; HardwareRevision : String, - 1, [0
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [0
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [0
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [0
-        "ProductCode"], false false false; DeviceManual : String, - 1, [0
-        "DeviceManual"], false false false; DeviceClass : String, - 1, [0 "DeviceClass"],
-        false false false; SerialNumber : String, - 1, [0 "SerialNumber"], false false
-        false; ProductInstanceUri : String, - 1, [0 "ProductInstanceUri"], false false
-        false; RevisionCounter : i32, - 1, [0 "RevisionCounter"], false false false;
-        SoftwareReleaseDate : ua::DateTime, - 1, [0 "SoftwareReleaseDate"], false false
-        false; PatchIdentifiers : String, 1, [0 "PatchIdentifiers"], false false false;
+        IVendorNameplateType;
+        required: [];
+        Manufacturer: ua::LocalizedText, -1, [0 "Manufacturer"], false false false;
+        ManufacturerUri: String, -1, [0 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [0 "Model"], false false false;
+        HardwareRevision: String, -1, [0 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [0 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [0 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [0 "ProductCode"], false false false;
+        DeviceManual: String, -1, [0 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [0 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [0 "SerialNumber"], false false false;
+        ProductInstanceUri: String, -1, [0 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [0 "RevisionCounter"], false false false;
+        SoftwareReleaseDate: ua::DateTime, -1, [0 "SoftwareReleaseDate"], false false false;
+        PatchIdentifiers: String, 1, [0 "PatchIdentifiers"], false false false;
     }
     t::object_members! {
-        InstallationStateMachineType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of InstallationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]")];
-        CurrentState : ua::LocalizedText, - 1, [1 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [1 "LastTransition"], false false false;
-        AvailableStates : ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [1 "AvailableTransitions"], false false
-        false; PercentComplete : u8, - 1, [0 "PercentComplete"], false false false;
-        InstallationDelay : f64, - 1, [0 "InstallationDelay"], false false false;
+        InstallationStateMachineType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of InstallationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], false false false;
+        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
+        PercentComplete: u8, -1, [0 "PercentComplete"], false false false;
+        InstallationDelay: f64, -1, [0 "InstallationDelay"], false false false;
     }
     t::object_members! {
-        LengthIndicationType; required : [];
+        LengthIndicationType;
+        required: [];
     }
     t::object_members! {
-        LockingServicesType; required : [("Locked",
-        "the mandatory variable `Locked` of LockingServicesType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Locked\")]"),
-        ("LockingClient",
-        "the mandatory variable `LockingClient` of LockingServicesType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LockingClient\")]"),
-        ("LockingUser",
-        "the mandatory variable `LockingUser` of LockingServicesType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LockingUser\")]"),
-        ("RemainingLockTime",
-        "the mandatory variable `RemainingLockTime` of LockingServicesType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RemainingLockTime\")]")];
-        Locked : bool, - 1, [0 "Locked"], true false false; LockingClient : String, - 1,
-        [0 "LockingClient"], true false false; LockingUser : String, - 1, [0
-        "LockingUser"], true false false; RemainingLockTime : f64, - 1, [0
-        "RemainingLockTime"], true false false;
+        LockingServicesType;
+        required: [
+            ("Locked", "the mandatory variable `Locked` of LockingServicesType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Locked\")]"),
+            ("LockingClient", "the mandatory variable `LockingClient` of LockingServicesType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LockingClient\")]"),
+            ("LockingUser", "the mandatory variable `LockingUser` of LockingServicesType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LockingUser\")]"),
+            ("RemainingLockTime", "the mandatory variable `RemainingLockTime` of LockingServicesType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RemainingLockTime\")]"),
+        ];
+        Locked: bool, -1, [0 "Locked"], true false false;
+        LockingClient: String, -1, [0 "LockingClient"], true false false;
+        LockingUser: String, -1, [0 "LockingUser"], true false false;
+        RemainingLockTime: f64, -1, [0 "RemainingLockTime"], true false false;
     }
     t::object_members! {
-        MaintenanceRequiredAlarmType; required : [("EventId",
-        "the mandatory variable `EventId` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
-        ("EventType",
-        "the mandatory variable `EventType` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
-        ("SourceNode",
-        "the mandatory variable `SourceNode` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceNode\")]"),
-        ("SourceName",
-        "the mandatory variable `SourceName` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceName\")]"),
-        ("Time",
-        "the mandatory variable `Time` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Time\")]"),
-        ("ReceiveTime",
-        "the mandatory variable `ReceiveTime` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ReceiveTime\")]"),
-        ("Message",
-        "the mandatory variable `Message` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Message\")]"),
-        ("Severity",
-        "the mandatory variable `Severity` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Severity\")]"),
-        ("ConditionClassId",
-        "the mandatory variable `ConditionClassId` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassId\")]"),
-        ("ConditionClassName",
-        "the mandatory variable `ConditionClassName` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassName\")]"),
-        ("ConditionName",
-        "the mandatory variable `ConditionName` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionName\")]"),
-        ("BranchId",
-        "the mandatory variable `BranchId` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"BranchId\")]"),
-        ("Retain",
-        "the mandatory variable `Retain` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Retain\")]"),
-        ("EnabledState",
-        "the mandatory variable `EnabledState` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EnabledState\")]"),
-        ("Quality",
-        "the mandatory variable `Quality` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Quality\")]"),
-        ("LastSeverity",
-        "the mandatory variable `LastSeverity` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastSeverity\")]"),
-        ("Comment",
-        "the mandatory variable `Comment` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Comment\")]"),
-        ("ClientUserId",
-        "the mandatory variable `ClientUserId` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ClientUserId\")]"),
-        ("AckedState",
-        "the mandatory variable `AckedState` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AckedState\")]"),
-        ("ActiveState",
-        "the mandatory variable `ActiveState` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ActiveState\")]"),
-        ("InputNode",
-        "the mandatory variable `InputNode` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputNode\")]"),
-        ("SuppressedOrShelved",
-        "the mandatory variable `SuppressedOrShelved` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SuppressedOrShelved\")]"),
-        ("NormalState",
-        "the mandatory variable `NormalState` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NormalState\")]")];
-        EventId : ua::ByteString, - 1, [1 "EventId"], true false false; EventType :
-        ua::NodeId, - 1, [1 "EventType"], true false false; SourceNode : ua::NodeId, - 1,
-        [1 "SourceNode"], true false false; SourceName : String, - 1, [1 "SourceName"],
-        true false false; Time : ua::DateTime, - 1, [1 "Time"], true false false;
-        ReceiveTime : ua::DateTime, - 1, [1 "ReceiveTime"], true false false; LocalTime :
-        ua::TimeZoneDataType, - 1, [1 "LocalTime"], false false false; Message :
-        ua::LocalizedText, - 1, [1 "Message"], true false false; Severity : u16, - 1, [1
-        "Severity"], true false false; ConditionClassId : ua::NodeId, - 1, [1
-        "ConditionClassId"], true false false; ConditionClassName : ua::LocalizedText, -
-        1, [1 "ConditionClassName"], true false false; ConditionSubClassId : ua::NodeId,
-        1, [1 "ConditionSubClassId"], false false false; ConditionSubClassName :
-        ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
-        ConditionName : String, - 1, [1 "ConditionName"], true false false; BranchId :
-        ua::NodeId, - 1, [1 "BranchId"], true false false; Retain : bool, - 1, [1
-        "Retain"], true false false; EnabledState : ua::LocalizedText, - 1, [1
-        "EnabledState"], true false false; Quality : ua::StatusCode, - 1, [1 "Quality"],
-        true false false; LastSeverity : u16, - 1, [1 "LastSeverity"], true false false;
-        Comment : ua::LocalizedText, - 1, [1 "Comment"], true false false; ClientUserId :
-        String, - 1, [1 "ClientUserId"], true false false; AckedState :
-        ua::LocalizedText, - 1, [1 "AckedState"], true false false; ConfirmedState :
-        ua::LocalizedText, - 1, [1 "ConfirmedState"], false false false; ActiveState :
-        ua::LocalizedText, - 1, [1 "ActiveState"], true false false; InputNode :
-        ua::NodeId, - 1, [1 "InputNode"], true false false; SuppressedState :
-        ua::LocalizedText, - 1, [1 "SuppressedState"], false false false;
-        OutOfServiceState : ua::LocalizedText, - 1, [1 "OutOfServiceState"], false false
-        false; ShelvingState__CurrentState : ua::LocalizedText, - 1, [1 "ShelvingState",
-        1 "CurrentState"], false false false; ShelvingState__LastTransition :
-        ua::LocalizedText, - 1, [1 "ShelvingState", 1 "LastTransition"], false false
-        false; ShelvingState__AvailableStates : ua::NodeId, 1, [1 "ShelvingState", 1
-        "AvailableStates"], false false false; ShelvingState__AvailableTransitions :
-        ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableTransitions"], false false false;
-        ShelvingState__UnshelveTime : f64, - 1, [1 "ShelvingState", 1 "UnshelveTime"],
-        false false false; SuppressedOrShelved : bool, - 1, [1 "SuppressedOrShelved"],
-        true false false; MaxTimeShelved : f64, - 1, [1 "MaxTimeShelved"], false false
-        false; AudibleEnabled : bool, - 1, [1 "AudibleEnabled"], false false false;
-        AudibleSound : ua::ByteString, - 1, [1 "AudibleSound"], false false false;
-        SilenceState : ua::LocalizedText, - 1, [1 "SilenceState"], false false false;
-        OnDelay : f64, - 1, [1 "OnDelay"], false false false; OffDelay : f64, - 1, [1
-        "OffDelay"], false false false; FirstInGroupFlag : bool, - 1, [1
-        "FirstInGroupFlag"], false false false; LatchedState : ua::LocalizedText, - 1, [1
-        "LatchedState"], false false false; ReAlarmTime : f64, - 1, [1 "ReAlarmTime"],
-        false false false; ReAlarmRepeatCount : i16, - 1, [1 "ReAlarmRepeatCount"], false
-        false false; NormalState : ua::NodeId, - 1, [1 "NormalState"], true false false;
+        MaintenanceRequiredAlarmType;
+        required: [
+            ("EventId", "the mandatory variable `EventId` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
+            ("EventType", "the mandatory variable `EventType` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
+            ("SourceNode", "the mandatory variable `SourceNode` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceNode\")]"),
+            ("SourceName", "the mandatory variable `SourceName` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceName\")]"),
+            ("Time", "the mandatory variable `Time` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Time\")]"),
+            ("ReceiveTime", "the mandatory variable `ReceiveTime` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ReceiveTime\")]"),
+            ("Message", "the mandatory variable `Message` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Message\")]"),
+            ("Severity", "the mandatory variable `Severity` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Severity\")]"),
+            ("ConditionClassId", "the mandatory variable `ConditionClassId` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassId\")]"),
+            ("ConditionClassName", "the mandatory variable `ConditionClassName` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassName\")]"),
+            ("ConditionName", "the mandatory variable `ConditionName` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionName\")]"),
+            ("BranchId", "the mandatory variable `BranchId` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"BranchId\")]"),
+            ("Retain", "the mandatory variable `Retain` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Retain\")]"),
+            ("EnabledState", "the mandatory variable `EnabledState` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EnabledState\")]"),
+            ("Quality", "the mandatory variable `Quality` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Quality\")]"),
+            ("LastSeverity", "the mandatory variable `LastSeverity` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastSeverity\")]"),
+            ("Comment", "the mandatory variable `Comment` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Comment\")]"),
+            ("ClientUserId", "the mandatory variable `ClientUserId` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ClientUserId\")]"),
+            ("AckedState", "the mandatory variable `AckedState` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AckedState\")]"),
+            ("ActiveState", "the mandatory variable `ActiveState` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ActiveState\")]"),
+            ("InputNode", "the mandatory variable `InputNode` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputNode\")]"),
+            ("SuppressedOrShelved", "the mandatory variable `SuppressedOrShelved` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SuppressedOrShelved\")]"),
+            ("NormalState", "the mandatory variable `NormalState` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NormalState\")]"),
+        ];
+        EventId: ua::ByteString, -1, [1 "EventId"], true false false;
+        EventType: ua::NodeId, -1, [1 "EventType"], true false false;
+        SourceNode: ua::NodeId, -1, [1 "SourceNode"], true false false;
+        SourceName: String, -1, [1 "SourceName"], true false false;
+        Time: ua::DateTime, -1, [1 "Time"], true false false;
+        ReceiveTime: ua::DateTime, -1, [1 "ReceiveTime"], true false false;
+        LocalTime: ua::TimeZoneDataType, -1, [1 "LocalTime"], false false false;
+        Message: ua::LocalizedText, -1, [1 "Message"], true false false;
+        Severity: u16, -1, [1 "Severity"], true false false;
+        ConditionClassId: ua::NodeId, -1, [1 "ConditionClassId"], true false false;
+        ConditionClassName: ua::LocalizedText, -1, [1 "ConditionClassName"], true false false;
+        ConditionSubClassId: ua::NodeId, 1, [1 "ConditionSubClassId"], false false false;
+        ConditionSubClassName: ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
+        ConditionName: String, -1, [1 "ConditionName"], true false false;
+        BranchId: ua::NodeId, -1, [1 "BranchId"], true false false;
+        Retain: bool, -1, [1 "Retain"], true false false;
+        EnabledState: ua::LocalizedText, -1, [1 "EnabledState"], true false false;
+        Quality: ua::StatusCode, -1, [1 "Quality"], true false false;
+        LastSeverity: u16, -1, [1 "LastSeverity"], true false false;
+        Comment: ua::LocalizedText, -1, [1 "Comment"], true false false;
+        ClientUserId: String, -1, [1 "ClientUserId"], true false false;
+        AckedState: ua::LocalizedText, -1, [1 "AckedState"], true false false;
+        ConfirmedState: ua::LocalizedText, -1, [1 "ConfirmedState"], false false false;
+        ActiveState: ua::LocalizedText, -1, [1 "ActiveState"], true false false;
+        InputNode: ua::NodeId, -1, [1 "InputNode"], true false false;
+        SuppressedState: ua::LocalizedText, -1, [1 "SuppressedState"], false false false;
+        OutOfServiceState: ua::LocalizedText, -1, [1 "OutOfServiceState"], false false false;
+        ShelvingState__CurrentState: ua::LocalizedText, -1, [1 "ShelvingState", 1 "CurrentState"], false false false;
+        ShelvingState__LastTransition: ua::LocalizedText, -1, [1 "ShelvingState", 1 "LastTransition"], false false false;
+        ShelvingState__AvailableStates: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableStates"], false false false;
+        ShelvingState__AvailableTransitions: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableTransitions"], false false false;
+        ShelvingState__UnshelveTime: f64, -1, [1 "ShelvingState", 1 "UnshelveTime"], false false false;
+        SuppressedOrShelved: bool, -1, [1 "SuppressedOrShelved"], true false false;
+        MaxTimeShelved: f64, -1, [1 "MaxTimeShelved"], false false false;
+        AudibleEnabled: bool, -1, [1 "AudibleEnabled"], false false false;
+        AudibleSound: ua::ByteString, -1, [1 "AudibleSound"], false false false;
+        SilenceState: ua::LocalizedText, -1, [1 "SilenceState"], false false false;
+        OnDelay: f64, -1, [1 "OnDelay"], false false false;
+        OffDelay: f64, -1, [1 "OffDelay"], false false false;
+        FirstInGroupFlag: bool, -1, [1 "FirstInGroupFlag"], false false false;
+        LatchedState: ua::LocalizedText, -1, [1 "LatchedState"], false false false;
+        ReAlarmTime: f64, -1, [1 "ReAlarmTime"], false false false;
+        ReAlarmRepeatCount: i16, -1, [1 "ReAlarmRepeatCount"], false false false;
+        NormalState: ua::NodeId, -1, [1 "NormalState"], true false false;
     }
     t::object_members! {
-        NetworkType; required : []; Lock__Locked : bool, - 1, [0 "Lock", 0 "Locked"],
-        false false false; Lock__LockingClient : String, - 1, [0 "Lock", 0
-        "LockingClient"], false false false; Lock__LockingUser : String, - 1, [0 "Lock",
-        0 "LockingUser"], false false false; Lock__RemainingLockTime : f64, - 1, [0
-        "Lock", 0 "RemainingLockTime"], false false false;
+        NetworkType;
+        required: [];
+        Lock__Locked: bool, -1, [0 "Lock", 0 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [0 "Lock", 0 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [0 "Lock", 0 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [0 "Lock", 0 "RemainingLockTime"], false false false;
     }
     t::object_members! {
-        NumberOfPartsIndicationType; required : [];
+        NumberOfPartsIndicationType;
+        required: [];
     }
     t::object_members! {
-        NumberOfUsagesIndicationType; required : [];
+        NumberOfUsagesIndicationType;
+        required: [];
     }
     t::object_members! {
-        OffSpecAlarmType; required : [("EventId",
-        "the mandatory variable `EventId` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
-        ("EventType",
-        "the mandatory variable `EventType` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
-        ("SourceNode",
-        "the mandatory variable `SourceNode` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceNode\")]"),
-        ("SourceName",
-        "the mandatory variable `SourceName` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceName\")]"),
-        ("Time",
-        "the mandatory variable `Time` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Time\")]"),
-        ("ReceiveTime",
-        "the mandatory variable `ReceiveTime` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ReceiveTime\")]"),
-        ("Message",
-        "the mandatory variable `Message` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Message\")]"),
-        ("Severity",
-        "the mandatory variable `Severity` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Severity\")]"),
-        ("ConditionClassId",
-        "the mandatory variable `ConditionClassId` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassId\")]"),
-        ("ConditionClassName",
-        "the mandatory variable `ConditionClassName` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassName\")]"),
-        ("ConditionName",
-        "the mandatory variable `ConditionName` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionName\")]"),
-        ("BranchId",
-        "the mandatory variable `BranchId` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"BranchId\")]"),
-        ("Retain",
-        "the mandatory variable `Retain` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Retain\")]"),
-        ("EnabledState",
-        "the mandatory variable `EnabledState` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EnabledState\")]"),
-        ("Quality",
-        "the mandatory variable `Quality` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Quality\")]"),
-        ("LastSeverity",
-        "the mandatory variable `LastSeverity` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastSeverity\")]"),
-        ("Comment",
-        "the mandatory variable `Comment` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Comment\")]"),
-        ("ClientUserId",
-        "the mandatory variable `ClientUserId` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ClientUserId\")]"),
-        ("AckedState",
-        "the mandatory variable `AckedState` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AckedState\")]"),
-        ("ActiveState",
-        "the mandatory variable `ActiveState` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ActiveState\")]"),
-        ("InputNode",
-        "the mandatory variable `InputNode` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputNode\")]"),
-        ("SuppressedOrShelved",
-        "the mandatory variable `SuppressedOrShelved` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SuppressedOrShelved\")]"),
-        ("NormalState",
-        "the mandatory variable `NormalState` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NormalState\")]")];
-        EventId : ua::ByteString, - 1, [1 "EventId"], true false false; EventType :
-        ua::NodeId, - 1, [1 "EventType"], true false false; SourceNode : ua::NodeId, - 1,
-        [1 "SourceNode"], true false false; SourceName : String, - 1, [1 "SourceName"],
-        true false false; Time : ua::DateTime, - 1, [1 "Time"], true false false;
-        ReceiveTime : ua::DateTime, - 1, [1 "ReceiveTime"], true false false; LocalTime :
-        ua::TimeZoneDataType, - 1, [1 "LocalTime"], false false false; Message :
-        ua::LocalizedText, - 1, [1 "Message"], true false false; Severity : u16, - 1, [1
-        "Severity"], true false false; ConditionClassId : ua::NodeId, - 1, [1
-        "ConditionClassId"], true false false; ConditionClassName : ua::LocalizedText, -
-        1, [1 "ConditionClassName"], true false false; ConditionSubClassId : ua::NodeId,
-        1, [1 "ConditionSubClassId"], false false false; ConditionSubClassName :
-        ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
-        ConditionName : String, - 1, [1 "ConditionName"], true false false; BranchId :
-        ua::NodeId, - 1, [1 "BranchId"], true false false; Retain : bool, - 1, [1
-        "Retain"], true false false; EnabledState : ua::LocalizedText, - 1, [1
-        "EnabledState"], true false false; Quality : ua::StatusCode, - 1, [1 "Quality"],
-        true false false; LastSeverity : u16, - 1, [1 "LastSeverity"], true false false;
-        Comment : ua::LocalizedText, - 1, [1 "Comment"], true false false; ClientUserId :
-        String, - 1, [1 "ClientUserId"], true false false; AckedState :
-        ua::LocalizedText, - 1, [1 "AckedState"], true false false; ConfirmedState :
-        ua::LocalizedText, - 1, [1 "ConfirmedState"], false false false; ActiveState :
-        ua::LocalizedText, - 1, [1 "ActiveState"], true false false; InputNode :
-        ua::NodeId, - 1, [1 "InputNode"], true false false; SuppressedState :
-        ua::LocalizedText, - 1, [1 "SuppressedState"], false false false;
-        OutOfServiceState : ua::LocalizedText, - 1, [1 "OutOfServiceState"], false false
-        false; ShelvingState__CurrentState : ua::LocalizedText, - 1, [1 "ShelvingState",
-        1 "CurrentState"], false false false; ShelvingState__LastTransition :
-        ua::LocalizedText, - 1, [1 "ShelvingState", 1 "LastTransition"], false false
-        false; ShelvingState__AvailableStates : ua::NodeId, 1, [1 "ShelvingState", 1
-        "AvailableStates"], false false false; ShelvingState__AvailableTransitions :
-        ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableTransitions"], false false false;
-        ShelvingState__UnshelveTime : f64, - 1, [1 "ShelvingState", 1 "UnshelveTime"],
-        false false false; SuppressedOrShelved : bool, - 1, [1 "SuppressedOrShelved"],
-        true false false; MaxTimeShelved : f64, - 1, [1 "MaxTimeShelved"], false false
-        false; AudibleEnabled : bool, - 1, [1 "AudibleEnabled"], false false false;
-        AudibleSound : ua::ByteString, - 1, [1 "AudibleSound"], false false false;
-        SilenceState : ua::LocalizedText, - 1, [1 "SilenceState"], false false false;
-        OnDelay : f64, - 1, [1 "OnDelay"], false false false; OffDelay : f64, - 1, [1
-        "OffDelay"], false false false; FirstInGroupFlag : bool, - 1, [1
-        "FirstInGroupFlag"], false false false; LatchedState : ua::LocalizedText, - 1, [1
-        "LatchedState"], false false false; ReAlarmTime : f64, - 1, [1 "ReAlarmTime"],
-        false false false; ReAlarmRepeatCount : i16, - 1, [1 "ReAlarmRepeatCount"], false
-        false false; NormalState : ua::NodeId, - 1, [1 "NormalState"], true false false;
+        OffSpecAlarmType;
+        required: [
+            ("EventId", "the mandatory variable `EventId` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
+            ("EventType", "the mandatory variable `EventType` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
+            ("SourceNode", "the mandatory variable `SourceNode` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceNode\")]"),
+            ("SourceName", "the mandatory variable `SourceName` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceName\")]"),
+            ("Time", "the mandatory variable `Time` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Time\")]"),
+            ("ReceiveTime", "the mandatory variable `ReceiveTime` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ReceiveTime\")]"),
+            ("Message", "the mandatory variable `Message` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Message\")]"),
+            ("Severity", "the mandatory variable `Severity` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Severity\")]"),
+            ("ConditionClassId", "the mandatory variable `ConditionClassId` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassId\")]"),
+            ("ConditionClassName", "the mandatory variable `ConditionClassName` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassName\")]"),
+            ("ConditionName", "the mandatory variable `ConditionName` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionName\")]"),
+            ("BranchId", "the mandatory variable `BranchId` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"BranchId\")]"),
+            ("Retain", "the mandatory variable `Retain` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Retain\")]"),
+            ("EnabledState", "the mandatory variable `EnabledState` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EnabledState\")]"),
+            ("Quality", "the mandatory variable `Quality` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Quality\")]"),
+            ("LastSeverity", "the mandatory variable `LastSeverity` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastSeverity\")]"),
+            ("Comment", "the mandatory variable `Comment` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Comment\")]"),
+            ("ClientUserId", "the mandatory variable `ClientUserId` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ClientUserId\")]"),
+            ("AckedState", "the mandatory variable `AckedState` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AckedState\")]"),
+            ("ActiveState", "the mandatory variable `ActiveState` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ActiveState\")]"),
+            ("InputNode", "the mandatory variable `InputNode` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputNode\")]"),
+            ("SuppressedOrShelved", "the mandatory variable `SuppressedOrShelved` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SuppressedOrShelved\")]"),
+            ("NormalState", "the mandatory variable `NormalState` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NormalState\")]"),
+        ];
+        EventId: ua::ByteString, -1, [1 "EventId"], true false false;
+        EventType: ua::NodeId, -1, [1 "EventType"], true false false;
+        SourceNode: ua::NodeId, -1, [1 "SourceNode"], true false false;
+        SourceName: String, -1, [1 "SourceName"], true false false;
+        Time: ua::DateTime, -1, [1 "Time"], true false false;
+        ReceiveTime: ua::DateTime, -1, [1 "ReceiveTime"], true false false;
+        LocalTime: ua::TimeZoneDataType, -1, [1 "LocalTime"], false false false;
+        Message: ua::LocalizedText, -1, [1 "Message"], true false false;
+        Severity: u16, -1, [1 "Severity"], true false false;
+        ConditionClassId: ua::NodeId, -1, [1 "ConditionClassId"], true false false;
+        ConditionClassName: ua::LocalizedText, -1, [1 "ConditionClassName"], true false false;
+        ConditionSubClassId: ua::NodeId, 1, [1 "ConditionSubClassId"], false false false;
+        ConditionSubClassName: ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
+        ConditionName: String, -1, [1 "ConditionName"], true false false;
+        BranchId: ua::NodeId, -1, [1 "BranchId"], true false false;
+        Retain: bool, -1, [1 "Retain"], true false false;
+        EnabledState: ua::LocalizedText, -1, [1 "EnabledState"], true false false;
+        Quality: ua::StatusCode, -1, [1 "Quality"], true false false;
+        LastSeverity: u16, -1, [1 "LastSeverity"], true false false;
+        Comment: ua::LocalizedText, -1, [1 "Comment"], true false false;
+        ClientUserId: String, -1, [1 "ClientUserId"], true false false;
+        AckedState: ua::LocalizedText, -1, [1 "AckedState"], true false false;
+        ConfirmedState: ua::LocalizedText, -1, [1 "ConfirmedState"], false false false;
+        ActiveState: ua::LocalizedText, -1, [1 "ActiveState"], true false false;
+        InputNode: ua::NodeId, -1, [1 "InputNode"], true false false;
+        SuppressedState: ua::LocalizedText, -1, [1 "SuppressedState"], false false false;
+        OutOfServiceState: ua::LocalizedText, -1, [1 "OutOfServiceState"], false false false;
+        ShelvingState__CurrentState: ua::LocalizedText, -1, [1 "ShelvingState", 1 "CurrentState"], false false false;
+        ShelvingState__LastTransition: ua::LocalizedText, -1, [1 "ShelvingState", 1 "LastTransition"], false false false;
+        ShelvingState__AvailableStates: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableStates"], false false false;
+        ShelvingState__AvailableTransitions: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableTransitions"], false false false;
+        ShelvingState__UnshelveTime: f64, -1, [1 "ShelvingState", 1 "UnshelveTime"], false false false;
+        SuppressedOrShelved: bool, -1, [1 "SuppressedOrShelved"], true false false;
+        MaxTimeShelved: f64, -1, [1 "MaxTimeShelved"], false false false;
+        AudibleEnabled: bool, -1, [1 "AudibleEnabled"], false false false;
+        AudibleSound: ua::ByteString, -1, [1 "AudibleSound"], false false false;
+        SilenceState: ua::LocalizedText, -1, [1 "SilenceState"], false false false;
+        OnDelay: f64, -1, [1 "OnDelay"], false false false;
+        OffDelay: f64, -1, [1 "OffDelay"], false false false;
+        FirstInGroupFlag: bool, -1, [1 "FirstInGroupFlag"], false false false;
+        LatchedState: ua::LocalizedText, -1, [1 "LatchedState"], false false false;
+        ReAlarmTime: f64, -1, [1 "ReAlarmTime"], false false false;
+        ReAlarmRepeatCount: i16, -1, [1 "ReAlarmRepeatCount"], false false false;
+        NormalState: ua::NodeId, -1, [1 "NormalState"], true false false;
     }
     t::object_members! {
-        PackageLoadingType; required : [("CurrentVersion/Manufacturer",
-        "the mandatory variable `CurrentVersion/Manufacturer` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/Manufacturer\")]"),
-        ("CurrentVersion/ManufacturerUri",
-        "the mandatory variable `CurrentVersion/ManufacturerUri` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/ManufacturerUri\")]"),
-        ("CurrentVersion/SoftwareRevision",
-        "the mandatory variable `CurrentVersion/SoftwareRevision` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/SoftwareRevision\")]"),
-        ("FileTransfer/ClientProcessingTimeout",
-        "the mandatory variable `FileTransfer/ClientProcessingTimeout` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"FileTransfer/ClientProcessingTimeout\")]"),
-        ("ErrorMessage",
-        "the mandatory variable `ErrorMessage` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ErrorMessage\")]")];
-        UpdateKey : String, - 1, [0 "UpdateKey"], false false false;
-        CurrentVersion__Manufacturer : ua::LocalizedText, - 1, [0 "CurrentVersion", 0
-        "Manufacturer"], true false false; CurrentVersion__ManufacturerUri : String, - 1,
-        [0 "CurrentVersion", 0 "ManufacturerUri"], true false false;
-        CurrentVersion__SoftwareRevision : String, - 1, [0 "CurrentVersion", 0
-        "SoftwareRevision"], true false false; CurrentVersion__PatchIdentifiers : String,
-        1, [0 "CurrentVersion", 0 "PatchIdentifiers"], false false false;
-        CurrentVersion__ReleaseDate : ua::DateTime, - 1, [0 "CurrentVersion", 0
-        "ReleaseDate"], false false false; CurrentVersion__ChangeLogReference : String, -
-        1, [0 "CurrentVersion", 0 "ChangeLogReference"], false false false;
-        CurrentVersion__Hash : ua::ByteString, - 1, [0 "CurrentVersion", 0 "Hash"], false
-        false false; FileTransfer__ClientProcessingTimeout : f64, - 1, [0 "FileTransfer",
-        1 "ClientProcessingTimeout"], true false false; ErrorMessage : ua::LocalizedText,
-        - 1, [0 "ErrorMessage"], true false false; WriteBlockSize : u32, - 1, [0
-        "WriteBlockSize"], false false false;
+        PackageLoadingType;
+        required: [
+            ("CurrentVersion/Manufacturer", "the mandatory variable `CurrentVersion/Manufacturer` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/Manufacturer\")]"),
+            ("CurrentVersion/ManufacturerUri", "the mandatory variable `CurrentVersion/ManufacturerUri` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/ManufacturerUri\")]"),
+            ("CurrentVersion/SoftwareRevision", "the mandatory variable `CurrentVersion/SoftwareRevision` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/SoftwareRevision\")]"),
+            ("FileTransfer/ClientProcessingTimeout", "the mandatory variable `FileTransfer/ClientProcessingTimeout` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"FileTransfer/ClientProcessingTimeout\")]"),
+            ("ErrorMessage", "the mandatory variable `ErrorMessage` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ErrorMessage\")]"),
+        ];
+        UpdateKey: String, -1, [0 "UpdateKey"], false false false;
+        CurrentVersion__Manufacturer: ua::LocalizedText, -1, [0 "CurrentVersion", 0 "Manufacturer"], true false false;
+        CurrentVersion__ManufacturerUri: String, -1, [0 "CurrentVersion", 0 "ManufacturerUri"], true false false;
+        CurrentVersion__SoftwareRevision: String, -1, [0 "CurrentVersion", 0 "SoftwareRevision"], true false false;
+        CurrentVersion__PatchIdentifiers: String, 1, [0 "CurrentVersion", 0 "PatchIdentifiers"], false false false;
+        CurrentVersion__ReleaseDate: ua::DateTime, -1, [0 "CurrentVersion", 0 "ReleaseDate"], false false false;
+        CurrentVersion__ChangeLogReference: String, -1, [0 "CurrentVersion", 0 "ChangeLogReference"], false false false;
+        CurrentVersion__Hash: ua::ByteString, -1, [0 "CurrentVersion", 0 "Hash"], false false false;
+        FileTransfer__ClientProcessingTimeout: f64, -1, [0 "FileTransfer", 1 "ClientProcessingTimeout"], true false false;
+        ErrorMessage: ua::LocalizedText, -1, [0 "ErrorMessage"], true false false;
+        WriteBlockSize: u32, -1, [0 "WriteBlockSize"], false false false;
     }
     t::object_members! {
-        PowerCycleStateMachineType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of PowerCycleStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]")];
-        CurrentState : ua::LocalizedText, - 1, [1 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [1 "LastTransition"], false false false;
-        AvailableStates : ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [1 "AvailableTransitions"], false false
-        false;
+        PowerCycleStateMachineType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of PowerCycleStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], false false false;
+        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
     }
     t::object_members! {
-        PrepareForUpdateStateMachineType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of PrepareForUpdateStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]")];
-        CurrentState : ua::LocalizedText, - 1, [1 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [1 "LastTransition"], false false false;
-        AvailableStates : ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [1 "AvailableTransitions"], false false
-        false; PercentComplete : u8, - 1, [0 "PercentComplete"], false false false;
+        PrepareForUpdateStateMachineType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of PrepareForUpdateStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], false false false;
+        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
+        PercentComplete: u8, -1, [0 "PercentComplete"], false false false;
     }
     t::object_members! {
-        ProtocolType; required : [];
+        ProtocolType;
+        required: [];
     }
     t::object_members! {
-        SoftwareFolderType; required : [("SoftwareClass",
-        "the mandatory variable `SoftwareClass` of SoftwareFolderType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SoftwareClass\")]")];
-        SoftwareClass : super::super::super::types::SoftwareClass, - 1, [0
-        "SoftwareClass"], true false false;
+        SoftwareFolderType;
+        required: [
+            ("SoftwareClass", "the mandatory variable `SoftwareClass` of SoftwareFolderType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SoftwareClass\")]"),
+        ];
+        SoftwareClass: super::super::super::types::SoftwareClass, -1, [0 "SoftwareClass"], true false false;
     }
     t::object_members! {
-        SoftwareLoadingType; required : []; UpdateKey : String, - 1, [0 "UpdateKey"],
-        false false false;
+        SoftwareLoadingType;
+        required: [];
+        UpdateKey: String, -1, [0 "UpdateKey"], false false false;
     }
     t::object_members! {
-        SoftwareType; required : [("Manufacturer",
-        "the mandatory variable `Manufacturer` of SoftwareType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
-        ("Model",
-        "the mandatory variable `Model` of SoftwareType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
-        ("SoftwareRevision",
-        "the mandatory variable `SoftwareRevision` of SoftwareType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SoftwareRevision\")]")];
-        Identification__UIElement : ua::Variant, - 1, [0 "Identification", 0
-        "UIElement"], false false false; Lock__Locked : bool, - 1, [0 "Lock", 0
-        "Locked"], false false false; Lock__LockingClient : String, - 1, [0 "Lock", 0
-        "LockingClient"], false false false; Lock__LockingUser : String, - 1, [0 "Lock",
-        0 "LockingUser"], false false false; Lock__RemainingLockTime : f64, - 1, [0
-        "Lock", 0 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [0 "Manufacturer"], true false false; ManufacturerUri :
-        String, - 1, [0 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [0 "Model"], true false false; HardwareRevision : String, - 1, [0
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [0
-        "SoftwareRevision"], true false false; DeviceRevision : String, - 1, [0
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [0
-        "ProductCode"], false false false; DeviceManual : String, - 1, [0
-        "DeviceManual"], false false false; DeviceClass : String, - 1, [0 "DeviceClass"],
-        false false false; SerialNumber : String, - 1, [0 "SerialNumber"], false false
-        false; ProductInstanceUri : String, - 1, [0 "ProductInstanceUri"], false false
-        false; RevisionCounter : i32, - 1, [0 "RevisionCounter"], false false false;
-        AssetId : String, - 1, [0 "AssetId"], false false false; ComponentName :
-        ua::LocalizedText, - 1, [0 "ComponentName"], false false false;
+        SoftwareType;
+        required: [
+            ("Manufacturer", "the mandatory variable `Manufacturer` of SoftwareType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
+            ("Model", "the mandatory variable `Model` of SoftwareType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
+            ("SoftwareRevision", "the mandatory variable `SoftwareRevision` of SoftwareType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SoftwareRevision\")]"),
+        ];
+        Identification__UIElement: ua::Variant, -1, [0 "Identification", 0 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [0 "Lock", 0 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [0 "Lock", 0 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [0 "Lock", 0 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [0 "Lock", 0 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [0 "Manufacturer"], true false false;
+        ManufacturerUri: String, -1, [0 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [0 "Model"], true false false;
+        HardwareRevision: String, -1, [0 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [0 "SoftwareRevision"], true false false;
+        DeviceRevision: String, -1, [0 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [0 "ProductCode"], false false false;
+        DeviceManual: String, -1, [0 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [0 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [0 "SerialNumber"], false false false;
+        ProductInstanceUri: String, -1, [0 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [0 "RevisionCounter"], false false false;
+        AssetId: String, -1, [0 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [0 "ComponentName"], false false false;
     }
     t::object_members! {
-        SoftwareUpdateType; required : []; Loading__UpdateKey : String, - 1, [0
-        "Loading", 0 "UpdateKey"], false false false; PrepareForUpdate__CurrentState :
-        ua::LocalizedText, - 1, [0 "PrepareForUpdate", 1 "CurrentState"], false false
-        false; PrepareForUpdate__LastTransition : ua::LocalizedText, - 1, [0
-        "PrepareForUpdate", 1 "LastTransition"], false false false;
-        PrepareForUpdate__AvailableStates : ua::NodeId, 1, [0 "PrepareForUpdate", 1
-        "AvailableStates"], false false false; PrepareForUpdate__AvailableTransitions :
-        ua::NodeId, 1, [0 "PrepareForUpdate", 1 "AvailableTransitions"], false false
-        false; PrepareForUpdate__PercentComplete : u8, - 1, [0 "PrepareForUpdate", 0
-        "PercentComplete"], false false false; Installation__CurrentState :
-        ua::LocalizedText, - 1, [0 "Installation", 1 "CurrentState"], false false false;
-        Installation__LastTransition : ua::LocalizedText, - 1, [0 "Installation", 1
-        "LastTransition"], false false false; Installation__AvailableStates : ua::NodeId,
-        1, [0 "Installation", 1 "AvailableStates"], false false false;
-        Installation__AvailableTransitions : ua::NodeId, 1, [0 "Installation", 1
-        "AvailableTransitions"], false false false; Installation__PercentComplete : u8, -
-        1, [0 "Installation", 0 "PercentComplete"], false false false;
-        Installation__InstallationDelay : f64, - 1, [0 "Installation", 0
-        "InstallationDelay"], false false false; PowerCycle__CurrentState :
-        ua::LocalizedText, - 1, [0 "PowerCycle", 1 "CurrentState"], false false false;
-        PowerCycle__LastTransition : ua::LocalizedText, - 1, [0 "PowerCycle", 1
-        "LastTransition"], false false false; PowerCycle__AvailableStates : ua::NodeId,
-        1, [0 "PowerCycle", 1 "AvailableStates"], false false false;
-        PowerCycle__AvailableTransitions : ua::NodeId, 1, [0 "PowerCycle", 1
-        "AvailableTransitions"], false false false; Confirmation__CurrentState :
-        ua::LocalizedText, - 1, [0 "Confirmation", 1 "CurrentState"], false false false;
-        Confirmation__LastTransition : ua::LocalizedText, - 1, [0 "Confirmation", 1
-        "LastTransition"], false false false; Confirmation__AvailableStates : ua::NodeId,
-        1, [0 "Confirmation", 1 "AvailableStates"], false false false;
-        Confirmation__AvailableTransitions : ua::NodeId, 1, [0 "Confirmation", 1
-        "AvailableTransitions"], false false false; Confirmation__ConfirmationTimeout :
-        f64, - 1, [0 "Confirmation", 0 "ConfirmationTimeout"], false false false;
-        Parameters__ClientProcessingTimeout : f64, - 1, [0 "Parameters", 1
-        "ClientProcessingTimeout"], false false false; UpdateStatus : ua::LocalizedText,
-        - 1, [0 "UpdateStatus"], false false false; SoftwareClass :
-        super::super::super::types::SoftwareClass, - 1, [0 "SoftwareClass"], false false
-        false; SoftwareSubclass : String, - 1, [0 "SoftwareSubclass"], false false false;
-        SoftwareName : String, - 1, [0 "SoftwareName"], false false false;
-        UnsignedPackageAllowed : bool, - 1, [0 "UnsignedPackageAllowed"], false false
-        false; VendorErrorCode : i32, - 1, [0 "VendorErrorCode"], false false false;
+        SoftwareUpdateType;
+        required: [];
+        Loading__UpdateKey: String, -1, [0 "Loading", 0 "UpdateKey"], false false false;
+        PrepareForUpdate__CurrentState: ua::LocalizedText, -1, [0 "PrepareForUpdate", 1 "CurrentState"], false false false;
+        PrepareForUpdate__LastTransition: ua::LocalizedText, -1, [0 "PrepareForUpdate", 1 "LastTransition"], false false false;
+        PrepareForUpdate__AvailableStates: ua::NodeId, 1, [0 "PrepareForUpdate", 1 "AvailableStates"], false false false;
+        PrepareForUpdate__AvailableTransitions: ua::NodeId, 1, [0 "PrepareForUpdate", 1 "AvailableTransitions"], false false false;
+        PrepareForUpdate__PercentComplete: u8, -1, [0 "PrepareForUpdate", 0 "PercentComplete"], false false false;
+        Installation__CurrentState: ua::LocalizedText, -1, [0 "Installation", 1 "CurrentState"], false false false;
+        Installation__LastTransition: ua::LocalizedText, -1, [0 "Installation", 1 "LastTransition"], false false false;
+        Installation__AvailableStates: ua::NodeId, 1, [0 "Installation", 1 "AvailableStates"], false false false;
+        Installation__AvailableTransitions: ua::NodeId, 1, [0 "Installation", 1 "AvailableTransitions"], false false false;
+        Installation__PercentComplete: u8, -1, [0 "Installation", 0 "PercentComplete"], false false false;
+        Installation__InstallationDelay: f64, -1, [0 "Installation", 0 "InstallationDelay"], false false false;
+        PowerCycle__CurrentState: ua::LocalizedText, -1, [0 "PowerCycle", 1 "CurrentState"], false false false;
+        PowerCycle__LastTransition: ua::LocalizedText, -1, [0 "PowerCycle", 1 "LastTransition"], false false false;
+        PowerCycle__AvailableStates: ua::NodeId, 1, [0 "PowerCycle", 1 "AvailableStates"], false false false;
+        PowerCycle__AvailableTransitions: ua::NodeId, 1, [0 "PowerCycle", 1 "AvailableTransitions"], false false false;
+        Confirmation__CurrentState: ua::LocalizedText, -1, [0 "Confirmation", 1 "CurrentState"], false false false;
+        Confirmation__LastTransition: ua::LocalizedText, -1, [0 "Confirmation", 1 "LastTransition"], false false false;
+        Confirmation__AvailableStates: ua::NodeId, 1, [0 "Confirmation", 1 "AvailableStates"], false false false;
+        Confirmation__AvailableTransitions: ua::NodeId, 1, [0 "Confirmation", 1 "AvailableTransitions"], false false false;
+        Confirmation__ConfirmationTimeout: f64, -1, [0 "Confirmation", 0 "ConfirmationTimeout"], false false false;
+        Parameters__ClientProcessingTimeout: f64, -1, [0 "Parameters", 1 "ClientProcessingTimeout"], false false false;
+        UpdateStatus: ua::LocalizedText, -1, [0 "UpdateStatus"], false false false;
+        SoftwareClass: super::super::super::types::SoftwareClass, -1, [0 "SoftwareClass"], false false false;
+        SoftwareSubclass: String, -1, [0 "SoftwareSubclass"], false false false;
+        SoftwareName: String, -1, [0 "SoftwareName"], false false false;
+        UnsignedPackageAllowed: bool, -1, [0 "UnsignedPackageAllowed"], false false false;
+        VendorErrorCode: i32, -1, [0 "VendorErrorCode"], false false false;
     }
     t::object_members! {
-        SoftwareVersionType; required : [("Manufacturer",
-        "the mandatory variable `Manufacturer` of SoftwareVersionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
-        ("ManufacturerUri",
-        "the mandatory variable `ManufacturerUri` of SoftwareVersionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ManufacturerUri\")]"),
-        ("SoftwareRevision",
-        "the mandatory variable `SoftwareRevision` of SoftwareVersionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SoftwareRevision\")]")];
-        Manufacturer : ua::LocalizedText, - 1, [0 "Manufacturer"], true false false;
-        ManufacturerUri : String, - 1, [0 "ManufacturerUri"], true false false;
-        SoftwareRevision : String, - 1, [0 "SoftwareRevision"], true false false;
-        PatchIdentifiers : String, 1, [0 "PatchIdentifiers"], false false false;
-        ReleaseDate : ua::DateTime, - 1, [0 "ReleaseDate"], false false false;
-        ChangeLogReference : String, - 1, [0 "ChangeLogReference"], false false false;
-        Hash : ua::ByteString, - 1, [0 "Hash"], false false false;
+        SoftwareVersionType;
+        required: [
+            ("Manufacturer", "the mandatory variable `Manufacturer` of SoftwareVersionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
+            ("ManufacturerUri", "the mandatory variable `ManufacturerUri` of SoftwareVersionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ManufacturerUri\")]"),
+            ("SoftwareRevision", "the mandatory variable `SoftwareRevision` of SoftwareVersionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SoftwareRevision\")]"),
+        ];
+        Manufacturer: ua::LocalizedText, -1, [0 "Manufacturer"], true false false;
+        ManufacturerUri: String, -1, [0 "ManufacturerUri"], true false false;
+        SoftwareRevision: String, -1, [0 "SoftwareRevision"], true false false;
+        PatchIdentifiers: String, 1, [0 "PatchIdentifiers"], false false false;
+        ReleaseDate: ua::DateTime, -1, [0 "ReleaseDate"], false false false;
+        ChangeLogReference: String, -1, [0 "ChangeLogReference"], false false false;
+        Hash: ua::ByteString, -1, [0 "Hash"], false false false;
     }
     t::object_members! {
-        SubstanceVolumeIndicationType; required : [];
+        SubstanceVolumeIndicationType;
+        required: [];
     }
     t::object_members! {
-        TimeIndicationType; required : [];
+        TimeIndicationType;
+        required: [];
     }
     t::object_members! {
-        TopologyElementType; required : []; Identification__UIElement : ua::Variant, - 1,
-        [0 "Identification", 0 "UIElement"], false false false; Lock__Locked : bool, - 1,
-        [0 "Lock", 0 "Locked"], false false false; Lock__LockingClient : String, - 1, [0
-        "Lock", 0 "LockingClient"], false false false; Lock__LockingUser : String, - 1,
-        [0 "Lock", 0 "LockingUser"], false false false; Lock__RemainingLockTime : f64, -
-        1, [0 "Lock", 0 "RemainingLockTime"], false false false;
+        TopologyElementType;
+        required: [];
+        Identification__UIElement: ua::Variant, -1, [0 "Identification", 0 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [0 "Lock", 0 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [0 "Lock", 0 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [0 "Lock", 0 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [0 "Lock", 0 "RemainingLockTime"], false false false;
     }
     t::object_members! {
-        TransferServicesType; required : [];
+        TransferServicesType;
+        required: [];
     }
 }

@@ -393,180 +393,114 @@ pub mod members {
     #[allow(unused_imports)]
     use super::t;
     t::object_members! {
-        DrillHoleSkillType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("Deletable",
-        "the mandatory variable `Deletable` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
-        ("AutoDelete",
-        "the mandatory variable `AutoDelete` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
-        ("RecycleCount",
-        "the mandatory variable `RecycleCount` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
-        ("InputParameterSet/InsertionDistance",
-        "the mandatory variable `InputParameterSet/InsertionDistance` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/InsertionDistance\")]"),
-        ("InputParameterSet/HoleDiameter",
-        "the mandatory variable `InputParameterSet/HoleDiameter` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/HoleDiameter\")]"),
-        ("InputParameterSet/Depth",
-        "the mandatory variable `InputParameterSet/Depth` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Depth\")]"),
-        ("InputParameterSet/FeedRate",
-        "the mandatory variable `InputParameterSet/FeedRate` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/FeedRate\")]"),
-        ("InputParameterSet/SpindleSpeed",
-        "the mandatory variable `InputParameterSet/SpindleSpeed` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/SpindleSpeed\")]"),
-        ("InputParameterSet/ClampForce",
-        "the mandatory variable `InputParameterSet/ClampForce` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/ClampForce\")]"),
-        ("OutputParameterSet/Result",
-        "the mandatory variable `OutputParameterSet/Result` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]")];
-        CurrentState : ua::LocalizedText, - 1, [2 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [2 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [2 "AvailableTransitions"], false false
-        false; Deletable : bool, - 1, [2 "Deletable"], true false false; AutoDelete :
-        bool, - 1, [2 "AutoDelete"], true false false; RecycleCount : i32, - 1, [2
-        "RecycleCount"], true false false; ProgramDiagnostic : ua::ExtensionObject, - 1,
-        [2 "ProgramDiagnostic"], false false false; InputParameterSet__InsertionDistance
-        : f64, - 1, [1 "InputParameterSet", 0 "InsertionDistance"], true false true;
-        InputParameterSet__HoleDiameter : f64, - 1, [1 "InputParameterSet", 0
-        "HoleDiameter"], true false true; InputParameterSet__Depth : f64, - 1, [1
-        "InputParameterSet", 0 "Depth"], true false true; InputParameterSet__FeedRate :
-        f64, - 1, [1 "InputParameterSet", 0 "FeedRate"], true false true;
-        InputParameterSet__SpindleSpeed : f64, - 1, [1 "InputParameterSet", 0
-        "SpindleSpeed"], true false true; InputParameterSet__ClampForce : f64, - 1, [1
-        "InputParameterSet", 0 "ClampForce"], true false true; OutputParameterSet__Result
-        : ua::StatusCode, - 1, [1 "OutputParameterSet", 1 "Result"], true false false;
+        DrillHoleSkillType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("Deletable", "the mandatory variable `Deletable` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
+            ("AutoDelete", "the mandatory variable `AutoDelete` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
+            ("RecycleCount", "the mandatory variable `RecycleCount` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
+            ("InputParameterSet/InsertionDistance", "the mandatory variable `InputParameterSet/InsertionDistance` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/InsertionDistance\")]"),
+            ("InputParameterSet/HoleDiameter", "the mandatory variable `InputParameterSet/HoleDiameter` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/HoleDiameter\")]"),
+            ("InputParameterSet/Depth", "the mandatory variable `InputParameterSet/Depth` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Depth\")]"),
+            ("InputParameterSet/FeedRate", "the mandatory variable `InputParameterSet/FeedRate` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/FeedRate\")]"),
+            ("InputParameterSet/SpindleSpeed", "the mandatory variable `InputParameterSet/SpindleSpeed` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/SpindleSpeed\")]"),
+            ("InputParameterSet/ClampForce", "the mandatory variable `InputParameterSet/ClampForce` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/ClampForce\")]"),
+            ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
+        Deletable: bool, -1, [2 "Deletable"], true false false;
+        AutoDelete: bool, -1, [2 "AutoDelete"], true false false;
+        RecycleCount: i32, -1, [2 "RecycleCount"], true false false;
+        ProgramDiagnostic: ua::ExtensionObject, -1, [2 "ProgramDiagnostic"], false false false;
+        InputParameterSet__InsertionDistance: f64, -1, [1 "InputParameterSet", 0 "InsertionDistance"], true false true;
+        InputParameterSet__HoleDiameter: f64, -1, [1 "InputParameterSet", 0 "HoleDiameter"], true false true;
+        InputParameterSet__Depth: f64, -1, [1 "InputParameterSet", 0 "Depth"], true false true;
+        InputParameterSet__FeedRate: f64, -1, [1 "InputParameterSet", 0 "FeedRate"], true false true;
+        InputParameterSet__SpindleSpeed: f64, -1, [1 "InputParameterSet", 0 "SpindleSpeed"], true false true;
+        InputParameterSet__ClampForce: f64, -1, [1 "InputParameterSet", 0 "ClampForce"], true false true;
+        OutputParameterSet__Result: ua::StatusCode, -1, [1 "OutputParameterSet", 1 "Result"], true false false;
     }
     t::object_members! {
-        DrillingCellType; required : [("SkillSet/ReferenceDrillBush/CurrentState",
-        "the mandatory variable `SkillSet/ReferenceDrillBush/CurrentState` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/CurrentState\")]"),
-        ("SkillSet/ReferenceDrillBush/LastTransition",
-        "the mandatory variable `SkillSet/ReferenceDrillBush/LastTransition` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/LastTransition\")]"),
-        ("SkillSet/ReferenceDrillBush/Deletable",
-        "the mandatory variable `SkillSet/ReferenceDrillBush/Deletable` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/Deletable\")]"),
-        ("SkillSet/ReferenceDrillBush/AutoDelete",
-        "the mandatory variable `SkillSet/ReferenceDrillBush/AutoDelete` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/AutoDelete\")]"),
-        ("SkillSet/ReferenceDrillBush/RecycleCount",
-        "the mandatory variable `SkillSet/ReferenceDrillBush/RecycleCount` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/RecycleCount\")]"),
-        ("SkillSet/ReferenceDrillBush/InputParameterSet/HolePosition",
-        "the mandatory variable `SkillSet/ReferenceDrillBush/InputParameterSet/HolePosition` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/InputParameterSet/HolePosition\")]"),
-        ("SkillSet/ReferenceDrillBush/InputParameterSet/ApproachDistance",
-        "the mandatory variable `SkillSet/ReferenceDrillBush/InputParameterSet/ApproachDistance` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/InputParameterSet/ApproachDistance\")]"),
-        ("SkillSet/ReferenceDrillBush/OutputParameterSet/Result",
-        "the mandatory variable `SkillSet/ReferenceDrillBush/OutputParameterSet/Result` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/OutputParameterSet/Result\")]"),
-        ("SkillSet/ReferenceDrillBush/OutputParameterSet/ReferencedHolePosition",
-        "the mandatory variable `SkillSet/ReferenceDrillBush/OutputParameterSet/ReferencedHolePosition` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/OutputParameterSet/ReferencedHolePosition\")]"),
-        ("SkillSet/DrillHole/CurrentState",
-        "the mandatory variable `SkillSet/DrillHole/CurrentState` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/CurrentState\")]"),
-        ("SkillSet/DrillHole/LastTransition",
-        "the mandatory variable `SkillSet/DrillHole/LastTransition` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/LastTransition\")]"),
-        ("SkillSet/DrillHole/Deletable",
-        "the mandatory variable `SkillSet/DrillHole/Deletable` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/Deletable\")]"),
-        ("SkillSet/DrillHole/AutoDelete",
-        "the mandatory variable `SkillSet/DrillHole/AutoDelete` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/AutoDelete\")]"),
-        ("SkillSet/DrillHole/RecycleCount",
-        "the mandatory variable `SkillSet/DrillHole/RecycleCount` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/RecycleCount\")]"),
-        ("SkillSet/DrillHole/InputParameterSet/InsertionDistance",
-        "the mandatory variable `SkillSet/DrillHole/InputParameterSet/InsertionDistance` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/InputParameterSet/InsertionDistance\")]"),
-        ("SkillSet/DrillHole/InputParameterSet/HoleDiameter",
-        "the mandatory variable `SkillSet/DrillHole/InputParameterSet/HoleDiameter` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/InputParameterSet/HoleDiameter\")]"),
-        ("SkillSet/DrillHole/InputParameterSet/Depth",
-        "the mandatory variable `SkillSet/DrillHole/InputParameterSet/Depth` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/InputParameterSet/Depth\")]"),
-        ("SkillSet/DrillHole/InputParameterSet/FeedRate",
-        "the mandatory variable `SkillSet/DrillHole/InputParameterSet/FeedRate` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/InputParameterSet/FeedRate\")]"),
-        ("SkillSet/DrillHole/InputParameterSet/SpindleSpeed",
-        "the mandatory variable `SkillSet/DrillHole/InputParameterSet/SpindleSpeed` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/InputParameterSet/SpindleSpeed\")]"),
-        ("SkillSet/DrillHole/InputParameterSet/ClampForce",
-        "the mandatory variable `SkillSet/DrillHole/InputParameterSet/ClampForce` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/InputParameterSet/ClampForce\")]"),
-        ("SkillSet/DrillHole/OutputParameterSet/Result",
-        "the mandatory variable `SkillSet/DrillHole/OutputParameterSet/Result` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/OutputParameterSet/Result\")]")];
-        SkillSet__ReferenceDrillBush__CurrentState : ua::LocalizedText, - 1, [1
-        "SkillSet", 0 "ReferenceDrillBush", 2 "CurrentState"], true false false;
-        SkillSet__ReferenceDrillBush__LastTransition : ua::LocalizedText, - 1, [1
-        "SkillSet", 0 "ReferenceDrillBush", 2 "LastTransition"], true false false;
-        SkillSet__ReferenceDrillBush__AvailableStates : ua::NodeId, 1, [1 "SkillSet", 0
-        "ReferenceDrillBush", 2 "AvailableStates"], false false false;
-        SkillSet__ReferenceDrillBush__AvailableTransitions : ua::NodeId, 1, [1
-        "SkillSet", 0 "ReferenceDrillBush", 2 "AvailableTransitions"], false false false;
-        SkillSet__ReferenceDrillBush__Deletable : bool, - 1, [1 "SkillSet", 0
-        "ReferenceDrillBush", 2 "Deletable"], true false false;
-        SkillSet__ReferenceDrillBush__AutoDelete : bool, - 1, [1 "SkillSet", 0
-        "ReferenceDrillBush", 2 "AutoDelete"], true false false;
-        SkillSet__ReferenceDrillBush__RecycleCount : i32, - 1, [1 "SkillSet", 0
-        "ReferenceDrillBush", 2 "RecycleCount"], true false false;
-        SkillSet__ReferenceDrillBush__ProgramDiagnostic : ua::ExtensionObject, - 1, [1
-        "SkillSet", 0 "ReferenceDrillBush", 2 "ProgramDiagnostic"], false false false;
-        SkillSet__ReferenceDrillBush__InputParameterSet__HolePosition : ua::ThreeDFrame,
-        - 1, [1 "SkillSet", 0 "ReferenceDrillBush", 1 "InputParameterSet", 0
-        "HolePosition"], true false true;
-        SkillSet__ReferenceDrillBush__InputParameterSet__ApproachDistance : f64, - 1, [1
-        "SkillSet", 0 "ReferenceDrillBush", 1 "InputParameterSet", 0 "ApproachDistance"],
-        true false true; SkillSet__ReferenceDrillBush__OutputParameterSet__Result :
-        ua::StatusCode, - 1, [1 "SkillSet", 0 "ReferenceDrillBush", 1
-        "OutputParameterSet", 1 "Result"], true false false;
-        SkillSet__ReferenceDrillBush__OutputParameterSet__ReferencedHolePosition :
-        ua::ThreeDFrame, - 1, [1 "SkillSet", 0 "ReferenceDrillBush", 1
-        "OutputParameterSet", 0 "ReferencedHolePosition"], true false false;
-        SkillSet__DrillHole__CurrentState : ua::LocalizedText, - 1, [1 "SkillSet", 0
-        "DrillHole", 2 "CurrentState"], true false false;
-        SkillSet__DrillHole__LastTransition : ua::LocalizedText, - 1, [1 "SkillSet", 0
-        "DrillHole", 2 "LastTransition"], true false false;
-        SkillSet__DrillHole__AvailableStates : ua::NodeId, 1, [1 "SkillSet", 0
-        "DrillHole", 2 "AvailableStates"], false false false;
-        SkillSet__DrillHole__AvailableTransitions : ua::NodeId, 1, [1 "SkillSet", 0
-        "DrillHole", 2 "AvailableTransitions"], false false false;
-        SkillSet__DrillHole__Deletable : bool, - 1, [1 "SkillSet", 0 "DrillHole", 2
-        "Deletable"], true false false; SkillSet__DrillHole__AutoDelete : bool, - 1, [1
-        "SkillSet", 0 "DrillHole", 2 "AutoDelete"], true false false;
-        SkillSet__DrillHole__RecycleCount : i32, - 1, [1 "SkillSet", 0 "DrillHole", 2
-        "RecycleCount"], true false false; SkillSet__DrillHole__ProgramDiagnostic :
-        ua::ExtensionObject, - 1, [1 "SkillSet", 0 "DrillHole", 2 "ProgramDiagnostic"],
-        false false false; SkillSet__DrillHole__InputParameterSet__InsertionDistance :
-        f64, - 1, [1 "SkillSet", 0 "DrillHole", 1 "InputParameterSet", 0
-        "InsertionDistance"], true false true;
-        SkillSet__DrillHole__InputParameterSet__HoleDiameter : f64, - 1, [1 "SkillSet", 0
-        "DrillHole", 1 "InputParameterSet", 0 "HoleDiameter"], true false true;
-        SkillSet__DrillHole__InputParameterSet__Depth : f64, - 1, [1 "SkillSet", 0
-        "DrillHole", 1 "InputParameterSet", 0 "Depth"], true false true;
-        SkillSet__DrillHole__InputParameterSet__FeedRate : f64, - 1, [1 "SkillSet", 0
-        "DrillHole", 1 "InputParameterSet", 0 "FeedRate"], true false true;
-        SkillSet__DrillHole__InputParameterSet__SpindleSpeed : f64, - 1, [1 "SkillSet", 0
-        "DrillHole", 1 "InputParameterSet", 0 "SpindleSpeed"], true false true;
-        SkillSet__DrillHole__InputParameterSet__ClampForce : f64, - 1, [1 "SkillSet", 0
-        "DrillHole", 1 "InputParameterSet", 0 "ClampForce"], true false true;
-        SkillSet__DrillHole__OutputParameterSet__Result : ua::StatusCode, - 1, [1
-        "SkillSet", 0 "DrillHole", 1 "OutputParameterSet", 1 "Result"], true false false;
+        DrillingCellType;
+        required: [
+            ("SkillSet/ReferenceDrillBush/CurrentState", "the mandatory variable `SkillSet/ReferenceDrillBush/CurrentState` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/CurrentState\")]"),
+            ("SkillSet/ReferenceDrillBush/LastTransition", "the mandatory variable `SkillSet/ReferenceDrillBush/LastTransition` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/LastTransition\")]"),
+            ("SkillSet/ReferenceDrillBush/Deletable", "the mandatory variable `SkillSet/ReferenceDrillBush/Deletable` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/Deletable\")]"),
+            ("SkillSet/ReferenceDrillBush/AutoDelete", "the mandatory variable `SkillSet/ReferenceDrillBush/AutoDelete` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/AutoDelete\")]"),
+            ("SkillSet/ReferenceDrillBush/RecycleCount", "the mandatory variable `SkillSet/ReferenceDrillBush/RecycleCount` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/RecycleCount\")]"),
+            ("SkillSet/ReferenceDrillBush/InputParameterSet/HolePosition", "the mandatory variable `SkillSet/ReferenceDrillBush/InputParameterSet/HolePosition` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/InputParameterSet/HolePosition\")]"),
+            ("SkillSet/ReferenceDrillBush/InputParameterSet/ApproachDistance", "the mandatory variable `SkillSet/ReferenceDrillBush/InputParameterSet/ApproachDistance` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/InputParameterSet/ApproachDistance\")]"),
+            ("SkillSet/ReferenceDrillBush/OutputParameterSet/Result", "the mandatory variable `SkillSet/ReferenceDrillBush/OutputParameterSet/Result` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/OutputParameterSet/Result\")]"),
+            ("SkillSet/ReferenceDrillBush/OutputParameterSet/ReferencedHolePosition", "the mandatory variable `SkillSet/ReferenceDrillBush/OutputParameterSet/ReferencedHolePosition` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/OutputParameterSet/ReferencedHolePosition\")]"),
+            ("SkillSet/DrillHole/CurrentState", "the mandatory variable `SkillSet/DrillHole/CurrentState` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/CurrentState\")]"),
+            ("SkillSet/DrillHole/LastTransition", "the mandatory variable `SkillSet/DrillHole/LastTransition` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/LastTransition\")]"),
+            ("SkillSet/DrillHole/Deletable", "the mandatory variable `SkillSet/DrillHole/Deletable` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/Deletable\")]"),
+            ("SkillSet/DrillHole/AutoDelete", "the mandatory variable `SkillSet/DrillHole/AutoDelete` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/AutoDelete\")]"),
+            ("SkillSet/DrillHole/RecycleCount", "the mandatory variable `SkillSet/DrillHole/RecycleCount` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/RecycleCount\")]"),
+            ("SkillSet/DrillHole/InputParameterSet/InsertionDistance", "the mandatory variable `SkillSet/DrillHole/InputParameterSet/InsertionDistance` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/InputParameterSet/InsertionDistance\")]"),
+            ("SkillSet/DrillHole/InputParameterSet/HoleDiameter", "the mandatory variable `SkillSet/DrillHole/InputParameterSet/HoleDiameter` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/InputParameterSet/HoleDiameter\")]"),
+            ("SkillSet/DrillHole/InputParameterSet/Depth", "the mandatory variable `SkillSet/DrillHole/InputParameterSet/Depth` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/InputParameterSet/Depth\")]"),
+            ("SkillSet/DrillHole/InputParameterSet/FeedRate", "the mandatory variable `SkillSet/DrillHole/InputParameterSet/FeedRate` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/InputParameterSet/FeedRate\")]"),
+            ("SkillSet/DrillHole/InputParameterSet/SpindleSpeed", "the mandatory variable `SkillSet/DrillHole/InputParameterSet/SpindleSpeed` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/InputParameterSet/SpindleSpeed\")]"),
+            ("SkillSet/DrillHole/InputParameterSet/ClampForce", "the mandatory variable `SkillSet/DrillHole/InputParameterSet/ClampForce` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/InputParameterSet/ClampForce\")]"),
+            ("SkillSet/DrillHole/OutputParameterSet/Result", "the mandatory variable `SkillSet/DrillHole/OutputParameterSet/Result` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/OutputParameterSet/Result\")]"),
+        ];
+        SkillSet__ReferenceDrillBush__CurrentState: ua::LocalizedText, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "CurrentState"], true false false;
+        SkillSet__ReferenceDrillBush__LastTransition: ua::LocalizedText, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "LastTransition"], true false false;
+        SkillSet__ReferenceDrillBush__AvailableStates: ua::NodeId, 1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "AvailableStates"], false false false;
+        SkillSet__ReferenceDrillBush__AvailableTransitions: ua::NodeId, 1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "AvailableTransitions"], false false false;
+        SkillSet__ReferenceDrillBush__Deletable: bool, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "Deletable"], true false false;
+        SkillSet__ReferenceDrillBush__AutoDelete: bool, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "AutoDelete"], true false false;
+        SkillSet__ReferenceDrillBush__RecycleCount: i32, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "RecycleCount"], true false false;
+        SkillSet__ReferenceDrillBush__ProgramDiagnostic: ua::ExtensionObject, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "ProgramDiagnostic"], false false false;
+        SkillSet__ReferenceDrillBush__InputParameterSet__HolePosition: ua::ThreeDFrame, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 1 "InputParameterSet", 0 "HolePosition"], true false true;
+        SkillSet__ReferenceDrillBush__InputParameterSet__ApproachDistance: f64, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 1 "InputParameterSet", 0 "ApproachDistance"], true false true;
+        SkillSet__ReferenceDrillBush__OutputParameterSet__Result: ua::StatusCode, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 1 "OutputParameterSet", 1 "Result"], true false false;
+        SkillSet__ReferenceDrillBush__OutputParameterSet__ReferencedHolePosition: ua::ThreeDFrame, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 1 "OutputParameterSet", 0 "ReferencedHolePosition"], true false false;
+        SkillSet__DrillHole__CurrentState: ua::LocalizedText, -1, [1 "SkillSet", 0 "DrillHole", 2 "CurrentState"], true false false;
+        SkillSet__DrillHole__LastTransition: ua::LocalizedText, -1, [1 "SkillSet", 0 "DrillHole", 2 "LastTransition"], true false false;
+        SkillSet__DrillHole__AvailableStates: ua::NodeId, 1, [1 "SkillSet", 0 "DrillHole", 2 "AvailableStates"], false false false;
+        SkillSet__DrillHole__AvailableTransitions: ua::NodeId, 1, [1 "SkillSet", 0 "DrillHole", 2 "AvailableTransitions"], false false false;
+        SkillSet__DrillHole__Deletable: bool, -1, [1 "SkillSet", 0 "DrillHole", 2 "Deletable"], true false false;
+        SkillSet__DrillHole__AutoDelete: bool, -1, [1 "SkillSet", 0 "DrillHole", 2 "AutoDelete"], true false false;
+        SkillSet__DrillHole__RecycleCount: i32, -1, [1 "SkillSet", 0 "DrillHole", 2 "RecycleCount"], true false false;
+        SkillSet__DrillHole__ProgramDiagnostic: ua::ExtensionObject, -1, [1 "SkillSet", 0 "DrillHole", 2 "ProgramDiagnostic"], false false false;
+        SkillSet__DrillHole__InputParameterSet__InsertionDistance: f64, -1, [1 "SkillSet", 0 "DrillHole", 1 "InputParameterSet", 0 "InsertionDistance"], true false true;
+        SkillSet__DrillHole__InputParameterSet__HoleDiameter: f64, -1, [1 "SkillSet", 0 "DrillHole", 1 "InputParameterSet", 0 "HoleDiameter"], true false true;
+        SkillSet__DrillHole__InputParameterSet__Depth: f64, -1, [1 "SkillSet", 0 "DrillHole", 1 "InputParameterSet", 0 "Depth"], true false true;
+        SkillSet__DrillHole__InputParameterSet__FeedRate: f64, -1, [1 "SkillSet", 0 "DrillHole", 1 "InputParameterSet", 0 "FeedRate"], true false true;
+        SkillSet__DrillHole__InputParameterSet__SpindleSpeed: f64, -1, [1 "SkillSet", 0 "DrillHole", 1 "InputParameterSet", 0 "SpindleSpeed"], true false true;
+        SkillSet__DrillHole__InputParameterSet__ClampForce: f64, -1, [1 "SkillSet", 0 "DrillHole", 1 "InputParameterSet", 0 "ClampForce"], true false true;
+        SkillSet__DrillHole__OutputParameterSet__Result: ua::StatusCode, -1, [1 "SkillSet", 0 "DrillHole", 1 "OutputParameterSet", 1 "Result"], true false false;
     }
     t::object_members! {
-        ReferenceDrillBushSkillType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("Deletable",
-        "the mandatory variable `Deletable` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
-        ("AutoDelete",
-        "the mandatory variable `AutoDelete` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
-        ("RecycleCount",
-        "the mandatory variable `RecycleCount` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
-        ("InputParameterSet/HolePosition",
-        "the mandatory variable `InputParameterSet/HolePosition` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/HolePosition\")]"),
-        ("InputParameterSet/ApproachDistance",
-        "the mandatory variable `InputParameterSet/ApproachDistance` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/ApproachDistance\")]"),
-        ("OutputParameterSet/Result",
-        "the mandatory variable `OutputParameterSet/Result` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
-        ("OutputParameterSet/ReferencedHolePosition",
-        "the mandatory variable `OutputParameterSet/ReferencedHolePosition` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/ReferencedHolePosition\")]")];
-        CurrentState : ua::LocalizedText, - 1, [2 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [2 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [2 "AvailableTransitions"], false false
-        false; Deletable : bool, - 1, [2 "Deletable"], true false false; AutoDelete :
-        bool, - 1, [2 "AutoDelete"], true false false; RecycleCount : i32, - 1, [2
-        "RecycleCount"], true false false; ProgramDiagnostic : ua::ExtensionObject, - 1,
-        [2 "ProgramDiagnostic"], false false false; InputParameterSet__HolePosition :
-        ua::ThreeDFrame, - 1, [1 "InputParameterSet", 0 "HolePosition"], true false true;
-        InputParameterSet__ApproachDistance : f64, - 1, [1 "InputParameterSet", 0
-        "ApproachDistance"], true false true; OutputParameterSet__Result :
-        ua::StatusCode, - 1, [1 "OutputParameterSet", 1 "Result"], true false false;
-        OutputParameterSet__ReferencedHolePosition : ua::ThreeDFrame, - 1, [1
-        "OutputParameterSet", 0 "ReferencedHolePosition"], true false false;
+        ReferenceDrillBushSkillType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("Deletable", "the mandatory variable `Deletable` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
+            ("AutoDelete", "the mandatory variable `AutoDelete` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
+            ("RecycleCount", "the mandatory variable `RecycleCount` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
+            ("InputParameterSet/HolePosition", "the mandatory variable `InputParameterSet/HolePosition` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/HolePosition\")]"),
+            ("InputParameterSet/ApproachDistance", "the mandatory variable `InputParameterSet/ApproachDistance` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/ApproachDistance\")]"),
+            ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
+            ("OutputParameterSet/ReferencedHolePosition", "the mandatory variable `OutputParameterSet/ReferencedHolePosition` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/ReferencedHolePosition\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
+        Deletable: bool, -1, [2 "Deletable"], true false false;
+        AutoDelete: bool, -1, [2 "AutoDelete"], true false false;
+        RecycleCount: i32, -1, [2 "RecycleCount"], true false false;
+        ProgramDiagnostic: ua::ExtensionObject, -1, [2 "ProgramDiagnostic"], false false false;
+        InputParameterSet__HolePosition: ua::ThreeDFrame, -1, [1 "InputParameterSet", 0 "HolePosition"], true false true;
+        InputParameterSet__ApproachDistance: f64, -1, [1 "InputParameterSet", 0 "ApproachDistance"], true false true;
+        OutputParameterSet__Result: ua::StatusCode, -1, [1 "OutputParameterSet", 1 "Result"], true false false;
+        OutputParameterSet__ReferencedHolePosition: ua::ThreeDFrame, -1, [1 "OutputParameterSet", 0 "ReferencedHolePosition"], true false false;
     }
 }

@@ -935,1906 +935,817 @@ pub mod members {
     #[allow(unused_imports)]
     use super::t;
     t::object_members! {
-        DrillingEndEffectorType; required : [("Manufacturer",
-        "the mandatory variable `Manufacturer` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
-        ("Model",
-        "the mandatory variable `Model` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
-        ("SerialNumber",
-        "the mandatory variable `SerialNumber` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
-        ("SkillSet/TemplateDrilling/CurrentState",
-        "the mandatory variable `SkillSet/TemplateDrilling/CurrentState` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/CurrentState\")]"),
-        ("SkillSet/TemplateDrilling/LastTransition",
-        "the mandatory variable `SkillSet/TemplateDrilling/LastTransition` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/LastTransition\")]"),
-        ("SkillSet/TemplateDrilling/Deletable",
-        "the mandatory variable `SkillSet/TemplateDrilling/Deletable` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/Deletable\")]"),
-        ("SkillSet/TemplateDrilling/AutoDelete",
-        "the mandatory variable `SkillSet/TemplateDrilling/AutoDelete` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/AutoDelete\")]"),
-        ("SkillSet/TemplateDrilling/RecycleCount",
-        "the mandatory variable `SkillSet/TemplateDrilling/RecycleCount` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/RecycleCount\")]"),
-        ("SkillSet/TemplateDrilling/InputParameterSet/HoleDiameter",
-        "the mandatory variable `SkillSet/TemplateDrilling/InputParameterSet/HoleDiameter` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/InputParameterSet/HoleDiameter\")]"),
-        ("SkillSet/TemplateDrilling/InputParameterSet/Depth",
-        "the mandatory variable `SkillSet/TemplateDrilling/InputParameterSet/Depth` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/InputParameterSet/Depth\")]"),
-        ("SkillSet/TemplateDrilling/InputParameterSet/FeedRate",
-        "the mandatory variable `SkillSet/TemplateDrilling/InputParameterSet/FeedRate` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/InputParameterSet/FeedRate\")]"),
-        ("SkillSet/TemplateDrilling/InputParameterSet/SpindleSpeed",
-        "the mandatory variable `SkillSet/TemplateDrilling/InputParameterSet/SpindleSpeed` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/InputParameterSet/SpindleSpeed\")]"),
-        ("SkillSet/TemplateDrilling/InputParameterSet/ClampForce",
-        "the mandatory variable `SkillSet/TemplateDrilling/InputParameterSet/ClampForce` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/InputParameterSet/ClampForce\")]"),
-        ("SkillSet/TemplateDrilling/OutputParameterSet/Result",
-        "the mandatory variable `SkillSet/TemplateDrilling/OutputParameterSet/Result` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/OutputParameterSet/Result\")]")];
-        Identification__UIElement : ua::Variant, - 1, [1 "Identification", 1
-        "UIElement"], false false false; Lock__Locked : bool, - 1, [1 "Lock", 1
-        "Locked"], false false false; Lock__LockingClient : String, - 1, [1 "Lock", 1
-        "LockingClient"], false false false; Lock__LockingUser : String, - 1, [1 "Lock",
-        1 "LockingUser"], false false false; Lock__RemainingLockTime : f64, - 1, [1
-        "Lock", 1 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [1 "Manufacturer"], true false false; ManufacturerUri :
-        String, - 1, [1 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [1 "Model"], true false false; HardwareRevision : String, - 1, [1
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [1
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [1
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [1
-        "ProductCode"], false false false; DeviceManual : String, - 1, [1
-        "DeviceManual"], false false false; DeviceClass : String, - 1, [1 "DeviceClass"],
-        false false false; SerialNumber : String, - 1, [1 "SerialNumber"], true false
-        false; ProductInstanceUri : String, - 1, [1 "ProductInstanceUri"], false false
-        false; RevisionCounter : i32, - 1, [1 "RevisionCounter"], false false false;
-        AssetId : String, - 1, [1 "AssetId"], false false false; ComponentName :
-        ua::LocalizedText, - 1, [1 "ComponentName"], false false false;
-        SkillSet__TemplateDrilling__CurrentState : ua::LocalizedText, - 1, [2 "SkillSet",
-        0 "TemplateDrilling", 3 "CurrentState"], true false false;
-        SkillSet__TemplateDrilling__LastTransition : ua::LocalizedText, - 1, [2
-        "SkillSet", 0 "TemplateDrilling", 3 "LastTransition"], true false false;
-        SkillSet__TemplateDrilling__AvailableStates : ua::NodeId, 1, [2 "SkillSet", 0
-        "TemplateDrilling", 3 "AvailableStates"], false false false;
-        SkillSet__TemplateDrilling__AvailableTransitions : ua::NodeId, 1, [2 "SkillSet",
-        0 "TemplateDrilling", 3 "AvailableTransitions"], false false false;
-        SkillSet__TemplateDrilling__Deletable : bool, - 1, [2 "SkillSet", 0
-        "TemplateDrilling", 3 "Deletable"], true false false;
-        SkillSet__TemplateDrilling__AutoDelete : bool, - 1, [2 "SkillSet", 0
-        "TemplateDrilling", 3 "AutoDelete"], true false false;
-        SkillSet__TemplateDrilling__RecycleCount : i32, - 1, [2 "SkillSet", 0
-        "TemplateDrilling", 3 "RecycleCount"], true false false;
-        SkillSet__TemplateDrilling__ProgramDiagnostic : ua::ExtensionObject, - 1, [2
-        "SkillSet", 0 "TemplateDrilling", 3 "ProgramDiagnostic"], false false false;
-        SkillSet__TemplateDrilling__InputParameterSet__HoleDiameter : f64, - 1, [2
-        "SkillSet", 0 "TemplateDrilling", 2 "InputParameterSet", 0 "HoleDiameter"], true
-        false true; SkillSet__TemplateDrilling__InputParameterSet__Depth : f64, - 1, [2
-        "SkillSet", 0 "TemplateDrilling", 2 "InputParameterSet", 0 "Depth"], true false
-        true; SkillSet__TemplateDrilling__InputParameterSet__FeedRate : f64, - 1, [2
-        "SkillSet", 0 "TemplateDrilling", 2 "InputParameterSet", 0 "FeedRate"], true
-        false true; SkillSet__TemplateDrilling__InputParameterSet__SpindleSpeed : f64, -
-        1, [2 "SkillSet", 0 "TemplateDrilling", 2 "InputParameterSet", 0 "SpindleSpeed"],
-        true false true; SkillSet__TemplateDrilling__InputParameterSet__ClampForce : f64,
-        - 1, [2 "SkillSet", 0 "TemplateDrilling", 2 "InputParameterSet", 0 "ClampForce"],
-        true false true; SkillSet__TemplateDrilling__OutputParameterSet__Result :
-        ua::StatusCode, - 1, [2 "SkillSet", 0 "TemplateDrilling", 2 "OutputParameterSet",
-        2 "Result"], true false false;
+        DrillingEndEffectorType;
+        required: [
+            ("Manufacturer", "the mandatory variable `Manufacturer` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
+            ("Model", "the mandatory variable `Model` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
+            ("SerialNumber", "the mandatory variable `SerialNumber` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
+            ("SkillSet/TemplateDrilling/CurrentState", "the mandatory variable `SkillSet/TemplateDrilling/CurrentState` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/CurrentState\")]"),
+            ("SkillSet/TemplateDrilling/LastTransition", "the mandatory variable `SkillSet/TemplateDrilling/LastTransition` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/LastTransition\")]"),
+            ("SkillSet/TemplateDrilling/Deletable", "the mandatory variable `SkillSet/TemplateDrilling/Deletable` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/Deletable\")]"),
+            ("SkillSet/TemplateDrilling/AutoDelete", "the mandatory variable `SkillSet/TemplateDrilling/AutoDelete` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/AutoDelete\")]"),
+            ("SkillSet/TemplateDrilling/RecycleCount", "the mandatory variable `SkillSet/TemplateDrilling/RecycleCount` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/RecycleCount\")]"),
+            ("SkillSet/TemplateDrilling/InputParameterSet/HoleDiameter", "the mandatory variable `SkillSet/TemplateDrilling/InputParameterSet/HoleDiameter` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/InputParameterSet/HoleDiameter\")]"),
+            ("SkillSet/TemplateDrilling/InputParameterSet/Depth", "the mandatory variable `SkillSet/TemplateDrilling/InputParameterSet/Depth` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/InputParameterSet/Depth\")]"),
+            ("SkillSet/TemplateDrilling/InputParameterSet/FeedRate", "the mandatory variable `SkillSet/TemplateDrilling/InputParameterSet/FeedRate` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/InputParameterSet/FeedRate\")]"),
+            ("SkillSet/TemplateDrilling/InputParameterSet/SpindleSpeed", "the mandatory variable `SkillSet/TemplateDrilling/InputParameterSet/SpindleSpeed` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/InputParameterSet/SpindleSpeed\")]"),
+            ("SkillSet/TemplateDrilling/InputParameterSet/ClampForce", "the mandatory variable `SkillSet/TemplateDrilling/InputParameterSet/ClampForce` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/InputParameterSet/ClampForce\")]"),
+            ("SkillSet/TemplateDrilling/OutputParameterSet/Result", "the mandatory variable `SkillSet/TemplateDrilling/OutputParameterSet/Result` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/OutputParameterSet/Result\")]"),
+        ];
+        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], true false false;
+        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [1 "Model"], true false false;
+        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [1 "ProductCode"], false false false;
+        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [1 "SerialNumber"], true false false;
+        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
+        AssetId: String, -1, [1 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
+        SkillSet__TemplateDrilling__CurrentState: ua::LocalizedText, -1, [2 "SkillSet", 0 "TemplateDrilling", 3 "CurrentState"], true false false;
+        SkillSet__TemplateDrilling__LastTransition: ua::LocalizedText, -1, [2 "SkillSet", 0 "TemplateDrilling", 3 "LastTransition"], true false false;
+        SkillSet__TemplateDrilling__AvailableStates: ua::NodeId, 1, [2 "SkillSet", 0 "TemplateDrilling", 3 "AvailableStates"], false false false;
+        SkillSet__TemplateDrilling__AvailableTransitions: ua::NodeId, 1, [2 "SkillSet", 0 "TemplateDrilling", 3 "AvailableTransitions"], false false false;
+        SkillSet__TemplateDrilling__Deletable: bool, -1, [2 "SkillSet", 0 "TemplateDrilling", 3 "Deletable"], true false false;
+        SkillSet__TemplateDrilling__AutoDelete: bool, -1, [2 "SkillSet", 0 "TemplateDrilling", 3 "AutoDelete"], true false false;
+        SkillSet__TemplateDrilling__RecycleCount: i32, -1, [2 "SkillSet", 0 "TemplateDrilling", 3 "RecycleCount"], true false false;
+        SkillSet__TemplateDrilling__ProgramDiagnostic: ua::ExtensionObject, -1, [2 "SkillSet", 0 "TemplateDrilling", 3 "ProgramDiagnostic"], false false false;
+        SkillSet__TemplateDrilling__InputParameterSet__HoleDiameter: f64, -1, [2 "SkillSet", 0 "TemplateDrilling", 2 "InputParameterSet", 0 "HoleDiameter"], true false true;
+        SkillSet__TemplateDrilling__InputParameterSet__Depth: f64, -1, [2 "SkillSet", 0 "TemplateDrilling", 2 "InputParameterSet", 0 "Depth"], true false true;
+        SkillSet__TemplateDrilling__InputParameterSet__FeedRate: f64, -1, [2 "SkillSet", 0 "TemplateDrilling", 2 "InputParameterSet", 0 "FeedRate"], true false true;
+        SkillSet__TemplateDrilling__InputParameterSet__SpindleSpeed: f64, -1, [2 "SkillSet", 0 "TemplateDrilling", 2 "InputParameterSet", 0 "SpindleSpeed"], true false true;
+        SkillSet__TemplateDrilling__InputParameterSet__ClampForce: f64, -1, [2 "SkillSet", 0 "TemplateDrilling", 2 "InputParameterSet", 0 "ClampForce"], true false true;
+        SkillSet__TemplateDrilling__OutputParameterSet__Result: ua::StatusCode, -1, [2 "SkillSet", 0 "TemplateDrilling", 2 "OutputParameterSet", 2 "Result"], true false false;
     }
     t::object_members! {
-        LwrSystemType; required : []; Identification__UIElement : ua::Variant, - 1, [1
-        "Identification", 1 "UIElement"], false false false; Lock__Locked : bool, - 1, [1
-        "Lock", 1 "Locked"], false false false; Lock__LockingClient : String, - 1, [1
-        "Lock", 1 "LockingClient"], false false false; Lock__LockingUser : String, - 1,
-        [1 "Lock", 1 "LockingUser"], false false false; Lock__RemainingLockTime : f64, -
-        1, [1 "Lock", 1 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [1 "Manufacturer"], false false false; ManufacturerUri :
-        String, - 1, [1 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [1 "Model"], false false false; HardwareRevision : String, - 1, [1
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [1
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [1
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [1
-        "ProductCode"], false false false; DeviceManual : String, - 1, [1
-        "DeviceManual"], false false false; DeviceClass : String, - 1, [1 "DeviceClass"],
-        false false false; SerialNumber : String, - 1, [1 "SerialNumber"], false false
-        false; ProductInstanceUri : String, - 1, [1 "ProductInstanceUri"], false false
-        false; RevisionCounter : i32, - 1, [1 "RevisionCounter"], false false false;
-        AssetId : String, - 1, [1 "AssetId"], false false false; ComponentName :
-        ua::LocalizedText, - 1, [1 "ComponentName"], false false false;
-        MotionDeviceSystem__Identification__UIElement : ua::Variant, - 1, [0
-        "MotionDeviceSystem", 1 "Identification", 1 "UIElement"], false false false;
-        MotionDeviceSystem__Lock__Locked : bool, - 1, [0 "MotionDeviceSystem", 1 "Lock",
-        1 "Locked"], false false false; MotionDeviceSystem__Lock__LockingClient : String,
-        - 1, [0 "MotionDeviceSystem", 1 "Lock", 1 "LockingClient"], false false false;
-        MotionDeviceSystem__Lock__LockingUser : String, - 1, [0 "MotionDeviceSystem", 1
-        "Lock", 1 "LockingUser"], false false false;
-        MotionDeviceSystem__Lock__RemainingLockTime : f64, - 1, [0 "MotionDeviceSystem",
-        1 "Lock", 1 "RemainingLockTime"], false false false;
-        MotionDeviceSystem__Manufacturer : ua::LocalizedText, - 1, [0
-        "MotionDeviceSystem", 1 "Manufacturer"], false false false;
-        MotionDeviceSystem__ManufacturerUri : String, - 1, [0 "MotionDeviceSystem", 1
-        "ManufacturerUri"], false false false; MotionDeviceSystem__Model :
-        ua::LocalizedText, - 1, [0 "MotionDeviceSystem", 1 "Model"], false false false;
-        MotionDeviceSystem__HardwareRevision : String, - 1, [0 "MotionDeviceSystem", 1
-        "HardwareRevision"], false false false; MotionDeviceSystem__SoftwareRevision :
-        String, - 1, [0 "MotionDeviceSystem", 1 "SoftwareRevision"], false false false;
-        MotionDeviceSystem__DeviceRevision : String, - 1, [0 "MotionDeviceSystem", 1
-        "DeviceRevision"], false false false; MotionDeviceSystem__ProductCode : String, -
-        1, [0 "MotionDeviceSystem", 1 "ProductCode"], false false false;
-        MotionDeviceSystem__DeviceManual : String, - 1, [0 "MotionDeviceSystem", 1
-        "DeviceManual"], false false false; MotionDeviceSystem__DeviceClass : String, -
-        1, [0 "MotionDeviceSystem", 1 "DeviceClass"], false false false;
-        MotionDeviceSystem__SerialNumber : String, - 1, [0 "MotionDeviceSystem", 1
-        "SerialNumber"], false false false; MotionDeviceSystem__ProductInstanceUri :
-        String, - 1, [0 "MotionDeviceSystem", 1 "ProductInstanceUri"], false false false;
-        MotionDeviceSystem__RevisionCounter : i32, - 1, [0 "MotionDeviceSystem", 1
-        "RevisionCounter"], false false false; MotionDeviceSystem__AssetId : String, - 1,
-        [0 "MotionDeviceSystem", 1 "AssetId"], false false false;
-        MotionDeviceSystem__ComponentName : ua::LocalizedText, - 1, [0
-        "MotionDeviceSystem", 1 "ComponentName"], false false false;
+        LwrSystemType;
+        required: [];
+        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
+        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
+        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [1 "ProductCode"], false false false;
+        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
+        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
+        AssetId: String, -1, [1 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
+        MotionDeviceSystem__Identification__UIElement: ua::Variant, -1, [0 "MotionDeviceSystem", 1 "Identification", 1 "UIElement"], false false false;
+        MotionDeviceSystem__Lock__Locked: bool, -1, [0 "MotionDeviceSystem", 1 "Lock", 1 "Locked"], false false false;
+        MotionDeviceSystem__Lock__LockingClient: String, -1, [0 "MotionDeviceSystem", 1 "Lock", 1 "LockingClient"], false false false;
+        MotionDeviceSystem__Lock__LockingUser: String, -1, [0 "MotionDeviceSystem", 1 "Lock", 1 "LockingUser"], false false false;
+        MotionDeviceSystem__Lock__RemainingLockTime: f64, -1, [0 "MotionDeviceSystem", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        MotionDeviceSystem__Manufacturer: ua::LocalizedText, -1, [0 "MotionDeviceSystem", 1 "Manufacturer"], false false false;
+        MotionDeviceSystem__ManufacturerUri: String, -1, [0 "MotionDeviceSystem", 1 "ManufacturerUri"], false false false;
+        MotionDeviceSystem__Model: ua::LocalizedText, -1, [0 "MotionDeviceSystem", 1 "Model"], false false false;
+        MotionDeviceSystem__HardwareRevision: String, -1, [0 "MotionDeviceSystem", 1 "HardwareRevision"], false false false;
+        MotionDeviceSystem__SoftwareRevision: String, -1, [0 "MotionDeviceSystem", 1 "SoftwareRevision"], false false false;
+        MotionDeviceSystem__DeviceRevision: String, -1, [0 "MotionDeviceSystem", 1 "DeviceRevision"], false false false;
+        MotionDeviceSystem__ProductCode: String, -1, [0 "MotionDeviceSystem", 1 "ProductCode"], false false false;
+        MotionDeviceSystem__DeviceManual: String, -1, [0 "MotionDeviceSystem", 1 "DeviceManual"], false false false;
+        MotionDeviceSystem__DeviceClass: String, -1, [0 "MotionDeviceSystem", 1 "DeviceClass"], false false false;
+        MotionDeviceSystem__SerialNumber: String, -1, [0 "MotionDeviceSystem", 1 "SerialNumber"], false false false;
+        MotionDeviceSystem__ProductInstanceUri: String, -1, [0 "MotionDeviceSystem", 1 "ProductInstanceUri"], false false false;
+        MotionDeviceSystem__RevisionCounter: i32, -1, [0 "MotionDeviceSystem", 1 "RevisionCounter"], false false false;
+        MotionDeviceSystem__AssetId: String, -1, [0 "MotionDeviceSystem", 1 "AssetId"], false false false;
+        MotionDeviceSystem__ComponentName: ua::LocalizedText, -1, [0 "MotionDeviceSystem", 1 "ComponentName"], false false false;
     }
     t::object_members! {
-        TemplateDrillingLwrSystemType; required : [("DrillingEndEffector/Manufacturer",
-        "the mandatory variable `DrillingEndEffector/Manufacturer` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/Manufacturer\")]"),
-        ("DrillingEndEffector/Model",
-        "the mandatory variable `DrillingEndEffector/Model` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/Model\")]"),
-        ("DrillingEndEffector/SerialNumber",
-        "the mandatory variable `DrillingEndEffector/SerialNumber` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SerialNumber\")]"),
-        ("DrillingEndEffector/SkillSet/TemplateDrilling/CurrentState",
-        "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/CurrentState` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/CurrentState\")]"),
-        ("DrillingEndEffector/SkillSet/TemplateDrilling/LastTransition",
-        "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/LastTransition` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/LastTransition\")]"),
-        ("DrillingEndEffector/SkillSet/TemplateDrilling/Deletable",
-        "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/Deletable` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/Deletable\")]"),
-        ("DrillingEndEffector/SkillSet/TemplateDrilling/AutoDelete",
-        "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/AutoDelete` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/AutoDelete\")]"),
-        ("DrillingEndEffector/SkillSet/TemplateDrilling/RecycleCount",
-        "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/RecycleCount` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/RecycleCount\")]"),
-        ("DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/HoleDiameter",
-        "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/HoleDiameter` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/HoleDiameter\")]"),
-        ("DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/Depth",
-        "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/Depth` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/Depth\")]"),
-        ("DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/FeedRate",
-        "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/FeedRate` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/FeedRate\")]"),
-        ("DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/SpindleSpeed",
-        "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/SpindleSpeed` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/SpindleSpeed\")]"),
-        ("DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/ClampForce",
-        "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/ClampForce` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/ClampForce\")]"),
-        ("DrillingEndEffector/SkillSet/TemplateDrilling/OutputParameterSet/Result",
-        "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/OutputParameterSet/Result` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/OutputParameterSet/Result\")]")];
-        Identification__UIElement : ua::Variant, - 1, [1 "Identification", 1
-        "UIElement"], false false false; Lock__Locked : bool, - 1, [1 "Lock", 1
-        "Locked"], false false false; Lock__LockingClient : String, - 1, [1 "Lock", 1
-        "LockingClient"], false false false; Lock__LockingUser : String, - 1, [1 "Lock",
-        1 "LockingUser"], false false false; Lock__RemainingLockTime : f64, - 1, [1
-        "Lock", 1 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [1 "Manufacturer"], false false false; ManufacturerUri :
-        String, - 1, [1 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [1 "Model"], false false false; HardwareRevision : String, - 1, [1
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [1
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [1
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [1
-        "ProductCode"], false false false; DeviceManual : String, - 1, [1
-        "DeviceManual"], false false false; DeviceClass : String, - 1, [1 "DeviceClass"],
-        false false false; SerialNumber : String, - 1, [1 "SerialNumber"], false false
-        false; ProductInstanceUri : String, - 1, [1 "ProductInstanceUri"], false false
-        false; RevisionCounter : i32, - 1, [1 "RevisionCounter"], false false false;
-        AssetId : String, - 1, [1 "AssetId"], false false false; ComponentName :
-        ua::LocalizedText, - 1, [1 "ComponentName"], false false false;
-        MotionDeviceSystem__Identification__UIElement : ua::Variant, - 1, [0
-        "MotionDeviceSystem", 1 "Identification", 1 "UIElement"], false false false;
-        MotionDeviceSystem__Lock__Locked : bool, - 1, [0 "MotionDeviceSystem", 1 "Lock",
-        1 "Locked"], false false false; MotionDeviceSystem__Lock__LockingClient : String,
-        - 1, [0 "MotionDeviceSystem", 1 "Lock", 1 "LockingClient"], false false false;
-        MotionDeviceSystem__Lock__LockingUser : String, - 1, [0 "MotionDeviceSystem", 1
-        "Lock", 1 "LockingUser"], false false false;
-        MotionDeviceSystem__Lock__RemainingLockTime : f64, - 1, [0 "MotionDeviceSystem",
-        1 "Lock", 1 "RemainingLockTime"], false false false;
-        MotionDeviceSystem__Manufacturer : ua::LocalizedText, - 1, [0
-        "MotionDeviceSystem", 1 "Manufacturer"], false false false;
-        MotionDeviceSystem__ManufacturerUri : String, - 1, [0 "MotionDeviceSystem", 1
-        "ManufacturerUri"], false false false; MotionDeviceSystem__Model :
-        ua::LocalizedText, - 1, [0 "MotionDeviceSystem", 1 "Model"], false false false;
-        MotionDeviceSystem__HardwareRevision : String, - 1, [0 "MotionDeviceSystem", 1
-        "HardwareRevision"], false false false; MotionDeviceSystem__SoftwareRevision :
-        String, - 1, [0 "MotionDeviceSystem", 1 "SoftwareRevision"], false false false;
-        MotionDeviceSystem__DeviceRevision : String, - 1, [0 "MotionDeviceSystem", 1
-        "DeviceRevision"], false false false; MotionDeviceSystem__ProductCode : String, -
-        1, [0 "MotionDeviceSystem", 1 "ProductCode"], false false false;
-        MotionDeviceSystem__DeviceManual : String, - 1, [0 "MotionDeviceSystem", 1
-        "DeviceManual"], false false false; MotionDeviceSystem__DeviceClass : String, -
-        1, [0 "MotionDeviceSystem", 1 "DeviceClass"], false false false;
-        MotionDeviceSystem__SerialNumber : String, - 1, [0 "MotionDeviceSystem", 1
-        "SerialNumber"], false false false; MotionDeviceSystem__ProductInstanceUri :
-        String, - 1, [0 "MotionDeviceSystem", 1 "ProductInstanceUri"], false false false;
-        MotionDeviceSystem__RevisionCounter : i32, - 1, [0 "MotionDeviceSystem", 1
-        "RevisionCounter"], false false false; MotionDeviceSystem__AssetId : String, - 1,
-        [0 "MotionDeviceSystem", 1 "AssetId"], false false false;
-        MotionDeviceSystem__ComponentName : ua::LocalizedText, - 1, [0
-        "MotionDeviceSystem", 1 "ComponentName"], false false false;
-        DrillingEndEffector__Identification__UIElement : ua::Variant, - 1, [0
-        "DrillingEndEffector", 1 "Identification", 1 "UIElement"], false false false;
-        DrillingEndEffector__Lock__Locked : bool, - 1, [0 "DrillingEndEffector", 1
-        "Lock", 1 "Locked"], false false false; DrillingEndEffector__Lock__LockingClient
-        : String, - 1, [0 "DrillingEndEffector", 1 "Lock", 1 "LockingClient"], false
-        false false; DrillingEndEffector__Lock__LockingUser : String, - 1, [0
-        "DrillingEndEffector", 1 "Lock", 1 "LockingUser"], false false false;
-        DrillingEndEffector__Lock__RemainingLockTime : f64, - 1, [0
-        "DrillingEndEffector", 1 "Lock", 1 "RemainingLockTime"], false false false;
-        DrillingEndEffector__Manufacturer : ua::LocalizedText, - 1, [0
-        "DrillingEndEffector", 1 "Manufacturer"], true false false;
-        DrillingEndEffector__ManufacturerUri : String, - 1, [0 "DrillingEndEffector", 1
-        "ManufacturerUri"], false false false; DrillingEndEffector__Model :
-        ua::LocalizedText, - 1, [0 "DrillingEndEffector", 1 "Model"], true false false;
-        DrillingEndEffector__HardwareRevision : String, - 1, [0 "DrillingEndEffector", 1
-        "HardwareRevision"], false false false; DrillingEndEffector__SoftwareRevision :
-        String, - 1, [0 "DrillingEndEffector", 1 "SoftwareRevision"], false false false;
-        DrillingEndEffector__DeviceRevision : String, - 1, [0 "DrillingEndEffector", 1
-        "DeviceRevision"], false false false; DrillingEndEffector__ProductCode : String,
-        - 1, [0 "DrillingEndEffector", 1 "ProductCode"], false false false;
-        DrillingEndEffector__DeviceManual : String, - 1, [0 "DrillingEndEffector", 1
-        "DeviceManual"], false false false; DrillingEndEffector__DeviceClass : String, -
-        1, [0 "DrillingEndEffector", 1 "DeviceClass"], false false false;
-        DrillingEndEffector__SerialNumber : String, - 1, [0 "DrillingEndEffector", 1
-        "SerialNumber"], true false false; DrillingEndEffector__ProductInstanceUri :
-        String, - 1, [0 "DrillingEndEffector", 1 "ProductInstanceUri"], false false
-        false; DrillingEndEffector__RevisionCounter : i32, - 1, [0 "DrillingEndEffector",
-        1 "RevisionCounter"], false false false; DrillingEndEffector__AssetId : String, -
-        1, [0 "DrillingEndEffector", 1 "AssetId"], false false false;
-        DrillingEndEffector__ComponentName : ua::LocalizedText, - 1, [0
-        "DrillingEndEffector", 1 "ComponentName"], false false false;
-        DrillingEndEffector__SkillSet__TemplateDrilling__CurrentState :
-        ua::LocalizedText, - 1, [0 "DrillingEndEffector", 2 "SkillSet", 0
-        "TemplateDrilling", 3 "CurrentState"], true false false;
-        DrillingEndEffector__SkillSet__TemplateDrilling__LastTransition :
-        ua::LocalizedText, - 1, [0 "DrillingEndEffector", 2 "SkillSet", 0
-        "TemplateDrilling", 3 "LastTransition"], true false false;
-        DrillingEndEffector__SkillSet__TemplateDrilling__AvailableStates : ua::NodeId, 1,
-        [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 3
-        "AvailableStates"], false false false;
-        DrillingEndEffector__SkillSet__TemplateDrilling__AvailableTransitions :
-        ua::NodeId, 1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 3
-        "AvailableTransitions"], false false false;
-        DrillingEndEffector__SkillSet__TemplateDrilling__Deletable : bool, - 1, [0
-        "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 3 "Deletable"], true
-        false false; DrillingEndEffector__SkillSet__TemplateDrilling__AutoDelete : bool,
-        - 1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 3
-        "AutoDelete"], true false false;
-        DrillingEndEffector__SkillSet__TemplateDrilling__RecycleCount : i32, - 1, [0
-        "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 3 "RecycleCount"],
-        true false false;
-        DrillingEndEffector__SkillSet__TemplateDrilling__ProgramDiagnostic :
-        ua::ExtensionObject, - 1, [0 "DrillingEndEffector", 2 "SkillSet", 0
-        "TemplateDrilling", 3 "ProgramDiagnostic"], false false false;
-        DrillingEndEffector__SkillSet__TemplateDrilling__InputParameterSet__HoleDiameter
-        : f64, - 1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 2
-        "InputParameterSet", 0 "HoleDiameter"], true false true;
-        DrillingEndEffector__SkillSet__TemplateDrilling__InputParameterSet__Depth : f64,
-        - 1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 2
-        "InputParameterSet", 0 "Depth"], true false true;
-        DrillingEndEffector__SkillSet__TemplateDrilling__InputParameterSet__FeedRate :
-        f64, - 1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 2
-        "InputParameterSet", 0 "FeedRate"], true false true;
-        DrillingEndEffector__SkillSet__TemplateDrilling__InputParameterSet__SpindleSpeed
-        : f64, - 1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 2
-        "InputParameterSet", 0 "SpindleSpeed"], true false true;
-        DrillingEndEffector__SkillSet__TemplateDrilling__InputParameterSet__ClampForce :
-        f64, - 1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 2
-        "InputParameterSet", 0 "ClampForce"], true false true;
-        DrillingEndEffector__SkillSet__TemplateDrilling__OutputParameterSet__Result :
-        ua::StatusCode, - 1, [0 "DrillingEndEffector", 2 "SkillSet", 0
-        "TemplateDrilling", 2 "OutputParameterSet", 2 "Result"], true false false;
+        TemplateDrillingLwrSystemType;
+        required: [
+            ("DrillingEndEffector/Manufacturer", "the mandatory variable `DrillingEndEffector/Manufacturer` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/Manufacturer\")]"),
+            ("DrillingEndEffector/Model", "the mandatory variable `DrillingEndEffector/Model` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/Model\")]"),
+            ("DrillingEndEffector/SerialNumber", "the mandatory variable `DrillingEndEffector/SerialNumber` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SerialNumber\")]"),
+            ("DrillingEndEffector/SkillSet/TemplateDrilling/CurrentState", "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/CurrentState` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/CurrentState\")]"),
+            ("DrillingEndEffector/SkillSet/TemplateDrilling/LastTransition", "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/LastTransition` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/LastTransition\")]"),
+            ("DrillingEndEffector/SkillSet/TemplateDrilling/Deletable", "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/Deletable` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/Deletable\")]"),
+            ("DrillingEndEffector/SkillSet/TemplateDrilling/AutoDelete", "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/AutoDelete` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/AutoDelete\")]"),
+            ("DrillingEndEffector/SkillSet/TemplateDrilling/RecycleCount", "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/RecycleCount` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/RecycleCount\")]"),
+            ("DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/HoleDiameter", "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/HoleDiameter` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/HoleDiameter\")]"),
+            ("DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/Depth", "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/Depth` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/Depth\")]"),
+            ("DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/FeedRate", "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/FeedRate` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/FeedRate\")]"),
+            ("DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/SpindleSpeed", "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/SpindleSpeed` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/SpindleSpeed\")]"),
+            ("DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/ClampForce", "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/ClampForce` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/ClampForce\")]"),
+            ("DrillingEndEffector/SkillSet/TemplateDrilling/OutputParameterSet/Result", "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/OutputParameterSet/Result` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/OutputParameterSet/Result\")]"),
+        ];
+        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
+        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
+        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [1 "ProductCode"], false false false;
+        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
+        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
+        AssetId: String, -1, [1 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
+        MotionDeviceSystem__Identification__UIElement: ua::Variant, -1, [0 "MotionDeviceSystem", 1 "Identification", 1 "UIElement"], false false false;
+        MotionDeviceSystem__Lock__Locked: bool, -1, [0 "MotionDeviceSystem", 1 "Lock", 1 "Locked"], false false false;
+        MotionDeviceSystem__Lock__LockingClient: String, -1, [0 "MotionDeviceSystem", 1 "Lock", 1 "LockingClient"], false false false;
+        MotionDeviceSystem__Lock__LockingUser: String, -1, [0 "MotionDeviceSystem", 1 "Lock", 1 "LockingUser"], false false false;
+        MotionDeviceSystem__Lock__RemainingLockTime: f64, -1, [0 "MotionDeviceSystem", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        MotionDeviceSystem__Manufacturer: ua::LocalizedText, -1, [0 "MotionDeviceSystem", 1 "Manufacturer"], false false false;
+        MotionDeviceSystem__ManufacturerUri: String, -1, [0 "MotionDeviceSystem", 1 "ManufacturerUri"], false false false;
+        MotionDeviceSystem__Model: ua::LocalizedText, -1, [0 "MotionDeviceSystem", 1 "Model"], false false false;
+        MotionDeviceSystem__HardwareRevision: String, -1, [0 "MotionDeviceSystem", 1 "HardwareRevision"], false false false;
+        MotionDeviceSystem__SoftwareRevision: String, -1, [0 "MotionDeviceSystem", 1 "SoftwareRevision"], false false false;
+        MotionDeviceSystem__DeviceRevision: String, -1, [0 "MotionDeviceSystem", 1 "DeviceRevision"], false false false;
+        MotionDeviceSystem__ProductCode: String, -1, [0 "MotionDeviceSystem", 1 "ProductCode"], false false false;
+        MotionDeviceSystem__DeviceManual: String, -1, [0 "MotionDeviceSystem", 1 "DeviceManual"], false false false;
+        MotionDeviceSystem__DeviceClass: String, -1, [0 "MotionDeviceSystem", 1 "DeviceClass"], false false false;
+        MotionDeviceSystem__SerialNumber: String, -1, [0 "MotionDeviceSystem", 1 "SerialNumber"], false false false;
+        MotionDeviceSystem__ProductInstanceUri: String, -1, [0 "MotionDeviceSystem", 1 "ProductInstanceUri"], false false false;
+        MotionDeviceSystem__RevisionCounter: i32, -1, [0 "MotionDeviceSystem", 1 "RevisionCounter"], false false false;
+        MotionDeviceSystem__AssetId: String, -1, [0 "MotionDeviceSystem", 1 "AssetId"], false false false;
+        MotionDeviceSystem__ComponentName: ua::LocalizedText, -1, [0 "MotionDeviceSystem", 1 "ComponentName"], false false false;
+        DrillingEndEffector__Identification__UIElement: ua::Variant, -1, [0 "DrillingEndEffector", 1 "Identification", 1 "UIElement"], false false false;
+        DrillingEndEffector__Lock__Locked: bool, -1, [0 "DrillingEndEffector", 1 "Lock", 1 "Locked"], false false false;
+        DrillingEndEffector__Lock__LockingClient: String, -1, [0 "DrillingEndEffector", 1 "Lock", 1 "LockingClient"], false false false;
+        DrillingEndEffector__Lock__LockingUser: String, -1, [0 "DrillingEndEffector", 1 "Lock", 1 "LockingUser"], false false false;
+        DrillingEndEffector__Lock__RemainingLockTime: f64, -1, [0 "DrillingEndEffector", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        DrillingEndEffector__Manufacturer: ua::LocalizedText, -1, [0 "DrillingEndEffector", 1 "Manufacturer"], true false false;
+        DrillingEndEffector__ManufacturerUri: String, -1, [0 "DrillingEndEffector", 1 "ManufacturerUri"], false false false;
+        DrillingEndEffector__Model: ua::LocalizedText, -1, [0 "DrillingEndEffector", 1 "Model"], true false false;
+        DrillingEndEffector__HardwareRevision: String, -1, [0 "DrillingEndEffector", 1 "HardwareRevision"], false false false;
+        DrillingEndEffector__SoftwareRevision: String, -1, [0 "DrillingEndEffector", 1 "SoftwareRevision"], false false false;
+        DrillingEndEffector__DeviceRevision: String, -1, [0 "DrillingEndEffector", 1 "DeviceRevision"], false false false;
+        DrillingEndEffector__ProductCode: String, -1, [0 "DrillingEndEffector", 1 "ProductCode"], false false false;
+        DrillingEndEffector__DeviceManual: String, -1, [0 "DrillingEndEffector", 1 "DeviceManual"], false false false;
+        DrillingEndEffector__DeviceClass: String, -1, [0 "DrillingEndEffector", 1 "DeviceClass"], false false false;
+        DrillingEndEffector__SerialNumber: String, -1, [0 "DrillingEndEffector", 1 "SerialNumber"], true false false;
+        DrillingEndEffector__ProductInstanceUri: String, -1, [0 "DrillingEndEffector", 1 "ProductInstanceUri"], false false false;
+        DrillingEndEffector__RevisionCounter: i32, -1, [0 "DrillingEndEffector", 1 "RevisionCounter"], false false false;
+        DrillingEndEffector__AssetId: String, -1, [0 "DrillingEndEffector", 1 "AssetId"], false false false;
+        DrillingEndEffector__ComponentName: ua::LocalizedText, -1, [0 "DrillingEndEffector", 1 "ComponentName"], false false false;
+        DrillingEndEffector__SkillSet__TemplateDrilling__CurrentState: ua::LocalizedText, -1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 3 "CurrentState"], true false false;
+        DrillingEndEffector__SkillSet__TemplateDrilling__LastTransition: ua::LocalizedText, -1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 3 "LastTransition"], true false false;
+        DrillingEndEffector__SkillSet__TemplateDrilling__AvailableStates: ua::NodeId, 1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 3 "AvailableStates"], false false false;
+        DrillingEndEffector__SkillSet__TemplateDrilling__AvailableTransitions: ua::NodeId, 1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 3 "AvailableTransitions"], false false false;
+        DrillingEndEffector__SkillSet__TemplateDrilling__Deletable: bool, -1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 3 "Deletable"], true false false;
+        DrillingEndEffector__SkillSet__TemplateDrilling__AutoDelete: bool, -1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 3 "AutoDelete"], true false false;
+        DrillingEndEffector__SkillSet__TemplateDrilling__RecycleCount: i32, -1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 3 "RecycleCount"], true false false;
+        DrillingEndEffector__SkillSet__TemplateDrilling__ProgramDiagnostic: ua::ExtensionObject, -1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 3 "ProgramDiagnostic"], false false false;
+        DrillingEndEffector__SkillSet__TemplateDrilling__InputParameterSet__HoleDiameter: f64, -1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 2 "InputParameterSet", 0 "HoleDiameter"], true false true;
+        DrillingEndEffector__SkillSet__TemplateDrilling__InputParameterSet__Depth: f64, -1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 2 "InputParameterSet", 0 "Depth"], true false true;
+        DrillingEndEffector__SkillSet__TemplateDrilling__InputParameterSet__FeedRate: f64, -1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 2 "InputParameterSet", 0 "FeedRate"], true false true;
+        DrillingEndEffector__SkillSet__TemplateDrilling__InputParameterSet__SpindleSpeed: f64, -1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 2 "InputParameterSet", 0 "SpindleSpeed"], true false true;
+        DrillingEndEffector__SkillSet__TemplateDrilling__InputParameterSet__ClampForce: f64, -1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 2 "InputParameterSet", 0 "ClampForce"], true false true;
+        DrillingEndEffector__SkillSet__TemplateDrilling__OutputParameterSet__Result: ua::StatusCode, -1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 2 "OutputParameterSet", 2 "Result"], true false false;
     }
     t::object_members! {
-        TemplateDrillingSkillType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("Deletable",
-        "the mandatory variable `Deletable` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
-        ("AutoDelete",
-        "the mandatory variable `AutoDelete` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
-        ("RecycleCount",
-        "the mandatory variable `RecycleCount` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
-        ("InputParameterSet/HoleDiameter",
-        "the mandatory variable `InputParameterSet/HoleDiameter` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/HoleDiameter\")]"),
-        ("InputParameterSet/Depth",
-        "the mandatory variable `InputParameterSet/Depth` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Depth\")]"),
-        ("InputParameterSet/FeedRate",
-        "the mandatory variable `InputParameterSet/FeedRate` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/FeedRate\")]"),
-        ("InputParameterSet/SpindleSpeed",
-        "the mandatory variable `InputParameterSet/SpindleSpeed` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/SpindleSpeed\")]"),
-        ("InputParameterSet/ClampForce",
-        "the mandatory variable `InputParameterSet/ClampForce` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/ClampForce\")]"),
-        ("OutputParameterSet/Result",
-        "the mandatory variable `OutputParameterSet/Result` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]")];
-        CurrentState : ua::LocalizedText, - 1, [3 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [3 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [3 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [3 "AvailableTransitions"], false false
-        false; Deletable : bool, - 1, [3 "Deletable"], true false false; AutoDelete :
-        bool, - 1, [3 "AutoDelete"], true false false; RecycleCount : i32, - 1, [3
-        "RecycleCount"], true false false; ProgramDiagnostic : ua::ExtensionObject, - 1,
-        [3 "ProgramDiagnostic"], false false false; InputParameterSet__HoleDiameter :
-        f64, - 1, [2 "InputParameterSet", 0 "HoleDiameter"], true false true;
-        InputParameterSet__Depth : f64, - 1, [2 "InputParameterSet", 0 "Depth"], true
-        false true; InputParameterSet__FeedRate : f64, - 1, [2 "InputParameterSet", 0
-        "FeedRate"], true false true; InputParameterSet__SpindleSpeed : f64, - 1, [2
-        "InputParameterSet", 0 "SpindleSpeed"], true false true;
-        InputParameterSet__ClampForce : f64, - 1, [2 "InputParameterSet", 0
-        "ClampForce"], true false true; OutputParameterSet__Result : ua::StatusCode, - 1,
-        [2 "OutputParameterSet", 2 "Result"], true false false;
+        TemplateDrillingSkillType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("Deletable", "the mandatory variable `Deletable` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Deletable\")]"),
+            ("AutoDelete", "the mandatory variable `AutoDelete` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AutoDelete\")]"),
+            ("RecycleCount", "the mandatory variable `RecycleCount` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
+            ("InputParameterSet/HoleDiameter", "the mandatory variable `InputParameterSet/HoleDiameter` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/HoleDiameter\")]"),
+            ("InputParameterSet/Depth", "the mandatory variable `InputParameterSet/Depth` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Depth\")]"),
+            ("InputParameterSet/FeedRate", "the mandatory variable `InputParameterSet/FeedRate` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/FeedRate\")]"),
+            ("InputParameterSet/SpindleSpeed", "the mandatory variable `InputParameterSet/SpindleSpeed` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/SpindleSpeed\")]"),
+            ("InputParameterSet/ClampForce", "the mandatory variable `InputParameterSet/ClampForce` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/ClampForce\")]"),
+            ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [3 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [3 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [3 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [3 "AvailableTransitions"], false false false;
+        Deletable: bool, -1, [3 "Deletable"], true false false;
+        AutoDelete: bool, -1, [3 "AutoDelete"], true false false;
+        RecycleCount: i32, -1, [3 "RecycleCount"], true false false;
+        ProgramDiagnostic: ua::ExtensionObject, -1, [3 "ProgramDiagnostic"], false false false;
+        InputParameterSet__HoleDiameter: f64, -1, [2 "InputParameterSet", 0 "HoleDiameter"], true false true;
+        InputParameterSet__Depth: f64, -1, [2 "InputParameterSet", 0 "Depth"], true false true;
+        InputParameterSet__FeedRate: f64, -1, [2 "InputParameterSet", 0 "FeedRate"], true false true;
+        InputParameterSet__SpindleSpeed: f64, -1, [2 "InputParameterSet", 0 "SpindleSpeed"], true false true;
+        InputParameterSet__ClampForce: f64, -1, [2 "InputParameterSet", 0 "ClampForce"], true false true;
+        OutputParameterSet__Result: ua::StatusCode, -1, [2 "OutputParameterSet", 2 "Result"], true false false;
     }
     t::object_members! {
-        Ur10eSystemType; required : [("Controllers/URController/ProductCode",
-        "the mandatory variable `Controllers/URController/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/ProductCode\")]"),
-        ("Controllers/URController/SerialNumber",
-        "the mandatory variable `Controllers/URController/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SerialNumber\")]"),
-        ("Controllers/URController/CurrentUser/Level",
-        "the mandatory variable `Controllers/URController/CurrentUser/Level` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/CurrentUser/Level\")]"),
-        ("Controllers/URController/Software/PolyScope/SoftwareRevision",
-        "the mandatory variable `Controllers/URController/Software/PolyScope/SoftwareRevision` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/Software/PolyScope/SoftwareRevision\")]"),
-        ("Controllers/URController/TaskControls/ProgramTask/ParameterSet/TaskProgramLoaded",
-        "the mandatory variable `Controllers/URController/TaskControls/ProgramTask/ParameterSet/TaskProgramLoaded` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/TaskControls/ProgramTask/ParameterSet/TaskProgramLoaded\")]"),
-        ("Controllers/URController/TaskControls/ProgramTask/ParameterSet/TaskProgramName",
-        "the mandatory variable `Controllers/URController/TaskControls/ProgramTask/ParameterSet/TaskProgramName` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/TaskControls/ProgramTask/ParameterSet/TaskProgramName\")]"),
-        ("Controllers/URController/TaskControls/ProgramTask/ComponentName",
-        "the mandatory variable `Controllers/URController/TaskControls/ProgramTask/ComponentName` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/TaskControls/ProgramTask/ComponentName\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/CurrentState",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/CurrentState` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/CurrentState\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/LastTransition",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/LastTransition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/LastTransition\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/Deletable",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/Deletable` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/Deletable\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/AutoDelete",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/AutoDelete` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/AutoDelete\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/RecycleCount",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/RecycleCount` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/RecycleCount\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/Speed",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/Speed` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/Speed\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/Acceleration",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/Acceleration` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/Acceleration\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/TargetJointPositions",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/TargetJointPositions` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/TargetJointPositions\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/OutputParameterSet/Result",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/OutputParameterSet/Result` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/OutputParameterSet/Result\")]"),
-        ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/CurrentState",
-        "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/CurrentState` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/CurrentState\")]"),
-        ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/LastTransition",
-        "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/LastTransition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/LastTransition\")]"),
-        ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/Deletable",
-        "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/Deletable` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/Deletable\")]"),
-        ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/AutoDelete",
-        "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/AutoDelete` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/AutoDelete\")]"),
-        ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/RecycleCount",
-        "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/RecycleCount` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/RecycleCount\")]"),
-        ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/Speed",
-        "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/Speed` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/Speed\")]"),
-        ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/Acceleration",
-        "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/Acceleration` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/Acceleration\")]"),
-        ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/PoseOffset",
-        "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/PoseOffset` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/PoseOffset\")]"),
-        ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/OutputParameterSet/Result",
-        "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/OutputParameterSet/Result` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/OutputParameterSet/Result\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/CurrentState",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/CurrentState` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/CurrentState\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/LastTransition",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/LastTransition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/LastTransition\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/Deletable",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/Deletable` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/Deletable\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/AutoDelete",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/AutoDelete` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/AutoDelete\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/RecycleCount",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/RecycleCount` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/RecycleCount\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/Speed",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/Speed` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/Speed\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/Acceleration",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/Acceleration` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/Acceleration\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/TargetPose",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/TargetPose` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/TargetPose\")]"),
-        ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/OutputParameterSet/Result",
-        "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/OutputParameterSet/Result` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/OutputParameterSet/Result\")]"),
-        ("MotionDevices/Manipulator/ParameterSet/SpeedOverride",
-        "the mandatory variable `MotionDevices/Manipulator/ParameterSet/SpeedOverride` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/ParameterSet/SpeedOverride\")]"),
-        ("MotionDevices/Manipulator/ProductCode",
-        "the mandatory variable `MotionDevices/Manipulator/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/ProductCode\")]"),
-        ("MotionDevices/Manipulator/SerialNumber",
-        "the mandatory variable `MotionDevices/Manipulator/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/SerialNumber\")]"),
-        ("MotionDevices/Manipulator/Axes/Base/ParameterSet/ActualPosition",
-        "the mandatory variable `MotionDevices/Manipulator/Axes/Base/ParameterSet/ActualPosition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/Axes/Base/ParameterSet/ActualPosition\")]"),
-        ("MotionDevices/Manipulator/Axes/Shoulder/ParameterSet/ActualPosition",
-        "the mandatory variable `MotionDevices/Manipulator/Axes/Shoulder/ParameterSet/ActualPosition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/Axes/Shoulder/ParameterSet/ActualPosition\")]"),
-        ("MotionDevices/Manipulator/Axes/Elbow/ParameterSet/ActualPosition",
-        "the mandatory variable `MotionDevices/Manipulator/Axes/Elbow/ParameterSet/ActualPosition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/Axes/Elbow/ParameterSet/ActualPosition\")]"),
-        ("MotionDevices/Manipulator/Axes/Wrist1/ParameterSet/ActualPosition",
-        "the mandatory variable `MotionDevices/Manipulator/Axes/Wrist1/ParameterSet/ActualPosition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/Axes/Wrist1/ParameterSet/ActualPosition\")]"),
-        ("MotionDevices/Manipulator/Axes/Wrist2/ParameterSet/ActualPosition",
-        "the mandatory variable `MotionDevices/Manipulator/Axes/Wrist2/ParameterSet/ActualPosition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/Axes/Wrist2/ParameterSet/ActualPosition\")]"),
-        ("MotionDevices/Manipulator/Axes/Wrist3/ParameterSet/ActualPosition",
-        "the mandatory variable `MotionDevices/Manipulator/Axes/Wrist3/ParameterSet/ActualPosition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/Axes/Wrist3/ParameterSet/ActualPosition\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/Model",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/Model` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/Model\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/ProductCode",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/ProductCode\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/SerialNumber",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/SerialNumber\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/Model",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/Model` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/Model\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/ProductCode",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/ProductCode\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/SerialNumber",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/SerialNumber\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/Model",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/Model` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/Model\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/ProductCode",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/ProductCode\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/SerialNumber",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/SerialNumber\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/Model",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/Model` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/Model\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/ProductCode",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/ProductCode\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/SerialNumber",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/SerialNumber\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/Model",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/Model` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/Model\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/ProductCode",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/ProductCode\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/SerialNumber",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/SerialNumber\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/Model",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/Model` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/Model\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/ProductCode",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/ProductCode\")]"),
-        ("MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/SerialNumber",
-        "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/SerialNumber\")]"),
-        ("SafetyStates/SafetyState/ParameterSet/EmergencyStop",
-        "the mandatory variable `SafetyStates/SafetyState/ParameterSet/EmergencyStop` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SafetyStates/SafetyState/ParameterSet/EmergencyStop\")]"),
-        ("SafetyStates/SafetyState/ParameterSet/OperationalMode",
-        "the mandatory variable `SafetyStates/SafetyState/ParameterSet/OperationalMode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SafetyStates/SafetyState/ParameterSet/OperationalMode\")]"),
-        ("SafetyStates/SafetyState/ParameterSet/ProtectiveStop",
-        "the mandatory variable `SafetyStates/SafetyState/ParameterSet/ProtectiveStop` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SafetyStates/SafetyState/ParameterSet/ProtectiveStop\")]")];
-        Identification__UIElement : ua::Variant, - 1, [1 "Identification", 1
-        "UIElement"], false false false; Lock__Locked : bool, - 1, [1 "Lock", 1
-        "Locked"], false false false; Lock__LockingClient : String, - 1, [1 "Lock", 1
-        "LockingClient"], false false false; Lock__LockingUser : String, - 1, [1 "Lock",
-        1 "LockingUser"], false false false; Lock__RemainingLockTime : f64, - 1, [1
-        "Lock", 1 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [1 "Manufacturer"], false false false; ManufacturerUri :
-        String, - 1, [1 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [1 "Model"], false false false; HardwareRevision : String, - 1, [1
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [1
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [1
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [1
-        "ProductCode"], false false false; DeviceManual : String, - 1, [1
-        "DeviceManual"], false false false; DeviceClass : String, - 1, [1 "DeviceClass"],
-        false false false; SerialNumber : String, - 1, [1 "SerialNumber"], false false
-        false; ProductInstanceUri : String, - 1, [1 "ProductInstanceUri"], false false
-        false; RevisionCounter : i32, - 1, [1 "RevisionCounter"], false false false;
-        AssetId : String, - 1, [1 "AssetId"], false false false; ComponentName :
-        ua::LocalizedText, - 1, [1 "ComponentName"], false false false;
-        Controllers__URController__ParameterSet__CabinetFanSpeed : f64, - 1, [4
-        "Controllers", 0 "URController", 1 "ParameterSet", 4 "CabinetFanSpeed"], false
-        false false; Controllers__URController__ParameterSet__CPUFanSpeed : f64, - 1, [4
-        "Controllers", 0 "URController", 1 "ParameterSet", 4 "CPUFanSpeed"], false false
-        false; Controllers__URController__ParameterSet__InputVoltage : f64, - 1, [4
-        "Controllers", 0 "URController", 1 "ParameterSet", 4 "InputVoltage"], false false
-        false; Controllers__URController__ParameterSet__StartUpTime : ua::DateTime, - 1,
-        [4 "Controllers", 0 "URController", 1 "ParameterSet", 4 "StartUpTime"], false
-        false false; Controllers__URController__ParameterSet__Temperature : f64, - 1, [4
-        "Controllers", 0 "URController", 1 "ParameterSet", 4 "Temperature"], false false
-        false; Controllers__URController__ParameterSet__TotalEnergyConsumption : f64, -
-        1, [4 "Controllers", 0 "URController", 1 "ParameterSet", 4
-        "TotalEnergyConsumption"], false false false;
-        Controllers__URController__ParameterSet__TotalPowerOnTime : String, - 1, [4
-        "Controllers", 0 "URController", 1 "ParameterSet", 4 "TotalPowerOnTime"], false
-        false false; Controllers__URController__ParameterSet__UpsState : String, - 1, [4
-        "Controllers", 0 "URController", 1 "ParameterSet", 4 "UpsState"], false false
-        false; Controllers__URController__Identification__UIElement : ua::Variant, - 1,
-        [4 "Controllers", 0 "URController", 1 "Identification", 1 "UIElement"], false
-        false false; Controllers__URController__Lock__Locked : bool, - 1, [4
-        "Controllers", 0 "URController", 1 "Lock", 1 "Locked"], false false false;
-        Controllers__URController__Lock__LockingClient : String, - 1, [4 "Controllers", 0
-        "URController", 1 "Lock", 1 "LockingClient"], false false false;
-        Controllers__URController__Lock__LockingUser : String, - 1, [4 "Controllers", 0
-        "URController", 1 "Lock", 1 "LockingUser"], false false false;
-        Controllers__URController__Lock__RemainingLockTime : f64, - 1, [4 "Controllers",
-        0 "URController", 1 "Lock", 1 "RemainingLockTime"], false false false;
-        Controllers__URController__Manufacturer : ua::LocalizedText, - 1, [4
-        "Controllers", 0 "URController", 1 "Manufacturer"], true true false;
-        Controllers__URController__ManufacturerUri : String, - 1, [4 "Controllers", 0
-        "URController", 1 "ManufacturerUri"], false false false;
-        Controllers__URController__Model : ua::LocalizedText, - 1, [4 "Controllers", 0
-        "URController", 1 "Model"], true true false;
-        Controllers__URController__HardwareRevision : String, - 1, [4 "Controllers", 0
-        "URController", 1 "HardwareRevision"], false false false;
-        Controllers__URController__SoftwareRevision : String, - 1, [4 "Controllers", 0
-        "URController", 1 "SoftwareRevision"], false false false;
-        Controllers__URController__DeviceRevision : String, - 1, [4 "Controllers", 0
-        "URController", 1 "DeviceRevision"], false false false;
-        Controllers__URController__ProductCode : String, - 1, [4 "Controllers", 0
-        "URController", 1 "ProductCode"], true false false;
-        Controllers__URController__DeviceManual : String, - 1, [4 "Controllers", 0
-        "URController", 1 "DeviceManual"], false false false;
-        Controllers__URController__DeviceClass : String, - 1, [4 "Controllers", 0
-        "URController", 1 "DeviceClass"], false false false;
-        Controllers__URController__SerialNumber : String, - 1, [4 "Controllers", 0
-        "URController", 1 "SerialNumber"], true false false;
-        Controllers__URController__ProductInstanceUri : String, - 1, [4 "Controllers", 0
-        "URController", 1 "ProductInstanceUri"], false false false;
-        Controllers__URController__RevisionCounter : i32, - 1, [4 "Controllers", 0
-        "URController", 1 "RevisionCounter"], false false false;
-        Controllers__URController__AssetId : String, - 1, [4 "Controllers", 0
-        "URController", 1 "AssetId"], false false false;
-        Controllers__URController__ComponentName : ua::LocalizedText, - 1, [4
-        "Controllers", 0 "URController", 1 "ComponentName"], false false false;
-        Controllers__URController__CurrentUser__Level : String, - 1, [4 "Controllers", 0
-        "URController", 4 "CurrentUser", 4 "Level"], true false false;
-        Controllers__URController__CurrentUser__Name : String, - 1, [4 "Controllers", 0
-        "URController", 4 "CurrentUser", 4 "Name"], false false false;
-        Controllers__URController__Software__PolyScope__Identification__UIElement :
-        ua::Variant, - 1, [4 "Controllers", 0 "URController", 4 "Software", 0
-        "PolyScope", 1 "Identification", 1 "UIElement"], false false false;
-        Controllers__URController__Software__PolyScope__Lock__Locked : bool, - 1, [4
-        "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "Lock", 1
-        "Locked"], false false false;
-        Controllers__URController__Software__PolyScope__Lock__LockingClient : String, -
-        1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "Lock", 1
-        "LockingClient"], false false false;
-        Controllers__URController__Software__PolyScope__Lock__LockingUser : String, - 1,
-        [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "Lock", 1
-        "LockingUser"], false false false;
-        Controllers__URController__Software__PolyScope__Lock__RemainingLockTime : f64, -
-        1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "Lock", 1
-        "RemainingLockTime"], false false false;
-        Controllers__URController__Software__PolyScope__Manufacturer : ua::LocalizedText,
-        - 1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1
-        "Manufacturer"], true true false;
-        Controllers__URController__Software__PolyScope__ManufacturerUri : String, - 1, [4
-        "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1
-        "ManufacturerUri"], false false false;
-        Controllers__URController__Software__PolyScope__Model : ua::LocalizedText, - 1,
-        [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "Model"], true
-        true false; Controllers__URController__Software__PolyScope__HardwareRevision :
-        String, - 1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1
-        "HardwareRevision"], false false false;
-        Controllers__URController__Software__PolyScope__SoftwareRevision : String, - 1,
-        [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1
-        "SoftwareRevision"], true false false;
-        Controllers__URController__Software__PolyScope__DeviceRevision : String, - 1, [4
-        "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1
-        "DeviceRevision"], false false false;
-        Controllers__URController__Software__PolyScope__ProductCode : String, - 1, [4
-        "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "ProductCode"],
-        false false false; Controllers__URController__Software__PolyScope__DeviceManual :
-        String, - 1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1
-        "DeviceManual"], false false false;
-        Controllers__URController__Software__PolyScope__DeviceClass : String, - 1, [4
-        "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "DeviceClass"],
-        false false false; Controllers__URController__Software__PolyScope__SerialNumber :
-        String, - 1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1
-        "SerialNumber"], false false false;
-        Controllers__URController__Software__PolyScope__ProductInstanceUri : String, - 1,
-        [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1
-        "ProductInstanceUri"], false false false;
-        Controllers__URController__Software__PolyScope__RevisionCounter : i32, - 1, [4
-        "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1
-        "RevisionCounter"], false false false;
-        Controllers__URController__Software__PolyScope__AssetId : String, - 1, [4
-        "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "AssetId"], false
-        false false; Controllers__URController__Software__PolyScope__ComponentName :
-        ua::LocalizedText, - 1, [4 "Controllers", 0 "URController", 4 "Software", 0
-        "PolyScope", 1 "ComponentName"], false false false;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__CurrentState
-        : ua::LocalizedText, - 1, [4 "Controllers", 0 "URController", 4
-        "SystemOperation", 4 "SystemOperationStateMachine", 3 "CurrentState"], false
-        false false;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__LastTransition
-        : ua::LocalizedText, - 1, [4 "Controllers", 0 "URController", 4
-        "SystemOperation", 4 "SystemOperationStateMachine", 3 "LastTransition"], false
-        false false;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__AvailableStates
-        : ua::NodeId, 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4
-        "SystemOperationStateMachine", 3 "AvailableStates"], false false false;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__AvailableTransitions
-        : ua::NodeId, 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4
-        "SystemOperationStateMachine", 3 "AvailableTransitions"], false false false;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__ConfiguredDefaultStopMode
-        : i16, - 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4
-        "SystemOperationStateMachine", 4 "ConfiguredDefaultStopMode"], false false true;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__LastTransitionReason
-        : i16, - 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4
-        "SystemOperationStateMachine", 4 "LastTransitionReason"], false false true;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__PossibleStopModes
-        : ua::EnumValueType, 1, [4 "Controllers", 0 "URController", 4 "SystemOperation",
-        4 "SystemOperationStateMachine", 4 "PossibleStopModes"], false true true;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__CurrentState
-        : ua::LocalizedText, - 1, [4 "Controllers", 0 "URController", 4
-        "SystemOperation", 4 "SystemOperationStateMachine", 4 "ExecutingSubstateMachine",
-        3 "CurrentState"], false false false;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__LastTransition
-        : ua::LocalizedText, - 1, [4 "Controllers", 0 "URController", 4
-        "SystemOperation", 4 "SystemOperationStateMachine", 4 "ExecutingSubstateMachine",
-        3 "LastTransition"], false false false;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__AvailableStates
-        : ua::NodeId, 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4
-        "SystemOperationStateMachine", 4 "ExecutingSubstateMachine", 3
-        "AvailableStates"], false false false;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__AvailableTransitions
-        : ua::NodeId, 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4
-        "SystemOperationStateMachine", 4 "ExecutingSubstateMachine", 3
-        "AvailableTransitions"], false false false;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__LastTransitionReason
-        : i16, - 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4
-        "SystemOperationStateMachine", 4 "ExecutingSubstateMachine", 4
-        "LastTransitionReason"], false false true;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__CurrentState
-        : ua::LocalizedText, - 1, [4 "Controllers", 0 "URController", 4
-        "SystemOperation", 4 "SystemOperationStateMachine", 4 "IdleSubstateMachine", 3
-        "CurrentState"], false false false;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__LastTransition
-        : ua::LocalizedText, - 1, [4 "Controllers", 0 "URController", 4
-        "SystemOperation", 4 "SystemOperationStateMachine", 4 "IdleSubstateMachine", 3
-        "LastTransition"], false false false;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__AvailableStates
-        : ua::NodeId, 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4
-        "SystemOperationStateMachine", 4 "IdleSubstateMachine", 3 "AvailableStates"],
-        false false false;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__AvailableTransitions
-        : ua::NodeId, 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4
-        "SystemOperationStateMachine", 4 "IdleSubstateMachine", 3
-        "AvailableTransitions"], false false false;
-        Controllers__URController__SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__LastTransitionReason
-        : i16, - 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4
-        "SystemOperationStateMachine", 4 "IdleSubstateMachine", 4
-        "LastTransitionReason"], false false true;
-        Controllers__URController__TaskControls__ProgramTask__ParameterSet__TaskProgramLoaded
-        : bool, - 1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0
-        "ProgramTask", 1 "ParameterSet", 4 "TaskProgramLoaded"], true false false;
-        Controllers__URController__TaskControls__ProgramTask__ParameterSet__TaskProgramName
-        : String, - 1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0
-        "ProgramTask", 1 "ParameterSet", 4 "TaskProgramName"], true false false;
-        Controllers__URController__TaskControls__ProgramTask__Identification__UIElement :
-        ua::Variant, - 1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0
-        "ProgramTask", 1 "Identification", 1 "UIElement"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__Lock__Locked : bool, - 1,
-        [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "Lock",
-        1 "Locked"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__Lock__LockingClient :
-        String, - 1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0
-        "ProgramTask", 1 "Lock", 1 "LockingClient"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__Lock__LockingUser : String,
-        - 1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1
-        "Lock", 1 "LockingUser"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__Lock__RemainingLockTime :
-        f64, - 1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask",
-        1 "Lock", 1 "RemainingLockTime"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__Manufacturer :
-        ua::LocalizedText, - 1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0
-        "ProgramTask", 1 "Manufacturer"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__ManufacturerUri : String, -
-        1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1
-        "ManufacturerUri"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__Model : ua::LocalizedText,
-        - 1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1
-        "Model"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__HardwareRevision : String,
-        - 1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1
-        "HardwareRevision"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__SoftwareRevision : String,
-        - 1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1
-        "SoftwareRevision"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__DeviceRevision : String, -
-        1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1
-        "DeviceRevision"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__ProductCode : String, - 1,
-        [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1
-        "ProductCode"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__DeviceManual : String, - 1,
-        [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1
-        "DeviceManual"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__DeviceClass : String, - 1,
-        [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1
-        "DeviceClass"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__SerialNumber : String, - 1,
-        [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1
-        "SerialNumber"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__ProductInstanceUri :
-        String, - 1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0
-        "ProgramTask", 1 "ProductInstanceUri"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__RevisionCounter : i32, - 1,
-        [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1
-        "RevisionCounter"], false false false;
-        Controllers__URController__TaskControls__ProgramTask__AssetId : String, - 1, [4
-        "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "AssetId"],
-        false false false;
-        Controllers__URController__TaskControls__ProgramTask__ComponentName :
-        ua::LocalizedText, - 1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0
-        "ProgramTask", 1 "ComponentName"], true false false;
-        Controllers__URController__TaskControls__ProgramTask__TaskControlOperation__MotionDevicesUnderControl
-        : ua::NodeId, 1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0
-        "ProgramTask", 4 "TaskControlOperation", 4 "MotionDevicesUnderControl"], false
-        false false;
-        Controllers__URController__SkillSet__AbsoluteJointPTPMove__CurrentState :
-        ua::LocalizedText, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteJointPTPMove", 3 "CurrentState"], true false false;
-        Controllers__URController__SkillSet__AbsoluteJointPTPMove__LastTransition :
-        ua::LocalizedText, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteJointPTPMove", 3 "LastTransition"], true false false;
-        Controllers__URController__SkillSet__AbsoluteJointPTPMove__AvailableStates :
-        ua::NodeId, 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteJointPTPMove", 3 "AvailableStates"], false false false;
-        Controllers__URController__SkillSet__AbsoluteJointPTPMove__AvailableTransitions :
-        ua::NodeId, 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteJointPTPMove", 3 "AvailableTransitions"], false false false;
-        Controllers__URController__SkillSet__AbsoluteJointPTPMove__Deletable : bool, - 1,
-        [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteJointPTPMove", 3
-        "Deletable"], true false false;
-        Controllers__URController__SkillSet__AbsoluteJointPTPMove__AutoDelete : bool, -
-        1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteJointPTPMove", 3
-        "AutoDelete"], true false false;
-        Controllers__URController__SkillSet__AbsoluteJointPTPMove__RecycleCount : i32, -
-        1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteJointPTPMove", 3
-        "RecycleCount"], true false false;
-        Controllers__URController__SkillSet__AbsoluteJointPTPMove__ProgramDiagnostic :
-        ua::ExtensionObject, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteJointPTPMove", 3 "ProgramDiagnostic"], false false false;
-        Controllers__URController__SkillSet__AbsoluteJointPTPMove__InputParameterSet__Speed
-        : f64, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteJointPTPMove", 2 "InputParameterSet", 2 "Speed"], true false true;
-        Controllers__URController__SkillSet__AbsoluteJointPTPMove__InputParameterSet__Acceleration
-        : f64, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteJointPTPMove", 2 "InputParameterSet", 2 "Acceleration"], true false
-        true;
-        Controllers__URController__SkillSet__AbsoluteJointPTPMove__InputParameterSet__TargetJointPositions
-        : f64, 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteJointPTPMove", 2 "InputParameterSet", 2 "TargetJointPositions"], true
-        false true;
-        Controllers__URController__SkillSet__AbsoluteJointPTPMove__OutputParameterSet__Result
-        : ua::StatusCode, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteJointPTPMove", 2 "OutputParameterSet", 2 "Result"], true false false;
-        Controllers__URController__SkillSet__RelativeCartesianLinearMove__CurrentState :
-        ua::LocalizedText, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "RelativeCartesianLinearMove", 3 "CurrentState"], true false false;
-        Controllers__URController__SkillSet__RelativeCartesianLinearMove__LastTransition
-        : ua::LocalizedText, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "RelativeCartesianLinearMove", 3 "LastTransition"], true false false;
-        Controllers__URController__SkillSet__RelativeCartesianLinearMove__AvailableStates
-        : ua::NodeId, 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "RelativeCartesianLinearMove", 3 "AvailableStates"], false false false;
-        Controllers__URController__SkillSet__RelativeCartesianLinearMove__AvailableTransitions
-        : ua::NodeId, 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "RelativeCartesianLinearMove", 3 "AvailableTransitions"], false false false;
-        Controllers__URController__SkillSet__RelativeCartesianLinearMove__Deletable :
-        bool, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "RelativeCartesianLinearMove", 3 "Deletable"], true false false;
-        Controllers__URController__SkillSet__RelativeCartesianLinearMove__AutoDelete :
-        bool, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "RelativeCartesianLinearMove", 3 "AutoDelete"], true false false;
-        Controllers__URController__SkillSet__RelativeCartesianLinearMove__RecycleCount :
-        i32, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "RelativeCartesianLinearMove", 3 "RecycleCount"], true false false;
-        Controllers__URController__SkillSet__RelativeCartesianLinearMove__ProgramDiagnostic
-        : ua::ExtensionObject, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "RelativeCartesianLinearMove", 3 "ProgramDiagnostic"], false false false;
-        Controllers__URController__SkillSet__RelativeCartesianLinearMove__InputParameterSet__Speed
-        : f64, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "RelativeCartesianLinearMove", 2 "InputParameterSet", 2 "Speed"], true false
-        true;
-        Controllers__URController__SkillSet__RelativeCartesianLinearMove__InputParameterSet__Acceleration
-        : f64, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "RelativeCartesianLinearMove", 2 "InputParameterSet", 2 "Acceleration"], true
-        false true;
-        Controllers__URController__SkillSet__RelativeCartesianLinearMove__InputParameterSet__PoseOffset
-        : ua::ThreeDFrame, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "RelativeCartesianLinearMove", 2 "InputParameterSet", 2 "PoseOffset"], true false
-        true;
-        Controllers__URController__SkillSet__RelativeCartesianLinearMove__OutputParameterSet__Result
-        : ua::StatusCode, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "RelativeCartesianLinearMove", 2 "OutputParameterSet", 2 "Result"], true false
-        false;
-        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__CurrentState :
-        ua::LocalizedText, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteCartesianLinearMove", 3 "CurrentState"], true false false;
-        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__LastTransition
-        : ua::LocalizedText, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteCartesianLinearMove", 3 "LastTransition"], true false false;
-        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__AvailableStates
-        : ua::NodeId, 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteCartesianLinearMove", 3 "AvailableStates"], false false false;
-        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__AvailableTransitions
-        : ua::NodeId, 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteCartesianLinearMove", 3 "AvailableTransitions"], false false false;
-        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__Deletable :
-        bool, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteCartesianLinearMove", 3 "Deletable"], true false false;
-        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__AutoDelete :
-        bool, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteCartesianLinearMove", 3 "AutoDelete"], true false false;
-        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__RecycleCount :
-        i32, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteCartesianLinearMove", 3 "RecycleCount"], true false false;
-        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__ProgramDiagnostic
-        : ua::ExtensionObject, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteCartesianLinearMove", 3 "ProgramDiagnostic"], false false false;
-        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__InputParameterSet__Speed
-        : f64, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteCartesianLinearMove", 2 "InputParameterSet", 2 "Speed"], true false
-        true;
-        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__InputParameterSet__Acceleration
-        : f64, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteCartesianLinearMove", 2 "InputParameterSet", 2 "Acceleration"], true
-        false true;
-        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__InputParameterSet__TargetPose
-        : ua::ThreeDFrame, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteCartesianLinearMove", 2 "InputParameterSet", 2 "TargetPose"], true false
-        true;
-        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__OutputParameterSet__Result
-        : ua::StatusCode, - 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0
-        "AbsoluteCartesianLinearMove", 2 "OutputParameterSet", 2 "Result"], true false
-        false; MotionDevices__Manipulator__ParameterSet__SpeedOverride : f64, - 1, [4
-        "MotionDevices", 0 "Manipulator", 1 "ParameterSet", 4 "SpeedOverride"], true
-        false false; MotionDevices__Manipulator__Identification__UIElement : ua::Variant,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 1 "Identification", 1 "UIElement"],
-        false false false; MotionDevices__Manipulator__Lock__Locked : bool, - 1, [4
-        "MotionDevices", 0 "Manipulator", 1 "Lock", 1 "Locked"], false false false;
-        MotionDevices__Manipulator__Lock__LockingClient : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 1 "Lock", 1 "LockingClient"], false false
-        false; MotionDevices__Manipulator__Lock__LockingUser : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 1 "Lock", 1 "LockingUser"], false false false;
-        MotionDevices__Manipulator__Lock__RemainingLockTime : f64, - 1, [4
-        "MotionDevices", 0 "Manipulator", 1 "Lock", 1 "RemainingLockTime"], false false
-        false; MotionDevices__Manipulator__Manufacturer : ua::LocalizedText, - 1, [4
-        "MotionDevices", 0 "Manipulator", 1 "Manufacturer"], true true false;
-        MotionDevices__Manipulator__ManufacturerUri : String, - 1, [4 "MotionDevices", 0
-        "Manipulator", 1 "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__Model : ua::LocalizedText, - 1, [4 "MotionDevices", 0
-        "Manipulator", 1 "Model"], true true false;
-        MotionDevices__Manipulator__HardwareRevision : String, - 1, [4 "MotionDevices", 0
-        "Manipulator", 1 "HardwareRevision"], false false false;
-        MotionDevices__Manipulator__SoftwareRevision : String, - 1, [4 "MotionDevices", 0
-        "Manipulator", 1 "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__DeviceRevision : String, - 1, [4 "MotionDevices", 0
-        "Manipulator", 1 "DeviceRevision"], false false false;
-        MotionDevices__Manipulator__ProductCode : String, - 1, [4 "MotionDevices", 0
-        "Manipulator", 1 "ProductCode"], true false false;
-        MotionDevices__Manipulator__DeviceManual : String, - 1, [4 "MotionDevices", 0
-        "Manipulator", 1 "DeviceManual"], false false false;
-        MotionDevices__Manipulator__DeviceClass : String, - 1, [4 "MotionDevices", 0
-        "Manipulator", 1 "DeviceClass"], false false false;
-        MotionDevices__Manipulator__SerialNumber : String, - 1, [4 "MotionDevices", 0
-        "Manipulator", 1 "SerialNumber"], true false false;
-        MotionDevices__Manipulator__ProductInstanceUri : String, - 1, [4 "MotionDevices",
-        0 "Manipulator", 1 "ProductInstanceUri"], false false false;
-        MotionDevices__Manipulator__RevisionCounter : i32, - 1, [4 "MotionDevices", 0
-        "Manipulator", 1 "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__AssetId : String, - 1, [4 "MotionDevices", 0
-        "Manipulator", 1 "AssetId"], false false false;
-        MotionDevices__Manipulator__ComponentName : ua::LocalizedText, - 1, [4
-        "MotionDevices", 0 "Manipulator", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__Axes__Base__ParameterSet__ActualPosition : f64, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "ParameterSet", 4
-        "ActualPosition"], true false false;
-        MotionDevices__Manipulator__Axes__Base__Identification__UIElement : ua::Variant,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "Identification",
-        1 "UIElement"], false false false;
-        MotionDevices__Manipulator__Axes__Base__Lock__Locked : bool, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "Lock", 1 "Locked"],
-        false false false; MotionDevices__Manipulator__Axes__Base__Lock__LockingClient :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "Lock", 1
-        "LockingClient"], false false false;
-        MotionDevices__Manipulator__Axes__Base__Lock__LockingUser : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "Lock", 1 "LockingUser"],
-        false false false;
-        MotionDevices__Manipulator__Axes__Base__Lock__RemainingLockTime : f64, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "Lock", 1
-        "RemainingLockTime"], false false false;
-        MotionDevices__Manipulator__Axes__Base__Manufacturer : ua::LocalizedText, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "Manufacturer"], false
-        false false; MotionDevices__Manipulator__Axes__Base__ManufacturerUri : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "ManufacturerUri"],
-        false false false; MotionDevices__Manipulator__Axes__Base__Model :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base",
-        1 "Model"], false false false;
-        MotionDevices__Manipulator__Axes__Base__HardwareRevision : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "HardwareRevision"],
-        false false false; MotionDevices__Manipulator__Axes__Base__SoftwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1
-        "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__Axes__Base__DeviceRevision : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "DeviceRevision"], false
-        false false; MotionDevices__Manipulator__Axes__Base__ProductCode : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "ProductCode"], false
-        false false; MotionDevices__Manipulator__Axes__Base__DeviceManual : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "DeviceManual"], false
-        false false; MotionDevices__Manipulator__Axes__Base__DeviceClass : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "DeviceClass"], false
-        false false; MotionDevices__Manipulator__Axes__Base__SerialNumber : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "SerialNumber"], false
-        false false; MotionDevices__Manipulator__Axes__Base__ProductInstanceUri : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1
-        "ProductInstanceUri"], false false false;
-        MotionDevices__Manipulator__Axes__Base__RevisionCounter : i32, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "RevisionCounter"], false
-        false false; MotionDevices__Manipulator__Axes__Base__AssetId : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "AssetId"], false false
-        false; MotionDevices__Manipulator__Axes__Base__ComponentName : ua::LocalizedText,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "ComponentName"],
-        false false false;
-        MotionDevices__Manipulator__Axes__Base__AdditionalLoad__CenterOfMass :
-        ua::ThreeDFrame, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 4
-        "AdditionalLoad", 4 "CenterOfMass"], false false false;
-        MotionDevices__Manipulator__Axes__Base__AdditionalLoad__Inertia :
-        ua::ThreeDVector, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 4
-        "AdditionalLoad", 4 "Inertia"], false false false;
-        MotionDevices__Manipulator__Axes__Base__AdditionalLoad__Mass : f64, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 4 "AdditionalLoad", 4
-        "Mass"], false false false; MotionDevices__Manipulator__Axes__Base__MotionProfile
-        : super::super::super::super::robotics::types::AxisMotionProfileEnumeration, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 4 "MotionProfile"], true
-        true false;
-        MotionDevices__Manipulator__Axes__Shoulder__ParameterSet__ActualPosition : f64, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "ParameterSet",
-        4 "ActualPosition"], true false false;
-        MotionDevices__Manipulator__Axes__Shoulder__Identification__UIElement :
-        ua::Variant, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1
-        "Identification", 1 "UIElement"], false false false;
-        MotionDevices__Manipulator__Axes__Shoulder__Lock__Locked : bool, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "Lock", 1 "Locked"],
-        false false false;
-        MotionDevices__Manipulator__Axes__Shoulder__Lock__LockingClient : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "Lock", 1
-        "LockingClient"], false false false;
-        MotionDevices__Manipulator__Axes__Shoulder__Lock__LockingUser : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "Lock", 1
-        "LockingUser"], false false false;
-        MotionDevices__Manipulator__Axes__Shoulder__Lock__RemainingLockTime : f64, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "Lock", 1
-        "RemainingLockTime"], false false false;
-        MotionDevices__Manipulator__Axes__Shoulder__Manufacturer : ua::LocalizedText, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1
-        "Manufacturer"], false false false;
-        MotionDevices__Manipulator__Axes__Shoulder__ManufacturerUri : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "ManufacturerUri"],
-        false false false; MotionDevices__Manipulator__Axes__Shoulder__Model :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0
-        "Shoulder", 1 "Model"], false false false;
-        MotionDevices__Manipulator__Axes__Shoulder__HardwareRevision : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "HardwareRevision"],
-        false false false; MotionDevices__Manipulator__Axes__Shoulder__SoftwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1
-        "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__Axes__Shoulder__DeviceRevision : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "DeviceRevision"],
-        false false false; MotionDevices__Manipulator__Axes__Shoulder__ProductCode :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1
-        "ProductCode"], false false false;
-        MotionDevices__Manipulator__Axes__Shoulder__DeviceManual : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "DeviceManual"],
-        false false false; MotionDevices__Manipulator__Axes__Shoulder__DeviceClass :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1
-        "DeviceClass"], false false false;
-        MotionDevices__Manipulator__Axes__Shoulder__SerialNumber : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "SerialNumber"],
-        false false false; MotionDevices__Manipulator__Axes__Shoulder__ProductInstanceUri
-        : String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1
-        "ProductInstanceUri"], false false false;
-        MotionDevices__Manipulator__Axes__Shoulder__RevisionCounter : i32, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "RevisionCounter"],
-        false false false; MotionDevices__Manipulator__Axes__Shoulder__AssetId : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "AssetId"],
-        false false false; MotionDevices__Manipulator__Axes__Shoulder__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0
-        "Shoulder", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__Axes__Shoulder__AdditionalLoad__CenterOfMass :
-        ua::ThreeDFrame, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0
-        "Shoulder", 4 "AdditionalLoad", 4 "CenterOfMass"], false false false;
-        MotionDevices__Manipulator__Axes__Shoulder__AdditionalLoad__Inertia :
-        ua::ThreeDVector, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0
-        "Shoulder", 4 "AdditionalLoad", 4 "Inertia"], false false false;
-        MotionDevices__Manipulator__Axes__Shoulder__AdditionalLoad__Mass : f64, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 4 "AdditionalLoad", 4
-        "Mass"], false false false;
-        MotionDevices__Manipulator__Axes__Shoulder__MotionProfile :
-        super::super::super::super::robotics::types::AxisMotionProfileEnumeration, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 4 "MotionProfile"],
-        true true false;
-        MotionDevices__Manipulator__Axes__Elbow__ParameterSet__ActualPosition : f64, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "ParameterSet", 4
-        "ActualPosition"], true false false;
-        MotionDevices__Manipulator__Axes__Elbow__Identification__UIElement : ua::Variant,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1
-        "Identification", 1 "UIElement"], false false false;
-        MotionDevices__Manipulator__Axes__Elbow__Lock__Locked : bool, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "Lock", 1 "Locked"],
-        false false false; MotionDevices__Manipulator__Axes__Elbow__Lock__LockingClient :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "Lock",
-        1 "LockingClient"], false false false;
-        MotionDevices__Manipulator__Axes__Elbow__Lock__LockingUser : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "Lock", 1
-        "LockingUser"], false false false;
-        MotionDevices__Manipulator__Axes__Elbow__Lock__RemainingLockTime : f64, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "Lock", 1
-        "RemainingLockTime"], false false false;
-        MotionDevices__Manipulator__Axes__Elbow__Manufacturer : ua::LocalizedText, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "Manufacturer"],
-        false false false; MotionDevices__Manipulator__Axes__Elbow__ManufacturerUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1
-        "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__Axes__Elbow__Model : ua::LocalizedText, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "Model"], false false
-        false; MotionDevices__Manipulator__Axes__Elbow__HardwareRevision : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "HardwareRevision"],
-        false false false; MotionDevices__Manipulator__Axes__Elbow__SoftwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1
-        "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__Axes__Elbow__DeviceRevision : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "DeviceRevision"], false
-        false false; MotionDevices__Manipulator__Axes__Elbow__ProductCode : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "ProductCode"], false
-        false false; MotionDevices__Manipulator__Axes__Elbow__DeviceManual : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "DeviceManual"],
-        false false false; MotionDevices__Manipulator__Axes__Elbow__DeviceClass : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "DeviceClass"],
-        false false false; MotionDevices__Manipulator__Axes__Elbow__SerialNumber :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1
-        "SerialNumber"], false false false;
-        MotionDevices__Manipulator__Axes__Elbow__ProductInstanceUri : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "ProductInstanceUri"],
-        false false false; MotionDevices__Manipulator__Axes__Elbow__RevisionCounter :
-        i32, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1
-        "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__Axes__Elbow__AssetId : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "AssetId"], false false
-        false; MotionDevices__Manipulator__Axes__Elbow__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow",
-        1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__Axes__Elbow__AdditionalLoad__CenterOfMass :
-        ua::ThreeDFrame, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 4
-        "AdditionalLoad", 4 "CenterOfMass"], false false false;
-        MotionDevices__Manipulator__Axes__Elbow__AdditionalLoad__Inertia :
-        ua::ThreeDVector, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow",
-        4 "AdditionalLoad", 4 "Inertia"], false false false;
-        MotionDevices__Manipulator__Axes__Elbow__AdditionalLoad__Mass : f64, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 4 "AdditionalLoad", 4
-        "Mass"], false false false;
-        MotionDevices__Manipulator__Axes__Elbow__MotionProfile :
-        super::super::super::super::robotics::types::AxisMotionProfileEnumeration, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 4 "MotionProfile"],
-        true true false;
-        MotionDevices__Manipulator__Axes__Wrist1__ParameterSet__ActualPosition : f64, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "ParameterSet", 4
-        "ActualPosition"], true false false;
-        MotionDevices__Manipulator__Axes__Wrist1__Identification__UIElement :
-        ua::Variant, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1
-        "Identification", 1 "UIElement"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist1__Lock__Locked : bool, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "Lock", 1 "Locked"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist1__Lock__LockingClient
-        : String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1
-        "Lock", 1 "LockingClient"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist1__Lock__LockingUser : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "Lock", 1
-        "LockingUser"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist1__Lock__RemainingLockTime : f64, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "Lock", 1
-        "RemainingLockTime"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist1__Manufacturer : ua::LocalizedText, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "Manufacturer"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist1__ManufacturerUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1
-        "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist1__Model : ua::LocalizedText, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "Model"], false false
-        false; MotionDevices__Manipulator__Axes__Wrist1__HardwareRevision : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "HardwareRevision"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist1__SoftwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1
-        "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist1__DeviceRevision : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "DeviceRevision"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist1__ProductCode :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1
-        "ProductCode"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist1__DeviceManual : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "DeviceManual"], false
-        false false; MotionDevices__Manipulator__Axes__Wrist1__DeviceClass : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "DeviceClass"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist1__SerialNumber :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1
-        "SerialNumber"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist1__ProductInstanceUri : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "ProductInstanceUri"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist1__RevisionCounter :
-        i32, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1
-        "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist1__AssetId : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "AssetId"], false false
-        false; MotionDevices__Manipulator__Axes__Wrist1__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0
-        "Wrist1", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist1__AdditionalLoad__CenterOfMass :
-        ua::ThreeDFrame, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1",
-        4 "AdditionalLoad", 4 "CenterOfMass"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist1__AdditionalLoad__Inertia :
-        ua::ThreeDVector, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1",
-        4 "AdditionalLoad", 4 "Inertia"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist1__AdditionalLoad__Mass : f64, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 4 "AdditionalLoad", 4
-        "Mass"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist1__MotionProfile :
-        super::super::super::super::robotics::types::AxisMotionProfileEnumeration, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 4 "MotionProfile"],
-        true true false;
-        MotionDevices__Manipulator__Axes__Wrist2__ParameterSet__ActualPosition : f64, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "ParameterSet", 4
-        "ActualPosition"], true false false;
-        MotionDevices__Manipulator__Axes__Wrist2__Identification__UIElement :
-        ua::Variant, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1
-        "Identification", 1 "UIElement"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist2__Lock__Locked : bool, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "Lock", 1 "Locked"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist2__Lock__LockingClient
-        : String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1
-        "Lock", 1 "LockingClient"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist2__Lock__LockingUser : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "Lock", 1
-        "LockingUser"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist2__Lock__RemainingLockTime : f64, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "Lock", 1
-        "RemainingLockTime"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist2__Manufacturer : ua::LocalizedText, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "Manufacturer"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist2__ManufacturerUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1
-        "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist2__Model : ua::LocalizedText, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "Model"], false false
-        false; MotionDevices__Manipulator__Axes__Wrist2__HardwareRevision : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "HardwareRevision"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist2__SoftwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1
-        "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist2__DeviceRevision : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "DeviceRevision"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist2__ProductCode :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1
-        "ProductCode"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist2__DeviceManual : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "DeviceManual"], false
-        false false; MotionDevices__Manipulator__Axes__Wrist2__DeviceClass : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "DeviceClass"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist2__SerialNumber :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1
-        "SerialNumber"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist2__ProductInstanceUri : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "ProductInstanceUri"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist2__RevisionCounter :
-        i32, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1
-        "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist2__AssetId : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "AssetId"], false false
-        false; MotionDevices__Manipulator__Axes__Wrist2__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0
-        "Wrist2", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist2__AdditionalLoad__CenterOfMass :
-        ua::ThreeDFrame, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2",
-        4 "AdditionalLoad", 4 "CenterOfMass"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist2__AdditionalLoad__Inertia :
-        ua::ThreeDVector, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2",
-        4 "AdditionalLoad", 4 "Inertia"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist2__AdditionalLoad__Mass : f64, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 4 "AdditionalLoad", 4
-        "Mass"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist2__MotionProfile :
-        super::super::super::super::robotics::types::AxisMotionProfileEnumeration, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 4 "MotionProfile"],
-        true true false;
-        MotionDevices__Manipulator__Axes__Wrist3__ParameterSet__ActualPosition : f64, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "ParameterSet", 4
-        "ActualPosition"], true false false;
-        MotionDevices__Manipulator__Axes__Wrist3__Identification__UIElement :
-        ua::Variant, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1
-        "Identification", 1 "UIElement"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist3__Lock__Locked : bool, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "Lock", 1 "Locked"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist3__Lock__LockingClient
-        : String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1
-        "Lock", 1 "LockingClient"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist3__Lock__LockingUser : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "Lock", 1
-        "LockingUser"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist3__Lock__RemainingLockTime : f64, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "Lock", 1
-        "RemainingLockTime"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist3__Manufacturer : ua::LocalizedText, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "Manufacturer"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist3__ManufacturerUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1
-        "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist3__Model : ua::LocalizedText, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "Model"], false false
-        false; MotionDevices__Manipulator__Axes__Wrist3__HardwareRevision : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "HardwareRevision"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist3__SoftwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1
-        "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist3__DeviceRevision : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "DeviceRevision"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist3__ProductCode :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1
-        "ProductCode"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist3__DeviceManual : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "DeviceManual"], false
-        false false; MotionDevices__Manipulator__Axes__Wrist3__DeviceClass : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "DeviceClass"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist3__SerialNumber :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1
-        "SerialNumber"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist3__ProductInstanceUri : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "ProductInstanceUri"],
-        false false false; MotionDevices__Manipulator__Axes__Wrist3__RevisionCounter :
-        i32, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1
-        "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist3__AssetId : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "AssetId"], false false
-        false; MotionDevices__Manipulator__Axes__Wrist3__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0
-        "Wrist3", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist3__AdditionalLoad__CenterOfMass :
-        ua::ThreeDFrame, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3",
-        4 "AdditionalLoad", 4 "CenterOfMass"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist3__AdditionalLoad__Inertia :
-        ua::ThreeDVector, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3",
-        4 "AdditionalLoad", 4 "Inertia"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist3__AdditionalLoad__Mass : f64, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 4 "AdditionalLoad", 4
-        "Mass"], false false false;
-        MotionDevices__Manipulator__Axes__Wrist3__MotionProfile :
-        super::super::super::super::robotics::types::AxisMotionProfileEnumeration, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 4 "MotionProfile"],
-        true true false; MotionDevices__Manipulator__FlangeLoad__CenterOfMass :
-        ua::ThreeDFrame, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "FlangeLoad", 4
-        "CenterOfMass"], false false false;
-        MotionDevices__Manipulator__FlangeLoad__Inertia : ua::ThreeDVector, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "FlangeLoad", 4 "Inertia"], false false
-        false; MotionDevices__Manipulator__FlangeLoad__Mass : f64, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "FlangeLoad", 4 "Mass"], false false false;
-        MotionDevices__Manipulator__MotionDeviceCategory :
-        super::super::super::super::robotics::types::MotionDeviceCategoryEnumeration, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "MotionDeviceCategory"], true true
-        false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Identification__UIElement :
-        ua::Variant, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "BaseDrive", 1 "Identification", 1 "UIElement"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Lock__Locked : bool, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "Lock", 1
-        "Locked"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Lock__LockingClient : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1
-        "Lock", 1 "LockingClient"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Lock__LockingUser : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "Lock",
-        1 "LockingUser"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Lock__RemainingLockTime :
-        f64, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1
-        "Lock", 1 "RemainingLockTime"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Manufacturer :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "BaseDrive", 1 "Manufacturer"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__ManufacturerUri : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1
-        "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Model : ua::LocalizedText, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1
-        "Model"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__HardwareRevision : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1
-        "HardwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__SoftwareRevision : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1
-        "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__DeviceRevision : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1
-        "DeviceRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__ProductCode : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1
-        "ProductCode"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__DeviceManual : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1
-        "DeviceManual"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__DeviceClass : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1
-        "DeviceClass"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__SerialNumber : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1
-        "SerialNumber"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__ProductInstanceUri : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1
-        "ProductInstanceUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__RevisionCounter : i32, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1
-        "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__AssetId : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "AssetId"],
-        false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "BaseDrive", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__Manufacturer :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "BaseDrive", 0 "Motor", 1 "Manufacturer"], true true false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__ManufacturerUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive",
-        0 "Motor", 1 "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__Model :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "BaseDrive", 0 "Motor", 1 "Model"], true false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__HardwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive",
-        0 "Motor", 1 "HardwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__SoftwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive",
-        0 "Motor", 1 "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__DeviceRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive",
-        0 "Motor", 1 "DeviceRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__ProductCode : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0
-        "Motor", 1 "ProductCode"], true false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__DeviceManual : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0
-        "Motor", 1 "DeviceManual"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__DeviceClass : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0
-        "Motor", 1 "DeviceClass"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__SerialNumber : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0
-        "Motor", 1 "SerialNumber"], true false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__ProductInstanceUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive",
-        0 "Motor", 1 "ProductInstanceUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__RevisionCounter : i32,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0
-        "Motor", 1 "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__AssetId : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0 "Motor", 1
-        "AssetId"], false false false;
-        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "BaseDrive", 0 "Motor", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Identification__UIElement
-        : ua::Variant, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 1 "Identification", 1 "UIElement"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Lock__Locked : bool, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1
-        "Lock", 1 "Locked"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Lock__LockingClient :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 1 "Lock", 1 "LockingClient"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Lock__LockingUser :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 1 "Lock", 1 "LockingUser"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Lock__RemainingLockTime :
-        f64, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 1 "Lock", 1 "RemainingLockTime"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Manufacturer :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 1 "Manufacturer"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__ManufacturerUri : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1
-        "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Model :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 1 "Model"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__HardwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 1 "HardwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__SoftwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 1 "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__DeviceRevision : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1
-        "DeviceRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__ProductCode : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1
-        "ProductCode"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__DeviceManual : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1
-        "DeviceManual"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__DeviceClass : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1
-        "DeviceClass"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__SerialNumber : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1
-        "SerialNumber"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__ProductInstanceUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 1 "ProductInstanceUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__RevisionCounter : i32, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1
-        "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__AssetId : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1
-        "AssetId"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__Manufacturer :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 0 "Motor", 1 "Manufacturer"], true true false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__ManufacturerUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 0 "Motor", 1 "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__Model :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 0 "Motor", 1 "Model"], true false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__HardwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 0 "Motor", 1 "HardwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__SoftwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 0 "Motor", 1 "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__DeviceRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 0 "Motor", 1 "DeviceRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__ProductCode :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 0 "Motor", 1 "ProductCode"], true false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__DeviceManual :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 0 "Motor", 1 "DeviceManual"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__DeviceClass :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 0 "Motor", 1 "DeviceClass"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__SerialNumber :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 0 "Motor", 1 "SerialNumber"], true false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__ProductInstanceUri
-        : String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 0 "Motor", 1 "ProductInstanceUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__RevisionCounter :
-        i32, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 0 "Motor", 1 "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__AssetId : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 0
-        "Motor", 1 "AssetId"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ShoulderDrive", 0 "Motor", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Identification__UIElement :
-        ua::Variant, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ElbowDrive", 1 "Identification", 1 "UIElement"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Lock__Locked : bool, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "Lock", 1
-        "Locked"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Lock__LockingClient :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ElbowDrive", 1 "Lock", 1 "LockingClient"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Lock__LockingUser : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1
-        "Lock", 1 "LockingUser"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Lock__RemainingLockTime :
-        f64, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1
-        "Lock", 1 "RemainingLockTime"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Manufacturer :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ElbowDrive", 1 "Manufacturer"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__ManufacturerUri : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1
-        "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Model : ua::LocalizedText, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1
-        "Model"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__HardwareRevision : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1
-        "HardwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__SoftwareRevision : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1
-        "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__DeviceRevision : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1
-        "DeviceRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__ProductCode : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1
-        "ProductCode"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__DeviceManual : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1
-        "DeviceManual"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__DeviceClass : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1
-        "DeviceClass"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__SerialNumber : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1
-        "SerialNumber"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__ProductInstanceUri : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1
-        "ProductInstanceUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__RevisionCounter : i32, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1
-        "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__AssetId : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "AssetId"],
-        false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ElbowDrive", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__Manufacturer :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ElbowDrive", 0 "Motor", 1 "Manufacturer"], true true false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__ManufacturerUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ElbowDrive", 0 "Motor", 1 "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__Model :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ElbowDrive", 0 "Motor", 1 "Model"], true false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__HardwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ElbowDrive", 0 "Motor", 1 "HardwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__SoftwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ElbowDrive", 0 "Motor", 1 "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__DeviceRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ElbowDrive", 0 "Motor", 1 "DeviceRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__ProductCode : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0
-        "Motor", 1 "ProductCode"], true false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__DeviceManual :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ElbowDrive", 0 "Motor", 1 "DeviceManual"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__DeviceClass : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0
-        "Motor", 1 "DeviceClass"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__SerialNumber :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ElbowDrive", 0 "Motor", 1 "SerialNumber"], true false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__ProductInstanceUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ElbowDrive", 0 "Motor", 1 "ProductInstanceUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__RevisionCounter :
-        i32, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0
-        "Motor", 1 "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__AssetId : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0
-        "Motor", 1 "AssetId"], false false false;
-        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "ElbowDrive", 0 "Motor", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Identification__UIElement :
-        ua::Variant, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 1 "Identification", 1 "UIElement"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Lock__Locked : bool, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "Lock",
-        1 "Locked"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Lock__LockingClient :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 1 "Lock", 1 "LockingClient"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Lock__LockingUser : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1
-        "Lock", 1 "LockingUser"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Lock__RemainingLockTime :
-        f64, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive",
-        1 "Lock", 1 "RemainingLockTime"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Manufacturer :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 1 "Manufacturer"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__ManufacturerUri : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1
-        "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Model : ua::LocalizedText,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1
-        "Model"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__HardwareRevision : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1
-        "HardwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__SoftwareRevision : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1
-        "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__DeviceRevision : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1
-        "DeviceRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__ProductCode : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1
-        "ProductCode"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__DeviceManual : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1
-        "DeviceManual"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__DeviceClass : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1
-        "DeviceClass"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__SerialNumber : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1
-        "SerialNumber"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__ProductInstanceUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 1 "ProductInstanceUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__RevisionCounter : i32, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1
-        "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__AssetId : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "AssetId"],
-        false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__Manufacturer :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 0 "Motor", 1 "Manufacturer"], true true false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__ManufacturerUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 0 "Motor", 1 "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__Model :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 0 "Motor", 1 "Model"], true false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__HardwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 0 "Motor", 1 "HardwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__SoftwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 0 "Motor", 1 "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__DeviceRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 0 "Motor", 1 "DeviceRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__ProductCode :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 0 "Motor", 1 "ProductCode"], true false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__DeviceManual :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 0 "Motor", 1 "DeviceManual"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__DeviceClass :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 0 "Motor", 1 "DeviceClass"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__SerialNumber :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 0 "Motor", 1 "SerialNumber"], true false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__ProductInstanceUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 0 "Motor", 1 "ProductInstanceUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__RevisionCounter :
-        i32, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive",
-        0 "Motor", 1 "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__AssetId : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 0
-        "Motor", 1 "AssetId"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist1Drive", 0 "Motor", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Identification__UIElement :
-        ua::Variant, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 1 "Identification", 1 "UIElement"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Lock__Locked : bool, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "Lock",
-        1 "Locked"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Lock__LockingClient :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 1 "Lock", 1 "LockingClient"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Lock__LockingUser : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1
-        "Lock", 1 "LockingUser"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Lock__RemainingLockTime :
-        f64, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive",
-        1 "Lock", 1 "RemainingLockTime"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Manufacturer :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 1 "Manufacturer"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__ManufacturerUri : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1
-        "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Model : ua::LocalizedText,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1
-        "Model"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__HardwareRevision : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1
-        "HardwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__SoftwareRevision : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1
-        "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__DeviceRevision : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1
-        "DeviceRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__ProductCode : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1
-        "ProductCode"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__DeviceManual : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1
-        "DeviceManual"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__DeviceClass : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1
-        "DeviceClass"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__SerialNumber : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1
-        "SerialNumber"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__ProductInstanceUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 1 "ProductInstanceUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__RevisionCounter : i32, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1
-        "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__AssetId : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "AssetId"],
-        false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__Manufacturer :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 0 "Motor", 1 "Manufacturer"], true true false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__ManufacturerUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 0 "Motor", 1 "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__Model :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 0 "Motor", 1 "Model"], true false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__HardwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 0 "Motor", 1 "HardwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__SoftwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 0 "Motor", 1 "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__DeviceRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 0 "Motor", 1 "DeviceRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__ProductCode :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 0 "Motor", 1 "ProductCode"], true false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__DeviceManual :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 0 "Motor", 1 "DeviceManual"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__DeviceClass :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 0 "Motor", 1 "DeviceClass"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__SerialNumber :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 0 "Motor", 1 "SerialNumber"], true false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__ProductInstanceUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 0 "Motor", 1 "ProductInstanceUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__RevisionCounter :
-        i32, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive",
-        0 "Motor", 1 "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__AssetId : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 0
-        "Motor", 1 "AssetId"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist2Drive", 0 "Motor", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Identification__UIElement :
-        ua::Variant, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 1 "Identification", 1 "UIElement"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Lock__Locked : bool, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "Lock",
-        1 "Locked"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Lock__LockingClient :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 1 "Lock", 1 "LockingClient"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Lock__LockingUser : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1
-        "Lock", 1 "LockingUser"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Lock__RemainingLockTime :
-        f64, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive",
-        1 "Lock", 1 "RemainingLockTime"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Manufacturer :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 1 "Manufacturer"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__ManufacturerUri : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1
-        "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Model : ua::LocalizedText,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1
-        "Model"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__HardwareRevision : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1
-        "HardwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__SoftwareRevision : String,
-        - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1
-        "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__DeviceRevision : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1
-        "DeviceRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__ProductCode : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1
-        "ProductCode"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__DeviceManual : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1
-        "DeviceManual"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__DeviceClass : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1
-        "DeviceClass"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__SerialNumber : String, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1
-        "SerialNumber"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__ProductInstanceUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 1 "ProductInstanceUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__RevisionCounter : i32, - 1,
-        [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1
-        "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__AssetId : String, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "AssetId"],
-        false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__Manufacturer :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 0 "Motor", 1 "Manufacturer"], true true false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__ManufacturerUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 0 "Motor", 1 "ManufacturerUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__Model :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 0 "Motor", 1 "Model"], true false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__HardwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 0 "Motor", 1 "HardwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__SoftwareRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 0 "Motor", 1 "SoftwareRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__DeviceRevision :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 0 "Motor", 1 "DeviceRevision"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__ProductCode :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 0 "Motor", 1 "ProductCode"], true false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__DeviceManual :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 0 "Motor", 1 "DeviceManual"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__DeviceClass :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 0 "Motor", 1 "DeviceClass"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__SerialNumber :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 0 "Motor", 1 "SerialNumber"], true false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__ProductInstanceUri :
-        String, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 0 "Motor", 1 "ProductInstanceUri"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__RevisionCounter :
-        i32, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive",
-        0 "Motor", 1 "RevisionCounter"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__AssetId : String, -
-        1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 0
-        "Motor", 1 "AssetId"], false false false;
-        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__ComponentName :
-        ua::LocalizedText, - 1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0
-        "Wrist3Drive", 0 "Motor", 1 "ComponentName"], false false false;
-        MotionDevices__Manipulator__TaskControlReference : ua::NodeId, - 1, [4
-        "MotionDevices", 0 "Manipulator", 4 "TaskControlReference"], false false false;
-        SafetyStates__SafetyState__ParameterSet__EmergencyStop : bool, - 1, [4
-        "SafetyStates", 0 "SafetyState", 1 "ParameterSet", 4 "EmergencyStop"], true false
-        false; SafetyStates__SafetyState__ParameterSet__OperationalMode :
-        super::super::super::super::robotics::types::OperationalModeEnumeration, - 1, [4
-        "SafetyStates", 0 "SafetyState", 1 "ParameterSet", 4 "OperationalMode"], true
-        false false; SafetyStates__SafetyState__ParameterSet__ProtectiveStop : bool, - 1,
-        [4 "SafetyStates", 0 "SafetyState", 1 "ParameterSet", 4 "ProtectiveStop"], true
-        false false; SafetyStates__SafetyState__Identification__UIElement : ua::Variant,
-        - 1, [4 "SafetyStates", 0 "SafetyState", 1 "Identification", 1 "UIElement"],
-        false false false; SafetyStates__SafetyState__Lock__Locked : bool, - 1, [4
-        "SafetyStates", 0 "SafetyState", 1 "Lock", 1 "Locked"], false false false;
-        SafetyStates__SafetyState__Lock__LockingClient : String, - 1, [4 "SafetyStates",
-        0 "SafetyState", 1 "Lock", 1 "LockingClient"], false false false;
-        SafetyStates__SafetyState__Lock__LockingUser : String, - 1, [4 "SafetyStates", 0
-        "SafetyState", 1 "Lock", 1 "LockingUser"], false false false;
-        SafetyStates__SafetyState__Lock__RemainingLockTime : f64, - 1, [4 "SafetyStates",
-        0 "SafetyState", 1 "Lock", 1 "RemainingLockTime"], false false false;
-        SafetyStates__SafetyState__Manufacturer : ua::LocalizedText, - 1, [4
-        "SafetyStates", 0 "SafetyState", 1 "Manufacturer"], false false false;
-        SafetyStates__SafetyState__ManufacturerUri : String, - 1, [4 "SafetyStates", 0
-        "SafetyState", 1 "ManufacturerUri"], false false false;
-        SafetyStates__SafetyState__Model : ua::LocalizedText, - 1, [4 "SafetyStates", 0
-        "SafetyState", 1 "Model"], false false false;
-        SafetyStates__SafetyState__HardwareRevision : String, - 1, [4 "SafetyStates", 0
-        "SafetyState", 1 "HardwareRevision"], false false false;
-        SafetyStates__SafetyState__SoftwareRevision : String, - 1, [4 "SafetyStates", 0
-        "SafetyState", 1 "SoftwareRevision"], false false false;
-        SafetyStates__SafetyState__DeviceRevision : String, - 1, [4 "SafetyStates", 0
-        "SafetyState", 1 "DeviceRevision"], false false false;
-        SafetyStates__SafetyState__ProductCode : String, - 1, [4 "SafetyStates", 0
-        "SafetyState", 1 "ProductCode"], false false false;
-        SafetyStates__SafetyState__DeviceManual : String, - 1, [4 "SafetyStates", 0
-        "SafetyState", 1 "DeviceManual"], false false false;
-        SafetyStates__SafetyState__DeviceClass : String, - 1, [4 "SafetyStates", 0
-        "SafetyState", 1 "DeviceClass"], false false false;
-        SafetyStates__SafetyState__SerialNumber : String, - 1, [4 "SafetyStates", 0
-        "SafetyState", 1 "SerialNumber"], false false false;
-        SafetyStates__SafetyState__ProductInstanceUri : String, - 1, [4 "SafetyStates", 0
-        "SafetyState", 1 "ProductInstanceUri"], false false false;
-        SafetyStates__SafetyState__RevisionCounter : i32, - 1, [4 "SafetyStates", 0
-        "SafetyState", 1 "RevisionCounter"], false false false;
-        SafetyStates__SafetyState__AssetId : String, - 1, [4 "SafetyStates", 0
-        "SafetyState", 1 "AssetId"], false false false;
-        SafetyStates__SafetyState__ComponentName : ua::LocalizedText, - 1, [4
-        "SafetyStates", 0 "SafetyState", 1 "ComponentName"], false false false;
+        Ur10eSystemType;
+        required: [
+            ("Controllers/URController/ProductCode", "the mandatory variable `Controllers/URController/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/ProductCode\")]"),
+            ("Controllers/URController/SerialNumber", "the mandatory variable `Controllers/URController/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SerialNumber\")]"),
+            ("Controllers/URController/CurrentUser/Level", "the mandatory variable `Controllers/URController/CurrentUser/Level` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/CurrentUser/Level\")]"),
+            ("Controllers/URController/Software/PolyScope/SoftwareRevision", "the mandatory variable `Controllers/URController/Software/PolyScope/SoftwareRevision` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/Software/PolyScope/SoftwareRevision\")]"),
+            ("Controllers/URController/TaskControls/ProgramTask/ParameterSet/TaskProgramLoaded", "the mandatory variable `Controllers/URController/TaskControls/ProgramTask/ParameterSet/TaskProgramLoaded` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/TaskControls/ProgramTask/ParameterSet/TaskProgramLoaded\")]"),
+            ("Controllers/URController/TaskControls/ProgramTask/ParameterSet/TaskProgramName", "the mandatory variable `Controllers/URController/TaskControls/ProgramTask/ParameterSet/TaskProgramName` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/TaskControls/ProgramTask/ParameterSet/TaskProgramName\")]"),
+            ("Controllers/URController/TaskControls/ProgramTask/ComponentName", "the mandatory variable `Controllers/URController/TaskControls/ProgramTask/ComponentName` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/TaskControls/ProgramTask/ComponentName\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/CurrentState", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/CurrentState` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/CurrentState\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/LastTransition", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/LastTransition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/LastTransition\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/Deletable", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/Deletable` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/Deletable\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/AutoDelete", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/AutoDelete` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/AutoDelete\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/RecycleCount", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/RecycleCount` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/RecycleCount\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/Speed", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/Speed` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/Speed\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/Acceleration", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/Acceleration` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/Acceleration\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/TargetJointPositions", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/TargetJointPositions` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/InputParameterSet/TargetJointPositions\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteJointPTPMove/OutputParameterSet/Result", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteJointPTPMove/OutputParameterSet/Result` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteJointPTPMove/OutputParameterSet/Result\")]"),
+            ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/CurrentState", "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/CurrentState` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/CurrentState\")]"),
+            ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/LastTransition", "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/LastTransition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/LastTransition\")]"),
+            ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/Deletable", "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/Deletable` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/Deletable\")]"),
+            ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/AutoDelete", "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/AutoDelete` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/AutoDelete\")]"),
+            ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/RecycleCount", "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/RecycleCount` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/RecycleCount\")]"),
+            ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/Speed", "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/Speed` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/Speed\")]"),
+            ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/Acceleration", "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/Acceleration` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/Acceleration\")]"),
+            ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/PoseOffset", "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/PoseOffset` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/InputParameterSet/PoseOffset\")]"),
+            ("Controllers/URController/SkillSet/RelativeCartesianLinearMove/OutputParameterSet/Result", "the mandatory variable `Controllers/URController/SkillSet/RelativeCartesianLinearMove/OutputParameterSet/Result` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/RelativeCartesianLinearMove/OutputParameterSet/Result\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/CurrentState", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/CurrentState` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/CurrentState\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/LastTransition", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/LastTransition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/LastTransition\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/Deletable", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/Deletable` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/Deletable\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/AutoDelete", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/AutoDelete` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/AutoDelete\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/RecycleCount", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/RecycleCount` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/RecycleCount\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/Speed", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/Speed` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/Speed\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/Acceleration", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/Acceleration` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/Acceleration\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/TargetPose", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/TargetPose` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/InputParameterSet/TargetPose\")]"),
+            ("Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/OutputParameterSet/Result", "the mandatory variable `Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/OutputParameterSet/Result` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SkillSet/AbsoluteCartesianLinearMove/OutputParameterSet/Result\")]"),
+            ("MotionDevices/Manipulator/ParameterSet/SpeedOverride", "the mandatory variable `MotionDevices/Manipulator/ParameterSet/SpeedOverride` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/ParameterSet/SpeedOverride\")]"),
+            ("MotionDevices/Manipulator/ProductCode", "the mandatory variable `MotionDevices/Manipulator/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/ProductCode\")]"),
+            ("MotionDevices/Manipulator/SerialNumber", "the mandatory variable `MotionDevices/Manipulator/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/SerialNumber\")]"),
+            ("MotionDevices/Manipulator/Axes/Base/ParameterSet/ActualPosition", "the mandatory variable `MotionDevices/Manipulator/Axes/Base/ParameterSet/ActualPosition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/Axes/Base/ParameterSet/ActualPosition\")]"),
+            ("MotionDevices/Manipulator/Axes/Shoulder/ParameterSet/ActualPosition", "the mandatory variable `MotionDevices/Manipulator/Axes/Shoulder/ParameterSet/ActualPosition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/Axes/Shoulder/ParameterSet/ActualPosition\")]"),
+            ("MotionDevices/Manipulator/Axes/Elbow/ParameterSet/ActualPosition", "the mandatory variable `MotionDevices/Manipulator/Axes/Elbow/ParameterSet/ActualPosition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/Axes/Elbow/ParameterSet/ActualPosition\")]"),
+            ("MotionDevices/Manipulator/Axes/Wrist1/ParameterSet/ActualPosition", "the mandatory variable `MotionDevices/Manipulator/Axes/Wrist1/ParameterSet/ActualPosition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/Axes/Wrist1/ParameterSet/ActualPosition\")]"),
+            ("MotionDevices/Manipulator/Axes/Wrist2/ParameterSet/ActualPosition", "the mandatory variable `MotionDevices/Manipulator/Axes/Wrist2/ParameterSet/ActualPosition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/Axes/Wrist2/ParameterSet/ActualPosition\")]"),
+            ("MotionDevices/Manipulator/Axes/Wrist3/ParameterSet/ActualPosition", "the mandatory variable `MotionDevices/Manipulator/Axes/Wrist3/ParameterSet/ActualPosition` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/Axes/Wrist3/ParameterSet/ActualPosition\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/Model", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/Model` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/Model\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/ProductCode", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/ProductCode\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/SerialNumber", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/BaseDrive/Motor/SerialNumber\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/Model", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/Model` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/Model\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/ProductCode", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/ProductCode\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/SerialNumber", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/ShoulderDrive/Motor/SerialNumber\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/Model", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/Model` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/Model\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/ProductCode", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/ProductCode\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/SerialNumber", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/ElbowDrive/Motor/SerialNumber\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/Model", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/Model` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/Model\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/ProductCode", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/ProductCode\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/SerialNumber", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist1Drive/Motor/SerialNumber\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/Model", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/Model` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/Model\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/ProductCode", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/ProductCode\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/SerialNumber", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist2Drive/Motor/SerialNumber\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/Model", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/Model` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/Model\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/ProductCode", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/ProductCode\")]"),
+            ("MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/SerialNumber", "the mandatory variable `MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDevices/Manipulator/PowerTrains/Wrist3Drive/Motor/SerialNumber\")]"),
+            ("SafetyStates/SafetyState/ParameterSet/EmergencyStop", "the mandatory variable `SafetyStates/SafetyState/ParameterSet/EmergencyStop` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SafetyStates/SafetyState/ParameterSet/EmergencyStop\")]"),
+            ("SafetyStates/SafetyState/ParameterSet/OperationalMode", "the mandatory variable `SafetyStates/SafetyState/ParameterSet/OperationalMode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SafetyStates/SafetyState/ParameterSet/OperationalMode\")]"),
+            ("SafetyStates/SafetyState/ParameterSet/ProtectiveStop", "the mandatory variable `SafetyStates/SafetyState/ParameterSet/ProtectiveStop` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SafetyStates/SafetyState/ParameterSet/ProtectiveStop\")]"),
+        ];
+        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
+        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
+        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [1 "ProductCode"], false false false;
+        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
+        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
+        AssetId: String, -1, [1 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
+        Controllers__URController__ParameterSet__CabinetFanSpeed: f64, -1, [4 "Controllers", 0 "URController", 1 "ParameterSet", 4 "CabinetFanSpeed"], false false false;
+        Controllers__URController__ParameterSet__CPUFanSpeed: f64, -1, [4 "Controllers", 0 "URController", 1 "ParameterSet", 4 "CPUFanSpeed"], false false false;
+        Controllers__URController__ParameterSet__InputVoltage: f64, -1, [4 "Controllers", 0 "URController", 1 "ParameterSet", 4 "InputVoltage"], false false false;
+        Controllers__URController__ParameterSet__StartUpTime: ua::DateTime, -1, [4 "Controllers", 0 "URController", 1 "ParameterSet", 4 "StartUpTime"], false false false;
+        Controllers__URController__ParameterSet__Temperature: f64, -1, [4 "Controllers", 0 "URController", 1 "ParameterSet", 4 "Temperature"], false false false;
+        Controllers__URController__ParameterSet__TotalEnergyConsumption: f64, -1, [4 "Controllers", 0 "URController", 1 "ParameterSet", 4 "TotalEnergyConsumption"], false false false;
+        Controllers__URController__ParameterSet__TotalPowerOnTime: String, -1, [4 "Controllers", 0 "URController", 1 "ParameterSet", 4 "TotalPowerOnTime"], false false false;
+        Controllers__URController__ParameterSet__UpsState: String, -1, [4 "Controllers", 0 "URController", 1 "ParameterSet", 4 "UpsState"], false false false;
+        Controllers__URController__Identification__UIElement: ua::Variant, -1, [4 "Controllers", 0 "URController", 1 "Identification", 1 "UIElement"], false false false;
+        Controllers__URController__Lock__Locked: bool, -1, [4 "Controllers", 0 "URController", 1 "Lock", 1 "Locked"], false false false;
+        Controllers__URController__Lock__LockingClient: String, -1, [4 "Controllers", 0 "URController", 1 "Lock", 1 "LockingClient"], false false false;
+        Controllers__URController__Lock__LockingUser: String, -1, [4 "Controllers", 0 "URController", 1 "Lock", 1 "LockingUser"], false false false;
+        Controllers__URController__Lock__RemainingLockTime: f64, -1, [4 "Controllers", 0 "URController", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        Controllers__URController__Manufacturer: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 1 "Manufacturer"], true true false;
+        Controllers__URController__ManufacturerUri: String, -1, [4 "Controllers", 0 "URController", 1 "ManufacturerUri"], false false false;
+        Controllers__URController__Model: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 1 "Model"], true true false;
+        Controllers__URController__HardwareRevision: String, -1, [4 "Controllers", 0 "URController", 1 "HardwareRevision"], false false false;
+        Controllers__URController__SoftwareRevision: String, -1, [4 "Controllers", 0 "URController", 1 "SoftwareRevision"], false false false;
+        Controllers__URController__DeviceRevision: String, -1, [4 "Controllers", 0 "URController", 1 "DeviceRevision"], false false false;
+        Controllers__URController__ProductCode: String, -1, [4 "Controllers", 0 "URController", 1 "ProductCode"], true false false;
+        Controllers__URController__DeviceManual: String, -1, [4 "Controllers", 0 "URController", 1 "DeviceManual"], false false false;
+        Controllers__URController__DeviceClass: String, -1, [4 "Controllers", 0 "URController", 1 "DeviceClass"], false false false;
+        Controllers__URController__SerialNumber: String, -1, [4 "Controllers", 0 "URController", 1 "SerialNumber"], true false false;
+        Controllers__URController__ProductInstanceUri: String, -1, [4 "Controllers", 0 "URController", 1 "ProductInstanceUri"], false false false;
+        Controllers__URController__RevisionCounter: i32, -1, [4 "Controllers", 0 "URController", 1 "RevisionCounter"], false false false;
+        Controllers__URController__AssetId: String, -1, [4 "Controllers", 0 "URController", 1 "AssetId"], false false false;
+        Controllers__URController__ComponentName: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 1 "ComponentName"], false false false;
+        Controllers__URController__CurrentUser__Level: String, -1, [4 "Controllers", 0 "URController", 4 "CurrentUser", 4 "Level"], true false false;
+        Controllers__URController__CurrentUser__Name: String, -1, [4 "Controllers", 0 "URController", 4 "CurrentUser", 4 "Name"], false false false;
+        Controllers__URController__Software__PolyScope__Identification__UIElement: ua::Variant, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "Identification", 1 "UIElement"], false false false;
+        Controllers__URController__Software__PolyScope__Lock__Locked: bool, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "Lock", 1 "Locked"], false false false;
+        Controllers__URController__Software__PolyScope__Lock__LockingClient: String, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "Lock", 1 "LockingClient"], false false false;
+        Controllers__URController__Software__PolyScope__Lock__LockingUser: String, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "Lock", 1 "LockingUser"], false false false;
+        Controllers__URController__Software__PolyScope__Lock__RemainingLockTime: f64, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        Controllers__URController__Software__PolyScope__Manufacturer: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "Manufacturer"], true true false;
+        Controllers__URController__Software__PolyScope__ManufacturerUri: String, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "ManufacturerUri"], false false false;
+        Controllers__URController__Software__PolyScope__Model: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "Model"], true true false;
+        Controllers__URController__Software__PolyScope__HardwareRevision: String, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "HardwareRevision"], false false false;
+        Controllers__URController__Software__PolyScope__SoftwareRevision: String, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "SoftwareRevision"], true false false;
+        Controllers__URController__Software__PolyScope__DeviceRevision: String, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "DeviceRevision"], false false false;
+        Controllers__URController__Software__PolyScope__ProductCode: String, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "ProductCode"], false false false;
+        Controllers__URController__Software__PolyScope__DeviceManual: String, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "DeviceManual"], false false false;
+        Controllers__URController__Software__PolyScope__DeviceClass: String, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "DeviceClass"], false false false;
+        Controllers__URController__Software__PolyScope__SerialNumber: String, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "SerialNumber"], false false false;
+        Controllers__URController__Software__PolyScope__ProductInstanceUri: String, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "ProductInstanceUri"], false false false;
+        Controllers__URController__Software__PolyScope__RevisionCounter: i32, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "RevisionCounter"], false false false;
+        Controllers__URController__Software__PolyScope__AssetId: String, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "AssetId"], false false false;
+        Controllers__URController__Software__PolyScope__ComponentName: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 4 "Software", 0 "PolyScope", 1 "ComponentName"], false false false;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__CurrentState: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 3 "CurrentState"], false false false;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__LastTransition: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 3 "LastTransition"], false false false;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__AvailableStates: ua::NodeId, 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 3 "AvailableStates"], false false false;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__AvailableTransitions: ua::NodeId, 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 3 "AvailableTransitions"], false false false;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__ConfiguredDefaultStopMode: i16, -1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 4 "ConfiguredDefaultStopMode"], false false true;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__LastTransitionReason: i16, -1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 4 "LastTransitionReason"], false false true;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__PossibleStopModes: ua::EnumValueType, 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 4 "PossibleStopModes"], false true true;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__CurrentState: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 4 "ExecutingSubstateMachine", 3 "CurrentState"], false false false;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__LastTransition: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 4 "ExecutingSubstateMachine", 3 "LastTransition"], false false false;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__AvailableStates: ua::NodeId, 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 4 "ExecutingSubstateMachine", 3 "AvailableStates"], false false false;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__AvailableTransitions: ua::NodeId, 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 4 "ExecutingSubstateMachine", 3 "AvailableTransitions"], false false false;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__LastTransitionReason: i16, -1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 4 "ExecutingSubstateMachine", 4 "LastTransitionReason"], false false true;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__CurrentState: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 4 "IdleSubstateMachine", 3 "CurrentState"], false false false;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__LastTransition: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 4 "IdleSubstateMachine", 3 "LastTransition"], false false false;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__AvailableStates: ua::NodeId, 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 4 "IdleSubstateMachine", 3 "AvailableStates"], false false false;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__AvailableTransitions: ua::NodeId, 1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 4 "IdleSubstateMachine", 3 "AvailableTransitions"], false false false;
+        Controllers__URController__SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__LastTransitionReason: i16, -1, [4 "Controllers", 0 "URController", 4 "SystemOperation", 4 "SystemOperationStateMachine", 4 "IdleSubstateMachine", 4 "LastTransitionReason"], false false true;
+        Controllers__URController__TaskControls__ProgramTask__ParameterSet__TaskProgramLoaded: bool, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "ParameterSet", 4 "TaskProgramLoaded"], true false false;
+        Controllers__URController__TaskControls__ProgramTask__ParameterSet__TaskProgramName: String, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "ParameterSet", 4 "TaskProgramName"], true false false;
+        Controllers__URController__TaskControls__ProgramTask__Identification__UIElement: ua::Variant, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "Identification", 1 "UIElement"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__Lock__Locked: bool, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "Lock", 1 "Locked"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__Lock__LockingClient: String, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "Lock", 1 "LockingClient"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__Lock__LockingUser: String, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "Lock", 1 "LockingUser"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__Lock__RemainingLockTime: f64, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__Manufacturer: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "Manufacturer"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__ManufacturerUri: String, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "ManufacturerUri"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__Model: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "Model"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__HardwareRevision: String, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "HardwareRevision"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__SoftwareRevision: String, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "SoftwareRevision"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__DeviceRevision: String, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "DeviceRevision"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__ProductCode: String, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "ProductCode"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__DeviceManual: String, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "DeviceManual"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__DeviceClass: String, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "DeviceClass"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__SerialNumber: String, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "SerialNumber"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__ProductInstanceUri: String, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "ProductInstanceUri"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__RevisionCounter: i32, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "RevisionCounter"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__AssetId: String, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "AssetId"], false false false;
+        Controllers__URController__TaskControls__ProgramTask__ComponentName: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 1 "ComponentName"], true false false;
+        Controllers__URController__TaskControls__ProgramTask__TaskControlOperation__MotionDevicesUnderControl: ua::NodeId, 1, [4 "Controllers", 0 "URController", 4 "TaskControls", 0 "ProgramTask", 4 "TaskControlOperation", 4 "MotionDevicesUnderControl"], false false false;
+        Controllers__URController__SkillSet__AbsoluteJointPTPMove__CurrentState: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteJointPTPMove", 3 "CurrentState"], true false false;
+        Controllers__URController__SkillSet__AbsoluteJointPTPMove__LastTransition: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteJointPTPMove", 3 "LastTransition"], true false false;
+        Controllers__URController__SkillSet__AbsoluteJointPTPMove__AvailableStates: ua::NodeId, 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteJointPTPMove", 3 "AvailableStates"], false false false;
+        Controllers__URController__SkillSet__AbsoluteJointPTPMove__AvailableTransitions: ua::NodeId, 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteJointPTPMove", 3 "AvailableTransitions"], false false false;
+        Controllers__URController__SkillSet__AbsoluteJointPTPMove__Deletable: bool, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteJointPTPMove", 3 "Deletable"], true false false;
+        Controllers__URController__SkillSet__AbsoluteJointPTPMove__AutoDelete: bool, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteJointPTPMove", 3 "AutoDelete"], true false false;
+        Controllers__URController__SkillSet__AbsoluteJointPTPMove__RecycleCount: i32, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteJointPTPMove", 3 "RecycleCount"], true false false;
+        Controllers__URController__SkillSet__AbsoluteJointPTPMove__ProgramDiagnostic: ua::ExtensionObject, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteJointPTPMove", 3 "ProgramDiagnostic"], false false false;
+        Controllers__URController__SkillSet__AbsoluteJointPTPMove__InputParameterSet__Speed: f64, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteJointPTPMove", 2 "InputParameterSet", 2 "Speed"], true false true;
+        Controllers__URController__SkillSet__AbsoluteJointPTPMove__InputParameterSet__Acceleration: f64, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteJointPTPMove", 2 "InputParameterSet", 2 "Acceleration"], true false true;
+        Controllers__URController__SkillSet__AbsoluteJointPTPMove__InputParameterSet__TargetJointPositions: f64, 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteJointPTPMove", 2 "InputParameterSet", 2 "TargetJointPositions"], true false true;
+        Controllers__URController__SkillSet__AbsoluteJointPTPMove__OutputParameterSet__Result: ua::StatusCode, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteJointPTPMove", 2 "OutputParameterSet", 2 "Result"], true false false;
+        Controllers__URController__SkillSet__RelativeCartesianLinearMove__CurrentState: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "RelativeCartesianLinearMove", 3 "CurrentState"], true false false;
+        Controllers__URController__SkillSet__RelativeCartesianLinearMove__LastTransition: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "RelativeCartesianLinearMove", 3 "LastTransition"], true false false;
+        Controllers__URController__SkillSet__RelativeCartesianLinearMove__AvailableStates: ua::NodeId, 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "RelativeCartesianLinearMove", 3 "AvailableStates"], false false false;
+        Controllers__URController__SkillSet__RelativeCartesianLinearMove__AvailableTransitions: ua::NodeId, 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "RelativeCartesianLinearMove", 3 "AvailableTransitions"], false false false;
+        Controllers__URController__SkillSet__RelativeCartesianLinearMove__Deletable: bool, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "RelativeCartesianLinearMove", 3 "Deletable"], true false false;
+        Controllers__URController__SkillSet__RelativeCartesianLinearMove__AutoDelete: bool, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "RelativeCartesianLinearMove", 3 "AutoDelete"], true false false;
+        Controllers__URController__SkillSet__RelativeCartesianLinearMove__RecycleCount: i32, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "RelativeCartesianLinearMove", 3 "RecycleCount"], true false false;
+        Controllers__URController__SkillSet__RelativeCartesianLinearMove__ProgramDiagnostic: ua::ExtensionObject, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "RelativeCartesianLinearMove", 3 "ProgramDiagnostic"], false false false;
+        Controllers__URController__SkillSet__RelativeCartesianLinearMove__InputParameterSet__Speed: f64, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "RelativeCartesianLinearMove", 2 "InputParameterSet", 2 "Speed"], true false true;
+        Controllers__URController__SkillSet__RelativeCartesianLinearMove__InputParameterSet__Acceleration: f64, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "RelativeCartesianLinearMove", 2 "InputParameterSet", 2 "Acceleration"], true false true;
+        Controllers__URController__SkillSet__RelativeCartesianLinearMove__InputParameterSet__PoseOffset: ua::ThreeDFrame, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "RelativeCartesianLinearMove", 2 "InputParameterSet", 2 "PoseOffset"], true false true;
+        Controllers__URController__SkillSet__RelativeCartesianLinearMove__OutputParameterSet__Result: ua::StatusCode, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "RelativeCartesianLinearMove", 2 "OutputParameterSet", 2 "Result"], true false false;
+        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__CurrentState: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteCartesianLinearMove", 3 "CurrentState"], true false false;
+        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__LastTransition: ua::LocalizedText, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteCartesianLinearMove", 3 "LastTransition"], true false false;
+        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__AvailableStates: ua::NodeId, 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteCartesianLinearMove", 3 "AvailableStates"], false false false;
+        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__AvailableTransitions: ua::NodeId, 1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteCartesianLinearMove", 3 "AvailableTransitions"], false false false;
+        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__Deletable: bool, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteCartesianLinearMove", 3 "Deletable"], true false false;
+        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__AutoDelete: bool, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteCartesianLinearMove", 3 "AutoDelete"], true false false;
+        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__RecycleCount: i32, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteCartesianLinearMove", 3 "RecycleCount"], true false false;
+        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__ProgramDiagnostic: ua::ExtensionObject, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteCartesianLinearMove", 3 "ProgramDiagnostic"], false false false;
+        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__InputParameterSet__Speed: f64, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteCartesianLinearMove", 2 "InputParameterSet", 2 "Speed"], true false true;
+        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__InputParameterSet__Acceleration: f64, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteCartesianLinearMove", 2 "InputParameterSet", 2 "Acceleration"], true false true;
+        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__InputParameterSet__TargetPose: ua::ThreeDFrame, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteCartesianLinearMove", 2 "InputParameterSet", 2 "TargetPose"], true false true;
+        Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__OutputParameterSet__Result: ua::StatusCode, -1, [4 "Controllers", 0 "URController", 2 "SkillSet", 0 "AbsoluteCartesianLinearMove", 2 "OutputParameterSet", 2 "Result"], true false false;
+        MotionDevices__Manipulator__ParameterSet__SpeedOverride: f64, -1, [4 "MotionDevices", 0 "Manipulator", 1 "ParameterSet", 4 "SpeedOverride"], true false false;
+        MotionDevices__Manipulator__Identification__UIElement: ua::Variant, -1, [4 "MotionDevices", 0 "Manipulator", 1 "Identification", 1 "UIElement"], false false false;
+        MotionDevices__Manipulator__Lock__Locked: bool, -1, [4 "MotionDevices", 0 "Manipulator", 1 "Lock", 1 "Locked"], false false false;
+        MotionDevices__Manipulator__Lock__LockingClient: String, -1, [4 "MotionDevices", 0 "Manipulator", 1 "Lock", 1 "LockingClient"], false false false;
+        MotionDevices__Manipulator__Lock__LockingUser: String, -1, [4 "MotionDevices", 0 "Manipulator", 1 "Lock", 1 "LockingUser"], false false false;
+        MotionDevices__Manipulator__Lock__RemainingLockTime: f64, -1, [4 "MotionDevices", 0 "Manipulator", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        MotionDevices__Manipulator__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 1 "Manufacturer"], true true false;
+        MotionDevices__Manipulator__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 1 "Model"], true true false;
+        MotionDevices__Manipulator__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 1 "ProductCode"], true false false;
+        MotionDevices__Manipulator__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 1 "SerialNumber"], true false false;
+        MotionDevices__Manipulator__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__Axes__Base__ParameterSet__ActualPosition: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "ParameterSet", 4 "ActualPosition"], true false false;
+        MotionDevices__Manipulator__Axes__Base__Identification__UIElement: ua::Variant, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "Identification", 1 "UIElement"], false false false;
+        MotionDevices__Manipulator__Axes__Base__Lock__Locked: bool, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "Lock", 1 "Locked"], false false false;
+        MotionDevices__Manipulator__Axes__Base__Lock__LockingClient: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "Lock", 1 "LockingClient"], false false false;
+        MotionDevices__Manipulator__Axes__Base__Lock__LockingUser: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "Lock", 1 "LockingUser"], false false false;
+        MotionDevices__Manipulator__Axes__Base__Lock__RemainingLockTime: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        MotionDevices__Manipulator__Axes__Base__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "Manufacturer"], false false false;
+        MotionDevices__Manipulator__Axes__Base__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__Axes__Base__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "Model"], false false false;
+        MotionDevices__Manipulator__Axes__Base__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Base__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Base__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Base__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "ProductCode"], false false false;
+        MotionDevices__Manipulator__Axes__Base__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__Axes__Base__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__Axes__Base__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "SerialNumber"], false false false;
+        MotionDevices__Manipulator__Axes__Base__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__Axes__Base__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__Axes__Base__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__Axes__Base__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__Axes__Base__AdditionalLoad__CenterOfMass: ua::ThreeDFrame, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 4 "AdditionalLoad", 4 "CenterOfMass"], false false false;
+        MotionDevices__Manipulator__Axes__Base__AdditionalLoad__Inertia: ua::ThreeDVector, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 4 "AdditionalLoad", 4 "Inertia"], false false false;
+        MotionDevices__Manipulator__Axes__Base__AdditionalLoad__Mass: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 4 "AdditionalLoad", 4 "Mass"], false false false;
+        MotionDevices__Manipulator__Axes__Base__MotionProfile: super::super::super::super::robotics::types::AxisMotionProfileEnumeration, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Base", 4 "MotionProfile"], true true false;
+        MotionDevices__Manipulator__Axes__Shoulder__ParameterSet__ActualPosition: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "ParameterSet", 4 "ActualPosition"], true false false;
+        MotionDevices__Manipulator__Axes__Shoulder__Identification__UIElement: ua::Variant, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "Identification", 1 "UIElement"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__Lock__Locked: bool, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "Lock", 1 "Locked"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__Lock__LockingClient: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "Lock", 1 "LockingClient"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__Lock__LockingUser: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "Lock", 1 "LockingUser"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__Lock__RemainingLockTime: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "Manufacturer"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "Model"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "ProductCode"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "SerialNumber"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__AdditionalLoad__CenterOfMass: ua::ThreeDFrame, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 4 "AdditionalLoad", 4 "CenterOfMass"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__AdditionalLoad__Inertia: ua::ThreeDVector, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 4 "AdditionalLoad", 4 "Inertia"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__AdditionalLoad__Mass: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 4 "AdditionalLoad", 4 "Mass"], false false false;
+        MotionDevices__Manipulator__Axes__Shoulder__MotionProfile: super::super::super::super::robotics::types::AxisMotionProfileEnumeration, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Shoulder", 4 "MotionProfile"], true true false;
+        MotionDevices__Manipulator__Axes__Elbow__ParameterSet__ActualPosition: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "ParameterSet", 4 "ActualPosition"], true false false;
+        MotionDevices__Manipulator__Axes__Elbow__Identification__UIElement: ua::Variant, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "Identification", 1 "UIElement"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__Lock__Locked: bool, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "Lock", 1 "Locked"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__Lock__LockingClient: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "Lock", 1 "LockingClient"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__Lock__LockingUser: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "Lock", 1 "LockingUser"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__Lock__RemainingLockTime: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "Manufacturer"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "Model"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "ProductCode"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "SerialNumber"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__AdditionalLoad__CenterOfMass: ua::ThreeDFrame, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 4 "AdditionalLoad", 4 "CenterOfMass"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__AdditionalLoad__Inertia: ua::ThreeDVector, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 4 "AdditionalLoad", 4 "Inertia"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__AdditionalLoad__Mass: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 4 "AdditionalLoad", 4 "Mass"], false false false;
+        MotionDevices__Manipulator__Axes__Elbow__MotionProfile: super::super::super::super::robotics::types::AxisMotionProfileEnumeration, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Elbow", 4 "MotionProfile"], true true false;
+        MotionDevices__Manipulator__Axes__Wrist1__ParameterSet__ActualPosition: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "ParameterSet", 4 "ActualPosition"], true false false;
+        MotionDevices__Manipulator__Axes__Wrist1__Identification__UIElement: ua::Variant, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "Identification", 1 "UIElement"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__Lock__Locked: bool, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "Lock", 1 "Locked"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__Lock__LockingClient: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "Lock", 1 "LockingClient"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__Lock__LockingUser: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "Lock", 1 "LockingUser"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__Lock__RemainingLockTime: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "Manufacturer"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "Model"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "ProductCode"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "SerialNumber"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__AdditionalLoad__CenterOfMass: ua::ThreeDFrame, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 4 "AdditionalLoad", 4 "CenterOfMass"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__AdditionalLoad__Inertia: ua::ThreeDVector, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 4 "AdditionalLoad", 4 "Inertia"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__AdditionalLoad__Mass: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 4 "AdditionalLoad", 4 "Mass"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist1__MotionProfile: super::super::super::super::robotics::types::AxisMotionProfileEnumeration, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist1", 4 "MotionProfile"], true true false;
+        MotionDevices__Manipulator__Axes__Wrist2__ParameterSet__ActualPosition: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "ParameterSet", 4 "ActualPosition"], true false false;
+        MotionDevices__Manipulator__Axes__Wrist2__Identification__UIElement: ua::Variant, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "Identification", 1 "UIElement"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__Lock__Locked: bool, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "Lock", 1 "Locked"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__Lock__LockingClient: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "Lock", 1 "LockingClient"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__Lock__LockingUser: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "Lock", 1 "LockingUser"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__Lock__RemainingLockTime: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "Manufacturer"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "Model"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "ProductCode"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "SerialNumber"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__AdditionalLoad__CenterOfMass: ua::ThreeDFrame, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 4 "AdditionalLoad", 4 "CenterOfMass"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__AdditionalLoad__Inertia: ua::ThreeDVector, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 4 "AdditionalLoad", 4 "Inertia"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__AdditionalLoad__Mass: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 4 "AdditionalLoad", 4 "Mass"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist2__MotionProfile: super::super::super::super::robotics::types::AxisMotionProfileEnumeration, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist2", 4 "MotionProfile"], true true false;
+        MotionDevices__Manipulator__Axes__Wrist3__ParameterSet__ActualPosition: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "ParameterSet", 4 "ActualPosition"], true false false;
+        MotionDevices__Manipulator__Axes__Wrist3__Identification__UIElement: ua::Variant, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "Identification", 1 "UIElement"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__Lock__Locked: bool, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "Lock", 1 "Locked"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__Lock__LockingClient: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "Lock", 1 "LockingClient"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__Lock__LockingUser: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "Lock", 1 "LockingUser"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__Lock__RemainingLockTime: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "Manufacturer"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "Model"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "ProductCode"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "SerialNumber"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__AdditionalLoad__CenterOfMass: ua::ThreeDFrame, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 4 "AdditionalLoad", 4 "CenterOfMass"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__AdditionalLoad__Inertia: ua::ThreeDVector, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 4 "AdditionalLoad", 4 "Inertia"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__AdditionalLoad__Mass: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 4 "AdditionalLoad", 4 "Mass"], false false false;
+        MotionDevices__Manipulator__Axes__Wrist3__MotionProfile: super::super::super::super::robotics::types::AxisMotionProfileEnumeration, -1, [4 "MotionDevices", 0 "Manipulator", 4 "Axes", 0 "Wrist3", 4 "MotionProfile"], true true false;
+        MotionDevices__Manipulator__FlangeLoad__CenterOfMass: ua::ThreeDFrame, -1, [4 "MotionDevices", 0 "Manipulator", 4 "FlangeLoad", 4 "CenterOfMass"], false false false;
+        MotionDevices__Manipulator__FlangeLoad__Inertia: ua::ThreeDVector, -1, [4 "MotionDevices", 0 "Manipulator", 4 "FlangeLoad", 4 "Inertia"], false false false;
+        MotionDevices__Manipulator__FlangeLoad__Mass: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "FlangeLoad", 4 "Mass"], false false false;
+        MotionDevices__Manipulator__MotionDeviceCategory: super::super::super::super::robotics::types::MotionDeviceCategoryEnumeration, -1, [4 "MotionDevices", 0 "Manipulator", 4 "MotionDeviceCategory"], true true false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Identification__UIElement: ua::Variant, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "Identification", 1 "UIElement"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Lock__Locked: bool, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "Lock", 1 "Locked"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Lock__LockingClient: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "Lock", 1 "LockingClient"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Lock__LockingUser: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "Lock", 1 "LockingUser"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Lock__RemainingLockTime: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "Manufacturer"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "Model"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "ProductCode"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "SerialNumber"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0 "Motor", 1 "Manufacturer"], true true false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0 "Motor", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0 "Motor", 1 "Model"], true false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0 "Motor", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0 "Motor", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0 "Motor", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0 "Motor", 1 "ProductCode"], true false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0 "Motor", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0 "Motor", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0 "Motor", 1 "SerialNumber"], true false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0 "Motor", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0 "Motor", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0 "Motor", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__PowerTrains__BaseDrive__Motor__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "BaseDrive", 0 "Motor", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Identification__UIElement: ua::Variant, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "Identification", 1 "UIElement"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Lock__Locked: bool, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "Lock", 1 "Locked"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Lock__LockingClient: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "Lock", 1 "LockingClient"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Lock__LockingUser: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "Lock", 1 "LockingUser"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Lock__RemainingLockTime: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "Manufacturer"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "Model"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "ProductCode"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "SerialNumber"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 0 "Motor", 1 "Manufacturer"], true true false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 0 "Motor", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 0 "Motor", 1 "Model"], true false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 0 "Motor", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 0 "Motor", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 0 "Motor", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 0 "Motor", 1 "ProductCode"], true false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 0 "Motor", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 0 "Motor", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 0 "Motor", 1 "SerialNumber"], true false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 0 "Motor", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 0 "Motor", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 0 "Motor", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Motor__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ShoulderDrive", 0 "Motor", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Identification__UIElement: ua::Variant, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "Identification", 1 "UIElement"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Lock__Locked: bool, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "Lock", 1 "Locked"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Lock__LockingClient: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "Lock", 1 "LockingClient"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Lock__LockingUser: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "Lock", 1 "LockingUser"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Lock__RemainingLockTime: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "Manufacturer"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "Model"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "ProductCode"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "SerialNumber"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0 "Motor", 1 "Manufacturer"], true true false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0 "Motor", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0 "Motor", 1 "Model"], true false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0 "Motor", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0 "Motor", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0 "Motor", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0 "Motor", 1 "ProductCode"], true false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0 "Motor", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0 "Motor", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0 "Motor", 1 "SerialNumber"], true false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0 "Motor", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0 "Motor", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0 "Motor", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__PowerTrains__ElbowDrive__Motor__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "ElbowDrive", 0 "Motor", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Identification__UIElement: ua::Variant, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "Identification", 1 "UIElement"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Lock__Locked: bool, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "Lock", 1 "Locked"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Lock__LockingClient: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "Lock", 1 "LockingClient"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Lock__LockingUser: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "Lock", 1 "LockingUser"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Lock__RemainingLockTime: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "Manufacturer"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "Model"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "ProductCode"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "SerialNumber"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 0 "Motor", 1 "Manufacturer"], true true false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 0 "Motor", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 0 "Motor", 1 "Model"], true false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 0 "Motor", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 0 "Motor", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 0 "Motor", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 0 "Motor", 1 "ProductCode"], true false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 0 "Motor", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 0 "Motor", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 0 "Motor", 1 "SerialNumber"], true false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 0 "Motor", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 0 "Motor", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 0 "Motor", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Motor__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist1Drive", 0 "Motor", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Identification__UIElement: ua::Variant, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "Identification", 1 "UIElement"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Lock__Locked: bool, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "Lock", 1 "Locked"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Lock__LockingClient: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "Lock", 1 "LockingClient"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Lock__LockingUser: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "Lock", 1 "LockingUser"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Lock__RemainingLockTime: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "Manufacturer"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "Model"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "ProductCode"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "SerialNumber"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 0 "Motor", 1 "Manufacturer"], true true false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 0 "Motor", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 0 "Motor", 1 "Model"], true false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 0 "Motor", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 0 "Motor", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 0 "Motor", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 0 "Motor", 1 "ProductCode"], true false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 0 "Motor", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 0 "Motor", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 0 "Motor", 1 "SerialNumber"], true false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 0 "Motor", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 0 "Motor", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 0 "Motor", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Motor__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist2Drive", 0 "Motor", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Identification__UIElement: ua::Variant, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "Identification", 1 "UIElement"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Lock__Locked: bool, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "Lock", 1 "Locked"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Lock__LockingClient: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "Lock", 1 "LockingClient"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Lock__LockingUser: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "Lock", 1 "LockingUser"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Lock__RemainingLockTime: f64, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "Manufacturer"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "Model"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "ProductCode"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "SerialNumber"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__Manufacturer: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 0 "Motor", 1 "Manufacturer"], true true false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__ManufacturerUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 0 "Motor", 1 "ManufacturerUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__Model: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 0 "Motor", 1 "Model"], true false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__HardwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 0 "Motor", 1 "HardwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__SoftwareRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 0 "Motor", 1 "SoftwareRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__DeviceRevision: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 0 "Motor", 1 "DeviceRevision"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__ProductCode: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 0 "Motor", 1 "ProductCode"], true false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__DeviceManual: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 0 "Motor", 1 "DeviceManual"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__DeviceClass: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 0 "Motor", 1 "DeviceClass"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__SerialNumber: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 0 "Motor", 1 "SerialNumber"], true false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__ProductInstanceUri: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 0 "Motor", 1 "ProductInstanceUri"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__RevisionCounter: i32, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 0 "Motor", 1 "RevisionCounter"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__AssetId: String, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 0 "Motor", 1 "AssetId"], false false false;
+        MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Motor__ComponentName: ua::LocalizedText, -1, [4 "MotionDevices", 0 "Manipulator", 4 "PowerTrains", 0 "Wrist3Drive", 0 "Motor", 1 "ComponentName"], false false false;
+        MotionDevices__Manipulator__TaskControlReference: ua::NodeId, -1, [4 "MotionDevices", 0 "Manipulator", 4 "TaskControlReference"], false false false;
+        SafetyStates__SafetyState__ParameterSet__EmergencyStop: bool, -1, [4 "SafetyStates", 0 "SafetyState", 1 "ParameterSet", 4 "EmergencyStop"], true false false;
+        SafetyStates__SafetyState__ParameterSet__OperationalMode: super::super::super::super::robotics::types::OperationalModeEnumeration, -1, [4 "SafetyStates", 0 "SafetyState", 1 "ParameterSet", 4 "OperationalMode"], true false false;
+        SafetyStates__SafetyState__ParameterSet__ProtectiveStop: bool, -1, [4 "SafetyStates", 0 "SafetyState", 1 "ParameterSet", 4 "ProtectiveStop"], true false false;
+        SafetyStates__SafetyState__Identification__UIElement: ua::Variant, -1, [4 "SafetyStates", 0 "SafetyState", 1 "Identification", 1 "UIElement"], false false false;
+        SafetyStates__SafetyState__Lock__Locked: bool, -1, [4 "SafetyStates", 0 "SafetyState", 1 "Lock", 1 "Locked"], false false false;
+        SafetyStates__SafetyState__Lock__LockingClient: String, -1, [4 "SafetyStates", 0 "SafetyState", 1 "Lock", 1 "LockingClient"], false false false;
+        SafetyStates__SafetyState__Lock__LockingUser: String, -1, [4 "SafetyStates", 0 "SafetyState", 1 "Lock", 1 "LockingUser"], false false false;
+        SafetyStates__SafetyState__Lock__RemainingLockTime: f64, -1, [4 "SafetyStates", 0 "SafetyState", 1 "Lock", 1 "RemainingLockTime"], false false false;
+        SafetyStates__SafetyState__Manufacturer: ua::LocalizedText, -1, [4 "SafetyStates", 0 "SafetyState", 1 "Manufacturer"], false false false;
+        SafetyStates__SafetyState__ManufacturerUri: String, -1, [4 "SafetyStates", 0 "SafetyState", 1 "ManufacturerUri"], false false false;
+        SafetyStates__SafetyState__Model: ua::LocalizedText, -1, [4 "SafetyStates", 0 "SafetyState", 1 "Model"], false false false;
+        SafetyStates__SafetyState__HardwareRevision: String, -1, [4 "SafetyStates", 0 "SafetyState", 1 "HardwareRevision"], false false false;
+        SafetyStates__SafetyState__SoftwareRevision: String, -1, [4 "SafetyStates", 0 "SafetyState", 1 "SoftwareRevision"], false false false;
+        SafetyStates__SafetyState__DeviceRevision: String, -1, [4 "SafetyStates", 0 "SafetyState", 1 "DeviceRevision"], false false false;
+        SafetyStates__SafetyState__ProductCode: String, -1, [4 "SafetyStates", 0 "SafetyState", 1 "ProductCode"], false false false;
+        SafetyStates__SafetyState__DeviceManual: String, -1, [4 "SafetyStates", 0 "SafetyState", 1 "DeviceManual"], false false false;
+        SafetyStates__SafetyState__DeviceClass: String, -1, [4 "SafetyStates", 0 "SafetyState", 1 "DeviceClass"], false false false;
+        SafetyStates__SafetyState__SerialNumber: String, -1, [4 "SafetyStates", 0 "SafetyState", 1 "SerialNumber"], false false false;
+        SafetyStates__SafetyState__ProductInstanceUri: String, -1, [4 "SafetyStates", 0 "SafetyState", 1 "ProductInstanceUri"], false false false;
+        SafetyStates__SafetyState__RevisionCounter: i32, -1, [4 "SafetyStates", 0 "SafetyState", 1 "RevisionCounter"], false false false;
+        SafetyStates__SafetyState__AssetId: String, -1, [4 "SafetyStates", 0 "SafetyState", 1 "AssetId"], false false false;
+        SafetyStates__SafetyState__ComponentName: ua::LocalizedText, -1, [4 "SafetyStates", 0 "SafetyState", 1 "ComponentName"], false false false;
     }
 }

@@ -2382,739 +2382,602 @@ pub mod members {
     #[allow(unused_imports)]
     use super::t;
     t::object_members! {
-        AuxiliaryComponentType; required : [("ProductCode",
-        "the mandatory variable `ProductCode` of AuxiliaryComponentType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]")];
-        Identification__UIElement : ua::Variant, - 1, [1 "Identification", 1
-        "UIElement"], false false false; Lock__Locked : bool, - 1, [1 "Lock", 1
-        "Locked"], false false false; Lock__LockingClient : String, - 1, [1 "Lock", 1
-        "LockingClient"], false false false; Lock__LockingUser : String, - 1, [1 "Lock",
-        1 "LockingUser"], false false false; Lock__RemainingLockTime : f64, - 1, [1
-        "Lock", 1 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [1 "Manufacturer"], false false false; ManufacturerUri :
-        String, - 1, [1 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [1 "Model"], false false false; HardwareRevision : String, - 1, [1
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [1
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [1
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [1
-        "ProductCode"], true false false; DeviceManual : String, - 1, [1 "DeviceManual"],
-        false false false; DeviceClass : String, - 1, [1 "DeviceClass"], false false
-        false; SerialNumber : String, - 1, [1 "SerialNumber"], false false false;
-        ProductInstanceUri : String, - 1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter : i32, - 1, [1 "RevisionCounter"], false false false; AssetId :
-        String, - 1, [1 "AssetId"], false false false; ComponentName : ua::LocalizedText,
-        - 1, [1 "ComponentName"], false false false;
+        AuxiliaryComponentType;
+        required: [
+            ("ProductCode", "the mandatory variable `ProductCode` of AuxiliaryComponentType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]"),
+        ];
+        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
+        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
+        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [1 "ProductCode"], true false false;
+        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
+        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
+        AssetId: String, -1, [1 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
     }
     t::object_members! {
-        AxisType; required : [("ParameterSet/ActualPosition",
-        "the mandatory variable `ParameterSet/ActualPosition` of AxisType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/ActualPosition\")]"),
-        ("MotionProfile",
-        "the mandatory variable `MotionProfile` of AxisType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionProfile\")]")];
-        ParameterSet__ActualAcceleration : f64, - 1, [1 "ParameterSet", 0
-        "ActualAcceleration"], false false false; ParameterSet__ActualPosition : f64, -
-        1, [1 "ParameterSet", 0 "ActualPosition"], true false false;
-        ParameterSet__ActualSpeed : f64, - 1, [1 "ParameterSet", 0 "ActualSpeed"], false
-        false false; Identification__UIElement : ua::Variant, - 1, [1 "Identification", 1
-        "UIElement"], false false false; Lock__Locked : bool, - 1, [1 "Lock", 1
-        "Locked"], false false false; Lock__LockingClient : String, - 1, [1 "Lock", 1
-        "LockingClient"], false false false; Lock__LockingUser : String, - 1, [1 "Lock",
-        1 "LockingUser"], false false false; Lock__RemainingLockTime : f64, - 1, [1
-        "Lock", 1 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [1 "Manufacturer"], false false false; ManufacturerUri :
-        String, - 1, [1 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [1 "Model"], false false false; HardwareRevision : String, - 1, [1
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [1
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [1
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [1
-        "ProductCode"], false false false; DeviceManual : String, - 1, [1
-        "DeviceManual"], false false false; DeviceClass : String, - 1, [1 "DeviceClass"],
-        false false false; SerialNumber : String, - 1, [1 "SerialNumber"], false false
-        false; ProductInstanceUri : String, - 1, [1 "ProductInstanceUri"], false false
-        false; RevisionCounter : i32, - 1, [1 "RevisionCounter"], false false false;
-        AssetId : String, - 1, [1 "AssetId"], false false false; ComponentName :
-        ua::LocalizedText, - 1, [1 "ComponentName"], false false false;
-        AdditionalLoad__CenterOfMass : ua::ThreeDFrame, - 1, [0 "AdditionalLoad", 0
-        "CenterOfMass"], false false false; AdditionalLoad__Inertia : ua::ThreeDVector, -
-        1, [0 "AdditionalLoad", 0 "Inertia"], false false false; AdditionalLoad__Mass :
-        f64, - 1, [0 "AdditionalLoad", 0 "Mass"], false false false; MotionProfile :
-        super::super::super::types::AxisMotionProfileEnumeration, - 1, [0
-        "MotionProfile"], true false false;
+        AxisType;
+        required: [
+            ("ParameterSet/ActualPosition", "the mandatory variable `ParameterSet/ActualPosition` of AxisType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/ActualPosition\")]"),
+            ("MotionProfile", "the mandatory variable `MotionProfile` of AxisType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionProfile\")]"),
+        ];
+        ParameterSet__ActualAcceleration: f64, -1, [1 "ParameterSet", 0 "ActualAcceleration"], false false false;
+        ParameterSet__ActualPosition: f64, -1, [1 "ParameterSet", 0 "ActualPosition"], true false false;
+        ParameterSet__ActualSpeed: f64, -1, [1 "ParameterSet", 0 "ActualSpeed"], false false false;
+        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
+        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
+        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [1 "ProductCode"], false false false;
+        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
+        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
+        AssetId: String, -1, [1 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
+        AdditionalLoad__CenterOfMass: ua::ThreeDFrame, -1, [0 "AdditionalLoad", 0 "CenterOfMass"], false false false;
+        AdditionalLoad__Inertia: ua::ThreeDVector, -1, [0 "AdditionalLoad", 0 "Inertia"], false false false;
+        AdditionalLoad__Mass: f64, -1, [0 "AdditionalLoad", 0 "Mass"], false false false;
+        MotionProfile: super::super::super::types::AxisMotionProfileEnumeration, -1, [0 "MotionProfile"], true false false;
     }
     t::object_members! {
-        ControllerType; required : [("Manufacturer",
-        "the mandatory variable `Manufacturer` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
-        ("Model",
-        "the mandatory variable `Model` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
-        ("ProductCode",
-        "the mandatory variable `ProductCode` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]"),
-        ("SerialNumber",
-        "the mandatory variable `SerialNumber` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
-        ("CurrentUser/Level",
-        "the mandatory variable `CurrentUser/Level` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentUser/Level\")]")];
-        ParameterSet__CabinetFanSpeed : f64, - 1, [1 "ParameterSet", 0
-        "CabinetFanSpeed"], false false false; ParameterSet__CPUFanSpeed : f64, - 1, [1
-        "ParameterSet", 0 "CPUFanSpeed"], false false false; ParameterSet__InputVoltage :
-        f64, - 1, [1 "ParameterSet", 0 "InputVoltage"], false false false;
-        ParameterSet__StartUpTime : ua::DateTime, - 1, [1 "ParameterSet", 0
-        "StartUpTime"], false false false; ParameterSet__Temperature : f64, - 1, [1
-        "ParameterSet", 0 "Temperature"], false false false;
-        ParameterSet__TotalEnergyConsumption : f64, - 1, [1 "ParameterSet", 0
-        "TotalEnergyConsumption"], false false false; ParameterSet__TotalPowerOnTime :
-        String, - 1, [1 "ParameterSet", 0 "TotalPowerOnTime"], false false false;
-        ParameterSet__UpsState : String, - 1, [1 "ParameterSet", 0 "UpsState"], false
-        false false; Identification__UIElement : ua::Variant, - 1, [1 "Identification", 1
-        "UIElement"], false false false; Lock__Locked : bool, - 1, [1 "Lock", 1
-        "Locked"], false false false; Lock__LockingClient : String, - 1, [1 "Lock", 1
-        "LockingClient"], false false false; Lock__LockingUser : String, - 1, [1 "Lock",
-        1 "LockingUser"], false false false; Lock__RemainingLockTime : f64, - 1, [1
-        "Lock", 1 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [1 "Manufacturer"], true false false; ManufacturerUri :
-        String, - 1, [1 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [1 "Model"], true false false; HardwareRevision : String, - 1, [1
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [1
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [1
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [1
-        "ProductCode"], true false false; DeviceManual : String, - 1, [1 "DeviceManual"],
-        false false false; DeviceClass : String, - 1, [1 "DeviceClass"], false false
-        false; SerialNumber : String, - 1, [1 "SerialNumber"], true false false;
-        ProductInstanceUri : String, - 1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter : i32, - 1, [1 "RevisionCounter"], false false false; AssetId :
-        String, - 1, [1 "AssetId"], false false false; ComponentName : ua::LocalizedText,
-        - 1, [1 "ComponentName"], false false false; CurrentUser__Level : String, - 1, [0
-        "CurrentUser", 0 "Level"], true false false; CurrentUser__Name : String, - 1, [0
-        "CurrentUser", 0 "Name"], false false false;
-        SystemOperation__SystemOperationStateMachine__CurrentState : ua::LocalizedText, -
-        1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 2 "CurrentState"],
-        false false false; SystemOperation__SystemOperationStateMachine__LastTransition :
-        ua::LocalizedText, - 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 2
-        "LastTransition"], false false false;
-        SystemOperation__SystemOperationStateMachine__AvailableStates : ua::NodeId, 1, [0
-        "SystemOperation", 0 "SystemOperationStateMachine", 2 "AvailableStates"], false
-        false false; SystemOperation__SystemOperationStateMachine__AvailableTransitions :
-        ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 2
-        "AvailableTransitions"], false false false;
-        SystemOperation__SystemOperationStateMachine__ConfiguredDefaultStopMode : i16, -
-        1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0
-        "ConfiguredDefaultStopMode"], false false true;
-        SystemOperation__SystemOperationStateMachine__LastTransitionReason : i16, - 1, [0
-        "SystemOperation", 0 "SystemOperationStateMachine", 0 "LastTransitionReason"],
-        false false true; SystemOperation__SystemOperationStateMachine__PossibleStopModes
-        : ua::EnumValueType, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0
-        "PossibleStopModes"], false true true;
-        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__CurrentState
-        : ua::LocalizedText, - 1, [0 "SystemOperation", 0 "SystemOperationStateMachine",
-        0 "ExecutingSubstateMachine", 2 "CurrentState"], false false false;
-        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__LastTransition
-        : ua::LocalizedText, - 1, [0 "SystemOperation", 0 "SystemOperationStateMachine",
-        0 "ExecutingSubstateMachine", 2 "LastTransition"], false false false;
-        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__AvailableStates
-        : ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0
-        "ExecutingSubstateMachine", 2 "AvailableStates"], false false false;
-        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__AvailableTransitions
-        : ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0
-        "ExecutingSubstateMachine", 2 "AvailableTransitions"], false false false;
-        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__LastTransitionReason
-        : i16, - 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0
-        "ExecutingSubstateMachine", 0 "LastTransitionReason"], false false true;
-        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__CurrentState :
-        ua::LocalizedText, - 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0
-        "IdleSubstateMachine", 2 "CurrentState"], false false false;
-        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__LastTransition
-        : ua::LocalizedText, - 1, [0 "SystemOperation", 0 "SystemOperationStateMachine",
-        0 "IdleSubstateMachine", 2 "LastTransition"], false false false;
-        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__AvailableStates
-        : ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0
-        "IdleSubstateMachine", 2 "AvailableStates"], false false false;
-        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__AvailableTransitions
-        : ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0
-        "IdleSubstateMachine", 2 "AvailableTransitions"], false false false;
-        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__LastTransitionReason
-        : i16, - 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0
-        "IdleSubstateMachine", 0 "LastTransitionReason"], false false true;
+        ControllerType;
+        required: [
+            ("Manufacturer", "the mandatory variable `Manufacturer` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
+            ("Model", "the mandatory variable `Model` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
+            ("ProductCode", "the mandatory variable `ProductCode` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]"),
+            ("SerialNumber", "the mandatory variable `SerialNumber` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
+            ("CurrentUser/Level", "the mandatory variable `CurrentUser/Level` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentUser/Level\")]"),
+        ];
+        ParameterSet__CabinetFanSpeed: f64, -1, [1 "ParameterSet", 0 "CabinetFanSpeed"], false false false;
+        ParameterSet__CPUFanSpeed: f64, -1, [1 "ParameterSet", 0 "CPUFanSpeed"], false false false;
+        ParameterSet__InputVoltage: f64, -1, [1 "ParameterSet", 0 "InputVoltage"], false false false;
+        ParameterSet__StartUpTime: ua::DateTime, -1, [1 "ParameterSet", 0 "StartUpTime"], false false false;
+        ParameterSet__Temperature: f64, -1, [1 "ParameterSet", 0 "Temperature"], false false false;
+        ParameterSet__TotalEnergyConsumption: f64, -1, [1 "ParameterSet", 0 "TotalEnergyConsumption"], false false false;
+        ParameterSet__TotalPowerOnTime: String, -1, [1 "ParameterSet", 0 "TotalPowerOnTime"], false false false;
+        ParameterSet__UpsState: String, -1, [1 "ParameterSet", 0 "UpsState"], false false false;
+        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], true false false;
+        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [1 "Model"], true false false;
+        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [1 "ProductCode"], true false false;
+        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [1 "SerialNumber"], true false false;
+        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
+        AssetId: String, -1, [1 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
+        CurrentUser__Level: String, -1, [0 "CurrentUser", 0 "Level"], true false false;
+        CurrentUser__Name: String, -1, [0 "CurrentUser", 0 "Name"], false false false;
+        SystemOperation__SystemOperationStateMachine__CurrentState: ua::LocalizedText, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 2 "CurrentState"], false false false;
+        SystemOperation__SystemOperationStateMachine__LastTransition: ua::LocalizedText, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 2 "LastTransition"], false false false;
+        SystemOperation__SystemOperationStateMachine__AvailableStates: ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 2 "AvailableStates"], false false false;
+        SystemOperation__SystemOperationStateMachine__AvailableTransitions: ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 2 "AvailableTransitions"], false false false;
+        SystemOperation__SystemOperationStateMachine__ConfiguredDefaultStopMode: i16, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "ConfiguredDefaultStopMode"], false false true;
+        SystemOperation__SystemOperationStateMachine__LastTransitionReason: i16, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "LastTransitionReason"], false false true;
+        SystemOperation__SystemOperationStateMachine__PossibleStopModes: ua::EnumValueType, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "PossibleStopModes"], false true true;
+        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "CurrentState"], false false false;
+        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "LastTransition"], false false false;
+        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__AvailableStates: ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "AvailableStates"], false false false;
+        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "AvailableTransitions"], false false false;
+        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__LastTransitionReason: i16, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 0 "LastTransitionReason"], false false true;
+        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "CurrentState"], false false false;
+        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "LastTransition"], false false false;
+        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__AvailableStates: ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "AvailableStates"], false false false;
+        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "AvailableTransitions"], false false false;
+        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__LastTransitionReason: i16, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 0 "LastTransitionReason"], false false true;
     }
     t::object_members! {
-        DriveType; required : [("ProductCode",
-        "the mandatory variable `ProductCode` of DriveType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]")];
-        Identification__UIElement : ua::Variant, - 1, [1 "Identification", 1
-        "UIElement"], false false false; Lock__Locked : bool, - 1, [1 "Lock", 1
-        "Locked"], false false false; Lock__LockingClient : String, - 1, [1 "Lock", 1
-        "LockingClient"], false false false; Lock__LockingUser : String, - 1, [1 "Lock",
-        1 "LockingUser"], false false false; Lock__RemainingLockTime : f64, - 1, [1
-        "Lock", 1 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [1 "Manufacturer"], false false false; ManufacturerUri :
-        String, - 1, [1 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [1 "Model"], false false false; HardwareRevision : String, - 1, [1
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [1
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [1
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [1
-        "ProductCode"], true false false; DeviceManual : String, - 1, [1 "DeviceManual"],
-        false false false; DeviceClass : String, - 1, [1 "DeviceClass"], false false
-        false; SerialNumber : String, - 1, [1 "SerialNumber"], false false false;
-        ProductInstanceUri : String, - 1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter : i32, - 1, [1 "RevisionCounter"], false false false; AssetId :
-        String, - 1, [1 "AssetId"], false false false; ComponentName : ua::LocalizedText,
-        - 1, [1 "ComponentName"], false false false;
+        DriveType;
+        required: [
+            ("ProductCode", "the mandatory variable `ProductCode` of DriveType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]"),
+        ];
+        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
+        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
+        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [1 "ProductCode"], true false false;
+        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
+        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
+        AssetId: String, -1, [1 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
     }
     t::object_members! {
-        EmergencyStopFunctionType; required : [("Active",
-        "the mandatory variable `Active` of EmergencyStopFunctionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Active\")]"),
-        ("Name",
-        "the mandatory variable `Name` of EmergencyStopFunctionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Name\")]")];
-        Active : bool, - 1, [0 "Active"], true false false; Name : String, - 1, [0
-        "Name"], true false false;
+        EmergencyStopFunctionType;
+        required: [
+            ("Active", "the mandatory variable `Active` of EmergencyStopFunctionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Active\")]"),
+            ("Name", "the mandatory variable `Name` of EmergencyStopFunctionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Name\")]"),
+        ];
+        Active: bool, -1, [0 "Active"], true false false;
+        Name: String, -1, [0 "Name"], true false false;
     }
     t::object_members! {
-        ExecutingSubstateMachineType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of ExecutingSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of ExecutingSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("LastTransitionReason",
-        "the mandatory variable `LastTransitionReason` of ExecutingSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]")];
-        CurrentState : ua::LocalizedText, - 1, [2 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [2 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [2 "AvailableTransitions"], false false
-        false; LastTransitionReason : i16, - 1, [0 "LastTransitionReason"], true false
-        true;
+        ExecutingSubstateMachineType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of ExecutingSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of ExecutingSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("LastTransitionReason", "the mandatory variable `LastTransitionReason` of ExecutingSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
+        LastTransitionReason: i16, -1, [0 "LastTransitionReason"], true false true;
     }
     t::object_members! {
-        GearType; required : [("Manufacturer",
-        "the mandatory variable `Manufacturer` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
-        ("Model",
-        "the mandatory variable `Model` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
-        ("ProductCode",
-        "the mandatory variable `ProductCode` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]"),
-        ("SerialNumber",
-        "the mandatory variable `SerialNumber` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
-        ("GearRatio",
-        "the mandatory variable `GearRatio` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"GearRatio\")]")];
-        Identification__UIElement : ua::Variant, - 1, [1 "Identification", 1
-        "UIElement"], false false false; Lock__Locked : bool, - 1, [1 "Lock", 1
-        "Locked"], false false false; Lock__LockingClient : String, - 1, [1 "Lock", 1
-        "LockingClient"], false false false; Lock__LockingUser : String, - 1, [1 "Lock",
-        1 "LockingUser"], false false false; Lock__RemainingLockTime : f64, - 1, [1
-        "Lock", 1 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [1 "Manufacturer"], true false false; ManufacturerUri :
-        String, - 1, [1 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [1 "Model"], true false false; HardwareRevision : String, - 1, [1
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [1
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [1
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [1
-        "ProductCode"], true false false; DeviceManual : String, - 1, [1 "DeviceManual"],
-        false false false; DeviceClass : String, - 1, [1 "DeviceClass"], false false
-        false; SerialNumber : String, - 1, [1 "SerialNumber"], true false false;
-        ProductInstanceUri : String, - 1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter : i32, - 1, [1 "RevisionCounter"], false false false; AssetId :
-        String, - 1, [1 "AssetId"], false false false; ComponentName : ua::LocalizedText,
-        - 1, [1 "ComponentName"], false false false; GearRatio : ua::RationalNumber, - 1,
-        [0 "GearRatio"], true false false; Pitch : f64, - 1, [0 "Pitch"], false false
-        false;
+        GearType;
+        required: [
+            ("Manufacturer", "the mandatory variable `Manufacturer` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
+            ("Model", "the mandatory variable `Model` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
+            ("ProductCode", "the mandatory variable `ProductCode` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]"),
+            ("SerialNumber", "the mandatory variable `SerialNumber` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
+            ("GearRatio", "the mandatory variable `GearRatio` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"GearRatio\")]"),
+        ];
+        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], true false false;
+        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [1 "Model"], true false false;
+        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [1 "ProductCode"], true false false;
+        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [1 "SerialNumber"], true false false;
+        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
+        AssetId: String, -1, [1 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
+        GearRatio: ua::RationalNumber, -1, [0 "GearRatio"], true false false;
+        Pitch: f64, -1, [0 "Pitch"], false false false;
     }
     t::object_members! {
-        IdleSubstateMachineType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of IdleSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of IdleSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("LastTransitionReason",
-        "the mandatory variable `LastTransitionReason` of IdleSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]")];
-        CurrentState : ua::LocalizedText, - 1, [2 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [2 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [2 "AvailableTransitions"], false false
-        false; LastTransitionReason : i16, - 1, [0 "LastTransitionReason"], true false
-        true;
+        IdleSubstateMachineType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of IdleSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of IdleSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("LastTransitionReason", "the mandatory variable `LastTransitionReason` of IdleSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
+        LastTransitionReason: i16, -1, [0 "LastTransitionReason"], true false true;
     }
     t::object_members! {
-        LoadType; required : [("Mass",
-        "the mandatory variable `Mass` of LoadType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Mass\")]")];
-        CenterOfMass : ua::ThreeDFrame, - 1, [0 "CenterOfMass"], false false false;
-        Inertia : ua::ThreeDVector, - 1, [0 "Inertia"], false false false; Mass : f64, -
-        1, [0 "Mass"], true false false;
+        LoadType;
+        required: [
+            ("Mass", "the mandatory variable `Mass` of LoadType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Mass\")]"),
+        ];
+        CenterOfMass: ua::ThreeDFrame, -1, [0 "CenterOfMass"], false false false;
+        Inertia: ua::ThreeDVector, -1, [0 "Inertia"], false false false;
+        Mass: f64, -1, [0 "Mass"], true false false;
     }
     t::object_members! {
-        MotionDeviceSystemType; required : []; Identification__UIElement : ua::Variant, -
-        1, [1 "Identification", 1 "UIElement"], false false false; Lock__Locked : bool, -
-        1, [1 "Lock", 1 "Locked"], false false false; Lock__LockingClient : String, - 1,
-        [1 "Lock", 1 "LockingClient"], false false false; Lock__LockingUser : String, -
-        1, [1 "Lock", 1 "LockingUser"], false false false; Lock__RemainingLockTime : f64,
-        - 1, [1 "Lock", 1 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [1 "Manufacturer"], false false false; ManufacturerUri :
-        String, - 1, [1 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [1 "Model"], false false false; HardwareRevision : String, - 1, [1
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [1
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [1
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [1
-        "ProductCode"], false false false; DeviceManual : String, - 1, [1
-        "DeviceManual"], false false false; DeviceClass : String, - 1, [1 "DeviceClass"],
-        false false false; SerialNumber : String, - 1, [1 "SerialNumber"], false false
-        false; ProductInstanceUri : String, - 1, [1 "ProductInstanceUri"], false false
-        false; RevisionCounter : i32, - 1, [1 "RevisionCounter"], false false false;
-        AssetId : String, - 1, [1 "AssetId"], false false false; ComponentName :
-        ua::LocalizedText, - 1, [1 "ComponentName"], false false false;
+        MotionDeviceSystemType;
+        required: [];
+        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
+        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
+        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [1 "ProductCode"], false false false;
+        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
+        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
+        AssetId: String, -1, [1 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
     }
     t::object_members! {
-        MotionDeviceType; required : [("ParameterSet/SpeedOverride",
-        "the mandatory variable `ParameterSet/SpeedOverride` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/SpeedOverride\")]"),
-        ("Manufacturer",
-        "the mandatory variable `Manufacturer` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
-        ("Model",
-        "the mandatory variable `Model` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
-        ("ProductCode",
-        "the mandatory variable `ProductCode` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]"),
-        ("SerialNumber",
-        "the mandatory variable `SerialNumber` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
-        ("MotionDeviceCategory",
-        "the mandatory variable `MotionDeviceCategory` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDeviceCategory\")]")];
-        ParameterSet__InControl : bool, - 1, [1 "ParameterSet", 0 "InControl"], false
-        false false; ParameterSet__OnPath : bool, - 1, [1 "ParameterSet", 0 "OnPath"],
-        false false false; ParameterSet__SpeedOverride : f64, - 1, [1 "ParameterSet", 0
-        "SpeedOverride"], true false false; Identification__UIElement : ua::Variant, - 1,
-        [1 "Identification", 1 "UIElement"], false false false; Lock__Locked : bool, - 1,
-        [1 "Lock", 1 "Locked"], false false false; Lock__LockingClient : String, - 1, [1
-        "Lock", 1 "LockingClient"], false false false; Lock__LockingUser : String, - 1,
-        [1 "Lock", 1 "LockingUser"], false false false; Lock__RemainingLockTime : f64, -
-        1, [1 "Lock", 1 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [1 "Manufacturer"], true false false; ManufacturerUri :
-        String, - 1, [1 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [1 "Model"], true false false; HardwareRevision : String, - 1, [1
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [1
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [1
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [1
-        "ProductCode"], true false false; DeviceManual : String, - 1, [1 "DeviceManual"],
-        false false false; DeviceClass : String, - 1, [1 "DeviceClass"], false false
-        false; SerialNumber : String, - 1, [1 "SerialNumber"], true false false;
-        ProductInstanceUri : String, - 1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter : i32, - 1, [1 "RevisionCounter"], false false false; AssetId :
-        String, - 1, [1 "AssetId"], false false false; ComponentName : ua::LocalizedText,
-        - 1, [1 "ComponentName"], false false false; FlangeLoad__CenterOfMass :
-        ua::ThreeDFrame, - 1, [0 "FlangeLoad", 0 "CenterOfMass"], false false false;
-        FlangeLoad__Inertia : ua::ThreeDVector, - 1, [0 "FlangeLoad", 0 "Inertia"], false
-        false false; FlangeLoad__Mass : f64, - 1, [0 "FlangeLoad", 0 "Mass"], false false
-        false; MotionDeviceCategory :
-        super::super::super::types::MotionDeviceCategoryEnumeration, - 1, [0
-        "MotionDeviceCategory"], true false false; TaskControlReference : ua::NodeId, -
-        1, [0 "TaskControlReference"], false false false;
+        MotionDeviceType;
+        required: [
+            ("ParameterSet/SpeedOverride", "the mandatory variable `ParameterSet/SpeedOverride` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/SpeedOverride\")]"),
+            ("Manufacturer", "the mandatory variable `Manufacturer` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
+            ("Model", "the mandatory variable `Model` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
+            ("ProductCode", "the mandatory variable `ProductCode` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]"),
+            ("SerialNumber", "the mandatory variable `SerialNumber` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
+            ("MotionDeviceCategory", "the mandatory variable `MotionDeviceCategory` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDeviceCategory\")]"),
+        ];
+        ParameterSet__InControl: bool, -1, [1 "ParameterSet", 0 "InControl"], false false false;
+        ParameterSet__OnPath: bool, -1, [1 "ParameterSet", 0 "OnPath"], false false false;
+        ParameterSet__SpeedOverride: f64, -1, [1 "ParameterSet", 0 "SpeedOverride"], true false false;
+        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], true false false;
+        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [1 "Model"], true false false;
+        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [1 "ProductCode"], true false false;
+        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [1 "SerialNumber"], true false false;
+        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
+        AssetId: String, -1, [1 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
+        FlangeLoad__CenterOfMass: ua::ThreeDFrame, -1, [0 "FlangeLoad", 0 "CenterOfMass"], false false false;
+        FlangeLoad__Inertia: ua::ThreeDVector, -1, [0 "FlangeLoad", 0 "Inertia"], false false false;
+        FlangeLoad__Mass: f64, -1, [0 "FlangeLoad", 0 "Mass"], false false false;
+        MotionDeviceCategory: super::super::super::types::MotionDeviceCategoryEnumeration, -1, [0 "MotionDeviceCategory"], true false false;
+        TaskControlReference: ua::NodeId, -1, [0 "TaskControlReference"], false false false;
     }
     t::object_members! {
-        MotorType; required : [("ParameterSet/MotorTemperature",
-        "the mandatory variable `ParameterSet/MotorTemperature` of MotorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/MotorTemperature\")]"),
-        ("Manufacturer",
-        "the mandatory variable `Manufacturer` of MotorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
-        ("Model",
-        "the mandatory variable `Model` of MotorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
-        ("ProductCode",
-        "the mandatory variable `ProductCode` of MotorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]"),
-        ("SerialNumber",
-        "the mandatory variable `SerialNumber` of MotorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]")];
-        ParameterSet__BrakeReleased : bool, - 1, [1 "ParameterSet", 0 "BrakeReleased"],
-        false false false; ParameterSet__EffectiveLoadRate : u16, - 1, [1 "ParameterSet",
-        0 "EffectiveLoadRate"], false false false; ParameterSet__MotorTemperature : f64,
-        - 1, [1 "ParameterSet", 0 "MotorTemperature"], true false false;
-        Identification__UIElement : ua::Variant, - 1, [1 "Identification", 1
-        "UIElement"], false false false; Lock__Locked : bool, - 1, [1 "Lock", 1
-        "Locked"], false false false; Lock__LockingClient : String, - 1, [1 "Lock", 1
-        "LockingClient"], false false false; Lock__LockingUser : String, - 1, [1 "Lock",
-        1 "LockingUser"], false false false; Lock__RemainingLockTime : f64, - 1, [1
-        "Lock", 1 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [1 "Manufacturer"], true false false; ManufacturerUri :
-        String, - 1, [1 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [1 "Model"], true false false; HardwareRevision : String, - 1, [1
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [1
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [1
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [1
-        "ProductCode"], true false false; DeviceManual : String, - 1, [1 "DeviceManual"],
-        false false false; DeviceClass : String, - 1, [1 "DeviceClass"], false false
-        false; SerialNumber : String, - 1, [1 "SerialNumber"], true false false;
-        ProductInstanceUri : String, - 1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter : i32, - 1, [1 "RevisionCounter"], false false false; AssetId :
-        String, - 1, [1 "AssetId"], false false false; ComponentName : ua::LocalizedText,
-        - 1, [1 "ComponentName"], false false false;
+        MotorType;
+        required: [
+            ("ParameterSet/MotorTemperature", "the mandatory variable `ParameterSet/MotorTemperature` of MotorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/MotorTemperature\")]"),
+            ("Manufacturer", "the mandatory variable `Manufacturer` of MotorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
+            ("Model", "the mandatory variable `Model` of MotorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
+            ("ProductCode", "the mandatory variable `ProductCode` of MotorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]"),
+            ("SerialNumber", "the mandatory variable `SerialNumber` of MotorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
+        ];
+        ParameterSet__BrakeReleased: bool, -1, [1 "ParameterSet", 0 "BrakeReleased"], false false false;
+        ParameterSet__EffectiveLoadRate: u16, -1, [1 "ParameterSet", 0 "EffectiveLoadRate"], false false false;
+        ParameterSet__MotorTemperature: f64, -1, [1 "ParameterSet", 0 "MotorTemperature"], true false false;
+        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], true false false;
+        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [1 "Model"], true false false;
+        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [1 "ProductCode"], true false false;
+        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [1 "SerialNumber"], true false false;
+        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
+        AssetId: String, -1, [1 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
     }
     t::object_members! {
-        MultiAcknowledgeableConditionType; required : [("EventId",
-        "the mandatory variable `EventId` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
-        ("EventType",
-        "the mandatory variable `EventType` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
-        ("SourceNode",
-        "the mandatory variable `SourceNode` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceNode\")]"),
-        ("SourceName",
-        "the mandatory variable `SourceName` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceName\")]"),
-        ("Time",
-        "the mandatory variable `Time` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Time\")]"),
-        ("ReceiveTime",
-        "the mandatory variable `ReceiveTime` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ReceiveTime\")]"),
-        ("Message",
-        "the mandatory variable `Message` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Message\")]"),
-        ("Severity",
-        "the mandatory variable `Severity` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Severity\")]"),
-        ("ConditionClassId",
-        "the mandatory variable `ConditionClassId` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassId\")]"),
-        ("ConditionClassName",
-        "the mandatory variable `ConditionClassName` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassName\")]"),
-        ("ConditionName",
-        "the mandatory variable `ConditionName` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionName\")]"),
-        ("BranchId",
-        "the mandatory variable `BranchId` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"BranchId\")]"),
-        ("Retain",
-        "the mandatory variable `Retain` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Retain\")]"),
-        ("EnabledState",
-        "the mandatory variable `EnabledState` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EnabledState\")]"),
-        ("Quality",
-        "the mandatory variable `Quality` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Quality\")]"),
-        ("LastSeverity",
-        "the mandatory variable `LastSeverity` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastSeverity\")]"),
-        ("Comment",
-        "the mandatory variable `Comment` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Comment\")]"),
-        ("ClientUserId",
-        "the mandatory variable `ClientUserId` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ClientUserId\")]"),
-        ("AckedState",
-        "the mandatory variable `AckedState` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AckedState\")]"),
-        ("ConditionDescriptions",
-        "the mandatory variable `ConditionDescriptions` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionDescriptions\")]")];
-        EventId : ua::ByteString, - 1, [2 "EventId"], true false false; EventType :
-        ua::NodeId, - 1, [2 "EventType"], true false false; SourceNode : ua::NodeId, - 1,
-        [2 "SourceNode"], true false false; SourceName : String, - 1, [2 "SourceName"],
-        true false false; Time : ua::DateTime, - 1, [2 "Time"], true false false;
-        ReceiveTime : ua::DateTime, - 1, [2 "ReceiveTime"], true false false; LocalTime :
-        ua::TimeZoneDataType, - 1, [2 "LocalTime"], false false false; Message :
-        ua::LocalizedText, - 1, [2 "Message"], true false false; Severity : u16, - 1, [2
-        "Severity"], true false false; ConditionClassId : ua::NodeId, - 1, [2
-        "ConditionClassId"], true false false; ConditionClassName : ua::LocalizedText, -
-        1, [2 "ConditionClassName"], true false false; ConditionSubClassId : ua::NodeId,
-        1, [2 "ConditionSubClassId"], false false false; ConditionSubClassName :
-        ua::LocalizedText, 1, [2 "ConditionSubClassName"], false false false;
-        ConditionName : String, - 1, [2 "ConditionName"], true false false; BranchId :
-        ua::NodeId, - 1, [2 "BranchId"], true false false; Retain : bool, - 1, [2
-        "Retain"], true false false; EnabledState : ua::LocalizedText, - 1, [2
-        "EnabledState"], true false false; Quality : ua::StatusCode, - 1, [2 "Quality"],
-        true false false; LastSeverity : u16, - 1, [2 "LastSeverity"], true false false;
-        Comment : ua::LocalizedText, - 1, [2 "Comment"], true false false; ClientUserId :
-        String, - 1, [2 "ClientUserId"], true false false; AckedState :
-        ua::LocalizedText, - 1, [2 "AckedState"], true false false; ConfirmedState :
-        ua::LocalizedText, - 1, [2 "ConfirmedState"], false false false;
-        ConditionDescriptions : ua::LocalizedText, 1, [0 "ConditionDescriptions"], true
-        false true;
+        MultiAcknowledgeableConditionType;
+        required: [
+            ("EventId", "the mandatory variable `EventId` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
+            ("EventType", "the mandatory variable `EventType` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
+            ("SourceNode", "the mandatory variable `SourceNode` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceNode\")]"),
+            ("SourceName", "the mandatory variable `SourceName` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SourceName\")]"),
+            ("Time", "the mandatory variable `Time` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Time\")]"),
+            ("ReceiveTime", "the mandatory variable `ReceiveTime` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ReceiveTime\")]"),
+            ("Message", "the mandatory variable `Message` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Message\")]"),
+            ("Severity", "the mandatory variable `Severity` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Severity\")]"),
+            ("ConditionClassId", "the mandatory variable `ConditionClassId` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassId\")]"),
+            ("ConditionClassName", "the mandatory variable `ConditionClassName` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionClassName\")]"),
+            ("ConditionName", "the mandatory variable `ConditionName` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionName\")]"),
+            ("BranchId", "the mandatory variable `BranchId` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"BranchId\")]"),
+            ("Retain", "the mandatory variable `Retain` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Retain\")]"),
+            ("EnabledState", "the mandatory variable `EnabledState` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EnabledState\")]"),
+            ("Quality", "the mandatory variable `Quality` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Quality\")]"),
+            ("LastSeverity", "the mandatory variable `LastSeverity` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastSeverity\")]"),
+            ("Comment", "the mandatory variable `Comment` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Comment\")]"),
+            ("ClientUserId", "the mandatory variable `ClientUserId` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ClientUserId\")]"),
+            ("AckedState", "the mandatory variable `AckedState` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AckedState\")]"),
+            ("ConditionDescriptions", "the mandatory variable `ConditionDescriptions` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionDescriptions\")]"),
+        ];
+        EventId: ua::ByteString, -1, [2 "EventId"], true false false;
+        EventType: ua::NodeId, -1, [2 "EventType"], true false false;
+        SourceNode: ua::NodeId, -1, [2 "SourceNode"], true false false;
+        SourceName: String, -1, [2 "SourceName"], true false false;
+        Time: ua::DateTime, -1, [2 "Time"], true false false;
+        ReceiveTime: ua::DateTime, -1, [2 "ReceiveTime"], true false false;
+        LocalTime: ua::TimeZoneDataType, -1, [2 "LocalTime"], false false false;
+        Message: ua::LocalizedText, -1, [2 "Message"], true false false;
+        Severity: u16, -1, [2 "Severity"], true false false;
+        ConditionClassId: ua::NodeId, -1, [2 "ConditionClassId"], true false false;
+        ConditionClassName: ua::LocalizedText, -1, [2 "ConditionClassName"], true false false;
+        ConditionSubClassId: ua::NodeId, 1, [2 "ConditionSubClassId"], false false false;
+        ConditionSubClassName: ua::LocalizedText, 1, [2 "ConditionSubClassName"], false false false;
+        ConditionName: String, -1, [2 "ConditionName"], true false false;
+        BranchId: ua::NodeId, -1, [2 "BranchId"], true false false;
+        Retain: bool, -1, [2 "Retain"], true false false;
+        EnabledState: ua::LocalizedText, -1, [2 "EnabledState"], true false false;
+        Quality: ua::StatusCode, -1, [2 "Quality"], true false false;
+        LastSeverity: u16, -1, [2 "LastSeverity"], true false false;
+        Comment: ua::LocalizedText, -1, [2 "Comment"], true false false;
+        ClientUserId: String, -1, [2 "ClientUserId"], true false false;
+        AckedState: ua::LocalizedText, -1, [2 "AckedState"], true false false;
+        ConfirmedState: ua::LocalizedText, -1, [2 "ConfirmedState"], false false false;
+        ConditionDescriptions: ua::LocalizedText, 1, [0 "ConditionDescriptions"], true false true;
     }
     t::object_members! {
-        OperationStateMachineType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of OperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of OperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("LastTransitionReason",
-        "the mandatory variable `LastTransitionReason` of OperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]")];
-        CurrentState : ua::LocalizedText, - 1, [2 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [2 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [2 "AvailableTransitions"], false false
-        false; ConfiguredDefaultStopMode : i16, - 1, [0 "ConfiguredDefaultStopMode"],
-        false false true; LastTransitionReason : i16, - 1, [0 "LastTransitionReason"],
-        true false true; PossibleStopModes : ua::EnumValueType, 1, [0
-        "PossibleStopModes"], false true true;
+        OperationStateMachineType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of OperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of OperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("LastTransitionReason", "the mandatory variable `LastTransitionReason` of OperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
+        ConfiguredDefaultStopMode: i16, -1, [0 "ConfiguredDefaultStopMode"], false false true;
+        LastTransitionReason: i16, -1, [0 "LastTransitionReason"], true false true;
+        PossibleStopModes: ua::EnumValueType, 1, [0 "PossibleStopModes"], false true true;
     }
     t::object_members! {
-        PowerTrainType; required : []; Identification__UIElement : ua::Variant, - 1, [1
-        "Identification", 1 "UIElement"], false false false; Lock__Locked : bool, - 1, [1
-        "Lock", 1 "Locked"], false false false; Lock__LockingClient : String, - 1, [1
-        "Lock", 1 "LockingClient"], false false false; Lock__LockingUser : String, - 1,
-        [1 "Lock", 1 "LockingUser"], false false false; Lock__RemainingLockTime : f64, -
-        1, [1 "Lock", 1 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [1 "Manufacturer"], false false false; ManufacturerUri :
-        String, - 1, [1 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [1 "Model"], false false false; HardwareRevision : String, - 1, [1
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [1
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [1
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [1
-        "ProductCode"], false false false; DeviceManual : String, - 1, [1
-        "DeviceManual"], false false false; DeviceClass : String, - 1, [1 "DeviceClass"],
-        false false false; SerialNumber : String, - 1, [1 "SerialNumber"], false false
-        false; ProductInstanceUri : String, - 1, [1 "ProductInstanceUri"], false false
-        false; RevisionCounter : i32, - 1, [1 "RevisionCounter"], false false false;
-        AssetId : String, - 1, [1 "AssetId"], false false false; ComponentName :
-        ua::LocalizedText, - 1, [1 "ComponentName"], false false false;
+        PowerTrainType;
+        required: [];
+        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
+        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
+        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [1 "ProductCode"], false false false;
+        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
+        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
+        AssetId: String, -1, [1 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
     }
     t::object_members! {
-        ProtectiveStopFunctionType; required : [("Active",
-        "the mandatory variable `Active` of ProtectiveStopFunctionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Active\")]"),
-        ("Enabled",
-        "the mandatory variable `Enabled` of ProtectiveStopFunctionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Enabled\")]"),
-        ("Name",
-        "the mandatory variable `Name` of ProtectiveStopFunctionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Name\")]")];
-        Active : bool, - 1, [0 "Active"], true false false; Enabled : bool, - 1, [0
-        "Enabled"], true false false; Name : String, - 1, [0 "Name"], true false false;
+        ProtectiveStopFunctionType;
+        required: [
+            ("Active", "the mandatory variable `Active` of ProtectiveStopFunctionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Active\")]"),
+            ("Enabled", "the mandatory variable `Enabled` of ProtectiveStopFunctionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Enabled\")]"),
+            ("Name", "the mandatory variable `Name` of ProtectiveStopFunctionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Name\")]"),
+        ];
+        Active: bool, -1, [0 "Active"], true false false;
+        Enabled: bool, -1, [0 "Enabled"], true false false;
+        Name: String, -1, [0 "Name"], true false false;
     }
     t::object_members! {
-        ReadySubstateMachineType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of ReadySubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of ReadySubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("LastTransitionReason",
-        "the mandatory variable `LastTransitionReason` of ReadySubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]")];
-        CurrentState : ua::LocalizedText, - 1, [2 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [2 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [2 "AvailableTransitions"], false false
-        false; LastTransitionReason : i16, - 1, [0 "LastTransitionReason"], true false
-        true;
+        ReadySubstateMachineType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of ReadySubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of ReadySubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("LastTransitionReason", "the mandatory variable `LastTransitionReason` of ReadySubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
+        LastTransitionReason: i16, -1, [0 "LastTransitionReason"], true false true;
     }
     t::object_members! {
-        SafetyStateType; required : [("ParameterSet/EmergencyStop",
-        "the mandatory variable `ParameterSet/EmergencyStop` of SafetyStateType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/EmergencyStop\")]"),
-        ("ParameterSet/OperationalMode",
-        "the mandatory variable `ParameterSet/OperationalMode` of SafetyStateType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/OperationalMode\")]"),
-        ("ParameterSet/ProtectiveStop",
-        "the mandatory variable `ParameterSet/ProtectiveStop` of SafetyStateType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/ProtectiveStop\")]")];
-        ParameterSet__EmergencyStop : bool, - 1, [1 "ParameterSet", 0 "EmergencyStop"],
-        true false false; ParameterSet__OperationalMode :
-        super::super::super::types::OperationalModeEnumeration, - 1, [1 "ParameterSet", 0
-        "OperationalMode"], true false false; ParameterSet__ProtectiveStop : bool, - 1,
-        [1 "ParameterSet", 0 "ProtectiveStop"], true false false;
-        Identification__UIElement : ua::Variant, - 1, [1 "Identification", 1
-        "UIElement"], false false false; Lock__Locked : bool, - 1, [1 "Lock", 1
-        "Locked"], false false false; Lock__LockingClient : String, - 1, [1 "Lock", 1
-        "LockingClient"], false false false; Lock__LockingUser : String, - 1, [1 "Lock",
-        1 "LockingUser"], false false false; Lock__RemainingLockTime : f64, - 1, [1
-        "Lock", 1 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [1 "Manufacturer"], false false false; ManufacturerUri :
-        String, - 1, [1 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [1 "Model"], false false false; HardwareRevision : String, - 1, [1
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [1
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [1
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [1
-        "ProductCode"], false false false; DeviceManual : String, - 1, [1
-        "DeviceManual"], false false false; DeviceClass : String, - 1, [1 "DeviceClass"],
-        false false false; SerialNumber : String, - 1, [1 "SerialNumber"], false false
-        false; ProductInstanceUri : String, - 1, [1 "ProductInstanceUri"], false false
-        false; RevisionCounter : i32, - 1, [1 "RevisionCounter"], false false false;
-        AssetId : String, - 1, [1 "AssetId"], false false false; ComponentName :
-        ua::LocalizedText, - 1, [1 "ComponentName"], false false false;
+        SafetyStateType;
+        required: [
+            ("ParameterSet/EmergencyStop", "the mandatory variable `ParameterSet/EmergencyStop` of SafetyStateType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/EmergencyStop\")]"),
+            ("ParameterSet/OperationalMode", "the mandatory variable `ParameterSet/OperationalMode` of SafetyStateType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/OperationalMode\")]"),
+            ("ParameterSet/ProtectiveStop", "the mandatory variable `ParameterSet/ProtectiveStop` of SafetyStateType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/ProtectiveStop\")]"),
+        ];
+        ParameterSet__EmergencyStop: bool, -1, [1 "ParameterSet", 0 "EmergencyStop"], true false false;
+        ParameterSet__OperationalMode: super::super::super::types::OperationalModeEnumeration, -1, [1 "ParameterSet", 0 "OperationalMode"], true false false;
+        ParameterSet__ProtectiveStop: bool, -1, [1 "ParameterSet", 0 "ProtectiveStop"], true false false;
+        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
+        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
+        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [1 "ProductCode"], false false false;
+        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
+        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
+        AssetId: String, -1, [1 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
     }
     t::object_members! {
-        SystemOperationStateMachineType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of SystemOperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of SystemOperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("LastTransitionReason",
-        "the mandatory variable `LastTransitionReason` of SystemOperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]")];
-        CurrentState : ua::LocalizedText, - 1, [2 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [2 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [2 "AvailableTransitions"], false false
-        false; ConfiguredDefaultStopMode : i16, - 1, [0 "ConfiguredDefaultStopMode"],
-        false false true; LastTransitionReason : i16, - 1, [0 "LastTransitionReason"],
-        true false true; PossibleStopModes : ua::EnumValueType, 1, [0
-        "PossibleStopModes"], false true true; ExecutingSubstateMachine__CurrentState :
-        ua::LocalizedText, - 1, [0 "ExecutingSubstateMachine", 2 "CurrentState"], false
-        false false; ExecutingSubstateMachine__LastTransition : ua::LocalizedText, - 1,
-        [0 "ExecutingSubstateMachine", 2 "LastTransition"], false false false;
-        ExecutingSubstateMachine__AvailableStates : ua::NodeId, 1, [0
-        "ExecutingSubstateMachine", 2 "AvailableStates"], false false false;
-        ExecutingSubstateMachine__AvailableTransitions : ua::NodeId, 1, [0
-        "ExecutingSubstateMachine", 2 "AvailableTransitions"], false false false;
-        ExecutingSubstateMachine__LastTransitionReason : i16, - 1, [0
-        "ExecutingSubstateMachine", 0 "LastTransitionReason"], false false true;
-        IdleSubstateMachine__CurrentState : ua::LocalizedText, - 1, [0
-        "IdleSubstateMachine", 2 "CurrentState"], false false false;
-        IdleSubstateMachine__LastTransition : ua::LocalizedText, - 1, [0
-        "IdleSubstateMachine", 2 "LastTransition"], false false false;
-        IdleSubstateMachine__AvailableStates : ua::NodeId, 1, [0 "IdleSubstateMachine", 2
-        "AvailableStates"], false false false; IdleSubstateMachine__AvailableTransitions
-        : ua::NodeId, 1, [0 "IdleSubstateMachine", 2 "AvailableTransitions"], false false
-        false; IdleSubstateMachine__LastTransitionReason : i16, - 1, [0
-        "IdleSubstateMachine", 0 "LastTransitionReason"], false false true;
+        SystemOperationStateMachineType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of SystemOperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of SystemOperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("LastTransitionReason", "the mandatory variable `LastTransitionReason` of SystemOperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
+        ConfiguredDefaultStopMode: i16, -1, [0 "ConfiguredDefaultStopMode"], false false true;
+        LastTransitionReason: i16, -1, [0 "LastTransitionReason"], true false true;
+        PossibleStopModes: ua::EnumValueType, 1, [0 "PossibleStopModes"], false true true;
+        ExecutingSubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "ExecutingSubstateMachine", 2 "CurrentState"], false false false;
+        ExecutingSubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "ExecutingSubstateMachine", 2 "LastTransition"], false false false;
+        ExecutingSubstateMachine__AvailableStates: ua::NodeId, 1, [0 "ExecutingSubstateMachine", 2 "AvailableStates"], false false false;
+        ExecutingSubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "ExecutingSubstateMachine", 2 "AvailableTransitions"], false false false;
+        ExecutingSubstateMachine__LastTransitionReason: i16, -1, [0 "ExecutingSubstateMachine", 0 "LastTransitionReason"], false false true;
+        IdleSubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "IdleSubstateMachine", 2 "CurrentState"], false false false;
+        IdleSubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "IdleSubstateMachine", 2 "LastTransition"], false false false;
+        IdleSubstateMachine__AvailableStates: ua::NodeId, 1, [0 "IdleSubstateMachine", 2 "AvailableStates"], false false false;
+        IdleSubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "IdleSubstateMachine", 2 "AvailableTransitions"], false false false;
+        IdleSubstateMachine__LastTransitionReason: i16, -1, [0 "IdleSubstateMachine", 0 "LastTransitionReason"], false false true;
     }
     t::object_members! {
-        SystemOperationType; required : [("SystemOperationStateMachine/CurrentState",
-        "the mandatory variable `SystemOperationStateMachine/CurrentState` of SystemOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SystemOperationStateMachine/CurrentState\")]"),
-        ("SystemOperationStateMachine/LastTransition",
-        "the mandatory variable `SystemOperationStateMachine/LastTransition` of SystemOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SystemOperationStateMachine/LastTransition\")]"),
-        ("SystemOperationStateMachine/LastTransitionReason",
-        "the mandatory variable `SystemOperationStateMachine/LastTransitionReason` of SystemOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SystemOperationStateMachine/LastTransitionReason\")]")];
-        SystemOperationStateMachine__CurrentState : ua::LocalizedText, - 1, [0
-        "SystemOperationStateMachine", 2 "CurrentState"], true false false;
-        SystemOperationStateMachine__LastTransition : ua::LocalizedText, - 1, [0
-        "SystemOperationStateMachine", 2 "LastTransition"], true false false;
-        SystemOperationStateMachine__AvailableStates : ua::NodeId, 1, [0
-        "SystemOperationStateMachine", 2 "AvailableStates"], false false false;
-        SystemOperationStateMachine__AvailableTransitions : ua::NodeId, 1, [0
-        "SystemOperationStateMachine", 2 "AvailableTransitions"], false false false;
-        SystemOperationStateMachine__ConfiguredDefaultStopMode : i16, - 1, [0
-        "SystemOperationStateMachine", 0 "ConfiguredDefaultStopMode"], false false true;
-        SystemOperationStateMachine__LastTransitionReason : i16, - 1, [0
-        "SystemOperationStateMachine", 0 "LastTransitionReason"], true false true;
-        SystemOperationStateMachine__PossibleStopModes : ua::EnumValueType, 1, [0
-        "SystemOperationStateMachine", 0 "PossibleStopModes"], false true true;
-        SystemOperationStateMachine__ExecutingSubstateMachine__CurrentState :
-        ua::LocalizedText, - 1, [0 "SystemOperationStateMachine", 0
-        "ExecutingSubstateMachine", 2 "CurrentState"], false false false;
-        SystemOperationStateMachine__ExecutingSubstateMachine__LastTransition :
-        ua::LocalizedText, - 1, [0 "SystemOperationStateMachine", 0
-        "ExecutingSubstateMachine", 2 "LastTransition"], false false false;
-        SystemOperationStateMachine__ExecutingSubstateMachine__AvailableStates :
-        ua::NodeId, 1, [0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2
-        "AvailableStates"], false false false;
-        SystemOperationStateMachine__ExecutingSubstateMachine__AvailableTransitions :
-        ua::NodeId, 1, [0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2
-        "AvailableTransitions"], false false false;
-        SystemOperationStateMachine__ExecutingSubstateMachine__LastTransitionReason :
-        i16, - 1, [0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 0
-        "LastTransitionReason"], false false true;
-        SystemOperationStateMachine__IdleSubstateMachine__CurrentState :
-        ua::LocalizedText, - 1, [0 "SystemOperationStateMachine", 0
-        "IdleSubstateMachine", 2 "CurrentState"], false false false;
-        SystemOperationStateMachine__IdleSubstateMachine__LastTransition :
-        ua::LocalizedText, - 1, [0 "SystemOperationStateMachine", 0
-        "IdleSubstateMachine", 2 "LastTransition"], false false false;
-        SystemOperationStateMachine__IdleSubstateMachine__AvailableStates : ua::NodeId,
-        1, [0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2
-        "AvailableStates"], false false false;
-        SystemOperationStateMachine__IdleSubstateMachine__AvailableTransitions :
-        ua::NodeId, 1, [0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2
-        "AvailableTransitions"], false false false;
-        SystemOperationStateMachine__IdleSubstateMachine__LastTransitionReason : i16, -
-        1, [0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 0
-        "LastTransitionReason"], false false true;
+        SystemOperationType;
+        required: [
+            ("SystemOperationStateMachine/CurrentState", "the mandatory variable `SystemOperationStateMachine/CurrentState` of SystemOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SystemOperationStateMachine/CurrentState\")]"),
+            ("SystemOperationStateMachine/LastTransition", "the mandatory variable `SystemOperationStateMachine/LastTransition` of SystemOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SystemOperationStateMachine/LastTransition\")]"),
+            ("SystemOperationStateMachine/LastTransitionReason", "the mandatory variable `SystemOperationStateMachine/LastTransitionReason` of SystemOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SystemOperationStateMachine/LastTransitionReason\")]"),
+        ];
+        SystemOperationStateMachine__CurrentState: ua::LocalizedText, -1, [0 "SystemOperationStateMachine", 2 "CurrentState"], true false false;
+        SystemOperationStateMachine__LastTransition: ua::LocalizedText, -1, [0 "SystemOperationStateMachine", 2 "LastTransition"], true false false;
+        SystemOperationStateMachine__AvailableStates: ua::NodeId, 1, [0 "SystemOperationStateMachine", 2 "AvailableStates"], false false false;
+        SystemOperationStateMachine__AvailableTransitions: ua::NodeId, 1, [0 "SystemOperationStateMachine", 2 "AvailableTransitions"], false false false;
+        SystemOperationStateMachine__ConfiguredDefaultStopMode: i16, -1, [0 "SystemOperationStateMachine", 0 "ConfiguredDefaultStopMode"], false false true;
+        SystemOperationStateMachine__LastTransitionReason: i16, -1, [0 "SystemOperationStateMachine", 0 "LastTransitionReason"], true false true;
+        SystemOperationStateMachine__PossibleStopModes: ua::EnumValueType, 1, [0 "SystemOperationStateMachine", 0 "PossibleStopModes"], false true true;
+        SystemOperationStateMachine__ExecutingSubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "CurrentState"], false false false;
+        SystemOperationStateMachine__ExecutingSubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "LastTransition"], false false false;
+        SystemOperationStateMachine__ExecutingSubstateMachine__AvailableStates: ua::NodeId, 1, [0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "AvailableStates"], false false false;
+        SystemOperationStateMachine__ExecutingSubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "AvailableTransitions"], false false false;
+        SystemOperationStateMachine__ExecutingSubstateMachine__LastTransitionReason: i16, -1, [0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 0 "LastTransitionReason"], false false true;
+        SystemOperationStateMachine__IdleSubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "CurrentState"], false false false;
+        SystemOperationStateMachine__IdleSubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "LastTransition"], false false false;
+        SystemOperationStateMachine__IdleSubstateMachine__AvailableStates: ua::NodeId, 1, [0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "AvailableStates"], false false false;
+        SystemOperationStateMachine__IdleSubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "AvailableTransitions"], false false false;
+        SystemOperationStateMachine__IdleSubstateMachine__LastTransitionReason: i16, -1, [0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 0 "LastTransitionReason"], false false true;
     }
     t::object_members! {
-        TaskControlOperationType; required : [("TaskControlStateMachine/CurrentState",
-        "the mandatory variable `TaskControlStateMachine/CurrentState` of TaskControlOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"TaskControlStateMachine/CurrentState\")]"),
-        ("TaskControlStateMachine/LastTransition",
-        "the mandatory variable `TaskControlStateMachine/LastTransition` of TaskControlOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"TaskControlStateMachine/LastTransition\")]"),
-        ("TaskControlStateMachine/LastTransitionReason",
-        "the mandatory variable `TaskControlStateMachine/LastTransitionReason` of TaskControlOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"TaskControlStateMachine/LastTransitionReason\")]")];
-        MotionDevicesUnderControl : ua::NodeId, 1, [0 "MotionDevicesUnderControl"], false
-        false false; TaskControlStateMachine__CurrentState : ua::LocalizedText, - 1, [0
-        "TaskControlStateMachine", 2 "CurrentState"], true false false;
-        TaskControlStateMachine__LastTransition : ua::LocalizedText, - 1, [0
-        "TaskControlStateMachine", 2 "LastTransition"], true false false;
-        TaskControlStateMachine__AvailableStates : ua::NodeId, 1, [0
-        "TaskControlStateMachine", 2 "AvailableStates"], false false false;
-        TaskControlStateMachine__AvailableTransitions : ua::NodeId, 1, [0
-        "TaskControlStateMachine", 2 "AvailableTransitions"], false false false;
-        TaskControlStateMachine__ConfiguredDefaultStopMode : i16, - 1, [0
-        "TaskControlStateMachine", 0 "ConfiguredDefaultStopMode"], false false true;
-        TaskControlStateMachine__LastTransitionReason : i16, - 1, [0
-        "TaskControlStateMachine", 0 "LastTransitionReason"], true false true;
-        TaskControlStateMachine__PossibleStopModes : ua::EnumValueType, 1, [0
-        "TaskControlStateMachine", 0 "PossibleStopModes"], false true true;
-        TaskControlStateMachine__ReadySubstateMachine__CurrentState : ua::LocalizedText,
-        - 1, [0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "CurrentState"],
-        false false false; TaskControlStateMachine__ReadySubstateMachine__LastTransition
-        : ua::LocalizedText, - 1, [0 "TaskControlStateMachine", 0 "ReadySubstateMachine",
-        2 "LastTransition"], false false false;
-        TaskControlStateMachine__ReadySubstateMachine__AvailableStates : ua::NodeId, 1,
-        [0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "AvailableStates"],
-        false false false;
-        TaskControlStateMachine__ReadySubstateMachine__AvailableTransitions : ua::NodeId,
-        1, [0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2
-        "AvailableTransitions"], false false false;
-        TaskControlStateMachine__ReadySubstateMachine__LastTransitionReason : i16, - 1,
-        [0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 0
-        "LastTransitionReason"], false false true;
+        TaskControlOperationType;
+        required: [
+            ("TaskControlStateMachine/CurrentState", "the mandatory variable `TaskControlStateMachine/CurrentState` of TaskControlOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"TaskControlStateMachine/CurrentState\")]"),
+            ("TaskControlStateMachine/LastTransition", "the mandatory variable `TaskControlStateMachine/LastTransition` of TaskControlOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"TaskControlStateMachine/LastTransition\")]"),
+            ("TaskControlStateMachine/LastTransitionReason", "the mandatory variable `TaskControlStateMachine/LastTransitionReason` of TaskControlOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"TaskControlStateMachine/LastTransitionReason\")]"),
+        ];
+        MotionDevicesUnderControl: ua::NodeId, 1, [0 "MotionDevicesUnderControl"], false false false;
+        TaskControlStateMachine__CurrentState: ua::LocalizedText, -1, [0 "TaskControlStateMachine", 2 "CurrentState"], true false false;
+        TaskControlStateMachine__LastTransition: ua::LocalizedText, -1, [0 "TaskControlStateMachine", 2 "LastTransition"], true false false;
+        TaskControlStateMachine__AvailableStates: ua::NodeId, 1, [0 "TaskControlStateMachine", 2 "AvailableStates"], false false false;
+        TaskControlStateMachine__AvailableTransitions: ua::NodeId, 1, [0 "TaskControlStateMachine", 2 "AvailableTransitions"], false false false;
+        TaskControlStateMachine__ConfiguredDefaultStopMode: i16, -1, [0 "TaskControlStateMachine", 0 "ConfiguredDefaultStopMode"], false false true;
+        TaskControlStateMachine__LastTransitionReason: i16, -1, [0 "TaskControlStateMachine", 0 "LastTransitionReason"], true false true;
+        TaskControlStateMachine__PossibleStopModes: ua::EnumValueType, 1, [0 "TaskControlStateMachine", 0 "PossibleStopModes"], false true true;
+        TaskControlStateMachine__ReadySubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "CurrentState"], false false false;
+        TaskControlStateMachine__ReadySubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "LastTransition"], false false false;
+        TaskControlStateMachine__ReadySubstateMachine__AvailableStates: ua::NodeId, 1, [0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "AvailableStates"], false false false;
+        TaskControlStateMachine__ReadySubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "AvailableTransitions"], false false false;
+        TaskControlStateMachine__ReadySubstateMachine__LastTransitionReason: i16, -1, [0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 0 "LastTransitionReason"], false false true;
     }
     t::object_members! {
-        TaskControlStateMachineType; required : [("CurrentState",
-        "the mandatory variable `CurrentState` of TaskControlStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
-        ("LastTransition",
-        "the mandatory variable `LastTransition` of TaskControlStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
-        ("LastTransitionReason",
-        "the mandatory variable `LastTransitionReason` of TaskControlStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]")];
-        CurrentState : ua::LocalizedText, - 1, [2 "CurrentState"], true false false;
-        LastTransition : ua::LocalizedText, - 1, [2 "LastTransition"], true false false;
-        AvailableStates : ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions : ua::NodeId, 1, [2 "AvailableTransitions"], false false
-        false; ConfiguredDefaultStopMode : i16, - 1, [0 "ConfiguredDefaultStopMode"],
-        false false true; LastTransitionReason : i16, - 1, [0 "LastTransitionReason"],
-        true false true; PossibleStopModes : ua::EnumValueType, 1, [0
-        "PossibleStopModes"], false true true; ReadySubstateMachine__CurrentState :
-        ua::LocalizedText, - 1, [0 "ReadySubstateMachine", 2 "CurrentState"], false false
-        false; ReadySubstateMachine__LastTransition : ua::LocalizedText, - 1, [0
-        "ReadySubstateMachine", 2 "LastTransition"], false false false;
-        ReadySubstateMachine__AvailableStates : ua::NodeId, 1, [0 "ReadySubstateMachine",
-        2 "AvailableStates"], false false false;
-        ReadySubstateMachine__AvailableTransitions : ua::NodeId, 1, [0
-        "ReadySubstateMachine", 2 "AvailableTransitions"], false false false;
-        ReadySubstateMachine__LastTransitionReason : i16, - 1, [0 "ReadySubstateMachine",
-        0 "LastTransitionReason"], false false true;
+        TaskControlStateMachineType;
+        required: [
+            ("CurrentState", "the mandatory variable `CurrentState` of TaskControlStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
+            ("LastTransition", "the mandatory variable `LastTransition` of TaskControlStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
+            ("LastTransitionReason", "the mandatory variable `LastTransitionReason` of TaskControlStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]"),
+        ];
+        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
+        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
+        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
+        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
+        ConfiguredDefaultStopMode: i16, -1, [0 "ConfiguredDefaultStopMode"], false false true;
+        LastTransitionReason: i16, -1, [0 "LastTransitionReason"], true false true;
+        PossibleStopModes: ua::EnumValueType, 1, [0 "PossibleStopModes"], false true true;
+        ReadySubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "ReadySubstateMachine", 2 "CurrentState"], false false false;
+        ReadySubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "ReadySubstateMachine", 2 "LastTransition"], false false false;
+        ReadySubstateMachine__AvailableStates: ua::NodeId, 1, [0 "ReadySubstateMachine", 2 "AvailableStates"], false false false;
+        ReadySubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "ReadySubstateMachine", 2 "AvailableTransitions"], false false false;
+        ReadySubstateMachine__LastTransitionReason: i16, -1, [0 "ReadySubstateMachine", 0 "LastTransitionReason"], false false true;
     }
     t::object_members! {
-        TaskControlType; required : [("ParameterSet/TaskProgramLoaded",
-        "the mandatory variable `ParameterSet/TaskProgramLoaded` of TaskControlType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/TaskProgramLoaded\")]"),
-        ("ParameterSet/TaskProgramName",
-        "the mandatory variable `ParameterSet/TaskProgramName` of TaskControlType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/TaskProgramName\")]"),
-        ("ComponentName",
-        "the mandatory variable `ComponentName` of TaskControlType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ComponentName\")]")];
-        ParameterSet__ExecutionMode :
-        super::super::super::types::ExecutionModeEnumeration, - 1, [1 "ParameterSet", 0
-        "ExecutionMode"], false false false; ParameterSet__TaskProgramLoaded : bool, - 1,
-        [1 "ParameterSet", 0 "TaskProgramLoaded"], true false false;
-        ParameterSet__TaskProgramName : String, - 1, [1 "ParameterSet", 0
-        "TaskProgramName"], true false false; Identification__UIElement : ua::Variant, -
-        1, [1 "Identification", 1 "UIElement"], false false false; Lock__Locked : bool, -
-        1, [1 "Lock", 1 "Locked"], false false false; Lock__LockingClient : String, - 1,
-        [1 "Lock", 1 "LockingClient"], false false false; Lock__LockingUser : String, -
-        1, [1 "Lock", 1 "LockingUser"], false false false; Lock__RemainingLockTime : f64,
-        - 1, [1 "Lock", 1 "RemainingLockTime"], false false false; Manufacturer :
-        ua::LocalizedText, - 1, [1 "Manufacturer"], false false false; ManufacturerUri :
-        String, - 1, [1 "ManufacturerUri"], false false false; Model : ua::LocalizedText,
-        - 1, [1 "Model"], false false false; HardwareRevision : String, - 1, [1
-        "HardwareRevision"], false false false; SoftwareRevision : String, - 1, [1
-        "SoftwareRevision"], false false false; DeviceRevision : String, - 1, [1
-        "DeviceRevision"], false false false; ProductCode : String, - 1, [1
-        "ProductCode"], false false false; DeviceManual : String, - 1, [1
-        "DeviceManual"], false false false; DeviceClass : String, - 1, [1 "DeviceClass"],
-        false false false; SerialNumber : String, - 1, [1 "SerialNumber"], false false
-        false; ProductInstanceUri : String, - 1, [1 "ProductInstanceUri"], false false
-        false; RevisionCounter : i32, - 1, [1 "RevisionCounter"], false false false;
-        AssetId : String, - 1, [1 "AssetId"], false false false; ComponentName :
-        ua::LocalizedText, - 1, [1 "ComponentName"], true false false;
-        TaskControlOperation__MotionDevicesUnderControl : ua::NodeId, 1, [0
-        "TaskControlOperation", 0 "MotionDevicesUnderControl"], false false false;
-        TaskControlOperation__TaskControlStateMachine__CurrentState : ua::LocalizedText,
-        - 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 2 "CurrentState"],
-        false false false; TaskControlOperation__TaskControlStateMachine__LastTransition
-        : ua::LocalizedText, - 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine",
-        2 "LastTransition"], false false false;
-        TaskControlOperation__TaskControlStateMachine__AvailableStates : ua::NodeId, 1,
-        [0 "TaskControlOperation", 0 "TaskControlStateMachine", 2 "AvailableStates"],
-        false false false;
-        TaskControlOperation__TaskControlStateMachine__AvailableTransitions : ua::NodeId,
-        1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 2
-        "AvailableTransitions"], false false false;
-        TaskControlOperation__TaskControlStateMachine__ConfiguredDefaultStopMode : i16, -
-        1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0
-        "ConfiguredDefaultStopMode"], false false true;
-        TaskControlOperation__TaskControlStateMachine__LastTransitionReason : i16, - 1,
-        [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0
-        "LastTransitionReason"], false false true;
-        TaskControlOperation__TaskControlStateMachine__PossibleStopModes :
-        ua::EnumValueType, 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0
-        "PossibleStopModes"], false true true;
-        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__CurrentState
-        : ua::LocalizedText, - 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine",
-        0 "ReadySubstateMachine", 2 "CurrentState"], false false false;
-        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__LastTransition
-        : ua::LocalizedText, - 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine",
-        0 "ReadySubstateMachine", 2 "LastTransition"], false false false;
-        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__AvailableStates
-        : ua::NodeId, 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0
-        "ReadySubstateMachine", 2 "AvailableStates"], false false false;
-        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__AvailableTransitions
-        : ua::NodeId, 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0
-        "ReadySubstateMachine", 2 "AvailableTransitions"], false false false;
-        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__LastTransitionReason
-        : i16, - 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0
-        "ReadySubstateMachine", 0 "LastTransitionReason"], false false true;
+        TaskControlType;
+        required: [
+            ("ParameterSet/TaskProgramLoaded", "the mandatory variable `ParameterSet/TaskProgramLoaded` of TaskControlType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/TaskProgramLoaded\")]"),
+            ("ParameterSet/TaskProgramName", "the mandatory variable `ParameterSet/TaskProgramName` of TaskControlType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/TaskProgramName\")]"),
+            ("ComponentName", "the mandatory variable `ComponentName` of TaskControlType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ComponentName\")]"),
+        ];
+        ParameterSet__ExecutionMode: super::super::super::types::ExecutionModeEnumeration, -1, [1 "ParameterSet", 0 "ExecutionMode"], false false false;
+        ParameterSet__TaskProgramLoaded: bool, -1, [1 "ParameterSet", 0 "TaskProgramLoaded"], true false false;
+        ParameterSet__TaskProgramName: String, -1, [1 "ParameterSet", 0 "TaskProgramName"], true false false;
+        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
+        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
+        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
+        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
+        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
+        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
+        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
+        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
+        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
+        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
+        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
+        ProductCode: String, -1, [1 "ProductCode"], false false false;
+        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
+        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
+        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
+        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
+        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
+        AssetId: String, -1, [1 "AssetId"], false false false;
+        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], true false false;
+        TaskControlOperation__MotionDevicesUnderControl: ua::NodeId, 1, [0 "TaskControlOperation", 0 "MotionDevicesUnderControl"], false false false;
+        TaskControlOperation__TaskControlStateMachine__CurrentState: ua::LocalizedText, -1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 2 "CurrentState"], false false false;
+        TaskControlOperation__TaskControlStateMachine__LastTransition: ua::LocalizedText, -1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 2 "LastTransition"], false false false;
+        TaskControlOperation__TaskControlStateMachine__AvailableStates: ua::NodeId, 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 2 "AvailableStates"], false false false;
+        TaskControlOperation__TaskControlStateMachine__AvailableTransitions: ua::NodeId, 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 2 "AvailableTransitions"], false false false;
+        TaskControlOperation__TaskControlStateMachine__ConfiguredDefaultStopMode: i16, -1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "ConfiguredDefaultStopMode"], false false true;
+        TaskControlOperation__TaskControlStateMachine__LastTransitionReason: i16, -1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "LastTransitionReason"], false false true;
+        TaskControlOperation__TaskControlStateMachine__PossibleStopModes: ua::EnumValueType, 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "PossibleStopModes"], false true true;
+        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "CurrentState"], false false false;
+        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "LastTransition"], false false false;
+        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__AvailableStates: ua::NodeId, 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "AvailableStates"], false false false;
+        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "AvailableTransitions"], false false false;
+        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__LastTransitionReason: i16, -1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 0 "LastTransitionReason"], false false true;
     }
     t::object_members! {
-        TaskModuleType; required : [("Name",
-        "the mandatory variable `Name` of TaskModuleType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Name\")]")];
-        IsReferenced : bool, - 1, [0 "IsReferenced"], false false true; Name : String, -
-        1, [0 "Name"], true false true; Version : String, - 1, [0 "Version"], false false
-        true;
+        TaskModuleType;
+        required: [
+            ("Name", "the mandatory variable `Name` of TaskModuleType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Name\")]"),
+        ];
+        IsReferenced: bool, -1, [0 "IsReferenced"], false false true;
+        Name: String, -1, [0 "Name"], true false true;
+        Version: String, -1, [0 "Version"], false false true;
     }
     t::object_members! {
-        UserType; required : [("Level",
-        "the mandatory variable `Level` of UserType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Level\")]")];
-        Level : String, - 1, [0 "Level"], true false false; Name : String, - 1, [0
-        "Name"], false false false;
+        UserType;
+        required: [
+            ("Level", "the mandatory variable `Level` of UserType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Level\")]"),
+        ];
+        Level: String, -1, [0 "Level"], true false false;
+        Name: String, -1, [0 "Name"], false false false;
     }
 }

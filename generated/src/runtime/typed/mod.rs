@@ -163,7 +163,7 @@ pub use crate::__nodeset_ua_struct as ua_struct;
 #[doc(hidden)]
 #[macro_export]
 macro_rules! __nodeset_object_members {
-    ($owner:ident; required: [$(($rp:literal, $rm:literal)),*]; $($m:ident: $scalar:ty, $rank:literal, [$($k:literal $name:literal),*], $mandatory:literal $default:literal $writable:literal;)*) => {
+    ($owner:ident; required: [$(($rp:literal, $rm:literal)),* $(,)?]; $($m:ident: $scalar:ty, $rank:literal, [$($k:literal $name:literal),*], $mandatory:literal $default:literal $writable:literal;)*) => {
         #[doc = concat!(" Member markers of [`", stringify!($owner), "`](super::", stringify!($owner), ") for `nodeset-derive`.")]
         pub mod $owner {
             #[allow(unused_imports)]

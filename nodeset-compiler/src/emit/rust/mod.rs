@@ -143,6 +143,9 @@ struct Gen<'m> {
     type_names: BTreeMap<NodeIx, String>,
     /// Type names of other namespaces, computed on demand with the same rules.
     foreign_type_names: std::cell::RefCell<BTreeMap<u16, BTreeMap<NodeIx, String>>>,
+    /// `objects.rs` item names and handle names per namespace, computed on demand.
+    item_names_cache: std::cell::RefCell<BTreeMap<u16, std::rc::Rc<BTreeMap<(NodeIx, programs::Item), String>>>>,
+    handle_names_cache: std::cell::RefCell<BTreeMap<u16, std::rc::Rc<BTreeMap<NodeIx, String>>>>,
     ns0_types: BTreeSet<&'static str>,
 }
 
@@ -211,6 +214,8 @@ impl<'m> Gen<'m> {
             diags: Diagnostics::new(),
             type_names,
             foreign_type_names: Default::default(),
+            item_names_cache: Default::default(),
+            handle_names_cache: Default::default(),
             ns0_types: async_opcua_ns0::TYPES.iter().copied().collect(),
         }
     }

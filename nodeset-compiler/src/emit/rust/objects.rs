@@ -15,6 +15,8 @@
 //! time (it never reads XML).
 
 use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write as _;
+use std::rc::Rc;
 
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;
@@ -86,7 +88,11 @@ impl Gen<'_> {
 
     /// Names of the items of a namespace's `objects.rs` in one scope: the handle structs of its types and
     /// the parameter structs of its program types.
-    pub(super) fn object_item_names(&self, ns: u16) -> BTreeMap<(NodeIx, Item), String> {
+    /// Computed once per namespace and generator (every handle path into another namespace needs them).
+    pub(super) fn object_item_names(&self, ns: u16) -> Rc<BTreeMap<(NodeIx, Item), String>> {
+        if let Some(names) = self.item_names_cache.borrow().get(&ns) {
+            return names.clone();
+        }
         let mut scope: Scope<(NodeIx, Item)> = Scope::new(Target::Rust, Case::UpperCamel);
         for r in ["NS", "Members"] {
             scope.reserve(r);
@@ -98,12 +104,25 @@ impl Gen<'_> {
             }
         }
         self.add_parameter_names(ns, &mut scope);
-        scope.finish().0
+        let names = Rc::new(scope.finish().0);
+        self.item_names_cache.borrow_mut().insert(ns, names.clone());
+        names
     }
 
-    /// Handle struct names of a namespace's types.
-    pub(super) fn handle_names(&self, ns: u16) -> BTreeMap<NodeIx, String> {
-        self.object_item_names(ns).into_iter().filter(|((_, item), _)| *item == Item::Handle).map(|((t, _), n)| (t, n)).collect()
+    /// Handle struct names of a namespace's types (cached like [`Self::object_item_names`]).
+    pub(super) fn handle_names(&self, ns: u16) -> Rc<BTreeMap<NodeIx, String>> {
+        if let Some(names) = self.handle_names_cache.borrow().get(&ns) {
+            return names.clone();
+        }
+        let names: Rc<BTreeMap<NodeIx, String>> = Rc::new(
+            self.object_item_names(ns)
+                .iter()
+                .filter(|((_, item), _)| *item == Item::Handle)
+                .map(|((t, _), n)| (*t, n.clone()))
+                .collect(),
+        );
+        self.handle_names_cache.borrow_mut().insert(ns, names.clone());
+        names
     }
 
     /// The Rust path of the module of another generated namespace, if this run reaches it.
@@ -398,7 +417,9 @@ impl Gen<'_> {
         }
     }
 
-    fn markers(&self, type_name: &str, members: &[(NodeIx, NodeIx)], uris: &mut BTreeMap<String, usize>) -> TokenStream {
+    /// The `object_members!` invocation of a type, as text: one marker per line (a table, like the node
+    /// rows of nodes.rs, which prettyplease would fold into a paragraph).
+    fn markers(&self, type_name: &str, members: &[(NodeIx, NodeIx)], uris: &mut BTreeMap<String, usize>) -> String {
         let model = self.model;
         let mut found = Vec::new();
         self.reach(members, &mut Vec::new(), &mut found);
@@ -420,9 +441,8 @@ impl Gen<'_> {
             let segs: Vec<&str> = r.path.iter().map(String::as_str).collect();
             *count.entry(marker_name(&segs)).or_default() += 1;
         }
-        let owner = ident(type_name);
-        let mut items = Vec::new();
-        let mut required = Vec::new();
+        let mut items = String::new();
+        let mut required = String::new();
         let mut seen = BTreeSet::new();
         for r in &reach {
             let segs: Vec<&str> = r.path.iter().map(String::as_str).collect();
@@ -432,36 +452,34 @@ impl Gen<'_> {
             }
             let n = model.node(r.node);
             let rank = n.attrs.value_rank.unwrap_or(-1);
-            let scalar = match self.value_type(n.attrs.data_type, -1) {
-                t if t.to_string().contains("Variant") => quote! { opcua::types::Variant },
+            let scalar = type_text(&self.value_type(n.attrs.data_type, -1));
+            let scalar = if scalar.contains("Variant") {
+                "ua::Variant".to_string()
+            } else if scalar.starts_with("super::") {
                 // Paths relative to objects.rs, seen from `members::<Owner>` two modules down.
-                t if t.to_string().starts_with("super ::") => quote! { super::super::#t },
-                t => t,
+                format!("super::super::{scalar}")
+            } else {
+                scalar
             };
             let has_default = n.value.is_some();
             let writable = n.attrs.access_level.unwrap_or(1) & 2 != 0;
-            let path_items = r.qpath.iter().map(|(k, s)| {
-                let k = Literal::usize_unsuffixed(*k);
-                let s = lit(s);
-                quote! { #k #s }
-            });
-            let m = ident(&mname);
-            let rank = Literal::i32_unsuffixed(rank);
-            let (mandatory, has_default_t, writable_t) = (r.mandatory, has_default, writable);
-            items.push(quote! { #m: #scalar, #rank, [#(#path_items),*], #mandatory #has_default_t #writable_t; });
+            let path: Vec<String> = r.qpath.iter().map(|(k, s)| format!("{k} {}", Literal::string(s))).collect();
+            let _ = writeln!(
+                items,
+                "        {mname}: {scalar}, {rank}, [{}], {} {has_default} {writable};",
+                path.join(", "),
+                r.mandatory
+            );
             if r.mandatory && !has_default {
-                let msg = lit(&format!(
-                    "the mandatory variable `{}` of {type_name} has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"{}\")]",
-                    r.path.join("/"),
-                    r.path.join("/")
-                ));
-                let p = lit(&r.path.join("/"));
-                required.push(quote! { (#p, #msg) });
+                let p = r.path.join("/");
+                let msg = format!(
+                    "the mandatory variable `{p}` of {type_name} has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"{p}\")]"
+                );
+                let _ = writeln!(required, "            ({}, {}),", Literal::string(&p), Literal::string(&msg));
             }
         }
-        quote! {
-            t::object_members! { #owner; required: [#(#required),*]; #(#items)* }
-        }
+        let required = if required.is_empty() { "[]".to_string() } else { format!("[\n{required}        ]") };
+        format!("    t::object_members! {{\n        {type_name};\n        required: {required};\n{items}    }}\n")
     }
 
     pub(super) fn objects_file(&mut self) -> OutFile {
@@ -534,19 +552,61 @@ impl Gen<'_> {
             #[allow(dead_code)]
             const NS: &[&str] = &[#(#ns_items),*];
             #(#items)*
-            /// Member markers of each ObjectType, named from browse paths (`ParameterSet__ActualPosition`).
-            #[allow(non_snake_case, non_camel_case_types)]
-            pub mod members {
-                #[allow(unused_imports)]
-                use super::t;
-                #(#markers)*
-            }
         };
         // async-opcua's types are named through a short alias in this file.
-        let text = tokens.to_string().replace("opcua :: types ::", "ua ::");
-        let tokens: TokenStream = text.parse().unwrap_or_else(|e| panic!("internal error: objects.rs of {}: {e}", self.uri()));
-        self.file("objects.rs", "Typed handles", tokens)
+        let mut file = self.file("objects.rs", "Typed handles", alias_ua(tokens));
+        file.contents.push_str(
+            "/// Member markers of each ObjectType, named from browse paths (`ParameterSet__ActualPosition`).\n\
+             #[allow(non_snake_case, non_camel_case_types)]\n\
+             pub mod members {\n    #[allow(unused_imports)]\n    use super::t;\n",
+        );
+        for m in &markers {
+            file.contents.push_str(m);
+        }
+        file.contents.push_str("}\n");
+        file
     }
+}
+
+/// `opcua::types::X` -> `ua::X` throughout a token stream (objects.rs imports `opcua::types as ua`).
+fn alias_ua(tokens: TokenStream) -> TokenStream {
+    use proc_macro2::{Group, Ident, Punct, Spacing, Span, TokenTree};
+    let tts: Vec<TokenTree> = tokens.into_iter().collect();
+    let is_ident = |t: &TokenTree, s: &str| matches!(t, TokenTree::Ident(i) if i == s);
+    let is_colon = |t: &TokenTree| matches!(t, TokenTree::Punct(p) if p.as_char() == ':');
+    let mut out: Vec<TokenTree> = Vec::with_capacity(tts.len());
+    let mut i = 0;
+    while i < tts.len() {
+        if i + 5 < tts.len()
+            && is_ident(&tts[i], "opcua")
+            && is_colon(&tts[i + 1])
+            && is_colon(&tts[i + 2])
+            && is_ident(&tts[i + 3], "types")
+            && is_colon(&tts[i + 4])
+            && is_colon(&tts[i + 5])
+        {
+            out.push(TokenTree::Ident(Ident::new("ua", Span::call_site())));
+            out.push(TokenTree::Punct(Punct::new(':', Spacing::Joint)));
+            out.push(TokenTree::Punct(Punct::new(':', Spacing::Alone)));
+            i += 6;
+            continue;
+        }
+        out.push(match &tts[i] {
+            TokenTree::Group(g) => {
+                let mut ng = Group::new(g.delimiter(), alias_ua(g.stream()));
+                ng.set_span(g.span());
+                TokenTree::Group(ng)
+            }
+            t => t.clone(),
+        });
+        i += 1;
+    }
+    out.into_iter().collect()
+}
+
+/// A type's tokens as a person writes them (`Vec<ua::LocalizedText>`, `super::types::Mode`).
+fn type_text(tokens: &TokenStream) -> String {
+    tokens.to_string().replace(" :: ", "::").replace(":: ", "::").replace(" < ", "<").replace(" >", ">").replace("opcua::types::", "ua::")
 }
 
 /// The prefix of nested handle struct names of a type (`AxisType` -> `AxisType_`).
