@@ -146,6 +146,7 @@ struct Gen<'m> {
     /// `objects.rs` item names and handle names per namespace, computed on demand.
     item_names_cache: std::cell::RefCell<BTreeMap<u16, std::rc::Rc<BTreeMap<(NodeIx, programs::Item), String>>>>,
     handle_names_cache: std::cell::RefCell<BTreeMap<u16, std::rc::Rc<BTreeMap<NodeIx, String>>>>,
+    value_type_cache: std::cell::RefCell<std::collections::HashMap<(Option<NodeIx>, i32), TokenStream>>,
     ns0_types: BTreeSet<&'static str>,
 }
 
@@ -216,6 +217,7 @@ impl<'m> Gen<'m> {
             foreign_type_names: Default::default(),
             item_names_cache: Default::default(),
             handle_names_cache: Default::default(),
+            value_type_cache: Default::default(),
             ns0_types: async_opcua_ns0::TYPES.iter().copied().collect(),
         }
     }

@@ -152,8 +152,18 @@ impl Gen<'_> {
         Some(quote! { #module::objects::#name })
     }
 
-    /// The Rust value type of a DataType and ValueRank, as typed handles use it.
+    /// The Rust value type of a DataType and ValueRank, as typed handles use it (memoized: thousands of
+    /// members share a few dozen types).
     pub(super) fn value_type(&self, dt: Option<NodeIx>, value_rank: i32) -> TokenStream {
+        if let Some(t) = self.value_type_cache.borrow().get(&(dt, value_rank)) {
+            return t.clone();
+        }
+        let t = self.compute_value_type(dt, value_rank);
+        self.value_type_cache.borrow_mut().insert((dt, value_rank), t.clone());
+        t
+    }
+
+    fn compute_value_type(&self, dt: Option<NodeIx>, value_rank: i32) -> TokenStream {
         let variant = quote! { opcua::types::Variant };
         let Some(dt) = dt else { return variant };
         let scalar = self.scalar_value_type(dt);
