@@ -158,7 +158,8 @@ impl Gen<'_> {
         if let Some(t) = self.value_type_cache.borrow().get(&(dt, value_rank)) {
             return t.clone();
         }
-        let t = self.compute_value_type(dt, value_rank);
+        // objects.rs names async-opcua's types through its `ua` alias.
+        let t = alias_ua(self.compute_value_type(dt, value_rank));
         self.value_type_cache.borrow_mut().insert((dt, value_rank), t.clone());
         t
     }
@@ -247,7 +248,7 @@ impl Gen<'_> {
         let tuple = |args: &[crate::model::Argument]| -> TokenStream {
             let items: Vec<TokenStream> = args.iter().map(|a| self.value_type(a.data_type, a.value_rank)).collect();
             if items.len() > 12 {
-                quote! { Vec<opcua::types::Variant> }
+                quote! { Vec<ua::Variant> }
             } else {
                 quote! { (#(#items,)*) }
             }
@@ -390,7 +391,7 @@ impl Gen<'_> {
             #allow
             pub struct #sname { #(#decls),* }
             impl t::Handle for #sname {
-                fn bind(b: &t::Binder<'_>, id: &opcua::types::NodeId) -> Result<Self, t::BindError> {
+                fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
                     Ok(Self { #(#binds),* })
                 }
             }
@@ -563,8 +564,7 @@ impl Gen<'_> {
             const NS: &[&str] = &[#(#ns_items),*];
             #(#items)*
         };
-        // async-opcua's types are named through a short alias in this file.
-        let mut file = self.file("objects.rs", "Typed handles", alias_ua(tokens));
+        let mut file = self.file("objects.rs", "Typed handles", tokens);
         file.contents.push_str(
             "/// Member markers of each ObjectType, named from browse paths (`ParameterSet__ActualPosition`).\n\
              #[allow(non_snake_case, non_camel_case_types)]\n\
@@ -578,7 +578,8 @@ impl Gen<'_> {
     }
 }
 
-/// `opcua::types::X` -> `ua::X` throughout a token stream (objects.rs imports `opcua::types as ua`).
+/// `opcua::types::X` -> `ua::X` throughout a token stream (objects.rs imports `opcua::types as ua`; the
+/// value types are computed by code shared with types.rs, which names the full path).
 fn alias_ua(tokens: TokenStream) -> TokenStream {
     use proc_macro2::{Group, Ident, Punct, Spacing, Span, TokenTree};
     let tts: Vec<TokenTree> = tokens.into_iter().collect();
