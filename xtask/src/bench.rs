@@ -951,7 +951,15 @@ mod rust {
                 ));
                 continue;
             }
-            out.push_str(line);
+            // Path dependencies (nodeset-derive) are relative to generated/; the crate lives elsewhere.
+            match line.split_once("path = \"") {
+                Some((head, rest)) if !rest.starts_with('/') => {
+                    let abs = root.join("generated").join(rest.split('"').next().unwrap_or(""));
+                    let tail = rest.split_once('"').map_or("", |(_, t)| t);
+                    out.push_str(&format!("{head}path = {:?}{tail}", abs.display().to_string()));
+                }
+                _ => out.push_str(line),
+            }
             out.push('\n');
         }
         out.push_str("\n[workspace]\n\n");
