@@ -349,7 +349,7 @@ impl Pass2<'_> {
             }
             let method_declaration =
                 raw.method_declaration_id.as_ref().and_then(|m| resolve_cached(cache, ctx, fast, model, ix, m, text, diags));
-            for r in &raw.references {
+            for r in self.files[fi as usize].raw.references_of(raw) {
                 // Numeric NodeIds need neither the text nor the cache; everything else, and every problem,
                 // takes the general path.
                 let numeric = fast.then(|| numeric_node(model, ctx, &r.reference_type)).flatten();

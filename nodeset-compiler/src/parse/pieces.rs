@@ -170,12 +170,16 @@ fn append(part: &mut Part, next: Part) {
     set.models.append(&mut more.models);
     set.aliases.append(&mut more.aliases);
     let offset = set.values.append(more.values);
+    let refs = set.references.len() as u32;
     for node in &mut more.nodes {
         if let Some(v) = &mut node.value {
             *v = ValueRef(v.0 + offset);
         }
+        node.references.start += refs;
+        node.references.end += refs;
     }
     set.nodes.append(&mut more.nodes);
+    set.references.append(&mut more.references);
     part.end = end;
 }
 
