@@ -608,7 +608,15 @@ impl<'a, 'd> Parser<'a, 'd> {
         // real node takes hundreds of bytes, so no more than one per 64 bytes is reserved for: a file full
         // of `<UA` cannot make the room many times its own size (its list grows as it is read).
         let rest = self.text.as_bytes().get(self.pos()..self.end).unwrap_or_default();
-        set.nodes.reserve(memchr::memmem::find_iter(rest, b"<UA").count().min(rest.len() / 64));
+        let mut room = memchr::memmem::find_iter(rest, b"<UA").count().min(rest.len() / 64);
+        if self.base == 0 && self.ends_early {
+            // The first piece of a file read in pieces: the later pieces are appended to this list (see
+            // `pieces::join`), so it gets room for about the whole file's nodes, estimated from its own
+            // share (room only: memory that is never written is never touched).
+            let whole = self.text.len().saturating_sub(self.pos());
+            room = (room * whole / rest.len().max(1) + room / 8).min(whole / 64);
+        }
+        set.nodes.reserve(room);
         loop {
             match self.next()? {
                 Ev::Start(e, span) => {

@@ -171,14 +171,15 @@ fn append(part: &mut Part, next: Part) {
     set.aliases.append(&mut more.aliases);
     let offset = set.values.append(more.values);
     let refs = set.references.len() as u32;
-    for node in &mut more.nodes {
+    // The nodes move with their indices into the values and references adjusted, in one pass over them.
+    set.nodes.extend(more.nodes.drain(..).map(|mut node| {
         if let Some(v) = &mut node.value {
             *v = ValueRef(v.0 + offset);
         }
         node.references.start += refs;
         node.references.end += refs;
-    }
-    set.nodes.append(&mut more.nodes);
+        node
+    }));
     set.references.append(&mut more.references);
     part.end = end;
 }
