@@ -81,7 +81,7 @@ pub fn reduce(text: &str, roots: &[u32]) -> String {
             continue;
         }
         let n = &set.nodes[i];
-        for r in &n.references {
+        for r in set.references_of(n) {
             let rt = number(r.reference_type.get(text));
             work.extend(rt);
             let supertype = rt == Some(45) && !r.is_forward;

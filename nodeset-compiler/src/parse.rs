@@ -174,6 +174,8 @@ struct Parser<'a, 'd> {
     tree_stack: Vec<(&'a str, Span, usize)>,
     /// The elements of the file's values.
     values: ValueArena,
+    /// The references of the nodes read so far (see [`RawNode::references`]).
+    references: Vec<RawReference>,
     /// The open elements of the value being read, as indices into `values`.
     value_stack: Vec<u32>,
 }
@@ -205,6 +207,7 @@ impl<'a, 'd> Parser<'a, 'd> {
             attr_buf: Vec::new(),
             tree_stack: Vec::new(),
             values: ValueArena::default(),
+            references: Vec::new(),
             value_stack: Vec::new(),
         }
     }
@@ -590,6 +593,7 @@ impl<'a, 'd> Parser<'a, 'd> {
             models: Vec::new(),
             aliases: Vec::new(),
             nodes: Vec::with_capacity(self.reader.get_ref().len() / 800),
+            references: Vec::new(),
             last_modified: None,
             values: ValueArena::default(),
         };
@@ -604,7 +608,15 @@ impl<'a, 'd> Parser<'a, 'd> {
         // real node takes hundreds of bytes, so no more than one per 64 bytes is reserved for: a file full
         // of `<UA` cannot make the room many times its own size (its list grows as it is read).
         let rest = self.text.as_bytes().get(self.pos()..self.end).unwrap_or_default();
-        set.nodes.reserve(memchr::memmem::find_iter(rest, b"<UA").count().min(rest.len() / 64));
+        let mut room = memchr::memmem::find_iter(rest, b"<UA").count().min(rest.len() / 64);
+        if self.base == 0 && self.ends_early {
+            // The first piece of a file read in pieces: the later pieces are appended to this list (see
+            // `pieces::join`), so it gets room for about the whole file's nodes, estimated from its own
+            // share (room only: memory that is never written is never touched).
+            let whole = self.text.len().saturating_sub(self.pos());
+            room = (room * whole / rest.len().max(1) + room / 8).min(whole / 64);
+        }
+        set.nodes.reserve(room);
         loop {
             match self.next()? {
                 Ev::Start(e, span) => {
@@ -639,6 +651,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                 Ev::Eof => {
                     // Only a piece that ends before the file does stops here (see `next`).
                     set.values = std::mem::take(&mut self.values);
+                    set.references = std::mem::take(&mut self.references);
                     part.end = PartEnd::Boundary;
                     return Ok(());
                 }
@@ -666,6 +679,7 @@ impl<'a, 'd> Parser<'a, 'd> {
             }
         }
         set.values = std::mem::take(&mut self.values);
+        set.references = std::mem::take(&mut self.references);
         part.end = PartEnd::Document;
         Ok(())
     }
@@ -919,6 +933,8 @@ impl<'a, 'd> Parser<'a, 'd> {
         if !have_bn {
             self.missing(span, class.element(), "BrowseName");
         }
+        node.references.start = self.references.len() as u32;
+        node.references.end = node.references.start;
         loop {
             match self.next()? {
                 Ev::Start(e, cspan) => {
@@ -941,7 +957,12 @@ impl<'a, 'd> Parser<'a, 'd> {
                             node.category.push(t.trim().to_string())
                         }
                         b"Documentation" => node.documentation = Some(self.text_content("Documentation")?.into_owned()),
-                        b"References" => self.references(&mut node.references)?,
+                        b"References" => {
+                            let mut out = std::mem::take(&mut self.references);
+                            let read = self.references(&mut out);
+                            self.references = out;
+                            read?
+                        }
                         b"RolePermissions" => node.role_permissions = self.role_permissions()?,
                         b"Extensions" => {
                             let mut sink = ElementSink::default();
@@ -961,6 +982,7 @@ impl<'a, 'd> Parser<'a, 'd> {
                 Ev::Eof => unreachable!(),
             }
         }
+        node.references.end = self.references.len() as u32;
         Ok(())
     }
 
@@ -1615,7 +1637,7 @@ pub(crate) mod tests {
         let a = &set.nodes[0];
         assert_eq!(a.display_names.len(), 2);
         assert_eq!(a.descriptions[0].text, "line1\nline2");
-        assert!(!a.references[0].is_forward);
+        assert!(!set.references_of(a)[0].is_forward);
         assert_eq!(&xml[a.node_id.span.start as usize..a.node_id.span.end as usize], "ns=1;i=1");
         let v = set.values.element(set.nodes[1].value.unwrap(), xml);
         assert_eq!(v.name(), "ListOfInt32");
@@ -1727,11 +1749,12 @@ pub(crate) mod tests {
             <Reference ReferenceType=\"Organizes\" IsForward=\"false\">i=85</Reference></References></UAObject></UANodeSet>";
         let (set, d) = parse_str(xml);
         assert!(d.items.is_empty(), "{d:?}");
-        let n = &set.unwrap().nodes[0];
+        let set = set.unwrap();
+        let n = &set.nodes[0];
         assert_eq!(n.node_id.get(xml), "ns=1;s=a&b");
         assert_eq!(&xml[n.node_id.span.start as usize..n.node_id.span.end as usize], "ns=1;s=a&amp;b");
         assert_eq!(n.browse_name.get(xml), "1:A");
-        let r = &n.references;
+        let r = set.references_of(n);
         assert_eq!((r[0].reference_type.get(xml), r[0].target.get(xml)), ("HasComponent", "ns=1;i=5"));
         assert_eq!(&xml[r[0].reference_type.span.start as usize..r[0].reference_type.span.end as usize], " HasComponent ");
         // The target's span is computed on the text after line-break normalisation, as it always was.

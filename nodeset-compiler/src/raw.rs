@@ -252,7 +252,10 @@ pub struct RawNode {
     pub descriptions: Vec<LocalizedText>,
     pub category: Vec<String>,
     pub documentation: Option<String>,
-    pub references: Vec<RawReference>,
+    /// The node's `<Reference>`s: a range of its file's [`RawNodeSet::references`] (read them with
+    /// [`RawNodeSet::references_of`]). One list per file, not one per node: nearly every node has
+    /// references, and a list of its own cost an allocation or more per node to build and free.
+    pub references: RefRange,
     pub role_permissions: Vec<RawRolePermission>,
     pub extensions: Vec<XmlElement>,
     // Instance attributes.
@@ -304,7 +307,7 @@ impl RawNode {
             descriptions: Vec::new(),
             category: Vec::new(),
             documentation: None,
-            references: Vec::new(),
+            references: RefRange::default(),
             role_permissions: Vec::new(),
             extensions: Vec::new(),
             parent_node_id: None,
@@ -341,9 +344,35 @@ pub struct RawNodeSet {
     pub models: Vec<RawModel>,
     pub aliases: Vec<RawAlias>,
     pub nodes: Vec<RawNode>,
+    /// The references of every node, in document order (see [`RawNode::references`]).
+    pub references: Vec<RawReference>,
     pub last_modified: Option<String>,
     /// The elements of every `<Value>` of the file.
     pub values: ValueArena,
+}
+
+impl RawNodeSet {
+    /// The references of one of the file's nodes.
+    pub fn references_of(&self, node: &RawNode) -> &[RawReference] {
+        self.references.get(node.references.start as usize..node.references.end as usize).unwrap_or_default()
+    }
+}
+
+/// A node's references: the range `start..end` of its file's [`RawNodeSet::references`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RefRange {
+    pub start: u32,
+    pub end: u32,
+}
+
+impl RefRange {
+    pub fn len(&self) -> usize {
+        (self.end - self.start) as usize
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.start == self.end
+    }
 }
 
 /// A node's value: the element inside its `<Value>`, as an index into its file's [`ValueArena`].

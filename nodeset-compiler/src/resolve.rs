@@ -157,7 +157,8 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 value: raw.value,
                 definition: raw.definition.take(),
                 extensions: std::mem::take(&mut raw.extensions),
-                references: Vec::with_capacity(raw.references.len()),
+                // Filled once all references are known, in one allocation (see `link`).
+                references: Vec::new(),
                 super_type: None,
                 type_definition: None,
                 modelling_rule: None,
@@ -191,6 +192,13 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
     let (first, second) = pending.split_at(half);
     let (later, earlier) = crate::join(|| pass.links(second), || pass.links(first));
     let mut seen_refs: FxHashSet<(NodeIx, NodeIx, NodeIx)> = FxHashSet::with_capacity_and_hasher(total * 3, Default::default());
+    // The declared references of every node, in node order (node `i`'s end at `own_end[i]`), and
+    // the inverses they give their targets: each node's list is built from both in `link`, in one go.
+    let mut own: Vec<Reference> = Vec::with_capacity(total * 3);
+    let mut own_end: Vec<u32> = Vec::with_capacity(total);
+    // What pass 2 found for every node, in node order: entered with the references in `link`, so that each
+    // node is written once.
+    let mut found_all: Vec<NodeLinks> = Vec::with_capacity(total);
     let mut incoming: Vec<(NodeIx, Reference)> = Vec::with_capacity(total * 3);
     // Nodes with a reference that could not be resolved (already reported): no follow-on warnings.
     let mut broken: HashSet<NodeIx> = HashSet::new();
@@ -199,20 +207,18 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         broken.extend(links.broken);
         let mut from = 0;
         for (&(ix, _, _), found) in part.iter().zip(links.nodes) {
-            let node = &mut model.nodes[ix.index()];
-            node.attrs.array_dimensions = found.array_dimensions;
-            node.attrs.data_type = found.data_type;
-            node.attrs.method_declaration = found.method_declaration;
-            node.parent = found.parent;
+            debug_assert_eq!(ix.index(), own_end.len(), "pending is in node order");
             for &(reference_type, target, forward, span) in &links.references[from..found.references_end as usize] {
                 let (src, dst) = if forward { (ix, target) } else { (target, ix) };
                 if !seen_refs.insert((src, reference_type, dst)) {
                     continue;
                 }
-                model.nodes[ix.index()].references.push(Reference { reference_type, target, forward, declared: true, span });
+                own.push(Reference { reference_type, target, forward, declared: true, span });
                 incoming.push((target, Reference { reference_type, target: ix, forward: !forward, declared: false, span }));
             }
+            own_end.push(own.len() as u32);
             from = found.references_end as usize;
+            found_all.push(found);
         }
     }
     model.files = files.iter().map(|f| f.raw.file).zip(contexts).collect();
@@ -220,24 +226,56 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
     model.value_arenas = value_arenas;
     drop(pending);
     // The raw files are not needed any more: another thread frees them while this one goes on.
-    crate::join(move || drop(files), || link(&mut model, incoming, &broken, diags));
+    let own = OwnReferences { references: own, ends: own_end, found: found_all };
+    crate::join(move || drop(files), || link(&mut model, own, incoming, &broken, diags));
     model
 }
 
+/// What pass 2 found for every node, in node order: the declared references (node `i`'s end at
+/// `ends[i]`) and the attributes that name nodes.
+struct OwnReferences {
+    references: Vec<Reference>,
+    ends: Vec<u32>,
+    found: Vec<NodeLinks>,
+}
+
 /// Passes 3 to 8, on the model with its references resolved.
-fn link(model: &mut Model, incoming: Vec<(NodeIx, Reference)>, broken: &HashSet<NodeIx>, diags: &mut Diagnostics) {
-    // Each node's inverse references go after its own, in the order they were found; room for them is
-    // made once per node.
-    let mut extra = vec![0u32; model.nodes.len()];
+fn link(model: &mut Model, own: OwnReferences, incoming: Vec<(NodeIx, Reference)>, broken: &HashSet<NodeIx>, diags: &mut Diagnostics) {
+    // Each node's inverse references go after its own, in the order they were found. The inverses are
+    // first sorted by node (stably, by counting), so that each node's list is allocated once at its final
+    // size and filled in order.
+    let n = model.nodes.len();
+    let mut starts = vec![0u32; n + 1];
     for (target, _) in &incoming {
-        extra[target.index()] += 1;
+        starts[target.index() + 1] += 1;
     }
-    for (node, n) in model.nodes.iter_mut().zip(extra) {
-        node.references.reserve_exact(n as usize);
+    for i in 0..n {
+        starts[i + 1] += starts[i];
     }
+    let mut next = starts.clone();
+    let placeholder = Reference { reference_type: NodeIx(0), target: NodeIx(0), forward: false, declared: false, span: Span::new(crate::source::FileId(0), 0, 0) };
+    let mut sorted = vec![placeholder; incoming.len()];
     for (target, r) in incoming {
-        model.nodes[target.index()].references.push(r);
+        let at = &mut next[target.index()];
+        sorted[*at as usize] = r;
+        *at += 1;
     }
+    let mut start = 0;
+    let OwnReferences { references: own, ends, found } = own;
+    for (i, ((node, &end), found)) in model.nodes.iter_mut().zip(&ends).zip(found).enumerate() {
+        node.attrs.array_dimensions = found.array_dimensions;
+        node.attrs.data_type = found.data_type;
+        node.attrs.method_declaration = found.method_declaration;
+        node.parent = found.parent;
+        let declared = &own[start..end as usize];
+        let inverse = &sorted[starts[i] as usize..starts[i + 1] as usize];
+        let mut list = Vec::with_capacity(declared.len() + inverse.len());
+        list.extend_from_slice(declared);
+        list.extend_from_slice(inverse);
+        node.references = list;
+        start = end as usize;
+    }
+    drop((own, ends, sorted, starts, next));
 
     // Pass 3: hierarchy flags, supertypes, type definitions, modelling rules, parents.
     link_types(model, broken, diags);
@@ -349,7 +387,7 @@ impl Pass2<'_> {
             }
             let method_declaration =
                 raw.method_declaration_id.as_ref().and_then(|m| resolve_cached(cache, ctx, fast, model, ix, m, text, diags));
-            for r in &raw.references {
+            for r in self.files[fi as usize].raw.references_of(raw) {
                 // Numeric NodeIds need neither the text nor the cache; everything else, and every problem,
                 // takes the general path.
                 let numeric = fast.then(|| numeric_node(model, ctx, &r.reference_type)).flatten();

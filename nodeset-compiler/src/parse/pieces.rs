@@ -170,12 +170,17 @@ fn append(part: &mut Part, next: Part) {
     set.models.append(&mut more.models);
     set.aliases.append(&mut more.aliases);
     let offset = set.values.append(more.values);
-    for node in &mut more.nodes {
+    let refs = set.references.len() as u32;
+    // The nodes move with their indices into the values and references adjusted, in one pass over them.
+    set.nodes.extend(more.nodes.drain(..).map(|mut node| {
         if let Some(v) = &mut node.value {
             *v = ValueRef(v.0 + offset);
         }
-    }
-    set.nodes.append(&mut more.nodes);
+        node.references.start += refs;
+        node.references.end += refs;
+        node
+    }));
+    set.references.append(&mut more.references);
     part.end = end;
 }
 
