@@ -14,7 +14,15 @@
 //! - `objects.rs`: typed handles of the ObjectTypes and VariableTypes and member markers (`objects`), the
 //!   state tables of state machine types, and the typed inputs and outputs of program types (`programs`).
 //!
-//! `generate` is a pure function of the model and the configuration; it returns files in memory.
+//! `generate` is a pure function of the model and the configuration; it returns files in memory. Its files
+//! are generated on all cores (one job per namespace and file), with the same output whatever the number of
+//! threads.
+//!
+//! Code is built with quote and printed by prettyplease. Three tables are written as text instead, because
+//! building and parsing token trees for data cost most of the generation time: the node rows of `nodes.rs`
+//! (one line each), the NodeId constants of `ids.rs` (in prettyplease's own layout; the tests
+//! `ids_text_is_what_prettyplease_prints` and `generated_code_is_in_prettyplease_layout` hold it to that),
+//! and the member markers at the end of `objects.rs` (one line each).
 //!
 //! [`NodeSetTable`]: https://docs.rs/nodeset-models (runtime::table::NodeSetTable)
 
