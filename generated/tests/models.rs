@@ -88,3 +88,17 @@ async fn skill_tables_import_completely() {
     }
     running.stop().await;
 }
+
+/// The runtime names CommonSkills' SkillTransitionEventType itself (so that it builds without the generated
+/// models); it must be the generated constant.
+#[test]
+fn skill_transition_event_type_matches_the_generated_id() {
+    assert_eq!(
+        nodeset_models::runtime::typed::program::SKILL_TRANSITION_EVENT_TYPE,
+        common_skills::ids::object_types::SKILL_TRANSITION_EVENT_TYPE
+    );
+    assert_eq!(
+        nodeset_models::runtime::typed::program::SKILL_TRANSITION_EVENT_TYPE.namespace_uri,
+        common_skills::NAMESPACE_URI
+    );
+}

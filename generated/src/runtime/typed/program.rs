@@ -514,7 +514,7 @@ fn event_setup(manager: &ModelManager, event_type: NodeId, instance_name: &str) 
     }
     let mut extra = Vec::new();
     // CommonSkills' SkillTransitionEventType names the skill (its BrowseName) in `SkillName`.
-    let skills = crate::models::common_skills::ids::object_types::SKILL_TRANSITION_EVENT_TYPE;
+    let skills = SKILL_TRANSITION_EVENT_TYPE;
     if let (Some(skill_event), Some(ns)) = (manager.resolve(skills), manager.namespace_index(skills.namespace_uri)) {
         if chain.contains(&skill_event) {
             extra.push((vec![QualifiedName::new(ns, "SkillName")], Variant::from(instance_name)));
@@ -522,6 +522,13 @@ fn event_setup(manager: &ModelManager, event_type: NodeId, instance_name: &str) 
     }
     EventSetup { event_type, chain, extra }
 }
+
+/// CommonSkills' `SkillTransitionEventType` (nodesets/CommonSkills.NodeSet2.xml, i=1100). Named here rather
+/// than taken from the generated `models::common_skills`, so that the runtime builds without the generated
+/// models (a build script's output uses it on its own); the test
+/// `skill_transition_event_type_matches_the_generated_id` keeps the two equal.
+pub const SKILL_TRANSITION_EVENT_TYPE: crate::runtime::NsNodeId =
+    crate::runtime::NsNodeId::numeric("http://nodeset-compiler.dev/CommonSkills/", 1100);
 
 /// The states of a program (Part 10), which the driver treats specially.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
