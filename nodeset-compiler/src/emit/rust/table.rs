@@ -56,6 +56,18 @@ fn dims(out: &mut String, d: &[u32]) {
     });
 }
 
+/// Appends the bytes of a GUID, `[1, 2, ...]`.
+fn guid(out: &mut String, g: &[u8; 16]) {
+    out.push('[');
+    for (i, b) in g.iter().enumerate() {
+        if i > 0 {
+            out.push_str(", ");
+        }
+        let _ = write!(out, "{b}");
+    }
+    out.push(']');
+}
+
 /// Appends an `rt::IdKind`.
 fn id_kind(out: &mut String, id: &Identifier) {
     match id {
@@ -68,14 +80,9 @@ fn id_kind(out: &mut String, id: &Identifier) {
             out.push(')');
         }
         Identifier::Guid(g) => {
-            out.push_str("rt::IdKind::Guid([");
-            for (i, b) in g.iter().enumerate() {
-                if i > 0 {
-                    out.push_str(", ");
-                }
-                let _ = write!(out, "{b}");
-            }
-            out.push_str("])");
+            out.push_str("rt::IdKind::Guid(");
+            guid(out, g);
+            out.push(')');
         }
         Identifier::Opaque(b) => {
             out.push_str("rt::IdKind::Opaque(");
@@ -352,7 +359,8 @@ impl Gen<'_> {
         }
     }
 
-    /// Appends the table value of a variable or variable type; false if it cannot be expressed.
+    /// Appends the table value of a variable or variable type; false if it cannot be expressed (then the
+    /// caller discards what was appended).
     fn value_text(&self, out: &mut String, ix: NodeIx, local: &dyn Fn(u16) -> u16) -> bool {
         match self.model.value(ix) {
             None => {
@@ -407,14 +415,9 @@ impl Gen<'_> {
                 out.push(')');
             }
             Variant::Guid(g) => {
-                out.push_str("rt::table::Val::Guid([");
-                for (i, b) in g.iter().enumerate() {
-                    if i > 0 {
-                        out.push_str(", ");
-                    }
-                    let _ = write!(out, "{b}");
-                }
-                out.push_str("])");
+                out.push_str("rt::table::Val::Guid(");
+                guid(out, g);
+                out.push(')');
             }
             Variant::ByteString(b) => {
                 out.push_str("rt::table::Val::ByteString(");
@@ -501,30 +504,30 @@ impl Gen<'_> {
         };
         match kind {
             ids::ARGUMENT => {
-                let mut text = String::from("rt::table::Val::Arguments(&[");
+                // On failure the caller discards what was written.
+                out.push_str("rt::table::Val::Arguments(&[");
                 for (i, b) in bodies.iter().enumerate() {
                     let dt_text = b.child("DataType").and_then(|d| d.child_text("Identifier")).unwrap_or("i=24");
                     let Some(dt) = self.map_value_node_id(dt_text) else { return false };
                     if i > 0 {
-                        text.push_str(", ");
+                        out.push_str(", ");
                     }
-                    text.push_str("rt::table::ArgRow { name: ");
-                    str_lit(&mut text, b.child_text("Name").unwrap_or("").trim());
-                    text.push_str(", data_type: ");
-                    table_id(&mut text, local(dt.ns), true, &dt.id);
+                    out.push_str("rt::table::ArgRow { name: ");
+                    str_lit(out, b.child_text("Name").unwrap_or("").trim());
+                    out.push_str(", data_type: ");
+                    table_id(out, local(dt.ns), true, &dt.id);
                     let vr: i32 = b.child_text("ValueRank").and_then(|t| t.trim().parse().ok()).unwrap_or(-1);
-                    let _ = write!(text, ", value_rank: {vr}i32, array_dimensions: ");
+                    let _ = write!(out, ", value_rank: {vr}i32, array_dimensions: ");
                     let d: Vec<u32> = b
                         .child("ArrayDimensions")
                         .map(|a| a.children.iter().filter_map(|c| c.text.trim().parse().ok()).collect())
                         .unwrap_or_default();
-                    dims(&mut text, &d);
-                    text.push_str(", description: ");
-                    opt_str(&mut text, description(b).as_deref());
-                    text.push_str(" }");
+                    dims(out, &d);
+                    out.push_str(", description: ");
+                    opt_str(out, description(b).as_deref());
+                    out.push_str(" }");
                 }
-                text.push_str("])");
-                out.push_str(&text);
+                out.push_str("])");
                 true
             }
             ids::ENUM_VALUE_TYPE => {
