@@ -102,3 +102,52 @@ fn skill_transition_event_type_matches_the_generated_id() {
         common_skills::NAMESPACE_URI
     );
 }
+
+/// A placeholder's instances bind in BrowseName order whatever order they were created in, and are found by
+/// BrowseName.
+#[tokio::test]
+async fn placeholder_instances_bind_by_browse_name() {
+    use nodeset_models::runtime::typed::{Instantiate, ObjectType};
+    let running = common::serve(
+        ServerConfig::new("placeholders")
+            .table(&di::TABLE)
+            .type_loader(di::TypeLoader)
+            .table(&ia::TABLE)
+            .type_loader(ia::TypeLoader)
+            .table(&robotics::TABLE)
+            .type_loader(robotics::TypeLoader),
+    )
+    .await;
+    let objects = NodeId::from(opcua::types::ObjectId::ObjectsFolder);
+    let mut options = Instantiate::new()
+        .placeholder("MotionDevices/<MotionDeviceIdentifier>", ["Right", "Left"])
+        .placeholder("Controllers/<ControllerIdentifier>", ["Controller"])
+        .placeholder("SafetyStates/<SafetyStateIdentifier>", ["SafetyState"])
+        .placeholder("Controllers/Controller/Software/<SoftwareIdentifier>", ["Software"])
+        .placeholder("Controllers/Controller/TaskControls/<TaskControlIdentifier>", ["Task"]);
+    for arm in ["Right", "Left"] {
+        options = options
+            .placeholder(format!("MotionDevices/{arm}/Axes/<AxisIdentifier>"), ["A1"])
+            .placeholder(format!("MotionDevices/{arm}/PowerTrains/<PowerTrainIdentifier>"), ["PT1"])
+            .placeholder(format!("MotionDevices/{arm}/PowerTrains/PT1/<MotorIdentifier>"), ["Motor"])
+            .placeholder(format!("MotionDevices/{arm}/PowerTrains/PT1/<GearIdentifier>"), ["Gear"]);
+    }
+    let robot = robotics::objects::MotionDeviceSystemType::instantiate(&running.manager, &objects, "Cell", &options)
+        .expect("instantiates the robot");
+    let arms = &robot.motion_devices.motion_device_identifier;
+    assert_eq!(arms.len(), 2);
+    assert!(!arms.is_empty());
+    assert_eq!(arms.keys().collect::<Vec<_>>(), ["Left", "Right"]);
+    let left = arms.get("Left").expect("the left arm is bound");
+    let browse_name = running.attribute(left.node.id(), AttributeId::BrowseName);
+    assert!(matches!(browse_name, Some(opcua::types::Variant::QualifiedName(q)) if q.name.as_ref() == "Left"));
+    assert!(arms.contains_key("Right"));
+    assert!(arms.get("Middle").is_none());
+    assert_eq!(arms.iter().map(|(name, arm)| (name, arm.node.id() == left.node.id())).collect::<Vec<_>>(), [
+        ("Left", true),
+        ("Right", false)
+    ]);
+    assert_eq!(arms.values().count(), 2);
+    assert_eq!(robot.safety_states.safety_state_identifier.keys().collect::<Vec<_>>(), ["SafetyState"]);
+    running.stop().await;
+}

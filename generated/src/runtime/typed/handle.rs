@@ -1,7 +1,6 @@
 //! Typed handles to the nodes of an instance: [`ObjectNode`], [`Variable<T>`], [`Method<I, O>`],
 //! [`Placeholders<H>`], and the [`Binder`] that generated handle structs use to find their children.
 
-use std::collections::BTreeMap;
 use std::fmt;
 use std::future::Future;
 use std::marker::PhantomData;
@@ -136,9 +135,20 @@ impl<'a> Binder<'a> {
     /// The instances of a placeholder: the children of `node` whose TypeDefinition is `type_id` or a
     /// subtype of it, keyed by BrowseName.
     pub fn placeholders<H: Handle>(&self, node: &NodeId, type_id: NsNodeId) -> Result<Placeholders<H>, BindError> {
+        // Only the binding is generic: it is compiled once per handle type of every placeholder there is.
+        let found = self.placeholder_children(node, type_id)?;
+        let mut out = Vec::with_capacity(found.len());
+        for (name, child) in found {
+            out.push((name, H::bind(self, &child)?));
+        }
+        Ok(Placeholders(out))
+    }
+
+    /// The children [`Binder::placeholders`] binds, sorted by BrowseName.
+    fn placeholder_children(&self, node: &NodeId, type_id: NsNodeId) -> Result<Vec<(String, NodeId)>, BindError> {
         let ty = type_id.resolve(self.tree.namespaces()).ok_or(BindError::UnknownNamespace(type_id.namespace_uri.to_owned()))?;
         let has_type_definition: NodeId = ReferenceTypeId::HasTypeDefinition.into();
-        let mut out = BTreeMap::new();
+        let mut found = Vec::new();
         for child in self.children(node) {
             let definition = self
                 .space
@@ -147,10 +157,13 @@ impl<'a> Binder<'a> {
                 .map(|r| r.target_node.clone());
             if definition.is_some_and(|d| d == ty || self.tree.is_subtype_of(&d, &ty)) {
                 let name = self.space.find(&child).map(|n| n.as_node().browse_name().name.as_ref().to_owned());
-                out.insert(name.unwrap_or_default(), H::bind(self, &child)?);
+                found.push((name.unwrap_or_default(), child));
             }
         }
-        Ok(Placeholders(out))
+        // BrowseNames are unique among siblings; should a server break that, the first one stored wins.
+        found.sort_by(|a, b| a.0.cmp(&b.0));
+        found.dedup_by(|later, first| later.0 == first.0);
+        Ok(found)
     }
 
     /// The ValueRank of a variable, for checks.
@@ -448,19 +461,52 @@ impl<I: Arguments, O: Arguments> Handle for Method<I, O> {
     }
 }
 
-/// The instances of a placeholder (`<AxisIdentifier>`), by BrowseName.
+/// The instances of a placeholder (`<AxisIdentifier>`), by BrowseName, in BrowseName order.
+///
+/// A sorted list rather than a `BTreeMap`: every handle type of a placeholder instantiates this type, and a
+/// map's code is several times larger for the few instances a placeholder has.
 #[derive(Clone, Debug)]
-pub struct Placeholders<H>(pub BTreeMap<String, H>);
+pub struct Placeholders<H>(Vec<(String, H)>);
 
-impl<H> std::ops::Deref for Placeholders<H> {
-    type Target = BTreeMap<String, H>;
-    fn deref(&self) -> &Self::Target {
-        &self.0
+impl<H> Placeholders<H> {
+    /// The instance with this BrowseName.
+    pub fn get(&self, name: &str) -> Option<&H> {
+        self.0.binary_search_by(|(n, _)| n.as_str().cmp(name)).ok().map(|i| &self.0[i].1)
+    }
+
+    /// Whether there is an instance with this BrowseName.
+    pub fn contains_key(&self, name: &str) -> bool {
+        self.get(name).is_some()
+    }
+
+    /// (BrowseName, instance) pairs in BrowseName order.
+    pub fn iter(&self) -> impl ExactSizeIterator<Item = (&str, &H)> {
+        self.0.iter().map(|(n, h)| (n.as_str(), h))
+    }
+
+    /// The BrowseNames, in order.
+    pub fn keys(&self) -> impl ExactSizeIterator<Item = &str> {
+        self.0.iter().map(|(n, _)| n.as_str())
+    }
+
+    /// The instances, in BrowseName order.
+    pub fn values(&self) -> impl ExactSizeIterator<Item = &H> {
+        self.0.iter().map(|(_, h)| h)
+    }
+
+    /// How many instances there are.
+    pub fn len(&self) -> usize {
+        self.0.len()
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
     }
 }
 
 impl<H> Default for Placeholders<H> {
     fn default() -> Self {
-        Placeholders(BTreeMap::new())
+        Placeholders(Vec::new())
     }
 }
