@@ -19,7 +19,7 @@ const NS: &[&str] = &[
 /// Handle of an instance of `AbsoluteCartesianLinearMoveSkillType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1800).
 ///
 /// Linear Cartesian motion to an absolute pose: the tool centre point moves on a straight line to TargetPose, expressed in the base frame of the robot.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct AbsoluteCartesianLinearMoveSkillType {
     /// The instance.
@@ -29,6 +29,7 @@ pub struct AbsoluteCartesianLinearMoveSkillType {
     /// `InputParameterSet` (Mandatory). The inputs of the absolute motion: TargetPose, Speed and Acceleration.
     pub input_parameter_set: AbsoluteCartesianLinearMoveSkillType_InputParameterSet,
 }
+t::debug_handle!(AbsoluteCartesianLinearMoveSkillType);
 impl t::Handle for AbsoluteCartesianLinearMoveSkillType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -40,7 +41,7 @@ impl t::Handle for AbsoluteCartesianLinearMoveSkillType {
 }
 t::deref_base!(AbsoluteCartesianLinearMoveSkillType => MoveSkillType);
 /// `InputParameterSet`, a member of `AbsoluteCartesianLinearMoveSkillType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct AbsoluteCartesianLinearMoveSkillType_InputParameterSet {
     /// The instance.
@@ -52,6 +53,7 @@ pub struct AbsoluteCartesianLinearMoveSkillType_InputParameterSet {
     /// `TargetPose` (Mandatory). Pose the tool centre point moves to, in the base frame of the robot; millimetres and degrees.
     pub target_pose: t::Variable<ua::ThreeDFrame>,
 }
+t::debug_handle!(AbsoluteCartesianLinearMoveSkillType_InputParameterSet);
 impl t::Handle for AbsoluteCartesianLinearMoveSkillType_InputParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -96,7 +98,7 @@ t::parameters!(
 /// Handle of an instance of `AbsoluteJointPTPMoveSkillType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1600).
 ///
 /// Point-to-point motion in joint space: every joint moves to its target angle, all joints start and stop together; the path of the tool between is not a straight line.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct AbsoluteJointPtpMoveSkillType {
     /// The instance.
@@ -106,6 +108,7 @@ pub struct AbsoluteJointPtpMoveSkillType {
     /// `InputParameterSet` (Mandatory). The inputs of the joint motion: TargetJointPositions, Speed and Acceleration.
     pub input_parameter_set: AbsoluteJointPtpMoveSkillType_InputParameterSet,
 }
+t::debug_handle!(AbsoluteJointPtpMoveSkillType);
 impl t::Handle for AbsoluteJointPtpMoveSkillType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -117,7 +120,7 @@ impl t::Handle for AbsoluteJointPtpMoveSkillType {
 }
 t::deref_base!(AbsoluteJointPtpMoveSkillType => MoveSkillType);
 /// `InputParameterSet`, a member of `AbsoluteJointPtpMoveSkillType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct AbsoluteJointPtpMoveSkillType_InputParameterSet {
     /// The instance.
@@ -129,6 +132,7 @@ pub struct AbsoluteJointPtpMoveSkillType_InputParameterSet {
     /// `TargetJointPositions` (Mandatory). Target angle of every joint, in degrees, in the order of the joints from the base to the flange. The array has one element per joint of the robot.
     pub target_joint_positions: t::Variable<Vec<f64>>,
 }
+t::debug_handle!(AbsoluteJointPtpMoveSkillType_InputParameterSet);
 impl t::Handle for AbsoluteJointPtpMoveSkillType_InputParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -174,7 +178,7 @@ t::parameters!(
 /// Handle of an instance of `CompositeSkillType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1400).
 ///
 /// A skill that runs other skills one after another, possibly of other devices and servers (for example move, drill, move). If a skill it uses is unavailable it suspends, if one halts it halts, so the state of the innermost skill reaches the outermost; Suspend and Resume are therefore Mandatory.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct CompositeSkillType {
     /// The instance.
@@ -186,6 +190,7 @@ pub struct CompositeSkillType {
     /// `Resume` (Mandatory). Continues the composite skill with the skill it had paused in.
     pub resume: t::Method<(), ()>,
 }
+t::debug_handle!(CompositeSkillType);
 impl t::Handle for CompositeSkillType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -214,7 +219,7 @@ t::program_type!(
 /// Handle of an instance of `GrippingSkillType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1900).
 ///
 /// Opening or closing a gripper. The run ends in Ready when the jaws have reached their end position or, when closing, hold the part with GripForce; in Halted when they could not.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct GrippingSkillType {
     /// The instance.
@@ -224,6 +229,7 @@ pub struct GrippingSkillType {
     /// `InputParameterSet` (Mandatory). The inputs of the gripping: Action and GripForce.
     pub input_parameter_set: GrippingSkillType_InputParameterSet,
 }
+t::debug_handle!(GrippingSkillType);
 impl t::Handle for GrippingSkillType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -235,7 +241,7 @@ impl t::Handle for GrippingSkillType {
 }
 t::deref_base!(GrippingSkillType => ProgramSkillStateMachineType);
 /// `InputParameterSet`, a member of `GrippingSkillType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct GrippingSkillType_InputParameterSet {
     /// The instance.
@@ -245,6 +251,7 @@ pub struct GrippingSkillType_InputParameterSet {
     /// `GripForce` (Mandatory). Force the jaws hold the part with when closing, in newtons; ignored when opening.
     pub grip_force: t::Variable<f64>,
 }
+t::debug_handle!(GrippingSkillType_InputParameterSet);
 impl t::Handle for GrippingSkillType_InputParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -284,7 +291,7 @@ t::parameters!(
 /// Handle of an instance of `ISkillSetType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1200).
 ///
 /// Interface of everything that offers skills: devices, device systems, controllers, cells. An object that implements it (HasInterface) has a folder SkillSet, and the SkillSet convention applies: every skill of the object is a component (HasComponent) of SkillSet, is an instance of a concrete subtype of ProgramSkillStateMachineType, and is named after its type without the suffix SkillType (AbsoluteJointPTPMove for AbsoluteJointPTPMoveSkillType). A client finds what an object can do by browsing its SkillSet; composite skills of a cell call the skills in the SkillSets of its devices.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ISkillSetType {
     /// The instance.
@@ -292,6 +299,7 @@ pub struct ISkillSetType {
     /// `SkillSet` (Mandatory). The skills of the object: each a component of this folder and an instance of a concrete ProgramSkillStateMachineType subtype.
     pub skill_set: t::ObjectNode,
 }
+t::debug_handle!(ISkillSetType);
 impl t::Handle for ISkillSetType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -304,7 +312,7 @@ t::object_type!(ISkillSetType, rt::NsNodeId::numeric(NS[0], 1200), "ISkillSetTyp
 /// Handle of an instance of `MoveSkillType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1500).
 ///
 /// A robot motion. Each concrete move skill fixes the target and the units of Speed and Acceleration; the run ends in Ready when the robot stands at the target, in Halted when the motion was stopped (an emergency or protective stop, or Halt).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct MoveSkillType {
     /// The instance.
@@ -314,6 +322,7 @@ pub struct MoveSkillType {
     /// `InputParameterSet` (Mandatory). The inputs of the motion: Speed and Acceleration, and the target the concrete move skill adds.
     pub input_parameter_set: MoveSkillType_InputParameterSet,
 }
+t::debug_handle!(MoveSkillType);
 impl t::Handle for MoveSkillType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -325,7 +334,7 @@ impl t::Handle for MoveSkillType {
 }
 t::deref_base!(MoveSkillType => ProgramSkillStateMachineType);
 /// `InputParameterSet`, a member of `MoveSkillType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct MoveSkillType_InputParameterSet {
     /// The instance.
@@ -335,6 +344,7 @@ pub struct MoveSkillType_InputParameterSet {
     /// `Acceleration` (Mandatory). Maximum acceleration of the motion, in the unit its EngineeringUnits name.
     pub acceleration: t::Variable<f64>,
 }
+t::debug_handle!(MoveSkillType_InputParameterSet);
 impl t::Handle for MoveSkillType_InputParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -372,7 +382,7 @@ t::parameters!(
 /// Handle of an instance of `ProgramSkillStateMachineType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1300).
 ///
 /// A skill: a capability of a device or cell that a client parameterises and runs. It is an OPC UA Program (ProgramStateMachineType) and keeps its states Ready, Running, Suspended and Halted, its transitions and their causes: a client writes the variables of InputParameterSet, calls Start, and the skill runs until it is back in Ready (success, results in OutputParameterSet) or in Halted (failure or Halt, Reset to go on). Start, Halt and Reset are Mandatory; Suspend and Resume are Optional and made Mandatory by subtypes that can pause. Every transition raises a SkillTransitionEventType.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ProgramSkillStateMachineType {
     /// The instance.
@@ -410,6 +420,7 @@ pub struct ProgramSkillStateMachineType {
     /// `OutputParameterSet` (Mandatory). The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here).
     pub output_parameter_set: ProgramSkillStateMachineType_OutputParameterSet,
 }
+t::debug_handle!(ProgramSkillStateMachineType);
 impl t::Handle for ProgramSkillStateMachineType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -434,7 +445,7 @@ impl t::Handle for ProgramSkillStateMachineType {
     }
 }
 /// `OutputParameterSet`, a member of `ProgramSkillStateMachineType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ProgramSkillStateMachineType_OutputParameterSet {
     /// The instance.
@@ -442,6 +453,7 @@ pub struct ProgramSkillStateMachineType_OutputParameterSet {
     /// `Result` (Mandatory). Outcome of the last run: Good when it ended in Ready, the Bad code of the cause when it ended in Halted. Uncertain_InitialValue before the first run.
     pub result: t::Variable<ua::StatusCode>,
 }
+t::debug_handle!(ProgramSkillStateMachineType_OutputParameterSet);
 impl t::Handle for ProgramSkillStateMachineType_OutputParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -600,7 +612,7 @@ t::parameters!(
 /// Handle of an instance of `RelativeCartesianLinearMoveSkillType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1700).
 ///
 /// Linear Cartesian motion relative to where the tool is: the tool centre point moves on a straight line by PoseOffset, expressed in the tool frame (the frame of the tool centre point when the motion starts). Used for short approach and retreat motions, such as moving a drill nose into a drill bush along tool Z.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct RelativeCartesianLinearMoveSkillType {
     /// The instance.
@@ -610,6 +622,7 @@ pub struct RelativeCartesianLinearMoveSkillType {
     /// `InputParameterSet` (Mandatory). The inputs of the relative motion: PoseOffset, Speed and Acceleration.
     pub input_parameter_set: RelativeCartesianLinearMoveSkillType_InputParameterSet,
 }
+t::debug_handle!(RelativeCartesianLinearMoveSkillType);
 impl t::Handle for RelativeCartesianLinearMoveSkillType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -621,7 +634,7 @@ impl t::Handle for RelativeCartesianLinearMoveSkillType {
 }
 t::deref_base!(RelativeCartesianLinearMoveSkillType => MoveSkillType);
 /// `InputParameterSet`, a member of `RelativeCartesianLinearMoveSkillType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct RelativeCartesianLinearMoveSkillType_InputParameterSet {
     /// The instance.
@@ -633,6 +646,7 @@ pub struct RelativeCartesianLinearMoveSkillType_InputParameterSet {
     /// `PoseOffset` (Mandatory). Displacement and rotation of the tool centre point, in the tool frame at the start of the motion; millimetres and degrees.
     pub pose_offset: t::Variable<ua::ThreeDFrame>,
 }
+t::debug_handle!(RelativeCartesianLinearMoveSkillType_InputParameterSet);
 impl t::Handle for RelativeCartesianLinearMoveSkillType_InputParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -677,7 +691,7 @@ t::parameters!(
 /// Handle of an instance of `SkillTransitionEventType` (nsu=http://nodeset-compiler.dev/CommonSkills/;i=1100).
 ///
 /// Event of a skill state change. A skill (a ProgramSkillStateMachineType) raises it for every transition of its state machine, as the ProgramTransitionEventType its ns0 transitions name as their effect, with the BrowseName of the skill added, so one subscription serves a dashboard of many skills.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct SkillTransitionEventType {
     /// The instance.
@@ -719,6 +733,7 @@ pub struct SkillTransitionEventType {
     /// `SkillName` (Mandatory). BrowseName (name part) of the skill that changed state, such as DrillHole.
     pub skill_name: t::Variable<String>,
 }
+t::debug_handle!(SkillTransitionEventType);
 impl t::Handle for SkillTransitionEventType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {

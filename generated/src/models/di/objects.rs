@@ -16,12 +16,13 @@ const NS: &[&str] = &["http://opcfoundation.org/UA/DI/", "http://opcfoundation.o
 /// Handle of an instance of `BaseLifetimeIndicationType` (nsu=http://opcfoundation.org/UA/DI/;i=473).
 ///
 /// Base indication type not further defining a semantic
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct BaseLifetimeIndicationType {
     /// The instance.
     pub node: t::ObjectNode,
 }
+t::debug_handle!(BaseLifetimeIndicationType);
 impl t::Handle for BaseLifetimeIndicationType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self { node: b.this(id)? })
@@ -32,7 +33,7 @@ t::object_type!(
     "BaseLifetimeIndicationType"
 );
 /// Handle of an instance of `BlockType` (nsu=http://opcfoundation.org/UA/DI/;i=1003).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct BlockType {
     /// The instance.
@@ -50,6 +51,7 @@ pub struct BlockType {
     /// `TargetMode` (Optional).
     pub target_mode: Option<t::Variable<Vec<ua::LocalizedText>>>,
 }
+t::debug_handle!(BlockType);
 impl t::Handle for BlockType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -66,7 +68,7 @@ impl t::Handle for BlockType {
 t::deref_base!(BlockType => TopologyElementType);
 t::object_type!(BlockType, rt::NsNodeId::numeric(NS[0], 1003), "BlockType");
 /// Handle of an instance of `CachedLoadingType` (nsu=http://opcfoundation.org/UA/DI/;i=171).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct CachedLoadingType {
     /// The instance.
@@ -83,6 +85,7 @@ pub struct CachedLoadingType {
         (super::types::UpdateBehavior,),
     >,
 }
+t::debug_handle!(CachedLoadingType);
 impl t::Handle for CachedLoadingType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -96,7 +99,7 @@ impl t::Handle for CachedLoadingType {
 }
 t::deref_base!(CachedLoadingType => PackageLoadingType);
 /// `PendingVersion`, a member of `CachedLoadingType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct CachedLoadingType_PendingVersion {
     /// The instance.
@@ -118,6 +121,7 @@ pub struct CachedLoadingType_PendingVersion {
     /// `Clear` (Optional).
     pub clear: Option<t::Method<(), ()>>,
 }
+t::debug_handle!(CachedLoadingType_PendingVersion);
 impl t::Handle for CachedLoadingType_PendingVersion {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -134,7 +138,7 @@ impl t::Handle for CachedLoadingType_PendingVersion {
     }
 }
 /// `FallbackVersion`, a member of `CachedLoadingType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct CachedLoadingType_FallbackVersion {
     /// The instance.
@@ -156,6 +160,7 @@ pub struct CachedLoadingType_FallbackVersion {
     /// `Clear` (Optional).
     pub clear: Option<t::Method<(), ()>>,
 }
+t::debug_handle!(CachedLoadingType_FallbackVersion);
 impl t::Handle for CachedLoadingType_FallbackVersion {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -175,7 +180,7 @@ t::object_type!(
     CachedLoadingType, rt::NsNodeId::numeric(NS[0], 171), "CachedLoadingType"
 );
 /// Handle of an instance of `CheckFunctionAlarmType` (nsu=http://opcfoundation.org/UA/DI/;i=15441).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct CheckFunctionAlarmType {
     /// The instance.
@@ -183,6 +188,7 @@ pub struct CheckFunctionAlarmType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: DeviceHealthDiagnosticAlarmType,
 }
+t::debug_handle!(CheckFunctionAlarmType);
 impl t::Handle for CheckFunctionAlarmType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -196,7 +202,7 @@ t::object_type!(
     CheckFunctionAlarmType, rt::NsNodeId::numeric(NS[0], 15441), "CheckFunctionAlarmType"
 );
 /// Handle of an instance of `ComponentType` (nsu=http://opcfoundation.org/UA/DI/;i=15063).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ComponentType {
     /// The instance.
@@ -232,6 +238,7 @@ pub struct ComponentType {
     /// `ComponentName` (Optional).
     pub component_name: Option<t::Variable<ua::LocalizedText>>,
 }
+t::debug_handle!(ComponentType);
 impl t::Handle for ComponentType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -257,7 +264,7 @@ impl t::Handle for ComponentType {
 t::deref_base!(ComponentType => TopologyElementType);
 t::object_type!(ComponentType, rt::NsNodeId::numeric(NS[0], 15063), "ComponentType");
 /// Handle of an instance of `ConfigurableObjectType` (nsu=http://opcfoundation.org/UA/DI/;i=1004).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ConfigurableObjectType {
     /// The instance.
@@ -267,6 +274,7 @@ pub struct ConfigurableObjectType {
     /// `<ObjectIdentifier>` (OptionalPlaceholder).
     pub object_identifier: t::Placeholders<t::ObjectNode>,
 }
+t::debug_handle!(ConfigurableObjectType);
 impl t::Handle for ConfigurableObjectType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -280,7 +288,7 @@ t::object_type!(
     ConfigurableObjectType, rt::NsNodeId::numeric(NS[0], 1004), "ConfigurableObjectType"
 );
 /// Handle of an instance of `ConfirmationStateMachineType` (nsu=http://opcfoundation.org/UA/DI/;i=307).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ConfirmationStateMachineType {
     /// The instance.
@@ -298,6 +306,7 @@ pub struct ConfirmationStateMachineType {
     /// `ConfirmationTimeout` (Mandatory).
     pub confirmation_timeout: t::Variable<f64>,
 }
+t::debug_handle!(ConfirmationStateMachineType);
 impl t::Handle for ConfirmationStateMachineType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -361,7 +370,7 @@ impl t::StateMachine for ConfirmationStateMachineType {
     }
 }
 /// Handle of an instance of `ConnectionPointType` (nsu=http://opcfoundation.org/UA/DI/;i=6308).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ConnectionPointType {
     /// The instance.
@@ -373,6 +382,7 @@ pub struct ConnectionPointType {
     /// `<ProfileIdentifier>` (MandatoryPlaceholder).
     pub profile_identifier: t::Placeholders<ProtocolType>,
 }
+t::debug_handle!(ConnectionPointType);
 impl t::Handle for ConnectionPointType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -388,7 +398,7 @@ t::object_type!(
     ConnectionPointType, rt::NsNodeId::numeric(NS[0], 6308), "ConnectionPointType"
 );
 /// Handle of an instance of `DeviceHealthDiagnosticAlarmType` (nsu=http://opcfoundation.org/UA/DI/;i=15143).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct DeviceHealthDiagnosticAlarmType {
     /// The instance.
@@ -512,6 +522,7 @@ pub struct DeviceHealthDiagnosticAlarmType {
     /// `NormalState` (Mandatory).
     pub normal_state: t::Variable<ua::NodeId>,
 }
+t::debug_handle!(DeviceHealthDiagnosticAlarmType);
 impl t::Handle for DeviceHealthDiagnosticAlarmType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -579,7 +590,7 @@ impl t::Handle for DeviceHealthDiagnosticAlarmType {
     }
 }
 /// `ShelvingState`, a member of `DeviceHealthDiagnosticAlarmType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct DeviceHealthDiagnosticAlarmType_ShelvingState {
     /// The instance.
@@ -607,6 +618,7 @@ pub struct DeviceHealthDiagnosticAlarmType_ShelvingState {
     /// `OneShotShelve2` (Optional).
     pub one_shot_shelve2: Option<t::Method<(ua::LocalizedText,), ()>>,
 }
+t::debug_handle!(DeviceHealthDiagnosticAlarmType_ShelvingState);
 impl t::Handle for DeviceHealthDiagnosticAlarmType_ShelvingState {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -630,7 +642,7 @@ t::object_type!(
     "DeviceHealthDiagnosticAlarmType"
 );
 /// Handle of an instance of `DeviceType` (nsu=http://opcfoundation.org/UA/DI/;i=1002).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct DeviceType {
     /// The instance.
@@ -676,6 +688,7 @@ pub struct DeviceType {
     /// `ImageSet` (Optional).
     pub image_set: Option<DeviceType_ImageSet>,
 }
+t::debug_handle!(DeviceType);
 impl t::Handle for DeviceType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -705,7 +718,7 @@ impl t::Handle for DeviceType {
 }
 t::deref_base!(DeviceType => ComponentType);
 /// `DeviceTypeImage`, a member of `DeviceType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct DeviceType_DeviceTypeImage {
     /// The instance.
@@ -713,6 +726,7 @@ pub struct DeviceType_DeviceTypeImage {
     /// `<ImageIdentifier>` (MandatoryPlaceholder).
     pub image_identifier: t::Placeholders<t::Variable<ua::ByteString>>,
 }
+t::debug_handle!(DeviceType_DeviceTypeImage);
 impl t::Handle for DeviceType_DeviceTypeImage {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -722,7 +736,7 @@ impl t::Handle for DeviceType_DeviceTypeImage {
     }
 }
 /// `Documentation`, a member of `DeviceType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct DeviceType_Documentation {
     /// The instance.
@@ -730,6 +744,7 @@ pub struct DeviceType_Documentation {
     /// `<DocumentIdentifier>` (MandatoryPlaceholder).
     pub document_identifier: t::Placeholders<t::Variable<ua::ByteString>>,
 }
+t::debug_handle!(DeviceType_Documentation);
 impl t::Handle for DeviceType_Documentation {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -739,7 +754,7 @@ impl t::Handle for DeviceType_Documentation {
     }
 }
 /// `ProtocolSupport`, a member of `DeviceType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct DeviceType_ProtocolSupport {
     /// The instance.
@@ -747,6 +762,7 @@ pub struct DeviceType_ProtocolSupport {
     /// `<ProtocolSupportIdentifier>` (MandatoryPlaceholder).
     pub protocol_support_identifier: t::Placeholders<t::Variable<ua::ByteString>>,
 }
+t::debug_handle!(DeviceType_ProtocolSupport);
 impl t::Handle for DeviceType_ProtocolSupport {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -757,7 +773,7 @@ impl t::Handle for DeviceType_ProtocolSupport {
     }
 }
 /// `ImageSet`, a member of `DeviceType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct DeviceType_ImageSet {
     /// The instance.
@@ -765,6 +781,7 @@ pub struct DeviceType_ImageSet {
     /// `<ImageIdentifier>` (MandatoryPlaceholder).
     pub image_identifier: t::Placeholders<t::Variable<ua::ByteString>>,
 }
+t::debug_handle!(DeviceType_ImageSet);
 impl t::Handle for DeviceType_ImageSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -777,7 +794,7 @@ t::object_type!(DeviceType, rt::NsNodeId::numeric(NS[0], 1002), "DeviceType");
 /// Handle of an instance of `DiameterIndicationType` (nsu=http://opcfoundation.org/UA/DI/;i=478).
 ///
 /// Indicates the abraded diameter, for example of a drill.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct DiameterIndicationType {
     /// The instance.
@@ -785,6 +802,7 @@ pub struct DiameterIndicationType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: BaseLifetimeIndicationType,
 }
+t::debug_handle!(DiameterIndicationType);
 impl t::Handle for DiameterIndicationType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -798,7 +816,7 @@ t::object_type!(
     DiameterIndicationType, rt::NsNodeId::numeric(NS[0], 478), "DiameterIndicationType"
 );
 /// Handle of an instance of `DirectLoadingType` (nsu=http://opcfoundation.org/UA/DI/;i=153).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct DirectLoadingType {
     /// The instance.
@@ -810,6 +828,7 @@ pub struct DirectLoadingType {
     /// `WriteTimeout` (Optional).
     pub write_timeout: Option<t::Variable<f64>>,
 }
+t::debug_handle!(DirectLoadingType);
 impl t::Handle for DirectLoadingType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -825,7 +844,7 @@ t::object_type!(
     DirectLoadingType, rt::NsNodeId::numeric(NS[0], 153), "DirectLoadingType"
 );
 /// Handle of an instance of `FailureAlarmType` (nsu=http://opcfoundation.org/UA/DI/;i=15292).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct FailureAlarmType {
     /// The instance.
@@ -833,6 +852,7 @@ pub struct FailureAlarmType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: DeviceHealthDiagnosticAlarmType,
 }
+t::debug_handle!(FailureAlarmType);
 impl t::Handle for FailureAlarmType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -846,7 +866,7 @@ t::object_type!(
     FailureAlarmType, rt::NsNodeId::numeric(NS[0], 15292), "FailureAlarmType"
 );
 /// Handle of an instance of `FileSystemLoadingType` (nsu=http://opcfoundation.org/UA/DI/;i=192).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct FileSystemLoadingType {
     /// The instance.
@@ -863,6 +883,7 @@ pub struct FileSystemLoadingType {
     /// `ValidateFiles` (Optional).
     pub validate_files: Option<t::Method<(Vec<ua::NodeId>,), (i32, ua::LocalizedText)>>,
 }
+t::debug_handle!(FileSystemLoadingType);
 impl t::Handle for FileSystemLoadingType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -876,7 +897,7 @@ impl t::Handle for FileSystemLoadingType {
 }
 t::deref_base!(FileSystemLoadingType => SoftwareLoadingType);
 /// `FileSystem`, a member of `FileSystemLoadingType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct FileSystemLoadingType_FileSystem {
     /// The instance.
@@ -894,6 +915,7 @@ pub struct FileSystemLoadingType_FileSystem {
     /// `MoveOrCopy` (Mandatory).
     pub move_or_copy: t::Method<(ua::NodeId, ua::NodeId, bool, String), (ua::NodeId,)>,
 }
+t::debug_handle!(FileSystemLoadingType_FileSystem);
 impl t::Handle for FileSystemLoadingType_FileSystem {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -912,7 +934,7 @@ t::object_type!(
     FileSystemLoadingType, rt::NsNodeId::numeric(NS[0], 192), "FileSystemLoadingType"
 );
 /// Handle of an instance of `FunctionalGroupType` (nsu=http://opcfoundation.org/UA/DI/;i=1005).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct FunctionalGroupType {
     /// The instance.
@@ -922,6 +944,7 @@ pub struct FunctionalGroupType {
     /// `UIElement` (Optional).
     pub ui_element: Option<t::Variable<ua::Variant>>,
 }
+t::debug_handle!(FunctionalGroupType);
 impl t::Handle for FunctionalGroupType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -935,7 +958,7 @@ t::object_type!(
     FunctionalGroupType, rt::NsNodeId::numeric(NS[0], 1005), "FunctionalGroupType"
 );
 /// Handle of an instance of `IAssetLocationIndicationType` (nsu=http://opcfoundation.org/UA/DI/;i=118).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct IAssetLocationIndicationType {
     /// The instance.
@@ -953,6 +976,7 @@ pub struct IAssetLocationIndicationType {
         t::Variable<super::types::LocationIndicationType>,
     >,
 }
+t::debug_handle!(IAssetLocationIndicationType);
 impl t::Handle for IAssetLocationIndicationType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -971,7 +995,7 @@ t::object_type!(
     "IAssetLocationIndicationType"
 );
 /// Handle of an instance of `IDeviceHealthType` (nsu=http://opcfoundation.org/UA/DI/;i=15051).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct IDeviceHealthType {
     /// The instance.
@@ -981,6 +1005,7 @@ pub struct IDeviceHealthType {
     /// `DeviceHealthAlarms` (Optional).
     pub device_health_alarms: Option<t::ObjectNode>,
 }
+t::debug_handle!(IDeviceHealthType);
 impl t::Handle for IDeviceHealthType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -996,7 +1021,7 @@ t::object_type!(
 /// Handle of an instance of `IOperationCounterType` (nsu=http://opcfoundation.org/UA/DI/;i=480).
 ///
 /// Interface defining counters for the duration of operation
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct IOperationCounterType {
     /// The instance.
@@ -1008,6 +1033,7 @@ pub struct IOperationCounterType {
     /// `OperationCycleCounter` (Optional). OperationCycleCounter is counting the times the Device switches from not performing an activity to performing an activity. For example, each time a valve starts moving, is counted. This value shall only increase during the lifetime of the Device and shall not be reset when the Device is restarted.
     pub operation_cycle_counter: Option<t::Variable<ua::Variant>>,
 }
+t::debug_handle!(IOperationCounterType);
 impl t::Handle for IOperationCounterType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1022,7 +1048,7 @@ t::object_type!(
     IOperationCounterType, rt::NsNodeId::numeric(NS[0], 480), "IOperationCounterType"
 );
 /// Handle of an instance of `ISupportInfoType` (nsu=http://opcfoundation.org/UA/DI/;i=15054).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ISupportInfoType {
     /// The instance.
@@ -1038,6 +1064,7 @@ pub struct ISupportInfoType {
     /// `ImageSet` (Optional).
     pub image_set: Option<ISupportInfoType_ImageSet>,
 }
+t::debug_handle!(ISupportInfoType);
 impl t::Handle for ISupportInfoType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1051,7 +1078,7 @@ impl t::Handle for ISupportInfoType {
     }
 }
 /// `DeviceTypeImage`, a member of `ISupportInfoType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ISupportInfoType_DeviceTypeImage {
     /// The instance.
@@ -1059,6 +1086,7 @@ pub struct ISupportInfoType_DeviceTypeImage {
     /// `<ImageIdentifier>` (MandatoryPlaceholder).
     pub image_identifier: t::Placeholders<t::Variable<ua::ByteString>>,
 }
+t::debug_handle!(ISupportInfoType_DeviceTypeImage);
 impl t::Handle for ISupportInfoType_DeviceTypeImage {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1068,7 +1096,7 @@ impl t::Handle for ISupportInfoType_DeviceTypeImage {
     }
 }
 /// `Documentation`, a member of `ISupportInfoType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ISupportInfoType_Documentation {
     /// The instance.
@@ -1076,6 +1104,7 @@ pub struct ISupportInfoType_Documentation {
     /// `<DocumentIdentifier>` (MandatoryPlaceholder).
     pub document_identifier: t::Placeholders<t::Variable<ua::ByteString>>,
 }
+t::debug_handle!(ISupportInfoType_Documentation);
 impl t::Handle for ISupportInfoType_Documentation {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1085,7 +1114,7 @@ impl t::Handle for ISupportInfoType_Documentation {
     }
 }
 /// `DocumentationFiles`, a member of `ISupportInfoType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ISupportInfoType_DocumentationFiles {
     /// The instance.
@@ -1093,6 +1122,7 @@ pub struct ISupportInfoType_DocumentationFiles {
     /// `<DocumentFileId>` (MandatoryPlaceholder).
     pub document_file_id: t::Placeholders<t::ObjectNode>,
 }
+t::debug_handle!(ISupportInfoType_DocumentationFiles);
 impl t::Handle for ISupportInfoType_DocumentationFiles {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1102,7 +1132,7 @@ impl t::Handle for ISupportInfoType_DocumentationFiles {
     }
 }
 /// `ProtocolSupport`, a member of `ISupportInfoType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ISupportInfoType_ProtocolSupport {
     /// The instance.
@@ -1110,6 +1140,7 @@ pub struct ISupportInfoType_ProtocolSupport {
     /// `<ProtocolSupportIdentifier>` (MandatoryPlaceholder).
     pub protocol_support_identifier: t::Placeholders<t::Variable<ua::ByteString>>,
 }
+t::debug_handle!(ISupportInfoType_ProtocolSupport);
 impl t::Handle for ISupportInfoType_ProtocolSupport {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1120,7 +1151,7 @@ impl t::Handle for ISupportInfoType_ProtocolSupport {
     }
 }
 /// `ImageSet`, a member of `ISupportInfoType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ISupportInfoType_ImageSet {
     /// The instance.
@@ -1128,6 +1159,7 @@ pub struct ISupportInfoType_ImageSet {
     /// `<ImageIdentifier>` (MandatoryPlaceholder).
     pub image_identifier: t::Placeholders<t::Variable<ua::ByteString>>,
 }
+t::debug_handle!(ISupportInfoType_ImageSet);
 impl t::Handle for ISupportInfoType_ImageSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1140,7 +1172,7 @@ t::object_type!(
     ISupportInfoType, rt::NsNodeId::numeric(NS[0], 15054), "ISupportInfoType"
 );
 /// Handle of an instance of `ITagNameplateType` (nsu=http://opcfoundation.org/UA/DI/;i=15048).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ITagNameplateType {
     /// The instance.
@@ -1150,6 +1182,7 @@ pub struct ITagNameplateType {
     /// `ComponentName` (Optional).
     pub component_name: Option<t::Variable<ua::LocalizedText>>,
 }
+t::debug_handle!(ITagNameplateType);
 impl t::Handle for ITagNameplateType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1163,7 +1196,7 @@ t::object_type!(
     ITagNameplateType, rt::NsNodeId::numeric(NS[0], 15048), "ITagNameplateType"
 );
 /// Handle of an instance of `IVendorNameplateType` (nsu=http://opcfoundation.org/UA/DI/;i=15035).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct IVendorNameplateType {
     /// The instance.
@@ -1197,6 +1230,7 @@ pub struct IVendorNameplateType {
     /// `PatchIdentifiers` (Optional).
     pub patch_identifiers: Option<t::Variable<Vec<String>>>,
 }
+t::debug_handle!(IVendorNameplateType);
 impl t::Handle for IVendorNameplateType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1222,7 +1256,7 @@ t::object_type!(
     IVendorNameplateType, rt::NsNodeId::numeric(NS[0], 15035), "IVendorNameplateType"
 );
 /// Handle of an instance of `InstallationStateMachineType` (nsu=http://opcfoundation.org/UA/DI/;i=249).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct InstallationStateMachineType {
     /// The instance.
@@ -1250,6 +1284,7 @@ pub struct InstallationStateMachineType {
     /// `Resume` (Mandatory).
     pub resume: t::Method<(), ()>,
 }
+t::debug_handle!(InstallationStateMachineType);
 impl t::Handle for InstallationStateMachineType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1348,7 +1383,7 @@ impl t::StateMachine for InstallationStateMachineType {
 /// Handle of an instance of `LengthIndicationType` (nsu=http://opcfoundation.org/UA/DI/;i=477).
 ///
 /// Indicates the abraded length, for example of a drill.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct LengthIndicationType {
     /// The instance.
@@ -1356,6 +1391,7 @@ pub struct LengthIndicationType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: BaseLifetimeIndicationType,
 }
+t::debug_handle!(LengthIndicationType);
 impl t::Handle for LengthIndicationType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1371,7 +1407,7 @@ t::object_type!(
 /// Handle of an instance of `LifetimeVariableType` (nsu=http://opcfoundation.org/UA/DI/;i=468).
 ///
 /// Remaining lifetime
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct LifetimeVariableType {
     /// The instance.
@@ -1399,6 +1435,7 @@ pub struct LifetimeVariableType {
     /// `WarningValues` (Optional). WarningValues indicates one or more levels when the end of lifetime is reached soon and can be used to inform the user when reached.
     pub warning_values: Option<t::Variable<ua::Variant>>,
 }
+t::debug_handle!(LifetimeVariableType);
 impl t::Handle for LifetimeVariableType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1421,7 +1458,7 @@ t::variable_type!(
     LifetimeVariableType, rt::NsNodeId::numeric(NS[0], 468), "LifetimeVariableType"
 );
 /// Handle of an instance of `LockingServicesType` (nsu=http://opcfoundation.org/UA/DI/;i=6388).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct LockingServicesType {
     /// The instance.
@@ -1443,6 +1480,7 @@ pub struct LockingServicesType {
     /// `BreakLock` (Mandatory).
     pub break_lock: t::Method<(), (i32,)>,
 }
+t::debug_handle!(LockingServicesType);
 impl t::Handle for LockingServicesType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1462,7 +1500,7 @@ t::object_type!(
     LockingServicesType, rt::NsNodeId::numeric(NS[0], 6388), "LockingServicesType"
 );
 /// Handle of an instance of `MaintenanceRequiredAlarmType` (nsu=http://opcfoundation.org/UA/DI/;i=15739).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct MaintenanceRequiredAlarmType {
     /// The instance.
@@ -1470,6 +1508,7 @@ pub struct MaintenanceRequiredAlarmType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: DeviceHealthDiagnosticAlarmType,
 }
+t::debug_handle!(MaintenanceRequiredAlarmType);
 impl t::Handle for MaintenanceRequiredAlarmType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1484,7 +1523,7 @@ t::object_type!(
     "MaintenanceRequiredAlarmType"
 );
 /// Handle of an instance of `NetworkType` (nsu=http://opcfoundation.org/UA/DI/;i=6247).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct NetworkType {
     /// The instance.
@@ -1494,6 +1533,7 @@ pub struct NetworkType {
     /// `Lock` (Optional).
     pub lock: Option<NetworkType_Lock>,
 }
+t::debug_handle!(NetworkType);
 impl t::Handle for NetworkType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1504,7 +1544,7 @@ impl t::Handle for NetworkType {
     }
 }
 /// `Lock`, a member of `NetworkType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct NetworkType_Lock {
     /// The instance.
@@ -1526,6 +1566,7 @@ pub struct NetworkType_Lock {
     /// `BreakLock` (Mandatory).
     pub break_lock: t::Method<(), (i32,)>,
 }
+t::debug_handle!(NetworkType_Lock);
 impl t::Handle for NetworkType_Lock {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1545,7 +1586,7 @@ t::object_type!(NetworkType, rt::NsNodeId::numeric(NS[0], 6247), "NetworkType");
 /// Handle of an instance of `NumberOfPartsIndicationType` (nsu=http://opcfoundation.org/UA/DI/;i=475).
 ///
 /// Indicates the total number of parts that have been produced or can still be produced.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct NumberOfPartsIndicationType {
     /// The instance.
@@ -1553,6 +1594,7 @@ pub struct NumberOfPartsIndicationType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: BaseLifetimeIndicationType,
 }
+t::debug_handle!(NumberOfPartsIndicationType);
 impl t::Handle for NumberOfPartsIndicationType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1569,7 +1611,7 @@ t::object_type!(
 /// Handle of an instance of `NumberOfUsagesIndicationType` (nsu=http://opcfoundation.org/UA/DI/;i=476).
 ///
 /// Indicates counting the process steps the entity has been used or can still be used for (for example usages of a punching tool).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct NumberOfUsagesIndicationType {
     /// The instance.
@@ -1577,6 +1619,7 @@ pub struct NumberOfUsagesIndicationType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: BaseLifetimeIndicationType,
 }
+t::debug_handle!(NumberOfUsagesIndicationType);
 impl t::Handle for NumberOfUsagesIndicationType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1591,7 +1634,7 @@ t::object_type!(
     "NumberOfUsagesIndicationType"
 );
 /// Handle of an instance of `OffSpecAlarmType` (nsu=http://opcfoundation.org/UA/DI/;i=15590).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct OffSpecAlarmType {
     /// The instance.
@@ -1599,6 +1642,7 @@ pub struct OffSpecAlarmType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: DeviceHealthDiagnosticAlarmType,
 }
+t::debug_handle!(OffSpecAlarmType);
 impl t::Handle for OffSpecAlarmType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1612,7 +1656,7 @@ t::object_type!(
     OffSpecAlarmType, rt::NsNodeId::numeric(NS[0], 15590), "OffSpecAlarmType"
 );
 /// Handle of an instance of `PackageLoadingType` (nsu=http://opcfoundation.org/UA/DI/;i=137).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct PackageLoadingType {
     /// The instance.
@@ -1628,6 +1672,7 @@ pub struct PackageLoadingType {
     /// `WriteBlockSize` (Optional).
     pub write_block_size: Option<t::Variable<u32>>,
 }
+t::debug_handle!(PackageLoadingType);
 impl t::Handle for PackageLoadingType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1642,7 +1687,7 @@ impl t::Handle for PackageLoadingType {
 }
 t::deref_base!(PackageLoadingType => SoftwareLoadingType);
 /// `CurrentVersion`, a member of `PackageLoadingType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct PackageLoadingType_CurrentVersion {
     /// The instance.
@@ -1664,6 +1709,7 @@ pub struct PackageLoadingType_CurrentVersion {
     /// `Clear` (Optional).
     pub clear: Option<t::Method<(), ()>>,
 }
+t::debug_handle!(PackageLoadingType_CurrentVersion);
 impl t::Handle for PackageLoadingType_CurrentVersion {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1680,7 +1726,7 @@ impl t::Handle for PackageLoadingType_CurrentVersion {
     }
 }
 /// `FileTransfer`, a member of `PackageLoadingType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct PackageLoadingType_FileTransfer {
     /// The instance.
@@ -1696,6 +1742,7 @@ pub struct PackageLoadingType_FileTransfer {
     /// `<TransferState>` (OptionalPlaceholder).
     pub transfer_state: t::Placeholders<t::ObjectNode>,
 }
+t::debug_handle!(PackageLoadingType_FileTransfer);
 impl t::Handle for PackageLoadingType_FileTransfer {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1712,7 +1759,7 @@ t::object_type!(
     PackageLoadingType, rt::NsNodeId::numeric(NS[0], 137), "PackageLoadingType"
 );
 /// Handle of an instance of `PowerCycleStateMachineType` (nsu=http://opcfoundation.org/UA/DI/;i=285).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct PowerCycleStateMachineType {
     /// The instance.
@@ -1726,6 +1773,7 @@ pub struct PowerCycleStateMachineType {
     /// `AvailableTransitions` (Optional).
     pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
 }
+t::debug_handle!(PowerCycleStateMachineType);
 impl t::Handle for PowerCycleStateMachineType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1787,7 +1835,7 @@ impl t::StateMachine for PowerCycleStateMachineType {
     }
 }
 /// Handle of an instance of `PrepareForUpdateStateMachineType` (nsu=http://opcfoundation.org/UA/DI/;i=213).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct PrepareForUpdateStateMachineType {
     /// The instance.
@@ -1809,6 +1857,7 @@ pub struct PrepareForUpdateStateMachineType {
     /// `Resume` (Optional).
     pub resume: Option<t::Method<(), ()>>,
 }
+t::debug_handle!(PrepareForUpdateStateMachineType);
 impl t::Handle for PrepareForUpdateStateMachineType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1915,12 +1964,13 @@ impl t::StateMachine for PrepareForUpdateStateMachineType {
     }
 }
 /// Handle of an instance of `ProtocolType` (nsu=http://opcfoundation.org/UA/DI/;i=1006).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ProtocolType {
     /// The instance.
     pub node: t::ObjectNode,
 }
+t::debug_handle!(ProtocolType);
 impl t::Handle for ProtocolType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self { node: b.this(id)? })
@@ -1928,7 +1978,7 @@ impl t::Handle for ProtocolType {
 }
 t::object_type!(ProtocolType, rt::NsNodeId::numeric(NS[0], 1006), "ProtocolType");
 /// Handle of an instance of `SoftwareFolderType` (nsu=http://opcfoundation.org/UA/DI/;i=364).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct SoftwareFolderType {
     /// The instance.
@@ -1940,6 +1990,7 @@ pub struct SoftwareFolderType {
     /// `Delete` (Mandatory).
     pub delete: t::Method<(ua::NodeId,), ()>,
 }
+t::debug_handle!(SoftwareFolderType);
 impl t::Handle for SoftwareFolderType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1954,7 +2005,7 @@ t::object_type!(
     SoftwareFolderType, rt::NsNodeId::numeric(NS[0], 364), "SoftwareFolderType"
 );
 /// Handle of an instance of `SoftwareLoadingType` (nsu=http://opcfoundation.org/UA/DI/;i=135).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct SoftwareLoadingType {
     /// The instance.
@@ -1962,6 +2013,7 @@ pub struct SoftwareLoadingType {
     /// `UpdateKey` (Optional).
     pub update_key: Option<t::Variable<String>>,
 }
+t::debug_handle!(SoftwareLoadingType);
 impl t::Handle for SoftwareLoadingType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1974,7 +2026,7 @@ t::object_type!(
     SoftwareLoadingType, rt::NsNodeId::numeric(NS[0], 135), "SoftwareLoadingType"
 );
 /// Handle of an instance of `SoftwareType` (nsu=http://opcfoundation.org/UA/DI/;i=15106).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct SoftwareType {
     /// The instance.
@@ -1988,6 +2040,7 @@ pub struct SoftwareType {
     /// `SoftwareRevision` (Mandatory).
     pub software_revision: t::Variable<String>,
 }
+t::debug_handle!(SoftwareType);
 impl t::Handle for SoftwareType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2002,7 +2055,7 @@ impl t::Handle for SoftwareType {
 t::deref_base!(SoftwareType => ComponentType);
 t::object_type!(SoftwareType, rt::NsNodeId::numeric(NS[0], 15106), "SoftwareType");
 /// Handle of an instance of `SoftwareUpdateType` (nsu=http://opcfoundation.org/UA/DI/;i=1).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct SoftwareUpdateType {
     /// The instance.
@@ -2032,6 +2085,7 @@ pub struct SoftwareUpdateType {
     /// `VendorErrorCode` (Optional).
     pub vendor_error_code: Option<t::Variable<i32>>,
 }
+t::debug_handle!(SoftwareUpdateType);
 impl t::Handle for SoftwareUpdateType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2052,7 +2106,7 @@ impl t::Handle for SoftwareUpdateType {
     }
 }
 /// `PrepareForUpdate`, a member of `SoftwareUpdateType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct SoftwareUpdateType_PrepareForUpdate {
     /// The instance.
@@ -2074,6 +2128,7 @@ pub struct SoftwareUpdateType_PrepareForUpdate {
     /// `Resume` (Optional).
     pub resume: Option<t::Method<(), ()>>,
 }
+t::debug_handle!(SoftwareUpdateType_PrepareForUpdate);
 impl t::Handle for SoftwareUpdateType_PrepareForUpdate {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2090,7 +2145,7 @@ impl t::Handle for SoftwareUpdateType_PrepareForUpdate {
     }
 }
 /// `Installation`, a member of `SoftwareUpdateType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct SoftwareUpdateType_Installation {
     /// The instance.
@@ -2118,6 +2173,7 @@ pub struct SoftwareUpdateType_Installation {
     /// `Resume` (Mandatory).
     pub resume: t::Method<(), ()>,
 }
+t::debug_handle!(SoftwareUpdateType_Installation);
 impl t::Handle for SoftwareUpdateType_Installation {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2136,7 +2192,7 @@ impl t::Handle for SoftwareUpdateType_Installation {
     }
 }
 /// `PowerCycle`, a member of `SoftwareUpdateType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct SoftwareUpdateType_PowerCycle {
     /// The instance.
@@ -2150,6 +2206,7 @@ pub struct SoftwareUpdateType_PowerCycle {
     /// `AvailableTransitions` (Optional).
     pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
 }
+t::debug_handle!(SoftwareUpdateType_PowerCycle);
 impl t::Handle for SoftwareUpdateType_PowerCycle {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2162,7 +2219,7 @@ impl t::Handle for SoftwareUpdateType_PowerCycle {
     }
 }
 /// `Confirmation`, a member of `SoftwareUpdateType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct SoftwareUpdateType_Confirmation {
     /// The instance.
@@ -2180,6 +2237,7 @@ pub struct SoftwareUpdateType_Confirmation {
     /// `ConfirmationTimeout` (Mandatory).
     pub confirmation_timeout: t::Variable<f64>,
 }
+t::debug_handle!(SoftwareUpdateType_Confirmation);
 impl t::Handle for SoftwareUpdateType_Confirmation {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2194,7 +2252,7 @@ impl t::Handle for SoftwareUpdateType_Confirmation {
     }
 }
 /// `Parameters`, a member of `SoftwareUpdateType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct SoftwareUpdateType_Parameters {
     /// The instance.
@@ -2210,6 +2268,7 @@ pub struct SoftwareUpdateType_Parameters {
     /// `<TransferState>` (OptionalPlaceholder).
     pub transfer_state: t::Placeholders<t::ObjectNode>,
 }
+t::debug_handle!(SoftwareUpdateType_Parameters);
 impl t::Handle for SoftwareUpdateType_Parameters {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2226,7 +2285,7 @@ t::object_type!(
     SoftwareUpdateType, rt::NsNodeId::numeric(NS[0], 1), "SoftwareUpdateType"
 );
 /// Handle of an instance of `SoftwareVersionType` (nsu=http://opcfoundation.org/UA/DI/;i=212).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct SoftwareVersionType {
     /// The instance.
@@ -2248,6 +2307,7 @@ pub struct SoftwareVersionType {
     /// `Clear` (Optional).
     pub clear: Option<t::Method<(), ()>>,
 }
+t::debug_handle!(SoftwareVersionType);
 impl t::Handle for SoftwareVersionType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2269,7 +2329,7 @@ t::object_type!(
 /// Handle of an instance of `SubstanceVolumeIndicationType` (nsu=http://opcfoundation.org/UA/DI/;i=479).
 ///
 /// Indicates the volume of a substance, for example of a liquid.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct SubstanceVolumeIndicationType {
     /// The instance.
@@ -2277,6 +2337,7 @@ pub struct SubstanceVolumeIndicationType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: BaseLifetimeIndicationType,
 }
+t::debug_handle!(SubstanceVolumeIndicationType);
 impl t::Handle for SubstanceVolumeIndicationType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2293,7 +2354,7 @@ t::object_type!(
 /// Handle of an instance of `TimeIndicationType` (nsu=http://opcfoundation.org/UA/DI/;i=474).
 ///
 /// Indicates the time the entity has been in use or can still be used
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct TimeIndicationType {
     /// The instance.
@@ -2301,6 +2362,7 @@ pub struct TimeIndicationType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: BaseLifetimeIndicationType,
 }
+t::debug_handle!(TimeIndicationType);
 impl t::Handle for TimeIndicationType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2314,7 +2376,7 @@ t::object_type!(
     TimeIndicationType, rt::NsNodeId::numeric(NS[0], 474), "TimeIndicationType"
 );
 /// Handle of an instance of `TopologyElementType` (nsu=http://opcfoundation.org/UA/DI/;i=1001).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct TopologyElementType {
     /// The instance.
@@ -2330,6 +2392,7 @@ pub struct TopologyElementType {
     /// `Lock` (Optional).
     pub lock: Option<TopologyElementType_Lock>,
 }
+t::debug_handle!(TopologyElementType);
 impl t::Handle for TopologyElementType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2343,7 +2406,7 @@ impl t::Handle for TopologyElementType {
     }
 }
 /// `ParameterSet`, a member of `TopologyElementType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct TopologyElementType_ParameterSet {
     /// The instance.
@@ -2351,6 +2414,7 @@ pub struct TopologyElementType_ParameterSet {
     /// `<ParameterIdentifier>` (MandatoryPlaceholder).
     pub parameter_identifier: t::Placeholders<t::Variable<ua::Variant>>,
 }
+t::debug_handle!(TopologyElementType_ParameterSet);
 impl t::Handle for TopologyElementType_ParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2360,7 +2424,7 @@ impl t::Handle for TopologyElementType_ParameterSet {
     }
 }
 /// `Lock`, a member of `TopologyElementType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct TopologyElementType_Lock {
     /// The instance.
@@ -2382,6 +2446,7 @@ pub struct TopologyElementType_Lock {
     /// `BreakLock` (Mandatory).
     pub break_lock: t::Method<(), (i32,)>,
 }
+t::debug_handle!(TopologyElementType_Lock);
 impl t::Handle for TopologyElementType_Lock {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2401,7 +2466,7 @@ t::object_type!(
     TopologyElementType, rt::NsNodeId::numeric(NS[0], 1001), "TopologyElementType"
 );
 /// Handle of an instance of `TransferServicesType` (nsu=http://opcfoundation.org/UA/DI/;i=6526).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct TransferServicesType {
     /// The instance.
@@ -2416,6 +2481,7 @@ pub struct TransferServicesType {
         (ua::ExtensionObject,),
     >,
 }
+t::debug_handle!(TransferServicesType);
 impl t::Handle for TransferServicesType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2430,12 +2496,13 @@ t::object_type!(
     TransferServicesType, rt::NsNodeId::numeric(NS[0], 6526), "TransferServicesType"
 );
 /// Handle of an instance of `UIElementType` (nsu=http://opcfoundation.org/UA/DI/;i=6246).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct UIElementType {
     /// The instance.
     pub node: t::Variable<ua::Variant>,
 }
+t::debug_handle!(UIElementType);
 impl t::Handle for UIElementType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self { node: b.this(id)? })

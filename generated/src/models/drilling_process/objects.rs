@@ -20,7 +20,7 @@ const NS: &[&str] = &[
 /// Handle of an instance of `DrillHoleSkillType` (nsu=http://nodeset-compiler.dev/DrillingProcess/;i=2000).
 ///
 /// Drills one hole through the drill bush the end effector is in front of: moves the nose into the bush by InsertionDistance along tool Z (RelativeCartesianLinearMove), runs TemplateDrilling of the end effector with the drilling parameters, and moves back out by the same distance (RelativeCartesianLinearMove).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct DrillHoleSkillType {
     /// The instance.
@@ -30,6 +30,7 @@ pub struct DrillHoleSkillType {
     /// `InputParameterSet` (Mandatory). The inputs: InsertionDistance and the drilling parameters passed to TemplateDrilling.
     pub input_parameter_set: DrillHoleSkillType_InputParameterSet,
 }
+t::debug_handle!(DrillHoleSkillType);
 impl t::Handle for DrillHoleSkillType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -43,7 +44,7 @@ t::deref_base!(
     DrillHoleSkillType => super::super::common_skills::objects::CompositeSkillType
 );
 /// `InputParameterSet`, a member of `DrillHoleSkillType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct DrillHoleSkillType_InputParameterSet {
     /// The instance.
@@ -61,6 +62,7 @@ pub struct DrillHoleSkillType_InputParameterSet {
     /// `ClampForce` (Mandatory). Force the nose clamps the stack against the template with, in newtons.
     pub clamp_force: t::Variable<f64>,
 }
+t::debug_handle!(DrillHoleSkillType_InputParameterSet);
 impl t::Handle for DrillHoleSkillType_InputParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -114,7 +116,7 @@ t::parameters!(
 /// Handle of an instance of `DrillingCellType` (nsu=http://nodeset-compiler.dev/DrillingProcess/;i=3000).
 ///
 /// A template drilling work cell: offers the process skills ReferenceDrillBush and DrillHole, which a process controller runs once per hole, using the skills of the robot system and its end effector.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct DrillingCellType {
     /// The instance.
@@ -122,6 +124,7 @@ pub struct DrillingCellType {
     /// `SkillSet` (Mandatory). The process skills of the cell (ISkillSetType).
     pub skill_set: DrillingCellType_SkillSet,
 }
+t::debug_handle!(DrillingCellType);
 impl t::Handle for DrillingCellType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -131,7 +134,7 @@ impl t::Handle for DrillingCellType {
     }
 }
 /// `SkillSet`, a member of `DrillingCellType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct DrillingCellType_SkillSet {
     /// The instance.
@@ -141,6 +144,7 @@ pub struct DrillingCellType_SkillSet {
     /// `DrillHole` (Mandatory). Drills the hole of the drill bush the end effector is in front of.
     pub drill_hole: DrillingCellType_SkillSet_DrillHole,
 }
+t::debug_handle!(DrillingCellType_SkillSet);
 impl t::Handle for DrillingCellType_SkillSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -151,7 +155,7 @@ impl t::Handle for DrillingCellType_SkillSet {
     }
 }
 /// `ReferenceDrillBush`, a member of `DrillingCellType_SkillSet` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct DrillingCellType_SkillSet_ReferenceDrillBush {
     /// The instance.
@@ -189,6 +193,7 @@ pub struct DrillingCellType_SkillSet_ReferenceDrillBush {
     /// `OutputParameterSet` (Mandatory). The results: Result and ReferencedHolePosition.
     pub output_parameter_set: t::ObjectNode,
 }
+t::debug_handle!(DrillingCellType_SkillSet_ReferenceDrillBush);
 impl t::Handle for DrillingCellType_SkillSet_ReferenceDrillBush {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -213,7 +218,7 @@ impl t::Handle for DrillingCellType_SkillSet_ReferenceDrillBush {
     }
 }
 /// `DrillHole`, a member of `DrillingCellType_SkillSet` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct DrillingCellType_SkillSet_DrillHole {
     /// The instance.
@@ -251,6 +256,7 @@ pub struct DrillingCellType_SkillSet_DrillHole {
     /// `OutputParameterSet` (Mandatory). The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here).
     pub output_parameter_set: t::ObjectNode,
 }
+t::debug_handle!(DrillingCellType_SkillSet_DrillHole);
 impl t::Handle for DrillingCellType_SkillSet_DrillHole {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -280,7 +286,7 @@ t::object_type!(
 /// Handle of an instance of `ReferenceDrillBushSkillType` (nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1000).
 ///
 /// Brings the drilling end effector in front of a drill bush: moves the robot to the rough pose of the bush measured by the template referencing camera (AbsoluteCartesianLinearMove), measures the bush with the hole referencing unit of the end effector, corrects position and perpendicularity and stops ApproachDistance in front of the bush. The corrected pose of the bush is the result.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ReferenceDrillBushSkillType {
     /// The instance.
@@ -292,6 +298,7 @@ pub struct ReferenceDrillBushSkillType {
     /// `OutputParameterSet` (Mandatory). The results: Result and ReferencedHolePosition.
     pub output_parameter_set: ReferenceDrillBushSkillType_OutputParameterSet,
 }
+t::debug_handle!(ReferenceDrillBushSkillType);
 impl t::Handle for ReferenceDrillBushSkillType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -307,7 +314,7 @@ t::deref_base!(
     super::super::common_skills::objects::CompositeSkillType
 );
 /// `InputParameterSet`, a member of `ReferenceDrillBushSkillType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ReferenceDrillBushSkillType_InputParameterSet {
     /// The instance.
@@ -317,6 +324,7 @@ pub struct ReferenceDrillBushSkillType_InputParameterSet {
     /// `ApproachDistance` (Mandatory). Distance in front of the bush face at which the end effector stops, in millimetres.
     pub approach_distance: t::Variable<f64>,
 }
+t::debug_handle!(ReferenceDrillBushSkillType_InputParameterSet);
 impl t::Handle for ReferenceDrillBushSkillType_InputParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -327,7 +335,7 @@ impl t::Handle for ReferenceDrillBushSkillType_InputParameterSet {
     }
 }
 /// `OutputParameterSet`, a member of `ReferenceDrillBushSkillType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ReferenceDrillBushSkillType_OutputParameterSet {
     /// The instance.
@@ -337,6 +345,7 @@ pub struct ReferenceDrillBushSkillType_OutputParameterSet {
     /// `ReferencedHolePosition` (Mandatory). Pose of the drill bush as the hole referencing unit measured it, in the base frame of the robot; millimetres and degrees. Valid after a run that ended in Ready.
     pub referenced_hole_position: t::Variable<ua::ThreeDFrame>,
 }
+t::debug_handle!(ReferenceDrillBushSkillType_OutputParameterSet);
 impl t::Handle for ReferenceDrillBushSkillType_OutputParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {

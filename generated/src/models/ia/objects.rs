@@ -20,7 +20,7 @@ const NS: &[&str] = &[
 /// Handle of an instance of `AcousticSignalType` (nsu=http://opcfoundation.org/UA/IA/;i=1009).
 ///
 /// Represents an acoustic signal.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct AcousticSignalType {
     /// The instance.
@@ -30,6 +30,7 @@ pub struct AcousticSignalType {
     /// `NumberInList` (Mandatory). Enumerate the acoustic signals. Instances of StackElementAcousticType index into this number using the OperationMode Property.
     pub number_in_list: t::Variable<ua::Variant>,
 }
+t::debug_handle!(AcousticSignalType);
 impl t::Handle for AcousticSignalType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -45,12 +46,13 @@ t::object_type!(
 /// Handle of an instance of `BaseCalibrationTargetCategoryType` (nsu=http://opcfoundation.org/UA/IA/;i=1014).
 ///
 /// Abstract base type for categorizing calibration targets. Subtypes define the concrete categories.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct BaseCalibrationTargetCategoryType {
     /// The instance.
     pub node: t::ObjectNode,
 }
+t::debug_handle!(BaseCalibrationTargetCategoryType);
 impl t::Handle for BaseCalibrationTargetCategoryType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self { node: b.this(id)? })
@@ -63,7 +65,7 @@ t::object_type!(
 /// Handle of an instance of `BasicStacklightType` (nsu=http://opcfoundation.org/UA/IA/;i=1002).
 ///
 /// Entry point to a stacklight containing elements of the stacklight as well as additional information valid for the whole unit.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct BasicStacklightType {
     /// The instance.
@@ -79,6 +81,7 @@ pub struct BasicStacklightType {
     /// `StackRunning` (Optional). Valid if the stacklight is used in “Running_Light” StacklightMode.
     pub stack_running: Option<Box<StackRunningType>>,
 }
+t::debug_handle!(BasicStacklightType);
 impl t::Handle for BasicStacklightType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -92,7 +95,7 @@ impl t::Handle for BasicStacklightType {
     }
 }
 /// `StackLevel`, a member of `BasicStacklightType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct BasicStacklightType_StackLevel {
     /// The instance.
@@ -102,6 +105,7 @@ pub struct BasicStacklightType_StackLevel {
     /// `LevelPercent` (Mandatory). Shows the percentual value the stacklight is representing. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent.
     pub level_percent: t::Variable<f32>,
 }
+t::debug_handle!(BasicStacklightType_StackLevel);
 impl t::Handle for BasicStacklightType_StackLevel {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -117,7 +121,7 @@ t::object_type!(
 /// Handle of an instance of `CalibrationTargetType` (nsu=http://opcfoundation.org/UA/IA/;i=1019).
 ///
 /// Provides information about a calibration target.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct CalibrationTargetType {
     /// The instance.
@@ -139,6 +143,7 @@ pub struct CalibrationTargetType {
     /// `Quality` (Optional). Provides the quality of the calibration target in percentage, this is, the value shall be between 0 and 100. 100 means the highest quality, 0 the lowest. The semantic of the quality is application-specific.
     pub quality: Option<t::Variable<u8>>,
 }
+t::debug_handle!(CalibrationTargetType);
 impl t::Handle for CalibrationTargetType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -157,7 +162,7 @@ impl t::Handle for CalibrationTargetType {
     }
 }
 /// `CalibrationTargetFeatures`, a member of `CalibrationTargetType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct CalibrationTargetType_CalibrationTargetFeatures {
     /// The instance.
@@ -167,6 +172,7 @@ pub struct CalibrationTargetType_CalibrationTargetFeatures {
     /// `<CapacityRange>` (OptionalPlaceholder). A capacity range indicates a range (low and high value) as well as a resolution, and thus defines a number of values the calibration target provides for calibration and includes the quantity and engineering unit.
     pub capacity_range: t::Placeholders<t::Variable<ua::Range>>,
 }
+t::debug_handle!(CalibrationTargetType_CalibrationTargetFeatures);
 impl t::Handle for CalibrationTargetType_CalibrationTargetFeatures {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -177,7 +183,7 @@ impl t::Handle for CalibrationTargetType_CalibrationTargetFeatures {
     }
 }
 /// `Identification`, a member of `CalibrationTargetType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct CalibrationTargetType_Identification {
     /// The instance.
@@ -217,6 +223,7 @@ pub struct CalibrationTargetType_Identification {
     /// `SoftwareRevision` (Optional).
     pub software_revision: Option<t::Variable<String>>,
 }
+t::debug_handle!(CalibrationTargetType_Identification);
 impl t::Handle for CalibrationTargetType_Identification {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -246,7 +253,7 @@ t::object_type!(
 /// Handle of an instance of `CalibrationValueType` (nsu=http://opcfoundation.org/UA/IA/;i=2002).
 ///
 /// Represents the specific quantity and value (with engineering unit) that a calibration target provides for calibration of equipment.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct CalibrationValueType {
     /// The instance.
@@ -258,6 +265,7 @@ pub struct CalibrationValueType {
     /// `EngineeringUnits` (Mandatory).
     pub engineering_units: t::Variable<ua::EUInformation>,
 }
+t::debug_handle!(CalibrationValueType);
 impl t::Handle for CalibrationValueType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -274,7 +282,7 @@ t::variable_type!(
 /// Handle of an instance of `CapacityRangeType` (nsu=http://opcfoundation.org/UA/IA/;i=2003).
 ///
 /// Represent a scale of calibration values. The value defines the range (lowest and highest value), and the resolution property the size of each step.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct CapacityRangeType {
     /// The instance.
@@ -288,6 +296,7 @@ pub struct CapacityRangeType {
     /// `Resolution` (Mandatory).
     pub resolution: t::Variable<f64>,
 }
+t::debug_handle!(CapacityRangeType);
 impl t::Handle for CapacityRangeType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -305,7 +314,7 @@ t::variable_type!(
 /// Handle of an instance of `ControlChannelType` (nsu=http://opcfoundation.org/UA/IA/;i=1008).
 ///
 /// Used for control channels of single colour elements within a stack element (e.g. RGB elements would use three ControlChannels, one for each controllable colour).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ControlChannelType {
     /// The instance.
@@ -319,6 +328,7 @@ pub struct ControlChannelType {
     /// `SignalOn` (Mandatory). Indicates if the colour is switched on.
     pub signal_on: t::Variable<bool>,
 }
+t::debug_handle!(ControlChannelType);
 impl t::Handle for ControlChannelType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -336,7 +346,7 @@ t::object_type!(
 /// Handle of an instance of `DynamicCalibrationTargetCategoryType` (nsu=http://opcfoundation.org/UA/IA/;i=1018).
 ///
 /// Characterizes a calibration target to be used together with a measurement instrument, that determines the values to be calibrated. It can be a piece created during the normal production process or an item specifically created for calibration purposes. The calibration target represents an individual piece or item, that is, if a new piece should be used or item is created, a new Object of this ObjectType is created.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct DynamicCalibrationTargetCategoryType {
     /// The instance.
@@ -344,6 +354,7 @@ pub struct DynamicCalibrationTargetCategoryType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: BaseCalibrationTargetCategoryType,
 }
+t::debug_handle!(DynamicCalibrationTargetCategoryType);
 impl t::Handle for DynamicCalibrationTargetCategoryType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -362,7 +373,7 @@ t::object_type!(
 /// Handle of an instance of `IAggregateStatisticsType` (nsu=http://opcfoundation.org/UA/IA/;i=1012).
 ///
 /// Base interface for managing statistical data that is not rolled over. All data from the start of tracking the statistical data are considered, until the tracking gets reset.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct IAggregateStatisticsType {
     /// The instance.
@@ -372,6 +383,7 @@ pub struct IAggregateStatisticsType {
     /// `ResetCondition` (Optional). The reason and context for the reset of the statistics, which is done without a trigger from an OPC UA Client, like calling the ResetStatistics Method. ResetCondition is a vendor-specific, human readable string. ResetCondition is non-localized and might contain an expression that can be parsed by certain clients. Examples are: “AFTER 4 HOURS”, “AFTER 1000 ITEMS”, “OPERATOR”. “OPERATOR” means, that an operator resets the statistics on a local HMI.
     pub reset_condition: Option<t::Variable<String>>,
 }
+t::debug_handle!(IAggregateStatisticsType);
 impl t::Handle for IAggregateStatisticsType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -389,7 +401,7 @@ t::object_type!(
 /// Handle of an instance of `IRollingStatisticsType` (nsu=http://opcfoundation.org/UA/IA/;i=1013).
 ///
 /// Base interface for managing statistical data that is rolled over, i.e. only a certain amount of data is considered for statistical data.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct IRollingStatisticsType {
     /// The instance.
@@ -401,6 +413,7 @@ pub struct IRollingStatisticsType {
     /// `WindowNumberOfValues` (Optional). The number of values before the data gets rolled over. For the statistical data, only the data fitting into the number of values is considered, even if more data were gathered since StartTime.
     pub window_number_of_values: Option<t::Variable<u32>>,
 }
+t::debug_handle!(IRollingStatisticsType);
 impl t::Handle for IRollingStatisticsType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -418,7 +431,7 @@ t::object_type!(
 /// Handle of an instance of `IStatisticsType` (nsu=http://opcfoundation.org/UA/IA/;i=1011).
 ///
 /// Base interface for managing statistical data.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct IStatisticsType {
     /// The instance.
@@ -428,6 +441,7 @@ pub struct IStatisticsType {
     /// `StartTime` (Optional). Indicates the point in time at which the collection of the statistical data has been started.
     pub start_time: Option<t::Variable<ua::DateTime>>,
 }
+t::debug_handle!(IStatisticsType);
 impl t::Handle for IStatisticsType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -441,7 +455,7 @@ t::object_type!(IStatisticsType, rt::NsNodeId::numeric(NS[0], 1011), "IStatistic
 /// Handle of an instance of `OneTimeCalibrationTargetCategoryType` (nsu=http://opcfoundation.org/UA/IA/;i=1017).
 ///
 /// Categorizes a calibration target to be used only once, for example because the calibration destroys the target. Typically, Objects of this ObjectType do not represent one individual calibration target, but a batch of calibration targets with the same characteristics.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct OneTimeCalibrationTargetCategoryType {
     /// The instance.
@@ -449,6 +463,7 @@ pub struct OneTimeCalibrationTargetCategoryType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: BaseCalibrationTargetCategoryType,
 }
+t::debug_handle!(OneTimeCalibrationTargetCategoryType);
 impl t::Handle for OneTimeCalibrationTargetCategoryType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -467,7 +482,7 @@ t::object_type!(
 /// Handle of an instance of `ReusableCalibrationTargetCategoryType` (nsu=http://opcfoundation.org/UA/IA/;i=1015).
 ///
 /// Categorizes a calibration target to be reused several times. For example, a calibration target like a meter, that is bought specifically for calibration and not destroyed by an individual usage is of this category.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ReusableCalibrationTargetCategoryType {
     /// The instance.
@@ -475,6 +490,7 @@ pub struct ReusableCalibrationTargetCategoryType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: BaseCalibrationTargetCategoryType,
 }
+t::debug_handle!(ReusableCalibrationTargetCategoryType);
 impl t::Handle for ReusableCalibrationTargetCategoryType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -493,7 +509,7 @@ t::object_type!(
 /// Handle of an instance of `ReusableDeviceCalibrationTargetCategoryType` (nsu=http://opcfoundation.org/UA/IA/;i=1016).
 ///
 /// Categorizes a calibration target to be a reusable device that produces a certain environment like pressure that can be used for calibration.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ReusableDeviceCalibrationTargetCategoryType {
     /// The instance.
@@ -501,6 +517,7 @@ pub struct ReusableDeviceCalibrationTargetCategoryType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: ReusableCalibrationTargetCategoryType,
 }
+t::debug_handle!(ReusableDeviceCalibrationTargetCategoryType);
 impl t::Handle for ReusableDeviceCalibrationTargetCategoryType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -519,7 +536,7 @@ t::object_type!(
 /// Handle of an instance of `StackElementAcousticType` (nsu=http://opcfoundation.org/UA/IA/;i=1007).
 ///
 /// Represents an acoustic element in a stacklight.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct StackElementAcousticType {
     /// The instance.
@@ -533,6 +550,7 @@ pub struct StackElementAcousticType {
     /// `OperationMode` (Mandatory). Indicates what signal of the list of AcousticSignalType nodes is played when the acoustic element is switched on. It shall contain an index into the NumberInList of the respective AcousticSignalType Object of AcousticSignals.
     pub operation_mode: t::Variable<ua::Variant>,
 }
+t::debug_handle!(StackElementAcousticType);
 impl t::Handle for StackElementAcousticType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -546,7 +564,7 @@ impl t::Handle for StackElementAcousticType {
 }
 t::deref_base!(StackElementAcousticType => StackElementType);
 /// `AcousticSignals`, a member of `StackElementAcousticType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct StackElementAcousticType_AcousticSignals {
     /// The instance.
@@ -556,6 +574,7 @@ pub struct StackElementAcousticType_AcousticSignals {
     /// `NodeVersion` (Optional).
     pub node_version: Option<t::Variable<String>>,
 }
+t::debug_handle!(StackElementAcousticType_AcousticSignals);
 impl t::Handle for StackElementAcousticType_AcousticSignals {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -572,7 +591,7 @@ t::object_type!(
 /// Handle of an instance of `StackElementLightType` (nsu=http://opcfoundation.org/UA/IA/;i=1006).
 ///
 /// Represents a lamp element in a stacklight.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct StackElementLightType {
     /// The instance.
@@ -590,6 +609,7 @@ pub struct StackElementLightType {
     /// `SignalRGBWValue` (Optional).
     pub signal_rgbw_value: Option<t::Variable<super::types::RgbwDataType>>,
 }
+t::debug_handle!(StackElementLightType);
 impl t::Handle for StackElementLightType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -610,7 +630,7 @@ t::object_type!(
 /// Handle of an instance of `StackElementType` (nsu=http://opcfoundation.org/UA/IA/;i=1005).
 ///
 /// Base class for elements in a stacklight.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct StackElementType {
     /// The instance.
@@ -622,6 +642,7 @@ pub struct StackElementType {
     /// `SignalOn` (Optional). Indicates if the signal emitted by the stack element is currently switched on or not.
     pub signal_on: Option<t::Variable<bool>>,
 }
+t::debug_handle!(StackElementType);
 impl t::Handle for StackElementType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -638,7 +659,7 @@ t::object_type!(
 /// Handle of an instance of `StackLevelType` (nsu=http://opcfoundation.org/UA/IA/;i=1003).
 ///
 /// Contains information relevant to a stacklight operating as a level meter. The whole stack is controlled by a percentual value.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct StackLevelType {
     /// The instance.
@@ -648,6 +669,7 @@ pub struct StackLevelType {
     /// `LevelPercent` (Mandatory). Shows the percentual value the stacklight is representing. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent.
     pub level_percent: t::Variable<f32>,
 }
+t::debug_handle!(StackLevelType);
 impl t::Handle for StackLevelType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -661,12 +683,13 @@ t::object_type!(StackLevelType, rt::NsNodeId::numeric(NS[0], 1003), "StackLevelT
 /// Handle of an instance of `StackRunningType` (nsu=http://opcfoundation.org/UA/IA/;i=1004).
 ///
 /// Contains information relevant to a stacklight operating as a running light. This base type does not define any specific information, but can be extended.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct StackRunningType {
     /// The instance.
     pub node: t::ObjectNode,
 }
+t::debug_handle!(StackRunningType);
 impl t::Handle for StackRunningType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self { node: b.this(id)? })
@@ -678,7 +701,7 @@ t::object_type!(
 /// Handle of an instance of `StacklightType` (nsu=http://opcfoundation.org/UA/IA/;i=1010).
 ///
 /// Entry point to a stacklight with the possibility to show the stacklight’s health status.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct StacklightType {
     /// The instance.
@@ -692,6 +715,7 @@ pub struct StacklightType {
     /// `DeviceHealthAlarms` (Optional). Contains alarms of the stacklights providing more detailed information on the health of the stacklight.
     pub device_health_alarms: Option<t::ObjectNode>,
 }
+t::debug_handle!(StacklightType);
 impl t::Handle for StacklightType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {

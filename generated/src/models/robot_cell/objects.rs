@@ -22,7 +22,7 @@ const NS: &[&str] = &[
 /// Handle of an instance of `DrillingEndEffectorType` (nsu=http://nodeset-compiler.dev/RobotCell/;i=2000).
 ///
 /// A drilling end effector for template drilling, carried by a robot: a drilling unit with a concentric collet nose and an expanding mandrel that locks into the drill bushes of a drilling template. Its skill TemplateDrilling drills one hole.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct DrillingEndEffectorType {
     /// The instance.
@@ -38,6 +38,7 @@ pub struct DrillingEndEffectorType {
     /// `SkillSet` (Mandatory). The skills of the end effector (ISkillSetType): TemplateDrilling.
     pub skill_set: DrillingEndEffectorType_SkillSet,
 }
+t::debug_handle!(DrillingEndEffectorType);
 impl t::Handle for DrillingEndEffectorType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -52,7 +53,7 @@ impl t::Handle for DrillingEndEffectorType {
 }
 t::deref_base!(DrillingEndEffectorType => super::super::di::objects::ComponentType);
 /// `SkillSet`, a member of `DrillingEndEffectorType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct DrillingEndEffectorType_SkillSet {
     /// The instance.
@@ -60,6 +61,7 @@ pub struct DrillingEndEffectorType_SkillSet {
     /// `TemplateDrilling` (Mandatory). Drills one hole through the drill bush the end effector sits in.
     pub template_drilling: DrillingEndEffectorType_SkillSet_TemplateDrilling,
 }
+t::debug_handle!(DrillingEndEffectorType_SkillSet);
 impl t::Handle for DrillingEndEffectorType_SkillSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -69,7 +71,7 @@ impl t::Handle for DrillingEndEffectorType_SkillSet {
     }
 }
 /// `TemplateDrilling`, a member of `DrillingEndEffectorType_SkillSet` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct DrillingEndEffectorType_SkillSet_TemplateDrilling {
     /// The instance.
@@ -107,6 +109,7 @@ pub struct DrillingEndEffectorType_SkillSet_TemplateDrilling {
     /// `OutputParameterSet` (Mandatory). The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here).
     pub output_parameter_set: t::ObjectNode,
 }
+t::debug_handle!(DrillingEndEffectorType_SkillSet_TemplateDrilling);
 impl t::Handle for DrillingEndEffectorType_SkillSet_TemplateDrilling {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -137,7 +140,7 @@ t::object_type!(
 /// Handle of an instance of `LwrSystemType` (nsu=http://nodeset-compiler.dev/RobotCell/;i=3000).
 ///
 /// A lightweight robot system: a collaborative robot arm with its controller (MotionDeviceSystem, as the Robotics companion specification models it) and the skills of the system as a whole in SkillSet. Subtypes add the end effectors of an application.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct LwrSystemType {
     /// The instance.
@@ -149,6 +152,7 @@ pub struct LwrSystemType {
     /// `SkillSet` (Mandatory). The skills of the system as a whole (ISkillSetType). The skills of its parts are in their own SkillSets, such as the one of the robot controller.
     pub skill_set: t::ObjectNode,
 }
+t::debug_handle!(LwrSystemType);
 impl t::Handle for LwrSystemType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -161,7 +165,7 @@ impl t::Handle for LwrSystemType {
 }
 t::deref_base!(LwrSystemType => super::super::di::objects::ComponentType);
 /// `MotionDeviceSystem`, a member of `LwrSystemType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct LwrSystemType_MotionDeviceSystem {
     /// The instance.
@@ -213,6 +217,7 @@ pub struct LwrSystemType_MotionDeviceSystem {
     /// `SafetyStates` (Mandatory). The safety states of the MotionDeviceSystem.
     pub safety_states: t::ObjectNode,
 }
+t::debug_handle!(LwrSystemType_MotionDeviceSystem);
 impl t::Handle for LwrSystemType_MotionDeviceSystem {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -243,7 +248,7 @@ impl t::Handle for LwrSystemType_MotionDeviceSystem {
     }
 }
 /// `ParameterSet`, a member of `LwrSystemType_MotionDeviceSystem` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct LwrSystemType_MotionDeviceSystem_ParameterSet {
     /// The instance.
@@ -251,6 +256,7 @@ pub struct LwrSystemType_MotionDeviceSystem_ParameterSet {
     /// `<ParameterIdentifier>` (MandatoryPlaceholder).
     pub parameter_identifier: t::Placeholders<t::Variable<ua::Variant>>,
 }
+t::debug_handle!(LwrSystemType_MotionDeviceSystem_ParameterSet);
 impl t::Handle for LwrSystemType_MotionDeviceSystem_ParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -260,7 +266,7 @@ impl t::Handle for LwrSystemType_MotionDeviceSystem_ParameterSet {
     }
 }
 /// `Lock`, a member of `LwrSystemType_MotionDeviceSystem` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct LwrSystemType_MotionDeviceSystem_Lock {
     /// The instance.
@@ -282,6 +288,7 @@ pub struct LwrSystemType_MotionDeviceSystem_Lock {
     /// `BreakLock` (Mandatory).
     pub break_lock: t::Method<(), (i32,)>,
 }
+t::debug_handle!(LwrSystemType_MotionDeviceSystem_Lock);
 impl t::Handle for LwrSystemType_MotionDeviceSystem_Lock {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -301,7 +308,7 @@ t::object_type!(LwrSystemType, rt::NsNodeId::numeric(NS[0], 3000), "LwrSystemTyp
 /// Handle of an instance of `TemplateDrillingLwrSystemType` (nsu=http://nodeset-compiler.dev/RobotCell/;i=5000).
 ///
 /// A lightweight robot system for template drilling: the robot of LwrSystemType carrying a drilling end effector. Composite skills such as DrillHole combine the move skills of the robot controller with the TemplateDrilling skill of the end effector.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct TemplateDrillingLwrSystemType {
     /// The instance.
@@ -311,6 +318,7 @@ pub struct TemplateDrillingLwrSystemType {
     /// `DrillingEndEffector` (Mandatory). The drilling end effector mounted on the flange of the robot.
     pub drilling_end_effector: TemplateDrillingLwrSystemType_DrillingEndEffector,
 }
+t::debug_handle!(TemplateDrillingLwrSystemType);
 impl t::Handle for TemplateDrillingLwrSystemType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -322,7 +330,7 @@ impl t::Handle for TemplateDrillingLwrSystemType {
 }
 t::deref_base!(TemplateDrillingLwrSystemType => LwrSystemType);
 /// `DrillingEndEffector`, a member of `TemplateDrillingLwrSystemType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct TemplateDrillingLwrSystemType_DrillingEndEffector {
     /// The instance.
@@ -372,6 +380,7 @@ pub struct TemplateDrillingLwrSystemType_DrillingEndEffector {
     /// `SkillSet` (Mandatory). The skills of the end effector (ISkillSetType): TemplateDrilling.
     pub skill_set: TemplateDrillingLwrSystemType_DrillingEndEffector_SkillSet,
 }
+t::debug_handle!(TemplateDrillingLwrSystemType_DrillingEndEffector);
 impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -400,7 +409,7 @@ impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector {
     }
 }
 /// `ParameterSet`, a member of `TemplateDrillingLwrSystemType_DrillingEndEffector` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct TemplateDrillingLwrSystemType_DrillingEndEffector_ParameterSet {
     /// The instance.
@@ -408,6 +417,7 @@ pub struct TemplateDrillingLwrSystemType_DrillingEndEffector_ParameterSet {
     /// `<ParameterIdentifier>` (MandatoryPlaceholder).
     pub parameter_identifier: t::Placeholders<t::Variable<ua::Variant>>,
 }
+t::debug_handle!(TemplateDrillingLwrSystemType_DrillingEndEffector_ParameterSet);
 impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector_ParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -417,7 +427,7 @@ impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector_ParameterSe
     }
 }
 /// `Lock`, a member of `TemplateDrillingLwrSystemType_DrillingEndEffector` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct TemplateDrillingLwrSystemType_DrillingEndEffector_Lock {
     /// The instance.
@@ -439,6 +449,7 @@ pub struct TemplateDrillingLwrSystemType_DrillingEndEffector_Lock {
     /// `BreakLock` (Mandatory).
     pub break_lock: t::Method<(), (i32,)>,
 }
+t::debug_handle!(TemplateDrillingLwrSystemType_DrillingEndEffector_Lock);
 impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector_Lock {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -455,7 +466,7 @@ impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector_Lock {
     }
 }
 /// `SkillSet`, a member of `TemplateDrillingLwrSystemType_DrillingEndEffector` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct TemplateDrillingLwrSystemType_DrillingEndEffector_SkillSet {
     /// The instance.
@@ -463,6 +474,7 @@ pub struct TemplateDrillingLwrSystemType_DrillingEndEffector_SkillSet {
     /// `TemplateDrilling` (Mandatory). Drills one hole through the drill bush the end effector sits in.
     pub template_drilling: Box<TemplateDrillingSkillType>,
 }
+t::debug_handle!(TemplateDrillingLwrSystemType_DrillingEndEffector_SkillSet);
 impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector_SkillSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -478,7 +490,7 @@ t::object_type!(
 /// Handle of an instance of `TemplateDrillingSkillType` (nsu=http://nodeset-compiler.dev/RobotCell/;i=1000).
 ///
 /// Drilling one hole through a drilling template: the end effector locks its expanding mandrel in the drill bush it sits in, clamps the stack with ClampForce, drills to Depth and retracts the drill. The run ends in Ready with the mandrel released, so the robot can move the end effector out of the bush.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct TemplateDrillingSkillType {
     /// The instance.
@@ -488,6 +500,7 @@ pub struct TemplateDrillingSkillType {
     /// `InputParameterSet` (Mandatory). The drilling parameters: HoleDiameter, Depth, FeedRate, SpindleSpeed and ClampForce.
     pub input_parameter_set: TemplateDrillingSkillType_InputParameterSet,
 }
+t::debug_handle!(TemplateDrillingSkillType);
 impl t::Handle for TemplateDrillingSkillType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -502,7 +515,7 @@ t::deref_base!(
     super::super::common_skills::objects::ProgramSkillStateMachineType
 );
 /// `InputParameterSet`, a member of `TemplateDrillingSkillType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct TemplateDrillingSkillType_InputParameterSet {
     /// The instance.
@@ -518,6 +531,7 @@ pub struct TemplateDrillingSkillType_InputParameterSet {
     /// `ClampForce` (Mandatory). Force the nose clamps the stack against the template with, in newtons.
     pub clamp_force: t::Variable<f64>,
 }
+t::debug_handle!(TemplateDrillingSkillType_InputParameterSet);
 impl t::Handle for TemplateDrillingSkillType_InputParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -569,7 +583,7 @@ t::parameters!(
 /// Handle of an instance of `UR10eSystemType` (nsu=http://nodeset-compiler.dev/RobotCell/;i=4000).
 ///
 /// A Universal Robots UR10e as a Robotics motion device system: the six-joint arm (12.5 kg payload, 1300 mm reach) and its controller. The controller offers the three basic move skills of CommonSkills in its SkillSet, so composite skills can drive any robot that offers the same skills.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct Ur10eSystemType {
     /// The instance.
@@ -583,6 +597,7 @@ pub struct Ur10eSystemType {
     /// `SafetyStates` (Mandatory). The safety state of the UR10e.
     pub safety_states: Ur10eSystemType_SafetyStates,
 }
+t::debug_handle!(Ur10eSystemType);
 impl t::Handle for Ur10eSystemType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -598,7 +613,7 @@ t::deref_base!(
     Ur10eSystemType => super::super::robotics::objects::MotionDeviceSystemType
 );
 /// `Controllers`, a member of `Ur10eSystemType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct Ur10eSystemType_Controllers {
     /// The instance.
@@ -606,6 +621,7 @@ pub struct Ur10eSystemType_Controllers {
     /// `URController` (Mandatory). The UR10e control box. Besides the Robotics controller data it offers the basic move skills of the robot in SkillSet (ISkillSetType).
     pub ur_controller: Ur10eSystemType_Controllers_URController,
 }
+t::debug_handle!(Ur10eSystemType_Controllers);
 impl t::Handle for Ur10eSystemType_Controllers {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -615,7 +631,7 @@ impl t::Handle for Ur10eSystemType_Controllers {
     }
 }
 /// `URController`, a member of `Ur10eSystemType_Controllers` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct Ur10eSystemType_Controllers_URController {
     /// The instance.
@@ -685,6 +701,7 @@ pub struct Ur10eSystemType_Controllers_URController {
     /// `SkillSet` (Mandatory). The basic move skills of the UR10e (ISkillSetType): AbsoluteJointPTPMove, RelativeCartesianLinearMove and AbsoluteCartesianLinearMove.
     pub skill_set: t::ObjectNode,
 }
+t::debug_handle!(Ur10eSystemType_Controllers_URController);
 impl t::Handle for Ur10eSystemType_Controllers_URController {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -723,7 +740,7 @@ impl t::Handle for Ur10eSystemType_Controllers_URController {
     }
 }
 /// `MotionDevices`, a member of `Ur10eSystemType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct Ur10eSystemType_MotionDevices {
     /// The instance.
@@ -731,6 +748,7 @@ pub struct Ur10eSystemType_MotionDevices {
     /// `Manipulator` (Mandatory). The six-joint UR10e arm.
     pub manipulator: Ur10eSystemType_MotionDevices_Manipulator,
 }
+t::debug_handle!(Ur10eSystemType_MotionDevices);
 impl t::Handle for Ur10eSystemType_MotionDevices {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -740,7 +758,7 @@ impl t::Handle for Ur10eSystemType_MotionDevices {
     }
 }
 /// `Manipulator`, a member of `Ur10eSystemType_MotionDevices` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct Ur10eSystemType_MotionDevices_Manipulator {
     /// The instance.
@@ -800,6 +818,7 @@ pub struct Ur10eSystemType_MotionDevices_Manipulator {
     /// `TaskControlReference` (Optional).
     pub task_control_reference: Option<t::Variable<ua::NodeId>>,
 }
+t::debug_handle!(Ur10eSystemType_MotionDevices_Manipulator);
 impl t::Handle for Ur10eSystemType_MotionDevices_Manipulator {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -833,7 +852,7 @@ impl t::Handle for Ur10eSystemType_MotionDevices_Manipulator {
     }
 }
 /// `SafetyStates`, a member of `Ur10eSystemType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct Ur10eSystemType_SafetyStates {
     /// The instance.
@@ -841,6 +860,7 @@ pub struct Ur10eSystemType_SafetyStates {
     /// `SafetyState` (Mandatory). Emergency stop, protective stop and operational mode of the UR10e.
     pub safety_state: Ur10eSystemType_SafetyStates_SafetyState,
 }
+t::debug_handle!(Ur10eSystemType_SafetyStates);
 impl t::Handle for Ur10eSystemType_SafetyStates {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -850,7 +870,7 @@ impl t::Handle for Ur10eSystemType_SafetyStates {
     }
 }
 /// `SafetyState`, a member of `Ur10eSystemType_SafetyStates` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct Ur10eSystemType_SafetyStates_SafetyState {
     /// The instance.
@@ -900,6 +920,7 @@ pub struct Ur10eSystemType_SafetyStates_SafetyState {
     /// `ProtectiveStopFunctions` (Optional). ProtectiveStopFunctions is a container for one or more instances of the ProtectiveStopFunctionType.
     pub protective_stop_functions: Option<t::ObjectNode>,
 }
+t::debug_handle!(Ur10eSystemType_SafetyStates_SafetyState);
 impl t::Handle for Ur10eSystemType_SafetyStates_SafetyState {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {

@@ -20,7 +20,7 @@ const NS: &[&str] = &[
 /// Handle of an instance of `AuxiliaryComponentType` (nsu=http://opcfoundation.org/UA/Robotics/;i=17725).
 ///
 /// Components mounted in a controller cabinet or a motion device e.g. an IO-board or a power supply.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct AuxiliaryComponentType {
     /// The instance.
@@ -32,6 +32,7 @@ pub struct AuxiliaryComponentType {
     /// `AssetId` (Optional).
     pub asset_id: Option<t::Variable<String>>,
 }
+t::debug_handle!(AuxiliaryComponentType);
 impl t::Handle for AuxiliaryComponentType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -49,7 +50,7 @@ t::object_type!(
 /// Handle of an instance of `AxisType` (nsu=http://opcfoundation.org/UA/Robotics/;i=16601).
 ///
 /// The AxisType describes an axis of a motion device.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct AxisType {
     /// The instance.
@@ -67,6 +68,7 @@ pub struct AxisType {
     /// `MotionProfile` (Mandatory). The kind of axis motion as defined with the AxisMotionProfileEnumeration.
     pub motion_profile: t::Variable<super::types::AxisMotionProfileEnumeration>,
 }
+t::debug_handle!(AxisType);
 impl t::Handle for AxisType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -83,7 +85,7 @@ impl t::Handle for AxisType {
 }
 t::deref_base!(AxisType => super::super::di::objects::ComponentType);
 /// `ParameterSet`, a member of `AxisType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct AxisType_ParameterSet {
     /// The instance.
@@ -95,6 +97,7 @@ pub struct AxisType_ParameterSet {
     /// `ActualSpeed` (Optional). The axis speed on load side (after gear/spindle) inclusive Unit.
     pub actual_speed: Option<t::Variable<f64>>,
 }
+t::debug_handle!(AxisType_ParameterSet);
 impl t::Handle for AxisType_ParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -106,7 +109,7 @@ impl t::Handle for AxisType_ParameterSet {
     }
 }
 /// `AdditionalLoad`, a member of `AxisType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct AxisType_AdditionalLoad {
     /// The instance.
@@ -118,6 +121,7 @@ pub struct AxisType_AdditionalLoad {
     /// `Mass` (Mandatory). The weight of the load mounted on one mounting point.
     pub mass: t::Variable<f64>,
 }
+t::debug_handle!(AxisType_AdditionalLoad);
 impl t::Handle for AxisType_AdditionalLoad {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -132,7 +136,7 @@ t::object_type!(AxisType, rt::NsNodeId::numeric(NS[0], 16601), "AxisType");
 /// Handle of an instance of `ControllerType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1003).
 ///
 /// The ControllerType describes the control unit of motion devices. One motion device system can have one or more instances of the ControllerType.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ControllerType {
     /// The instance.
@@ -172,6 +176,7 @@ pub struct ControllerType {
     /// `TaskControls` (Mandatory). TaskControls is a container for one or more instances of TaskControlType.
     pub task_controls: ControllerType_TaskControls,
 }
+t::debug_handle!(ControllerType);
 impl t::Handle for ControllerType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -200,7 +205,7 @@ impl t::Handle for ControllerType {
 }
 t::deref_base!(ControllerType => super::super::di::objects::ComponentType);
 /// `ParameterSet`, a member of `ControllerType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ControllerType_ParameterSet {
     /// The instance.
@@ -222,6 +227,7 @@ pub struct ControllerType_ParameterSet {
     /// `UpsState` (Optional). The vendor specific status of an integrated UPS or accumulator system.
     pub ups_state: Option<t::Variable<String>>,
 }
+t::debug_handle!(ControllerType_ParameterSet);
 impl t::Handle for ControllerType_ParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -238,7 +244,7 @@ impl t::Handle for ControllerType_ParameterSet {
     }
 }
 /// `Components`, a member of `ControllerType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ControllerType_Components {
     /// The instance.
@@ -246,6 +252,7 @@ pub struct ControllerType_Components {
     /// `<ComponentIdentifier>` (MandatoryPlaceholder). The intention is to integrate inside this container devices which are defined in other companion specifications using DI.
     pub component_identifier: t::Placeholders<super::super::di::objects::ComponentType>,
 }
+t::debug_handle!(ControllerType_Components);
 impl t::Handle for ControllerType_Components {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -256,7 +263,7 @@ impl t::Handle for ControllerType_Components {
     }
 }
 /// `CurrentUser`, a member of `ControllerType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ControllerType_CurrentUser {
     /// The instance.
@@ -266,6 +273,7 @@ pub struct ControllerType_CurrentUser {
     /// `Name` (Optional). The name for the current user within the control system.
     pub name: Option<t::Variable<String>>,
 }
+t::debug_handle!(ControllerType_CurrentUser);
 impl t::Handle for ControllerType_CurrentUser {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -276,7 +284,7 @@ impl t::Handle for ControllerType_CurrentUser {
     }
 }
 /// `Programs`, a member of `ControllerType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ControllerType_Programs {
     /// The instance.
@@ -294,6 +302,7 @@ pub struct ControllerType_Programs {
     /// `MoveOrCopy` (Mandatory).
     pub move_or_copy: t::Method<(ua::NodeId, ua::NodeId, bool, String), (ua::NodeId,)>,
 }
+t::debug_handle!(ControllerType_Programs);
 impl t::Handle for ControllerType_Programs {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -309,7 +318,7 @@ impl t::Handle for ControllerType_Programs {
     }
 }
 /// `Software`, a member of `ControllerType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ControllerType_Software {
     /// The instance.
@@ -317,6 +326,7 @@ pub struct ControllerType_Software {
     /// `<SoftwareIdentifier>` (MandatoryPlaceholder).
     pub software_identifier: t::Placeholders<super::super::di::objects::SoftwareType>,
 }
+t::debug_handle!(ControllerType_Software);
 impl t::Handle for ControllerType_Software {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -326,7 +336,7 @@ impl t::Handle for ControllerType_Software {
     }
 }
 /// `SystemOperation`, a member of `ControllerType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ControllerType_SystemOperation {
     /// The instance.
@@ -336,6 +346,7 @@ pub struct ControllerType_SystemOperation {
     /// `SystemOperationStateMachine` (Mandatory).
     pub system_operation_state_machine: ControllerType_SystemOperation_SystemOperationStateMachine,
 }
+t::debug_handle!(ControllerType_SystemOperation);
 impl t::Handle for ControllerType_SystemOperation {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -347,7 +358,7 @@ impl t::Handle for ControllerType_SystemOperation {
     }
 }
 /// `Conditions`, a member of `ControllerType_SystemOperation` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ControllerType_SystemOperation_Conditions {
     /// The instance.
@@ -355,6 +366,7 @@ pub struct ControllerType_SystemOperation_Conditions {
     /// `<AcknowledgeableCondition>` (MandatoryPlaceholder).
     pub acknowledgeable_condition: t::Placeholders<t::ObjectNode>,
 }
+t::debug_handle!(ControllerType_SystemOperation_Conditions);
 impl t::Handle for ControllerType_SystemOperation_Conditions {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -365,7 +377,7 @@ impl t::Handle for ControllerType_SystemOperation_Conditions {
     }
 }
 /// `SystemOperationStateMachine`, a member of `ControllerType_SystemOperation` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ControllerType_SystemOperation_SystemOperationStateMachine {
     /// The instance.
@@ -397,6 +409,7 @@ pub struct ControllerType_SystemOperation_SystemOperationStateMachine {
     /// `StandDown` (Optional).
     pub stand_down: Option<t::Method<(), (i32,)>>,
 }
+t::debug_handle!(ControllerType_SystemOperation_SystemOperationStateMachine);
 impl t::Handle for ControllerType_SystemOperation_SystemOperationStateMachine {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -420,7 +433,7 @@ impl t::Handle for ControllerType_SystemOperation_SystemOperationStateMachine {
     }
 }
 /// `TaskControls`, a member of `ControllerType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct ControllerType_TaskControls {
     /// The instance.
@@ -428,6 +441,7 @@ pub struct ControllerType_TaskControls {
     /// `<TaskControlIdentifier>` (MandatoryPlaceholder).
     pub task_control_identifier: t::Placeholders<TaskControlType>,
 }
+t::debug_handle!(ControllerType_TaskControls);
 impl t::Handle for ControllerType_TaskControls {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -441,7 +455,7 @@ t::object_type!(ControllerType, rt::NsNodeId::numeric(NS[0], 1003), "ControllerT
 /// Handle of an instance of `DriveType` (nsu=http://opcfoundation.org/UA/Robotics/;i=17793).
 ///
 /// Drives (multi-slot or single-slot axis amplifier) mounted in a controller cabinet or a motion device.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct DriveType {
     /// The instance.
@@ -453,6 +467,7 @@ pub struct DriveType {
     /// `AssetId` (Optional).
     pub asset_id: Option<t::Variable<String>>,
 }
+t::debug_handle!(DriveType);
 impl t::Handle for DriveType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -468,7 +483,7 @@ t::object_type!(DriveType, rt::NsNodeId::numeric(NS[0], 17793), "DriveType");
 /// Handle of an instance of `EmergencyStopFunctionType` (nsu=http://opcfoundation.org/UA/Robotics/;i=17230).
 ///
 /// According to ISO 10218-1:2011 Ch.5.5.2 Emergency stop the robot shall have one or more emergency stop functions.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct EmergencyStopFunctionType {
     /// The instance.
@@ -478,6 +493,7 @@ pub struct EmergencyStopFunctionType {
     /// `Name` (Mandatory). The Name of the EmergencyStopFunctionType provides a manufacturer-specific emergency stop function identifier within the safety system.
     pub name: t::Variable<String>,
 }
+t::debug_handle!(EmergencyStopFunctionType);
 impl t::Handle for EmergencyStopFunctionType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -492,7 +508,7 @@ t::object_type!(
     "EmergencyStopFunctionType"
 );
 /// Handle of an instance of `ExecutingSubstateMachineType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1007).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ExecutingSubstateMachineType {
     /// The instance.
@@ -508,6 +524,7 @@ pub struct ExecutingSubstateMachineType {
     /// `LastTransitionReason` (Mandatory).
     pub last_transition_reason: t::Variable<i16>,
 }
+t::debug_handle!(ExecutingSubstateMachineType);
 impl t::Handle for ExecutingSubstateMachineType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -563,7 +580,7 @@ impl t::StateMachine for ExecutingSubstateMachineType {
 /// Handle of an instance of `GearType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1022).
 ///
 /// The GearType describes a gear in a powertrain, e.g. a gear box or a spindle.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct GearType {
     /// The instance.
@@ -585,6 +602,7 @@ pub struct GearType {
     /// `Pitch` (Optional). Pitch describes the distance covered in millimeters (mm) for linear motion per one revolution of the output side of the driving unit. Pitch is used in combination with GearRatio to describe the overall transmission from input to output of the gear.
     pub pitch: Option<t::Variable<f64>>,
 }
+t::debug_handle!(GearType);
 impl t::Handle for GearType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -603,7 +621,7 @@ impl t::Handle for GearType {
 t::deref_base!(GearType => super::super::di::objects::ComponentType);
 t::object_type!(GearType, rt::NsNodeId::numeric(NS[0], 1022), "GearType");
 /// Handle of an instance of `IdleSubstateMachineType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1009).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct IdleSubstateMachineType {
     /// The instance.
@@ -619,6 +637,7 @@ pub struct IdleSubstateMachineType {
     /// `LastTransitionReason` (Mandatory).
     pub last_transition_reason: t::Variable<i16>,
 }
+t::debug_handle!(IdleSubstateMachineType);
 impl t::Handle for IdleSubstateMachineType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -683,7 +702,7 @@ impl t::StateMachine for IdleSubstateMachineType {
 /// Handle of an instance of `LoadType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1018).
 ///
 /// The LoadType is for describing loads mounted on the motion device typically by an integrator or a customer.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct LoadType {
     /// The instance.
@@ -695,6 +714,7 @@ pub struct LoadType {
     /// `Mass` (Mandatory). The weight of the load mounted on one mounting point.
     pub mass: t::Variable<f64>,
 }
+t::debug_handle!(LoadType);
 impl t::Handle for LoadType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -709,7 +729,7 @@ t::object_type!(LoadType, rt::NsNodeId::numeric(NS[0], 1018), "LoadType");
 /// Handle of an instance of `MotionDeviceSystemType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1002).
 ///
 /// Contains the set of controllers and motion devices in a closely-coupled motion device system.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct MotionDeviceSystemType {
     /// The instance.
@@ -725,6 +745,7 @@ pub struct MotionDeviceSystemType {
     /// `SafetyStates` (Mandatory). Contains safety-related data from motion device system.
     pub safety_states: MotionDeviceSystemType_SafetyStates,
 }
+t::debug_handle!(MotionDeviceSystemType);
 impl t::Handle for MotionDeviceSystemType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -739,7 +760,7 @@ impl t::Handle for MotionDeviceSystemType {
 }
 t::deref_base!(MotionDeviceSystemType => super::super::di::objects::ComponentType);
 /// `Controllers`, a member of `MotionDeviceSystemType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct MotionDeviceSystemType_Controllers {
     /// The instance.
@@ -747,6 +768,7 @@ pub struct MotionDeviceSystemType_Controllers {
     /// `<ControllerIdentifier>` (MandatoryPlaceholder).
     pub controller_identifier: t::Placeholders<ControllerType>,
 }
+t::debug_handle!(MotionDeviceSystemType_Controllers);
 impl t::Handle for MotionDeviceSystemType_Controllers {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -757,7 +779,7 @@ impl t::Handle for MotionDeviceSystemType_Controllers {
     }
 }
 /// `MotionDevices`, a member of `MotionDeviceSystemType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct MotionDeviceSystemType_MotionDevices {
     /// The instance.
@@ -765,6 +787,7 @@ pub struct MotionDeviceSystemType_MotionDevices {
     /// `<MotionDeviceIdentifier>` (MandatoryPlaceholder).
     pub motion_device_identifier: t::Placeholders<MotionDeviceType>,
 }
+t::debug_handle!(MotionDeviceSystemType_MotionDevices);
 impl t::Handle for MotionDeviceSystemType_MotionDevices {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -775,7 +798,7 @@ impl t::Handle for MotionDeviceSystemType_MotionDevices {
     }
 }
 /// `SafetyStates`, a member of `MotionDeviceSystemType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct MotionDeviceSystemType_SafetyStates {
     /// The instance.
@@ -783,6 +806,7 @@ pub struct MotionDeviceSystemType_SafetyStates {
     /// `<SafetyStateIdentifier>` (MandatoryPlaceholder).
     pub safety_state_identifier: t::Placeholders<SafetyStateType>,
 }
+t::debug_handle!(MotionDeviceSystemType_SafetyStates);
 impl t::Handle for MotionDeviceSystemType_SafetyStates {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -798,7 +822,7 @@ t::object_type!(
 /// Handle of an instance of `MotionDeviceType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1004).
 ///
 /// Represents a specific motion device in the motion device system like a robot, a linear unit or a positioner. A MotionDevice should have at least one axis.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct MotionDeviceType {
     /// The instance.
@@ -836,6 +860,7 @@ pub struct MotionDeviceType {
     /// `TaskControlReference` (Optional).
     pub task_control_reference: Option<t::Variable<ua::NodeId>>,
 }
+t::debug_handle!(MotionDeviceType);
 impl t::Handle for MotionDeviceType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -860,7 +885,7 @@ impl t::Handle for MotionDeviceType {
 }
 t::deref_base!(MotionDeviceType => super::super::di::objects::ComponentType);
 /// `ParameterSet`, a member of `MotionDeviceType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct MotionDeviceType_ParameterSet {
     /// The instance.
@@ -872,6 +897,7 @@ pub struct MotionDeviceType_ParameterSet {
     /// `SpeedOverride` (Mandatory). SpeedOverride provides the current speed setting in percent of programmed speed (0 - 100%).
     pub speed_override: t::Variable<f64>,
 }
+t::debug_handle!(MotionDeviceType_ParameterSet);
 impl t::Handle for MotionDeviceType_ParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -883,7 +909,7 @@ impl t::Handle for MotionDeviceType_ParameterSet {
     }
 }
 /// `AdditionalComponents`, a member of `MotionDeviceType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct MotionDeviceType_AdditionalComponents {
     /// The instance.
@@ -891,6 +917,7 @@ pub struct MotionDeviceType_AdditionalComponents {
     /// `<AdditionalComponentIdentifier>` (MandatoryPlaceholder).
     pub additional_component_identifier: t::Placeholders<t::ObjectNode>,
 }
+t::debug_handle!(MotionDeviceType_AdditionalComponents);
 impl t::Handle for MotionDeviceType_AdditionalComponents {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -901,7 +928,7 @@ impl t::Handle for MotionDeviceType_AdditionalComponents {
     }
 }
 /// `Axes`, a member of `MotionDeviceType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct MotionDeviceType_Axes {
     /// The instance.
@@ -909,6 +936,7 @@ pub struct MotionDeviceType_Axes {
     /// `<AxisIdentifier>` (MandatoryPlaceholder).
     pub axis_identifier: t::Placeholders<AxisType>,
 }
+t::debug_handle!(MotionDeviceType_Axes);
 impl t::Handle for MotionDeviceType_Axes {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -918,7 +946,7 @@ impl t::Handle for MotionDeviceType_Axes {
     }
 }
 /// `FlangeLoad`, a member of `MotionDeviceType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct MotionDeviceType_FlangeLoad {
     /// The instance.
@@ -930,6 +958,7 @@ pub struct MotionDeviceType_FlangeLoad {
     /// `Mass` (Mandatory). The weight of the load mounted on one mounting point.
     pub mass: t::Variable<f64>,
 }
+t::debug_handle!(MotionDeviceType_FlangeLoad);
 impl t::Handle for MotionDeviceType_FlangeLoad {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -941,7 +970,7 @@ impl t::Handle for MotionDeviceType_FlangeLoad {
     }
 }
 /// `PowerTrains`, a member of `MotionDeviceType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct MotionDeviceType_PowerTrains {
     /// The instance.
@@ -949,6 +978,7 @@ pub struct MotionDeviceType_PowerTrains {
     /// `<PowerTrainIdentifier>` (MandatoryPlaceholder).
     pub power_train_identifier: t::Placeholders<PowerTrainType>,
 }
+t::debug_handle!(MotionDeviceType_PowerTrains);
 impl t::Handle for MotionDeviceType_PowerTrains {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -964,7 +994,7 @@ t::object_type!(
 /// Handle of an instance of `MotorType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1019).
 ///
 /// The MotorType is for representing instances of electric motors.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct MotorType {
     /// The instance.
@@ -986,6 +1016,7 @@ pub struct MotorType {
     /// `<DriveIdentifier>` (OptionalPlaceholder).
     pub drive_identifier: t::Placeholders<t::ObjectNode>,
 }
+t::debug_handle!(MotorType);
 impl t::Handle for MotorType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1003,7 +1034,7 @@ impl t::Handle for MotorType {
 }
 t::deref_base!(MotorType => super::super::di::objects::ComponentType);
 /// `ParameterSet`, a member of `MotorType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct MotorType_ParameterSet {
     /// The instance.
@@ -1015,6 +1046,7 @@ pub struct MotorType_ParameterSet {
     /// `MotorTemperature` (Mandatory). The motor temperature provides the temperature of the motor. If there is no temperature sensor the value is set to \"null\".
     pub motor_temperature: t::Variable<f64>,
 }
+t::debug_handle!(MotorType_ParameterSet);
 impl t::Handle for MotorType_ParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1027,7 +1059,7 @@ impl t::Handle for MotorType_ParameterSet {
 }
 t::object_type!(MotorType, rt::NsNodeId::numeric(NS[0], 1019), "MotorType");
 /// Handle of an instance of `MultiAcknowledgeableConditionType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1015).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct MultiAcknowledgeableConditionType {
     /// The instance.
@@ -1091,6 +1123,7 @@ pub struct MultiAcknowledgeableConditionType {
     /// `ConditionDescriptions` (Mandatory).
     pub condition_descriptions: t::Variable<Vec<ua::LocalizedText>>,
 }
+t::debug_handle!(MultiAcknowledgeableConditionType);
 impl t::Handle for MultiAcknowledgeableConditionType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1132,7 +1165,7 @@ t::object_type!(
     "MultiAcknowledgeableConditionType"
 );
 /// Handle of an instance of `OperationStateMachineType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1006).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct OperationStateMachineType {
     /// The instance.
@@ -1156,6 +1189,7 @@ pub struct OperationStateMachineType {
     /// `Stop` (Optional).
     pub stop: Option<t::Method<(i64,), (i32,)>>,
 }
+t::debug_handle!(OperationStateMachineType);
 impl t::Handle for OperationStateMachineType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1268,7 +1302,7 @@ impl t::StateMachine for OperationStateMachineType {
 /// Handle of an instance of `PowerTrainType` (nsu=http://opcfoundation.org/UA/Robotics/;i=16794).
 ///
 /// The PowerTrainType represents instances of powertrains of a motion device.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct PowerTrainType {
     /// The instance.
@@ -1286,6 +1320,7 @@ pub struct PowerTrainType {
     /// `<PowerTrainIdentifier>` (OptionalPlaceholder). HasSlave is a reference to provide the master-slave relationship of powertrains which provide torque for a common axis. The InverseName is IsSlaveOf.
     pub power_train_identifier: t::Placeholders<PowerTrainType>,
 }
+t::debug_handle!(PowerTrainType);
 impl t::Handle for PowerTrainType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1305,7 +1340,7 @@ t::object_type!(PowerTrainType, rt::NsNodeId::numeric(NS[0], 16794), "PowerTrain
 /// Handle of an instance of `ProtectiveStopFunctionType` (nsu=http://opcfoundation.org/UA/Robotics/;i=17233).
 ///
 /// According to ISO 10218-1:2011 Ch.5.5.3 the robot shall have one or more protective stop functions designed for the connection of external protective devices.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ProtectiveStopFunctionType {
     /// The instance.
@@ -1317,6 +1352,7 @@ pub struct ProtectiveStopFunctionType {
     /// `Name` (Mandatory). The Name of the ProtectiveStopFunctionType provides a manufacturer-specific protective stop function identifier within the safety system.
     pub name: t::Variable<String>,
 }
+t::debug_handle!(ProtectiveStopFunctionType);
 impl t::Handle for ProtectiveStopFunctionType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1332,7 +1368,7 @@ t::object_type!(
     "ProtectiveStopFunctionType"
 );
 /// Handle of an instance of `ReadySubstateMachineType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1012).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct ReadySubstateMachineType {
     /// The instance.
@@ -1350,6 +1386,7 @@ pub struct ReadySubstateMachineType {
     /// `ResetToProgramStart` (Optional).
     pub reset_to_program_start: Option<t::Method<(), (i32,)>>,
 }
+t::debug_handle!(ReadySubstateMachineType);
 impl t::Handle for ReadySubstateMachineType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1415,7 +1452,7 @@ impl t::StateMachine for ReadySubstateMachineType {
 /// Handle of an instance of `SafetyStateType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1013).
 ///
 /// SafetyStateType describes the safety states of the motion devices and controllers. One motion device system is associated with one or more instances of the SafetyStateType.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct SafetyStateType {
     /// The instance.
@@ -1431,6 +1468,7 @@ pub struct SafetyStateType {
     /// `ProtectiveStopFunctions` (Optional). ProtectiveStopFunctions is a container for one or more instances of the ProtectiveStopFunctionType.
     pub protective_stop_functions: Option<SafetyStateType_ProtectiveStopFunctions>,
 }
+t::debug_handle!(SafetyStateType);
 impl t::Handle for SafetyStateType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1445,7 +1483,7 @@ impl t::Handle for SafetyStateType {
 }
 t::deref_base!(SafetyStateType => super::super::di::objects::ComponentType);
 /// `ParameterSet`, a member of `SafetyStateType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct SafetyStateType_ParameterSet {
     /// The instance.
@@ -1457,6 +1495,7 @@ pub struct SafetyStateType_ParameterSet {
     /// `ProtectiveStop` (Mandatory). The ProtectiveStop variable is TRUE if one or more of the enabled protective stop functions in the system are active, FALSE otherwise. If the ProtectiveStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed protective stop functions are enabled and active.
     pub protective_stop: t::Variable<bool>,
 }
+t::debug_handle!(SafetyStateType_ParameterSet);
 impl t::Handle for SafetyStateType_ParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1468,7 +1507,7 @@ impl t::Handle for SafetyStateType_ParameterSet {
     }
 }
 /// `EmergencyStopFunctions`, a member of `SafetyStateType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct SafetyStateType_EmergencyStopFunctions {
     /// The instance.
@@ -1476,6 +1515,7 @@ pub struct SafetyStateType_EmergencyStopFunctions {
     /// `<EmergencyStopFunctionIdentifier>` (MandatoryPlaceholder).
     pub emergency_stop_function_identifier: t::Placeholders<EmergencyStopFunctionType>,
 }
+t::debug_handle!(SafetyStateType_EmergencyStopFunctions);
 impl t::Handle for SafetyStateType_EmergencyStopFunctions {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1486,7 +1526,7 @@ impl t::Handle for SafetyStateType_EmergencyStopFunctions {
     }
 }
 /// `ProtectiveStopFunctions`, a member of `SafetyStateType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct SafetyStateType_ProtectiveStopFunctions {
     /// The instance.
@@ -1494,6 +1534,7 @@ pub struct SafetyStateType_ProtectiveStopFunctions {
     /// `<ProtectiveStopFunctionIdentifier>` (MandatoryPlaceholder).
     pub protective_stop_function_identifier: t::Placeholders<ProtectiveStopFunctionType>,
 }
+t::debug_handle!(SafetyStateType_ProtectiveStopFunctions);
 impl t::Handle for SafetyStateType_ProtectiveStopFunctions {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1505,7 +1546,7 @@ impl t::Handle for SafetyStateType_ProtectiveStopFunctions {
 }
 t::object_type!(SafetyStateType, rt::NsNodeId::numeric(NS[0], 1013), "SafetyStateType");
 /// Handle of an instance of `SystemOperationStateMachineType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1021).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct SystemOperationStateMachineType {
     /// The instance.
@@ -1537,6 +1578,7 @@ pub struct SystemOperationStateMachineType {
     /// `StandDown` (Optional).
     pub stand_down: Option<t::Method<(), (i32,)>>,
 }
+t::debug_handle!(SystemOperationStateMachineType);
 impl t::Handle for SystemOperationStateMachineType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1559,7 +1601,7 @@ impl t::Handle for SystemOperationStateMachineType {
 }
 t::deref_base!(SystemOperationStateMachineType => OperationStateMachineType);
 /// `ExecutingSubstateMachine`, a member of `SystemOperationStateMachineType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct SystemOperationStateMachineType_ExecutingSubstateMachine {
     /// The instance.
@@ -1575,6 +1617,7 @@ pub struct SystemOperationStateMachineType_ExecutingSubstateMachine {
     /// `LastTransitionReason` (Mandatory).
     pub last_transition_reason: t::Variable<i16>,
 }
+t::debug_handle!(SystemOperationStateMachineType_ExecutingSubstateMachine);
 impl t::Handle for SystemOperationStateMachineType_ExecutingSubstateMachine {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1588,7 +1631,7 @@ impl t::Handle for SystemOperationStateMachineType_ExecutingSubstateMachine {
     }
 }
 /// `IdleSubstateMachine`, a member of `SystemOperationStateMachineType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct SystemOperationStateMachineType_IdleSubstateMachine {
     /// The instance.
@@ -1604,6 +1647,7 @@ pub struct SystemOperationStateMachineType_IdleSubstateMachine {
     /// `LastTransitionReason` (Mandatory).
     pub last_transition_reason: t::Variable<i16>,
 }
+t::debug_handle!(SystemOperationStateMachineType_IdleSubstateMachine);
 impl t::Handle for SystemOperationStateMachineType_IdleSubstateMachine {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1709,7 +1753,7 @@ impl t::StateMachine for SystemOperationStateMachineType {
     }
 }
 /// Handle of an instance of `SystemOperationType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1028).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct SystemOperationType {
     /// The instance.
@@ -1719,6 +1763,7 @@ pub struct SystemOperationType {
     /// `SystemOperationStateMachine` (Mandatory).
     pub system_operation_state_machine: SystemOperationType_SystemOperationStateMachine,
 }
+t::debug_handle!(SystemOperationType);
 impl t::Handle for SystemOperationType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1730,7 +1775,7 @@ impl t::Handle for SystemOperationType {
     }
 }
 /// `Conditions`, a member of `SystemOperationType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct SystemOperationType_Conditions {
     /// The instance.
@@ -1738,6 +1783,7 @@ pub struct SystemOperationType_Conditions {
     /// `<AcknowledgeableCondition>` (MandatoryPlaceholder).
     pub acknowledgeable_condition: t::Placeholders<t::ObjectNode>,
 }
+t::debug_handle!(SystemOperationType_Conditions);
 impl t::Handle for SystemOperationType_Conditions {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1748,7 +1794,7 @@ impl t::Handle for SystemOperationType_Conditions {
     }
 }
 /// `SystemOperationStateMachine`, a member of `SystemOperationType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct SystemOperationType_SystemOperationStateMachine {
     /// The instance.
@@ -1784,6 +1830,7 @@ pub struct SystemOperationType_SystemOperationStateMachine {
     /// `StandDown` (Optional).
     pub stand_down: Option<t::Method<(), (i32,)>>,
 }
+t::debug_handle!(SystemOperationType_SystemOperationStateMachine);
 impl t::Handle for SystemOperationType_SystemOperationStateMachine {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1807,7 +1854,7 @@ impl t::Handle for SystemOperationType_SystemOperationStateMachine {
     }
 }
 /// `ExecutingSubstateMachine`, a member of `SystemOperationType_SystemOperationStateMachine` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct SystemOperationType_SystemOperationStateMachine_ExecutingSubstateMachine {
     /// The instance.
@@ -1823,6 +1870,9 @@ pub struct SystemOperationType_SystemOperationStateMachine_ExecutingSubstateMach
     /// `LastTransitionReason` (Mandatory).
     pub last_transition_reason: t::Variable<i16>,
 }
+t::debug_handle!(
+    SystemOperationType_SystemOperationStateMachine_ExecutingSubstateMachine
+);
 impl t::Handle
 for SystemOperationType_SystemOperationStateMachine_ExecutingSubstateMachine {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
@@ -1837,7 +1887,7 @@ for SystemOperationType_SystemOperationStateMachine_ExecutingSubstateMachine {
     }
 }
 /// `IdleSubstateMachine`, a member of `SystemOperationType_SystemOperationStateMachine` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct SystemOperationType_SystemOperationStateMachine_IdleSubstateMachine {
     /// The instance.
@@ -1853,6 +1903,7 @@ pub struct SystemOperationType_SystemOperationStateMachine_IdleSubstateMachine {
     /// `LastTransitionReason` (Mandatory).
     pub last_transition_reason: t::Variable<i16>,
 }
+t::debug_handle!(SystemOperationType_SystemOperationStateMachine_IdleSubstateMachine);
 impl t::Handle for SystemOperationType_SystemOperationStateMachine_IdleSubstateMachine {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1869,7 +1920,7 @@ t::object_type!(
     SystemOperationType, rt::NsNodeId::numeric(NS[0], 1028), "SystemOperationType"
 );
 /// Handle of an instance of `TaskControlOperationType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1008).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct TaskControlOperationType {
     /// The instance.
@@ -1879,6 +1930,7 @@ pub struct TaskControlOperationType {
     /// `TaskControlStateMachine` (Mandatory).
     pub task_control_state_machine: TaskControlOperationType_TaskControlStateMachine,
 }
+t::debug_handle!(TaskControlOperationType);
 impl t::Handle for TaskControlOperationType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1890,7 +1942,7 @@ impl t::Handle for TaskControlOperationType {
     }
 }
 /// `TaskControlStateMachine`, a member of `TaskControlOperationType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct TaskControlOperationType_TaskControlStateMachine {
     /// The instance.
@@ -1928,6 +1980,7 @@ pub struct TaskControlOperationType_TaskControlStateMachine {
     /// `UnloadProgram` (Optional).
     pub unload_program: Option<t::Method<(), (i32,)>>,
 }
+t::debug_handle!(TaskControlOperationType_TaskControlStateMachine);
 impl t::Handle for TaskControlOperationType_TaskControlStateMachine {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -1952,7 +2005,7 @@ impl t::Handle for TaskControlOperationType_TaskControlStateMachine {
     }
 }
 /// `ReadySubstateMachine`, a member of `TaskControlOperationType_TaskControlStateMachine` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct TaskControlOperationType_TaskControlStateMachine_ReadySubstateMachine {
     /// The instance.
@@ -1970,6 +2023,7 @@ pub struct TaskControlOperationType_TaskControlStateMachine_ReadySubstateMachine
     /// `ResetToProgramStart` (Optional).
     pub reset_to_program_start: Option<t::Method<(), (i32,)>>,
 }
+t::debug_handle!(TaskControlOperationType_TaskControlStateMachine_ReadySubstateMachine);
 impl t::Handle
 for TaskControlOperationType_TaskControlStateMachine_ReadySubstateMachine {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
@@ -1989,7 +2043,7 @@ t::object_type!(
     "TaskControlOperationType"
 );
 /// Handle of an instance of `TaskControlStateMachineType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1025).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct TaskControlStateMachineType {
     /// The instance.
@@ -2021,6 +2075,7 @@ pub struct TaskControlStateMachineType {
     /// `UnloadProgram` (Optional).
     pub unload_program: Option<t::Method<(), (i32,)>>,
 }
+t::debug_handle!(TaskControlStateMachineType);
 impl t::Handle for TaskControlStateMachineType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2044,7 +2099,7 @@ impl t::Handle for TaskControlStateMachineType {
 }
 t::deref_base!(TaskControlStateMachineType => OperationStateMachineType);
 /// `ReadySubstateMachine`, a member of `TaskControlStateMachineType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct TaskControlStateMachineType_ReadySubstateMachine {
     /// The instance.
@@ -2062,6 +2117,7 @@ pub struct TaskControlStateMachineType_ReadySubstateMachine {
     /// `ResetToProgramStart` (Optional).
     pub reset_to_program_start: Option<t::Method<(), (i32,)>>,
 }
+t::debug_handle!(TaskControlStateMachineType_ReadySubstateMachine);
 impl t::Handle for TaskControlStateMachineType_ReadySubstateMachine {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2174,7 +2230,7 @@ impl t::StateMachine for TaskControlStateMachineType {
 /// Handle of an instance of `TaskControlType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1011).
 ///
 /// Represents a specific task control active on the controller.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct TaskControlType {
     /// The instance.
@@ -2192,6 +2248,7 @@ pub struct TaskControlType {
     /// `TaskModules` (Optional).
     pub task_modules: Option<TaskControlType_TaskModules>,
 }
+t::debug_handle!(TaskControlType);
 impl t::Handle for TaskControlType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2208,7 +2265,7 @@ impl t::Handle for TaskControlType {
 }
 t::deref_base!(TaskControlType => super::super::di::objects::ComponentType);
 /// `ParameterSet`, a member of `TaskControlType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct TaskControlType_ParameterSet {
     /// The instance.
@@ -2220,6 +2277,7 @@ pub struct TaskControlType_ParameterSet {
     /// `TaskProgramName` (Mandatory). A customer given identifier for the task program.
     pub task_program_name: t::Variable<String>,
 }
+t::debug_handle!(TaskControlType_ParameterSet);
 impl t::Handle for TaskControlType_ParameterSet {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2231,7 +2289,7 @@ impl t::Handle for TaskControlType_ParameterSet {
     }
 }
 /// `TaskControlOperation`, a member of `TaskControlType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct TaskControlType_TaskControlOperation {
     /// The instance.
@@ -2241,6 +2299,7 @@ pub struct TaskControlType_TaskControlOperation {
     /// `TaskControlStateMachine` (Mandatory).
     pub task_control_state_machine: TaskControlType_TaskControlOperation_TaskControlStateMachine,
 }
+t::debug_handle!(TaskControlType_TaskControlOperation);
 impl t::Handle for TaskControlType_TaskControlOperation {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2252,7 +2311,7 @@ impl t::Handle for TaskControlType_TaskControlOperation {
     }
 }
 /// `TaskControlStateMachine`, a member of `TaskControlType_TaskControlOperation` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct TaskControlType_TaskControlOperation_TaskControlStateMachine {
     /// The instance.
@@ -2288,6 +2347,7 @@ pub struct TaskControlType_TaskControlOperation_TaskControlStateMachine {
     /// `UnloadProgram` (Optional).
     pub unload_program: Option<t::Method<(), (i32,)>>,
 }
+t::debug_handle!(TaskControlType_TaskControlOperation_TaskControlStateMachine);
 impl t::Handle for TaskControlType_TaskControlOperation_TaskControlStateMachine {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2312,7 +2372,7 @@ impl t::Handle for TaskControlType_TaskControlOperation_TaskControlStateMachine 
     }
 }
 /// `TaskModules`, a member of `TaskControlType` with children of its own.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
 pub struct TaskControlType_TaskModules {
     /// The instance.
@@ -2320,6 +2380,7 @@ pub struct TaskControlType_TaskModules {
     /// `<TaskModule>` (OptionalPlaceholder).
     pub task_module: t::Placeholders<TaskModuleType>,
 }
+t::debug_handle!(TaskControlType_TaskModules);
 impl t::Handle for TaskControlType_TaskModules {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2330,7 +2391,7 @@ impl t::Handle for TaskControlType_TaskModules {
 }
 t::object_type!(TaskControlType, rt::NsNodeId::numeric(NS[0], 1011), "TaskControlType");
 /// Handle of an instance of `TaskModuleType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1016).
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct TaskModuleType {
     /// The instance.
@@ -2342,6 +2403,7 @@ pub struct TaskModuleType {
     /// `Version` (Optional).
     pub version: Option<t::Variable<String>>,
 }
+t::debug_handle!(TaskModuleType);
 impl t::Handle for TaskModuleType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {
@@ -2356,7 +2418,7 @@ t::object_type!(TaskModuleType, rt::NsNodeId::numeric(NS[0], 1016), "TaskModuleT
 /// Handle of an instance of `UserType` (nsu=http://opcfoundation.org/UA/Robotics/;i=18175).
 ///
 /// The UserType ObjectType describes information of the registered user groups within the control system.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 #[allow(non_snake_case)]
 pub struct UserType {
     /// The instance.
@@ -2366,6 +2428,7 @@ pub struct UserType {
     /// `Name` (Optional). The name for the current user within the control system.
     pub name: Option<t::Variable<String>>,
 }
+t::debug_handle!(UserType);
 impl t::Handle for UserType {
     fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
         Ok(Self {

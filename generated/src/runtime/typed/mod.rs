@@ -191,6 +191,27 @@ macro_rules! __nodeset_object_members {
 }
 pub use crate::__nodeset_object_members as object_members;
 
+/// `Debug` of a generated handle: its name and node, not the whole tree of members (which a derive would
+/// print, and compile a `Debug` of every member type for).
+#[doc(hidden)]
+#[macro_export]
+macro_rules! __nodeset_debug_handle {
+    ($t:ident) => {
+        impl ::std::fmt::Debug for $t {
+            fn fmt(&self, f: &mut ::std::fmt::Formatter<'_>) -> ::std::fmt::Result {
+                $crate::runtime::typed::fmt_handle(f, stringify!($t), &self.node)
+            }
+        }
+    };
+}
+pub use crate::__nodeset_debug_handle as debug_handle;
+
+/// What [`debug_handle!`] prints: `Name { node: .., .. }`.
+#[doc(hidden)]
+pub fn fmt_handle(f: &mut std::fmt::Formatter<'_>, name: &str, node: &dyn std::fmt::Debug) -> std::fmt::Result {
+    f.debug_struct(name).field("node", node).finish_non_exhaustive()
+}
+
 /// `Deref` from a generated handle to the handle of its supertype.
 #[doc(hidden)]
 #[macro_export]

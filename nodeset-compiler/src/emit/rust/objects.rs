@@ -325,7 +325,7 @@ impl Gen<'_> {
                 },
                 _ => continue,
             };
-            // Placeholders are kept in a map, on the heap already.
+            // Placeholders are kept in a list, on the heap already.
             let single = if boxed { quote! { Box<#handle> } } else { handle.clone() };
             let (ty, bind) = match rule {
                 ModellingRule::Mandatory => (single, quote! { b.child(id, NS[#k], #bname)? }),
@@ -387,9 +387,10 @@ impl Gen<'_> {
         }
         quote! {
             #docs
-            #[derive(Clone, Debug)]
+            #[derive(Clone)]
             #allow
             pub struct #sname { #(#decls),* }
+            t::debug_handle!(#sname);
             impl t::Handle for #sname {
                 fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
                     Ok(Self { #(#binds),* })
