@@ -514,9 +514,9 @@ fn print_table(reports: &[Report], split: bool, yard: Option<&Result<rust::Yards
 ///    run, `cargo clean -p nodeset-models` and a timed build (cold, our crate alone), then
 ///    `generated/src/models/robotics/types.rs` is touched and the build timed again (incremental). A no-op
 ///    build shows cargo's own share of these wall times. Debug builds run `--runs-build` times, release
-///    builds once. The crate also holds the hand-written runtime, so the runtime alone is built the same way
-///    as the crate `nodeset-runtime-only` (`generated/Cargo.toml`'s dependencies, a `lib.rs` that includes
-///    `generated/src/runtime/`), to show what the generated models add.
+///    builds once. The hand-written runtime is the crate `nodeset-runtime` (`generated/runtime/`), a
+///    dependency built once like async-opcua; its cold build is timed the same way, so that what a user
+///    compiles in all from a clean target is also shown.
 /// 4. Import: `generated/examples/import_bench.rs` (release), which says what it includes.
 /// 5. Peer: async-opcua-codegen 0.19.0, installed once into `target/bench-tools`, with a config written to
 ///    `target/bench-build/peer/codegen.yml` (a `types` and a `nodes` target per namespace; the nodes target
@@ -564,7 +564,7 @@ mod rust {
     const PEER: &str = "async-opcua-codegen";
     pub(super) const PEER_VERSION: &str = "0.19.0";
     const PEER_CRATE: &str = "codegen-peer-models";
-    const RUNTIME_CRATE: &str = "nodeset-runtime-only";
+    const RUNTIME_CRATE: &str = "nodeset-runtime";
     /// Release builds run once: they are slow, and the release profile compiles without incremental.
     const RELEASE_RUNS: usize = 1;
     /// Our crate, and the file touched before an incremental build (the peer's counterpart is its Robotics
@@ -757,7 +757,7 @@ mod rust {
         let (mut debug, mut release, mut runtime_only) = (skipped(), skipped(), skipped());
         let mut import = Err("skipped (--no-builds)".to_string());
         let mut yard_import = None;
-        let runtime_size = count_rs(&root.join("generated/src/runtime"));
+        let runtime_size = count_rs(&root.join("generated/runtime/src"));
         if !args.no_builds {
             let touched = root.join(TOUCHED);
             eprintln!(
@@ -773,19 +773,16 @@ mod rust {
                 Some(&touched),
                 args.runs_build,
             );
-            eprintln!("rust: building the runtime alone (debug) ...");
-            let dir = bench_target.join("runtime-only");
-            runtime_only = write_runtime_crate(root, &dir).and_then(|()| {
-                time_builds(
-                    &bench,
-                    &dir,
-                    &bench_target,
-                    RUNTIME_CRATE,
-                    false,
-                    None,
-                    args.runs_build,
-                )
-            });
+            eprintln!("rust: building {RUNTIME_CRATE} (debug) ...");
+            runtime_only = time_builds(
+                &bench,
+                root,
+                &bench_target,
+                RUNTIME_CRATE,
+                false,
+                None,
+                args.runs_build,
+            );
             eprintln!("rust: building the import_bench example (release) ...");
             import = cargo(
                 root,
@@ -850,6 +847,7 @@ mod rust {
         print(
             &results,
             args,
+            root,
             start.elapsed().as_secs_f64(),
             (load_start, load_average()),
         );
@@ -1098,64 +1096,6 @@ mod rust {
     /// that they share its dependencies' builds and are compiled the same way.
     const PROFILES: &str =
         "[profile.dev.package.\"*\"]\nopt-level = 2\n\n[profile.release]\ndebug = 1\n";
-
-    /// Writes the crate `nodeset-runtime-only`: `generated/Cargo.toml` without the workspace keys and the
-    /// dev-dependencies, and a `lib.rs` that includes `generated/src/runtime/` by path.
-    fn write_runtime_crate(root: &Path, dir: &Path) -> Step<()> {
-        let manifest_path = root.join("generated/Cargo.toml");
-        let manifest = fs::read_to_string(&manifest_path)
-            .map_err(|e| format!("cannot read {}: {e}", manifest_path.display()))?;
-        let mut out = String::from(
-            "# Written by `cargo xtask bench --scenario rust`: generated/Cargo.toml for the runtime alone.\n",
-        );
-        let mut section = String::new();
-        for line in manifest.lines() {
-            let t = line.trim();
-            if t.starts_with('[') {
-                section = t.to_string();
-            }
-            if section == "[dev-dependencies]" || t.contains(".workspace") {
-                continue;
-            }
-            if section == "[package]" && t.starts_with("name") {
-                out.push_str(&format!(
-                    "name = \"{RUNTIME_CRATE}\"\nedition = \"2021\"\npublish = false\n"
-                ));
-                continue;
-            }
-            // Path dependencies (nodeset-derive) are relative to generated/; the crate lives elsewhere.
-            match line.split_once("path = \"") {
-                Some((head, rest)) if !rest.starts_with('/') => {
-                    let abs = root
-                        .join("generated")
-                        .join(rest.split('"').next().unwrap_or(""));
-                    let tail = rest.split_once('"').map_or("", |(_, t)| t);
-                    out.push_str(&format!(
-                        "{head}path = {:?}{tail}",
-                        abs.display().to_string()
-                    ));
-                }
-                _ => out.push_str(line),
-            }
-            out.push('\n');
-        }
-        out.push_str("\n[workspace]\n\n");
-        out.push_str(PROFILES);
-        let lib = format!(
-            "//! generated/src/runtime/ without the generated models. Written by `cargo xtask bench`.\n\
-             #![allow(warnings)]\n\n#[path = {:?}]\npub mod runtime;\n",
-            root.join("generated/src/runtime/mod.rs").display().to_string()
-        );
-        let write = |path: PathBuf, text: String| {
-            fs::create_dir_all(path.parent().unwrap_or(dir))
-                .and_then(|()| fs::write(&path, text))
-                .map_err(|e| format!("cannot write {}: {e}", path.display()))
-        };
-        write(dir.join("Cargo.toml"), out)?;
-        write(dir.join("src/lib.rs"), lib)?;
-        let _ = fs::copy(root.join("Cargo.lock"), dir.join("Cargo.lock"));
-        Ok(())
-    }
 
     /// A YAML string (a JSON string is one).
     fn yaml(s: &str) -> String {
@@ -1486,7 +1426,7 @@ mod rust {
             .unwrap_or(f64::NAN)
     }
 
-    fn print(r: &Results, args: &Args, total_s: f64, load: (f64, f64)) {
+    fn print(r: &Results, args: &Args, root: &Path, total_s: f64, load: (f64, f64)) {
         let g = &r.gen;
         println!();
         println!(
@@ -1618,18 +1558,19 @@ mod rust {
             );
         }
         print_builds("release", &r.release, None);
-        print_builds("runtime alone", &r.runtime_only, None);
+        print_builds(RUNTIME_CRATE, &r.runtime_only, None);
         if let (Ok(all), Ok(rt), Ok(rt_size), Ok(disk)) =
             (&r.debug, &r.runtime_only, &r.runtime_size, &r.disk)
         {
             let models = sum(disk, &["di", "ia", "robotics"]);
             println!(
-                "   {:<16} {:>6.2} s, CPU {:.2} s (debug cold, median: {CRATE} - runtime alone); the crate is {} \
-                 generated lines + {} hand-written runtime lines",
-                "models share",
-                all.cold.median - rt.cold.median,
-                all.cold.cpu - rt.cold.cpu,
+                "   {:<16} {:>6.2} s, CPU {:.2} s (debug cold, medians): {CRATE} ({} generated lines of DI + IA + \
+                 Robotics, {} in all) and the {RUNTIME_CRATE} it depends on ({} hand-written lines), both from clean",
+                "both",
+                all.cold.median + rt.cold.median,
+                all.cold.cpu + rt.cold.cpu,
                 models.lines,
+                count_rs(&root.join("generated/src")).map_or(0, |s| s.lines),
                 rt_size.lines
             );
         }
@@ -1800,11 +1741,11 @@ mod rust {
         }
         if let (Ok(a), Ok(rt), Ok(b)) = (&r.debug, &r.runtime_only, &p.debug) {
             println!(
-                "     debug   models share (ours minus the runtime alone) vs their crate, cold: {} (CPU {})   \
+                "     debug   {CRATE} and {RUNTIME_CRATE} together vs their crate, cold: {} (CPU {})   \
                  ({:.2} s vs {:.2} s)",
-                ratio(a.cold.median - rt.cold.median, b.cold.median),
-                ratio(a.cold.cpu - rt.cold.cpu, b.cold.cpu),
-                a.cold.median - rt.cold.median,
+                ratio(a.cold.median + rt.cold.median, b.cold.median),
+                ratio(a.cold.cpu + rt.cold.cpu, b.cold.cpu),
+                a.cold.median + rt.cold.median,
                 b.cold.median
             );
         }

@@ -4,13 +4,13 @@
 //! their type loaders, on one SecurityPolicy None endpoint that accepts anonymous users:
 //!
 //! ```no_run
-//! # async fn demo(table: &'static nodeset_models::runtime::table::NodeSetTable) -> Result<(), String> {
-//! use nodeset_models::runtime::server::ServerConfig;
+//! # async fn demo(table: &'static nodeset_runtime::table::NodeSetTable) -> Result<(), String> {
+//! use nodeset_runtime::server::ServerConfig;
 //! use opcua::types::{StatusCode, Variant};
 //!
 //! let server = ServerConfig::new("My robot").port(4855).table(table).build()?;
 //! let manager = server.manager().clone();
-//! let speed = manager.resolve(nodeset_models::runtime::NsNodeId::numeric(table.namespace_uri, 6001)).unwrap();
+//! let speed = manager.resolve(nodeset_runtime::NsNodeId::numeric(table.namespace_uri, 6001)).unwrap();
 //! manager.on_write(&speed, |v| match v {
 //!     Variant::Double(d) if *d > 100.0 => Err(StatusCode::BadOutOfRange),
 //!     _ => Ok(None),

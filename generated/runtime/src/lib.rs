@@ -3,6 +3,8 @@
 //! import of a table into an async-opcua address space ([`import`]), a server that serves tables
 //! ([`server`]), and the client side of composite skills ([`remote`]).
 
+#![cfg_attr(test, deny(warnings))]
+
 pub mod demo;
 pub mod import;
 pub mod remote;

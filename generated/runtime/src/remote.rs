@@ -60,7 +60,7 @@ use opcua::types::{
 use tokio::sync::{mpsc, Mutex};
 use tokio::task::JoinHandle;
 
-use crate::runtime::typed::{Control, Parameters, ProgramState};
+use crate::typed::{Control, Parameters, ProgramState};
 
 /// How long a request to another server may take before its server counts as unreachable.
 const REQUEST_TIMEOUT: Duration = Duration::from_secs(3);

@@ -13,8 +13,8 @@ use opcua::types::{
 };
 
 use super::value::{rank_fits, UaValue};
-use crate::runtime::server::{MethodError, MethodInvocation, ModelManager};
-use crate::runtime::NsNodeId;
+use crate::server::{MethodError, MethodInvocation, ModelManager};
+use crate::NsNodeId;
 
 /// Why a handle could not be bound to a node.
 #[derive(Clone, Debug, PartialEq)]

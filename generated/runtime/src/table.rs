@@ -119,7 +119,7 @@ pub enum Val {
     EnumValues(&'static [EnumRow]),
     /// Any other ExtensionObject value (scalar, or an array when it returns several), built at import time
     /// because it contains NodeIds whose namespace indices are only known then.
-    Struct(fn(&crate::runtime::NamespaceMap) -> opcua::types::Variant),
+    Struct(fn(&crate::NamespaceMap) -> opcua::types::Variant),
 }
 
 /// What kind of node a row is, with the attributes of that node class.

@@ -23,8 +23,8 @@ pub use value::{UaStruct, UaValue};
 
 use opcua::types::{NodeId, QualifiedName};
 
-use crate::runtime::server::ModelManager;
-use crate::runtime::NsNodeId;
+use crate::server::ModelManager;
+use crate::NsNodeId;
 
 /// A generated handle of an ObjectType: its instances can be created ([`ObjectType::instantiate`]) and bound
 /// ([`ModelManager::bind`]).
@@ -110,7 +110,7 @@ impl Holds<String> for opcua::types::UAString {}
 #[macro_export]
 macro_rules! __nodeset_ua_enum {
     ($($t:ty),* $(,)?) => {$(
-        impl $crate::runtime::typed::UaValue for $t {
+        impl $crate::typed::UaValue for $t {
             type Scalar = $t;
             const VALUE_RANK: i32 = -1;
             const VARIANT_TYPE: opcua::types::VariantScalarTypeId = opcua::types::VariantScalarTypeId::Int32;
@@ -118,7 +118,7 @@ macro_rules! __nodeset_ua_enum {
                 opcua::types::Variant::Int32(*self as i32)
             }
             fn from_variant(value: &opcua::types::Variant) -> Option<Self> {
-                let i = $crate::runtime::typed::value::enum_value(value)?;
+                let i = $crate::typed::value::enum_value(value)?;
                 <$t>::try_from(i32::try_from(i).ok()?).ok()
             }
         }
@@ -131,7 +131,7 @@ pub use crate::__nodeset_ua_enum as ua_enum;
 #[macro_export]
 macro_rules! __nodeset_ua_option_set {
     ($t:ty, $bits:ty, $variant:ident) => {
-        impl $crate::runtime::typed::UaValue for $t {
+        impl $crate::typed::UaValue for $t {
             type Scalar = $t;
             const VALUE_RANK: i32 = -1;
             const VARIANT_TYPE: opcua::types::VariantScalarTypeId = opcua::types::VariantScalarTypeId::$variant;
@@ -139,7 +139,7 @@ macro_rules! __nodeset_ua_option_set {
                 opcua::types::Variant::$variant(self.bits())
             }
             fn from_variant(value: &opcua::types::Variant) -> Option<Self> {
-                let bits = $crate::runtime::typed::value::option_set_bits(value)?;
+                let bits = $crate::typed::value::option_set_bits(value)?;
                 Some(<$t>::from_bits_retain(<$bits>::try_from(bits).ok()?))
             }
         }
@@ -151,7 +151,7 @@ pub use crate::__nodeset_ua_option_set as ua_option_set;
 #[doc(hidden)]
 #[macro_export]
 macro_rules! __nodeset_ua_struct {
-    ($($t:ty),* $(,)?) => {$( impl $crate::runtime::typed::UaStruct for $t {} )*};
+    ($($t:ty),* $(,)?) => {$( impl $crate::typed::UaStruct for $t {} )*};
 }
 pub use crate::__nodeset_ua_struct as ua_struct;
 
@@ -171,13 +171,13 @@ macro_rules! __nodeset_object_members {
             $(
                 #[doc = concat!(" The variable `", $($name, "/",)* "`.")]
                 pub struct $m;
-                impl $crate::runtime::typed::Member for $m {
+                impl $crate::typed::Member for $m {
                     type Owner = super::super::$owner;
                     const PATH: &'static [(&'static str, &'static str)] = &[$((NS[$k], $name)),*];
-                    const KIND: $crate::runtime::typed::MemberKind = $crate::runtime::typed::MemberKind::Variable;
+                    const KIND: $crate::typed::MemberKind = $crate::typed::MemberKind::Variable;
                     const MANDATORY: bool = $mandatory;
                 }
-                impl $crate::runtime::typed::VariableMember for $m {
+                impl $crate::typed::VariableMember for $m {
                     type Scalar = $scalar;
                     const VALUE_RANK: i32 = $rank;
                     const HAS_DEFAULT: bool = $default;
@@ -199,7 +199,7 @@ macro_rules! __nodeset_debug_handle {
     ($t:ident) => {
         impl ::std::fmt::Debug for $t {
             fn fmt(&self, f: &mut ::std::fmt::Formatter<'_>) -> ::std::fmt::Result {
-                $crate::runtime::typed::fmt_handle(f, stringify!($t), &self.node)
+                $crate::typed::fmt_handle(f, stringify!($t), &self.node)
             }
         }
     };
@@ -232,8 +232,8 @@ pub use crate::__nodeset_deref_base as deref_base;
 #[macro_export]
 macro_rules! __nodeset_object_type {
     ($t:ident, $id:expr, $name:literal) => {
-        impl $crate::runtime::typed::ObjectType for $t {
-            const TYPE_ID: $crate::runtime::NsNodeId = $id;
+        impl $crate::typed::ObjectType for $t {
+            const TYPE_ID: $crate::NsNodeId = $id;
             const BROWSE_NAME: &'static str = $name;
         }
     };
@@ -245,8 +245,8 @@ pub use crate::__nodeset_object_type as object_type;
 #[macro_export]
 macro_rules! __nodeset_variable_type {
     ($t:ident, $id:expr, $name:literal) => {
-        impl $crate::runtime::typed::VariableType for $t {
-            const TYPE_ID: $crate::runtime::NsNodeId = $id;
+        impl $crate::typed::VariableType for $t {
+            const TYPE_ID: $crate::NsNodeId = $id;
             const BROWSE_NAME: &'static str = $name;
         }
     };

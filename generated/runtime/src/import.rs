@@ -32,7 +32,7 @@ const HAS_ENCODING: u32 = 38;
 
 /// A generated table as an async-opcua [`NodeSetImport`].
 ///
-/// Pass it to `AddressSpace::import_node_set` (the node manager of [`crate::runtime::server`] does this for
+/// Pass it to `AddressSpace::import_node_set` (the node manager of [`crate::server`] does this for
 /// every table it serves).
 #[derive(Clone, Copy, Debug)]
 pub struct TableImport(pub &'static NodeSetTable);

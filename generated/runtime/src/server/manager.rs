@@ -23,11 +23,11 @@ use opcua::types::{
 use tracing::warn;
 
 use super::check::Types;
-use crate::runtime::import::{build_map, parse_date_time, TableImport, OPC_UA_NAMESPACE, UNMAPPED};
-use crate::runtime::table::NodeSetTable;
-use crate::runtime::typed::instance::{Planner, Spaces};
-use crate::runtime::typed::{BindError, Binder, Handle, Instantiate, InstantiateError};
-use crate::runtime::{NamespaceMap, NsNodeId};
+use crate::import::{build_map, parse_date_time, TableImport, OPC_UA_NAMESPACE, UNMAPPED};
+use crate::table::NodeSetTable;
+use crate::typed::instance::{Planner, Spaces};
+use crate::typed::{BindError, Binder, Handle, Instantiate, InstantiateError};
+use crate::{NamespaceMap, NsNodeId};
 
 /// ns0 HasProperty.
 const HAS_PROPERTY: u32 = 46;
@@ -608,7 +608,7 @@ impl ModelManager {
     }
 
     /// Creates an instance of an ObjectType or VariableType under `parent` as the type prescribes (see
-    /// [`crate::runtime::typed::instance`]) and returns its NodeId. Nothing is created if anything fails.
+    /// [`crate::typed::instance`]) and returns its NodeId. Nothing is created if anything fails.
     pub fn instantiate(
         &self,
         type_id: &NodeId,

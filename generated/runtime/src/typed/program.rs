@@ -51,8 +51,8 @@ use tracing::warn;
 use super::handle::{BindError, Binder, ObjectNode};
 use super::value::UaValue;
 use super::ObjectType;
-use crate::runtime::server::{MethodError, MethodInvocation, ModelManager};
-use crate::runtime::NsNodeId;
+use crate::server::{MethodError, MethodInvocation, ModelManager};
+use crate::NsNodeId;
 
 /// The ns0 namespace URI, for the BrowseNames of the state machine's variables.
 const UA: &str = "http://opcfoundation.org/UA/";
@@ -527,8 +527,8 @@ fn event_setup(manager: &ModelManager, event_type: NodeId, instance_name: &str) 
 /// than taken from the generated `models::common_skills`, so that the runtime builds without the generated
 /// models (a build script's output uses it on its own); the test
 /// `skill_transition_event_type_matches_the_generated_id` keeps the two equal.
-pub const SKILL_TRANSITION_EVENT_TYPE: crate::runtime::NsNodeId =
-    crate::runtime::NsNodeId::numeric("http://nodeset-compiler.dev/CommonSkills/", 1100);
+pub const SKILL_TRANSITION_EVENT_TYPE: crate::NsNodeId =
+    crate::NsNodeId::numeric("http://nodeset-compiler.dev/CommonSkills/", 1100);
 
 /// The states of a program (Part 10), which the driver treats specially.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -974,7 +974,7 @@ impl Machine {
 #[macro_export]
 macro_rules! __nodeset_program_type {
     ($t:ident, $inputs:ty, $outputs:ty) => {
-        impl $crate::runtime::typed::ProgramType for $t {
+        impl $crate::typed::ProgramType for $t {
             type Inputs = $inputs;
             type Outputs = $outputs;
         }
@@ -985,14 +985,14 @@ macro_rules! __nodeset_program_type {
             pub fn serve<F, Fut>(
                 &self,
                 body: F,
-            ) -> ::std::result::Result<$crate::runtime::typed::Program, $crate::runtime::typed::ProgramError>
+            ) -> ::std::result::Result<$crate::typed::Program, $crate::typed::ProgramError>
             where
-                F: Fn($inputs, $crate::runtime::typed::Control) -> Fut + Send + Sync + 'static,
+                F: Fn($inputs, $crate::typed::Control) -> Fut + Send + Sync + 'static,
                 Fut: ::std::future::Future<Output = ::std::result::Result<$outputs, opcua::types::StatusCode>>
                     + Send
                     + 'static,
             {
-                $crate::runtime::typed::Program::serve(self, body)
+                $crate::typed::Program::serve(self, body)
             }
         }
     };
@@ -1010,7 +1010,7 @@ macro_rules! __nodeset_parameters {
         $crate::__nodeset_parameters!(@impl $t; $sk $set; None; $($f $k $name)*);
     };
     (@impl $t:ident; $sk:literal $set:literal; $outcome:expr; $($f:ident $k:literal $name:literal)*) => {
-        impl $crate::runtime::typed::Parameters for $t {
+        impl $crate::typed::Parameters for $t {
             const SET: Option<(&'static str, &'static str)> = Some((NS[$sk], $set));
             const NAMES: &'static [(&'static str, &'static str)] = &[$((NS[$k], $name)),*];
             const OUTCOME: Option<(&'static str, &'static str)> = $outcome;
@@ -1021,7 +1021,7 @@ macro_rules! __nodeset_parameters {
                 let mut at = 0usize;
                 Ok(Self {
                     $($f: {
-                        let value = $crate::runtime::typed::ParameterValue::from_value(
+                        let value = $crate::typed::ParameterValue::from_value(
                             values.get(at).and_then(|v| v.as_ref()),
                         )
                         .map_err(|status| (at, status))?;
@@ -1031,7 +1031,7 @@ macro_rules! __nodeset_parameters {
                 })
             }
             fn into_values(self) -> Vec<Option<opcua::types::Variant>> {
-                vec![$($crate::runtime::typed::ParameterValue::to_value(&self.$f)),*]
+                vec![$($crate::typed::ParameterValue::to_value(&self.$f)),*]
             }
         }
     };

@@ -11,7 +11,7 @@ pub use opcua::types::Variant;
 use opcua::types::{NodeId, QualifiedName, StatusCode};
 
 use super::{BindError, Binder, Instantiate, InstantiateError, ObjectType};
-use crate::runtime::server::ModelManager;
+use crate::server::ModelManager;
 
 /// One field of a derived struct and the variable it binds.
 #[derive(Clone, Copy, Debug)]
