@@ -565,6 +565,8 @@ mod rust {
     pub(super) const PEER_VERSION: &str = "0.19.0";
     const PEER_CRATE: &str = "codegen-peer-models";
     const RUNTIME_CRATE: &str = "nodeset-runtime";
+    /// The CLI's output for DI + IA + Robotics (the peer's inputs) as a crate of its own on nodeset-runtime.
+    const THREE_CRATE: &str = "nodeset-models-di-ia-robotics";
     /// Release builds run once: they are slow, and the release profile compiles without incremental.
     const RELEASE_RUNS: usize = 1;
     /// Our crate, and the file touched before an incremental build (the peer's counterpart is its Robotics
@@ -670,6 +672,9 @@ mod rust {
         debug: Step<Builds>,
         release: Step<Builds>,
         runtime_only: Step<Builds>,
+        /// The CLI's DI + IA + Robotics output alone, the peer's ground (nodeset-models also holds our three
+        /// skill namespaces).
+        three: Step<Builds>,
         runtime_size: Step<Size>,
         import: Step<Report>,
         peer: Option<Peer>,
@@ -755,6 +760,7 @@ mod rust {
         // 3 and 4. Builds of our crate, and the import.
         let skipped = || Err::<Builds, _>("skipped (--no-builds)".to_string());
         let (mut debug, mut release, mut runtime_only) = (skipped(), skipped(), skipped());
+        let mut three = skipped();
         let mut import = Err("skipped (--no-builds)".to_string());
         let mut yard_import = None;
         let runtime_size = count_rs(&root.join("generated/runtime/src"));
@@ -773,6 +779,24 @@ mod rust {
                 Some(&touched),
                 args.runs_build,
             );
+            eprintln!(
+                "rust: building the CLI's DI + IA + Robotics output as {THREE_CRATE} (debug) ..."
+            );
+            let dir = bench_target.join("ours-cli");
+            three = match &cli {
+                Ok(_) => write_three_crate(root, &dir).and_then(|()| {
+                    time_builds(
+                        &bench,
+                        &dir,
+                        &bench_target,
+                        THREE_CRATE,
+                        false,
+                        Some(&dir.join("models/robotics/types.rs")),
+                        args.runs_build,
+                    )
+                }),
+                Err(_) => Err("the CLI run failed".into()),
+            };
             eprintln!("rust: building {RUNTIME_CRATE} (debug) ...");
             runtime_only = time_builds(
                 &bench,
@@ -838,6 +862,7 @@ mod rust {
             debug,
             release,
             runtime_only,
+            three,
             runtime_size,
             import,
             peer,
@@ -1096,6 +1121,33 @@ mod rust {
     /// that they share its dependencies' builds and are compiled the same way.
     const PROFILES: &str =
         "[profile.dev.package.\"*\"]\nopt-level = 2\n\n[profile.release]\ndebug = 1\n";
+
+    /// Makes `dir` (which holds the CLI's `models/`) the crate [`THREE_CRATE`]: the generated modules on
+    /// nodeset-runtime, re-exported as `crate::runtime` as the CLI was told.
+    fn write_three_crate(root: &Path, dir: &Path) -> Step<()> {
+        let write = |path: PathBuf, text: String| {
+            fs::write(&path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))
+        };
+        write(
+            dir.join("Cargo.toml"),
+            format!(
+                "# Written by `cargo xtask bench --scenario rust`: the CLI's output for DI + IA + Robotics as a crate.\n\
+                 [package]\nname = \"{THREE_CRATE}\"\nversion = \"0.0.0\"\nedition = \"2021\"\npublish = false\n\n\
+                 [lib]\npath = \"lib.rs\"\n\n[workspace]\n\n[features]\njson = [\"async-opcua/json\"]\nxml = [\"async-opcua/xml\"]\n\n\
+                 [dependencies]\nnodeset-runtime = {{ path = {:?} }}\n\
+                 async-opcua = {{ version = \"=0.19.0\", features = [\"server\", \"client\"] }}\nbitflags = \"2\"\n\n{PROFILES}",
+                root.join("generated/runtime").display().to_string()
+            ),
+        )?;
+        write(
+            dir.join("lib.rs"),
+            "//! The CLI's output for DI + IA + Robotics. Written by `cargo xtask bench`.\n#![allow(warnings)]\n\n\
+             pub use nodeset_runtime as runtime;\npub mod models;\n"
+                .into(),
+        )?;
+        let _ = fs::copy(root.join("Cargo.lock"), dir.join("Cargo.lock"));
+        Ok(())
+    }
 
     /// A YAML string (a JSON string is one).
     fn yaml(s: &str) -> String {
@@ -1559,6 +1611,7 @@ mod rust {
         }
         print_builds("release", &r.release, None);
         print_builds(RUNTIME_CRATE, &r.runtime_only, None);
+        print_builds("DI + IA + Robotics", &r.three, None);
         if let (Ok(all), Ok(rt), Ok(rt_size), Ok(disk)) =
             (&r.debug, &r.runtime_only, &r.runtime_size, &r.disk)
         {
@@ -1738,6 +1791,17 @@ mod rust {
                     b.cold.median
                 );
             }
+        }
+        if let (Ok(a), Ok(b)) = (&r.three, &p.debug) {
+            println!(
+                "     debug   same ground: the CLI's DI + IA + Robotics alone vs their crate, cold: {} (CPU {})   \
+                 incremental {}   ({:.2} s vs {:.2} s cold)",
+                ratio(a.cold.median, b.cold.median),
+                ratio(a.cold.cpu, b.cold.cpu),
+                ratio(a.incr.map_or(f64::NAN, |i| i.median), b.incr.map_or(f64::NAN, |i| i.median)),
+                a.cold.median,
+                b.cold.median
+            );
         }
         if let (Ok(a), Ok(rt), Ok(b)) = (&r.debug, &r.runtime_only, &p.debug) {
             println!(
