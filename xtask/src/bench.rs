@@ -516,7 +516,9 @@ fn print_table(reports: &[Report], split: bool, yard: Option<&Result<rust::Yards
 ///    build shows cargo's own share of these wall times. Debug builds run `--runs-build` times, release
 ///    builds once. The hand-written runtime is the crate `nodeset-runtime` (`generated/runtime/`), a
 ///    dependency built once like async-opcua; its cold build is timed the same way, so that what a user
-///    compiles in all from a clean target is also shown.
+///    compiles in all from a clean target is also shown. nodeset-models holds six namespaces; the CLI's
+///    output of step 1 (DI + IA + Robotics, the peer's inputs) is built the same way as the crate
+///    `nodeset-models-di-ia-robotics` on nodeset-runtime, the figure to set beside the peer's crate.
 /// 4. Import: `generated/examples/import_bench.rs` (release), which says what it includes.
 /// 5. Peer: async-opcua-codegen 0.19.0, installed once into `target/bench-tools`, with a config written to
 ///    `target/bench-build/peer/codegen.yml` (a `types` and a `nodes` target per namespace; the nodes target
