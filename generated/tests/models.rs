@@ -151,3 +151,40 @@ async fn placeholder_instances_bind_by_browse_name() {
     assert_eq!(robot.safety_states.safety_state_identifier.keys().collect::<Vec<_>>(), ["SafetyState"]);
     running.stop().await;
 }
+
+/// Binding a handle to a node that does not fit it fails with the first problem, in the order of the handle's
+/// members: a node that is not there, a node of another class, a mandatory child that is missing.
+#[tokio::test]
+async fn binding_a_handle_to_the_wrong_node_says_why() {
+    use nodeset_models::runtime::typed::{BindError, Instantiate, ObjectType, Variable};
+    use opcua::types::{NodeClass, ObjectId};
+    let running = common::serve(ServerConfig::new("bind errors").table(&di::TABLE).type_loader(di::TypeLoader)).await;
+    let m = &running.manager;
+    let objects = NodeId::from(ObjectId::ObjectsFolder);
+    let device = di::objects::ComponentType::instantiate(m, &objects, "Device", &Instantiate::new().optional("SerialNumber"))
+        .expect("instantiates a component");
+    let serial = device.serial_number.as_ref().expect("the optional SerialNumber was created").id().clone();
+
+    // ns0's nodes are served by async-opcua's core node manager, not by ours.
+    let server = NodeId::from(ObjectId::Server);
+    assert_eq!(m.bind::<di::objects::ComponentType>(&server).err(), Some(BindError::UnknownNode(server)));
+    // An ObjectType handle on a variable.
+    assert_eq!(
+        m.bind::<di::objects::ComponentType>(&serial).err(),
+        Some(BindError::WrongClass { node: serial.clone(), expected: NodeClass::Object, found: NodeClass::Variable })
+    );
+    // A scalar cannot be bound as an array.
+    assert!(matches!(m.bind::<Variable<Vec<String>>>(&serial), Err(BindError::ValueRank { .. })));
+    // A component is not a device: DeviceType's mandatory members are missing.
+    match m.bind::<di::objects::DeviceType>(device.node.id()) {
+        Err(BindError::MissingChild { parent, browse_name }) => {
+            assert_eq!(&parent, device.node.id());
+            assert!(["Manufacturer", "Model", "SerialNumber", "DeviceRevision"].contains(&browse_name.as_str()), "{browse_name}");
+        }
+        other => panic!("expected a missing child, got {other:?}"),
+    }
+    // And the right handle binds.
+    let again = m.bind::<di::objects::ComponentType>(device.node.id()).expect("binds");
+    assert_eq!(again.node.id(), device.node.id());
+    running.stop().await;
+}
