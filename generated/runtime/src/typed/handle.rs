@@ -54,15 +54,25 @@ impl std::error::Error for BindError {}
 
 /// A typed handle to a node: generated handle structs, [`ObjectNode`], [`Variable<T>`], [`Method<I, O>`].
 pub trait Handle: Sized {
-    /// Binds the handle to `node`, finding its children through `binder`.
-    fn bind(binder: &Binder<'_>, node: &NodeId) -> Result<Self, BindError>;
+    /// Builds the handle of `node`, finding its children through `binder`. It does not fail: a problem is
+    /// recorded in the binder, which keeps the first one, and the rest of the handle is built without
+    /// looking anything up; [`Handle::bind`] then returns that problem. (Generated handles are structs of
+    /// many members: a `?` per member made their code several times larger.)
+    fn build(binder: &Binder<'_>, node: &NodeId) -> Self;
+
+    /// Binds the handle to `node`: [`Handle::build`], then the first problem it met, if any.
+    fn bind(binder: &Binder<'_>, node: &NodeId) -> Result<Self, BindError> {
+        binder.finish(Self::build(binder, node))
+    }
 }
 
-/// Finds the children of instances for [`Handle::bind`] while holding one read lock on the address space.
+/// Finds the children of instances for [`Handle::build`] while holding one read lock on the address space.
 pub struct Binder<'a> {
     manager: &'a ModelManager,
     space: &'a AddressSpace,
     tree: &'a DefaultTypeTree,
+    /// The first problem met since the last [`Binder::finish`].
+    problem: std::cell::RefCell<Option<BindError>>,
 }
 
 impl<'a> Binder<'a> {
@@ -72,7 +82,25 @@ impl<'a> Binder<'a> {
     }
 
     pub(crate) fn new(manager: &'a ModelManager, space: &'a AddressSpace, tree: &'a DefaultTypeTree) -> Binder<'a> {
-        Binder { manager, space, tree }
+        Binder { manager, space, tree, problem: Default::default() }
+    }
+
+    /// Records a problem; the first one is kept.
+    pub fn fail(&self, problem: BindError) {
+        self.problem.borrow_mut().get_or_insert(problem);
+    }
+
+    /// Whether a problem has been recorded: what is built from now on is not looked up.
+    pub fn failed(&self) -> bool {
+        self.problem.borrow().is_some()
+    }
+
+    /// `value`, or the first problem recorded while it was built (which is then cleared).
+    pub fn finish<H>(&self, value: H) -> Result<H, BindError> {
+        match self.problem.borrow_mut().take() {
+            Some(problem) => Err(problem),
+            None => Ok(value),
+        }
     }
 
     /// The manager the handles will use.
@@ -92,6 +120,70 @@ impl<'a> Binder<'a> {
     /// `H` bound to the same node (for the supertype part of a generated handle).
     pub fn this<H: Handle>(&self, node: &NodeId) -> Result<H, BindError> {
         H::bind(self, node)
+    }
+
+    /// [`Binder::this`] for [`Handle::build`].
+    pub fn build_this<H: Handle>(&self, node: &NodeId) -> H {
+        H::build(self, node)
+    }
+
+    /// [`Binder::child`] for [`Handle::build`].
+    pub fn build_child<H: Handle>(&self, node: &NodeId, uri: &str, name: &str) -> H {
+        H::build(self, &self.mandatory_child(node, uri, name))
+    }
+
+    /// [`Binder::optional`] for [`Handle::build`].
+    pub fn build_optional<H: Handle>(&self, node: &NodeId, uri: &str, name: &str) -> Option<H> {
+        match self.optional_child(node, uri, name) {
+            Some(child) => Some(H::build(self, &child)),
+            None => None,
+        }
+    }
+
+    /// [`Binder::placeholders`] for [`Handle::build`].
+    pub fn build_placeholders<H: Handle>(&self, node: &NodeId, type_id: NsNodeId) -> Placeholders<H> {
+        let found = if self.failed() {
+            Vec::new()
+        } else {
+            self.placeholder_children(node, type_id).unwrap_or_else(|e| {
+                self.fail(e);
+                Vec::new()
+            })
+        };
+        let mut out = Vec::with_capacity(found.len());
+        for (name, child) in found {
+            out.push((name, H::build(self, &child)));
+        }
+        Placeholders(out)
+    }
+
+    /// The mandatory child to build; after a problem (or for a missing child, which is one) the null NodeId.
+    fn mandatory_child(&self, node: &NodeId, uri: &str, name: &str) -> NodeId {
+        if self.failed() {
+            return NodeId::null();
+        }
+        match self.find_child(node, uri, name) {
+            Ok(Some(child)) => child,
+            Ok(None) => {
+                self.fail(BindError::MissingChild { parent: node.clone(), browse_name: name.to_owned() });
+                NodeId::null()
+            }
+            Err(e) => {
+                self.fail(e);
+                NodeId::null()
+            }
+        }
+    }
+
+    /// The optional child to build, if the instance has it (and no problem was met before).
+    fn optional_child(&self, node: &NodeId, uri: &str, name: &str) -> Option<NodeId> {
+        if self.failed() {
+            return None;
+        }
+        self.find_child(node, uri, name).unwrap_or_else(|e| {
+            self.fail(e);
+            None
+        })
     }
 
     /// The BrowseName of a node, if there is such a node.
@@ -121,27 +213,18 @@ impl<'a> Binder<'a> {
 
     /// A mandatory child, bound as `H`.
     pub fn child<H: Handle>(&self, node: &NodeId, uri: &str, name: &str) -> Result<H, BindError> {
-        match self.find_child(node, uri, name)? {
-            Some(child) => H::bind(self, &child),
-            None => Err(BindError::MissingChild { parent: node.clone(), browse_name: name.to_owned() }),
-        }
+        self.finish(self.build_child(node, uri, name))
     }
 
     /// An optional child, bound as `H` if the instance has it.
     pub fn optional<H: Handle>(&self, node: &NodeId, uri: &str, name: &str) -> Result<Option<H>, BindError> {
-        self.find_child(node, uri, name)?.map(|child| H::bind(self, &child)).transpose()
+        self.finish(self.build_optional(node, uri, name))
     }
 
     /// The instances of a placeholder: the children of `node` whose TypeDefinition is `type_id` or a
     /// subtype of it, keyed by BrowseName.
     pub fn placeholders<H: Handle>(&self, node: &NodeId, type_id: NsNodeId) -> Result<Placeholders<H>, BindError> {
-        // Only the binding is generic: it is compiled once per handle type of every placeholder there is.
-        let found = self.placeholder_children(node, type_id)?;
-        let mut out = Vec::with_capacity(found.len());
-        for (name, child) in found {
-            out.push((name, H::bind(self, &child)?));
-        }
-        Ok(Placeholders(out))
+        self.finish(self.build_placeholders(node, type_id))
     }
 
     /// The children [`Binder::placeholders`] binds, sorted by BrowseName.
@@ -164,6 +247,29 @@ impl<'a> Binder<'a> {
         found.sort_by(|a, b| a.0.cmp(&b.0));
         found.dedup_by(|later, first| later.0 == first.0);
         Ok(found)
+    }
+
+    /// Records that `node` is not of class `expected`, if it is not (and no problem was met before).
+    fn check_class(&self, node: &NodeId, expected: NodeClass) {
+        if !self.failed() {
+            if let Err(e) = self.expect_class(node, expected) {
+                self.fail(e);
+            }
+        }
+    }
+
+    /// Records why `node` cannot be a variable of a Rust type of ValueRank `rust_value_rank`, if it cannot.
+    fn check_variable(&self, node: &NodeId, rust_value_rank: i32) {
+        if self.failed() {
+            return;
+        }
+        match self.variable_rank(node) {
+            Ok(value_rank) if !rank_fits(rust_value_rank, value_rank) => {
+                self.fail(BindError::ValueRank { node: node.clone(), value_rank, rust_value_rank })
+            }
+            Ok(_) => {}
+            Err(e) => self.fail(e),
+        }
     }
 
     /// The ValueRank of a variable, for checks.
@@ -213,9 +319,9 @@ impl fmt::Debug for ObjectNode {
 }
 
 impl Handle for ObjectNode {
-    fn bind(binder: &Binder<'_>, node: &NodeId) -> Result<Self, BindError> {
-        binder.expect_class(node, NodeClass::Object)?;
-        Ok(ObjectNode { id: node.clone(), manager: binder.manager.clone() })
+    fn build(binder: &Binder<'_>, node: &NodeId) -> Self {
+        binder.check_class(node, NodeClass::Object);
+        ObjectNode { id: node.clone(), manager: binder.manager.clone() }
     }
 }
 
@@ -298,18 +404,15 @@ impl<T: UaValue> Variable<T> {
 /// `<EthernetPort>` of type `EthernetPortType`), or of a subtype of a type that contains it, which by value
 /// would be a struct of infinite size. Field access and method calls reach through the `Box` as before.
 impl<H: Handle> Handle for Box<H> {
-    fn bind(binder: &Binder<'_>, node: &NodeId) -> Result<Self, BindError> {
-        H::bind(binder, node).map(Box::new)
+    fn build(binder: &Binder<'_>, node: &NodeId) -> Self {
+        Box::new(H::build(binder, node))
     }
 }
 
 impl<T: UaValue> Handle for Variable<T> {
-    fn bind(binder: &Binder<'_>, node: &NodeId) -> Result<Self, BindError> {
-        let value_rank = binder.variable_rank(node)?;
-        if !rank_fits(T::VALUE_RANK, value_rank) {
-            return Err(BindError::ValueRank { node: node.clone(), value_rank, rust_value_rank: T::VALUE_RANK });
-        }
-        Ok(Variable { id: node.clone(), manager: binder.manager.clone(), _value: PhantomData })
+    fn build(binder: &Binder<'_>, node: &NodeId) -> Self {
+        binder.check_variable(node, T::VALUE_RANK);
+        Variable { id: node.clone(), manager: binder.manager.clone(), _value: PhantomData }
     }
 }
 
@@ -455,9 +558,9 @@ impl<I: Arguments, O: Arguments> Method<I, O> {
 }
 
 impl<I: Arguments, O: Arguments> Handle for Method<I, O> {
-    fn bind(binder: &Binder<'_>, node: &NodeId) -> Result<Self, BindError> {
-        binder.expect_class(node, NodeClass::Method)?;
-        Ok(Method { id: node.clone(), manager: binder.manager.clone(), _signature: PhantomData })
+    fn build(binder: &Binder<'_>, node: &NodeId) -> Self {
+        binder.check_class(node, NodeClass::Method);
+        Method { id: node.clone(), manager: binder.manager.clone(), _signature: PhantomData }
     }
 }
 

@@ -31,12 +31,12 @@ pub struct AbsoluteCartesianLinearMoveSkillType {
 }
 t::debug_handle!(AbsoluteCartesianLinearMoveSkillType);
 impl t::Handle for AbsoluteCartesianLinearMoveSkillType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            input_parameter_set: b.child(id, NS[0], "InputParameterSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            input_parameter_set: b.build_child(id, NS[0], "InputParameterSet"),
+        }
     }
 }
 t::deref_base!(AbsoluteCartesianLinearMoveSkillType => MoveSkillType);
@@ -55,13 +55,13 @@ pub struct AbsoluteCartesianLinearMoveSkillType_InputParameterSet {
 }
 t::debug_handle!(AbsoluteCartesianLinearMoveSkillType_InputParameterSet);
 impl t::Handle for AbsoluteCartesianLinearMoveSkillType_InputParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            speed: b.child(id, NS[0], "Speed")?,
-            acceleration: b.child(id, NS[0], "Acceleration")?,
-            target_pose: b.child(id, NS[0], "TargetPose")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            speed: b.build_child(id, NS[0], "Speed"),
+            acceleration: b.build_child(id, NS[0], "Acceleration"),
+            target_pose: b.build_child(id, NS[0], "TargetPose"),
+        }
     }
 }
 t::object_type!(
@@ -110,12 +110,12 @@ pub struct AbsoluteJointPtpMoveSkillType {
 }
 t::debug_handle!(AbsoluteJointPtpMoveSkillType);
 impl t::Handle for AbsoluteJointPtpMoveSkillType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            input_parameter_set: b.child(id, NS[0], "InputParameterSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            input_parameter_set: b.build_child(id, NS[0], "InputParameterSet"),
+        }
     }
 }
 t::deref_base!(AbsoluteJointPtpMoveSkillType => MoveSkillType);
@@ -134,13 +134,13 @@ pub struct AbsoluteJointPtpMoveSkillType_InputParameterSet {
 }
 t::debug_handle!(AbsoluteJointPtpMoveSkillType_InputParameterSet);
 impl t::Handle for AbsoluteJointPtpMoveSkillType_InputParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            speed: b.child(id, NS[0], "Speed")?,
-            acceleration: b.child(id, NS[0], "Acceleration")?,
-            target_joint_positions: b.child(id, NS[0], "TargetJointPositions")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            speed: b.build_child(id, NS[0], "Speed"),
+            acceleration: b.build_child(id, NS[0], "Acceleration"),
+            target_joint_positions: b.build_child(id, NS[0], "TargetJointPositions"),
+        }
     }
 }
 t::object_type!(
@@ -192,13 +192,13 @@ pub struct CompositeSkillType {
 }
 t::debug_handle!(CompositeSkillType);
 impl t::Handle for CompositeSkillType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            suspend: b.child(id, NS[1], "Suspend")?,
-            resume: b.child(id, NS[1], "Resume")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            suspend: b.build_child(id, NS[1], "Suspend"),
+            resume: b.build_child(id, NS[1], "Resume"),
+        }
     }
 }
 t::deref_base!(CompositeSkillType => ProgramSkillStateMachineType);
@@ -231,12 +231,12 @@ pub struct GrippingSkillType {
 }
 t::debug_handle!(GrippingSkillType);
 impl t::Handle for GrippingSkillType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            input_parameter_set: b.child(id, NS[0], "InputParameterSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            input_parameter_set: b.build_child(id, NS[0], "InputParameterSet"),
+        }
     }
 }
 t::deref_base!(GrippingSkillType => ProgramSkillStateMachineType);
@@ -253,12 +253,12 @@ pub struct GrippingSkillType_InputParameterSet {
 }
 t::debug_handle!(GrippingSkillType_InputParameterSet);
 impl t::Handle for GrippingSkillType_InputParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            action: b.child(id, NS[0], "Action")?,
-            grip_force: b.child(id, NS[0], "GripForce")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            action: b.build_child(id, NS[0], "Action"),
+            grip_force: b.build_child(id, NS[0], "GripForce"),
+        }
     }
 }
 t::object_type!(
@@ -301,11 +301,11 @@ pub struct ISkillSetType {
 }
 t::debug_handle!(ISkillSetType);
 impl t::Handle for ISkillSetType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            skill_set: b.child(id, NS[0], "SkillSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            skill_set: b.build_child(id, NS[0], "SkillSet"),
+        }
     }
 }
 t::object_type!(ISkillSetType, rt::NsNodeId::numeric(NS[0], 1200), "ISkillSetType");
@@ -324,12 +324,12 @@ pub struct MoveSkillType {
 }
 t::debug_handle!(MoveSkillType);
 impl t::Handle for MoveSkillType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            input_parameter_set: b.child(id, NS[0], "InputParameterSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            input_parameter_set: b.build_child(id, NS[0], "InputParameterSet"),
+        }
     }
 }
 t::deref_base!(MoveSkillType => ProgramSkillStateMachineType);
@@ -346,12 +346,12 @@ pub struct MoveSkillType_InputParameterSet {
 }
 t::debug_handle!(MoveSkillType_InputParameterSet);
 impl t::Handle for MoveSkillType_InputParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            speed: b.child(id, NS[0], "Speed")?,
-            acceleration: b.child(id, NS[0], "Acceleration")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            speed: b.build_child(id, NS[0], "Speed"),
+            acceleration: b.build_child(id, NS[0], "Acceleration"),
+        }
     }
 }
 t::object_type!(MoveSkillType, rt::NsNodeId::numeric(NS[0], 1500), "MoveSkillType");
@@ -422,26 +422,26 @@ pub struct ProgramSkillStateMachineType {
 }
 t::debug_handle!(ProgramSkillStateMachineType);
 impl t::Handle for ProgramSkillStateMachineType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[1], "CurrentState")?,
-            last_transition: b.child(id, NS[1], "LastTransition")?,
-            available_states: b.optional(id, NS[1], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[1], "AvailableTransitions")?,
-            deletable: b.child(id, NS[1], "Deletable")?,
-            auto_delete: b.child(id, NS[1], "AutoDelete")?,
-            recycle_count: b.child(id, NS[1], "RecycleCount")?,
-            program_diagnostic: b.optional(id, NS[1], "ProgramDiagnostic")?,
-            final_result_data: b.optional(id, NS[1], "FinalResultData")?,
-            start: b.child(id, NS[1], "Start")?,
-            suspend: b.optional(id, NS[1], "Suspend")?,
-            resume: b.optional(id, NS[1], "Resume")?,
-            halt: b.child(id, NS[1], "Halt")?,
-            reset: b.child(id, NS[1], "Reset")?,
-            input_parameter_set: b.child(id, NS[0], "InputParameterSet")?,
-            output_parameter_set: b.child(id, NS[0], "OutputParameterSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[1], "CurrentState"),
+            last_transition: b.build_child(id, NS[1], "LastTransition"),
+            available_states: b.build_optional(id, NS[1], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[1], "AvailableTransitions"),
+            deletable: b.build_child(id, NS[1], "Deletable"),
+            auto_delete: b.build_child(id, NS[1], "AutoDelete"),
+            recycle_count: b.build_child(id, NS[1], "RecycleCount"),
+            program_diagnostic: b.build_optional(id, NS[1], "ProgramDiagnostic"),
+            final_result_data: b.build_optional(id, NS[1], "FinalResultData"),
+            start: b.build_child(id, NS[1], "Start"),
+            suspend: b.build_optional(id, NS[1], "Suspend"),
+            resume: b.build_optional(id, NS[1], "Resume"),
+            halt: b.build_child(id, NS[1], "Halt"),
+            reset: b.build_child(id, NS[1], "Reset"),
+            input_parameter_set: b.build_child(id, NS[0], "InputParameterSet"),
+            output_parameter_set: b.build_child(id, NS[0], "OutputParameterSet"),
+        }
     }
 }
 /// `OutputParameterSet`, a member of `ProgramSkillStateMachineType` with children of its own.
@@ -455,11 +455,11 @@ pub struct ProgramSkillStateMachineType_OutputParameterSet {
 }
 t::debug_handle!(ProgramSkillStateMachineType_OutputParameterSet);
 impl t::Handle for ProgramSkillStateMachineType_OutputParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            result: b.child(id, NS[0], "Result")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            result: b.build_child(id, NS[0], "Result"),
+        }
     }
 }
 t::object_type!(
@@ -624,12 +624,12 @@ pub struct RelativeCartesianLinearMoveSkillType {
 }
 t::debug_handle!(RelativeCartesianLinearMoveSkillType);
 impl t::Handle for RelativeCartesianLinearMoveSkillType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            input_parameter_set: b.child(id, NS[0], "InputParameterSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            input_parameter_set: b.build_child(id, NS[0], "InputParameterSet"),
+        }
     }
 }
 t::deref_base!(RelativeCartesianLinearMoveSkillType => MoveSkillType);
@@ -648,13 +648,13 @@ pub struct RelativeCartesianLinearMoveSkillType_InputParameterSet {
 }
 t::debug_handle!(RelativeCartesianLinearMoveSkillType_InputParameterSet);
 impl t::Handle for RelativeCartesianLinearMoveSkillType_InputParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            speed: b.child(id, NS[0], "Speed")?,
-            acceleration: b.child(id, NS[0], "Acceleration")?,
-            pose_offset: b.child(id, NS[0], "PoseOffset")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            speed: b.build_child(id, NS[0], "Speed"),
+            acceleration: b.build_child(id, NS[0], "Acceleration"),
+            pose_offset: b.build_child(id, NS[0], "PoseOffset"),
+        }
     }
 }
 t::object_type!(
@@ -735,28 +735,29 @@ pub struct SkillTransitionEventType {
 }
 t::debug_handle!(SkillTransitionEventType);
 impl t::Handle for SkillTransitionEventType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            event_id: b.child(id, NS[1], "EventId")?,
-            event_type: b.child(id, NS[1], "EventType")?,
-            source_node: b.child(id, NS[1], "SourceNode")?,
-            source_name: b.child(id, NS[1], "SourceName")?,
-            time: b.child(id, NS[1], "Time")?,
-            receive_time: b.child(id, NS[1], "ReceiveTime")?,
-            local_time: b.optional(id, NS[1], "LocalTime")?,
-            message: b.child(id, NS[1], "Message")?,
-            severity: b.child(id, NS[1], "Severity")?,
-            condition_class_id: b.optional(id, NS[1], "ConditionClassId")?,
-            condition_class_name: b.optional(id, NS[1], "ConditionClassName")?,
-            condition_sub_class_id: b.optional(id, NS[1], "ConditionSubClassId")?,
-            condition_sub_class_name: b.optional(id, NS[1], "ConditionSubClassName")?,
-            transition: b.child(id, NS[1], "Transition")?,
-            from_state: b.child(id, NS[1], "FromState")?,
-            to_state: b.child(id, NS[1], "ToState")?,
-            intermediate_result: b.child(id, NS[1], "IntermediateResult")?,
-            skill_name: b.child(id, NS[0], "SkillName")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            event_id: b.build_child(id, NS[1], "EventId"),
+            event_type: b.build_child(id, NS[1], "EventType"),
+            source_node: b.build_child(id, NS[1], "SourceNode"),
+            source_name: b.build_child(id, NS[1], "SourceName"),
+            time: b.build_child(id, NS[1], "Time"),
+            receive_time: b.build_child(id, NS[1], "ReceiveTime"),
+            local_time: b.build_optional(id, NS[1], "LocalTime"),
+            message: b.build_child(id, NS[1], "Message"),
+            severity: b.build_child(id, NS[1], "Severity"),
+            condition_class_id: b.build_optional(id, NS[1], "ConditionClassId"),
+            condition_class_name: b.build_optional(id, NS[1], "ConditionClassName"),
+            condition_sub_class_id: b.build_optional(id, NS[1], "ConditionSubClassId"),
+            condition_sub_class_name: b
+                .build_optional(id, NS[1], "ConditionSubClassName"),
+            transition: b.build_child(id, NS[1], "Transition"),
+            from_state: b.build_child(id, NS[1], "FromState"),
+            to_state: b.build_child(id, NS[1], "ToState"),
+            intermediate_result: b.build_child(id, NS[1], "IntermediateResult"),
+            skill_name: b.build_child(id, NS[0], "SkillName"),
+        }
     }
 }
 t::object_type!(

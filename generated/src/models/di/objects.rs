@@ -24,8 +24,8 @@ pub struct BaseLifetimeIndicationType {
 }
 t::debug_handle!(BaseLifetimeIndicationType);
 impl t::Handle for BaseLifetimeIndicationType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self { node: b.this(id)? })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self { node: b.build_this(id) }
     }
 }
 t::object_type!(
@@ -53,16 +53,16 @@ pub struct BlockType {
 }
 t::debug_handle!(BlockType);
 impl t::Handle for BlockType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            revision_counter: b.optional(id, NS[0], "RevisionCounter")?,
-            actual_mode: b.optional(id, NS[0], "ActualMode")?,
-            permitted_mode: b.optional(id, NS[0], "PermittedMode")?,
-            normal_mode: b.optional(id, NS[0], "NormalMode")?,
-            target_mode: b.optional(id, NS[0], "TargetMode")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            revision_counter: b.build_optional(id, NS[0], "RevisionCounter"),
+            actual_mode: b.build_optional(id, NS[0], "ActualMode"),
+            permitted_mode: b.build_optional(id, NS[0], "PermittedMode"),
+            normal_mode: b.build_optional(id, NS[0], "NormalMode"),
+            target_mode: b.build_optional(id, NS[0], "TargetMode"),
+        }
     }
 }
 t::deref_base!(BlockType => TopologyElementType);
@@ -87,14 +87,14 @@ pub struct CachedLoadingType {
 }
 t::debug_handle!(CachedLoadingType);
 impl t::Handle for CachedLoadingType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            pending_version: b.child(id, NS[0], "PendingVersion")?,
-            fallback_version: b.optional(id, NS[0], "FallbackVersion")?,
-            get_update_behavior: b.child(id, NS[0], "GetUpdateBehavior")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            pending_version: b.build_child(id, NS[0], "PendingVersion"),
+            fallback_version: b.build_optional(id, NS[0], "FallbackVersion"),
+            get_update_behavior: b.build_child(id, NS[0], "GetUpdateBehavior"),
+        }
     }
 }
 t::deref_base!(CachedLoadingType => PackageLoadingType);
@@ -123,18 +123,18 @@ pub struct CachedLoadingType_PendingVersion {
 }
 t::debug_handle!(CachedLoadingType_PendingVersion);
 impl t::Handle for CachedLoadingType_PendingVersion {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            manufacturer: b.child(id, NS[0], "Manufacturer")?,
-            manufacturer_uri: b.child(id, NS[0], "ManufacturerUri")?,
-            software_revision: b.child(id, NS[0], "SoftwareRevision")?,
-            patch_identifiers: b.optional(id, NS[0], "PatchIdentifiers")?,
-            release_date: b.optional(id, NS[0], "ReleaseDate")?,
-            change_log_reference: b.optional(id, NS[0], "ChangeLogReference")?,
-            hash: b.optional(id, NS[0], "Hash")?,
-            clear: b.optional(id, NS[0], "Clear")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            manufacturer: b.build_child(id, NS[0], "Manufacturer"),
+            manufacturer_uri: b.build_child(id, NS[0], "ManufacturerUri"),
+            software_revision: b.build_child(id, NS[0], "SoftwareRevision"),
+            patch_identifiers: b.build_optional(id, NS[0], "PatchIdentifiers"),
+            release_date: b.build_optional(id, NS[0], "ReleaseDate"),
+            change_log_reference: b.build_optional(id, NS[0], "ChangeLogReference"),
+            hash: b.build_optional(id, NS[0], "Hash"),
+            clear: b.build_optional(id, NS[0], "Clear"),
+        }
     }
 }
 /// `FallbackVersion`, a member of `CachedLoadingType` with children of its own.
@@ -162,18 +162,18 @@ pub struct CachedLoadingType_FallbackVersion {
 }
 t::debug_handle!(CachedLoadingType_FallbackVersion);
 impl t::Handle for CachedLoadingType_FallbackVersion {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            manufacturer: b.child(id, NS[0], "Manufacturer")?,
-            manufacturer_uri: b.child(id, NS[0], "ManufacturerUri")?,
-            software_revision: b.child(id, NS[0], "SoftwareRevision")?,
-            patch_identifiers: b.optional(id, NS[0], "PatchIdentifiers")?,
-            release_date: b.optional(id, NS[0], "ReleaseDate")?,
-            change_log_reference: b.optional(id, NS[0], "ChangeLogReference")?,
-            hash: b.optional(id, NS[0], "Hash")?,
-            clear: b.optional(id, NS[0], "Clear")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            manufacturer: b.build_child(id, NS[0], "Manufacturer"),
+            manufacturer_uri: b.build_child(id, NS[0], "ManufacturerUri"),
+            software_revision: b.build_child(id, NS[0], "SoftwareRevision"),
+            patch_identifiers: b.build_optional(id, NS[0], "PatchIdentifiers"),
+            release_date: b.build_optional(id, NS[0], "ReleaseDate"),
+            change_log_reference: b.build_optional(id, NS[0], "ChangeLogReference"),
+            hash: b.build_optional(id, NS[0], "Hash"),
+            clear: b.build_optional(id, NS[0], "Clear"),
+        }
     }
 }
 t::object_type!(
@@ -190,11 +190,11 @@ pub struct CheckFunctionAlarmType {
 }
 t::debug_handle!(CheckFunctionAlarmType);
 impl t::Handle for CheckFunctionAlarmType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+        }
     }
 }
 t::deref_base!(CheckFunctionAlarmType => DeviceHealthDiagnosticAlarmType);
@@ -240,25 +240,25 @@ pub struct ComponentType {
 }
 t::debug_handle!(ComponentType);
 impl t::Handle for ComponentType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            manufacturer: b.optional(id, NS[0], "Manufacturer")?,
-            manufacturer_uri: b.optional(id, NS[0], "ManufacturerUri")?,
-            model: b.optional(id, NS[0], "Model")?,
-            hardware_revision: b.optional(id, NS[0], "HardwareRevision")?,
-            software_revision: b.optional(id, NS[0], "SoftwareRevision")?,
-            device_revision: b.optional(id, NS[0], "DeviceRevision")?,
-            product_code: b.optional(id, NS[0], "ProductCode")?,
-            device_manual: b.optional(id, NS[0], "DeviceManual")?,
-            device_class: b.optional(id, NS[0], "DeviceClass")?,
-            serial_number: b.optional(id, NS[0], "SerialNumber")?,
-            product_instance_uri: b.optional(id, NS[0], "ProductInstanceUri")?,
-            revision_counter: b.optional(id, NS[0], "RevisionCounter")?,
-            asset_id: b.optional(id, NS[0], "AssetId")?,
-            component_name: b.optional(id, NS[0], "ComponentName")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            manufacturer: b.build_optional(id, NS[0], "Manufacturer"),
+            manufacturer_uri: b.build_optional(id, NS[0], "ManufacturerUri"),
+            model: b.build_optional(id, NS[0], "Model"),
+            hardware_revision: b.build_optional(id, NS[0], "HardwareRevision"),
+            software_revision: b.build_optional(id, NS[0], "SoftwareRevision"),
+            device_revision: b.build_optional(id, NS[0], "DeviceRevision"),
+            product_code: b.build_optional(id, NS[0], "ProductCode"),
+            device_manual: b.build_optional(id, NS[0], "DeviceManual"),
+            device_class: b.build_optional(id, NS[0], "DeviceClass"),
+            serial_number: b.build_optional(id, NS[0], "SerialNumber"),
+            product_instance_uri: b.build_optional(id, NS[0], "ProductInstanceUri"),
+            revision_counter: b.build_optional(id, NS[0], "RevisionCounter"),
+            asset_id: b.build_optional(id, NS[0], "AssetId"),
+            component_name: b.build_optional(id, NS[0], "ComponentName"),
+        }
     }
 }
 t::deref_base!(ComponentType => TopologyElementType);
@@ -276,12 +276,12 @@ pub struct ConfigurableObjectType {
 }
 t::debug_handle!(ConfigurableObjectType);
 impl t::Handle for ConfigurableObjectType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            supported_types: b.child(id, NS[0], "SupportedTypes")?,
-            object_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 58))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            supported_types: b.build_child(id, NS[0], "SupportedTypes"),
+            object_identifier: b.build_placeholders(id, rt::NsNodeId::numeric(NS[1], 58)),
+        }
     }
 }
 t::object_type!(
@@ -308,16 +308,16 @@ pub struct ConfirmationStateMachineType {
 }
 t::debug_handle!(ConfirmationStateMachineType);
 impl t::Handle for ConfirmationStateMachineType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[1], "CurrentState")?,
-            last_transition: b.optional(id, NS[1], "LastTransition")?,
-            available_states: b.optional(id, NS[1], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[1], "AvailableTransitions")?,
-            confirm: b.child(id, NS[0], "Confirm")?,
-            confirmation_timeout: b.child(id, NS[0], "ConfirmationTimeout")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[1], "CurrentState"),
+            last_transition: b.build_optional(id, NS[1], "LastTransition"),
+            available_states: b.build_optional(id, NS[1], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[1], "AvailableTransitions"),
+            confirm: b.build_child(id, NS[0], "Confirm"),
+            confirmation_timeout: b.build_child(id, NS[0], "ConfirmationTimeout"),
+        }
     }
 }
 t::object_type!(
@@ -384,13 +384,14 @@ pub struct ConnectionPointType {
 }
 t::debug_handle!(ConnectionPointType);
 impl t::Handle for ConnectionPointType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            network_address: b.child(id, NS[0], "NetworkAddress")?,
-            profile_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[0], 1006))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            network_address: b.build_child(id, NS[0], "NetworkAddress"),
+            profile_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1006)),
+        }
     }
 }
 t::deref_base!(ConnectionPointType => TopologyElementType);
@@ -524,69 +525,70 @@ pub struct DeviceHealthDiagnosticAlarmType {
 }
 t::debug_handle!(DeviceHealthDiagnosticAlarmType);
 impl t::Handle for DeviceHealthDiagnosticAlarmType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            event_id: b.child(id, NS[1], "EventId")?,
-            event_type: b.child(id, NS[1], "EventType")?,
-            source_node: b.child(id, NS[1], "SourceNode")?,
-            source_name: b.child(id, NS[1], "SourceName")?,
-            time: b.child(id, NS[1], "Time")?,
-            receive_time: b.child(id, NS[1], "ReceiveTime")?,
-            local_time: b.optional(id, NS[1], "LocalTime")?,
-            message: b.child(id, NS[1], "Message")?,
-            severity: b.child(id, NS[1], "Severity")?,
-            condition_class_id: b.child(id, NS[1], "ConditionClassId")?,
-            condition_class_name: b.child(id, NS[1], "ConditionClassName")?,
-            condition_sub_class_id: b.optional(id, NS[1], "ConditionSubClassId")?,
-            condition_sub_class_name: b.optional(id, NS[1], "ConditionSubClassName")?,
-            condition_name: b.child(id, NS[1], "ConditionName")?,
-            branch_id: b.child(id, NS[1], "BranchId")?,
-            retain: b.child(id, NS[1], "Retain")?,
-            enabled_state: b.child(id, NS[1], "EnabledState")?,
-            quality: b.child(id, NS[1], "Quality")?,
-            last_severity: b.child(id, NS[1], "LastSeverity")?,
-            comment: b.child(id, NS[1], "Comment")?,
-            client_user_id: b.child(id, NS[1], "ClientUserId")?,
-            disable: b.child(id, NS[1], "Disable")?,
-            enable: b.child(id, NS[1], "Enable")?,
-            add_comment: b.child(id, NS[1], "AddComment")?,
-            acked_state: b.child(id, NS[1], "AckedState")?,
-            confirmed_state: b.optional(id, NS[1], "ConfirmedState")?,
-            acknowledge: b.child(id, NS[1], "Acknowledge")?,
-            confirm: b.optional(id, NS[1], "Confirm")?,
-            active_state: b.child(id, NS[1], "ActiveState")?,
-            input_node: b.child(id, NS[1], "InputNode")?,
-            suppressed_state: b.optional(id, NS[1], "SuppressedState")?,
-            out_of_service_state: b.optional(id, NS[1], "OutOfServiceState")?,
-            shelving_state: b.optional(id, NS[1], "ShelvingState")?,
-            suppressed_or_shelved: b.child(id, NS[1], "SuppressedOrShelved")?,
-            max_time_shelved: b.optional(id, NS[1], "MaxTimeShelved")?,
-            audible_enabled: b.optional(id, NS[1], "AudibleEnabled")?,
-            audible_sound: b.optional(id, NS[1], "AudibleSound")?,
-            silence_state: b.optional(id, NS[1], "SilenceState")?,
-            on_delay: b.optional(id, NS[1], "OnDelay")?,
-            off_delay: b.optional(id, NS[1], "OffDelay")?,
-            first_in_group_flag: b.optional(id, NS[1], "FirstInGroupFlag")?,
-            first_in_group: b.optional(id, NS[1], "FirstInGroup")?,
-            latched_state: b.optional(id, NS[1], "LatchedState")?,
-            alarm_group: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 16405))?,
-            re_alarm_time: b.optional(id, NS[1], "ReAlarmTime")?,
-            re_alarm_repeat_count: b.optional(id, NS[1], "ReAlarmRepeatCount")?,
-            silence: b.optional(id, NS[1], "Silence")?,
-            suppress: b.optional(id, NS[1], "Suppress")?,
-            suppress2: b.optional(id, NS[1], "Suppress2")?,
-            unsuppress: b.optional(id, NS[1], "Unsuppress")?,
-            unsuppress2: b.optional(id, NS[1], "Unsuppress2")?,
-            remove_from_service: b.optional(id, NS[1], "RemoveFromService")?,
-            remove_from_service2: b.optional(id, NS[1], "RemoveFromService2")?,
-            place_in_service: b.optional(id, NS[1], "PlaceInService")?,
-            place_in_service2: b.optional(id, NS[1], "PlaceInService2")?,
-            reset: b.optional(id, NS[1], "Reset")?,
-            reset2: b.optional(id, NS[1], "Reset2")?,
-            get_group_memberships: b.optional(id, NS[1], "GetGroupMemberships")?,
-            normal_state: b.child(id, NS[1], "NormalState")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            event_id: b.build_child(id, NS[1], "EventId"),
+            event_type: b.build_child(id, NS[1], "EventType"),
+            source_node: b.build_child(id, NS[1], "SourceNode"),
+            source_name: b.build_child(id, NS[1], "SourceName"),
+            time: b.build_child(id, NS[1], "Time"),
+            receive_time: b.build_child(id, NS[1], "ReceiveTime"),
+            local_time: b.build_optional(id, NS[1], "LocalTime"),
+            message: b.build_child(id, NS[1], "Message"),
+            severity: b.build_child(id, NS[1], "Severity"),
+            condition_class_id: b.build_child(id, NS[1], "ConditionClassId"),
+            condition_class_name: b.build_child(id, NS[1], "ConditionClassName"),
+            condition_sub_class_id: b.build_optional(id, NS[1], "ConditionSubClassId"),
+            condition_sub_class_name: b
+                .build_optional(id, NS[1], "ConditionSubClassName"),
+            condition_name: b.build_child(id, NS[1], "ConditionName"),
+            branch_id: b.build_child(id, NS[1], "BranchId"),
+            retain: b.build_child(id, NS[1], "Retain"),
+            enabled_state: b.build_child(id, NS[1], "EnabledState"),
+            quality: b.build_child(id, NS[1], "Quality"),
+            last_severity: b.build_child(id, NS[1], "LastSeverity"),
+            comment: b.build_child(id, NS[1], "Comment"),
+            client_user_id: b.build_child(id, NS[1], "ClientUserId"),
+            disable: b.build_child(id, NS[1], "Disable"),
+            enable: b.build_child(id, NS[1], "Enable"),
+            add_comment: b.build_child(id, NS[1], "AddComment"),
+            acked_state: b.build_child(id, NS[1], "AckedState"),
+            confirmed_state: b.build_optional(id, NS[1], "ConfirmedState"),
+            acknowledge: b.build_child(id, NS[1], "Acknowledge"),
+            confirm: b.build_optional(id, NS[1], "Confirm"),
+            active_state: b.build_child(id, NS[1], "ActiveState"),
+            input_node: b.build_child(id, NS[1], "InputNode"),
+            suppressed_state: b.build_optional(id, NS[1], "SuppressedState"),
+            out_of_service_state: b.build_optional(id, NS[1], "OutOfServiceState"),
+            shelving_state: b.build_optional(id, NS[1], "ShelvingState"),
+            suppressed_or_shelved: b.build_child(id, NS[1], "SuppressedOrShelved"),
+            max_time_shelved: b.build_optional(id, NS[1], "MaxTimeShelved"),
+            audible_enabled: b.build_optional(id, NS[1], "AudibleEnabled"),
+            audible_sound: b.build_optional(id, NS[1], "AudibleSound"),
+            silence_state: b.build_optional(id, NS[1], "SilenceState"),
+            on_delay: b.build_optional(id, NS[1], "OnDelay"),
+            off_delay: b.build_optional(id, NS[1], "OffDelay"),
+            first_in_group_flag: b.build_optional(id, NS[1], "FirstInGroupFlag"),
+            first_in_group: b.build_optional(id, NS[1], "FirstInGroup"),
+            latched_state: b.build_optional(id, NS[1], "LatchedState"),
+            alarm_group: b.build_placeholders(id, rt::NsNodeId::numeric(NS[1], 16405)),
+            re_alarm_time: b.build_optional(id, NS[1], "ReAlarmTime"),
+            re_alarm_repeat_count: b.build_optional(id, NS[1], "ReAlarmRepeatCount"),
+            silence: b.build_optional(id, NS[1], "Silence"),
+            suppress: b.build_optional(id, NS[1], "Suppress"),
+            suppress2: b.build_optional(id, NS[1], "Suppress2"),
+            unsuppress: b.build_optional(id, NS[1], "Unsuppress"),
+            unsuppress2: b.build_optional(id, NS[1], "Unsuppress2"),
+            remove_from_service: b.build_optional(id, NS[1], "RemoveFromService"),
+            remove_from_service2: b.build_optional(id, NS[1], "RemoveFromService2"),
+            place_in_service: b.build_optional(id, NS[1], "PlaceInService"),
+            place_in_service2: b.build_optional(id, NS[1], "PlaceInService2"),
+            reset: b.build_optional(id, NS[1], "Reset"),
+            reset2: b.build_optional(id, NS[1], "Reset2"),
+            get_group_memberships: b.build_optional(id, NS[1], "GetGroupMemberships"),
+            normal_state: b.build_child(id, NS[1], "NormalState"),
+        }
     }
 }
 /// `ShelvingState`, a member of `DeviceHealthDiagnosticAlarmType` with children of its own.
@@ -620,21 +622,21 @@ pub struct DeviceHealthDiagnosticAlarmType_ShelvingState {
 }
 t::debug_handle!(DeviceHealthDiagnosticAlarmType_ShelvingState);
 impl t::Handle for DeviceHealthDiagnosticAlarmType_ShelvingState {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[1], "CurrentState")?,
-            last_transition: b.optional(id, NS[1], "LastTransition")?,
-            available_states: b.optional(id, NS[1], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[1], "AvailableTransitions")?,
-            unshelve_time: b.child(id, NS[1], "UnshelveTime")?,
-            timed_shelve: b.child(id, NS[1], "TimedShelve")?,
-            timed_shelve2: b.optional(id, NS[1], "TimedShelve2")?,
-            unshelve: b.child(id, NS[1], "Unshelve")?,
-            unshelve2: b.optional(id, NS[1], "Unshelve2")?,
-            one_shot_shelve: b.child(id, NS[1], "OneShotShelve")?,
-            one_shot_shelve2: b.optional(id, NS[1], "OneShotShelve2")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[1], "CurrentState"),
+            last_transition: b.build_optional(id, NS[1], "LastTransition"),
+            available_states: b.build_optional(id, NS[1], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[1], "AvailableTransitions"),
+            unshelve_time: b.build_child(id, NS[1], "UnshelveTime"),
+            timed_shelve: b.build_child(id, NS[1], "TimedShelve"),
+            timed_shelve2: b.build_optional(id, NS[1], "TimedShelve2"),
+            unshelve: b.build_child(id, NS[1], "Unshelve"),
+            unshelve2: b.build_optional(id, NS[1], "Unshelve2"),
+            one_shot_shelve: b.build_child(id, NS[1], "OneShotShelve"),
+            one_shot_shelve2: b.build_optional(id, NS[1], "OneShotShelve2"),
+        }
     }
 }
 t::object_type!(
@@ -690,30 +692,30 @@ pub struct DeviceType {
 }
 t::debug_handle!(DeviceType);
 impl t::Handle for DeviceType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            manufacturer: b.child(id, NS[0], "Manufacturer")?,
-            manufacturer_uri: b.optional(id, NS[0], "ManufacturerUri")?,
-            model: b.child(id, NS[0], "Model")?,
-            hardware_revision: b.child(id, NS[0], "HardwareRevision")?,
-            software_revision: b.child(id, NS[0], "SoftwareRevision")?,
-            device_revision: b.child(id, NS[0], "DeviceRevision")?,
-            product_code: b.optional(id, NS[0], "ProductCode")?,
-            device_manual: b.child(id, NS[0], "DeviceManual")?,
-            device_class: b.optional(id, NS[0], "DeviceClass")?,
-            serial_number: b.child(id, NS[0], "SerialNumber")?,
-            product_instance_uri: b.optional(id, NS[0], "ProductInstanceUri")?,
-            revision_counter: b.child(id, NS[0], "RevisionCounter")?,
-            cp_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[0], 6308))?,
-            device_health: b.optional(id, NS[0], "DeviceHealth")?,
-            device_health_alarms: b.optional(id, NS[0], "DeviceHealthAlarms")?,
-            device_type_image: b.optional(id, NS[0], "DeviceTypeImage")?,
-            documentation: b.optional(id, NS[0], "Documentation")?,
-            protocol_support: b.optional(id, NS[0], "ProtocolSupport")?,
-            image_set: b.optional(id, NS[0], "ImageSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            manufacturer: b.build_child(id, NS[0], "Manufacturer"),
+            manufacturer_uri: b.build_optional(id, NS[0], "ManufacturerUri"),
+            model: b.build_child(id, NS[0], "Model"),
+            hardware_revision: b.build_child(id, NS[0], "HardwareRevision"),
+            software_revision: b.build_child(id, NS[0], "SoftwareRevision"),
+            device_revision: b.build_child(id, NS[0], "DeviceRevision"),
+            product_code: b.build_optional(id, NS[0], "ProductCode"),
+            device_manual: b.build_child(id, NS[0], "DeviceManual"),
+            device_class: b.build_optional(id, NS[0], "DeviceClass"),
+            serial_number: b.build_child(id, NS[0], "SerialNumber"),
+            product_instance_uri: b.build_optional(id, NS[0], "ProductInstanceUri"),
+            revision_counter: b.build_child(id, NS[0], "RevisionCounter"),
+            cp_identifier: b.build_placeholders(id, rt::NsNodeId::numeric(NS[0], 6308)),
+            device_health: b.build_optional(id, NS[0], "DeviceHealth"),
+            device_health_alarms: b.build_optional(id, NS[0], "DeviceHealthAlarms"),
+            device_type_image: b.build_optional(id, NS[0], "DeviceTypeImage"),
+            documentation: b.build_optional(id, NS[0], "Documentation"),
+            protocol_support: b.build_optional(id, NS[0], "ProtocolSupport"),
+            image_set: b.build_optional(id, NS[0], "ImageSet"),
+        }
     }
 }
 t::deref_base!(DeviceType => ComponentType);
@@ -728,11 +730,11 @@ pub struct DeviceType_DeviceTypeImage {
 }
 t::debug_handle!(DeviceType_DeviceTypeImage);
 impl t::Handle for DeviceType_DeviceTypeImage {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            image_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 63))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            image_identifier: b.build_placeholders(id, rt::NsNodeId::numeric(NS[1], 63)),
+        }
     }
 }
 /// `Documentation`, a member of `DeviceType` with children of its own.
@@ -746,11 +748,12 @@ pub struct DeviceType_Documentation {
 }
 t::debug_handle!(DeviceType_Documentation);
 impl t::Handle for DeviceType_Documentation {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            document_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 63))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            document_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 63)),
+        }
     }
 }
 /// `ProtocolSupport`, a member of `DeviceType` with children of its own.
@@ -764,12 +767,12 @@ pub struct DeviceType_ProtocolSupport {
 }
 t::debug_handle!(DeviceType_ProtocolSupport);
 impl t::Handle for DeviceType_ProtocolSupport {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             protocol_support_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[1], 63))?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 63)),
+        }
     }
 }
 /// `ImageSet`, a member of `DeviceType` with children of its own.
@@ -783,11 +786,11 @@ pub struct DeviceType_ImageSet {
 }
 t::debug_handle!(DeviceType_ImageSet);
 impl t::Handle for DeviceType_ImageSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            image_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 63))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            image_identifier: b.build_placeholders(id, rt::NsNodeId::numeric(NS[1], 63)),
+        }
     }
 }
 t::object_type!(DeviceType, rt::NsNodeId::numeric(NS[0], 1002), "DeviceType");
@@ -804,11 +807,11 @@ pub struct DiameterIndicationType {
 }
 t::debug_handle!(DiameterIndicationType);
 impl t::Handle for DiameterIndicationType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+        }
     }
 }
 t::deref_base!(DiameterIndicationType => BaseLifetimeIndicationType);
@@ -830,13 +833,13 @@ pub struct DirectLoadingType {
 }
 t::debug_handle!(DirectLoadingType);
 impl t::Handle for DirectLoadingType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            update_behavior: b.child(id, NS[0], "UpdateBehavior")?,
-            write_timeout: b.optional(id, NS[0], "WriteTimeout")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            update_behavior: b.build_child(id, NS[0], "UpdateBehavior"),
+            write_timeout: b.build_optional(id, NS[0], "WriteTimeout"),
+        }
     }
 }
 t::deref_base!(DirectLoadingType => PackageLoadingType);
@@ -854,11 +857,11 @@ pub struct FailureAlarmType {
 }
 t::debug_handle!(FailureAlarmType);
 impl t::Handle for FailureAlarmType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+        }
     }
 }
 t::deref_base!(FailureAlarmType => DeviceHealthDiagnosticAlarmType);
@@ -885,14 +888,14 @@ pub struct FileSystemLoadingType {
 }
 t::debug_handle!(FileSystemLoadingType);
 impl t::Handle for FileSystemLoadingType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            file_system: b.child(id, NS[1], "FileSystem")?,
-            get_update_behavior: b.child(id, NS[0], "GetUpdateBehavior")?,
-            validate_files: b.optional(id, NS[0], "ValidateFiles")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            file_system: b.build_child(id, NS[1], "FileSystem"),
+            get_update_behavior: b.build_child(id, NS[0], "GetUpdateBehavior"),
+            validate_files: b.build_optional(id, NS[0], "ValidateFiles"),
+        }
     }
 }
 t::deref_base!(FileSystemLoadingType => SoftwareLoadingType);
@@ -917,17 +920,17 @@ pub struct FileSystemLoadingType_FileSystem {
 }
 t::debug_handle!(FileSystemLoadingType_FileSystem);
 impl t::Handle for FileSystemLoadingType_FileSystem {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             file_directory_name: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[1], 13353))?,
-            file_name: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 11575))?,
-            create_directory: b.child(id, NS[1], "CreateDirectory")?,
-            create_file: b.child(id, NS[1], "CreateFile")?,
-            delete: b.child(id, NS[1], "Delete")?,
-            move_or_copy: b.child(id, NS[1], "MoveOrCopy")?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 13353)),
+            file_name: b.build_placeholders(id, rt::NsNodeId::numeric(NS[1], 11575)),
+            create_directory: b.build_child(id, NS[1], "CreateDirectory"),
+            create_file: b.build_child(id, NS[1], "CreateFile"),
+            delete: b.build_child(id, NS[1], "Delete"),
+            move_or_copy: b.build_child(id, NS[1], "MoveOrCopy"),
+        }
     }
 }
 t::object_type!(
@@ -946,12 +949,13 @@ pub struct FunctionalGroupType {
 }
 t::debug_handle!(FunctionalGroupType);
 impl t::Handle for FunctionalGroupType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            group_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[0], 1005))?,
-            ui_element: b.optional(id, NS[0], "UIElement")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            group_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1005)),
+            ui_element: b.build_optional(id, NS[0], "UIElement"),
+        }
     }
 }
 t::object_type!(
@@ -978,16 +982,17 @@ pub struct IAssetLocationIndicationType {
 }
 t::debug_handle!(IAssetLocationIndicationType);
 impl t::Handle for IAssetLocationIndicationType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            start_location_indication: b.child(id, NS[0], "StartLocationIndication")?,
-            stop_location_indication: b.child(id, NS[0], "StopLocationIndication")?,
-            is_indicating: b.child(id, NS[0], "IsIndicating")?,
-            used_indication_type: b.optional(id, NS[0], "UsedIndicationType")?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            start_location_indication: b
+                .build_child(id, NS[0], "StartLocationIndication"),
+            stop_location_indication: b.build_child(id, NS[0], "StopLocationIndication"),
+            is_indicating: b.build_child(id, NS[0], "IsIndicating"),
+            used_indication_type: b.build_optional(id, NS[0], "UsedIndicationType"),
             supported_indication_types: b
-                .optional(id, NS[0], "SupportedIndicationTypes")?,
-        })
+                .build_optional(id, NS[0], "SupportedIndicationTypes"),
+        }
     }
 }
 t::object_type!(
@@ -1007,12 +1012,12 @@ pub struct IDeviceHealthType {
 }
 t::debug_handle!(IDeviceHealthType);
 impl t::Handle for IDeviceHealthType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            device_health: b.optional(id, NS[0], "DeviceHealth")?,
-            device_health_alarms: b.optional(id, NS[0], "DeviceHealthAlarms")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            device_health: b.build_optional(id, NS[0], "DeviceHealth"),
+            device_health_alarms: b.build_optional(id, NS[0], "DeviceHealthAlarms"),
+        }
     }
 }
 t::object_type!(
@@ -1035,13 +1040,13 @@ pub struct IOperationCounterType {
 }
 t::debug_handle!(IOperationCounterType);
 impl t::Handle for IOperationCounterType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            power_on_duration: b.optional(id, NS[0], "PowerOnDuration")?,
-            operation_duration: b.optional(id, NS[0], "OperationDuration")?,
-            operation_cycle_counter: b.optional(id, NS[0], "OperationCycleCounter")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            power_on_duration: b.build_optional(id, NS[0], "PowerOnDuration"),
+            operation_duration: b.build_optional(id, NS[0], "OperationDuration"),
+            operation_cycle_counter: b.build_optional(id, NS[0], "OperationCycleCounter"),
+        }
     }
 }
 t::object_type!(
@@ -1066,15 +1071,15 @@ pub struct ISupportInfoType {
 }
 t::debug_handle!(ISupportInfoType);
 impl t::Handle for ISupportInfoType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            device_type_image: b.optional(id, NS[0], "DeviceTypeImage")?,
-            documentation: b.optional(id, NS[0], "Documentation")?,
-            documentation_files: b.optional(id, NS[0], "DocumentationFiles")?,
-            protocol_support: b.optional(id, NS[0], "ProtocolSupport")?,
-            image_set: b.optional(id, NS[0], "ImageSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            device_type_image: b.build_optional(id, NS[0], "DeviceTypeImage"),
+            documentation: b.build_optional(id, NS[0], "Documentation"),
+            documentation_files: b.build_optional(id, NS[0], "DocumentationFiles"),
+            protocol_support: b.build_optional(id, NS[0], "ProtocolSupport"),
+            image_set: b.build_optional(id, NS[0], "ImageSet"),
+        }
     }
 }
 /// `DeviceTypeImage`, a member of `ISupportInfoType` with children of its own.
@@ -1088,11 +1093,11 @@ pub struct ISupportInfoType_DeviceTypeImage {
 }
 t::debug_handle!(ISupportInfoType_DeviceTypeImage);
 impl t::Handle for ISupportInfoType_DeviceTypeImage {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            image_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 63))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            image_identifier: b.build_placeholders(id, rt::NsNodeId::numeric(NS[1], 63)),
+        }
     }
 }
 /// `Documentation`, a member of `ISupportInfoType` with children of its own.
@@ -1106,11 +1111,12 @@ pub struct ISupportInfoType_Documentation {
 }
 t::debug_handle!(ISupportInfoType_Documentation);
 impl t::Handle for ISupportInfoType_Documentation {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            document_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 63))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            document_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 63)),
+        }
     }
 }
 /// `DocumentationFiles`, a member of `ISupportInfoType` with children of its own.
@@ -1124,11 +1130,12 @@ pub struct ISupportInfoType_DocumentationFiles {
 }
 t::debug_handle!(ISupportInfoType_DocumentationFiles);
 impl t::Handle for ISupportInfoType_DocumentationFiles {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            document_file_id: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 11575))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            document_file_id: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 11575)),
+        }
     }
 }
 /// `ProtocolSupport`, a member of `ISupportInfoType` with children of its own.
@@ -1142,12 +1149,12 @@ pub struct ISupportInfoType_ProtocolSupport {
 }
 t::debug_handle!(ISupportInfoType_ProtocolSupport);
 impl t::Handle for ISupportInfoType_ProtocolSupport {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             protocol_support_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[1], 63))?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 63)),
+        }
     }
 }
 /// `ImageSet`, a member of `ISupportInfoType` with children of its own.
@@ -1161,11 +1168,11 @@ pub struct ISupportInfoType_ImageSet {
 }
 t::debug_handle!(ISupportInfoType_ImageSet);
 impl t::Handle for ISupportInfoType_ImageSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            image_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 63))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            image_identifier: b.build_placeholders(id, rt::NsNodeId::numeric(NS[1], 63)),
+        }
     }
 }
 t::object_type!(
@@ -1184,12 +1191,12 @@ pub struct ITagNameplateType {
 }
 t::debug_handle!(ITagNameplateType);
 impl t::Handle for ITagNameplateType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            asset_id: b.optional(id, NS[0], "AssetId")?,
-            component_name: b.optional(id, NS[0], "ComponentName")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            asset_id: b.build_optional(id, NS[0], "AssetId"),
+            component_name: b.build_optional(id, NS[0], "ComponentName"),
+        }
     }
 }
 t::object_type!(
@@ -1232,24 +1239,24 @@ pub struct IVendorNameplateType {
 }
 t::debug_handle!(IVendorNameplateType);
 impl t::Handle for IVendorNameplateType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            manufacturer: b.optional(id, NS[0], "Manufacturer")?,
-            manufacturer_uri: b.optional(id, NS[0], "ManufacturerUri")?,
-            model: b.optional(id, NS[0], "Model")?,
-            hardware_revision: b.optional(id, NS[0], "HardwareRevision")?,
-            software_revision: b.optional(id, NS[0], "SoftwareRevision")?,
-            device_revision: b.optional(id, NS[0], "DeviceRevision")?,
-            product_code: b.optional(id, NS[0], "ProductCode")?,
-            device_manual: b.optional(id, NS[0], "DeviceManual")?,
-            device_class: b.optional(id, NS[0], "DeviceClass")?,
-            serial_number: b.optional(id, NS[0], "SerialNumber")?,
-            product_instance_uri: b.optional(id, NS[0], "ProductInstanceUri")?,
-            revision_counter: b.optional(id, NS[0], "RevisionCounter")?,
-            software_release_date: b.optional(id, NS[0], "SoftwareReleaseDate")?,
-            patch_identifiers: b.optional(id, NS[0], "PatchIdentifiers")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            manufacturer: b.build_optional(id, NS[0], "Manufacturer"),
+            manufacturer_uri: b.build_optional(id, NS[0], "ManufacturerUri"),
+            model: b.build_optional(id, NS[0], "Model"),
+            hardware_revision: b.build_optional(id, NS[0], "HardwareRevision"),
+            software_revision: b.build_optional(id, NS[0], "SoftwareRevision"),
+            device_revision: b.build_optional(id, NS[0], "DeviceRevision"),
+            product_code: b.build_optional(id, NS[0], "ProductCode"),
+            device_manual: b.build_optional(id, NS[0], "DeviceManual"),
+            device_class: b.build_optional(id, NS[0], "DeviceClass"),
+            serial_number: b.build_optional(id, NS[0], "SerialNumber"),
+            product_instance_uri: b.build_optional(id, NS[0], "ProductInstanceUri"),
+            revision_counter: b.build_optional(id, NS[0], "RevisionCounter"),
+            software_release_date: b.build_optional(id, NS[0], "SoftwareReleaseDate"),
+            patch_identifiers: b.build_optional(id, NS[0], "PatchIdentifiers"),
+        }
     }
 }
 t::object_type!(
@@ -1286,20 +1293,21 @@ pub struct InstallationStateMachineType {
 }
 t::debug_handle!(InstallationStateMachineType);
 impl t::Handle for InstallationStateMachineType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[1], "CurrentState")?,
-            last_transition: b.optional(id, NS[1], "LastTransition")?,
-            available_states: b.optional(id, NS[1], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[1], "AvailableTransitions")?,
-            percent_complete: b.optional(id, NS[0], "PercentComplete")?,
-            installation_delay: b.optional(id, NS[0], "InstallationDelay")?,
-            install_software_package: b.optional(id, NS[0], "InstallSoftwarePackage")?,
-            install_files: b.optional(id, NS[0], "InstallFiles")?,
-            uninstall: b.optional(id, NS[0], "Uninstall")?,
-            resume: b.child(id, NS[0], "Resume")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[1], "CurrentState"),
+            last_transition: b.build_optional(id, NS[1], "LastTransition"),
+            available_states: b.build_optional(id, NS[1], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[1], "AvailableTransitions"),
+            percent_complete: b.build_optional(id, NS[0], "PercentComplete"),
+            installation_delay: b.build_optional(id, NS[0], "InstallationDelay"),
+            install_software_package: b
+                .build_optional(id, NS[0], "InstallSoftwarePackage"),
+            install_files: b.build_optional(id, NS[0], "InstallFiles"),
+            uninstall: b.build_optional(id, NS[0], "Uninstall"),
+            resume: b.build_child(id, NS[0], "Resume"),
+        }
     }
 }
 t::object_type!(
@@ -1393,11 +1401,11 @@ pub struct LengthIndicationType {
 }
 t::debug_handle!(LengthIndicationType);
 impl t::Handle for LengthIndicationType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+        }
     }
 }
 t::deref_base!(LengthIndicationType => BaseLifetimeIndicationType);
@@ -1437,21 +1445,22 @@ pub struct LifetimeVariableType {
 }
 t::debug_handle!(LifetimeVariableType);
 impl t::Handle for LifetimeVariableType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            definition: b.optional(id, NS[1], "Definition")?,
-            value_precision: b.optional(id, NS[1], "ValuePrecision")?,
-            instrument_range: b.optional(id, NS[1], "InstrumentRange")?,
-            instrument_number_range: b.optional(id, NS[1], "InstrumentNumberRange")?,
-            eu_range: b.optional(id, NS[1], "EURange")?,
-            eu_number_range: b.optional(id, NS[1], "EUNumberRange")?,
-            engineering_units: b.child(id, NS[1], "EngineeringUnits")?,
-            start_value: b.child(id, NS[0], "StartValue")?,
-            limit_value: b.child(id, NS[0], "LimitValue")?,
-            indication: b.optional(id, NS[0], "Indication")?,
-            warning_values: b.optional(id, NS[0], "WarningValues")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            definition: b.build_optional(id, NS[1], "Definition"),
+            value_precision: b.build_optional(id, NS[1], "ValuePrecision"),
+            instrument_range: b.build_optional(id, NS[1], "InstrumentRange"),
+            instrument_number_range: b
+                .build_optional(id, NS[1], "InstrumentNumberRange"),
+            eu_range: b.build_optional(id, NS[1], "EURange"),
+            eu_number_range: b.build_optional(id, NS[1], "EUNumberRange"),
+            engineering_units: b.build_child(id, NS[1], "EngineeringUnits"),
+            start_value: b.build_child(id, NS[0], "StartValue"),
+            limit_value: b.build_child(id, NS[0], "LimitValue"),
+            indication: b.build_optional(id, NS[0], "Indication"),
+            warning_values: b.build_optional(id, NS[0], "WarningValues"),
+        }
     }
 }
 t::variable_type!(
@@ -1482,18 +1491,18 @@ pub struct LockingServicesType {
 }
 t::debug_handle!(LockingServicesType);
 impl t::Handle for LockingServicesType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            locked: b.child(id, NS[0], "Locked")?,
-            locking_client: b.child(id, NS[0], "LockingClient")?,
-            locking_user: b.child(id, NS[0], "LockingUser")?,
-            remaining_lock_time: b.child(id, NS[0], "RemainingLockTime")?,
-            init_lock: b.child(id, NS[0], "InitLock")?,
-            renew_lock: b.child(id, NS[0], "RenewLock")?,
-            exit_lock: b.child(id, NS[0], "ExitLock")?,
-            break_lock: b.child(id, NS[0], "BreakLock")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            locked: b.build_child(id, NS[0], "Locked"),
+            locking_client: b.build_child(id, NS[0], "LockingClient"),
+            locking_user: b.build_child(id, NS[0], "LockingUser"),
+            remaining_lock_time: b.build_child(id, NS[0], "RemainingLockTime"),
+            init_lock: b.build_child(id, NS[0], "InitLock"),
+            renew_lock: b.build_child(id, NS[0], "RenewLock"),
+            exit_lock: b.build_child(id, NS[0], "ExitLock"),
+            break_lock: b.build_child(id, NS[0], "BreakLock"),
+        }
     }
 }
 t::object_type!(
@@ -1510,11 +1519,11 @@ pub struct MaintenanceRequiredAlarmType {
 }
 t::debug_handle!(MaintenanceRequiredAlarmType);
 impl t::Handle for MaintenanceRequiredAlarmType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+        }
     }
 }
 t::deref_base!(MaintenanceRequiredAlarmType => DeviceHealthDiagnosticAlarmType);
@@ -1535,12 +1544,13 @@ pub struct NetworkType {
 }
 t::debug_handle!(NetworkType);
 impl t::Handle for NetworkType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            profile_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[0], 1006))?,
-            lock: b.optional(id, NS[0], "Lock")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            profile_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1006)),
+            lock: b.build_optional(id, NS[0], "Lock"),
+        }
     }
 }
 /// `Lock`, a member of `NetworkType` with children of its own.
@@ -1568,18 +1578,18 @@ pub struct NetworkType_Lock {
 }
 t::debug_handle!(NetworkType_Lock);
 impl t::Handle for NetworkType_Lock {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            locked: b.child(id, NS[0], "Locked")?,
-            locking_client: b.child(id, NS[0], "LockingClient")?,
-            locking_user: b.child(id, NS[0], "LockingUser")?,
-            remaining_lock_time: b.child(id, NS[0], "RemainingLockTime")?,
-            init_lock: b.child(id, NS[0], "InitLock")?,
-            renew_lock: b.child(id, NS[0], "RenewLock")?,
-            exit_lock: b.child(id, NS[0], "ExitLock")?,
-            break_lock: b.child(id, NS[0], "BreakLock")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            locked: b.build_child(id, NS[0], "Locked"),
+            locking_client: b.build_child(id, NS[0], "LockingClient"),
+            locking_user: b.build_child(id, NS[0], "LockingUser"),
+            remaining_lock_time: b.build_child(id, NS[0], "RemainingLockTime"),
+            init_lock: b.build_child(id, NS[0], "InitLock"),
+            renew_lock: b.build_child(id, NS[0], "RenewLock"),
+            exit_lock: b.build_child(id, NS[0], "ExitLock"),
+            break_lock: b.build_child(id, NS[0], "BreakLock"),
+        }
     }
 }
 t::object_type!(NetworkType, rt::NsNodeId::numeric(NS[0], 6247), "NetworkType");
@@ -1596,11 +1606,11 @@ pub struct NumberOfPartsIndicationType {
 }
 t::debug_handle!(NumberOfPartsIndicationType);
 impl t::Handle for NumberOfPartsIndicationType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+        }
     }
 }
 t::deref_base!(NumberOfPartsIndicationType => BaseLifetimeIndicationType);
@@ -1621,11 +1631,11 @@ pub struct NumberOfUsagesIndicationType {
 }
 t::debug_handle!(NumberOfUsagesIndicationType);
 impl t::Handle for NumberOfUsagesIndicationType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+        }
     }
 }
 t::deref_base!(NumberOfUsagesIndicationType => BaseLifetimeIndicationType);
@@ -1644,11 +1654,11 @@ pub struct OffSpecAlarmType {
 }
 t::debug_handle!(OffSpecAlarmType);
 impl t::Handle for OffSpecAlarmType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+        }
     }
 }
 t::deref_base!(OffSpecAlarmType => DeviceHealthDiagnosticAlarmType);
@@ -1674,15 +1684,15 @@ pub struct PackageLoadingType {
 }
 t::debug_handle!(PackageLoadingType);
 impl t::Handle for PackageLoadingType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            current_version: b.child(id, NS[0], "CurrentVersion")?,
-            file_transfer: b.child(id, NS[0], "FileTransfer")?,
-            error_message: b.child(id, NS[0], "ErrorMessage")?,
-            write_block_size: b.optional(id, NS[0], "WriteBlockSize")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            current_version: b.build_child(id, NS[0], "CurrentVersion"),
+            file_transfer: b.build_child(id, NS[0], "FileTransfer"),
+            error_message: b.build_child(id, NS[0], "ErrorMessage"),
+            write_block_size: b.build_optional(id, NS[0], "WriteBlockSize"),
+        }
     }
 }
 t::deref_base!(PackageLoadingType => SoftwareLoadingType);
@@ -1711,18 +1721,18 @@ pub struct PackageLoadingType_CurrentVersion {
 }
 t::debug_handle!(PackageLoadingType_CurrentVersion);
 impl t::Handle for PackageLoadingType_CurrentVersion {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            manufacturer: b.child(id, NS[0], "Manufacturer")?,
-            manufacturer_uri: b.child(id, NS[0], "ManufacturerUri")?,
-            software_revision: b.child(id, NS[0], "SoftwareRevision")?,
-            patch_identifiers: b.optional(id, NS[0], "PatchIdentifiers")?,
-            release_date: b.optional(id, NS[0], "ReleaseDate")?,
-            change_log_reference: b.optional(id, NS[0], "ChangeLogReference")?,
-            hash: b.optional(id, NS[0], "Hash")?,
-            clear: b.optional(id, NS[0], "Clear")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            manufacturer: b.build_child(id, NS[0], "Manufacturer"),
+            manufacturer_uri: b.build_child(id, NS[0], "ManufacturerUri"),
+            software_revision: b.build_child(id, NS[0], "SoftwareRevision"),
+            patch_identifiers: b.build_optional(id, NS[0], "PatchIdentifiers"),
+            release_date: b.build_optional(id, NS[0], "ReleaseDate"),
+            change_log_reference: b.build_optional(id, NS[0], "ChangeLogReference"),
+            hash: b.build_optional(id, NS[0], "Hash"),
+            clear: b.build_optional(id, NS[0], "Clear"),
+        }
     }
 }
 /// `FileTransfer`, a member of `PackageLoadingType` with children of its own.
@@ -1744,15 +1754,16 @@ pub struct PackageLoadingType_FileTransfer {
 }
 t::debug_handle!(PackageLoadingType_FileTransfer);
 impl t::Handle for PackageLoadingType_FileTransfer {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            client_processing_timeout: b.child(id, NS[1], "ClientProcessingTimeout")?,
-            generate_file_for_read: b.child(id, NS[1], "GenerateFileForRead")?,
-            generate_file_for_write: b.child(id, NS[1], "GenerateFileForWrite")?,
-            close_and_commit: b.child(id, NS[1], "CloseAndCommit")?,
-            transfer_state: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 15803))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            client_processing_timeout: b
+                .build_child(id, NS[1], "ClientProcessingTimeout"),
+            generate_file_for_read: b.build_child(id, NS[1], "GenerateFileForRead"),
+            generate_file_for_write: b.build_child(id, NS[1], "GenerateFileForWrite"),
+            close_and_commit: b.build_child(id, NS[1], "CloseAndCommit"),
+            transfer_state: b.build_placeholders(id, rt::NsNodeId::numeric(NS[1], 15803)),
+        }
     }
 }
 t::object_type!(
@@ -1775,14 +1786,14 @@ pub struct PowerCycleStateMachineType {
 }
 t::debug_handle!(PowerCycleStateMachineType);
 impl t::Handle for PowerCycleStateMachineType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[1], "CurrentState")?,
-            last_transition: b.optional(id, NS[1], "LastTransition")?,
-            available_states: b.optional(id, NS[1], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[1], "AvailableTransitions")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[1], "CurrentState"),
+            last_transition: b.build_optional(id, NS[1], "LastTransition"),
+            available_states: b.build_optional(id, NS[1], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[1], "AvailableTransitions"),
+        }
     }
 }
 t::object_type!(
@@ -1859,18 +1870,18 @@ pub struct PrepareForUpdateStateMachineType {
 }
 t::debug_handle!(PrepareForUpdateStateMachineType);
 impl t::Handle for PrepareForUpdateStateMachineType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[1], "CurrentState")?,
-            last_transition: b.optional(id, NS[1], "LastTransition")?,
-            available_states: b.optional(id, NS[1], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[1], "AvailableTransitions")?,
-            percent_complete: b.optional(id, NS[0], "PercentComplete")?,
-            prepare: b.child(id, NS[0], "Prepare")?,
-            abort: b.child(id, NS[0], "Abort")?,
-            resume: b.optional(id, NS[0], "Resume")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[1], "CurrentState"),
+            last_transition: b.build_optional(id, NS[1], "LastTransition"),
+            available_states: b.build_optional(id, NS[1], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[1], "AvailableTransitions"),
+            percent_complete: b.build_optional(id, NS[0], "PercentComplete"),
+            prepare: b.build_child(id, NS[0], "Prepare"),
+            abort: b.build_child(id, NS[0], "Abort"),
+            resume: b.build_optional(id, NS[0], "Resume"),
+        }
     }
 }
 t::object_type!(
@@ -1972,8 +1983,8 @@ pub struct ProtocolType {
 }
 t::debug_handle!(ProtocolType);
 impl t::Handle for ProtocolType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self { node: b.this(id)? })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self { node: b.build_this(id) }
     }
 }
 t::object_type!(ProtocolType, rt::NsNodeId::numeric(NS[0], 1006), "ProtocolType");
@@ -1992,13 +2003,13 @@ pub struct SoftwareFolderType {
 }
 t::debug_handle!(SoftwareFolderType);
 impl t::Handle for SoftwareFolderType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            software_class: b.child(id, NS[0], "SoftwareClass")?,
-            add: b.child(id, NS[0], "Add")?,
-            delete: b.child(id, NS[0], "Delete")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            software_class: b.build_child(id, NS[0], "SoftwareClass"),
+            add: b.build_child(id, NS[0], "Add"),
+            delete: b.build_child(id, NS[0], "Delete"),
+        }
     }
 }
 t::object_type!(
@@ -2015,11 +2026,11 @@ pub struct SoftwareLoadingType {
 }
 t::debug_handle!(SoftwareLoadingType);
 impl t::Handle for SoftwareLoadingType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            update_key: b.optional(id, NS[0], "UpdateKey")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            update_key: b.build_optional(id, NS[0], "UpdateKey"),
+        }
     }
 }
 t::object_type!(
@@ -2042,14 +2053,14 @@ pub struct SoftwareType {
 }
 t::debug_handle!(SoftwareType);
 impl t::Handle for SoftwareType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            manufacturer: b.child(id, NS[0], "Manufacturer")?,
-            model: b.child(id, NS[0], "Model")?,
-            software_revision: b.child(id, NS[0], "SoftwareRevision")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            manufacturer: b.build_child(id, NS[0], "Manufacturer"),
+            model: b.build_child(id, NS[0], "Model"),
+            software_revision: b.build_child(id, NS[0], "SoftwareRevision"),
+        }
     }
 }
 t::deref_base!(SoftwareType => ComponentType);
@@ -2087,22 +2098,23 @@ pub struct SoftwareUpdateType {
 }
 t::debug_handle!(SoftwareUpdateType);
 impl t::Handle for SoftwareUpdateType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            loading: b.optional(id, NS[0], "Loading")?,
-            prepare_for_update: b.optional(id, NS[0], "PrepareForUpdate")?,
-            installation: b.optional(id, NS[0], "Installation")?,
-            power_cycle: b.optional(id, NS[0], "PowerCycle")?,
-            confirmation: b.optional(id, NS[0], "Confirmation")?,
-            parameters: b.optional(id, NS[0], "Parameters")?,
-            update_status: b.optional(id, NS[0], "UpdateStatus")?,
-            software_class: b.optional(id, NS[0], "SoftwareClass")?,
-            software_subclass: b.optional(id, NS[0], "SoftwareSubclass")?,
-            software_name: b.optional(id, NS[0], "SoftwareName")?,
-            unsigned_package_allowed: b.optional(id, NS[0], "UnsignedPackageAllowed")?,
-            vendor_error_code: b.optional(id, NS[0], "VendorErrorCode")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            loading: b.build_optional(id, NS[0], "Loading"),
+            prepare_for_update: b.build_optional(id, NS[0], "PrepareForUpdate"),
+            installation: b.build_optional(id, NS[0], "Installation"),
+            power_cycle: b.build_optional(id, NS[0], "PowerCycle"),
+            confirmation: b.build_optional(id, NS[0], "Confirmation"),
+            parameters: b.build_optional(id, NS[0], "Parameters"),
+            update_status: b.build_optional(id, NS[0], "UpdateStatus"),
+            software_class: b.build_optional(id, NS[0], "SoftwareClass"),
+            software_subclass: b.build_optional(id, NS[0], "SoftwareSubclass"),
+            software_name: b.build_optional(id, NS[0], "SoftwareName"),
+            unsigned_package_allowed: b
+                .build_optional(id, NS[0], "UnsignedPackageAllowed"),
+            vendor_error_code: b.build_optional(id, NS[0], "VendorErrorCode"),
+        }
     }
 }
 /// `PrepareForUpdate`, a member of `SoftwareUpdateType` with children of its own.
@@ -2130,18 +2142,18 @@ pub struct SoftwareUpdateType_PrepareForUpdate {
 }
 t::debug_handle!(SoftwareUpdateType_PrepareForUpdate);
 impl t::Handle for SoftwareUpdateType_PrepareForUpdate {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[1], "CurrentState")?,
-            last_transition: b.optional(id, NS[1], "LastTransition")?,
-            available_states: b.optional(id, NS[1], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[1], "AvailableTransitions")?,
-            percent_complete: b.optional(id, NS[0], "PercentComplete")?,
-            prepare: b.child(id, NS[0], "Prepare")?,
-            abort: b.child(id, NS[0], "Abort")?,
-            resume: b.optional(id, NS[0], "Resume")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[1], "CurrentState"),
+            last_transition: b.build_optional(id, NS[1], "LastTransition"),
+            available_states: b.build_optional(id, NS[1], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[1], "AvailableTransitions"),
+            percent_complete: b.build_optional(id, NS[0], "PercentComplete"),
+            prepare: b.build_child(id, NS[0], "Prepare"),
+            abort: b.build_child(id, NS[0], "Abort"),
+            resume: b.build_optional(id, NS[0], "Resume"),
+        }
     }
 }
 /// `Installation`, a member of `SoftwareUpdateType` with children of its own.
@@ -2175,20 +2187,21 @@ pub struct SoftwareUpdateType_Installation {
 }
 t::debug_handle!(SoftwareUpdateType_Installation);
 impl t::Handle for SoftwareUpdateType_Installation {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[1], "CurrentState")?,
-            last_transition: b.optional(id, NS[1], "LastTransition")?,
-            available_states: b.optional(id, NS[1], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[1], "AvailableTransitions")?,
-            percent_complete: b.optional(id, NS[0], "PercentComplete")?,
-            installation_delay: b.optional(id, NS[0], "InstallationDelay")?,
-            install_software_package: b.optional(id, NS[0], "InstallSoftwarePackage")?,
-            install_files: b.optional(id, NS[0], "InstallFiles")?,
-            uninstall: b.optional(id, NS[0], "Uninstall")?,
-            resume: b.child(id, NS[0], "Resume")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[1], "CurrentState"),
+            last_transition: b.build_optional(id, NS[1], "LastTransition"),
+            available_states: b.build_optional(id, NS[1], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[1], "AvailableTransitions"),
+            percent_complete: b.build_optional(id, NS[0], "PercentComplete"),
+            installation_delay: b.build_optional(id, NS[0], "InstallationDelay"),
+            install_software_package: b
+                .build_optional(id, NS[0], "InstallSoftwarePackage"),
+            install_files: b.build_optional(id, NS[0], "InstallFiles"),
+            uninstall: b.build_optional(id, NS[0], "Uninstall"),
+            resume: b.build_child(id, NS[0], "Resume"),
+        }
     }
 }
 /// `PowerCycle`, a member of `SoftwareUpdateType` with children of its own.
@@ -2208,14 +2221,14 @@ pub struct SoftwareUpdateType_PowerCycle {
 }
 t::debug_handle!(SoftwareUpdateType_PowerCycle);
 impl t::Handle for SoftwareUpdateType_PowerCycle {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[1], "CurrentState")?,
-            last_transition: b.optional(id, NS[1], "LastTransition")?,
-            available_states: b.optional(id, NS[1], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[1], "AvailableTransitions")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[1], "CurrentState"),
+            last_transition: b.build_optional(id, NS[1], "LastTransition"),
+            available_states: b.build_optional(id, NS[1], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[1], "AvailableTransitions"),
+        }
     }
 }
 /// `Confirmation`, a member of `SoftwareUpdateType` with children of its own.
@@ -2239,16 +2252,16 @@ pub struct SoftwareUpdateType_Confirmation {
 }
 t::debug_handle!(SoftwareUpdateType_Confirmation);
 impl t::Handle for SoftwareUpdateType_Confirmation {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[1], "CurrentState")?,
-            last_transition: b.optional(id, NS[1], "LastTransition")?,
-            available_states: b.optional(id, NS[1], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[1], "AvailableTransitions")?,
-            confirm: b.child(id, NS[0], "Confirm")?,
-            confirmation_timeout: b.child(id, NS[0], "ConfirmationTimeout")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[1], "CurrentState"),
+            last_transition: b.build_optional(id, NS[1], "LastTransition"),
+            available_states: b.build_optional(id, NS[1], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[1], "AvailableTransitions"),
+            confirm: b.build_child(id, NS[0], "Confirm"),
+            confirmation_timeout: b.build_child(id, NS[0], "ConfirmationTimeout"),
+        }
     }
 }
 /// `Parameters`, a member of `SoftwareUpdateType` with children of its own.
@@ -2270,15 +2283,16 @@ pub struct SoftwareUpdateType_Parameters {
 }
 t::debug_handle!(SoftwareUpdateType_Parameters);
 impl t::Handle for SoftwareUpdateType_Parameters {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            client_processing_timeout: b.child(id, NS[1], "ClientProcessingTimeout")?,
-            generate_file_for_read: b.child(id, NS[1], "GenerateFileForRead")?,
-            generate_file_for_write: b.child(id, NS[1], "GenerateFileForWrite")?,
-            close_and_commit: b.child(id, NS[1], "CloseAndCommit")?,
-            transfer_state: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 15803))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            client_processing_timeout: b
+                .build_child(id, NS[1], "ClientProcessingTimeout"),
+            generate_file_for_read: b.build_child(id, NS[1], "GenerateFileForRead"),
+            generate_file_for_write: b.build_child(id, NS[1], "GenerateFileForWrite"),
+            close_and_commit: b.build_child(id, NS[1], "CloseAndCommit"),
+            transfer_state: b.build_placeholders(id, rt::NsNodeId::numeric(NS[1], 15803)),
+        }
     }
 }
 t::object_type!(
@@ -2309,18 +2323,18 @@ pub struct SoftwareVersionType {
 }
 t::debug_handle!(SoftwareVersionType);
 impl t::Handle for SoftwareVersionType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            manufacturer: b.child(id, NS[0], "Manufacturer")?,
-            manufacturer_uri: b.child(id, NS[0], "ManufacturerUri")?,
-            software_revision: b.child(id, NS[0], "SoftwareRevision")?,
-            patch_identifiers: b.optional(id, NS[0], "PatchIdentifiers")?,
-            release_date: b.optional(id, NS[0], "ReleaseDate")?,
-            change_log_reference: b.optional(id, NS[0], "ChangeLogReference")?,
-            hash: b.optional(id, NS[0], "Hash")?,
-            clear: b.optional(id, NS[0], "Clear")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            manufacturer: b.build_child(id, NS[0], "Manufacturer"),
+            manufacturer_uri: b.build_child(id, NS[0], "ManufacturerUri"),
+            software_revision: b.build_child(id, NS[0], "SoftwareRevision"),
+            patch_identifiers: b.build_optional(id, NS[0], "PatchIdentifiers"),
+            release_date: b.build_optional(id, NS[0], "ReleaseDate"),
+            change_log_reference: b.build_optional(id, NS[0], "ChangeLogReference"),
+            hash: b.build_optional(id, NS[0], "Hash"),
+            clear: b.build_optional(id, NS[0], "Clear"),
+        }
     }
 }
 t::object_type!(
@@ -2339,11 +2353,11 @@ pub struct SubstanceVolumeIndicationType {
 }
 t::debug_handle!(SubstanceVolumeIndicationType);
 impl t::Handle for SubstanceVolumeIndicationType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+        }
     }
 }
 t::deref_base!(SubstanceVolumeIndicationType => BaseLifetimeIndicationType);
@@ -2364,11 +2378,11 @@ pub struct TimeIndicationType {
 }
 t::debug_handle!(TimeIndicationType);
 impl t::Handle for TimeIndicationType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+        }
     }
 }
 t::deref_base!(TimeIndicationType => BaseLifetimeIndicationType);
@@ -2394,15 +2408,16 @@ pub struct TopologyElementType {
 }
 t::debug_handle!(TopologyElementType);
 impl t::Handle for TopologyElementType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            parameter_set: b.optional(id, NS[0], "ParameterSet")?,
-            method_set: b.optional(id, NS[0], "MethodSet")?,
-            group_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[0], 1005))?,
-            identification: b.optional(id, NS[0], "Identification")?,
-            lock: b.optional(id, NS[0], "Lock")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            parameter_set: b.build_optional(id, NS[0], "ParameterSet"),
+            method_set: b.build_optional(id, NS[0], "MethodSet"),
+            group_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1005)),
+            identification: b.build_optional(id, NS[0], "Identification"),
+            lock: b.build_optional(id, NS[0], "Lock"),
+        }
     }
 }
 /// `ParameterSet`, a member of `TopologyElementType` with children of its own.
@@ -2416,11 +2431,12 @@ pub struct TopologyElementType_ParameterSet {
 }
 t::debug_handle!(TopologyElementType_ParameterSet);
 impl t::Handle for TopologyElementType_ParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            parameter_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 63))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            parameter_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 63)),
+        }
     }
 }
 /// `Lock`, a member of `TopologyElementType` with children of its own.
@@ -2448,18 +2464,18 @@ pub struct TopologyElementType_Lock {
 }
 t::debug_handle!(TopologyElementType_Lock);
 impl t::Handle for TopologyElementType_Lock {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            locked: b.child(id, NS[0], "Locked")?,
-            locking_client: b.child(id, NS[0], "LockingClient")?,
-            locking_user: b.child(id, NS[0], "LockingUser")?,
-            remaining_lock_time: b.child(id, NS[0], "RemainingLockTime")?,
-            init_lock: b.child(id, NS[0], "InitLock")?,
-            renew_lock: b.child(id, NS[0], "RenewLock")?,
-            exit_lock: b.child(id, NS[0], "ExitLock")?,
-            break_lock: b.child(id, NS[0], "BreakLock")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            locked: b.build_child(id, NS[0], "Locked"),
+            locking_client: b.build_child(id, NS[0], "LockingClient"),
+            locking_user: b.build_child(id, NS[0], "LockingUser"),
+            remaining_lock_time: b.build_child(id, NS[0], "RemainingLockTime"),
+            init_lock: b.build_child(id, NS[0], "InitLock"),
+            renew_lock: b.build_child(id, NS[0], "RenewLock"),
+            exit_lock: b.build_child(id, NS[0], "ExitLock"),
+            break_lock: b.build_child(id, NS[0], "BreakLock"),
+        }
     }
 }
 t::object_type!(
@@ -2483,13 +2499,14 @@ pub struct TransferServicesType {
 }
 t::debug_handle!(TransferServicesType);
 impl t::Handle for TransferServicesType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            transfer_to_device: b.child(id, NS[0], "TransferToDevice")?,
-            transfer_from_device: b.child(id, NS[0], "TransferFromDevice")?,
-            fetch_transfer_result_data: b.child(id, NS[0], "FetchTransferResultData")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            transfer_to_device: b.build_child(id, NS[0], "TransferToDevice"),
+            transfer_from_device: b.build_child(id, NS[0], "TransferFromDevice"),
+            fetch_transfer_result_data: b
+                .build_child(id, NS[0], "FetchTransferResultData"),
+        }
     }
 }
 t::object_type!(
@@ -2504,8 +2521,8 @@ pub struct UIElementType {
 }
 t::debug_handle!(UIElementType);
 impl t::Handle for UIElementType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self { node: b.this(id)? })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self { node: b.build_this(id) }
     }
 }
 t::variable_type!(UIElementType, rt::NsNodeId::numeric(NS[0], 6246), "UIElementType");

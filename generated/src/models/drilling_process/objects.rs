@@ -32,12 +32,12 @@ pub struct DrillHoleSkillType {
 }
 t::debug_handle!(DrillHoleSkillType);
 impl t::Handle for DrillHoleSkillType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            input_parameter_set: b.child(id, NS[1], "InputParameterSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            input_parameter_set: b.build_child(id, NS[1], "InputParameterSet"),
+        }
     }
 }
 t::deref_base!(
@@ -64,16 +64,16 @@ pub struct DrillHoleSkillType_InputParameterSet {
 }
 t::debug_handle!(DrillHoleSkillType_InputParameterSet);
 impl t::Handle for DrillHoleSkillType_InputParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            insertion_distance: b.child(id, NS[0], "InsertionDistance")?,
-            hole_diameter: b.child(id, NS[0], "HoleDiameter")?,
-            depth: b.child(id, NS[0], "Depth")?,
-            feed_rate: b.child(id, NS[0], "FeedRate")?,
-            spindle_speed: b.child(id, NS[0], "SpindleSpeed")?,
-            clamp_force: b.child(id, NS[0], "ClampForce")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            insertion_distance: b.build_child(id, NS[0], "InsertionDistance"),
+            hole_diameter: b.build_child(id, NS[0], "HoleDiameter"),
+            depth: b.build_child(id, NS[0], "Depth"),
+            feed_rate: b.build_child(id, NS[0], "FeedRate"),
+            spindle_speed: b.build_child(id, NS[0], "SpindleSpeed"),
+            clamp_force: b.build_child(id, NS[0], "ClampForce"),
+        }
     }
 }
 t::object_type!(
@@ -126,11 +126,11 @@ pub struct DrillingCellType {
 }
 t::debug_handle!(DrillingCellType);
 impl t::Handle for DrillingCellType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            skill_set: b.child(id, NS[1], "SkillSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            skill_set: b.build_child(id, NS[1], "SkillSet"),
+        }
     }
 }
 /// `SkillSet`, a member of `DrillingCellType` with children of its own.
@@ -146,12 +146,12 @@ pub struct DrillingCellType_SkillSet {
 }
 t::debug_handle!(DrillingCellType_SkillSet);
 impl t::Handle for DrillingCellType_SkillSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            reference_drill_bush: b.child(id, NS[0], "ReferenceDrillBush")?,
-            drill_hole: b.child(id, NS[0], "DrillHole")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            reference_drill_bush: b.build_child(id, NS[0], "ReferenceDrillBush"),
+            drill_hole: b.build_child(id, NS[0], "DrillHole"),
+        }
     }
 }
 /// `ReferenceDrillBush`, a member of `DrillingCellType_SkillSet` with children of its own.
@@ -195,26 +195,26 @@ pub struct DrillingCellType_SkillSet_ReferenceDrillBush {
 }
 t::debug_handle!(DrillingCellType_SkillSet_ReferenceDrillBush);
 impl t::Handle for DrillingCellType_SkillSet_ReferenceDrillBush {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
-            deletable: b.child(id, NS[2], "Deletable")?,
-            auto_delete: b.child(id, NS[2], "AutoDelete")?,
-            recycle_count: b.child(id, NS[2], "RecycleCount")?,
-            program_diagnostic: b.optional(id, NS[2], "ProgramDiagnostic")?,
-            final_result_data: b.optional(id, NS[2], "FinalResultData")?,
-            start: b.child(id, NS[2], "Start")?,
-            suspend: b.child(id, NS[2], "Suspend")?,
-            resume: b.child(id, NS[2], "Resume")?,
-            halt: b.child(id, NS[2], "Halt")?,
-            reset: b.child(id, NS[2], "Reset")?,
-            input_parameter_set: b.child(id, NS[1], "InputParameterSet")?,
-            output_parameter_set: b.child(id, NS[1], "OutputParameterSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
+            deletable: b.build_child(id, NS[2], "Deletable"),
+            auto_delete: b.build_child(id, NS[2], "AutoDelete"),
+            recycle_count: b.build_child(id, NS[2], "RecycleCount"),
+            program_diagnostic: b.build_optional(id, NS[2], "ProgramDiagnostic"),
+            final_result_data: b.build_optional(id, NS[2], "FinalResultData"),
+            start: b.build_child(id, NS[2], "Start"),
+            suspend: b.build_child(id, NS[2], "Suspend"),
+            resume: b.build_child(id, NS[2], "Resume"),
+            halt: b.build_child(id, NS[2], "Halt"),
+            reset: b.build_child(id, NS[2], "Reset"),
+            input_parameter_set: b.build_child(id, NS[1], "InputParameterSet"),
+            output_parameter_set: b.build_child(id, NS[1], "OutputParameterSet"),
+        }
     }
 }
 /// `DrillHole`, a member of `DrillingCellType_SkillSet` with children of its own.
@@ -258,26 +258,26 @@ pub struct DrillingCellType_SkillSet_DrillHole {
 }
 t::debug_handle!(DrillingCellType_SkillSet_DrillHole);
 impl t::Handle for DrillingCellType_SkillSet_DrillHole {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
-            deletable: b.child(id, NS[2], "Deletable")?,
-            auto_delete: b.child(id, NS[2], "AutoDelete")?,
-            recycle_count: b.child(id, NS[2], "RecycleCount")?,
-            program_diagnostic: b.optional(id, NS[2], "ProgramDiagnostic")?,
-            final_result_data: b.optional(id, NS[2], "FinalResultData")?,
-            start: b.child(id, NS[2], "Start")?,
-            suspend: b.child(id, NS[2], "Suspend")?,
-            resume: b.child(id, NS[2], "Resume")?,
-            halt: b.child(id, NS[2], "Halt")?,
-            reset: b.child(id, NS[2], "Reset")?,
-            input_parameter_set: b.child(id, NS[1], "InputParameterSet")?,
-            output_parameter_set: b.child(id, NS[1], "OutputParameterSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
+            deletable: b.build_child(id, NS[2], "Deletable"),
+            auto_delete: b.build_child(id, NS[2], "AutoDelete"),
+            recycle_count: b.build_child(id, NS[2], "RecycleCount"),
+            program_diagnostic: b.build_optional(id, NS[2], "ProgramDiagnostic"),
+            final_result_data: b.build_optional(id, NS[2], "FinalResultData"),
+            start: b.build_child(id, NS[2], "Start"),
+            suspend: b.build_child(id, NS[2], "Suspend"),
+            resume: b.build_child(id, NS[2], "Resume"),
+            halt: b.build_child(id, NS[2], "Halt"),
+            reset: b.build_child(id, NS[2], "Reset"),
+            input_parameter_set: b.build_child(id, NS[1], "InputParameterSet"),
+            output_parameter_set: b.build_child(id, NS[1], "OutputParameterSet"),
+        }
     }
 }
 t::object_type!(
@@ -300,13 +300,13 @@ pub struct ReferenceDrillBushSkillType {
 }
 t::debug_handle!(ReferenceDrillBushSkillType);
 impl t::Handle for ReferenceDrillBushSkillType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            input_parameter_set: b.child(id, NS[1], "InputParameterSet")?,
-            output_parameter_set: b.child(id, NS[1], "OutputParameterSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            input_parameter_set: b.build_child(id, NS[1], "InputParameterSet"),
+            output_parameter_set: b.build_child(id, NS[1], "OutputParameterSet"),
+        }
     }
 }
 t::deref_base!(
@@ -326,12 +326,12 @@ pub struct ReferenceDrillBushSkillType_InputParameterSet {
 }
 t::debug_handle!(ReferenceDrillBushSkillType_InputParameterSet);
 impl t::Handle for ReferenceDrillBushSkillType_InputParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            hole_position: b.child(id, NS[0], "HolePosition")?,
-            approach_distance: b.child(id, NS[0], "ApproachDistance")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            hole_position: b.build_child(id, NS[0], "HolePosition"),
+            approach_distance: b.build_child(id, NS[0], "ApproachDistance"),
+        }
     }
 }
 /// `OutputParameterSet`, a member of `ReferenceDrillBushSkillType` with children of its own.
@@ -347,12 +347,12 @@ pub struct ReferenceDrillBushSkillType_OutputParameterSet {
 }
 t::debug_handle!(ReferenceDrillBushSkillType_OutputParameterSet);
 impl t::Handle for ReferenceDrillBushSkillType_OutputParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            result: b.child(id, NS[1], "Result")?,
-            referenced_hole_position: b.child(id, NS[0], "ReferencedHolePosition")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            result: b.build_child(id, NS[1], "Result"),
+            referenced_hole_position: b.build_child(id, NS[0], "ReferencedHolePosition"),
+        }
     }
 }
 t::object_type!(

@@ -32,12 +32,12 @@ pub struct AcousticSignalType {
 }
 t::debug_handle!(AcousticSignalType);
 impl t::Handle for AcousticSignalType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            audio_sample: b.optional(id, NS[0], "AudioSample")?,
-            number_in_list: b.child(id, NS[1], "NumberInList")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            audio_sample: b.build_optional(id, NS[0], "AudioSample"),
+            number_in_list: b.build_child(id, NS[1], "NumberInList"),
+        }
     }
 }
 t::object_type!(
@@ -54,8 +54,8 @@ pub struct BaseCalibrationTargetCategoryType {
 }
 t::debug_handle!(BaseCalibrationTargetCategoryType);
 impl t::Handle for BaseCalibrationTargetCategoryType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self { node: b.this(id)? })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self { node: b.build_this(id) }
     }
 }
 t::object_type!(
@@ -83,15 +83,15 @@ pub struct BasicStacklightType {
 }
 t::debug_handle!(BasicStacklightType);
 impl t::Handle for BasicStacklightType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            ordered_object: b.placeholders(id, rt::NsNodeId::numeric(NS[0], 1005))?,
-            node_version: b.optional(id, NS[1], "NodeVersion")?,
-            stack_level: b.optional(id, NS[0], "StackLevel")?,
-            stacklight_mode: b.child(id, NS[0], "StacklightMode")?,
-            stack_running: b.optional(id, NS[0], "StackRunning")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            ordered_object: b.build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1005)),
+            node_version: b.build_optional(id, NS[1], "NodeVersion"),
+            stack_level: b.build_optional(id, NS[0], "StackLevel"),
+            stacklight_mode: b.build_child(id, NS[0], "StacklightMode"),
+            stack_running: b.build_optional(id, NS[0], "StackRunning"),
+        }
     }
 }
 /// `StackLevel`, a member of `BasicStacklightType` with children of its own.
@@ -107,12 +107,12 @@ pub struct BasicStacklightType_StackLevel {
 }
 t::debug_handle!(BasicStacklightType_StackLevel);
 impl t::Handle for BasicStacklightType_StackLevel {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            display_mode: b.child(id, NS[0], "DisplayMode")?,
-            level_percent: b.child(id, NS[0], "LevelPercent")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            display_mode: b.build_child(id, NS[0], "DisplayMode"),
+            level_percent: b.build_child(id, NS[0], "LevelPercent"),
+        }
     }
 }
 t::object_type!(
@@ -145,20 +145,20 @@ pub struct CalibrationTargetType {
 }
 t::debug_handle!(CalibrationTargetType);
 impl t::Handle for CalibrationTargetType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             calibration_target_category: b
-                .child(id, NS[0], "CalibrationTargetCategory")?,
+                .build_child(id, NS[0], "CalibrationTargetCategory"),
             calibration_target_features: b
-                .child(id, NS[0], "CalibrationTargetFeatures")?,
-            certificate_uri: b.optional(id, NS[0], "CertificateUri")?,
-            identification: b.child(id, NS[2], "Identification")?,
-            last_validation_date: b.optional(id, NS[0], "LastValidationDate")?,
-            next_validation_date: b.optional(id, NS[0], "NextValidationDate")?,
-            operational_conditions: b.optional(id, NS[0], "OperationalConditions")?,
-            quality: b.optional(id, NS[0], "Quality")?,
-        })
+                .build_child(id, NS[0], "CalibrationTargetFeatures"),
+            certificate_uri: b.build_optional(id, NS[0], "CertificateUri"),
+            identification: b.build_child(id, NS[2], "Identification"),
+            last_validation_date: b.build_optional(id, NS[0], "LastValidationDate"),
+            next_validation_date: b.build_optional(id, NS[0], "NextValidationDate"),
+            operational_conditions: b.build_optional(id, NS[0], "OperationalConditions"),
+            quality: b.build_optional(id, NS[0], "Quality"),
+        }
     }
 }
 /// `CalibrationTargetFeatures`, a member of `CalibrationTargetType` with children of its own.
@@ -174,12 +174,13 @@ pub struct CalibrationTargetType_CalibrationTargetFeatures {
 }
 t::debug_handle!(CalibrationTargetType_CalibrationTargetFeatures);
 impl t::Handle for CalibrationTargetType_CalibrationTargetFeatures {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            calibration_value: b.placeholders(id, rt::NsNodeId::numeric(NS[0], 2002))?,
-            capacity_range: b.placeholders(id, rt::NsNodeId::numeric(NS[0], 2003))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            calibration_value: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 2002)),
+            capacity_range: b.build_placeholders(id, rt::NsNodeId::numeric(NS[0], 2003)),
+        }
     }
 }
 /// `Identification`, a member of `CalibrationTargetType` with children of its own.
@@ -225,26 +226,27 @@ pub struct CalibrationTargetType_Identification {
 }
 t::debug_handle!(CalibrationTargetType_Identification);
 impl t::Handle for CalibrationTargetType_Identification {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            group_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[2], 1005))?,
-            ui_element: b.optional(id, NS[2], "UIElement")?,
-            asset_id: b.optional(id, NS[2], "AssetId")?,
-            component_name: b.optional(id, NS[2], "ComponentName")?,
-            device_class: b.optional(id, NS[2], "DeviceClass")?,
-            device_manual: b.optional(id, NS[2], "DeviceManual")?,
-            device_revision: b.optional(id, NS[2], "DeviceRevision")?,
-            hardware_revision: b.optional(id, NS[2], "HardwareRevision")?,
-            manufacturer: b.optional(id, NS[2], "Manufacturer")?,
-            manufacturer_uri: b.optional(id, NS[2], "ManufacturerUri")?,
-            model: b.optional(id, NS[2], "Model")?,
-            product_code: b.optional(id, NS[2], "ProductCode")?,
-            product_instance_uri: b.optional(id, NS[2], "ProductInstanceUri")?,
-            revision_counter: b.optional(id, NS[2], "RevisionCounter")?,
-            serial_number: b.optional(id, NS[2], "SerialNumber")?,
-            software_revision: b.optional(id, NS[2], "SoftwareRevision")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            group_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[2], 1005)),
+            ui_element: b.build_optional(id, NS[2], "UIElement"),
+            asset_id: b.build_optional(id, NS[2], "AssetId"),
+            component_name: b.build_optional(id, NS[2], "ComponentName"),
+            device_class: b.build_optional(id, NS[2], "DeviceClass"),
+            device_manual: b.build_optional(id, NS[2], "DeviceManual"),
+            device_revision: b.build_optional(id, NS[2], "DeviceRevision"),
+            hardware_revision: b.build_optional(id, NS[2], "HardwareRevision"),
+            manufacturer: b.build_optional(id, NS[2], "Manufacturer"),
+            manufacturer_uri: b.build_optional(id, NS[2], "ManufacturerUri"),
+            model: b.build_optional(id, NS[2], "Model"),
+            product_code: b.build_optional(id, NS[2], "ProductCode"),
+            product_instance_uri: b.build_optional(id, NS[2], "ProductInstanceUri"),
+            revision_counter: b.build_optional(id, NS[2], "RevisionCounter"),
+            serial_number: b.build_optional(id, NS[2], "SerialNumber"),
+            software_revision: b.build_optional(id, NS[2], "SoftwareRevision"),
+        }
     }
 }
 t::object_type!(
@@ -267,13 +269,13 @@ pub struct CalibrationValueType {
 }
 t::debug_handle!(CalibrationValueType);
 impl t::Handle for CalibrationValueType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            definition: b.optional(id, NS[1], "Definition")?,
-            value_precision: b.optional(id, NS[1], "ValuePrecision")?,
-            engineering_units: b.child(id, NS[1], "EngineeringUnits")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            definition: b.build_optional(id, NS[1], "Definition"),
+            value_precision: b.build_optional(id, NS[1], "ValuePrecision"),
+            engineering_units: b.build_child(id, NS[1], "EngineeringUnits"),
+        }
     }
 }
 t::variable_type!(
@@ -298,14 +300,14 @@ pub struct CapacityRangeType {
 }
 t::debug_handle!(CapacityRangeType);
 impl t::Handle for CapacityRangeType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            definition: b.optional(id, NS[1], "Definition")?,
-            value_precision: b.optional(id, NS[1], "ValuePrecision")?,
-            engineering_units: b.child(id, NS[1], "EngineeringUnits")?,
-            resolution: b.child(id, NS[0], "Resolution")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            definition: b.build_optional(id, NS[1], "Definition"),
+            value_precision: b.build_optional(id, NS[1], "ValuePrecision"),
+            engineering_units: b.build_child(id, NS[1], "EngineeringUnits"),
+            resolution: b.build_child(id, NS[0], "Resolution"),
+        }
     }
 }
 t::variable_type!(
@@ -330,14 +332,14 @@ pub struct ControlChannelType {
 }
 t::debug_handle!(ControlChannelType);
 impl t::Handle for ControlChannelType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            channel_color: b.child(id, NS[0], "ChannelColor")?,
-            intensity: b.optional(id, NS[0], "Intensity")?,
-            signal_mode: b.child(id, NS[0], "SignalMode")?,
-            signal_on: b.child(id, NS[0], "SignalOn")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            channel_color: b.build_child(id, NS[0], "ChannelColor"),
+            intensity: b.build_optional(id, NS[0], "Intensity"),
+            signal_mode: b.build_child(id, NS[0], "SignalMode"),
+            signal_on: b.build_child(id, NS[0], "SignalOn"),
+        }
     }
 }
 t::object_type!(
@@ -356,11 +358,11 @@ pub struct DynamicCalibrationTargetCategoryType {
 }
 t::debug_handle!(DynamicCalibrationTargetCategoryType);
 impl t::Handle for DynamicCalibrationTargetCategoryType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+        }
     }
 }
 t::deref_base!(
@@ -385,12 +387,12 @@ pub struct IAggregateStatisticsType {
 }
 t::debug_handle!(IAggregateStatisticsType);
 impl t::Handle for IAggregateStatisticsType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            reset_condition: b.optional(id, NS[0], "ResetCondition")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            reset_condition: b.build_optional(id, NS[0], "ResetCondition"),
+        }
     }
 }
 t::deref_base!(IAggregateStatisticsType => IStatisticsType);
@@ -415,13 +417,13 @@ pub struct IRollingStatisticsType {
 }
 t::debug_handle!(IRollingStatisticsType);
 impl t::Handle for IRollingStatisticsType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            window_duration: b.optional(id, NS[0], "WindowDuration")?,
-            window_number_of_values: b.optional(id, NS[0], "WindowNumberOfValues")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            window_duration: b.build_optional(id, NS[0], "WindowDuration"),
+            window_number_of_values: b.build_optional(id, NS[0], "WindowNumberOfValues"),
+        }
     }
 }
 t::deref_base!(IRollingStatisticsType => IStatisticsType);
@@ -443,12 +445,12 @@ pub struct IStatisticsType {
 }
 t::debug_handle!(IStatisticsType);
 impl t::Handle for IStatisticsType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            reset_statistics: b.optional(id, NS[0], "ResetStatistics")?,
-            start_time: b.optional(id, NS[0], "StartTime")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            reset_statistics: b.build_optional(id, NS[0], "ResetStatistics"),
+            start_time: b.build_optional(id, NS[0], "StartTime"),
+        }
     }
 }
 t::object_type!(IStatisticsType, rt::NsNodeId::numeric(NS[0], 1011), "IStatisticsType");
@@ -465,11 +467,11 @@ pub struct OneTimeCalibrationTargetCategoryType {
 }
 t::debug_handle!(OneTimeCalibrationTargetCategoryType);
 impl t::Handle for OneTimeCalibrationTargetCategoryType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+        }
     }
 }
 t::deref_base!(
@@ -492,11 +494,11 @@ pub struct ReusableCalibrationTargetCategoryType {
 }
 t::debug_handle!(ReusableCalibrationTargetCategoryType);
 impl t::Handle for ReusableCalibrationTargetCategoryType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+        }
     }
 }
 t::deref_base!(
@@ -519,11 +521,11 @@ pub struct ReusableDeviceCalibrationTargetCategoryType {
 }
 t::debug_handle!(ReusableDeviceCalibrationTargetCategoryType);
 impl t::Handle for ReusableDeviceCalibrationTargetCategoryType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+        }
     }
 }
 t::deref_base!(
@@ -552,14 +554,14 @@ pub struct StackElementAcousticType {
 }
 t::debug_handle!(StackElementAcousticType);
 impl t::Handle for StackElementAcousticType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            acoustic_signals: b.child(id, NS[0], "AcousticSignals")?,
-            intensity: b.optional(id, NS[0], "Intensity")?,
-            operation_mode: b.child(id, NS[0], "OperationMode")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            acoustic_signals: b.build_child(id, NS[0], "AcousticSignals"),
+            intensity: b.build_optional(id, NS[0], "Intensity"),
+            operation_mode: b.build_child(id, NS[0], "OperationMode"),
+        }
     }
 }
 t::deref_base!(StackElementAcousticType => StackElementType);
@@ -576,12 +578,12 @@ pub struct StackElementAcousticType_AcousticSignals {
 }
 t::debug_handle!(StackElementAcousticType_AcousticSignals);
 impl t::Handle for StackElementAcousticType_AcousticSignals {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            ordered_object: b.placeholders(id, rt::NsNodeId::numeric(NS[0], 1009))?,
-            node_version: b.optional(id, NS[1], "NodeVersion")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            ordered_object: b.build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1009)),
+            node_version: b.build_optional(id, NS[1], "NodeVersion"),
+        }
     }
 }
 t::object_type!(
@@ -611,16 +613,17 @@ pub struct StackElementLightType {
 }
 t::debug_handle!(StackElementLightType);
 impl t::Handle for StackElementLightType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            control_channel: b.placeholders(id, rt::NsNodeId::numeric(NS[0], 1008))?,
-            intensity: b.optional(id, NS[0], "Intensity")?,
-            signal_color: b.optional(id, NS[0], "SignalColor")?,
-            signal_mode: b.optional(id, NS[0], "SignalMode")?,
-            signal_rgbw_value: b.optional(id, NS[0], "SignalRGBWValue")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            control_channel: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1008)),
+            intensity: b.build_optional(id, NS[0], "Intensity"),
+            signal_color: b.build_optional(id, NS[0], "SignalColor"),
+            signal_mode: b.build_optional(id, NS[0], "SignalMode"),
+            signal_rgbw_value: b.build_optional(id, NS[0], "SignalRGBWValue"),
+        }
     }
 }
 t::deref_base!(StackElementLightType => StackElementType);
@@ -644,13 +647,13 @@ pub struct StackElementType {
 }
 t::debug_handle!(StackElementType);
 impl t::Handle for StackElementType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            is_part_of_base: b.optional(id, NS[0], "IsPartOfBase")?,
-            number_in_list: b.child(id, NS[1], "NumberInList")?,
-            signal_on: b.optional(id, NS[0], "SignalOn")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            is_part_of_base: b.build_optional(id, NS[0], "IsPartOfBase"),
+            number_in_list: b.build_child(id, NS[1], "NumberInList"),
+            signal_on: b.build_optional(id, NS[0], "SignalOn"),
+        }
     }
 }
 t::object_type!(
@@ -671,12 +674,12 @@ pub struct StackLevelType {
 }
 t::debug_handle!(StackLevelType);
 impl t::Handle for StackLevelType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            display_mode: b.child(id, NS[0], "DisplayMode")?,
-            level_percent: b.child(id, NS[0], "LevelPercent")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            display_mode: b.build_child(id, NS[0], "DisplayMode"),
+            level_percent: b.build_child(id, NS[0], "LevelPercent"),
+        }
     }
 }
 t::object_type!(StackLevelType, rt::NsNodeId::numeric(NS[0], 1003), "StackLevelType");
@@ -691,8 +694,8 @@ pub struct StackRunningType {
 }
 t::debug_handle!(StackRunningType);
 impl t::Handle for StackRunningType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self { node: b.this(id)? })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self { node: b.build_this(id) }
     }
 }
 t::object_type!(
@@ -717,13 +720,13 @@ pub struct StacklightType {
 }
 t::debug_handle!(StacklightType);
 impl t::Handle for StacklightType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            device_health: b.optional(id, NS[2], "DeviceHealth")?,
-            device_health_alarms: b.optional(id, NS[2], "DeviceHealthAlarms")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            device_health: b.build_optional(id, NS[2], "DeviceHealth"),
+            device_health_alarms: b.build_optional(id, NS[2], "DeviceHealthAlarms"),
+        }
     }
 }
 t::deref_base!(StacklightType => BasicStacklightType);

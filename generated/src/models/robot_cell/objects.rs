@@ -40,15 +40,15 @@ pub struct DrillingEndEffectorType {
 }
 t::debug_handle!(DrillingEndEffectorType);
 impl t::Handle for DrillingEndEffectorType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            manufacturer: b.child(id, NS[1], "Manufacturer")?,
-            model: b.child(id, NS[1], "Model")?,
-            serial_number: b.child(id, NS[1], "SerialNumber")?,
-            skill_set: b.child(id, NS[2], "SkillSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            manufacturer: b.build_child(id, NS[1], "Manufacturer"),
+            model: b.build_child(id, NS[1], "Model"),
+            serial_number: b.build_child(id, NS[1], "SerialNumber"),
+            skill_set: b.build_child(id, NS[2], "SkillSet"),
+        }
     }
 }
 t::deref_base!(DrillingEndEffectorType => super::super::di::objects::ComponentType);
@@ -63,11 +63,11 @@ pub struct DrillingEndEffectorType_SkillSet {
 }
 t::debug_handle!(DrillingEndEffectorType_SkillSet);
 impl t::Handle for DrillingEndEffectorType_SkillSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            template_drilling: b.child(id, NS[0], "TemplateDrilling")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            template_drilling: b.build_child(id, NS[0], "TemplateDrilling"),
+        }
     }
 }
 /// `TemplateDrilling`, a member of `DrillingEndEffectorType_SkillSet` with children of its own.
@@ -111,26 +111,26 @@ pub struct DrillingEndEffectorType_SkillSet_TemplateDrilling {
 }
 t::debug_handle!(DrillingEndEffectorType_SkillSet_TemplateDrilling);
 impl t::Handle for DrillingEndEffectorType_SkillSet_TemplateDrilling {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[3], "CurrentState")?,
-            last_transition: b.child(id, NS[3], "LastTransition")?,
-            available_states: b.optional(id, NS[3], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[3], "AvailableTransitions")?,
-            deletable: b.child(id, NS[3], "Deletable")?,
-            auto_delete: b.child(id, NS[3], "AutoDelete")?,
-            recycle_count: b.child(id, NS[3], "RecycleCount")?,
-            program_diagnostic: b.optional(id, NS[3], "ProgramDiagnostic")?,
-            final_result_data: b.optional(id, NS[3], "FinalResultData")?,
-            start: b.child(id, NS[3], "Start")?,
-            suspend: b.optional(id, NS[3], "Suspend")?,
-            resume: b.optional(id, NS[3], "Resume")?,
-            halt: b.child(id, NS[3], "Halt")?,
-            reset: b.child(id, NS[3], "Reset")?,
-            input_parameter_set: b.child(id, NS[2], "InputParameterSet")?,
-            output_parameter_set: b.child(id, NS[2], "OutputParameterSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[3], "CurrentState"),
+            last_transition: b.build_child(id, NS[3], "LastTransition"),
+            available_states: b.build_optional(id, NS[3], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[3], "AvailableTransitions"),
+            deletable: b.build_child(id, NS[3], "Deletable"),
+            auto_delete: b.build_child(id, NS[3], "AutoDelete"),
+            recycle_count: b.build_child(id, NS[3], "RecycleCount"),
+            program_diagnostic: b.build_optional(id, NS[3], "ProgramDiagnostic"),
+            final_result_data: b.build_optional(id, NS[3], "FinalResultData"),
+            start: b.build_child(id, NS[3], "Start"),
+            suspend: b.build_optional(id, NS[3], "Suspend"),
+            resume: b.build_optional(id, NS[3], "Resume"),
+            halt: b.build_child(id, NS[3], "Halt"),
+            reset: b.build_child(id, NS[3], "Reset"),
+            input_parameter_set: b.build_child(id, NS[2], "InputParameterSet"),
+            output_parameter_set: b.build_child(id, NS[2], "OutputParameterSet"),
+        }
     }
 }
 t::object_type!(
@@ -154,13 +154,13 @@ pub struct LwrSystemType {
 }
 t::debug_handle!(LwrSystemType);
 impl t::Handle for LwrSystemType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            motion_device_system: b.child(id, NS[0], "MotionDeviceSystem")?,
-            skill_set: b.child(id, NS[2], "SkillSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            motion_device_system: b.build_child(id, NS[0], "MotionDeviceSystem"),
+            skill_set: b.build_child(id, NS[2], "SkillSet"),
+        }
     }
 }
 t::deref_base!(LwrSystemType => super::super::di::objects::ComponentType);
@@ -219,32 +219,33 @@ pub struct LwrSystemType_MotionDeviceSystem {
 }
 t::debug_handle!(LwrSystemType_MotionDeviceSystem);
 impl t::Handle for LwrSystemType_MotionDeviceSystem {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            parameter_set: b.optional(id, NS[1], "ParameterSet")?,
-            method_set: b.optional(id, NS[1], "MethodSet")?,
-            group_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 1005))?,
-            identification: b.optional(id, NS[1], "Identification")?,
-            lock: b.optional(id, NS[1], "Lock")?,
-            manufacturer: b.optional(id, NS[1], "Manufacturer")?,
-            manufacturer_uri: b.optional(id, NS[1], "ManufacturerUri")?,
-            model: b.optional(id, NS[1], "Model")?,
-            hardware_revision: b.optional(id, NS[1], "HardwareRevision")?,
-            software_revision: b.optional(id, NS[1], "SoftwareRevision")?,
-            device_revision: b.optional(id, NS[1], "DeviceRevision")?,
-            product_code: b.optional(id, NS[1], "ProductCode")?,
-            device_manual: b.optional(id, NS[1], "DeviceManual")?,
-            device_class: b.optional(id, NS[1], "DeviceClass")?,
-            serial_number: b.optional(id, NS[1], "SerialNumber")?,
-            product_instance_uri: b.optional(id, NS[1], "ProductInstanceUri")?,
-            revision_counter: b.optional(id, NS[1], "RevisionCounter")?,
-            asset_id: b.optional(id, NS[1], "AssetId")?,
-            component_name: b.optional(id, NS[1], "ComponentName")?,
-            controllers: b.child(id, NS[4], "Controllers")?,
-            motion_devices: b.child(id, NS[4], "MotionDevices")?,
-            safety_states: b.child(id, NS[4], "SafetyStates")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            parameter_set: b.build_optional(id, NS[1], "ParameterSet"),
+            method_set: b.build_optional(id, NS[1], "MethodSet"),
+            group_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 1005)),
+            identification: b.build_optional(id, NS[1], "Identification"),
+            lock: b.build_optional(id, NS[1], "Lock"),
+            manufacturer: b.build_optional(id, NS[1], "Manufacturer"),
+            manufacturer_uri: b.build_optional(id, NS[1], "ManufacturerUri"),
+            model: b.build_optional(id, NS[1], "Model"),
+            hardware_revision: b.build_optional(id, NS[1], "HardwareRevision"),
+            software_revision: b.build_optional(id, NS[1], "SoftwareRevision"),
+            device_revision: b.build_optional(id, NS[1], "DeviceRevision"),
+            product_code: b.build_optional(id, NS[1], "ProductCode"),
+            device_manual: b.build_optional(id, NS[1], "DeviceManual"),
+            device_class: b.build_optional(id, NS[1], "DeviceClass"),
+            serial_number: b.build_optional(id, NS[1], "SerialNumber"),
+            product_instance_uri: b.build_optional(id, NS[1], "ProductInstanceUri"),
+            revision_counter: b.build_optional(id, NS[1], "RevisionCounter"),
+            asset_id: b.build_optional(id, NS[1], "AssetId"),
+            component_name: b.build_optional(id, NS[1], "ComponentName"),
+            controllers: b.build_child(id, NS[4], "Controllers"),
+            motion_devices: b.build_child(id, NS[4], "MotionDevices"),
+            safety_states: b.build_child(id, NS[4], "SafetyStates"),
+        }
     }
 }
 /// `ParameterSet`, a member of `LwrSystemType_MotionDeviceSystem` with children of its own.
@@ -258,11 +259,12 @@ pub struct LwrSystemType_MotionDeviceSystem_ParameterSet {
 }
 t::debug_handle!(LwrSystemType_MotionDeviceSystem_ParameterSet);
 impl t::Handle for LwrSystemType_MotionDeviceSystem_ParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            parameter_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[3], 63))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            parameter_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[3], 63)),
+        }
     }
 }
 /// `Lock`, a member of `LwrSystemType_MotionDeviceSystem` with children of its own.
@@ -290,18 +292,18 @@ pub struct LwrSystemType_MotionDeviceSystem_Lock {
 }
 t::debug_handle!(LwrSystemType_MotionDeviceSystem_Lock);
 impl t::Handle for LwrSystemType_MotionDeviceSystem_Lock {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            locked: b.child(id, NS[1], "Locked")?,
-            locking_client: b.child(id, NS[1], "LockingClient")?,
-            locking_user: b.child(id, NS[1], "LockingUser")?,
-            remaining_lock_time: b.child(id, NS[1], "RemainingLockTime")?,
-            init_lock: b.child(id, NS[1], "InitLock")?,
-            renew_lock: b.child(id, NS[1], "RenewLock")?,
-            exit_lock: b.child(id, NS[1], "ExitLock")?,
-            break_lock: b.child(id, NS[1], "BreakLock")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            locked: b.build_child(id, NS[1], "Locked"),
+            locking_client: b.build_child(id, NS[1], "LockingClient"),
+            locking_user: b.build_child(id, NS[1], "LockingUser"),
+            remaining_lock_time: b.build_child(id, NS[1], "RemainingLockTime"),
+            init_lock: b.build_child(id, NS[1], "InitLock"),
+            renew_lock: b.build_child(id, NS[1], "RenewLock"),
+            exit_lock: b.build_child(id, NS[1], "ExitLock"),
+            break_lock: b.build_child(id, NS[1], "BreakLock"),
+        }
     }
 }
 t::object_type!(LwrSystemType, rt::NsNodeId::numeric(NS[0], 3000), "LwrSystemType");
@@ -320,12 +322,12 @@ pub struct TemplateDrillingLwrSystemType {
 }
 t::debug_handle!(TemplateDrillingLwrSystemType);
 impl t::Handle for TemplateDrillingLwrSystemType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            drilling_end_effector: b.child(id, NS[0], "DrillingEndEffector")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            drilling_end_effector: b.build_child(id, NS[0], "DrillingEndEffector"),
+        }
     }
 }
 t::deref_base!(TemplateDrillingLwrSystemType => LwrSystemType);
@@ -382,30 +384,31 @@ pub struct TemplateDrillingLwrSystemType_DrillingEndEffector {
 }
 t::debug_handle!(TemplateDrillingLwrSystemType_DrillingEndEffector);
 impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            parameter_set: b.optional(id, NS[1], "ParameterSet")?,
-            method_set: b.optional(id, NS[1], "MethodSet")?,
-            group_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 1005))?,
-            identification: b.optional(id, NS[1], "Identification")?,
-            lock: b.optional(id, NS[1], "Lock")?,
-            manufacturer: b.child(id, NS[1], "Manufacturer")?,
-            manufacturer_uri: b.optional(id, NS[1], "ManufacturerUri")?,
-            model: b.child(id, NS[1], "Model")?,
-            hardware_revision: b.optional(id, NS[1], "HardwareRevision")?,
-            software_revision: b.optional(id, NS[1], "SoftwareRevision")?,
-            device_revision: b.optional(id, NS[1], "DeviceRevision")?,
-            product_code: b.optional(id, NS[1], "ProductCode")?,
-            device_manual: b.optional(id, NS[1], "DeviceManual")?,
-            device_class: b.optional(id, NS[1], "DeviceClass")?,
-            serial_number: b.child(id, NS[1], "SerialNumber")?,
-            product_instance_uri: b.optional(id, NS[1], "ProductInstanceUri")?,
-            revision_counter: b.optional(id, NS[1], "RevisionCounter")?,
-            asset_id: b.optional(id, NS[1], "AssetId")?,
-            component_name: b.optional(id, NS[1], "ComponentName")?,
-            skill_set: b.child(id, NS[2], "SkillSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            parameter_set: b.build_optional(id, NS[1], "ParameterSet"),
+            method_set: b.build_optional(id, NS[1], "MethodSet"),
+            group_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 1005)),
+            identification: b.build_optional(id, NS[1], "Identification"),
+            lock: b.build_optional(id, NS[1], "Lock"),
+            manufacturer: b.build_child(id, NS[1], "Manufacturer"),
+            manufacturer_uri: b.build_optional(id, NS[1], "ManufacturerUri"),
+            model: b.build_child(id, NS[1], "Model"),
+            hardware_revision: b.build_optional(id, NS[1], "HardwareRevision"),
+            software_revision: b.build_optional(id, NS[1], "SoftwareRevision"),
+            device_revision: b.build_optional(id, NS[1], "DeviceRevision"),
+            product_code: b.build_optional(id, NS[1], "ProductCode"),
+            device_manual: b.build_optional(id, NS[1], "DeviceManual"),
+            device_class: b.build_optional(id, NS[1], "DeviceClass"),
+            serial_number: b.build_child(id, NS[1], "SerialNumber"),
+            product_instance_uri: b.build_optional(id, NS[1], "ProductInstanceUri"),
+            revision_counter: b.build_optional(id, NS[1], "RevisionCounter"),
+            asset_id: b.build_optional(id, NS[1], "AssetId"),
+            component_name: b.build_optional(id, NS[1], "ComponentName"),
+            skill_set: b.build_child(id, NS[2], "SkillSet"),
+        }
     }
 }
 /// `ParameterSet`, a member of `TemplateDrillingLwrSystemType_DrillingEndEffector` with children of its own.
@@ -419,11 +422,12 @@ pub struct TemplateDrillingLwrSystemType_DrillingEndEffector_ParameterSet {
 }
 t::debug_handle!(TemplateDrillingLwrSystemType_DrillingEndEffector_ParameterSet);
 impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector_ParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            parameter_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[3], 63))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            parameter_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[3], 63)),
+        }
     }
 }
 /// `Lock`, a member of `TemplateDrillingLwrSystemType_DrillingEndEffector` with children of its own.
@@ -451,18 +455,18 @@ pub struct TemplateDrillingLwrSystemType_DrillingEndEffector_Lock {
 }
 t::debug_handle!(TemplateDrillingLwrSystemType_DrillingEndEffector_Lock);
 impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector_Lock {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            locked: b.child(id, NS[1], "Locked")?,
-            locking_client: b.child(id, NS[1], "LockingClient")?,
-            locking_user: b.child(id, NS[1], "LockingUser")?,
-            remaining_lock_time: b.child(id, NS[1], "RemainingLockTime")?,
-            init_lock: b.child(id, NS[1], "InitLock")?,
-            renew_lock: b.child(id, NS[1], "RenewLock")?,
-            exit_lock: b.child(id, NS[1], "ExitLock")?,
-            break_lock: b.child(id, NS[1], "BreakLock")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            locked: b.build_child(id, NS[1], "Locked"),
+            locking_client: b.build_child(id, NS[1], "LockingClient"),
+            locking_user: b.build_child(id, NS[1], "LockingUser"),
+            remaining_lock_time: b.build_child(id, NS[1], "RemainingLockTime"),
+            init_lock: b.build_child(id, NS[1], "InitLock"),
+            renew_lock: b.build_child(id, NS[1], "RenewLock"),
+            exit_lock: b.build_child(id, NS[1], "ExitLock"),
+            break_lock: b.build_child(id, NS[1], "BreakLock"),
+        }
     }
 }
 /// `SkillSet`, a member of `TemplateDrillingLwrSystemType_DrillingEndEffector` with children of its own.
@@ -476,11 +480,11 @@ pub struct TemplateDrillingLwrSystemType_DrillingEndEffector_SkillSet {
 }
 t::debug_handle!(TemplateDrillingLwrSystemType_DrillingEndEffector_SkillSet);
 impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector_SkillSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            template_drilling: b.child(id, NS[0], "TemplateDrilling")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            template_drilling: b.build_child(id, NS[0], "TemplateDrilling"),
+        }
     }
 }
 t::object_type!(
@@ -502,12 +506,12 @@ pub struct TemplateDrillingSkillType {
 }
 t::debug_handle!(TemplateDrillingSkillType);
 impl t::Handle for TemplateDrillingSkillType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            input_parameter_set: b.child(id, NS[2], "InputParameterSet")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            input_parameter_set: b.build_child(id, NS[2], "InputParameterSet"),
+        }
     }
 }
 t::deref_base!(
@@ -533,15 +537,15 @@ pub struct TemplateDrillingSkillType_InputParameterSet {
 }
 t::debug_handle!(TemplateDrillingSkillType_InputParameterSet);
 impl t::Handle for TemplateDrillingSkillType_InputParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            hole_diameter: b.child(id, NS[0], "HoleDiameter")?,
-            depth: b.child(id, NS[0], "Depth")?,
-            feed_rate: b.child(id, NS[0], "FeedRate")?,
-            spindle_speed: b.child(id, NS[0], "SpindleSpeed")?,
-            clamp_force: b.child(id, NS[0], "ClampForce")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            hole_diameter: b.build_child(id, NS[0], "HoleDiameter"),
+            depth: b.build_child(id, NS[0], "Depth"),
+            feed_rate: b.build_child(id, NS[0], "FeedRate"),
+            spindle_speed: b.build_child(id, NS[0], "SpindleSpeed"),
+            clamp_force: b.build_child(id, NS[0], "ClampForce"),
+        }
     }
 }
 t::object_type!(
@@ -599,14 +603,14 @@ pub struct Ur10eSystemType {
 }
 t::debug_handle!(Ur10eSystemType);
 impl t::Handle for Ur10eSystemType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            controllers: b.child(id, NS[4], "Controllers")?,
-            motion_devices: b.child(id, NS[4], "MotionDevices")?,
-            safety_states: b.child(id, NS[4], "SafetyStates")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            controllers: b.build_child(id, NS[4], "Controllers"),
+            motion_devices: b.build_child(id, NS[4], "MotionDevices"),
+            safety_states: b.build_child(id, NS[4], "SafetyStates"),
+        }
     }
 }
 t::deref_base!(
@@ -623,11 +627,11 @@ pub struct Ur10eSystemType_Controllers {
 }
 t::debug_handle!(Ur10eSystemType_Controllers);
 impl t::Handle for Ur10eSystemType_Controllers {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            ur_controller: b.child(id, NS[0], "URController")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            ur_controller: b.build_child(id, NS[0], "URController"),
+        }
     }
 }
 /// `URController`, a member of `Ur10eSystemType_Controllers` with children of its own.
@@ -703,40 +707,41 @@ pub struct Ur10eSystemType_Controllers_URController {
 }
 t::debug_handle!(Ur10eSystemType_Controllers_URController);
 impl t::Handle for Ur10eSystemType_Controllers_URController {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            parameter_set: b.optional(id, NS[1], "ParameterSet")?,
-            method_set: b.optional(id, NS[1], "MethodSet")?,
-            group_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 1005))?,
-            identification: b.optional(id, NS[1], "Identification")?,
-            lock: b.optional(id, NS[1], "Lock")?,
-            manufacturer: b.child(id, NS[1], "Manufacturer")?,
-            manufacturer_uri: b.optional(id, NS[1], "ManufacturerUri")?,
-            model: b.child(id, NS[1], "Model")?,
-            hardware_revision: b.optional(id, NS[1], "HardwareRevision")?,
-            software_revision: b.optional(id, NS[1], "SoftwareRevision")?,
-            device_revision: b.optional(id, NS[1], "DeviceRevision")?,
-            product_code: b.child(id, NS[1], "ProductCode")?,
-            device_manual: b.optional(id, NS[1], "DeviceManual")?,
-            device_class: b.optional(id, NS[1], "DeviceClass")?,
-            serial_number: b.child(id, NS[1], "SerialNumber")?,
-            product_instance_uri: b.optional(id, NS[1], "ProductInstanceUri")?,
-            revision_counter: b.optional(id, NS[1], "RevisionCounter")?,
-            asset_id: b.optional(id, NS[1], "AssetId")?,
-            component_name: b.optional(id, NS[1], "ComponentName")?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            parameter_set: b.build_optional(id, NS[1], "ParameterSet"),
+            method_set: b.build_optional(id, NS[1], "MethodSet"),
+            group_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 1005)),
+            identification: b.build_optional(id, NS[1], "Identification"),
+            lock: b.build_optional(id, NS[1], "Lock"),
+            manufacturer: b.build_child(id, NS[1], "Manufacturer"),
+            manufacturer_uri: b.build_optional(id, NS[1], "ManufacturerUri"),
+            model: b.build_child(id, NS[1], "Model"),
+            hardware_revision: b.build_optional(id, NS[1], "HardwareRevision"),
+            software_revision: b.build_optional(id, NS[1], "SoftwareRevision"),
+            device_revision: b.build_optional(id, NS[1], "DeviceRevision"),
+            product_code: b.build_child(id, NS[1], "ProductCode"),
+            device_manual: b.build_optional(id, NS[1], "DeviceManual"),
+            device_class: b.build_optional(id, NS[1], "DeviceClass"),
+            serial_number: b.build_child(id, NS[1], "SerialNumber"),
+            product_instance_uri: b.build_optional(id, NS[1], "ProductInstanceUri"),
+            revision_counter: b.build_optional(id, NS[1], "RevisionCounter"),
+            asset_id: b.build_optional(id, NS[1], "AssetId"),
+            component_name: b.build_optional(id, NS[1], "ComponentName"),
             motion_device_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[4], 1004))?,
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[4], 1004)),
             safety_states_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[4], 1013))?,
-            components: b.optional(id, NS[4], "Components")?,
-            current_user: b.child(id, NS[4], "CurrentUser")?,
-            programs: b.optional(id, NS[4], "Programs")?,
-            software: b.child(id, NS[4], "Software")?,
-            system_operation: b.optional(id, NS[4], "SystemOperation")?,
-            task_controls: b.child(id, NS[4], "TaskControls")?,
-            skill_set: b.child(id, NS[2], "SkillSet")?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[4], 1013)),
+            components: b.build_optional(id, NS[4], "Components"),
+            current_user: b.build_child(id, NS[4], "CurrentUser"),
+            programs: b.build_optional(id, NS[4], "Programs"),
+            software: b.build_child(id, NS[4], "Software"),
+            system_operation: b.build_optional(id, NS[4], "SystemOperation"),
+            task_controls: b.build_child(id, NS[4], "TaskControls"),
+            skill_set: b.build_child(id, NS[2], "SkillSet"),
+        }
     }
 }
 /// `MotionDevices`, a member of `Ur10eSystemType` with children of its own.
@@ -750,11 +755,11 @@ pub struct Ur10eSystemType_MotionDevices {
 }
 t::debug_handle!(Ur10eSystemType_MotionDevices);
 impl t::Handle for Ur10eSystemType_MotionDevices {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            manipulator: b.child(id, NS[0], "Manipulator")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            manipulator: b.build_child(id, NS[0], "Manipulator"),
+        }
     }
 }
 /// `Manipulator`, a member of `Ur10eSystemType_MotionDevices` with children of its own.
@@ -820,35 +825,36 @@ pub struct Ur10eSystemType_MotionDevices_Manipulator {
 }
 t::debug_handle!(Ur10eSystemType_MotionDevices_Manipulator);
 impl t::Handle for Ur10eSystemType_MotionDevices_Manipulator {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            parameter_set: b.child(id, NS[1], "ParameterSet")?,
-            method_set: b.optional(id, NS[1], "MethodSet")?,
-            group_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 1005))?,
-            identification: b.optional(id, NS[1], "Identification")?,
-            lock: b.optional(id, NS[1], "Lock")?,
-            manufacturer: b.child(id, NS[1], "Manufacturer")?,
-            manufacturer_uri: b.optional(id, NS[1], "ManufacturerUri")?,
-            model: b.child(id, NS[1], "Model")?,
-            hardware_revision: b.optional(id, NS[1], "HardwareRevision")?,
-            software_revision: b.optional(id, NS[1], "SoftwareRevision")?,
-            device_revision: b.optional(id, NS[1], "DeviceRevision")?,
-            product_code: b.child(id, NS[1], "ProductCode")?,
-            device_manual: b.optional(id, NS[1], "DeviceManual")?,
-            device_class: b.optional(id, NS[1], "DeviceClass")?,
-            serial_number: b.child(id, NS[1], "SerialNumber")?,
-            product_instance_uri: b.optional(id, NS[1], "ProductInstanceUri")?,
-            revision_counter: b.optional(id, NS[1], "RevisionCounter")?,
-            asset_id: b.optional(id, NS[1], "AssetId")?,
-            component_name: b.optional(id, NS[1], "ComponentName")?,
-            additional_components: b.optional(id, NS[4], "AdditionalComponents")?,
-            axes: b.child(id, NS[4], "Axes")?,
-            flange_load: b.optional(id, NS[4], "FlangeLoad")?,
-            motion_device_category: b.child(id, NS[4], "MotionDeviceCategory")?,
-            power_trains: b.child(id, NS[4], "PowerTrains")?,
-            task_control_reference: b.optional(id, NS[4], "TaskControlReference")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            parameter_set: b.build_child(id, NS[1], "ParameterSet"),
+            method_set: b.build_optional(id, NS[1], "MethodSet"),
+            group_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 1005)),
+            identification: b.build_optional(id, NS[1], "Identification"),
+            lock: b.build_optional(id, NS[1], "Lock"),
+            manufacturer: b.build_child(id, NS[1], "Manufacturer"),
+            manufacturer_uri: b.build_optional(id, NS[1], "ManufacturerUri"),
+            model: b.build_child(id, NS[1], "Model"),
+            hardware_revision: b.build_optional(id, NS[1], "HardwareRevision"),
+            software_revision: b.build_optional(id, NS[1], "SoftwareRevision"),
+            device_revision: b.build_optional(id, NS[1], "DeviceRevision"),
+            product_code: b.build_child(id, NS[1], "ProductCode"),
+            device_manual: b.build_optional(id, NS[1], "DeviceManual"),
+            device_class: b.build_optional(id, NS[1], "DeviceClass"),
+            serial_number: b.build_child(id, NS[1], "SerialNumber"),
+            product_instance_uri: b.build_optional(id, NS[1], "ProductInstanceUri"),
+            revision_counter: b.build_optional(id, NS[1], "RevisionCounter"),
+            asset_id: b.build_optional(id, NS[1], "AssetId"),
+            component_name: b.build_optional(id, NS[1], "ComponentName"),
+            additional_components: b.build_optional(id, NS[4], "AdditionalComponents"),
+            axes: b.build_child(id, NS[4], "Axes"),
+            flange_load: b.build_optional(id, NS[4], "FlangeLoad"),
+            motion_device_category: b.build_child(id, NS[4], "MotionDeviceCategory"),
+            power_trains: b.build_child(id, NS[4], "PowerTrains"),
+            task_control_reference: b.build_optional(id, NS[4], "TaskControlReference"),
+        }
     }
 }
 /// `SafetyStates`, a member of `Ur10eSystemType` with children of its own.
@@ -862,11 +868,11 @@ pub struct Ur10eSystemType_SafetyStates {
 }
 t::debug_handle!(Ur10eSystemType_SafetyStates);
 impl t::Handle for Ur10eSystemType_SafetyStates {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            safety_state: b.child(id, NS[0], "SafetyState")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            safety_state: b.build_child(id, NS[0], "SafetyState"),
+        }
     }
 }
 /// `SafetyState`, a member of `Ur10eSystemType_SafetyStates` with children of its own.
@@ -922,31 +928,34 @@ pub struct Ur10eSystemType_SafetyStates_SafetyState {
 }
 t::debug_handle!(Ur10eSystemType_SafetyStates_SafetyState);
 impl t::Handle for Ur10eSystemType_SafetyStates_SafetyState {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            parameter_set: b.child(id, NS[1], "ParameterSet")?,
-            method_set: b.optional(id, NS[1], "MethodSet")?,
-            group_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 1005))?,
-            identification: b.optional(id, NS[1], "Identification")?,
-            lock: b.optional(id, NS[1], "Lock")?,
-            manufacturer: b.optional(id, NS[1], "Manufacturer")?,
-            manufacturer_uri: b.optional(id, NS[1], "ManufacturerUri")?,
-            model: b.optional(id, NS[1], "Model")?,
-            hardware_revision: b.optional(id, NS[1], "HardwareRevision")?,
-            software_revision: b.optional(id, NS[1], "SoftwareRevision")?,
-            device_revision: b.optional(id, NS[1], "DeviceRevision")?,
-            product_code: b.optional(id, NS[1], "ProductCode")?,
-            device_manual: b.optional(id, NS[1], "DeviceManual")?,
-            device_class: b.optional(id, NS[1], "DeviceClass")?,
-            serial_number: b.optional(id, NS[1], "SerialNumber")?,
-            product_instance_uri: b.optional(id, NS[1], "ProductInstanceUri")?,
-            revision_counter: b.optional(id, NS[1], "RevisionCounter")?,
-            asset_id: b.optional(id, NS[1], "AssetId")?,
-            component_name: b.optional(id, NS[1], "ComponentName")?,
-            emergency_stop_functions: b.optional(id, NS[4], "EmergencyStopFunctions")?,
-            protective_stop_functions: b.optional(id, NS[4], "ProtectiveStopFunctions")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            parameter_set: b.build_child(id, NS[1], "ParameterSet"),
+            method_set: b.build_optional(id, NS[1], "MethodSet"),
+            group_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 1005)),
+            identification: b.build_optional(id, NS[1], "Identification"),
+            lock: b.build_optional(id, NS[1], "Lock"),
+            manufacturer: b.build_optional(id, NS[1], "Manufacturer"),
+            manufacturer_uri: b.build_optional(id, NS[1], "ManufacturerUri"),
+            model: b.build_optional(id, NS[1], "Model"),
+            hardware_revision: b.build_optional(id, NS[1], "HardwareRevision"),
+            software_revision: b.build_optional(id, NS[1], "SoftwareRevision"),
+            device_revision: b.build_optional(id, NS[1], "DeviceRevision"),
+            product_code: b.build_optional(id, NS[1], "ProductCode"),
+            device_manual: b.build_optional(id, NS[1], "DeviceManual"),
+            device_class: b.build_optional(id, NS[1], "DeviceClass"),
+            serial_number: b.build_optional(id, NS[1], "SerialNumber"),
+            product_instance_uri: b.build_optional(id, NS[1], "ProductInstanceUri"),
+            revision_counter: b.build_optional(id, NS[1], "RevisionCounter"),
+            asset_id: b.build_optional(id, NS[1], "AssetId"),
+            component_name: b.build_optional(id, NS[1], "ComponentName"),
+            emergency_stop_functions: b
+                .build_optional(id, NS[4], "EmergencyStopFunctions"),
+            protective_stop_functions: b
+                .build_optional(id, NS[4], "ProtectiveStopFunctions"),
+        }
     }
 }
 t::object_type!(Ur10eSystemType, rt::NsNodeId::numeric(NS[0], 4000), "UR10eSystemType");

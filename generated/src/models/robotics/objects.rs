@@ -34,13 +34,13 @@ pub struct AuxiliaryComponentType {
 }
 t::debug_handle!(AuxiliaryComponentType);
 impl t::Handle for AuxiliaryComponentType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            product_code: b.child(id, NS[1], "ProductCode")?,
-            asset_id: b.optional(id, NS[1], "AssetId")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            product_code: b.build_child(id, NS[1], "ProductCode"),
+            asset_id: b.build_optional(id, NS[1], "AssetId"),
+        }
     }
 }
 t::deref_base!(AuxiliaryComponentType => super::super::di::objects::ComponentType);
@@ -70,17 +70,17 @@ pub struct AxisType {
 }
 t::debug_handle!(AxisType);
 impl t::Handle for AxisType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            parameter_set: b.child(id, NS[1], "ParameterSet")?,
-            asset_id: b.optional(id, NS[1], "AssetId")?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            parameter_set: b.build_child(id, NS[1], "ParameterSet"),
+            asset_id: b.build_optional(id, NS[1], "AssetId"),
             power_train_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[0], 16794))?,
-            additional_load: b.optional(id, NS[0], "AdditionalLoad")?,
-            motion_profile: b.child(id, NS[0], "MotionProfile")?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 16794)),
+            additional_load: b.build_optional(id, NS[0], "AdditionalLoad"),
+            motion_profile: b.build_child(id, NS[0], "MotionProfile"),
+        }
     }
 }
 t::deref_base!(AxisType => super::super::di::objects::ComponentType);
@@ -99,13 +99,13 @@ pub struct AxisType_ParameterSet {
 }
 t::debug_handle!(AxisType_ParameterSet);
 impl t::Handle for AxisType_ParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            actual_acceleration: b.optional(id, NS[0], "ActualAcceleration")?,
-            actual_position: b.child(id, NS[0], "ActualPosition")?,
-            actual_speed: b.optional(id, NS[0], "ActualSpeed")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            actual_acceleration: b.build_optional(id, NS[0], "ActualAcceleration"),
+            actual_position: b.build_child(id, NS[0], "ActualPosition"),
+            actual_speed: b.build_optional(id, NS[0], "ActualSpeed"),
+        }
     }
 }
 /// `AdditionalLoad`, a member of `AxisType` with children of its own.
@@ -123,13 +123,13 @@ pub struct AxisType_AdditionalLoad {
 }
 t::debug_handle!(AxisType_AdditionalLoad);
 impl t::Handle for AxisType_AdditionalLoad {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            center_of_mass: b.optional(id, NS[0], "CenterOfMass")?,
-            inertia: b.optional(id, NS[0], "Inertia")?,
-            mass: b.child(id, NS[0], "Mass")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            center_of_mass: b.build_optional(id, NS[0], "CenterOfMass"),
+            inertia: b.build_optional(id, NS[0], "Inertia"),
+            mass: b.build_child(id, NS[0], "Mass"),
+        }
     }
 }
 t::object_type!(AxisType, rt::NsNodeId::numeric(NS[0], 16601), "AxisType");
@@ -178,29 +178,29 @@ pub struct ControllerType {
 }
 t::debug_handle!(ControllerType);
 impl t::Handle for ControllerType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            parameter_set: b.optional(id, NS[1], "ParameterSet")?,
-            manufacturer: b.child(id, NS[1], "Manufacturer")?,
-            model: b.child(id, NS[1], "Model")?,
-            product_code: b.child(id, NS[1], "ProductCode")?,
-            device_manual: b.optional(id, NS[1], "DeviceManual")?,
-            serial_number: b.child(id, NS[1], "SerialNumber")?,
-            asset_id: b.optional(id, NS[1], "AssetId")?,
-            component_name: b.optional(id, NS[1], "ComponentName")?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            parameter_set: b.build_optional(id, NS[1], "ParameterSet"),
+            manufacturer: b.build_child(id, NS[1], "Manufacturer"),
+            model: b.build_child(id, NS[1], "Model"),
+            product_code: b.build_child(id, NS[1], "ProductCode"),
+            device_manual: b.build_optional(id, NS[1], "DeviceManual"),
+            serial_number: b.build_child(id, NS[1], "SerialNumber"),
+            asset_id: b.build_optional(id, NS[1], "AssetId"),
+            component_name: b.build_optional(id, NS[1], "ComponentName"),
             motion_device_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[0], 1004))?,
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1004)),
             safety_states_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[0], 1013))?,
-            components: b.optional(id, NS[0], "Components")?,
-            current_user: b.child(id, NS[0], "CurrentUser")?,
-            programs: b.optional(id, NS[0], "Programs")?,
-            software: b.child(id, NS[0], "Software")?,
-            system_operation: b.optional(id, NS[0], "SystemOperation")?,
-            task_controls: b.child(id, NS[0], "TaskControls")?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1013)),
+            components: b.build_optional(id, NS[0], "Components"),
+            current_user: b.build_child(id, NS[0], "CurrentUser"),
+            programs: b.build_optional(id, NS[0], "Programs"),
+            software: b.build_child(id, NS[0], "Software"),
+            system_operation: b.build_optional(id, NS[0], "SystemOperation"),
+            task_controls: b.build_child(id, NS[0], "TaskControls"),
+        }
     }
 }
 t::deref_base!(ControllerType => super::super::di::objects::ComponentType);
@@ -229,18 +229,19 @@ pub struct ControllerType_ParameterSet {
 }
 t::debug_handle!(ControllerType_ParameterSet);
 impl t::Handle for ControllerType_ParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            cabinet_fan_speed: b.optional(id, NS[0], "CabinetFanSpeed")?,
-            cpu_fan_speed: b.optional(id, NS[0], "CPUFanSpeed")?,
-            input_voltage: b.optional(id, NS[0], "InputVoltage")?,
-            start_up_time: b.optional(id, NS[0], "StartUpTime")?,
-            temperature: b.optional(id, NS[0], "Temperature")?,
-            total_energy_consumption: b.optional(id, NS[0], "TotalEnergyConsumption")?,
-            total_power_on_time: b.optional(id, NS[0], "TotalPowerOnTime")?,
-            ups_state: b.optional(id, NS[0], "UpsState")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            cabinet_fan_speed: b.build_optional(id, NS[0], "CabinetFanSpeed"),
+            cpu_fan_speed: b.build_optional(id, NS[0], "CPUFanSpeed"),
+            input_voltage: b.build_optional(id, NS[0], "InputVoltage"),
+            start_up_time: b.build_optional(id, NS[0], "StartUpTime"),
+            temperature: b.build_optional(id, NS[0], "Temperature"),
+            total_energy_consumption: b
+                .build_optional(id, NS[0], "TotalEnergyConsumption"),
+            total_power_on_time: b.build_optional(id, NS[0], "TotalPowerOnTime"),
+            ups_state: b.build_optional(id, NS[0], "UpsState"),
+        }
     }
 }
 /// `Components`, a member of `ControllerType` with children of its own.
@@ -254,12 +255,12 @@ pub struct ControllerType_Components {
 }
 t::debug_handle!(ControllerType_Components);
 impl t::Handle for ControllerType_Components {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             component_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[1], 15063))?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 15063)),
+        }
     }
 }
 /// `CurrentUser`, a member of `ControllerType` with children of its own.
@@ -275,12 +276,12 @@ pub struct ControllerType_CurrentUser {
 }
 t::debug_handle!(ControllerType_CurrentUser);
 impl t::Handle for ControllerType_CurrentUser {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            level: b.child(id, NS[0], "Level")?,
-            name: b.optional(id, NS[0], "Name")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            level: b.build_child(id, NS[0], "Level"),
+            name: b.build_optional(id, NS[0], "Name"),
+        }
     }
 }
 /// `Programs`, a member of `ControllerType` with children of its own.
@@ -304,17 +305,17 @@ pub struct ControllerType_Programs {
 }
 t::debug_handle!(ControllerType_Programs);
 impl t::Handle for ControllerType_Programs {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             file_directory_name: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[2], 13353))?,
-            file_name: b.placeholders(id, rt::NsNodeId::numeric(NS[2], 11575))?,
-            create_directory: b.child(id, NS[2], "CreateDirectory")?,
-            create_file: b.child(id, NS[2], "CreateFile")?,
-            delete: b.child(id, NS[2], "Delete")?,
-            move_or_copy: b.child(id, NS[2], "MoveOrCopy")?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[2], 13353)),
+            file_name: b.build_placeholders(id, rt::NsNodeId::numeric(NS[2], 11575)),
+            create_directory: b.build_child(id, NS[2], "CreateDirectory"),
+            create_file: b.build_child(id, NS[2], "CreateFile"),
+            delete: b.build_child(id, NS[2], "Delete"),
+            move_or_copy: b.build_child(id, NS[2], "MoveOrCopy"),
+        }
     }
 }
 /// `Software`, a member of `ControllerType` with children of its own.
@@ -328,11 +329,12 @@ pub struct ControllerType_Software {
 }
 t::debug_handle!(ControllerType_Software);
 impl t::Handle for ControllerType_Software {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            software_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[1], 15106))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            software_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 15106)),
+        }
     }
 }
 /// `SystemOperation`, a member of `ControllerType` with children of its own.
@@ -348,13 +350,13 @@ pub struct ControllerType_SystemOperation {
 }
 t::debug_handle!(ControllerType_SystemOperation);
 impl t::Handle for ControllerType_SystemOperation {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            conditions: b.optional(id, NS[0], "Conditions")?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            conditions: b.build_optional(id, NS[0], "Conditions"),
             system_operation_state_machine: b
-                .child(id, NS[0], "SystemOperationStateMachine")?,
-        })
+                .build_child(id, NS[0], "SystemOperationStateMachine"),
+        }
     }
 }
 /// `Conditions`, a member of `ControllerType_SystemOperation` with children of its own.
@@ -368,12 +370,12 @@ pub struct ControllerType_SystemOperation_Conditions {
 }
 t::debug_handle!(ControllerType_SystemOperation_Conditions);
 impl t::Handle for ControllerType_SystemOperation_Conditions {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             acknowledgeable_condition: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[2], 2881))?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[2], 2881)),
+        }
     }
 }
 /// `SystemOperationStateMachine`, a member of `ControllerType_SystemOperation` with children of its own.
@@ -411,25 +413,25 @@ pub struct ControllerType_SystemOperation_SystemOperationStateMachine {
 }
 t::debug_handle!(ControllerType_SystemOperation_SystemOperationStateMachine);
 impl t::Handle for ControllerType_SystemOperation_SystemOperationStateMachine {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
             configured_default_stop_mode: b
-                .optional(id, NS[0], "ConfiguredDefaultStopMode")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-            possible_stop_modes: b.optional(id, NS[0], "PossibleStopModes")?,
-            start: b.optional(id, NS[0], "Start")?,
-            stop: b.optional(id, NS[0], "Stop")?,
+                .build_optional(id, NS[0], "ConfiguredDefaultStopMode"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+            possible_stop_modes: b.build_optional(id, NS[0], "PossibleStopModes"),
+            start: b.build_optional(id, NS[0], "Start"),
+            stop: b.build_optional(id, NS[0], "Stop"),
             executing_substate_machine: b
-                .optional(id, NS[0], "ExecutingSubstateMachine")?,
-            get_ready: b.optional(id, NS[0], "GetReady")?,
-            idle_substate_machine: b.optional(id, NS[0], "IdleSubstateMachine")?,
-            stand_down: b.optional(id, NS[0], "StandDown")?,
-        })
+                .build_optional(id, NS[0], "ExecutingSubstateMachine"),
+            get_ready: b.build_optional(id, NS[0], "GetReady"),
+            idle_substate_machine: b.build_optional(id, NS[0], "IdleSubstateMachine"),
+            stand_down: b.build_optional(id, NS[0], "StandDown"),
+        }
     }
 }
 /// `TaskControls`, a member of `ControllerType` with children of its own.
@@ -443,12 +445,12 @@ pub struct ControllerType_TaskControls {
 }
 t::debug_handle!(ControllerType_TaskControls);
 impl t::Handle for ControllerType_TaskControls {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             task_control_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[0], 1011))?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1011)),
+        }
     }
 }
 t::object_type!(ControllerType, rt::NsNodeId::numeric(NS[0], 1003), "ControllerType");
@@ -469,13 +471,13 @@ pub struct DriveType {
 }
 t::debug_handle!(DriveType);
 impl t::Handle for DriveType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            product_code: b.child(id, NS[1], "ProductCode")?,
-            asset_id: b.optional(id, NS[1], "AssetId")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            product_code: b.build_child(id, NS[1], "ProductCode"),
+            asset_id: b.build_optional(id, NS[1], "AssetId"),
+        }
     }
 }
 t::deref_base!(DriveType => super::super::di::objects::ComponentType);
@@ -495,12 +497,12 @@ pub struct EmergencyStopFunctionType {
 }
 t::debug_handle!(EmergencyStopFunctionType);
 impl t::Handle for EmergencyStopFunctionType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            active: b.child(id, NS[0], "Active")?,
-            name: b.child(id, NS[0], "Name")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            active: b.build_child(id, NS[0], "Active"),
+            name: b.build_child(id, NS[0], "Name"),
+        }
     }
 }
 t::object_type!(
@@ -526,15 +528,15 @@ pub struct ExecutingSubstateMachineType {
 }
 t::debug_handle!(ExecutingSubstateMachineType);
 impl t::Handle for ExecutingSubstateMachineType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+        }
     }
 }
 t::object_type!(
@@ -604,18 +606,18 @@ pub struct GearType {
 }
 t::debug_handle!(GearType);
 impl t::Handle for GearType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            manufacturer: b.child(id, NS[1], "Manufacturer")?,
-            model: b.child(id, NS[1], "Model")?,
-            product_code: b.child(id, NS[1], "ProductCode")?,
-            serial_number: b.child(id, NS[1], "SerialNumber")?,
-            asset_id: b.optional(id, NS[1], "AssetId")?,
-            gear_ratio: b.child(id, NS[0], "GearRatio")?,
-            pitch: b.optional(id, NS[0], "Pitch")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            manufacturer: b.build_child(id, NS[1], "Manufacturer"),
+            model: b.build_child(id, NS[1], "Model"),
+            product_code: b.build_child(id, NS[1], "ProductCode"),
+            serial_number: b.build_child(id, NS[1], "SerialNumber"),
+            asset_id: b.build_optional(id, NS[1], "AssetId"),
+            gear_ratio: b.build_child(id, NS[0], "GearRatio"),
+            pitch: b.build_optional(id, NS[0], "Pitch"),
+        }
     }
 }
 t::deref_base!(GearType => super::super::di::objects::ComponentType);
@@ -639,15 +641,15 @@ pub struct IdleSubstateMachineType {
 }
 t::debug_handle!(IdleSubstateMachineType);
 impl t::Handle for IdleSubstateMachineType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+        }
     }
 }
 t::object_type!(
@@ -716,13 +718,13 @@ pub struct LoadType {
 }
 t::debug_handle!(LoadType);
 impl t::Handle for LoadType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            center_of_mass: b.optional(id, NS[0], "CenterOfMass")?,
-            inertia: b.optional(id, NS[0], "Inertia")?,
-            mass: b.child(id, NS[0], "Mass")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            center_of_mass: b.build_optional(id, NS[0], "CenterOfMass"),
+            inertia: b.build_optional(id, NS[0], "Inertia"),
+            mass: b.build_child(id, NS[0], "Mass"),
+        }
     }
 }
 t::object_type!(LoadType, rt::NsNodeId::numeric(NS[0], 1018), "LoadType");
@@ -747,15 +749,15 @@ pub struct MotionDeviceSystemType {
 }
 t::debug_handle!(MotionDeviceSystemType);
 impl t::Handle for MotionDeviceSystemType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            component_name: b.optional(id, NS[1], "ComponentName")?,
-            controllers: b.child(id, NS[0], "Controllers")?,
-            motion_devices: b.child(id, NS[0], "MotionDevices")?,
-            safety_states: b.child(id, NS[0], "SafetyStates")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            component_name: b.build_optional(id, NS[1], "ComponentName"),
+            controllers: b.build_child(id, NS[0], "Controllers"),
+            motion_devices: b.build_child(id, NS[0], "MotionDevices"),
+            safety_states: b.build_child(id, NS[0], "SafetyStates"),
+        }
     }
 }
 t::deref_base!(MotionDeviceSystemType => super::super::di::objects::ComponentType);
@@ -770,12 +772,12 @@ pub struct MotionDeviceSystemType_Controllers {
 }
 t::debug_handle!(MotionDeviceSystemType_Controllers);
 impl t::Handle for MotionDeviceSystemType_Controllers {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             controller_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[0], 1003))?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1003)),
+        }
     }
 }
 /// `MotionDevices`, a member of `MotionDeviceSystemType` with children of its own.
@@ -789,12 +791,12 @@ pub struct MotionDeviceSystemType_MotionDevices {
 }
 t::debug_handle!(MotionDeviceSystemType_MotionDevices);
 impl t::Handle for MotionDeviceSystemType_MotionDevices {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             motion_device_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[0], 1004))?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1004)),
+        }
     }
 }
 /// `SafetyStates`, a member of `MotionDeviceSystemType` with children of its own.
@@ -808,12 +810,12 @@ pub struct MotionDeviceSystemType_SafetyStates {
 }
 t::debug_handle!(MotionDeviceSystemType_SafetyStates);
 impl t::Handle for MotionDeviceSystemType_SafetyStates {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             safety_state_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[0], 1013))?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1013)),
+        }
     }
 }
 t::object_type!(
@@ -862,25 +864,25 @@ pub struct MotionDeviceType {
 }
 t::debug_handle!(MotionDeviceType);
 impl t::Handle for MotionDeviceType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            parameter_set: b.child(id, NS[1], "ParameterSet")?,
-            manufacturer: b.child(id, NS[1], "Manufacturer")?,
-            model: b.child(id, NS[1], "Model")?,
-            product_code: b.child(id, NS[1], "ProductCode")?,
-            device_manual: b.optional(id, NS[1], "DeviceManual")?,
-            serial_number: b.child(id, NS[1], "SerialNumber")?,
-            asset_id: b.optional(id, NS[1], "AssetId")?,
-            component_name: b.optional(id, NS[1], "ComponentName")?,
-            additional_components: b.optional(id, NS[0], "AdditionalComponents")?,
-            axes: b.child(id, NS[0], "Axes")?,
-            flange_load: b.optional(id, NS[0], "FlangeLoad")?,
-            motion_device_category: b.child(id, NS[0], "MotionDeviceCategory")?,
-            power_trains: b.child(id, NS[0], "PowerTrains")?,
-            task_control_reference: b.optional(id, NS[0], "TaskControlReference")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            parameter_set: b.build_child(id, NS[1], "ParameterSet"),
+            manufacturer: b.build_child(id, NS[1], "Manufacturer"),
+            model: b.build_child(id, NS[1], "Model"),
+            product_code: b.build_child(id, NS[1], "ProductCode"),
+            device_manual: b.build_optional(id, NS[1], "DeviceManual"),
+            serial_number: b.build_child(id, NS[1], "SerialNumber"),
+            asset_id: b.build_optional(id, NS[1], "AssetId"),
+            component_name: b.build_optional(id, NS[1], "ComponentName"),
+            additional_components: b.build_optional(id, NS[0], "AdditionalComponents"),
+            axes: b.build_child(id, NS[0], "Axes"),
+            flange_load: b.build_optional(id, NS[0], "FlangeLoad"),
+            motion_device_category: b.build_child(id, NS[0], "MotionDeviceCategory"),
+            power_trains: b.build_child(id, NS[0], "PowerTrains"),
+            task_control_reference: b.build_optional(id, NS[0], "TaskControlReference"),
+        }
     }
 }
 t::deref_base!(MotionDeviceType => super::super::di::objects::ComponentType);
@@ -899,13 +901,13 @@ pub struct MotionDeviceType_ParameterSet {
 }
 t::debug_handle!(MotionDeviceType_ParameterSet);
 impl t::Handle for MotionDeviceType_ParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            in_control: b.optional(id, NS[0], "InControl")?,
-            on_path: b.optional(id, NS[0], "OnPath")?,
-            speed_override: b.child(id, NS[0], "SpeedOverride")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            in_control: b.build_optional(id, NS[0], "InControl"),
+            on_path: b.build_optional(id, NS[0], "OnPath"),
+            speed_override: b.build_child(id, NS[0], "SpeedOverride"),
+        }
     }
 }
 /// `AdditionalComponents`, a member of `MotionDeviceType` with children of its own.
@@ -919,12 +921,12 @@ pub struct MotionDeviceType_AdditionalComponents {
 }
 t::debug_handle!(MotionDeviceType_AdditionalComponents);
 impl t::Handle for MotionDeviceType_AdditionalComponents {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             additional_component_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[2], 58))?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[2], 58)),
+        }
     }
 }
 /// `Axes`, a member of `MotionDeviceType` with children of its own.
@@ -938,11 +940,12 @@ pub struct MotionDeviceType_Axes {
 }
 t::debug_handle!(MotionDeviceType_Axes);
 impl t::Handle for MotionDeviceType_Axes {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            axis_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[0], 16601))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            axis_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 16601)),
+        }
     }
 }
 /// `FlangeLoad`, a member of `MotionDeviceType` with children of its own.
@@ -960,13 +963,13 @@ pub struct MotionDeviceType_FlangeLoad {
 }
 t::debug_handle!(MotionDeviceType_FlangeLoad);
 impl t::Handle for MotionDeviceType_FlangeLoad {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            center_of_mass: b.optional(id, NS[0], "CenterOfMass")?,
-            inertia: b.optional(id, NS[0], "Inertia")?,
-            mass: b.child(id, NS[0], "Mass")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            center_of_mass: b.build_optional(id, NS[0], "CenterOfMass"),
+            inertia: b.build_optional(id, NS[0], "Inertia"),
+            mass: b.build_child(id, NS[0], "Mass"),
+        }
     }
 }
 /// `PowerTrains`, a member of `MotionDeviceType` with children of its own.
@@ -980,12 +983,12 @@ pub struct MotionDeviceType_PowerTrains {
 }
 t::debug_handle!(MotionDeviceType_PowerTrains);
 impl t::Handle for MotionDeviceType_PowerTrains {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             power_train_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[0], 16794))?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 16794)),
+        }
     }
 }
 t::object_type!(
@@ -1018,18 +1021,18 @@ pub struct MotorType {
 }
 t::debug_handle!(MotorType);
 impl t::Handle for MotorType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            parameter_set: b.child(id, NS[1], "ParameterSet")?,
-            manufacturer: b.child(id, NS[1], "Manufacturer")?,
-            model: b.child(id, NS[1], "Model")?,
-            product_code: b.child(id, NS[1], "ProductCode")?,
-            serial_number: b.child(id, NS[1], "SerialNumber")?,
-            asset_id: b.optional(id, NS[1], "AssetId")?,
-            drive_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[2], 58))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            parameter_set: b.build_child(id, NS[1], "ParameterSet"),
+            manufacturer: b.build_child(id, NS[1], "Manufacturer"),
+            model: b.build_child(id, NS[1], "Model"),
+            product_code: b.build_child(id, NS[1], "ProductCode"),
+            serial_number: b.build_child(id, NS[1], "SerialNumber"),
+            asset_id: b.build_optional(id, NS[1], "AssetId"),
+            drive_identifier: b.build_placeholders(id, rt::NsNodeId::numeric(NS[2], 58)),
+        }
     }
 }
 t::deref_base!(MotorType => super::super::di::objects::ComponentType);
@@ -1048,13 +1051,13 @@ pub struct MotorType_ParameterSet {
 }
 t::debug_handle!(MotorType_ParameterSet);
 impl t::Handle for MotorType_ParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            brake_released: b.optional(id, NS[0], "BrakeReleased")?,
-            effective_load_rate: b.optional(id, NS[0], "EffectiveLoadRate")?,
-            motor_temperature: b.child(id, NS[0], "MotorTemperature")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            brake_released: b.build_optional(id, NS[0], "BrakeReleased"),
+            effective_load_rate: b.build_optional(id, NS[0], "EffectiveLoadRate"),
+            motor_temperature: b.build_child(id, NS[0], "MotorTemperature"),
+        }
     }
 }
 t::object_type!(MotorType, rt::NsNodeId::numeric(NS[0], 1019), "MotorType");
@@ -1125,39 +1128,40 @@ pub struct MultiAcknowledgeableConditionType {
 }
 t::debug_handle!(MultiAcknowledgeableConditionType);
 impl t::Handle for MultiAcknowledgeableConditionType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            event_id: b.child(id, NS[2], "EventId")?,
-            event_type: b.child(id, NS[2], "EventType")?,
-            source_node: b.child(id, NS[2], "SourceNode")?,
-            source_name: b.child(id, NS[2], "SourceName")?,
-            time: b.child(id, NS[2], "Time")?,
-            receive_time: b.child(id, NS[2], "ReceiveTime")?,
-            local_time: b.optional(id, NS[2], "LocalTime")?,
-            message: b.child(id, NS[2], "Message")?,
-            severity: b.child(id, NS[2], "Severity")?,
-            condition_class_id: b.child(id, NS[2], "ConditionClassId")?,
-            condition_class_name: b.child(id, NS[2], "ConditionClassName")?,
-            condition_sub_class_id: b.optional(id, NS[2], "ConditionSubClassId")?,
-            condition_sub_class_name: b.optional(id, NS[2], "ConditionSubClassName")?,
-            condition_name: b.child(id, NS[2], "ConditionName")?,
-            branch_id: b.child(id, NS[2], "BranchId")?,
-            retain: b.child(id, NS[2], "Retain")?,
-            enabled_state: b.child(id, NS[2], "EnabledState")?,
-            quality: b.child(id, NS[2], "Quality")?,
-            last_severity: b.child(id, NS[2], "LastSeverity")?,
-            comment: b.child(id, NS[2], "Comment")?,
-            client_user_id: b.child(id, NS[2], "ClientUserId")?,
-            disable: b.child(id, NS[2], "Disable")?,
-            enable: b.child(id, NS[2], "Enable")?,
-            add_comment: b.child(id, NS[2], "AddComment")?,
-            acked_state: b.child(id, NS[2], "AckedState")?,
-            confirmed_state: b.optional(id, NS[2], "ConfirmedState")?,
-            acknowledge: b.child(id, NS[2], "Acknowledge")?,
-            confirm: b.optional(id, NS[2], "Confirm")?,
-            condition_descriptions: b.child(id, NS[0], "ConditionDescriptions")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            event_id: b.build_child(id, NS[2], "EventId"),
+            event_type: b.build_child(id, NS[2], "EventType"),
+            source_node: b.build_child(id, NS[2], "SourceNode"),
+            source_name: b.build_child(id, NS[2], "SourceName"),
+            time: b.build_child(id, NS[2], "Time"),
+            receive_time: b.build_child(id, NS[2], "ReceiveTime"),
+            local_time: b.build_optional(id, NS[2], "LocalTime"),
+            message: b.build_child(id, NS[2], "Message"),
+            severity: b.build_child(id, NS[2], "Severity"),
+            condition_class_id: b.build_child(id, NS[2], "ConditionClassId"),
+            condition_class_name: b.build_child(id, NS[2], "ConditionClassName"),
+            condition_sub_class_id: b.build_optional(id, NS[2], "ConditionSubClassId"),
+            condition_sub_class_name: b
+                .build_optional(id, NS[2], "ConditionSubClassName"),
+            condition_name: b.build_child(id, NS[2], "ConditionName"),
+            branch_id: b.build_child(id, NS[2], "BranchId"),
+            retain: b.build_child(id, NS[2], "Retain"),
+            enabled_state: b.build_child(id, NS[2], "EnabledState"),
+            quality: b.build_child(id, NS[2], "Quality"),
+            last_severity: b.build_child(id, NS[2], "LastSeverity"),
+            comment: b.build_child(id, NS[2], "Comment"),
+            client_user_id: b.build_child(id, NS[2], "ClientUserId"),
+            disable: b.build_child(id, NS[2], "Disable"),
+            enable: b.build_child(id, NS[2], "Enable"),
+            add_comment: b.build_child(id, NS[2], "AddComment"),
+            acked_state: b.build_child(id, NS[2], "AckedState"),
+            confirmed_state: b.build_optional(id, NS[2], "ConfirmedState"),
+            acknowledge: b.build_child(id, NS[2], "Acknowledge"),
+            confirm: b.build_optional(id, NS[2], "Confirm"),
+            condition_descriptions: b.build_child(id, NS[0], "ConditionDescriptions"),
+        }
     }
 }
 t::object_type!(
@@ -1191,20 +1195,20 @@ pub struct OperationStateMachineType {
 }
 t::debug_handle!(OperationStateMachineType);
 impl t::Handle for OperationStateMachineType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
             configured_default_stop_mode: b
-                .optional(id, NS[0], "ConfiguredDefaultStopMode")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-            possible_stop_modes: b.optional(id, NS[0], "PossibleStopModes")?,
-            start: b.optional(id, NS[0], "Start")?,
-            stop: b.optional(id, NS[0], "Stop")?,
-        })
+                .build_optional(id, NS[0], "ConfiguredDefaultStopMode"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+            possible_stop_modes: b.build_optional(id, NS[0], "PossibleStopModes"),
+            start: b.build_optional(id, NS[0], "Start"),
+            stop: b.build_optional(id, NS[0], "Stop"),
+        }
     }
 }
 t::object_type!(
@@ -1322,17 +1326,20 @@ pub struct PowerTrainType {
 }
 t::debug_handle!(PowerTrainType);
 impl t::Handle for PowerTrainType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            component_name: b.optional(id, NS[1], "ComponentName")?,
-            axis_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[0], 16601))?,
-            gear_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[0], 1022))?,
-            motor_identifier: b.placeholders(id, rt::NsNodeId::numeric(NS[0], 1019))?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            component_name: b.build_optional(id, NS[1], "ComponentName"),
+            axis_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 16601)),
+            gear_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1022)),
+            motor_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1019)),
             power_train_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[0], 16794))?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 16794)),
+        }
     }
 }
 t::deref_base!(PowerTrainType => super::super::di::objects::ComponentType);
@@ -1354,13 +1361,13 @@ pub struct ProtectiveStopFunctionType {
 }
 t::debug_handle!(ProtectiveStopFunctionType);
 impl t::Handle for ProtectiveStopFunctionType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            active: b.child(id, NS[0], "Active")?,
-            enabled: b.child(id, NS[0], "Enabled")?,
-            name: b.child(id, NS[0], "Name")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            active: b.build_child(id, NS[0], "Active"),
+            enabled: b.build_child(id, NS[0], "Enabled"),
+            name: b.build_child(id, NS[0], "Name"),
+        }
     }
 }
 t::object_type!(
@@ -1388,16 +1395,16 @@ pub struct ReadySubstateMachineType {
 }
 t::debug_handle!(ReadySubstateMachineType);
 impl t::Handle for ReadySubstateMachineType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-            reset_to_program_start: b.optional(id, NS[0], "ResetToProgramStart")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+            reset_to_program_start: b.build_optional(id, NS[0], "ResetToProgramStart"),
+        }
     }
 }
 t::object_type!(
@@ -1470,15 +1477,17 @@ pub struct SafetyStateType {
 }
 t::debug_handle!(SafetyStateType);
 impl t::Handle for SafetyStateType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            parameter_set: b.child(id, NS[1], "ParameterSet")?,
-            component_name: b.optional(id, NS[1], "ComponentName")?,
-            emergency_stop_functions: b.optional(id, NS[0], "EmergencyStopFunctions")?,
-            protective_stop_functions: b.optional(id, NS[0], "ProtectiveStopFunctions")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            parameter_set: b.build_child(id, NS[1], "ParameterSet"),
+            component_name: b.build_optional(id, NS[1], "ComponentName"),
+            emergency_stop_functions: b
+                .build_optional(id, NS[0], "EmergencyStopFunctions"),
+            protective_stop_functions: b
+                .build_optional(id, NS[0], "ProtectiveStopFunctions"),
+        }
     }
 }
 t::deref_base!(SafetyStateType => super::super::di::objects::ComponentType);
@@ -1497,13 +1506,13 @@ pub struct SafetyStateType_ParameterSet {
 }
 t::debug_handle!(SafetyStateType_ParameterSet);
 impl t::Handle for SafetyStateType_ParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            emergency_stop: b.child(id, NS[0], "EmergencyStop")?,
-            operational_mode: b.child(id, NS[0], "OperationalMode")?,
-            protective_stop: b.child(id, NS[0], "ProtectiveStop")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            emergency_stop: b.build_child(id, NS[0], "EmergencyStop"),
+            operational_mode: b.build_child(id, NS[0], "OperationalMode"),
+            protective_stop: b.build_child(id, NS[0], "ProtectiveStop"),
+        }
     }
 }
 /// `EmergencyStopFunctions`, a member of `SafetyStateType` with children of its own.
@@ -1517,12 +1526,12 @@ pub struct SafetyStateType_EmergencyStopFunctions {
 }
 t::debug_handle!(SafetyStateType_EmergencyStopFunctions);
 impl t::Handle for SafetyStateType_EmergencyStopFunctions {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             emergency_stop_function_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[0], 17230))?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 17230)),
+        }
     }
 }
 /// `ProtectiveStopFunctions`, a member of `SafetyStateType` with children of its own.
@@ -1536,12 +1545,12 @@ pub struct SafetyStateType_ProtectiveStopFunctions {
 }
 t::debug_handle!(SafetyStateType_ProtectiveStopFunctions);
 impl t::Handle for SafetyStateType_ProtectiveStopFunctions {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             protective_stop_function_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[0], 17233))?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 17233)),
+        }
     }
 }
 t::object_type!(SafetyStateType, rt::NsNodeId::numeric(NS[0], 1013), "SafetyStateType");
@@ -1580,23 +1589,23 @@ pub struct SystemOperationStateMachineType {
 }
 t::debug_handle!(SystemOperationStateMachineType);
 impl t::Handle for SystemOperationStateMachineType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
             configured_default_stop_mode: b
-                .optional(id, NS[0], "ConfiguredDefaultStopMode")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-            possible_stop_modes: b.optional(id, NS[0], "PossibleStopModes")?,
-            start: b.optional(id, NS[0], "Start")?,
-            stop: b.optional(id, NS[0], "Stop")?,
+                .build_optional(id, NS[0], "ConfiguredDefaultStopMode"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+            possible_stop_modes: b.build_optional(id, NS[0], "PossibleStopModes"),
+            start: b.build_optional(id, NS[0], "Start"),
+            stop: b.build_optional(id, NS[0], "Stop"),
             executing_substate_machine: b
-                .optional(id, NS[0], "ExecutingSubstateMachine")?,
-            get_ready: b.optional(id, NS[0], "GetReady")?,
-            idle_substate_machine: b.optional(id, NS[0], "IdleSubstateMachine")?,
-            stand_down: b.optional(id, NS[0], "StandDown")?,
-        })
+                .build_optional(id, NS[0], "ExecutingSubstateMachine"),
+            get_ready: b.build_optional(id, NS[0], "GetReady"),
+            idle_substate_machine: b.build_optional(id, NS[0], "IdleSubstateMachine"),
+            stand_down: b.build_optional(id, NS[0], "StandDown"),
+        }
     }
 }
 t::deref_base!(SystemOperationStateMachineType => OperationStateMachineType);
@@ -1619,15 +1628,15 @@ pub struct SystemOperationStateMachineType_ExecutingSubstateMachine {
 }
 t::debug_handle!(SystemOperationStateMachineType_ExecutingSubstateMachine);
 impl t::Handle for SystemOperationStateMachineType_ExecutingSubstateMachine {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+        }
     }
 }
 /// `IdleSubstateMachine`, a member of `SystemOperationStateMachineType` with children of its own.
@@ -1649,15 +1658,15 @@ pub struct SystemOperationStateMachineType_IdleSubstateMachine {
 }
 t::debug_handle!(SystemOperationStateMachineType_IdleSubstateMachine);
 impl t::Handle for SystemOperationStateMachineType_IdleSubstateMachine {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+        }
     }
 }
 t::object_type!(
@@ -1765,13 +1774,13 @@ pub struct SystemOperationType {
 }
 t::debug_handle!(SystemOperationType);
 impl t::Handle for SystemOperationType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            conditions: b.optional(id, NS[0], "Conditions")?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            conditions: b.build_optional(id, NS[0], "Conditions"),
             system_operation_state_machine: b
-                .child(id, NS[0], "SystemOperationStateMachine")?,
-        })
+                .build_child(id, NS[0], "SystemOperationStateMachine"),
+        }
     }
 }
 /// `Conditions`, a member of `SystemOperationType` with children of its own.
@@ -1785,12 +1794,12 @@ pub struct SystemOperationType_Conditions {
 }
 t::debug_handle!(SystemOperationType_Conditions);
 impl t::Handle for SystemOperationType_Conditions {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             acknowledgeable_condition: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[2], 2881))?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[2], 2881)),
+        }
     }
 }
 /// `SystemOperationStateMachine`, a member of `SystemOperationType` with children of its own.
@@ -1832,25 +1841,25 @@ pub struct SystemOperationType_SystemOperationStateMachine {
 }
 t::debug_handle!(SystemOperationType_SystemOperationStateMachine);
 impl t::Handle for SystemOperationType_SystemOperationStateMachine {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
             configured_default_stop_mode: b
-                .optional(id, NS[0], "ConfiguredDefaultStopMode")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-            possible_stop_modes: b.optional(id, NS[0], "PossibleStopModes")?,
-            start: b.optional(id, NS[0], "Start")?,
-            stop: b.optional(id, NS[0], "Stop")?,
+                .build_optional(id, NS[0], "ConfiguredDefaultStopMode"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+            possible_stop_modes: b.build_optional(id, NS[0], "PossibleStopModes"),
+            start: b.build_optional(id, NS[0], "Start"),
+            stop: b.build_optional(id, NS[0], "Stop"),
             executing_substate_machine: b
-                .optional(id, NS[0], "ExecutingSubstateMachine")?,
-            get_ready: b.optional(id, NS[0], "GetReady")?,
-            idle_substate_machine: b.optional(id, NS[0], "IdleSubstateMachine")?,
-            stand_down: b.optional(id, NS[0], "StandDown")?,
-        })
+                .build_optional(id, NS[0], "ExecutingSubstateMachine"),
+            get_ready: b.build_optional(id, NS[0], "GetReady"),
+            idle_substate_machine: b.build_optional(id, NS[0], "IdleSubstateMachine"),
+            stand_down: b.build_optional(id, NS[0], "StandDown"),
+        }
     }
 }
 /// `ExecutingSubstateMachine`, a member of `SystemOperationType_SystemOperationStateMachine` with children of its own.
@@ -1875,15 +1884,15 @@ t::debug_handle!(
 );
 impl t::Handle
 for SystemOperationType_SystemOperationStateMachine_ExecutingSubstateMachine {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+        }
     }
 }
 /// `IdleSubstateMachine`, a member of `SystemOperationType_SystemOperationStateMachine` with children of its own.
@@ -1905,15 +1914,15 @@ pub struct SystemOperationType_SystemOperationStateMachine_IdleSubstateMachine {
 }
 t::debug_handle!(SystemOperationType_SystemOperationStateMachine_IdleSubstateMachine);
 impl t::Handle for SystemOperationType_SystemOperationStateMachine_IdleSubstateMachine {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+        }
     }
 }
 t::object_type!(
@@ -1932,13 +1941,14 @@ pub struct TaskControlOperationType {
 }
 t::debug_handle!(TaskControlOperationType);
 impl t::Handle for TaskControlOperationType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             motion_devices_under_control: b
-                .optional(id, NS[0], "MotionDevicesUnderControl")?,
-            task_control_state_machine: b.child(id, NS[0], "TaskControlStateMachine")?,
-        })
+                .build_optional(id, NS[0], "MotionDevicesUnderControl"),
+            task_control_state_machine: b
+                .build_child(id, NS[0], "TaskControlStateMachine"),
+        }
     }
 }
 /// `TaskControlStateMachine`, a member of `TaskControlOperationType` with children of its own.
@@ -1982,26 +1992,26 @@ pub struct TaskControlOperationType_TaskControlStateMachine {
 }
 t::debug_handle!(TaskControlOperationType_TaskControlStateMachine);
 impl t::Handle for TaskControlOperationType_TaskControlStateMachine {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
             configured_default_stop_mode: b
-                .optional(id, NS[0], "ConfiguredDefaultStopMode")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-            possible_stop_modes: b.optional(id, NS[0], "PossibleStopModes")?,
-            start: b.optional(id, NS[0], "Start")?,
-            stop: b.optional(id, NS[0], "Stop")?,
-            load_by_name: b.optional(id, NS[0], "LoadByName")?,
-            load_by_node_id: b.optional(id, NS[0], "LoadByNodeId")?,
-            ready_substate_machine: b.optional(id, NS[0], "ReadySubstateMachine")?,
-            unload_by_name: b.optional(id, NS[0], "UnloadByName")?,
-            unload_by_node_id: b.optional(id, NS[0], "UnloadByNodeId")?,
-            unload_program: b.optional(id, NS[0], "UnloadProgram")?,
-        })
+                .build_optional(id, NS[0], "ConfiguredDefaultStopMode"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+            possible_stop_modes: b.build_optional(id, NS[0], "PossibleStopModes"),
+            start: b.build_optional(id, NS[0], "Start"),
+            stop: b.build_optional(id, NS[0], "Stop"),
+            load_by_name: b.build_optional(id, NS[0], "LoadByName"),
+            load_by_node_id: b.build_optional(id, NS[0], "LoadByNodeId"),
+            ready_substate_machine: b.build_optional(id, NS[0], "ReadySubstateMachine"),
+            unload_by_name: b.build_optional(id, NS[0], "UnloadByName"),
+            unload_by_node_id: b.build_optional(id, NS[0], "UnloadByNodeId"),
+            unload_program: b.build_optional(id, NS[0], "UnloadProgram"),
+        }
     }
 }
 /// `ReadySubstateMachine`, a member of `TaskControlOperationType_TaskControlStateMachine` with children of its own.
@@ -2026,16 +2036,16 @@ pub struct TaskControlOperationType_TaskControlStateMachine_ReadySubstateMachine
 t::debug_handle!(TaskControlOperationType_TaskControlStateMachine_ReadySubstateMachine);
 impl t::Handle
 for TaskControlOperationType_TaskControlStateMachine_ReadySubstateMachine {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-            reset_to_program_start: b.optional(id, NS[0], "ResetToProgramStart")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+            reset_to_program_start: b.build_optional(id, NS[0], "ResetToProgramStart"),
+        }
     }
 }
 t::object_type!(
@@ -2077,24 +2087,24 @@ pub struct TaskControlStateMachineType {
 }
 t::debug_handle!(TaskControlStateMachineType);
 impl t::Handle for TaskControlStateMachineType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
             configured_default_stop_mode: b
-                .optional(id, NS[0], "ConfiguredDefaultStopMode")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-            possible_stop_modes: b.optional(id, NS[0], "PossibleStopModes")?,
-            start: b.optional(id, NS[0], "Start")?,
-            stop: b.optional(id, NS[0], "Stop")?,
-            load_by_name: b.optional(id, NS[0], "LoadByName")?,
-            load_by_node_id: b.optional(id, NS[0], "LoadByNodeId")?,
-            ready_substate_machine: b.optional(id, NS[0], "ReadySubstateMachine")?,
-            unload_by_name: b.optional(id, NS[0], "UnloadByName")?,
-            unload_by_node_id: b.optional(id, NS[0], "UnloadByNodeId")?,
-            unload_program: b.optional(id, NS[0], "UnloadProgram")?,
-        })
+                .build_optional(id, NS[0], "ConfiguredDefaultStopMode"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+            possible_stop_modes: b.build_optional(id, NS[0], "PossibleStopModes"),
+            start: b.build_optional(id, NS[0], "Start"),
+            stop: b.build_optional(id, NS[0], "Stop"),
+            load_by_name: b.build_optional(id, NS[0], "LoadByName"),
+            load_by_node_id: b.build_optional(id, NS[0], "LoadByNodeId"),
+            ready_substate_machine: b.build_optional(id, NS[0], "ReadySubstateMachine"),
+            unload_by_name: b.build_optional(id, NS[0], "UnloadByName"),
+            unload_by_node_id: b.build_optional(id, NS[0], "UnloadByNodeId"),
+            unload_program: b.build_optional(id, NS[0], "UnloadProgram"),
+        }
     }
 }
 t::deref_base!(TaskControlStateMachineType => OperationStateMachineType);
@@ -2119,16 +2129,16 @@ pub struct TaskControlStateMachineType_ReadySubstateMachine {
 }
 t::debug_handle!(TaskControlStateMachineType_ReadySubstateMachine);
 impl t::Handle for TaskControlStateMachineType_ReadySubstateMachine {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-            reset_to_program_start: b.optional(id, NS[0], "ResetToProgramStart")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+            reset_to_program_start: b.build_optional(id, NS[0], "ResetToProgramStart"),
+        }
     }
 }
 t::object_type!(
@@ -2250,17 +2260,17 @@ pub struct TaskControlType {
 }
 t::debug_handle!(TaskControlType);
 impl t::Handle for TaskControlType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            base: b.this(id)?,
-            parameter_set: b.child(id, NS[1], "ParameterSet")?,
-            component_name: b.child(id, NS[1], "ComponentName")?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            base: b.build_this(id),
+            parameter_set: b.build_child(id, NS[1], "ParameterSet"),
+            component_name: b.build_child(id, NS[1], "ComponentName"),
             motion_device_identifier: b
-                .placeholders(id, rt::NsNodeId::numeric(NS[0], 1004))?,
-            task_control_operation: b.optional(id, NS[0], "TaskControlOperation")?,
-            task_modules: b.optional(id, NS[0], "TaskModules")?,
-        })
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1004)),
+            task_control_operation: b.build_optional(id, NS[0], "TaskControlOperation"),
+            task_modules: b.build_optional(id, NS[0], "TaskModules"),
+        }
     }
 }
 t::deref_base!(TaskControlType => super::super::di::objects::ComponentType);
@@ -2279,13 +2289,13 @@ pub struct TaskControlType_ParameterSet {
 }
 t::debug_handle!(TaskControlType_ParameterSet);
 impl t::Handle for TaskControlType_ParameterSet {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            execution_mode: b.optional(id, NS[0], "ExecutionMode")?,
-            task_program_loaded: b.child(id, NS[0], "TaskProgramLoaded")?,
-            task_program_name: b.child(id, NS[0], "TaskProgramName")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            execution_mode: b.build_optional(id, NS[0], "ExecutionMode"),
+            task_program_loaded: b.build_child(id, NS[0], "TaskProgramLoaded"),
+            task_program_name: b.build_child(id, NS[0], "TaskProgramName"),
+        }
     }
 }
 /// `TaskControlOperation`, a member of `TaskControlType` with children of its own.
@@ -2301,13 +2311,14 @@ pub struct TaskControlType_TaskControlOperation {
 }
 t::debug_handle!(TaskControlType_TaskControlOperation);
 impl t::Handle for TaskControlType_TaskControlOperation {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
             motion_devices_under_control: b
-                .optional(id, NS[0], "MotionDevicesUnderControl")?,
-            task_control_state_machine: b.child(id, NS[0], "TaskControlStateMachine")?,
-        })
+                .build_optional(id, NS[0], "MotionDevicesUnderControl"),
+            task_control_state_machine: b
+                .build_child(id, NS[0], "TaskControlStateMachine"),
+        }
     }
 }
 /// `TaskControlStateMachine`, a member of `TaskControlType_TaskControlOperation` with children of its own.
@@ -2349,26 +2360,26 @@ pub struct TaskControlType_TaskControlOperation_TaskControlStateMachine {
 }
 t::debug_handle!(TaskControlType_TaskControlOperation_TaskControlStateMachine);
 impl t::Handle for TaskControlType_TaskControlOperation_TaskControlStateMachine {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            current_state: b.child(id, NS[2], "CurrentState")?,
-            last_transition: b.child(id, NS[2], "LastTransition")?,
-            available_states: b.optional(id, NS[2], "AvailableStates")?,
-            available_transitions: b.optional(id, NS[2], "AvailableTransitions")?,
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            current_state: b.build_child(id, NS[2], "CurrentState"),
+            last_transition: b.build_child(id, NS[2], "LastTransition"),
+            available_states: b.build_optional(id, NS[2], "AvailableStates"),
+            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
             configured_default_stop_mode: b
-                .optional(id, NS[0], "ConfiguredDefaultStopMode")?,
-            last_transition_reason: b.child(id, NS[0], "LastTransitionReason")?,
-            possible_stop_modes: b.optional(id, NS[0], "PossibleStopModes")?,
-            start: b.optional(id, NS[0], "Start")?,
-            stop: b.optional(id, NS[0], "Stop")?,
-            load_by_name: b.optional(id, NS[0], "LoadByName")?,
-            load_by_node_id: b.optional(id, NS[0], "LoadByNodeId")?,
-            ready_substate_machine: b.optional(id, NS[0], "ReadySubstateMachine")?,
-            unload_by_name: b.optional(id, NS[0], "UnloadByName")?,
-            unload_by_node_id: b.optional(id, NS[0], "UnloadByNodeId")?,
-            unload_program: b.optional(id, NS[0], "UnloadProgram")?,
-        })
+                .build_optional(id, NS[0], "ConfiguredDefaultStopMode"),
+            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
+            possible_stop_modes: b.build_optional(id, NS[0], "PossibleStopModes"),
+            start: b.build_optional(id, NS[0], "Start"),
+            stop: b.build_optional(id, NS[0], "Stop"),
+            load_by_name: b.build_optional(id, NS[0], "LoadByName"),
+            load_by_node_id: b.build_optional(id, NS[0], "LoadByNodeId"),
+            ready_substate_machine: b.build_optional(id, NS[0], "ReadySubstateMachine"),
+            unload_by_name: b.build_optional(id, NS[0], "UnloadByName"),
+            unload_by_node_id: b.build_optional(id, NS[0], "UnloadByNodeId"),
+            unload_program: b.build_optional(id, NS[0], "UnloadProgram"),
+        }
     }
 }
 /// `TaskModules`, a member of `TaskControlType` with children of its own.
@@ -2382,11 +2393,11 @@ pub struct TaskControlType_TaskModules {
 }
 t::debug_handle!(TaskControlType_TaskModules);
 impl t::Handle for TaskControlType_TaskModules {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            task_module: b.placeholders(id, rt::NsNodeId::numeric(NS[0], 1016))?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            task_module: b.build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1016)),
+        }
     }
 }
 t::object_type!(TaskControlType, rt::NsNodeId::numeric(NS[0], 1011), "TaskControlType");
@@ -2405,13 +2416,13 @@ pub struct TaskModuleType {
 }
 t::debug_handle!(TaskModuleType);
 impl t::Handle for TaskModuleType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            is_referenced: b.optional(id, NS[0], "IsReferenced")?,
-            name: b.child(id, NS[0], "Name")?,
-            version: b.optional(id, NS[0], "Version")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            is_referenced: b.build_optional(id, NS[0], "IsReferenced"),
+            name: b.build_child(id, NS[0], "Name"),
+            version: b.build_optional(id, NS[0], "Version"),
+        }
     }
 }
 t::object_type!(TaskModuleType, rt::NsNodeId::numeric(NS[0], 1016), "TaskModuleType");
@@ -2430,12 +2441,12 @@ pub struct UserType {
 }
 t::debug_handle!(UserType);
 impl t::Handle for UserType {
-    fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-        Ok(Self {
-            node: b.this(id)?,
-            level: b.child(id, NS[0], "Level")?,
-            name: b.optional(id, NS[0], "Name")?,
-        })
+    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+        Self {
+            node: b.build_this(id),
+            level: b.build_child(id, NS[0], "Level"),
+            name: b.build_optional(id, NS[0], "Name"),
+        }
     }
 }
 t::object_type!(UserType, rt::NsNodeId::numeric(NS[0], 18175), "UserType");

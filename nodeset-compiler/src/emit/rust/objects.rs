@@ -328,12 +328,12 @@ impl Gen<'_> {
             // Placeholders are kept in a list, on the heap already.
             let single = if boxed { quote! { Box<#handle> } } else { handle.clone() };
             let (ty, bind) = match rule {
-                ModellingRule::Mandatory => (single, quote! { b.child(id, NS[#k], #bname)? }),
-                ModellingRule::Optional => (quote! { Option<#single> }, quote! { b.optional(id, NS[#k], #bname)? }),
+                ModellingRule::Mandatory => (single, quote! { b.build_child(id, NS[#k], #bname) }),
+                ModellingRule::Optional => (quote! { Option<#single> }, quote! { b.build_optional(id, NS[#k], #bname) }),
                 _ => {
                     let Some(td) = n.type_definition else { continue };
                     let tid = self.ns_node_id(uris, td);
-                    (quote! { t::Placeholders<#handle> }, quote! { b.placeholders(id, #tid)? })
+                    (quote! { t::Placeholders<#handle> }, quote! { b.build_placeholders(id, #tid) })
                 }
             };
             let mut text = format!("`{}` ({}).", n.browse_name.name, rule.name());
@@ -372,11 +372,11 @@ impl Gen<'_> {
             quote! { #[allow(non_snake_case)] }
         };
         let mut decls = vec![quote! { #[doc = " The instance."] pub node: #node_ty }];
-        let mut binds = vec![quote! { node: b.this(id)? }];
+        let mut binds = vec![quote! { node: b.build_this(id) }];
         let mut deref = quote! {};
         if let Some(base) = &base {
             decls.push(quote! { #[doc = " The members inherited from the supertype (also reached through `Deref`)."] pub base: #base });
-            binds.push(quote! { base: b.this(id)? });
+            binds.push(quote! { base: b.build_this(id) });
             deref = quote! { t::deref_base!(#sname => #base); };
         }
         for f in &fields {
@@ -392,8 +392,8 @@ impl Gen<'_> {
             pub struct #sname { #(#decls),* }
             t::debug_handle!(#sname);
             impl t::Handle for #sname {
-                fn bind(b: &t::Binder<'_>, id: &ua::NodeId) -> Result<Self, t::BindError> {
-                    Ok(Self { #(#binds),* })
+                fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
+                    Self { #(#binds),* }
                 }
             }
             #deref
