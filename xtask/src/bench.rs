@@ -181,28 +181,11 @@ pub fn run(args: Args) -> Result<(), String> {
     // The peer's whole DI + Robotics run just before and after ours: how fast the shared host is right now.
     let mut yard: Option<Result<rust::Yardstick, String>> = None;
     if want("robotics") {
-        let runner = (!args.no_peer).then(|| rust::yardstick_runner(&root, &tree));
-        let peer = |what: &str| {
-            runner.as_ref().map(|r| match r {
-                Ok(run) => {
-                    eprintln!("running the peer's DI + Robotics run ({what} ours) ...");
-                    run(args.runs_process)
-                }
-                Err(e) => Err(e.clone()),
-            })
-        };
-        let before = peer("before");
-        reports.push(measure(
-            &exe,
-            "robotics",
-            args.runs_robotics,
-            &[],
-            args.no_split,
-        )?);
-        let after = peer("after");
-        yard = before
-            .zip(after)
-            .map(|(b, a)| Ok(rust::yardstick(&b?, &a?)));
+        let (report, y) = rust::Yardsticks::new(&args, &root, &tree).around("ours", || {
+            measure(&exe, "robotics", args.runs_robotics, &[], args.no_split)
+        });
+        reports.push(report?);
+        yard = y;
     }
     if run_tree {
         let tree_arg = ["--tree".to_string(), tree.display().to_string()];
@@ -705,54 +688,43 @@ mod rust {
 
         // The yardstick of the host's speed (the peer's whole DI + Robotics run), taken around the
         // generation and around the import.
-        let runner = (!args.no_peer).then(|| yardstick_runner(root, tree));
-        let peer_runs = |what: &str| {
-            runner.as_ref().map(|r| match r {
-                Ok(run) => {
-                    eprintln!("rust: the peer's DI + Robotics run as a yardstick ({what}) ...");
-                    run(args.runs_process)
-                }
-                Err(e) => Err(e.clone()),
-            })
-        };
-        let around = |before: Option<Step<Report>>, after: Option<Step<Report>>| {
-            before.zip(after).map(|(b, a)| Ok(yardstick(&b?, &a?)))
-        };
+        let yardsticks = Yardsticks::new(args, root, tree);
 
         // 1. Generation, in process and as a CLI process.
-        let before_gen = peer_runs("before the generation");
-        eprintln!("rust: generation ({} run(s)) ...", args.runs_rust.max(1));
-        let gen = run_report(
-            Command::new(&bench)
-                .arg("generate")
-                .arg("--runs")
-                .arg(args.runs_rust.max(1).to_string())
-                .arg("--vendor")
-                .arg(&vendor),
-        )?;
-        eprintln!(
-            "rust: the nodeset-compiler CLI as a process ({} run(s)) ...",
-            args.runs_process.max(1)
-        );
-        let cli_out = bench_target.join("ours-cli/models");
-        let mut cli_args: Vec<String> = vec!["rust".into()];
-        cli_args.extend(
-            NAMESPACES
-                .iter()
-                .map(|n| vendor.join(n.1).display().to_string()),
-        );
-        cli_args.extend(["--models".into(), vendor.display().to_string()]);
-        cli_args.extend(["--out".into(), cli_out.display().to_string()]);
-        cli_args.extend(["--runtime".into(), "crate::runtime".into()]);
-        for (module, _, uri, _) in NAMESPACES {
-            cli_args.extend(["--module".into(), format!("{uri}={module}")]);
-        }
-        let _ = fs::remove_dir_all(&cli_out);
-        let cli = fs::create_dir_all(&bench_target)
-            .map_err(|e| format!("cannot create {}: {e}", bench_target.display()))
-            .and_then(|()| exec(&bench, args.runs_process, root, &[], &cli_exe, &cli_args));
-
-        let yard_gen = around(before_gen, peer_runs("after the generation"));
+        let (generated, yard_gen) = yardsticks.around("the generation", || -> Step<_> {
+            eprintln!("rust: generation ({} run(s)) ...", args.runs_rust.max(1));
+            let gen = run_report(
+                Command::new(&bench)
+                    .arg("generate")
+                    .arg("--runs")
+                    .arg(args.runs_rust.max(1).to_string())
+                    .arg("--vendor")
+                    .arg(&vendor),
+            )?;
+            eprintln!(
+                "rust: the nodeset-compiler CLI as a process ({} run(s)) ...",
+                args.runs_process.max(1)
+            );
+            let cli_out = bench_target.join("ours-cli/models");
+            let mut cli_args: Vec<String> = vec!["rust".into()];
+            cli_args.extend(
+                NAMESPACES
+                    .iter()
+                    .map(|n| vendor.join(n.1).display().to_string()),
+            );
+            cli_args.extend(["--models".into(), vendor.display().to_string()]);
+            cli_args.extend(["--out".into(), cli_out.display().to_string()]);
+            cli_args.extend(["--runtime".into(), "crate::runtime".into()]);
+            for (module, _, uri, _) in NAMESPACES {
+                cli_args.extend(["--module".into(), format!("{uri}={module}")]);
+            }
+            let _ = fs::remove_dir_all(&cli_out);
+            let cli = fs::create_dir_all(&bench_target)
+                .map_err(|e| format!("cannot create {}: {e}", bench_target.display()))
+                .and_then(|()| exec(&bench, args.runs_process, root, &[], &cli_exe, &cli_args));
+            Ok((gen, cli))
+        });
+        let (gen, cli) = generated?;
 
         // 2. Lines, as checked in.
         let models = root.join("generated/src/models");
@@ -834,14 +806,15 @@ mod rust {
                 let exe = bench_target
                     .join("release/examples")
                     .join(format!("import_bench{}", env::consts::EXE_SUFFIX));
-                let before = peer_runs("before the import");
-                eprintln!("rust: import ({} run(s)) ...", args.runs_import.max(1));
-                let r = run_report(
-                    Command::new(exe)
-                        .arg("--runs")
-                        .arg(args.runs_import.max(1).to_string()),
-                );
-                yard_import = around(before, peer_runs("after the import"));
+                let (r, y) = yardsticks.around("the import", || {
+                    eprintln!("rust: import ({} run(s)) ...", args.runs_import.max(1));
+                    run_report(
+                        Command::new(exe)
+                            .arg("--runs")
+                            .arg(args.runs_import.max(1).to_string()),
+                    )
+                });
+                yard_import = y;
                 r
             });
             release = if args.no_release {
@@ -1062,51 +1035,96 @@ mod rust {
         }
     }
 
-    /// Builds what the yardstick needs (the peer, installed once; `rust_bench` as the stopwatch) and writes
-    /// the peer's config for DI + Robotics (types and nodes of both; ns0 and IA, which Robotics 1.02 requires,
-    /// loaded as dependencies) into `target/bench-build/peer-di-robotics`. Returns a closure that times
-    /// `runs` of the peer's whole run; call it before and after the measured work and [`yardstick`] the two.
-    pub(super) fn yardstick_runner(
-        root: &Path,
-        tree: &Path,
-    ) -> Step<impl Fn(usize) -> Step<Report>> {
-        let (exe, _) = ensure_peer(root);
-        let exe = exe?;
-        let bench = build(root, "rust_bench", &["--bin", "nodeset-compiler"])?;
-        let vendor = root.join("nodesets/vendor");
-        let dir = root.join("target/bench-build/peer-di-robotics");
-        let schemas: Vec<PathBuf> = std::iter::once(NS0_XSD)
-            .chain(NAMESPACES.iter().map(|n| n.3))
-            .map(|x| tree.join(x))
-            .collect();
-        if let Some(missing) = schemas.iter().find(|p| !p.is_file()) {
-            return Err(format!(
-                "the peer needs the XML schemas of the UA-Nodeset tree and {} is missing (give the tree with --tree DIR)",
-                missing.display()
-            ));
+    /// The peer's whole DI + Robotics run, ready to be timed: `rust_bench` as the stopwatch, the peer and its
+    /// config for DI + Robotics (types and nodes of both; ns0 and IA, which Robotics 1.02 requires, loaded
+    /// as dependencies) in `target/bench-build/peer-di-robotics`.
+    struct PeerRun {
+        bench: PathBuf,
+        exe: PathBuf,
+        dir: PathBuf,
+        config: String,
+    }
+
+    /// Takes the yardstick around measured work; holds nothing with `--no-peer`, or why the peer cannot run.
+    pub(super) struct Yardsticks {
+        peer: Option<Step<PeerRun>>,
+        runs: usize,
+    }
+
+    impl Yardsticks {
+        /// Installs the peer once if needed and writes its config (unless `args.no_peer`).
+        pub(super) fn new(args: &Args, root: &Path, tree: &Path) -> Yardsticks {
+            let peer = (!args.no_peer).then(|| PeerRun::prepare(root, tree));
+            Yardsticks {
+                peer,
+                runs: args.runs_process,
+            }
         }
-        write_peer_config(
-            &dir,
-            &vendor,
-            &schemas,
-            &["di", "robotics"],
-            "DI + Robotics",
-        )?;
-        let config = dir.join("codegen.yml").display().to_string();
-        Ok(move |runs: usize| {
-            exec(
-                &bench,
-                runs,
+
+        /// Runs `work` between two timings of the peer (`what` names the work in the progress lines); the
+        /// yardstick is None with `--no-peer`.
+        pub(super) fn around<T>(
+            &self,
+            what: &str,
+            work: impl FnOnce() -> T,
+        ) -> (T, Option<Step<Yardstick>>) {
+            let time = |when: &str| {
+                self.peer.as_ref().map(|peer| {
+                    let peer = peer.as_ref().map_err(Clone::clone)?;
+                    eprintln!("the peer's DI + Robotics run as a yardstick ({when} {what}) ...");
+                    exec(
+                        &peer.bench,
+                        self.runs,
+                        &peer.dir,
+                        &[("RUST_LOG", "warn")],
+                        &peer.exe,
+                        std::slice::from_ref(&peer.config),
+                    )
+                })
+            };
+            let before = time("before");
+            let out = work();
+            let after = time("after");
+            (out, before.zip(after).map(|(b, a)| Ok(yardstick(&b?, &a?))))
+        }
+    }
+
+    impl PeerRun {
+        fn prepare(root: &Path, tree: &Path) -> Step<PeerRun> {
+            let (exe, _) = ensure_peer(root);
+            let exe = exe?;
+            let bench = build(root, "rust_bench", &["--bin", "nodeset-compiler"])?;
+            let vendor = root.join("nodesets/vendor");
+            let dir = root.join("target/bench-build/peer-di-robotics");
+            let schemas: Vec<PathBuf> = std::iter::once(NS0_XSD)
+                .chain(NAMESPACES.iter().map(|n| n.3))
+                .map(|x| tree.join(x))
+                .collect();
+            if let Some(missing) = schemas.iter().find(|p| !p.is_file()) {
+                return Err(format!(
+                    "the peer needs the XML schemas of the UA-Nodeset tree and {} is missing (give the tree with --tree DIR)",
+                    missing.display()
+                ));
+            }
+            write_peer_config(
                 &dir,
-                &[("RUST_LOG", "warn")],
-                &exe,
-                std::slice::from_ref(&config),
-            )
-        })
+                &vendor,
+                &schemas,
+                &["di", "robotics"],
+                "DI + Robotics",
+            )?;
+            let config = dir.join("codegen.yml").display().to_string();
+            Ok(PeerRun {
+                bench,
+                exe,
+                dir,
+                config,
+            })
+        }
     }
 
     /// The yardstick from the peer's runs before and after the measured work.
-    pub(super) fn yardstick(before: &Report, after: &Report) -> Yardstick {
+    fn yardstick(before: &Report, after: &Report) -> Yardstick {
         let runs = |r: &Report| r.f("runs").max(0.0) as usize;
         let (a, b) = (runs(before), runs(after));
         Yardstick {
