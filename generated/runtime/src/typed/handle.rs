@@ -159,20 +159,13 @@ impl<'a> Binder<'a> {
 
     /// The mandatory child to build; after a problem (or for a missing child, which is one) the null NodeId.
     fn mandatory_child(&self, node: &NodeId, uri: &str, name: &str) -> NodeId {
-        if self.failed() {
-            return NodeId::null();
-        }
-        match self.find_child(node, uri, name) {
-            Ok(Some(child)) => child,
-            Ok(None) => {
+        let child = self.optional_child(node, uri, name);
+        child.unwrap_or_else(|| {
+            if !self.failed() {
                 self.fail(BindError::MissingChild { parent: node.clone(), browse_name: name.to_owned() });
-                NodeId::null()
             }
-            Err(e) => {
-                self.fail(e);
-                NodeId::null()
-            }
-        }
+            NodeId::null()
+        })
     }
 
     /// The optional child to build, if the instance has it (and no problem was met before).
