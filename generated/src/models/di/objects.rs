@@ -76,9 +76,9 @@ pub struct CachedLoadingType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: PackageLoadingType,
     /// `PendingVersion` (Mandatory).
-    pub pending_version: CachedLoadingType_PendingVersion,
+    pub pending_version: Box<SoftwareVersionType>,
     /// `FallbackVersion` (Optional).
-    pub fallback_version: Option<CachedLoadingType_FallbackVersion>,
+    pub fallback_version: Option<Box<SoftwareVersionType>>,
     /// `GetUpdateBehavior` (Mandatory).
     pub get_update_behavior: t::Method<
         (String, String, Vec<String>),
@@ -98,84 +98,6 @@ impl t::Handle for CachedLoadingType {
     }
 }
 t::deref_base!(CachedLoadingType => PackageLoadingType);
-/// `PendingVersion`, a member of `CachedLoadingType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct CachedLoadingType_PendingVersion {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `Manufacturer` (Mandatory).
-    pub manufacturer: t::Variable<ua::LocalizedText>,
-    /// `ManufacturerUri` (Mandatory).
-    pub manufacturer_uri: t::Variable<String>,
-    /// `SoftwareRevision` (Mandatory).
-    pub software_revision: t::Variable<String>,
-    /// `PatchIdentifiers` (Optional).
-    pub patch_identifiers: Option<t::Variable<Vec<String>>>,
-    /// `ReleaseDate` (Optional).
-    pub release_date: Option<t::Variable<ua::DateTime>>,
-    /// `ChangeLogReference` (Optional).
-    pub change_log_reference: Option<t::Variable<String>>,
-    /// `Hash` (Optional).
-    pub hash: Option<t::Variable<ua::ByteString>>,
-    /// `Clear` (Optional).
-    pub clear: Option<t::Method<(), ()>>,
-}
-t::debug_handle!(CachedLoadingType_PendingVersion);
-impl t::Handle for CachedLoadingType_PendingVersion {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            manufacturer: b.build_child(id, NS[0], "Manufacturer"),
-            manufacturer_uri: b.build_child(id, NS[0], "ManufacturerUri"),
-            software_revision: b.build_child(id, NS[0], "SoftwareRevision"),
-            patch_identifiers: b.build_optional(id, NS[0], "PatchIdentifiers"),
-            release_date: b.build_optional(id, NS[0], "ReleaseDate"),
-            change_log_reference: b.build_optional(id, NS[0], "ChangeLogReference"),
-            hash: b.build_optional(id, NS[0], "Hash"),
-            clear: b.build_optional(id, NS[0], "Clear"),
-        }
-    }
-}
-/// `FallbackVersion`, a member of `CachedLoadingType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct CachedLoadingType_FallbackVersion {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `Manufacturer` (Mandatory).
-    pub manufacturer: t::Variable<ua::LocalizedText>,
-    /// `ManufacturerUri` (Mandatory).
-    pub manufacturer_uri: t::Variable<String>,
-    /// `SoftwareRevision` (Mandatory).
-    pub software_revision: t::Variable<String>,
-    /// `PatchIdentifiers` (Optional).
-    pub patch_identifiers: Option<t::Variable<Vec<String>>>,
-    /// `ReleaseDate` (Optional).
-    pub release_date: Option<t::Variable<ua::DateTime>>,
-    /// `ChangeLogReference` (Optional).
-    pub change_log_reference: Option<t::Variable<String>>,
-    /// `Hash` (Optional).
-    pub hash: Option<t::Variable<ua::ByteString>>,
-    /// `Clear` (Optional).
-    pub clear: Option<t::Method<(), ()>>,
-}
-t::debug_handle!(CachedLoadingType_FallbackVersion);
-impl t::Handle for CachedLoadingType_FallbackVersion {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            manufacturer: b.build_child(id, NS[0], "Manufacturer"),
-            manufacturer_uri: b.build_child(id, NS[0], "ManufacturerUri"),
-            software_revision: b.build_child(id, NS[0], "SoftwareRevision"),
-            patch_identifiers: b.build_optional(id, NS[0], "PatchIdentifiers"),
-            release_date: b.build_optional(id, NS[0], "ReleaseDate"),
-            change_log_reference: b.build_optional(id, NS[0], "ChangeLogReference"),
-            hash: b.build_optional(id, NS[0], "Hash"),
-            clear: b.build_optional(id, NS[0], "Clear"),
-        }
-    }
-}
 t::object_type!(
     CachedLoadingType, rt::NsNodeId::numeric(NS[0], 171), "CachedLoadingType"
 );
@@ -1540,7 +1462,7 @@ pub struct NetworkType {
     /// `<ProfileIdentifier>` (MandatoryPlaceholder).
     pub profile_identifier: t::Placeholders<ProtocolType>,
     /// `Lock` (Optional).
-    pub lock: Option<NetworkType_Lock>,
+    pub lock: Option<Box<LockingServicesType>>,
 }
 t::debug_handle!(NetworkType);
 impl t::Handle for NetworkType {
@@ -1550,45 +1472,6 @@ impl t::Handle for NetworkType {
             profile_identifier: b
                 .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 1006)),
             lock: b.build_optional(id, NS[0], "Lock"),
-        }
-    }
-}
-/// `Lock`, a member of `NetworkType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct NetworkType_Lock {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `Locked` (Mandatory).
-    pub locked: t::Variable<bool>,
-    /// `LockingClient` (Mandatory).
-    pub locking_client: t::Variable<String>,
-    /// `LockingUser` (Mandatory).
-    pub locking_user: t::Variable<String>,
-    /// `RemainingLockTime` (Mandatory).
-    pub remaining_lock_time: t::Variable<f64>,
-    /// `InitLock` (Mandatory).
-    pub init_lock: t::Method<(String,), (i32,)>,
-    /// `RenewLock` (Mandatory).
-    pub renew_lock: t::Method<(), (i32,)>,
-    /// `ExitLock` (Mandatory).
-    pub exit_lock: t::Method<(), (i32,)>,
-    /// `BreakLock` (Mandatory).
-    pub break_lock: t::Method<(), (i32,)>,
-}
-t::debug_handle!(NetworkType_Lock);
-impl t::Handle for NetworkType_Lock {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            locked: b.build_child(id, NS[0], "Locked"),
-            locking_client: b.build_child(id, NS[0], "LockingClient"),
-            locking_user: b.build_child(id, NS[0], "LockingUser"),
-            remaining_lock_time: b.build_child(id, NS[0], "RemainingLockTime"),
-            init_lock: b.build_child(id, NS[0], "InitLock"),
-            renew_lock: b.build_child(id, NS[0], "RenewLock"),
-            exit_lock: b.build_child(id, NS[0], "ExitLock"),
-            break_lock: b.build_child(id, NS[0], "BreakLock"),
         }
     }
 }
@@ -1674,7 +1557,7 @@ pub struct PackageLoadingType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: SoftwareLoadingType,
     /// `CurrentVersion` (Mandatory).
-    pub current_version: PackageLoadingType_CurrentVersion,
+    pub current_version: Box<SoftwareVersionType>,
     /// `FileTransfer` (Mandatory).
     pub file_transfer: PackageLoadingType_FileTransfer,
     /// `ErrorMessage` (Mandatory).
@@ -1696,45 +1579,6 @@ impl t::Handle for PackageLoadingType {
     }
 }
 t::deref_base!(PackageLoadingType => SoftwareLoadingType);
-/// `CurrentVersion`, a member of `PackageLoadingType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct PackageLoadingType_CurrentVersion {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `Manufacturer` (Mandatory).
-    pub manufacturer: t::Variable<ua::LocalizedText>,
-    /// `ManufacturerUri` (Mandatory).
-    pub manufacturer_uri: t::Variable<String>,
-    /// `SoftwareRevision` (Mandatory).
-    pub software_revision: t::Variable<String>,
-    /// `PatchIdentifiers` (Optional).
-    pub patch_identifiers: Option<t::Variable<Vec<String>>>,
-    /// `ReleaseDate` (Optional).
-    pub release_date: Option<t::Variable<ua::DateTime>>,
-    /// `ChangeLogReference` (Optional).
-    pub change_log_reference: Option<t::Variable<String>>,
-    /// `Hash` (Optional).
-    pub hash: Option<t::Variable<ua::ByteString>>,
-    /// `Clear` (Optional).
-    pub clear: Option<t::Method<(), ()>>,
-}
-t::debug_handle!(PackageLoadingType_CurrentVersion);
-impl t::Handle for PackageLoadingType_CurrentVersion {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            manufacturer: b.build_child(id, NS[0], "Manufacturer"),
-            manufacturer_uri: b.build_child(id, NS[0], "ManufacturerUri"),
-            software_revision: b.build_child(id, NS[0], "SoftwareRevision"),
-            patch_identifiers: b.build_optional(id, NS[0], "PatchIdentifiers"),
-            release_date: b.build_optional(id, NS[0], "ReleaseDate"),
-            change_log_reference: b.build_optional(id, NS[0], "ChangeLogReference"),
-            hash: b.build_optional(id, NS[0], "Hash"),
-            clear: b.build_optional(id, NS[0], "Clear"),
-        }
-    }
-}
 /// `FileTransfer`, a member of `PackageLoadingType` with children of its own.
 #[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
@@ -2074,13 +1918,13 @@ pub struct SoftwareUpdateType {
     /// `Loading` (Optional).
     pub loading: Option<Box<SoftwareLoadingType>>,
     /// `PrepareForUpdate` (Optional).
-    pub prepare_for_update: Option<SoftwareUpdateType_PrepareForUpdate>,
+    pub prepare_for_update: Option<Box<PrepareForUpdateStateMachineType>>,
     /// `Installation` (Optional).
-    pub installation: Option<SoftwareUpdateType_Installation>,
+    pub installation: Option<Box<InstallationStateMachineType>>,
     /// `PowerCycle` (Optional).
-    pub power_cycle: Option<SoftwareUpdateType_PowerCycle>,
+    pub power_cycle: Option<Box<PowerCycleStateMachineType>>,
     /// `Confirmation` (Optional).
-    pub confirmation: Option<SoftwareUpdateType_Confirmation>,
+    pub confirmation: Option<Box<ConfirmationStateMachineType>>,
     /// `Parameters` (Optional).
     pub parameters: Option<SoftwareUpdateType_Parameters>,
     /// `UpdateStatus` (Optional).
@@ -2114,153 +1958,6 @@ impl t::Handle for SoftwareUpdateType {
             unsigned_package_allowed: b
                 .build_optional(id, NS[0], "UnsignedPackageAllowed"),
             vendor_error_code: b.build_optional(id, NS[0], "VendorErrorCode"),
-        }
-    }
-}
-/// `PrepareForUpdate`, a member of `SoftwareUpdateType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct SoftwareUpdateType_PrepareForUpdate {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory).
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Optional).
-    pub last_transition: Option<t::Variable<ua::LocalizedText>>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `PercentComplete` (Optional).
-    pub percent_complete: Option<t::Variable<u8>>,
-    /// `Prepare` (Mandatory).
-    pub prepare: t::Method<(), ()>,
-    /// `Abort` (Mandatory).
-    pub abort: t::Method<(), ()>,
-    /// `Resume` (Optional).
-    pub resume: Option<t::Method<(), ()>>,
-}
-t::debug_handle!(SoftwareUpdateType_PrepareForUpdate);
-impl t::Handle for SoftwareUpdateType_PrepareForUpdate {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[1], "CurrentState"),
-            last_transition: b.build_optional(id, NS[1], "LastTransition"),
-            available_states: b.build_optional(id, NS[1], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[1], "AvailableTransitions"),
-            percent_complete: b.build_optional(id, NS[0], "PercentComplete"),
-            prepare: b.build_child(id, NS[0], "Prepare"),
-            abort: b.build_child(id, NS[0], "Abort"),
-            resume: b.build_optional(id, NS[0], "Resume"),
-        }
-    }
-}
-/// `Installation`, a member of `SoftwareUpdateType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct SoftwareUpdateType_Installation {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory).
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Optional).
-    pub last_transition: Option<t::Variable<ua::LocalizedText>>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `PercentComplete` (Optional).
-    pub percent_complete: Option<t::Variable<u8>>,
-    /// `InstallationDelay` (Optional).
-    pub installation_delay: Option<t::Variable<f64>>,
-    /// `InstallSoftwarePackage` (Optional).
-    pub install_software_package: Option<
-        t::Method<(String, String, Vec<String>, ua::ByteString), ()>,
-    >,
-    /// `InstallFiles` (Optional).
-    pub install_files: Option<t::Method<(Vec<ua::NodeId>,), ()>>,
-    /// `Uninstall` (Optional).
-    pub uninstall: Option<t::Method<(), ()>>,
-    /// `Resume` (Mandatory).
-    pub resume: t::Method<(), ()>,
-}
-t::debug_handle!(SoftwareUpdateType_Installation);
-impl t::Handle for SoftwareUpdateType_Installation {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[1], "CurrentState"),
-            last_transition: b.build_optional(id, NS[1], "LastTransition"),
-            available_states: b.build_optional(id, NS[1], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[1], "AvailableTransitions"),
-            percent_complete: b.build_optional(id, NS[0], "PercentComplete"),
-            installation_delay: b.build_optional(id, NS[0], "InstallationDelay"),
-            install_software_package: b
-                .build_optional(id, NS[0], "InstallSoftwarePackage"),
-            install_files: b.build_optional(id, NS[0], "InstallFiles"),
-            uninstall: b.build_optional(id, NS[0], "Uninstall"),
-            resume: b.build_child(id, NS[0], "Resume"),
-        }
-    }
-}
-/// `PowerCycle`, a member of `SoftwareUpdateType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct SoftwareUpdateType_PowerCycle {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory).
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Optional).
-    pub last_transition: Option<t::Variable<ua::LocalizedText>>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-}
-t::debug_handle!(SoftwareUpdateType_PowerCycle);
-impl t::Handle for SoftwareUpdateType_PowerCycle {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[1], "CurrentState"),
-            last_transition: b.build_optional(id, NS[1], "LastTransition"),
-            available_states: b.build_optional(id, NS[1], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[1], "AvailableTransitions"),
-        }
-    }
-}
-/// `Confirmation`, a member of `SoftwareUpdateType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct SoftwareUpdateType_Confirmation {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory).
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Optional).
-    pub last_transition: Option<t::Variable<ua::LocalizedText>>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `Confirm` (Mandatory).
-    pub confirm: t::Method<(), ()>,
-    /// `ConfirmationTimeout` (Mandatory).
-    pub confirmation_timeout: t::Variable<f64>,
-}
-t::debug_handle!(SoftwareUpdateType_Confirmation);
-impl t::Handle for SoftwareUpdateType_Confirmation {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[1], "CurrentState"),
-            last_transition: b.build_optional(id, NS[1], "LastTransition"),
-            available_states: b.build_optional(id, NS[1], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[1], "AvailableTransitions"),
-            confirm: b.build_child(id, NS[0], "Confirm"),
-            confirmation_timeout: b.build_child(id, NS[0], "ConfirmationTimeout"),
         }
     }
 }
@@ -2404,7 +2101,7 @@ pub struct TopologyElementType {
     /// `Identification` (Optional).
     pub identification: Option<Box<FunctionalGroupType>>,
     /// `Lock` (Optional).
-    pub lock: Option<TopologyElementType_Lock>,
+    pub lock: Option<Box<LockingServicesType>>,
 }
 t::debug_handle!(TopologyElementType);
 impl t::Handle for TopologyElementType {
@@ -2436,45 +2133,6 @@ impl t::Handle for TopologyElementType_ParameterSet {
             node: b.build_this(id),
             parameter_identifier: b
                 .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 63)),
-        }
-    }
-}
-/// `Lock`, a member of `TopologyElementType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct TopologyElementType_Lock {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `Locked` (Mandatory).
-    pub locked: t::Variable<bool>,
-    /// `LockingClient` (Mandatory).
-    pub locking_client: t::Variable<String>,
-    /// `LockingUser` (Mandatory).
-    pub locking_user: t::Variable<String>,
-    /// `RemainingLockTime` (Mandatory).
-    pub remaining_lock_time: t::Variable<f64>,
-    /// `InitLock` (Mandatory).
-    pub init_lock: t::Method<(String,), (i32,)>,
-    /// `RenewLock` (Mandatory).
-    pub renew_lock: t::Method<(), (i32,)>,
-    /// `ExitLock` (Mandatory).
-    pub exit_lock: t::Method<(), (i32,)>,
-    /// `BreakLock` (Mandatory).
-    pub break_lock: t::Method<(), (i32,)>,
-}
-t::debug_handle!(TopologyElementType_Lock);
-impl t::Handle for TopologyElementType_Lock {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            locked: b.build_child(id, NS[0], "Locked"),
-            locking_client: b.build_child(id, NS[0], "LockingClient"),
-            locking_user: b.build_child(id, NS[0], "LockingUser"),
-            remaining_lock_time: b.build_child(id, NS[0], "RemainingLockTime"),
-            init_lock: b.build_child(id, NS[0], "InitLock"),
-            renew_lock: b.build_child(id, NS[0], "RenewLock"),
-            exit_lock: b.build_child(id, NS[0], "ExitLock"),
-            break_lock: b.build_child(id, NS[0], "BreakLock"),
         }
     }
 }

@@ -140,9 +140,9 @@ pub struct DrillingCellType_SkillSet {
     /// The instance.
     pub node: t::ObjectNode,
     /// `ReferenceDrillBush` (Mandatory). Positions the end effector in front of the next drill bush.
-    pub reference_drill_bush: DrillingCellType_SkillSet_ReferenceDrillBush,
+    pub reference_drill_bush: Box<ReferenceDrillBushSkillType>,
     /// `DrillHole` (Mandatory). Drills the hole of the drill bush the end effector is in front of.
-    pub drill_hole: DrillingCellType_SkillSet_DrillHole,
+    pub drill_hole: Box<DrillHoleSkillType>,
 }
 t::debug_handle!(DrillingCellType_SkillSet);
 impl t::Handle for DrillingCellType_SkillSet {
@@ -151,132 +151,6 @@ impl t::Handle for DrillingCellType_SkillSet {
             node: b.build_this(id),
             reference_drill_bush: b.build_child(id, NS[0], "ReferenceDrillBush"),
             drill_hole: b.build_child(id, NS[0], "DrillHole"),
-        }
-    }
-}
-/// `ReferenceDrillBush`, a member of `DrillingCellType_SkillSet` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct DrillingCellType_SkillSet_ReferenceDrillBush {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory). The state the ReferenceDrillBush skill is in: Ready, Running, Suspended or Halted.
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Mandatory). The last state change of the ReferenceDrillBush skill.
-    pub last_transition: t::Variable<ua::LocalizedText>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `Deletable` (Mandatory). Whether a client may delete the ReferenceDrillBush skill; false, the skill belongs to its owner.
-    pub deletable: t::Variable<bool>,
-    /// `AutoDelete` (Mandatory). Whether the server removes the ReferenceDrillBush skill when a run ends; false, the skill stays.
-    pub auto_delete: t::Variable<bool>,
-    /// `RecycleCount` (Mandatory). How often the ReferenceDrillBush skill has been reset from Halted to Ready.
-    pub recycle_count: t::Variable<i32>,
-    /// `ProgramDiagnostic` (Optional).
-    pub program_diagnostic: Option<t::Variable<ua::ExtensionObject>>,
-    /// `FinalResultData` (Optional).
-    pub final_result_data: Option<t::ObjectNode>,
-    /// `Start` (Mandatory). Starts the skill with the current values of InputParameterSet (Ready to Running).
-    pub start: t::Method<(), ()>,
-    /// `Suspend` (Mandatory). Pauses the composite skill after the skill it is running has paused or finished.
-    pub suspend: t::Method<(), ()>,
-    /// `Resume` (Mandatory). Continues the composite skill with the skill it had paused in.
-    pub resume: t::Method<(), ()>,
-    /// `Halt` (Mandatory). Aborts the skill (Ready, Running or Suspended to Halted).
-    pub halt: t::Method<(), ()>,
-    /// `Reset` (Mandatory). Brings the halted skill back to Ready so that it can be started again.
-    pub reset: t::Method<(), ()>,
-    /// `InputParameterSet` (Mandatory). The inputs: HolePosition and ApproachDistance.
-    pub input_parameter_set: t::ObjectNode,
-    /// `OutputParameterSet` (Mandatory). The results: Result and ReferencedHolePosition.
-    pub output_parameter_set: t::ObjectNode,
-}
-t::debug_handle!(DrillingCellType_SkillSet_ReferenceDrillBush);
-impl t::Handle for DrillingCellType_SkillSet_ReferenceDrillBush {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[2], "CurrentState"),
-            last_transition: b.build_child(id, NS[2], "LastTransition"),
-            available_states: b.build_optional(id, NS[2], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
-            deletable: b.build_child(id, NS[2], "Deletable"),
-            auto_delete: b.build_child(id, NS[2], "AutoDelete"),
-            recycle_count: b.build_child(id, NS[2], "RecycleCount"),
-            program_diagnostic: b.build_optional(id, NS[2], "ProgramDiagnostic"),
-            final_result_data: b.build_optional(id, NS[2], "FinalResultData"),
-            start: b.build_child(id, NS[2], "Start"),
-            suspend: b.build_child(id, NS[2], "Suspend"),
-            resume: b.build_child(id, NS[2], "Resume"),
-            halt: b.build_child(id, NS[2], "Halt"),
-            reset: b.build_child(id, NS[2], "Reset"),
-            input_parameter_set: b.build_child(id, NS[1], "InputParameterSet"),
-            output_parameter_set: b.build_child(id, NS[1], "OutputParameterSet"),
-        }
-    }
-}
-/// `DrillHole`, a member of `DrillingCellType_SkillSet` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct DrillingCellType_SkillSet_DrillHole {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory). The state the DrillHole skill is in: Ready, Running, Suspended or Halted.
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Mandatory). The last state change of the DrillHole skill.
-    pub last_transition: t::Variable<ua::LocalizedText>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `Deletable` (Mandatory). Whether a client may delete the DrillHole skill; false, the skill belongs to its owner.
-    pub deletable: t::Variable<bool>,
-    /// `AutoDelete` (Mandatory). Whether the server removes the DrillHole skill when a run ends; false, the skill stays.
-    pub auto_delete: t::Variable<bool>,
-    /// `RecycleCount` (Mandatory). How often the DrillHole skill has been reset from Halted to Ready.
-    pub recycle_count: t::Variable<i32>,
-    /// `ProgramDiagnostic` (Optional).
-    pub program_diagnostic: Option<t::Variable<ua::ExtensionObject>>,
-    /// `FinalResultData` (Optional).
-    pub final_result_data: Option<t::ObjectNode>,
-    /// `Start` (Mandatory). Starts the skill with the current values of InputParameterSet (Ready to Running).
-    pub start: t::Method<(), ()>,
-    /// `Suspend` (Mandatory). Pauses the composite skill after the skill it is running has paused or finished.
-    pub suspend: t::Method<(), ()>,
-    /// `Resume` (Mandatory). Continues the composite skill with the skill it had paused in.
-    pub resume: t::Method<(), ()>,
-    /// `Halt` (Mandatory). Aborts the skill (Ready, Running or Suspended to Halted).
-    pub halt: t::Method<(), ()>,
-    /// `Reset` (Mandatory). Brings the halted skill back to Ready so that it can be started again.
-    pub reset: t::Method<(), ()>,
-    /// `InputParameterSet` (Mandatory). The inputs: InsertionDistance and the drilling parameters passed to TemplateDrilling.
-    pub input_parameter_set: t::ObjectNode,
-    /// `OutputParameterSet` (Mandatory). The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here).
-    pub output_parameter_set: t::ObjectNode,
-}
-t::debug_handle!(DrillingCellType_SkillSet_DrillHole);
-impl t::Handle for DrillingCellType_SkillSet_DrillHole {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[2], "CurrentState"),
-            last_transition: b.build_child(id, NS[2], "LastTransition"),
-            available_states: b.build_optional(id, NS[2], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
-            deletable: b.build_child(id, NS[2], "Deletable"),
-            auto_delete: b.build_child(id, NS[2], "AutoDelete"),
-            recycle_count: b.build_child(id, NS[2], "RecycleCount"),
-            program_diagnostic: b.build_optional(id, NS[2], "ProgramDiagnostic"),
-            final_result_data: b.build_optional(id, NS[2], "FinalResultData"),
-            start: b.build_child(id, NS[2], "Start"),
-            suspend: b.build_child(id, NS[2], "Suspend"),
-            resume: b.build_child(id, NS[2], "Resume"),
-            halt: b.build_child(id, NS[2], "Halt"),
-            reset: b.build_child(id, NS[2], "Reset"),
-            input_parameter_set: b.build_child(id, NS[1], "InputParameterSet"),
-            output_parameter_set: b.build_child(id, NS[1], "OutputParameterSet"),
         }
     }
 }

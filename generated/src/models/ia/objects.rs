@@ -75,7 +75,7 @@ pub struct BasicStacklightType {
     /// `NodeVersion` (Optional).
     pub node_version: Option<t::Variable<String>>,
     /// `StackLevel` (Optional). Valid if the stacklight is used in “Levelmeter” StacklightMode. If so, the whole stack is controlled by a single percentual value. In this case, the SignalOn parameter of any stack element of StackElementLightType has no meaning.
-    pub stack_level: Option<BasicStacklightType_StackLevel>,
+    pub stack_level: Option<Box<StackLevelType>>,
     /// `StacklightMode` (Mandatory). Shows in what way (stack of individual lights, level meter, running light) the stacklight unit is used.
     pub stacklight_mode: t::Variable<super::types::StacklightOperationMode>,
     /// `StackRunning` (Optional). Valid if the stacklight is used in “Running_Light” StacklightMode.
@@ -91,27 +91,6 @@ impl t::Handle for BasicStacklightType {
             stack_level: b.build_optional(id, NS[0], "StackLevel"),
             stacklight_mode: b.build_child(id, NS[0], "StacklightMode"),
             stack_running: b.build_optional(id, NS[0], "StackRunning"),
-        }
-    }
-}
-/// `StackLevel`, a member of `BasicStacklightType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct BasicStacklightType_StackLevel {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `DisplayMode` (Mandatory). Indicates in what way the percentual value is displayed with the stacklight.
-    pub display_mode: t::Variable<super::types::LevelDisplayMode>,
-    /// `LevelPercent` (Mandatory). Shows the percentual value the stacklight is representing. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent.
-    pub level_percent: t::Variable<f32>,
-}
-t::debug_handle!(BasicStacklightType_StackLevel);
-impl t::Handle for BasicStacklightType_StackLevel {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            display_mode: b.build_child(id, NS[0], "DisplayMode"),
-            level_percent: b.build_child(id, NS[0], "LevelPercent"),
         }
     }
 }

@@ -59,7 +59,7 @@ pub struct DrillingEndEffectorType_SkillSet {
     /// The instance.
     pub node: t::ObjectNode,
     /// `TemplateDrilling` (Mandatory). Drills one hole through the drill bush the end effector sits in.
-    pub template_drilling: DrillingEndEffectorType_SkillSet_TemplateDrilling,
+    pub template_drilling: Box<TemplateDrillingSkillType>,
 }
 t::debug_handle!(DrillingEndEffectorType_SkillSet);
 impl t::Handle for DrillingEndEffectorType_SkillSet {
@@ -67,69 +67,6 @@ impl t::Handle for DrillingEndEffectorType_SkillSet {
         Self {
             node: b.build_this(id),
             template_drilling: b.build_child(id, NS[0], "TemplateDrilling"),
-        }
-    }
-}
-/// `TemplateDrilling`, a member of `DrillingEndEffectorType_SkillSet` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct DrillingEndEffectorType_SkillSet_TemplateDrilling {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory). The state the TemplateDrilling skill is in: Ready, Running, Suspended or Halted.
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Mandatory). The last state change of the TemplateDrilling skill.
-    pub last_transition: t::Variable<ua::LocalizedText>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `Deletable` (Mandatory). Whether a client may delete the TemplateDrilling skill; false, the skill belongs to its owner.
-    pub deletable: t::Variable<bool>,
-    /// `AutoDelete` (Mandatory). Whether the server removes the TemplateDrilling skill when a run ends; false, the skill stays.
-    pub auto_delete: t::Variable<bool>,
-    /// `RecycleCount` (Mandatory). How often the TemplateDrilling skill has been reset from Halted to Ready.
-    pub recycle_count: t::Variable<i32>,
-    /// `ProgramDiagnostic` (Optional).
-    pub program_diagnostic: Option<t::Variable<ua::ExtensionObject>>,
-    /// `FinalResultData` (Optional).
-    pub final_result_data: Option<t::ObjectNode>,
-    /// `Start` (Mandatory). Starts the skill with the current values of InputParameterSet (Ready to Running).
-    pub start: t::Method<(), ()>,
-    /// `Suspend` (Optional). Pauses the running skill so that Resume can continue it (Running to Suspended).
-    pub suspend: Option<t::Method<(), ()>>,
-    /// `Resume` (Optional). Continues the suspended skill (Suspended to Running).
-    pub resume: Option<t::Method<(), ()>>,
-    /// `Halt` (Mandatory). Aborts the skill (Ready, Running or Suspended to Halted).
-    pub halt: t::Method<(), ()>,
-    /// `Reset` (Mandatory). Brings the halted skill back to Ready so that it can be started again.
-    pub reset: t::Method<(), ()>,
-    /// `InputParameterSet` (Mandatory). The drilling parameters: HoleDiameter, Depth, FeedRate, SpindleSpeed and ClampForce.
-    pub input_parameter_set: t::ObjectNode,
-    /// `OutputParameterSet` (Mandatory). The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here).
-    pub output_parameter_set: t::ObjectNode,
-}
-t::debug_handle!(DrillingEndEffectorType_SkillSet_TemplateDrilling);
-impl t::Handle for DrillingEndEffectorType_SkillSet_TemplateDrilling {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[3], "CurrentState"),
-            last_transition: b.build_child(id, NS[3], "LastTransition"),
-            available_states: b.build_optional(id, NS[3], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[3], "AvailableTransitions"),
-            deletable: b.build_child(id, NS[3], "Deletable"),
-            auto_delete: b.build_child(id, NS[3], "AutoDelete"),
-            recycle_count: b.build_child(id, NS[3], "RecycleCount"),
-            program_diagnostic: b.build_optional(id, NS[3], "ProgramDiagnostic"),
-            final_result_data: b.build_optional(id, NS[3], "FinalResultData"),
-            start: b.build_child(id, NS[3], "Start"),
-            suspend: b.build_optional(id, NS[3], "Suspend"),
-            resume: b.build_optional(id, NS[3], "Resume"),
-            halt: b.build_child(id, NS[3], "Halt"),
-            reset: b.build_child(id, NS[3], "Reset"),
-            input_parameter_set: b.build_child(id, NS[2], "InputParameterSet"),
-            output_parameter_set: b.build_child(id, NS[2], "OutputParameterSet"),
         }
     }
 }
@@ -181,7 +118,7 @@ pub struct LwrSystemType_MotionDeviceSystem {
     /// `Identification` (Optional).
     pub identification: Option<Box<super::super::di::objects::FunctionalGroupType>>,
     /// `Lock` (Optional).
-    pub lock: Option<LwrSystemType_MotionDeviceSystem_Lock>,
+    pub lock: Option<Box<super::super::di::objects::LockingServicesType>>,
     /// `Manufacturer` (Optional).
     pub manufacturer: Option<t::Variable<ua::LocalizedText>>,
     /// `ManufacturerUri` (Optional).
@@ -267,45 +204,6 @@ impl t::Handle for LwrSystemType_MotionDeviceSystem_ParameterSet {
         }
     }
 }
-/// `Lock`, a member of `LwrSystemType_MotionDeviceSystem` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct LwrSystemType_MotionDeviceSystem_Lock {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `Locked` (Mandatory).
-    pub locked: t::Variable<bool>,
-    /// `LockingClient` (Mandatory).
-    pub locking_client: t::Variable<String>,
-    /// `LockingUser` (Mandatory).
-    pub locking_user: t::Variable<String>,
-    /// `RemainingLockTime` (Mandatory).
-    pub remaining_lock_time: t::Variable<f64>,
-    /// `InitLock` (Mandatory).
-    pub init_lock: t::Method<(String,), (i32,)>,
-    /// `RenewLock` (Mandatory).
-    pub renew_lock: t::Method<(), (i32,)>,
-    /// `ExitLock` (Mandatory).
-    pub exit_lock: t::Method<(), (i32,)>,
-    /// `BreakLock` (Mandatory).
-    pub break_lock: t::Method<(), (i32,)>,
-}
-t::debug_handle!(LwrSystemType_MotionDeviceSystem_Lock);
-impl t::Handle for LwrSystemType_MotionDeviceSystem_Lock {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            locked: b.build_child(id, NS[1], "Locked"),
-            locking_client: b.build_child(id, NS[1], "LockingClient"),
-            locking_user: b.build_child(id, NS[1], "LockingUser"),
-            remaining_lock_time: b.build_child(id, NS[1], "RemainingLockTime"),
-            init_lock: b.build_child(id, NS[1], "InitLock"),
-            renew_lock: b.build_child(id, NS[1], "RenewLock"),
-            exit_lock: b.build_child(id, NS[1], "ExitLock"),
-            break_lock: b.build_child(id, NS[1], "BreakLock"),
-        }
-    }
-}
 t::object_type!(LwrSystemType, rt::NsNodeId::numeric(NS[0], 3000), "LwrSystemType");
 /// Handle of an instance of `TemplateDrillingLwrSystemType` (nsu=http://nodeset-compiler.dev/RobotCell/;i=5000).
 ///
@@ -318,7 +216,7 @@ pub struct TemplateDrillingLwrSystemType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: LwrSystemType,
     /// `DrillingEndEffector` (Mandatory). The drilling end effector mounted on the flange of the robot.
-    pub drilling_end_effector: TemplateDrillingLwrSystemType_DrillingEndEffector,
+    pub drilling_end_effector: Box<DrillingEndEffectorType>,
 }
 t::debug_handle!(TemplateDrillingLwrSystemType);
 impl t::Handle for TemplateDrillingLwrSystemType {
@@ -331,162 +229,6 @@ impl t::Handle for TemplateDrillingLwrSystemType {
     }
 }
 t::deref_base!(TemplateDrillingLwrSystemType => LwrSystemType);
-/// `DrillingEndEffector`, a member of `TemplateDrillingLwrSystemType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct TemplateDrillingLwrSystemType_DrillingEndEffector {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `ParameterSet` (Optional).
-    pub parameter_set: Option<
-        TemplateDrillingLwrSystemType_DrillingEndEffector_ParameterSet,
-    >,
-    /// `MethodSet` (Optional).
-    pub method_set: Option<t::ObjectNode>,
-    /// `<GroupIdentifier>` (OptionalPlaceholder).
-    pub group_identifier: t::Placeholders<
-        super::super::di::objects::FunctionalGroupType,
-    >,
-    /// `Identification` (Optional).
-    pub identification: Option<Box<super::super::di::objects::FunctionalGroupType>>,
-    /// `Lock` (Optional).
-    pub lock: Option<TemplateDrillingLwrSystemType_DrillingEndEffector_Lock>,
-    /// `Manufacturer` (Mandatory). Manufacturer of the end effector.
-    pub manufacturer: t::Variable<ua::LocalizedText>,
-    /// `ManufacturerUri` (Optional).
-    pub manufacturer_uri: Option<t::Variable<String>>,
-    /// `Model` (Mandatory). Model name of the end effector.
-    pub model: t::Variable<ua::LocalizedText>,
-    /// `HardwareRevision` (Optional).
-    pub hardware_revision: Option<t::Variable<String>>,
-    /// `SoftwareRevision` (Optional).
-    pub software_revision: Option<t::Variable<String>>,
-    /// `DeviceRevision` (Optional).
-    pub device_revision: Option<t::Variable<String>>,
-    /// `ProductCode` (Optional).
-    pub product_code: Option<t::Variable<String>>,
-    /// `DeviceManual` (Optional).
-    pub device_manual: Option<t::Variable<String>>,
-    /// `DeviceClass` (Optional).
-    pub device_class: Option<t::Variable<String>>,
-    /// `SerialNumber` (Mandatory). Serial number of the end effector.
-    pub serial_number: t::Variable<String>,
-    /// `ProductInstanceUri` (Optional).
-    pub product_instance_uri: Option<t::Variable<String>>,
-    /// `RevisionCounter` (Optional).
-    pub revision_counter: Option<t::Variable<i32>>,
-    /// `AssetId` (Optional).
-    pub asset_id: Option<t::Variable<String>>,
-    /// `ComponentName` (Optional).
-    pub component_name: Option<t::Variable<ua::LocalizedText>>,
-    /// `SkillSet` (Mandatory). The skills of the end effector (ISkillSetType): TemplateDrilling.
-    pub skill_set: TemplateDrillingLwrSystemType_DrillingEndEffector_SkillSet,
-}
-t::debug_handle!(TemplateDrillingLwrSystemType_DrillingEndEffector);
-impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            parameter_set: b.build_optional(id, NS[1], "ParameterSet"),
-            method_set: b.build_optional(id, NS[1], "MethodSet"),
-            group_identifier: b
-                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 1005)),
-            identification: b.build_optional(id, NS[1], "Identification"),
-            lock: b.build_optional(id, NS[1], "Lock"),
-            manufacturer: b.build_child(id, NS[1], "Manufacturer"),
-            manufacturer_uri: b.build_optional(id, NS[1], "ManufacturerUri"),
-            model: b.build_child(id, NS[1], "Model"),
-            hardware_revision: b.build_optional(id, NS[1], "HardwareRevision"),
-            software_revision: b.build_optional(id, NS[1], "SoftwareRevision"),
-            device_revision: b.build_optional(id, NS[1], "DeviceRevision"),
-            product_code: b.build_optional(id, NS[1], "ProductCode"),
-            device_manual: b.build_optional(id, NS[1], "DeviceManual"),
-            device_class: b.build_optional(id, NS[1], "DeviceClass"),
-            serial_number: b.build_child(id, NS[1], "SerialNumber"),
-            product_instance_uri: b.build_optional(id, NS[1], "ProductInstanceUri"),
-            revision_counter: b.build_optional(id, NS[1], "RevisionCounter"),
-            asset_id: b.build_optional(id, NS[1], "AssetId"),
-            component_name: b.build_optional(id, NS[1], "ComponentName"),
-            skill_set: b.build_child(id, NS[2], "SkillSet"),
-        }
-    }
-}
-/// `ParameterSet`, a member of `TemplateDrillingLwrSystemType_DrillingEndEffector` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct TemplateDrillingLwrSystemType_DrillingEndEffector_ParameterSet {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `<ParameterIdentifier>` (MandatoryPlaceholder).
-    pub parameter_identifier: t::Placeholders<t::Variable<ua::Variant>>,
-}
-t::debug_handle!(TemplateDrillingLwrSystemType_DrillingEndEffector_ParameterSet);
-impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector_ParameterSet {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            parameter_identifier: b
-                .build_placeholders(id, rt::NsNodeId::numeric(NS[3], 63)),
-        }
-    }
-}
-/// `Lock`, a member of `TemplateDrillingLwrSystemType_DrillingEndEffector` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct TemplateDrillingLwrSystemType_DrillingEndEffector_Lock {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `Locked` (Mandatory).
-    pub locked: t::Variable<bool>,
-    /// `LockingClient` (Mandatory).
-    pub locking_client: t::Variable<String>,
-    /// `LockingUser` (Mandatory).
-    pub locking_user: t::Variable<String>,
-    /// `RemainingLockTime` (Mandatory).
-    pub remaining_lock_time: t::Variable<f64>,
-    /// `InitLock` (Mandatory).
-    pub init_lock: t::Method<(String,), (i32,)>,
-    /// `RenewLock` (Mandatory).
-    pub renew_lock: t::Method<(), (i32,)>,
-    /// `ExitLock` (Mandatory).
-    pub exit_lock: t::Method<(), (i32,)>,
-    /// `BreakLock` (Mandatory).
-    pub break_lock: t::Method<(), (i32,)>,
-}
-t::debug_handle!(TemplateDrillingLwrSystemType_DrillingEndEffector_Lock);
-impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector_Lock {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            locked: b.build_child(id, NS[1], "Locked"),
-            locking_client: b.build_child(id, NS[1], "LockingClient"),
-            locking_user: b.build_child(id, NS[1], "LockingUser"),
-            remaining_lock_time: b.build_child(id, NS[1], "RemainingLockTime"),
-            init_lock: b.build_child(id, NS[1], "InitLock"),
-            renew_lock: b.build_child(id, NS[1], "RenewLock"),
-            exit_lock: b.build_child(id, NS[1], "ExitLock"),
-            break_lock: b.build_child(id, NS[1], "BreakLock"),
-        }
-    }
-}
-/// `SkillSet`, a member of `TemplateDrillingLwrSystemType_DrillingEndEffector` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct TemplateDrillingLwrSystemType_DrillingEndEffector_SkillSet {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `TemplateDrilling` (Mandatory). Drills one hole through the drill bush the end effector sits in.
-    pub template_drilling: Box<TemplateDrillingSkillType>,
-}
-t::debug_handle!(TemplateDrillingLwrSystemType_DrillingEndEffector_SkillSet);
-impl t::Handle for TemplateDrillingLwrSystemType_DrillingEndEffector_SkillSet {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            template_drilling: b.build_child(id, NS[0], "TemplateDrilling"),
-        }
-    }
-}
 t::object_type!(
     TemplateDrillingLwrSystemType, rt::NsNodeId::numeric(NS[0], 5000),
     "TemplateDrillingLwrSystemType"
@@ -864,7 +606,7 @@ pub struct Ur10eSystemType_SafetyStates {
     /// The instance.
     pub node: t::ObjectNode,
     /// `SafetyState` (Mandatory). Emergency stop, protective stop and operational mode of the UR10e.
-    pub safety_state: Ur10eSystemType_SafetyStates_SafetyState,
+    pub safety_state: Box<super::super::robotics::objects::SafetyStateType>,
 }
 t::debug_handle!(Ur10eSystemType_SafetyStates);
 impl t::Handle for Ur10eSystemType_SafetyStates {
@@ -872,89 +614,6 @@ impl t::Handle for Ur10eSystemType_SafetyStates {
         Self {
             node: b.build_this(id),
             safety_state: b.build_child(id, NS[0], "SafetyState"),
-        }
-    }
-}
-/// `SafetyState`, a member of `Ur10eSystemType_SafetyStates` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct Ur10eSystemType_SafetyStates_SafetyState {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `ParameterSet` (Mandatory). Runtime values of the SafetyState.
-    pub parameter_set: t::ObjectNode,
-    /// `MethodSet` (Optional).
-    pub method_set: Option<t::ObjectNode>,
-    /// `<GroupIdentifier>` (OptionalPlaceholder).
-    pub group_identifier: t::Placeholders<
-        super::super::di::objects::FunctionalGroupType,
-    >,
-    /// `Identification` (Optional).
-    pub identification: Option<Box<super::super::di::objects::FunctionalGroupType>>,
-    /// `Lock` (Optional).
-    pub lock: Option<Box<super::super::di::objects::LockingServicesType>>,
-    /// `Manufacturer` (Optional).
-    pub manufacturer: Option<t::Variable<ua::LocalizedText>>,
-    /// `ManufacturerUri` (Optional).
-    pub manufacturer_uri: Option<t::Variable<String>>,
-    /// `Model` (Optional).
-    pub model: Option<t::Variable<ua::LocalizedText>>,
-    /// `HardwareRevision` (Optional).
-    pub hardware_revision: Option<t::Variable<String>>,
-    /// `SoftwareRevision` (Optional).
-    pub software_revision: Option<t::Variable<String>>,
-    /// `DeviceRevision` (Optional).
-    pub device_revision: Option<t::Variable<String>>,
-    /// `ProductCode` (Optional).
-    pub product_code: Option<t::Variable<String>>,
-    /// `DeviceManual` (Optional).
-    pub device_manual: Option<t::Variable<String>>,
-    /// `DeviceClass` (Optional).
-    pub device_class: Option<t::Variable<String>>,
-    /// `SerialNumber` (Optional).
-    pub serial_number: Option<t::Variable<String>>,
-    /// `ProductInstanceUri` (Optional).
-    pub product_instance_uri: Option<t::Variable<String>>,
-    /// `RevisionCounter` (Optional).
-    pub revision_counter: Option<t::Variable<i32>>,
-    /// `AssetId` (Optional).
-    pub asset_id: Option<t::Variable<String>>,
-    /// `ComponentName` (Optional).
-    pub component_name: Option<t::Variable<ua::LocalizedText>>,
-    /// `EmergencyStopFunctions` (Optional). EmergencyStopFunctions is a container for one or more instances of the EmergencyStopFunctionType.
-    pub emergency_stop_functions: Option<t::ObjectNode>,
-    /// `ProtectiveStopFunctions` (Optional). ProtectiveStopFunctions is a container for one or more instances of the ProtectiveStopFunctionType.
-    pub protective_stop_functions: Option<t::ObjectNode>,
-}
-t::debug_handle!(Ur10eSystemType_SafetyStates_SafetyState);
-impl t::Handle for Ur10eSystemType_SafetyStates_SafetyState {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            parameter_set: b.build_child(id, NS[1], "ParameterSet"),
-            method_set: b.build_optional(id, NS[1], "MethodSet"),
-            group_identifier: b
-                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 1005)),
-            identification: b.build_optional(id, NS[1], "Identification"),
-            lock: b.build_optional(id, NS[1], "Lock"),
-            manufacturer: b.build_optional(id, NS[1], "Manufacturer"),
-            manufacturer_uri: b.build_optional(id, NS[1], "ManufacturerUri"),
-            model: b.build_optional(id, NS[1], "Model"),
-            hardware_revision: b.build_optional(id, NS[1], "HardwareRevision"),
-            software_revision: b.build_optional(id, NS[1], "SoftwareRevision"),
-            device_revision: b.build_optional(id, NS[1], "DeviceRevision"),
-            product_code: b.build_optional(id, NS[1], "ProductCode"),
-            device_manual: b.build_optional(id, NS[1], "DeviceManual"),
-            device_class: b.build_optional(id, NS[1], "DeviceClass"),
-            serial_number: b.build_optional(id, NS[1], "SerialNumber"),
-            product_instance_uri: b.build_optional(id, NS[1], "ProductInstanceUri"),
-            revision_counter: b.build_optional(id, NS[1], "RevisionCounter"),
-            asset_id: b.build_optional(id, NS[1], "AssetId"),
-            component_name: b.build_optional(id, NS[1], "ComponentName"),
-            emergency_stop_functions: b
-                .build_optional(id, NS[4], "EmergencyStopFunctions"),
-            protective_stop_functions: b
-                .build_optional(id, NS[4], "ProtectiveStopFunctions"),
         }
     }
 }

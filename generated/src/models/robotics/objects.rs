@@ -64,7 +64,7 @@ pub struct AxisType {
     /// `<PowerTrainIdentifier>` (OptionalPlaceholder). The Requires reference provides the relationship of axes to powertrains. For complex kinematics this does not need to be a one to one relationship, because more than one power train might influence the motion of one axis. This reference connects all power trains to an axis that must be actively driven when only this axis should move and all other axes should stand still. Virtual axes that are not actively driven by a power train do not have this reference.
     pub power_train_identifier: t::Placeholders<PowerTrainType>,
     /// `AdditionalLoad` (Optional). The additional load which is mounted on this axis. E.g. for process-need a transformer for welding.
-    pub additional_load: Option<AxisType_AdditionalLoad>,
+    pub additional_load: Option<Box<LoadType>>,
     /// `MotionProfile` (Mandatory). The kind of axis motion as defined with the AxisMotionProfileEnumeration.
     pub motion_profile: t::Variable<super::types::AxisMotionProfileEnumeration>,
 }
@@ -108,30 +108,6 @@ impl t::Handle for AxisType_ParameterSet {
         }
     }
 }
-/// `AdditionalLoad`, a member of `AxisType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct AxisType_AdditionalLoad {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CenterOfMass` (Optional). The position and orientation of the center of the mass related to the mounting point using a FrameType. X, Y, Z define the position of the center of gravity relative to the mounting point coordinate system. A, B, C define the orientation of the principal axes of inertia relative to the mounting point coordinate system. Orientation A, B, C can be "0" for systems which do not need these  values.
-    pub center_of_mass: Option<t::Variable<ua::ThreeDFrame>>,
-    /// `Inertia` (Optional). The Inertia uses the VectorType to describe the three values of the principal moments of inertia with respect to the mounting point coordinate system. If inertia values are provided for rotary axis the CenterOfMass shall be completely filled as well.
-    pub inertia: Option<t::Variable<ua::ThreeDVector>>,
-    /// `Mass` (Mandatory). The weight of the load mounted on one mounting point.
-    pub mass: t::Variable<f64>,
-}
-t::debug_handle!(AxisType_AdditionalLoad);
-impl t::Handle for AxisType_AdditionalLoad {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            center_of_mass: b.build_optional(id, NS[0], "CenterOfMass"),
-            inertia: b.build_optional(id, NS[0], "Inertia"),
-            mass: b.build_child(id, NS[0], "Mass"),
-        }
-    }
-}
 t::object_type!(AxisType, rt::NsNodeId::numeric(NS[0], 16601), "AxisType");
 /// Handle of an instance of `ControllerType` (nsu=http://opcfoundation.org/UA/Robotics/;i=1003).
 ///
@@ -166,13 +142,13 @@ pub struct ControllerType {
     /// `Components` (Optional). Components is a container for one or more instances of subtypes of ComponentType defined in OPC UA DI. The listed components are installed in the motion device system, e.g. a processing-unit, a power-supply, an IO-board or a drive, and have an electrical interface to the controller.
     pub components: Option<ControllerType_Components>,
     /// `CurrentUser` (Mandatory). The current user of the system.
-    pub current_user: ControllerType_CurrentUser,
+    pub current_user: Box<UserType>,
     /// `Programs` (Optional).
     pub programs: Option<ControllerType_Programs>,
     /// `Software` (Mandatory). Software is a container for one or more instances of SoftwareType defined in OPC UA DI.
     pub software: ControllerType_Software,
     /// `SystemOperation` (Optional).
-    pub system_operation: Option<ControllerType_SystemOperation>,
+    pub system_operation: Option<Box<SystemOperationType>>,
     /// `TaskControls` (Mandatory). TaskControls is a container for one or more instances of TaskControlType.
     pub task_controls: ControllerType_TaskControls,
 }
@@ -263,27 +239,6 @@ impl t::Handle for ControllerType_Components {
         }
     }
 }
-/// `CurrentUser`, a member of `ControllerType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct ControllerType_CurrentUser {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `Level` (Mandatory). The weight of the load mounted on one mounting point.
-    pub level: t::Variable<String>,
-    /// `Name` (Optional). The name for the current user within the control system.
-    pub name: Option<t::Variable<String>>,
-}
-t::debug_handle!(ControllerType_CurrentUser);
-impl t::Handle for ControllerType_CurrentUser {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            level: b.build_child(id, NS[0], "Level"),
-            name: b.build_optional(id, NS[0], "Name"),
-        }
-    }
-}
 /// `Programs`, a member of `ControllerType` with children of its own.
 #[derive(Clone)]
 #[allow(non_camel_case_types, non_snake_case)]
@@ -334,103 +289,6 @@ impl t::Handle for ControllerType_Software {
             node: b.build_this(id),
             software_identifier: b
                 .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 15106)),
-        }
-    }
-}
-/// `SystemOperation`, a member of `ControllerType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct ControllerType_SystemOperation {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `Conditions` (Optional).
-    pub conditions: Option<ControllerType_SystemOperation_Conditions>,
-    /// `SystemOperationStateMachine` (Mandatory).
-    pub system_operation_state_machine: ControllerType_SystemOperation_SystemOperationStateMachine,
-}
-t::debug_handle!(ControllerType_SystemOperation);
-impl t::Handle for ControllerType_SystemOperation {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            conditions: b.build_optional(id, NS[0], "Conditions"),
-            system_operation_state_machine: b
-                .build_child(id, NS[0], "SystemOperationStateMachine"),
-        }
-    }
-}
-/// `Conditions`, a member of `ControllerType_SystemOperation` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct ControllerType_SystemOperation_Conditions {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `<AcknowledgeableCondition>` (MandatoryPlaceholder).
-    pub acknowledgeable_condition: t::Placeholders<t::ObjectNode>,
-}
-t::debug_handle!(ControllerType_SystemOperation_Conditions);
-impl t::Handle for ControllerType_SystemOperation_Conditions {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            acknowledgeable_condition: b
-                .build_placeholders(id, rt::NsNodeId::numeric(NS[2], 2881)),
-        }
-    }
-}
-/// `SystemOperationStateMachine`, a member of `ControllerType_SystemOperation` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct ControllerType_SystemOperation_SystemOperationStateMachine {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory).
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Mandatory).
-    pub last_transition: t::Variable<ua::LocalizedText>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `ConfiguredDefaultStopMode` (Optional).
-    pub configured_default_stop_mode: Option<t::Variable<i16>>,
-    /// `LastTransitionReason` (Mandatory).
-    pub last_transition_reason: t::Variable<i16>,
-    /// `PossibleStopModes` (Optional).
-    pub possible_stop_modes: Option<t::Variable<Vec<ua::EnumValueType>>>,
-    /// `Start` (Optional).
-    pub start: Option<t::Method<(), (i32,)>>,
-    /// `Stop` (Optional).
-    pub stop: Option<t::Method<(i64,), (i32,)>>,
-    /// `ExecutingSubstateMachine` (Optional).
-    pub executing_substate_machine: Option<Box<ExecutingSubstateMachineType>>,
-    /// `GetReady` (Optional).
-    pub get_ready: Option<t::Method<(), (i32,)>>,
-    /// `IdleSubstateMachine` (Optional).
-    pub idle_substate_machine: Option<Box<IdleSubstateMachineType>>,
-    /// `StandDown` (Optional).
-    pub stand_down: Option<t::Method<(), (i32,)>>,
-}
-t::debug_handle!(ControllerType_SystemOperation_SystemOperationStateMachine);
-impl t::Handle for ControllerType_SystemOperation_SystemOperationStateMachine {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[2], "CurrentState"),
-            last_transition: b.build_child(id, NS[2], "LastTransition"),
-            available_states: b.build_optional(id, NS[2], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
-            configured_default_stop_mode: b
-                .build_optional(id, NS[0], "ConfiguredDefaultStopMode"),
-            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
-            possible_stop_modes: b.build_optional(id, NS[0], "PossibleStopModes"),
-            start: b.build_optional(id, NS[0], "Start"),
-            stop: b.build_optional(id, NS[0], "Stop"),
-            executing_substate_machine: b
-                .build_optional(id, NS[0], "ExecutingSubstateMachine"),
-            get_ready: b.build_optional(id, NS[0], "GetReady"),
-            idle_substate_machine: b.build_optional(id, NS[0], "IdleSubstateMachine"),
-            stand_down: b.build_optional(id, NS[0], "StandDown"),
         }
     }
 }
@@ -852,7 +710,7 @@ pub struct MotionDeviceType {
     /// `Axes` (Mandatory). Axes is a container for one or more instances of the AxisType.
     pub axes: MotionDeviceType_Axes,
     /// `FlangeLoad` (Optional). The FlangeLoad is the load on the flange or at the mounting point of the MotionDevice. This can be the maximum load of the MotionDevice.
-    pub flange_load: Option<MotionDeviceType_FlangeLoad>,
+    pub flange_load: Option<Box<LoadType>>,
     /// `MotionDeviceCategory` (Mandatory). The variable MotionDeviceCategory provides the kind of motion device defined by MotionDeviceCategoryEnumeration based on ISO 8373.
     pub motion_device_category: t::Variable<
         super::types::MotionDeviceCategoryEnumeration,
@@ -945,30 +803,6 @@ impl t::Handle for MotionDeviceType_Axes {
             node: b.build_this(id),
             axis_identifier: b
                 .build_placeholders(id, rt::NsNodeId::numeric(NS[0], 16601)),
-        }
-    }
-}
-/// `FlangeLoad`, a member of `MotionDeviceType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct MotionDeviceType_FlangeLoad {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CenterOfMass` (Optional). The position and orientation of the center of the mass related to the mounting point using a FrameType. X, Y, Z define the position of the center of gravity relative to the mounting point coordinate system. A, B, C define the orientation of the principal axes of inertia relative to the mounting point coordinate system. Orientation A, B, C can be "0" for systems which do not need these  values.
-    pub center_of_mass: Option<t::Variable<ua::ThreeDFrame>>,
-    /// `Inertia` (Optional). The Inertia uses the VectorType to describe the three values of the principal moments of inertia with respect to the mounting point coordinate system. If inertia values are provided for rotary axis the CenterOfMass shall be completely filled as well.
-    pub inertia: Option<t::Variable<ua::ThreeDVector>>,
-    /// `Mass` (Mandatory). The weight of the load mounted on one mounting point.
-    pub mass: t::Variable<f64>,
-}
-t::debug_handle!(MotionDeviceType_FlangeLoad);
-impl t::Handle for MotionDeviceType_FlangeLoad {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            center_of_mass: b.build_optional(id, NS[0], "CenterOfMass"),
-            inertia: b.build_optional(id, NS[0], "Inertia"),
-            mass: b.build_child(id, NS[0], "Mass"),
         }
     }
 }
@@ -1575,15 +1409,11 @@ pub struct SystemOperationStateMachineType {
     /// `Stop` (Optional).
     pub stop: Option<t::Method<(i64,), (i32,)>>,
     /// `ExecutingSubstateMachine` (Optional).
-    pub executing_substate_machine: Option<
-        SystemOperationStateMachineType_ExecutingSubstateMachine,
-    >,
+    pub executing_substate_machine: Option<Box<ExecutingSubstateMachineType>>,
     /// `GetReady` (Optional).
     pub get_ready: Option<t::Method<(), (i32,)>>,
     /// `IdleSubstateMachine` (Optional).
-    pub idle_substate_machine: Option<
-        SystemOperationStateMachineType_IdleSubstateMachine,
-    >,
+    pub idle_substate_machine: Option<Box<IdleSubstateMachineType>>,
     /// `StandDown` (Optional).
     pub stand_down: Option<t::Method<(), (i32,)>>,
 }
@@ -1609,66 +1439,6 @@ impl t::Handle for SystemOperationStateMachineType {
     }
 }
 t::deref_base!(SystemOperationStateMachineType => OperationStateMachineType);
-/// `ExecutingSubstateMachine`, a member of `SystemOperationStateMachineType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct SystemOperationStateMachineType_ExecutingSubstateMachine {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory).
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Mandatory).
-    pub last_transition: t::Variable<ua::LocalizedText>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `LastTransitionReason` (Mandatory).
-    pub last_transition_reason: t::Variable<i16>,
-}
-t::debug_handle!(SystemOperationStateMachineType_ExecutingSubstateMachine);
-impl t::Handle for SystemOperationStateMachineType_ExecutingSubstateMachine {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[2], "CurrentState"),
-            last_transition: b.build_child(id, NS[2], "LastTransition"),
-            available_states: b.build_optional(id, NS[2], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
-            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
-        }
-    }
-}
-/// `IdleSubstateMachine`, a member of `SystemOperationStateMachineType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct SystemOperationStateMachineType_IdleSubstateMachine {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory).
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Mandatory).
-    pub last_transition: t::Variable<ua::LocalizedText>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `LastTransitionReason` (Mandatory).
-    pub last_transition_reason: t::Variable<i16>,
-}
-t::debug_handle!(SystemOperationStateMachineType_IdleSubstateMachine);
-impl t::Handle for SystemOperationStateMachineType_IdleSubstateMachine {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[2], "CurrentState"),
-            last_transition: b.build_child(id, NS[2], "LastTransition"),
-            available_states: b.build_optional(id, NS[2], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
-            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
-        }
-    }
-}
 t::object_type!(
     SystemOperationStateMachineType, rt::NsNodeId::numeric(NS[0], 1021),
     "SystemOperationStateMachineType"
@@ -1770,7 +1540,7 @@ pub struct SystemOperationType {
     /// `Conditions` (Optional).
     pub conditions: Option<SystemOperationType_Conditions>,
     /// `SystemOperationStateMachine` (Mandatory).
-    pub system_operation_state_machine: SystemOperationType_SystemOperationStateMachine,
+    pub system_operation_state_machine: Box<SystemOperationStateMachineType>,
 }
 t::debug_handle!(SystemOperationType);
 impl t::Handle for SystemOperationType {
@@ -1802,129 +1572,6 @@ impl t::Handle for SystemOperationType_Conditions {
         }
     }
 }
-/// `SystemOperationStateMachine`, a member of `SystemOperationType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct SystemOperationType_SystemOperationStateMachine {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory).
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Mandatory).
-    pub last_transition: t::Variable<ua::LocalizedText>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `ConfiguredDefaultStopMode` (Optional).
-    pub configured_default_stop_mode: Option<t::Variable<i16>>,
-    /// `LastTransitionReason` (Mandatory).
-    pub last_transition_reason: t::Variable<i16>,
-    /// `PossibleStopModes` (Optional).
-    pub possible_stop_modes: Option<t::Variable<Vec<ua::EnumValueType>>>,
-    /// `Start` (Optional).
-    pub start: Option<t::Method<(), (i32,)>>,
-    /// `Stop` (Optional).
-    pub stop: Option<t::Method<(i64,), (i32,)>>,
-    /// `ExecutingSubstateMachine` (Optional).
-    pub executing_substate_machine: Option<
-        SystemOperationType_SystemOperationStateMachine_ExecutingSubstateMachine,
-    >,
-    /// `GetReady` (Optional).
-    pub get_ready: Option<t::Method<(), (i32,)>>,
-    /// `IdleSubstateMachine` (Optional).
-    pub idle_substate_machine: Option<
-        SystemOperationType_SystemOperationStateMachine_IdleSubstateMachine,
-    >,
-    /// `StandDown` (Optional).
-    pub stand_down: Option<t::Method<(), (i32,)>>,
-}
-t::debug_handle!(SystemOperationType_SystemOperationStateMachine);
-impl t::Handle for SystemOperationType_SystemOperationStateMachine {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[2], "CurrentState"),
-            last_transition: b.build_child(id, NS[2], "LastTransition"),
-            available_states: b.build_optional(id, NS[2], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
-            configured_default_stop_mode: b
-                .build_optional(id, NS[0], "ConfiguredDefaultStopMode"),
-            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
-            possible_stop_modes: b.build_optional(id, NS[0], "PossibleStopModes"),
-            start: b.build_optional(id, NS[0], "Start"),
-            stop: b.build_optional(id, NS[0], "Stop"),
-            executing_substate_machine: b
-                .build_optional(id, NS[0], "ExecutingSubstateMachine"),
-            get_ready: b.build_optional(id, NS[0], "GetReady"),
-            idle_substate_machine: b.build_optional(id, NS[0], "IdleSubstateMachine"),
-            stand_down: b.build_optional(id, NS[0], "StandDown"),
-        }
-    }
-}
-/// `ExecutingSubstateMachine`, a member of `SystemOperationType_SystemOperationStateMachine` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct SystemOperationType_SystemOperationStateMachine_ExecutingSubstateMachine {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory).
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Mandatory).
-    pub last_transition: t::Variable<ua::LocalizedText>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `LastTransitionReason` (Mandatory).
-    pub last_transition_reason: t::Variable<i16>,
-}
-t::debug_handle!(
-    SystemOperationType_SystemOperationStateMachine_ExecutingSubstateMachine
-);
-impl t::Handle
-for SystemOperationType_SystemOperationStateMachine_ExecutingSubstateMachine {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[2], "CurrentState"),
-            last_transition: b.build_child(id, NS[2], "LastTransition"),
-            available_states: b.build_optional(id, NS[2], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
-            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
-        }
-    }
-}
-/// `IdleSubstateMachine`, a member of `SystemOperationType_SystemOperationStateMachine` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct SystemOperationType_SystemOperationStateMachine_IdleSubstateMachine {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory).
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Mandatory).
-    pub last_transition: t::Variable<ua::LocalizedText>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `LastTransitionReason` (Mandatory).
-    pub last_transition_reason: t::Variable<i16>,
-}
-t::debug_handle!(SystemOperationType_SystemOperationStateMachine_IdleSubstateMachine);
-impl t::Handle for SystemOperationType_SystemOperationStateMachine_IdleSubstateMachine {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[2], "CurrentState"),
-            last_transition: b.build_child(id, NS[2], "LastTransition"),
-            available_states: b.build_optional(id, NS[2], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
-            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
-        }
-    }
-}
 t::object_type!(
     SystemOperationType, rt::NsNodeId::numeric(NS[0], 1028), "SystemOperationType"
 );
@@ -1937,7 +1584,7 @@ pub struct TaskControlOperationType {
     /// `MotionDevicesUnderControl` (Optional).
     pub motion_devices_under_control: Option<t::Variable<Vec<ua::NodeId>>>,
     /// `TaskControlStateMachine` (Mandatory).
-    pub task_control_state_machine: TaskControlOperationType_TaskControlStateMachine,
+    pub task_control_state_machine: Box<TaskControlStateMachineType>,
 }
 t::debug_handle!(TaskControlOperationType);
 impl t::Handle for TaskControlOperationType {
@@ -1948,103 +1595,6 @@ impl t::Handle for TaskControlOperationType {
                 .build_optional(id, NS[0], "MotionDevicesUnderControl"),
             task_control_state_machine: b
                 .build_child(id, NS[0], "TaskControlStateMachine"),
-        }
-    }
-}
-/// `TaskControlStateMachine`, a member of `TaskControlOperationType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct TaskControlOperationType_TaskControlStateMachine {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory).
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Mandatory).
-    pub last_transition: t::Variable<ua::LocalizedText>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `ConfiguredDefaultStopMode` (Optional).
-    pub configured_default_stop_mode: Option<t::Variable<i16>>,
-    /// `LastTransitionReason` (Mandatory).
-    pub last_transition_reason: t::Variable<i16>,
-    /// `PossibleStopModes` (Optional).
-    pub possible_stop_modes: Option<t::Variable<Vec<ua::EnumValueType>>>,
-    /// `Start` (Optional).
-    pub start: Option<t::Method<(), (i32,)>>,
-    /// `Stop` (Optional).
-    pub stop: Option<t::Method<(i64,), (i32,)>>,
-    /// `LoadByName` (Optional).
-    pub load_by_name: Option<t::Method<(String,), (i32,)>>,
-    /// `LoadByNodeId` (Optional).
-    pub load_by_node_id: Option<t::Method<(ua::ExpandedNodeId,), (i32,)>>,
-    /// `ReadySubstateMachine` (Optional).
-    pub ready_substate_machine: Option<
-        TaskControlOperationType_TaskControlStateMachine_ReadySubstateMachine,
-    >,
-    /// `UnloadByName` (Optional).
-    pub unload_by_name: Option<t::Method<(String,), (i32,)>>,
-    /// `UnloadByNodeId` (Optional).
-    pub unload_by_node_id: Option<t::Method<(ua::ExpandedNodeId,), (i32,)>>,
-    /// `UnloadProgram` (Optional).
-    pub unload_program: Option<t::Method<(), (i32,)>>,
-}
-t::debug_handle!(TaskControlOperationType_TaskControlStateMachine);
-impl t::Handle for TaskControlOperationType_TaskControlStateMachine {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[2], "CurrentState"),
-            last_transition: b.build_child(id, NS[2], "LastTransition"),
-            available_states: b.build_optional(id, NS[2], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
-            configured_default_stop_mode: b
-                .build_optional(id, NS[0], "ConfiguredDefaultStopMode"),
-            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
-            possible_stop_modes: b.build_optional(id, NS[0], "PossibleStopModes"),
-            start: b.build_optional(id, NS[0], "Start"),
-            stop: b.build_optional(id, NS[0], "Stop"),
-            load_by_name: b.build_optional(id, NS[0], "LoadByName"),
-            load_by_node_id: b.build_optional(id, NS[0], "LoadByNodeId"),
-            ready_substate_machine: b.build_optional(id, NS[0], "ReadySubstateMachine"),
-            unload_by_name: b.build_optional(id, NS[0], "UnloadByName"),
-            unload_by_node_id: b.build_optional(id, NS[0], "UnloadByNodeId"),
-            unload_program: b.build_optional(id, NS[0], "UnloadProgram"),
-        }
-    }
-}
-/// `ReadySubstateMachine`, a member of `TaskControlOperationType_TaskControlStateMachine` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct TaskControlOperationType_TaskControlStateMachine_ReadySubstateMachine {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory).
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Mandatory).
-    pub last_transition: t::Variable<ua::LocalizedText>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `LastTransitionReason` (Mandatory).
-    pub last_transition_reason: t::Variable<i16>,
-    /// `ResetToProgramStart` (Optional).
-    pub reset_to_program_start: Option<t::Method<(), (i32,)>>,
-}
-t::debug_handle!(TaskControlOperationType_TaskControlStateMachine_ReadySubstateMachine);
-impl t::Handle
-for TaskControlOperationType_TaskControlStateMachine_ReadySubstateMachine {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[2], "CurrentState"),
-            last_transition: b.build_child(id, NS[2], "LastTransition"),
-            available_states: b.build_optional(id, NS[2], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
-            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
-            reset_to_program_start: b.build_optional(id, NS[0], "ResetToProgramStart"),
         }
     }
 }
@@ -2077,7 +1627,7 @@ pub struct TaskControlStateMachineType {
     /// `LoadByNodeId` (Optional).
     pub load_by_node_id: Option<t::Method<(ua::ExpandedNodeId,), (i32,)>>,
     /// `ReadySubstateMachine` (Optional).
-    pub ready_substate_machine: Option<TaskControlStateMachineType_ReadySubstateMachine>,
+    pub ready_substate_machine: Option<Box<ReadySubstateMachineType>>,
     /// `UnloadByName` (Optional).
     pub unload_by_name: Option<t::Method<(String,), (i32,)>>,
     /// `UnloadByNodeId` (Optional).
@@ -2108,39 +1658,6 @@ impl t::Handle for TaskControlStateMachineType {
     }
 }
 t::deref_base!(TaskControlStateMachineType => OperationStateMachineType);
-/// `ReadySubstateMachine`, a member of `TaskControlStateMachineType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct TaskControlStateMachineType_ReadySubstateMachine {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory).
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Mandatory).
-    pub last_transition: t::Variable<ua::LocalizedText>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `LastTransitionReason` (Mandatory).
-    pub last_transition_reason: t::Variable<i16>,
-    /// `ResetToProgramStart` (Optional).
-    pub reset_to_program_start: Option<t::Method<(), (i32,)>>,
-}
-t::debug_handle!(TaskControlStateMachineType_ReadySubstateMachine);
-impl t::Handle for TaskControlStateMachineType_ReadySubstateMachine {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[2], "CurrentState"),
-            last_transition: b.build_child(id, NS[2], "LastTransition"),
-            available_states: b.build_optional(id, NS[2], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
-            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
-            reset_to_program_start: b.build_optional(id, NS[0], "ResetToProgramStart"),
-        }
-    }
-}
 t::object_type!(
     TaskControlStateMachineType, rt::NsNodeId::numeric(NS[0], 1025),
     "TaskControlStateMachineType"
@@ -2254,7 +1771,7 @@ pub struct TaskControlType {
     /// `<MotionDeviceIdentifier>` (OptionalPlaceholder). Controls is a reference to provide the relationship between a task control and a motion device.
     pub motion_device_identifier: t::Placeholders<MotionDeviceType>,
     /// `TaskControlOperation` (Optional).
-    pub task_control_operation: Option<TaskControlType_TaskControlOperation>,
+    pub task_control_operation: Option<Box<TaskControlOperationType>>,
     /// `TaskModules` (Optional).
     pub task_modules: Option<TaskControlType_TaskModules>,
 }
@@ -2295,90 +1812,6 @@ impl t::Handle for TaskControlType_ParameterSet {
             execution_mode: b.build_optional(id, NS[0], "ExecutionMode"),
             task_program_loaded: b.build_child(id, NS[0], "TaskProgramLoaded"),
             task_program_name: b.build_child(id, NS[0], "TaskProgramName"),
-        }
-    }
-}
-/// `TaskControlOperation`, a member of `TaskControlType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct TaskControlType_TaskControlOperation {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `MotionDevicesUnderControl` (Optional).
-    pub motion_devices_under_control: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `TaskControlStateMachine` (Mandatory).
-    pub task_control_state_machine: TaskControlType_TaskControlOperation_TaskControlStateMachine,
-}
-t::debug_handle!(TaskControlType_TaskControlOperation);
-impl t::Handle for TaskControlType_TaskControlOperation {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            motion_devices_under_control: b
-                .build_optional(id, NS[0], "MotionDevicesUnderControl"),
-            task_control_state_machine: b
-                .build_child(id, NS[0], "TaskControlStateMachine"),
-        }
-    }
-}
-/// `TaskControlStateMachine`, a member of `TaskControlType_TaskControlOperation` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct TaskControlType_TaskControlOperation_TaskControlStateMachine {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `CurrentState` (Mandatory).
-    pub current_state: t::Variable<ua::LocalizedText>,
-    /// `LastTransition` (Mandatory).
-    pub last_transition: t::Variable<ua::LocalizedText>,
-    /// `AvailableStates` (Optional).
-    pub available_states: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `AvailableTransitions` (Optional).
-    pub available_transitions: Option<t::Variable<Vec<ua::NodeId>>>,
-    /// `ConfiguredDefaultStopMode` (Optional).
-    pub configured_default_stop_mode: Option<t::Variable<i16>>,
-    /// `LastTransitionReason` (Mandatory).
-    pub last_transition_reason: t::Variable<i16>,
-    /// `PossibleStopModes` (Optional).
-    pub possible_stop_modes: Option<t::Variable<Vec<ua::EnumValueType>>>,
-    /// `Start` (Optional).
-    pub start: Option<t::Method<(), (i32,)>>,
-    /// `Stop` (Optional).
-    pub stop: Option<t::Method<(i64,), (i32,)>>,
-    /// `LoadByName` (Optional).
-    pub load_by_name: Option<t::Method<(String,), (i32,)>>,
-    /// `LoadByNodeId` (Optional).
-    pub load_by_node_id: Option<t::Method<(ua::ExpandedNodeId,), (i32,)>>,
-    /// `ReadySubstateMachine` (Optional).
-    pub ready_substate_machine: Option<Box<ReadySubstateMachineType>>,
-    /// `UnloadByName` (Optional).
-    pub unload_by_name: Option<t::Method<(String,), (i32,)>>,
-    /// `UnloadByNodeId` (Optional).
-    pub unload_by_node_id: Option<t::Method<(ua::ExpandedNodeId,), (i32,)>>,
-    /// `UnloadProgram` (Optional).
-    pub unload_program: Option<t::Method<(), (i32,)>>,
-}
-t::debug_handle!(TaskControlType_TaskControlOperation_TaskControlStateMachine);
-impl t::Handle for TaskControlType_TaskControlOperation_TaskControlStateMachine {
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            current_state: b.build_child(id, NS[2], "CurrentState"),
-            last_transition: b.build_child(id, NS[2], "LastTransition"),
-            available_states: b.build_optional(id, NS[2], "AvailableStates"),
-            available_transitions: b.build_optional(id, NS[2], "AvailableTransitions"),
-            configured_default_stop_mode: b
-                .build_optional(id, NS[0], "ConfiguredDefaultStopMode"),
-            last_transition_reason: b.build_child(id, NS[0], "LastTransitionReason"),
-            possible_stop_modes: b.build_optional(id, NS[0], "PossibleStopModes"),
-            start: b.build_optional(id, NS[0], "Start"),
-            stop: b.build_optional(id, NS[0], "Stop"),
-            load_by_name: b.build_optional(id, NS[0], "LoadByName"),
-            load_by_node_id: b.build_optional(id, NS[0], "LoadByNodeId"),
-            ready_substate_machine: b.build_optional(id, NS[0], "ReadySubstateMachine"),
-            unload_by_name: b.build_optional(id, NS[0], "UnloadByName"),
-            unload_by_node_id: b.build_optional(id, NS[0], "UnloadByNodeId"),
-            unload_program: b.build_optional(id, NS[0], "UnloadProgram"),
         }
     }
 }

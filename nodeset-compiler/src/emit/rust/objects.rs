@@ -3,7 +3,7 @@
 //! For every ObjectType a struct whose fields are typed handles of its members (`Variable<T>` with `T` from
 //! the DataType and ValueRank, `Method<(inputs), (outputs)>` from the Argument definitions, nested structs
 //! for object members whose declaration adds children, `Box<_>` around the handle of a member typed by another
-//! ObjectType, `Option<_>` for Optional members, `Placeholders<_>`
+//! ObjectType (also when its declaration only repeats that type's members: one struct, not a copy per use), `Option<_>` for Optional members, `Placeholders<_>`
 //! for `<Placeholder>` members); the members of the nearest supertype that has a handle of its own are in
 //! its `base` field, reached through `Deref`, so a subtype's handle reaches what it inherits. Supertypes
 //! without a handle (ns0's) have their members folded into the first generated subtype.
@@ -243,6 +243,59 @@ impl Gen<'_> {
         self.model.children(decl).any(|(_, c)| self.rule(c).is_some())
     }
 
+    /// Whether an object declaration with children of its own only repeats the members of its
+    /// TypeDefinition, which has a handle: then that handle is the member's type, and no nested struct is
+    /// generated for it (DI's `PendingVersion` and `FallbackVersion` are `SoftwareVersionType`s; each skill
+    /// of a SkillSet repeats its skill type).
+    fn repeats_its_type(&self, decl: NodeIx, names: &BTreeMap<NodeIx, String>) -> bool {
+        let Some(td) = self.model.node(decl).type_definition else { return false };
+        if self.handle_path(td, names).is_none() {
+            return false;
+        }
+        let of_type: Vec<(NodeIx, NodeIx)> = self
+            .model
+            .members
+            .get(&td)
+            .map(|ms| ms.iter().filter(|m| self.rule(m.node).is_some()).map(|m| (m.node, m.reference_type)).collect())
+            .unwrap_or_default();
+        let (mut a, mut b) = (String::new(), String::new());
+        self.members_signature(&self.decl_members(decl), 0, &mut a);
+        self.members_signature(&of_type, 0, &mut b);
+        a == b
+    }
+
+    /// What a list of members gives a handle, as text: per member in BrowseName order its name, class and
+    /// rule, the value or method type, and for an object its TypeDefinition and, down to [`MAX_DEPTH`],
+    /// its own members. Equal signatures give handles with the same fields at every level.
+    fn members_signature(&self, members: &[(NodeIx, NodeIx)], depth: usize, out: &mut String) {
+        let model = self.model;
+        let mut ordered: Vec<NodeIx> = members.iter().map(|&(m, _)| m).filter(|&m| self.rule(m).is_some()).collect();
+        ordered.sort_by(|a, b| model.node(*a).browse_name.cmp(&model.node(*b).browse_name));
+        out.push('{');
+        for m in ordered {
+            let n = model.node(m);
+            let rule = self.rule(m).map_or("", |r| r.name());
+            let _ = write!(out, "{}:{} {:?} {rule} ", n.browse_name.ns, n.browse_name.name, n.class);
+            match n.class {
+                NodeClass::Variable => {
+                    let _ = write!(out, "{}", self.value_type(n.attrs.data_type, n.attrs.value_rank.unwrap_or(-1)));
+                }
+                NodeClass::Method => {
+                    let _ = write!(out, "{}", self.method_type(m));
+                }
+                NodeClass::Object => {
+                    let _ = write!(out, "{:?}", n.type_definition);
+                    if depth < MAX_DEPTH && !self.rule(m).is_some_and(|r| r.is_placeholder()) {
+                        self.members_signature(&self.decl_members(m), depth + 1, out);
+                    }
+                }
+                _ => {}
+            }
+            out.push(';');
+        }
+        out.push('}');
+    }
+
     fn method_type(&self, decl: NodeIx) -> TokenStream {
         let info = self.model.methods.get(&decl).cloned().unwrap_or_default();
         let tuple = |args: &[crate::model::Argument]| -> TokenStream {
@@ -306,7 +359,12 @@ impl Gen<'_> {
                     quote! { t::Variable<#vt> }
                 }
                 NodeClass::Method => self.method_type(m),
-                NodeClass::Object if depth < NESTED_DEPTH && !rule.is_placeholder() && self.adds_children(m) => {
+                NodeClass::Object
+                    if depth < NESTED_DEPTH
+                        && !rule.is_placeholder()
+                        && self.adds_children(m)
+                        && !self.repeats_its_type(m, names) =>
+                {
                     let sname = format!("{prefix}{}", crate::names::sanitize(&n.browse_name.name, Case::UpperCamel, Target::Rust).trim_start_matches("r#"));
                     let sub = self.decl_members(m);
                     let text = format!("`{}`, a member of `{}` with children of its own.", n.browse_name.name, prefix.trim_end_matches('_'));
