@@ -22,11 +22,11 @@
 //!
 //! Each field is bound to a variable of the ObjectType's instances, named by the field (`serial_number` is
 //! `SerialNumber`) or by `#[opcua(path = "ParameterSet/SpeedOverride")]`. The derive never reads XML: it
-//! names the marker type the generated code declares for that browse path
-//! (`objects::members::MotionDeviceType::SerialNumber`) and lets the compiler check, through the markers'
-//! traits and constants, that the path exists (a misspelled path gets rustc's "similar name" suggestion),
-//! that the field's Rust type holds the variable's DataType and ValueRank, and that every mandatory variable
-//! without a default value is bound. Errors point at the offending field or attribute.
+//! names the marker constant the generated code declares for that browse path
+//! (`objects::members::MotionDeviceType::SerialNumber`, a `VariableMember<String>`) and lets the compiler
+//! check, through the marker's type and fields, that the path exists (a misspelled path gets rustc's
+//! "similar name" suggestion), that the field's Rust type holds the variable's DataType and ValueRank, and
+//! that every mandatory variable without a default value is bound. Errors point at the offending field or attribute.
 //!
 //! At run time [`ObjectModel`] (in `nodeset_models::runtime::typed::model`) instantiates the ObjectType from
 //! a value of the struct, publishes the fields that changed, and receives client writes of writable
@@ -227,13 +227,13 @@ fn expand(input: &DeriveInput) -> syn::Result<TokenStream2> {
         );
         checks.push(quote_spanned! {ty_span=>
             const _: fn() = || {
-                fn __holds<M: #t::VariableMember, F: #t::Holds<<M as #t::VariableMember>::Scalar>>() {}
-                __holds::<#marker_path, #ty>();
+                fn __holds<S, F: #t::Holds<S>>(_: &#t::VariableMember<S>) {}
+                __holds::<_, #ty>(&#marker_path);
             };
         });
         checks.push(quote_spanned! {ty_span=>
             const _: () = ::core::assert!(
-                #t::value::rank_fits(<#ty as #t::UaValue>::VALUE_RANK, <#marker_path as #t::VariableMember>::VALUE_RANK),
+                #t::value::rank_fits(<#ty as #t::UaValue>::VALUE_RANK, #marker_path.value_rank),
                 #rank_message
             );
         });
@@ -242,8 +242,8 @@ fn expand(input: &DeriveInput) -> syn::Result<TokenStream2> {
             #t::model::FieldBinding {
                 field: #field_name,
                 path: #p,
-                browse_path: <#marker_path as #t::Member>::PATH,
-                writable: <#marker_path as #t::VariableMember>::WRITABLE,
+                browse_path: #marker_path.path,
+                writable: #marker_path.writable,
             }
         });
         to_variants.push(quote! { #t::UaValue::to_variant(&self.#field) });

@@ -1,8 +1,8 @@
 //! The typed API generated handles are built on: Rust value types for OPC UA DataTypes ([`UaValue`]),
 //! handles to the nodes of an instance ([`Variable<T>`], [`Method<I, O>`], [`ObjectNode`],
 //! [`Placeholders<H>`]), instantiation of types as they prescribe ([`Instantiate`]), and the traits that
-//! generated code implements for every ObjectType ([`ObjectType`]) and that `nodeset-derive` checks bindings
-//! against ([`Member`], [`VariableMember`]).
+//! generated code implements for every ObjectType ([`ObjectType`]), and the member markers that
+//! `nodeset-derive` checks bindings against ([`VariableMember`]).
 
 pub mod handle;
 pub mod instance;
@@ -20,6 +20,8 @@ pub use program::{
 pub use crate::__nodeset_parameters as parameters;
 pub use crate::__nodeset_program_type as program_type;
 pub use value::{UaStruct, UaValue};
+
+use std::marker::PhantomData;
 
 use opcua::types::{NodeId, QualifiedName};
 
@@ -59,38 +61,41 @@ pub trait VariableType: Handle {
     const BROWSE_NAME: &'static str;
 }
 
-/// What kind of node a member is.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum MemberKind {
-    Object,
-    Variable,
-    Method,
-}
-
-/// An instance declaration of an ObjectType, as a zero-sized marker type that generated code declares per
-/// member path (`<type module>::members::ParameterSet__ActualPosition`). `nodeset-derive` names these
-/// markers to check a binding at compile time.
-pub trait Member {
-    /// The ObjectType handle the member belongs to.
-    type Owner;
-    /// BrowseNames from the instance down to the member, each with its namespace URI.
-    const PATH: &'static [(&'static str, &'static str)];
-    /// The member's NodeClass.
-    const KIND: MemberKind;
-    /// Whether every instance has it (Mandatory, all the way down).
-    const MANDATORY: bool;
-}
-
-/// A member that is a variable.
-pub trait VariableMember: Member {
-    /// The Rust type of one value of the variable's DataType.
-    type Scalar;
+/// A variable reachable from an instance of an ObjectType (without crossing a placeholder), as generated
+/// code declares it: one `const` per browse path in `<type module>::members::<Owner>`, named from the path
+/// (`ParameterSet__ActualPosition`). `nodeset-derive` names these to check a binding at compile time: the
+/// field's type against `S` (through [`Holds`]), its ValueRank against `value_rank`, and the mandatory
+/// variables against the module's `REQUIRED`.
+///
+/// A marker is a value, not a type with trait impls: a namespace has about a thousand of them, and one
+/// constant each is what the compiler checks fastest.
+pub struct VariableMember<S> {
+    /// BrowseNames from the instance down to the variable, each with its namespace URI.
+    pub path: &'static [(&'static str, &'static str)],
     /// The variable's ValueRank.
-    const VALUE_RANK: i32;
+    pub value_rank: i32,
+    /// Whether every instance has it (Mandatory, all the way down).
+    pub mandatory: bool,
     /// Whether the nodeset gives the declaration an initial value.
-    const HAS_DEFAULT: bool;
+    pub has_default: bool,
     /// Whether clients may write it (CurrentWrite in its AccessLevel).
-    const WRITABLE: bool;
+    pub writable: bool,
+    /// `S`: the Rust type of one value of the variable's DataType. (Public so that a marker is a struct
+    /// literal: its `path` is then a `'static` slice in place, which a `const fn` argument would not be.)
+    pub scalar: PhantomData<fn() -> S>,
+}
+
+impl<S> std::fmt::Debug for VariableMember<S> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("VariableMember")
+            .field("path", &self.path)
+            .field("scalar", &std::any::type_name::<S>())
+            .field("value_rank", &self.value_rank)
+            .field("mandatory", &self.mandatory)
+            .field("has_default", &self.has_default)
+            .field("writable", &self.writable)
+            .finish()
+    }
 }
 
 /// Checks, for `nodeset-derive`, that a field's Rust type holds the values of a variable member: the same
@@ -156,33 +161,29 @@ macro_rules! __nodeset_ua_struct {
 pub use crate::__nodeset_ua_struct as ua_struct;
 
 /// Declares the member markers of an ObjectType (generated `members` modules use it): a module named
-/// after the handle with, for each variable member, the marker name, the Rust scalar type, the ValueRank,
-/// the browse path as (index into `NS`, name) pairs, and whether it is mandatory, has a default value, and
-/// is writable; and `REQUIRED`, the mandatory variables without a default, with the message for a derive
-/// that leaves one unbound.
+/// after the handle with, for each variable member, a [`VariableMember`] constant given the marker name,
+/// the Rust scalar type, the ValueRank, the browse path as (index into `NS`, name) pairs, and whether it
+/// is mandatory, has a default value, and is writable; and `REQUIRED`, the mandatory variables without a
+/// default, with the message for a derive that leaves one unbound.
 #[doc(hidden)]
 #[macro_export]
 macro_rules! __nodeset_object_members {
     ($owner:ident; required: [$(($rp:literal, $rm:literal)),* $(,)?]; $($m:ident: $scalar:ty, $rank:literal, [$($k:literal $name:literal),*], $mandatory:literal $default:literal $writable:literal;)*) => {
         #[doc = concat!(" Member markers of [`", stringify!($owner), "`](super::", stringify!($owner), ") for `nodeset-derive`.")]
+        #[allow(non_upper_case_globals)]
         pub mod $owner {
             #[allow(unused_imports)]
-            use super::super::{t, ua, NS};
+            use super::super::{t, ua};
             $(
                 #[doc = concat!(" The variable `", $($name, "/",)* "`.")]
-                pub struct $m;
-                impl $crate::typed::Member for $m {
-                    type Owner = super::super::$owner;
-                    const PATH: &'static [(&'static str, &'static str)] = &[$((NS[$k], $name)),*];
-                    const KIND: $crate::typed::MemberKind = $crate::typed::MemberKind::Variable;
-                    const MANDATORY: bool = $mandatory;
-                }
-                impl $crate::typed::VariableMember for $m {
-                    type Scalar = $scalar;
-                    const VALUE_RANK: i32 = $rank;
-                    const HAS_DEFAULT: bool = $default;
-                    const WRITABLE: bool = $writable;
-                }
+                pub const $m: $crate::typed::VariableMember<$scalar> = $crate::typed::VariableMember {
+                    path: &[$((super::super::NS[$k], $name)),*],
+                    value_rank: $rank,
+                    mandatory: $mandatory,
+                    has_default: $default,
+                    writable: $writable,
+                    scalar: ::core::marker::PhantomData,
+                };
             )*
             /// Mandatory variables without a default value, with the message for an unbound one.
             pub const REQUIRED: &[(&str, &str)] = &[$(($rp, $rm)),*];

@@ -8,11 +8,12 @@
 //! its `base` field, reached through `Deref`, so a subtype's handle reaches what it inherits. Supertypes
 //! without a handle (ns0's) have their members folded into the first generated subtype.
 //!
-//! `members::<Type>` holds one zero-sized marker per variable reachable from an instance without crossing
-//! a placeholder, named from the browse path (`ParameterSet__ActualPosition`), with the DataType's Rust
-//! scalar type, ValueRank, whether it is mandatory, has a default, is writable; plus `REQUIRED`, the
-//! mandatory variables without a default value. `nodeset-derive` checks bindings against these at compile
-//! time (it never reads XML).
+//! `members::<Type>` holds one marker constant (`runtime::typed::VariableMember<Scalar>`) per variable
+//! reachable from an instance without crossing a placeholder, named from the browse path
+//! (`ParameterSet__ActualPosition`), with the DataType's Rust scalar type, ValueRank, whether it is mandatory,
+//! has a default, is writable; plus `REQUIRED`, the mandatory variables without a default value.
+//! `nodeset-derive` checks bindings against these at compile time (it never reads XML). A path whose marker
+//! name would be `REQUIRED` gets no marker, like a name that two paths map to.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -505,7 +506,8 @@ impl Gen<'_> {
                 mandatory,
             })
             .collect();
-        // A marker name two paths map to is left out (the derive cannot name either): order-independent.
+        // A marker name two paths map to is left out (the derive cannot name either): order-independent. So
+        // is one that would be the module's `REQUIRED`.
         let mut count: BTreeMap<String, usize> = BTreeMap::new();
         for r in &reach {
             let segs: Vec<&str> = r.path.iter().map(String::as_str).collect();
@@ -517,7 +519,7 @@ impl Gen<'_> {
         for r in &reach {
             let segs: Vec<&str> = r.path.iter().map(String::as_str).collect();
             let mname = marker_name(&segs);
-            if count[&mname] > 1 || !seen.insert(mname.clone()) {
+            if count[&mname] > 1 || mname == "REQUIRED" || !seen.insert(mname.clone()) {
                 continue;
             }
             let n = model.node(r.node);
