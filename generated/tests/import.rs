@@ -157,6 +157,7 @@ const fn edge_row(id: Id, name: &'static str, kind: Kind, refs: &'static [Ref]) 
         user_write_mask: 0,
         kind,
         refs,
+        nrefs: &[],
     }
 }
 const fn var(data_type: Id, value: Val) -> Kind {

@@ -186,6 +186,7 @@ const fn row(id: u32, name: &'static str, kind: Kind, refs: &'static [Ref]) -> N
         user_write_mask: 0,
         kind,
         refs,
+        nrefs: &[],
     }
 }
 
@@ -199,6 +200,7 @@ const fn property(id: u32, name: &'static str, data_type: Id, value: Val) -> Nod
         user_write_mask: 0,
         kind: variable(data_type, 1, READ, value),
         refs: PROPERTY_REFS,
+        nrefs: &[],
     }
 }
 
@@ -280,6 +282,7 @@ pub static TABLE: NodeSetTable = NodeSetTable {
             user_write_mask: 0,
             kind: Kind::Object { event_notifier: 0 },
             refs: &[fwd(HAS_TYPE_DEFINITION, DATA_TYPE_ENCODING_TYPE)],
+            nrefs: &[],
         },
         row(
             ids::DEMO_MODE,

@@ -190,7 +190,7 @@ fn build_item(table: &NodeSetTable, row: &NodeRow, map: &NamespaceMap) -> Option
             View::new_full(base, EventNotifier::from_bits_truncate(*event_notifier), *contains_no_loops).into()
         }
     };
-    let references = row.refs.iter().filter_map(|r| ctx.reference(r, &node_id)).collect();
+    let references = row.references().filter_map(|r| ctx.reference(&r, &node_id)).collect();
     Some(ImportedItem { node, references })
 }
 
@@ -306,8 +306,7 @@ impl Ctx<'_> {
     /// The target of the row's HasEncoding reference whose BrowseName is "Default Binary", for a structure
     /// definition that does not name its encoding.
     fn default_binary_encoding(&self, row: &NodeRow) -> Option<Id> {
-        row.refs
-            .iter()
+        row.references()
             .filter(|r| r.forward && r.reference_type == Id::ns0(HAS_ENCODING))
             .map(|r| r.target)
             .find(|t| self.table.nodes.iter().any(|n| n.id == *t && n.browse_name.1 == "Default Binary"))

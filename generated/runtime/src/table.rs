@@ -39,6 +39,11 @@ pub struct Ref {
     pub forward: bool,
 }
 
+/// A reference whose type and target have numeric identifiers (nearly all of a nodeset's): reference type
+/// namespace and number, target namespace and number, forward. A tuple of literals, because a row is data
+/// the compiler checks expression by expression: this is three times fewer expressions than a [`Ref`].
+pub type NumRef = (u16, u32, u16, u32, bool);
+
 /// A field of a structure's DataTypeDefinition.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FieldRow {
@@ -178,8 +183,23 @@ pub struct NodeRow {
     pub write_mask: u32,
     pub user_write_mask: u32,
     pub kind: Kind,
-    /// References declared on this node (forward and inverse), as the nodeset declares them.
+    /// References declared on this node (forward and inverse), as the nodeset declares them, when one of
+    /// them has an identifier that is not numeric; otherwise empty, and they are in `nrefs`.
     pub refs: &'static [Ref],
+    /// References declared on this node when all of them are numeric (generated tables use one of the two
+    /// lists, so the order is the nodeset's either way).
+    pub nrefs: &'static [NumRef],
+}
+
+impl NodeRow {
+    /// Every reference of the row: `refs`, then `nrefs`.
+    pub fn references(&self) -> impl Iterator<Item = Ref> + '_ {
+        self.refs.iter().copied().chain(self.nrefs.iter().map(|&(rns, rid, tns, tid, forward)| Ref {
+            reference_type: Id::numeric(rns, rid),
+            target: Id::numeric(tns, tid),
+            forward,
+        }))
+    }
 }
 
 /// A namespace's address space.
@@ -195,4 +215,44 @@ pub struct NodeSetTable {
     /// The index of `namespace_uri` in `namespaces`.
     pub own: u16,
     pub nodes: &'static [NodeRow],
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const fn row(refs: &'static [Ref], nrefs: &'static [NumRef]) -> NodeRow {
+        NodeRow {
+            id: Id::numeric(1, 1),
+            browse_name: (1, "N"),
+            display_name: "N",
+            description: None,
+            write_mask: 0,
+            user_write_mask: 0,
+            kind: Kind::Object { event_notifier: 0 },
+            refs,
+            nrefs,
+        }
+    }
+
+    #[test]
+    fn numeric_references_read_as_refs_in_their_order() {
+        let r = row(&[], &[(0, 40, 0, 58, true), (2, 4002, 1, 1003, false)]);
+        let got: Vec<Ref> = r.references().collect();
+        assert_eq!(
+            got,
+            [
+                Ref { reference_type: Id::ns0(40), target: Id::ns0(58), forward: true },
+                Ref { reference_type: Id::numeric(2, 4002), target: Id::numeric(1, 1003), forward: false },
+            ]
+        );
+    }
+
+    #[test]
+    fn general_references_come_through_unchanged() {
+        const REFS: &[Ref] =
+            &[Ref { reference_type: Id::ns0(47), target: Id { ns: 1, id: IdKind::String("Pump") }, forward: true }];
+        assert_eq!(row(REFS, &[]).references().collect::<Vec<_>>(), REFS);
+        assert_eq!(row(&[], &[]).references().count(), 0);
+    }
 }

@@ -6,6 +6,12 @@
 //! those cost about 70% of the whole Rust generation. Literals are still printed by proc-macro2's `Literal`, so
 //! strings, byte strings and floats are escaped exactly as the token-based parts of the emitter escape them.
 //! The few lines around the rows (the module head and the table header) go through quote and prettyplease.
+//!
+//! A row's references are written as tuples of numbers, `(0, 45, 2, 3008, false)` (reference type namespace
+//! and number, target namespace and number, forward), when all of them are numeric: references are most of a
+//! table's expressions, and a tuple of literals is a third of the expressions of `rt::table::Ref { .. }` with
+//! its two `Id`s. For DI + IA + Robotics the table text shrinks from 1,077 KB to 660 KB, and a crate of only
+//! their three tables builds with 19% less rustc self time (2.54 -> 2.06 s, mean of three clean builds).
 
 use super::{lit, path, Gen};
 use crate::diag::{Code, Diagnostic};
@@ -247,14 +253,38 @@ impl Gen<'_> {
                     );
                 }
             }
-            out.push_str(", refs: ");
-            list(out, n.references.iter().filter(|r| r.declared), |out, r| {
-                out.push_str("rt::table::Ref { reference_type: ");
-                id_of(out, r.reference_type);
-                out.push_str(", target: ");
-                id_of(out, r.target);
-                let _ = write!(out, ", forward: {} }}", r.forward);
-            });
+            // References go to `nrefs` as tuples of numbers when all of them are numeric (nearly always), else
+            // all to `refs`, so that the order is the nodeset's either way.
+            let declared = || n.references.iter().filter(|r| r.declared);
+            let numeric = |ix: NodeIx| match model.node(ix).id.id {
+                Identifier::Numeric(v) => Some(v),
+                _ => None,
+            };
+            if declared().all(|r| numeric(r.reference_type).is_some() && numeric(r.target).is_some()) {
+                out.push_str(", refs: &[], nrefs: ");
+                list(out, declared(), |out, r| {
+                    let (rt, target) = (model.node(r.reference_type), model.node(r.target));
+                    let _ = write!(
+                        out,
+                        "({}, {}, {}, {}, {})",
+                        local(rt.id.ns),
+                        numeric(r.reference_type).unwrap_or(0),
+                        local(target.id.ns),
+                        numeric(r.target).unwrap_or(0),
+                        r.forward
+                    );
+                });
+            } else {
+                out.push_str(", refs: ");
+                list(out, declared(), |out, r| {
+                    out.push_str("rt::table::Ref { reference_type: ");
+                    id_of(out, r.reference_type);
+                    out.push_str(", target: ");
+                    id_of(out, r.target);
+                    let _ = write!(out, ", forward: {} }}", r.forward);
+                });
+                out.push_str(", nrefs: &[]");
+            }
             out.push_str(" }, \n");
         }
         if dropped_values > 0 {
