@@ -227,8 +227,7 @@ fn expand(input: &DeriveInput) -> syn::Result<TokenStream2> {
         );
         checks.push(quote_spanned! {ty_span=>
             const _: fn() = || {
-                fn __holds<S, F: #t::Holds<S>>(_: &#t::VariableMember<S>) {}
-                __holds::<_, #ty>(&#marker_path);
+                #marker_path.holds::<#ty>();
             };
         });
         checks.push(quote_spanned! {ty_span=>

@@ -85,6 +85,13 @@ pub struct VariableMember<S> {
     pub scalar: PhantomData<fn() -> S>,
 }
 
+impl<S> VariableMember<S> {
+    /// Compiles only if a field of type `F` holds this variable's values (`nodeset-derive` calls it for
+    /// each bound field). A method, so that `S` is the marker's and only `F` is named: the check is then
+    /// `F: Holds<S>` with both known, and fails with [`Holds`]'s message.
+    pub fn holds<F: Holds<S>>(&self) {}
+}
+
 impl<S> std::fmt::Debug for VariableMember<S> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("VariableMember")
