@@ -3,8 +3,8 @@
 //! For every ObjectType a struct whose fields are typed handles of its members (`Variable<T>` with `T` from
 //! the DataType and ValueRank, `Method<(inputs), (outputs)>` from the Argument definitions, nested structs
 //! for object members whose declaration adds children, `Box<_>` around the handle of a member typed by another
-//! ObjectType (also when its declaration only repeats that type's members: one struct, not a copy per use), `Option<_>` for Optional members, `Placeholders<_>`
-//! for `<Placeholder>` members); the members of the nearest supertype that has a handle of its own are in
+//! ObjectType (also when its declaration only repeats that type's members: one struct, not a copy per use),
+//! `Option<_>` for Optional members, `Placeholders<_>` for `<Placeholder>` members); the members of the nearest supertype that has a handle of its own are in
 //! its `base` field, reached through `Deref`, so a subtype's handle reaches what it inherits. Supertypes
 //! without a handle (ns0's) have their members folded into the first generated subtype.
 //!
@@ -253,16 +253,19 @@ impl Gen<'_> {
         if self.handle_path(td, names).is_none() {
             return false;
         }
-        let of_type: Vec<(NodeIx, NodeIx)> = self
-            .model
-            .members
-            .get(&td)
-            .map(|ms| ms.iter().filter(|m| self.rule(m.node).is_some()).map(|m| (m.node, m.reference_type)).collect())
-            .unwrap_or_default();
         let (mut a, mut b) = (String::new(), String::new());
         self.members_signature(&self.decl_members(decl), 0, &mut a);
-        self.members_signature(&of_type, 0, &mut b);
+        self.members_signature(&self.type_members(td), 0, &mut b);
         a == b
+    }
+
+    /// The members of a type, inherited ones included, that instances get (those with a rule).
+    fn type_members(&self, t: NodeIx) -> Vec<(NodeIx, NodeIx)> {
+        self.model
+            .members
+            .get(&t)
+            .map(|ms| ms.iter().filter(|m| self.rule(m.node).is_some()).map(|m| (m.node, m.reference_type)).collect())
+            .unwrap_or_default()
     }
 
     /// What a list of members gives a handle, as text: per member in BrowseName order its name, class and
@@ -566,11 +569,7 @@ impl Gen<'_> {
         let mut markers = Vec::new();
         for (name, t) in ordered {
             let n = model.node(t);
-            let all: Vec<(NodeIx, NodeIx)> = model
-                .members
-                .get(&t)
-                .map(|ms| ms.iter().filter(|m| self.rule(m.node).is_some()).map(|m| (m.node, m.reference_type)).collect())
-                .unwrap_or_default();
+            let all = self.type_members(t);
             let mut text = format!("Handle of an instance of `{}` ({}).", n.browse_name.name, crate::resolve::display_id(model, &n.id));
             if let Some(d) = n.doc() {
                 text.push_str("\n\n");
