@@ -188,3 +188,22 @@ async fn binding_a_handle_to_the_wrong_node_says_why() {
     assert_eq!(again.node.id(), device.node.id());
     running.stop().await;
 }
+
+/// A subtype's member markers: those it inherits unchanged are its supertype's (re-exported, across
+/// namespaces), those it overrides are its own, and its REQUIRED list names the inherited ones too.
+#[test]
+fn subtype_markers_inherit_and_override() {
+    use di::objects::members::ComponentType as Component;
+    use robotics::objects::members::{AuxiliaryComponentType as Auxiliary, AxisType as Axis};
+    // Inherited from DI's ComponentType: the same constant, with DI's namespace in the path.
+    assert_eq!(Axis::SerialNumber.path, Component::SerialNumber.path);
+    assert_eq!(Axis::SerialNumber.path, &[(di::NAMESPACE_URI, "SerialNumber")]);
+    assert_eq!(Axis::AssetId.path, Component::AssetId.path);
+    // Robotics makes ProductCode mandatory on AuxiliaryComponentType; ComponentType has it optional.
+    assert!(!Component::ProductCode.mandatory);
+    assert!(Auxiliary::ProductCode.mandatory);
+    assert!(Auxiliary::REQUIRED.iter().any(|(p, _)| *p == "ProductCode"));
+    assert!(!Component::REQUIRED.iter().any(|(p, _)| *p == "ProductCode"));
+    // AxisType's own members are declared in its own module.
+    assert_eq!(Axis::ParameterSet__ActualPosition.path, &[(di::NAMESPACE_URI, "ParameterSet"), (robotics::NAMESPACE_URI, "ActualPosition")]);
+}

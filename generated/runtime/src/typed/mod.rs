@@ -168,19 +168,25 @@ macro_rules! __nodeset_ua_struct {
 pub use crate::__nodeset_ua_struct as ua_struct;
 
 /// Declares the member markers of an ObjectType (generated `members` modules use it): a module named
-/// after the handle with, for each variable member, a [`VariableMember`] constant given the marker name,
+/// after the handle that re-exports the markers of its supertype's module when one is given (`Owner: path;`;
+/// a marker declared here shadows the supertype's of that name), with, for each variable member declared
+/// here, a [`VariableMember`] constant given the marker name,
 /// the Rust scalar type, the ValueRank, the browse path as (index into `NS`, name) pairs, and whether it
 /// is mandatory, has a default value, and is writable; and `REQUIRED`, the mandatory variables without a
 /// default, with the message for a derive that leaves one unbound.
 #[doc(hidden)]
 #[macro_export]
 macro_rules! __nodeset_object_members {
-    ($owner:ident; required: [$(($rp:literal, $rm:literal)),* $(,)?]; $($m:ident: $scalar:ty, $rank:literal, [$($k:literal $name:literal),*], $mandatory:literal $default:literal $writable:literal;)*) => {
+    ($owner:ident $(: $base:path)?; required: [$(($rp:literal, $rm:literal)),* $(,)?]; $($m:ident: $scalar:ty, $rank:literal, [$($k:literal $name:literal),*], $mandatory:literal $default:literal $writable:literal;)*) => {
         #[doc = concat!(" Member markers of [`", stringify!($owner), "`](super::", stringify!($owner), ") for `nodeset-derive`.")]
         #[allow(non_upper_case_globals)]
         pub mod $owner {
             #[allow(unused_imports)]
             use super::super::{t, ua};
+            $(
+                #[doc(no_inline)]
+                pub use $base::*;
+            )?
             $(
                 #[doc = concat!(" The variable `", $($name, "/",)* "`.")]
                 pub const $m: $crate::typed::VariableMember<$scalar> = $crate::typed::VariableMember {

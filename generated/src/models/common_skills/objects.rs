@@ -770,7 +770,7 @@ pub mod members {
     #[allow(unused_imports)]
     use super::t;
     t::object_members! {
-        AbsoluteCartesianLinearMoveSkillType;
+        AbsoluteCartesianLinearMoveSkillType: super::MoveSkillType;
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
@@ -782,21 +782,10 @@ pub mod members {
             ("InputParameterSet/TargetPose", "the mandatory variable `InputParameterSet/TargetPose` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/TargetPose\")]"),
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
-        Deletable: bool, -1, [1 "Deletable"], true false false;
-        AutoDelete: bool, -1, [1 "AutoDelete"], true false false;
-        RecycleCount: i32, -1, [1 "RecycleCount"], true false false;
-        ProgramDiagnostic: ua::ExtensionObject, -1, [1 "ProgramDiagnostic"], false false false;
-        InputParameterSet__Speed: f64, -1, [0 "InputParameterSet", 0 "Speed"], true false true;
-        InputParameterSet__Acceleration: f64, -1, [0 "InputParameterSet", 0 "Acceleration"], true false true;
         InputParameterSet__TargetPose: ua::ThreeDFrame, -1, [0 "InputParameterSet", 0 "TargetPose"], true false true;
-        OutputParameterSet__Result: ua::StatusCode, -1, [0 "OutputParameterSet", 0 "Result"], true false false;
     }
     t::object_members! {
-        AbsoluteJointPtpMoveSkillType;
+        AbsoluteJointPtpMoveSkillType: super::MoveSkillType;
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
@@ -808,21 +797,10 @@ pub mod members {
             ("InputParameterSet/TargetJointPositions", "the mandatory variable `InputParameterSet/TargetJointPositions` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/TargetJointPositions\")]"),
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
-        Deletable: bool, -1, [1 "Deletable"], true false false;
-        AutoDelete: bool, -1, [1 "AutoDelete"], true false false;
-        RecycleCount: i32, -1, [1 "RecycleCount"], true false false;
-        ProgramDiagnostic: ua::ExtensionObject, -1, [1 "ProgramDiagnostic"], false false false;
-        InputParameterSet__Speed: f64, -1, [0 "InputParameterSet", 0 "Speed"], true false true;
-        InputParameterSet__Acceleration: f64, -1, [0 "InputParameterSet", 0 "Acceleration"], true false true;
         InputParameterSet__TargetJointPositions: f64, 1, [0 "InputParameterSet", 0 "TargetJointPositions"], true false true;
-        OutputParameterSet__Result: ua::StatusCode, -1, [0 "OutputParameterSet", 0 "Result"], true false false;
     }
     t::object_members! {
-        CompositeSkillType;
+        CompositeSkillType: super::ProgramSkillStateMachineType;
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
@@ -831,18 +809,9 @@ pub mod members {
             ("RecycleCount", "the mandatory variable `RecycleCount` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
-        Deletable: bool, -1, [1 "Deletable"], true false false;
-        AutoDelete: bool, -1, [1 "AutoDelete"], true false false;
-        RecycleCount: i32, -1, [1 "RecycleCount"], true false false;
-        ProgramDiagnostic: ua::ExtensionObject, -1, [1 "ProgramDiagnostic"], false false false;
-        OutputParameterSet__Result: ua::StatusCode, -1, [0 "OutputParameterSet", 0 "Result"], true false false;
     }
     t::object_members! {
-        GrippingSkillType;
+        GrippingSkillType: super::ProgramSkillStateMachineType;
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
@@ -853,24 +822,15 @@ pub mod members {
             ("InputParameterSet/GripForce", "the mandatory variable `InputParameterSet/GripForce` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/GripForce\")]"),
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
-        Deletable: bool, -1, [1 "Deletable"], true false false;
-        AutoDelete: bool, -1, [1 "AutoDelete"], true false false;
-        RecycleCount: i32, -1, [1 "RecycleCount"], true false false;
-        ProgramDiagnostic: ua::ExtensionObject, -1, [1 "ProgramDiagnostic"], false false false;
         InputParameterSet__Action: super::super::super::types::GripperActionEnumeration, -1, [0 "InputParameterSet", 0 "Action"], true false true;
         InputParameterSet__GripForce: f64, -1, [0 "InputParameterSet", 0 "GripForce"], true false true;
-        OutputParameterSet__Result: ua::StatusCode, -1, [0 "OutputParameterSet", 0 "Result"], true false false;
     }
     t::object_members! {
         ISkillSetType;
         required: [];
     }
     t::object_members! {
-        MoveSkillType;
+        MoveSkillType: super::ProgramSkillStateMachineType;
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
@@ -881,17 +841,8 @@ pub mod members {
             ("InputParameterSet/Acceleration", "the mandatory variable `InputParameterSet/Acceleration` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Acceleration\")]"),
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
-        Deletable: bool, -1, [1 "Deletable"], true false false;
-        AutoDelete: bool, -1, [1 "AutoDelete"], true false false;
-        RecycleCount: i32, -1, [1 "RecycleCount"], true false false;
-        ProgramDiagnostic: ua::ExtensionObject, -1, [1 "ProgramDiagnostic"], false false false;
         InputParameterSet__Speed: f64, -1, [0 "InputParameterSet", 0 "Speed"], true false true;
         InputParameterSet__Acceleration: f64, -1, [0 "InputParameterSet", 0 "Acceleration"], true false true;
-        OutputParameterSet__Result: ua::StatusCode, -1, [0 "OutputParameterSet", 0 "Result"], true false false;
     }
     t::object_members! {
         ProgramSkillStateMachineType;
@@ -914,7 +865,7 @@ pub mod members {
         OutputParameterSet__Result: ua::StatusCode, -1, [0 "OutputParameterSet", 0 "Result"], true false false;
     }
     t::object_members! {
-        RelativeCartesianLinearMoveSkillType;
+        RelativeCartesianLinearMoveSkillType: super::MoveSkillType;
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
@@ -926,18 +877,7 @@ pub mod members {
             ("InputParameterSet/PoseOffset", "the mandatory variable `InputParameterSet/PoseOffset` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/PoseOffset\")]"),
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
-        Deletable: bool, -1, [1 "Deletable"], true false false;
-        AutoDelete: bool, -1, [1 "AutoDelete"], true false false;
-        RecycleCount: i32, -1, [1 "RecycleCount"], true false false;
-        ProgramDiagnostic: ua::ExtensionObject, -1, [1 "ProgramDiagnostic"], false false false;
-        InputParameterSet__Speed: f64, -1, [0 "InputParameterSet", 0 "Speed"], true false true;
-        InputParameterSet__Acceleration: f64, -1, [0 "InputParameterSet", 0 "Acceleration"], true false true;
         InputParameterSet__PoseOffset: ua::ThreeDFrame, -1, [0 "InputParameterSet", 0 "PoseOffset"], true false true;
-        OutputParameterSet__Result: ua::StatusCode, -1, [0 "OutputParameterSet", 0 "Result"], true false false;
     }
     t::object_members! {
         SkillTransitionEventType;

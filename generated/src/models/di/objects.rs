@@ -2194,13 +2194,8 @@ pub mod members {
         required: [];
     }
     t::object_members! {
-        BlockType;
+        BlockType: super::TopologyElementType;
         required: [];
-        Identification__UIElement: ua::Variant, -1, [0 "Identification", 0 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [0 "Lock", 0 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [0 "Lock", 0 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [0 "Lock", 0 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [0 "Lock", 0 "RemainingLockTime"], false false false;
         RevisionCounter: i32, -1, [0 "RevisionCounter"], false false false;
         ActualMode: ua::LocalizedText, -1, [0 "ActualMode"], false false false;
         PermittedMode: ua::LocalizedText, 1, [0 "PermittedMode"], false false false;
@@ -2208,7 +2203,7 @@ pub mod members {
         TargetMode: ua::LocalizedText, 1, [0 "TargetMode"], false false false;
     }
     t::object_members! {
-        CachedLoadingType;
+        CachedLoadingType: super::PackageLoadingType;
         required: [
             ("CurrentVersion/Manufacturer", "the mandatory variable `CurrentVersion/Manufacturer` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/Manufacturer\")]"),
             ("CurrentVersion/ManufacturerUri", "the mandatory variable `CurrentVersion/ManufacturerUri` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/ManufacturerUri\")]"),
@@ -2219,17 +2214,6 @@ pub mod members {
             ("PendingVersion/ManufacturerUri", "the mandatory variable `PendingVersion/ManufacturerUri` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"PendingVersion/ManufacturerUri\")]"),
             ("PendingVersion/SoftwareRevision", "the mandatory variable `PendingVersion/SoftwareRevision` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"PendingVersion/SoftwareRevision\")]"),
         ];
-        UpdateKey: String, -1, [0 "UpdateKey"], false false false;
-        CurrentVersion__Manufacturer: ua::LocalizedText, -1, [0 "CurrentVersion", 0 "Manufacturer"], true false false;
-        CurrentVersion__ManufacturerUri: String, -1, [0 "CurrentVersion", 0 "ManufacturerUri"], true false false;
-        CurrentVersion__SoftwareRevision: String, -1, [0 "CurrentVersion", 0 "SoftwareRevision"], true false false;
-        CurrentVersion__PatchIdentifiers: String, 1, [0 "CurrentVersion", 0 "PatchIdentifiers"], false false false;
-        CurrentVersion__ReleaseDate: ua::DateTime, -1, [0 "CurrentVersion", 0 "ReleaseDate"], false false false;
-        CurrentVersion__ChangeLogReference: String, -1, [0 "CurrentVersion", 0 "ChangeLogReference"], false false false;
-        CurrentVersion__Hash: ua::ByteString, -1, [0 "CurrentVersion", 0 "Hash"], false false false;
-        FileTransfer__ClientProcessingTimeout: f64, -1, [0 "FileTransfer", 1 "ClientProcessingTimeout"], true false false;
-        ErrorMessage: ua::LocalizedText, -1, [0 "ErrorMessage"], true false false;
-        WriteBlockSize: u32, -1, [0 "WriteBlockSize"], false false false;
         PendingVersion__Manufacturer: ua::LocalizedText, -1, [0 "PendingVersion", 0 "Manufacturer"], true false false;
         PendingVersion__ManufacturerUri: String, -1, [0 "PendingVersion", 0 "ManufacturerUri"], true false false;
         PendingVersion__SoftwareRevision: String, -1, [0 "PendingVersion", 0 "SoftwareRevision"], true false false;
@@ -2246,7 +2230,7 @@ pub mod members {
         FallbackVersion__Hash: ua::ByteString, -1, [0 "FallbackVersion", 0 "Hash"], false false false;
     }
     t::object_members! {
-        CheckFunctionAlarmType;
+        CheckFunctionAlarmType: super::DeviceHealthDiagnosticAlarmType;
         required: [
             ("EventId", "the mandatory variable `EventId` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
             ("EventType", "the mandatory variable `EventType` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
@@ -2272,59 +2256,10 @@ pub mod members {
             ("SuppressedOrShelved", "the mandatory variable `SuppressedOrShelved` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SuppressedOrShelved\")]"),
             ("NormalState", "the mandatory variable `NormalState` of CheckFunctionAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NormalState\")]"),
         ];
-        EventId: ua::ByteString, -1, [1 "EventId"], true false false;
-        EventType: ua::NodeId, -1, [1 "EventType"], true false false;
-        SourceNode: ua::NodeId, -1, [1 "SourceNode"], true false false;
-        SourceName: String, -1, [1 "SourceName"], true false false;
-        Time: ua::DateTime, -1, [1 "Time"], true false false;
-        ReceiveTime: ua::DateTime, -1, [1 "ReceiveTime"], true false false;
-        LocalTime: ua::TimeZoneDataType, -1, [1 "LocalTime"], false false false;
-        Message: ua::LocalizedText, -1, [1 "Message"], true false false;
-        Severity: u16, -1, [1 "Severity"], true false false;
-        ConditionClassId: ua::NodeId, -1, [1 "ConditionClassId"], true false false;
-        ConditionClassName: ua::LocalizedText, -1, [1 "ConditionClassName"], true false false;
-        ConditionSubClassId: ua::NodeId, 1, [1 "ConditionSubClassId"], false false false;
-        ConditionSubClassName: ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
-        ConditionName: String, -1, [1 "ConditionName"], true false false;
-        BranchId: ua::NodeId, -1, [1 "BranchId"], true false false;
-        Retain: bool, -1, [1 "Retain"], true false false;
-        EnabledState: ua::LocalizedText, -1, [1 "EnabledState"], true false false;
-        Quality: ua::StatusCode, -1, [1 "Quality"], true false false;
-        LastSeverity: u16, -1, [1 "LastSeverity"], true false false;
-        Comment: ua::LocalizedText, -1, [1 "Comment"], true false false;
-        ClientUserId: String, -1, [1 "ClientUserId"], true false false;
-        AckedState: ua::LocalizedText, -1, [1 "AckedState"], true false false;
-        ConfirmedState: ua::LocalizedText, -1, [1 "ConfirmedState"], false false false;
-        ActiveState: ua::LocalizedText, -1, [1 "ActiveState"], true false false;
-        InputNode: ua::NodeId, -1, [1 "InputNode"], true false false;
-        SuppressedState: ua::LocalizedText, -1, [1 "SuppressedState"], false false false;
-        OutOfServiceState: ua::LocalizedText, -1, [1 "OutOfServiceState"], false false false;
-        ShelvingState__CurrentState: ua::LocalizedText, -1, [1 "ShelvingState", 1 "CurrentState"], false false false;
-        ShelvingState__LastTransition: ua::LocalizedText, -1, [1 "ShelvingState", 1 "LastTransition"], false false false;
-        ShelvingState__AvailableStates: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableStates"], false false false;
-        ShelvingState__AvailableTransitions: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableTransitions"], false false false;
-        ShelvingState__UnshelveTime: f64, -1, [1 "ShelvingState", 1 "UnshelveTime"], false false false;
-        SuppressedOrShelved: bool, -1, [1 "SuppressedOrShelved"], true false false;
-        MaxTimeShelved: f64, -1, [1 "MaxTimeShelved"], false false false;
-        AudibleEnabled: bool, -1, [1 "AudibleEnabled"], false false false;
-        AudibleSound: ua::ByteString, -1, [1 "AudibleSound"], false false false;
-        SilenceState: ua::LocalizedText, -1, [1 "SilenceState"], false false false;
-        OnDelay: f64, -1, [1 "OnDelay"], false false false;
-        OffDelay: f64, -1, [1 "OffDelay"], false false false;
-        FirstInGroupFlag: bool, -1, [1 "FirstInGroupFlag"], false false false;
-        LatchedState: ua::LocalizedText, -1, [1 "LatchedState"], false false false;
-        ReAlarmTime: f64, -1, [1 "ReAlarmTime"], false false false;
-        ReAlarmRepeatCount: i16, -1, [1 "ReAlarmRepeatCount"], false false false;
-        NormalState: ua::NodeId, -1, [1 "NormalState"], true false false;
     }
     t::object_members! {
-        ComponentType;
+        ComponentType: super::TopologyElementType;
         required: [];
-        Identification__UIElement: ua::Variant, -1, [0 "Identification", 0 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [0 "Lock", 0 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [0 "Lock", 0 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [0 "Lock", 0 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [0 "Lock", 0 "RemainingLockTime"], false false false;
         Manufacturer: ua::LocalizedText, -1, [0 "Manufacturer"], false false false;
         ManufacturerUri: String, -1, [0 "ManufacturerUri"], false false false;
         Model: ua::LocalizedText, -1, [0 "Model"], false false false;
@@ -2357,13 +2292,8 @@ pub mod members {
         ConfirmationTimeout: f64, -1, [0 "ConfirmationTimeout"], true false false;
     }
     t::object_members! {
-        ConnectionPointType;
+        ConnectionPointType: super::TopologyElementType;
         required: [];
-        Identification__UIElement: ua::Variant, -1, [0 "Identification", 0 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [0 "Lock", 0 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [0 "Lock", 0 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [0 "Lock", 0 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [0 "Lock", 0 "RemainingLockTime"], false false false;
         NetworkAddress__UIElement: ua::Variant, -1, [0 "NetworkAddress", 0 "UIElement"], false false false;
     }
     t::object_members! {
@@ -2439,7 +2369,7 @@ pub mod members {
         NormalState: ua::NodeId, -1, [1 "NormalState"], true false false;
     }
     t::object_members! {
-        DeviceType;
+        DeviceType: super::ComponentType;
         required: [
             ("Manufacturer", "the mandatory variable `Manufacturer` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
             ("Model", "the mandatory variable `Model` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
@@ -2450,33 +2380,22 @@ pub mod members {
             ("SerialNumber", "the mandatory variable `SerialNumber` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
             ("RevisionCounter", "the mandatory variable `RevisionCounter` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RevisionCounter\")]"),
         ];
-        Identification__UIElement: ua::Variant, -1, [0 "Identification", 0 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [0 "Lock", 0 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [0 "Lock", 0 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [0 "Lock", 0 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [0 "Lock", 0 "RemainingLockTime"], false false false;
         Manufacturer: ua::LocalizedText, -1, [0 "Manufacturer"], true false false;
-        ManufacturerUri: String, -1, [0 "ManufacturerUri"], false false false;
         Model: ua::LocalizedText, -1, [0 "Model"], true false false;
         HardwareRevision: String, -1, [0 "HardwareRevision"], true false false;
         SoftwareRevision: String, -1, [0 "SoftwareRevision"], true false false;
         DeviceRevision: String, -1, [0 "DeviceRevision"], true false false;
-        ProductCode: String, -1, [0 "ProductCode"], false false false;
         DeviceManual: String, -1, [0 "DeviceManual"], true false false;
-        DeviceClass: String, -1, [0 "DeviceClass"], false false false;
         SerialNumber: String, -1, [0 "SerialNumber"], true false false;
-        ProductInstanceUri: String, -1, [0 "ProductInstanceUri"], false false false;
         RevisionCounter: i32, -1, [0 "RevisionCounter"], true false false;
-        AssetId: String, -1, [0 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [0 "ComponentName"], false false false;
         DeviceHealth: super::super::super::types::DeviceHealthEnumeration, -1, [0 "DeviceHealth"], false false false;
     }
     t::object_members! {
-        DiameterIndicationType;
+        DiameterIndicationType: super::BaseLifetimeIndicationType;
         required: [];
     }
     t::object_members! {
-        DirectLoadingType;
+        DirectLoadingType: super::PackageLoadingType;
         required: [
             ("CurrentVersion/Manufacturer", "the mandatory variable `CurrentVersion/Manufacturer` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/Manufacturer\")]"),
             ("CurrentVersion/ManufacturerUri", "the mandatory variable `CurrentVersion/ManufacturerUri` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/ManufacturerUri\")]"),
@@ -2485,22 +2404,11 @@ pub mod members {
             ("ErrorMessage", "the mandatory variable `ErrorMessage` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ErrorMessage\")]"),
             ("UpdateBehavior", "the mandatory variable `UpdateBehavior` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"UpdateBehavior\")]"),
         ];
-        UpdateKey: String, -1, [0 "UpdateKey"], false false false;
-        CurrentVersion__Manufacturer: ua::LocalizedText, -1, [0 "CurrentVersion", 0 "Manufacturer"], true false false;
-        CurrentVersion__ManufacturerUri: String, -1, [0 "CurrentVersion", 0 "ManufacturerUri"], true false false;
-        CurrentVersion__SoftwareRevision: String, -1, [0 "CurrentVersion", 0 "SoftwareRevision"], true false false;
-        CurrentVersion__PatchIdentifiers: String, 1, [0 "CurrentVersion", 0 "PatchIdentifiers"], false false false;
-        CurrentVersion__ReleaseDate: ua::DateTime, -1, [0 "CurrentVersion", 0 "ReleaseDate"], false false false;
-        CurrentVersion__ChangeLogReference: String, -1, [0 "CurrentVersion", 0 "ChangeLogReference"], false false false;
-        CurrentVersion__Hash: ua::ByteString, -1, [0 "CurrentVersion", 0 "Hash"], false false false;
-        FileTransfer__ClientProcessingTimeout: f64, -1, [0 "FileTransfer", 1 "ClientProcessingTimeout"], true false false;
-        ErrorMessage: ua::LocalizedText, -1, [0 "ErrorMessage"], true false false;
-        WriteBlockSize: u32, -1, [0 "WriteBlockSize"], false false false;
         UpdateBehavior: super::super::super::types::UpdateBehavior, -1, [0 "UpdateBehavior"], true false false;
         WriteTimeout: f64, -1, [0 "WriteTimeout"], false false false;
     }
     t::object_members! {
-        FailureAlarmType;
+        FailureAlarmType: super::DeviceHealthDiagnosticAlarmType;
         required: [
             ("EventId", "the mandatory variable `EventId` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
             ("EventType", "the mandatory variable `EventType` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
@@ -2526,55 +2434,10 @@ pub mod members {
             ("SuppressedOrShelved", "the mandatory variable `SuppressedOrShelved` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SuppressedOrShelved\")]"),
             ("NormalState", "the mandatory variable `NormalState` of FailureAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NormalState\")]"),
         ];
-        EventId: ua::ByteString, -1, [1 "EventId"], true false false;
-        EventType: ua::NodeId, -1, [1 "EventType"], true false false;
-        SourceNode: ua::NodeId, -1, [1 "SourceNode"], true false false;
-        SourceName: String, -1, [1 "SourceName"], true false false;
-        Time: ua::DateTime, -1, [1 "Time"], true false false;
-        ReceiveTime: ua::DateTime, -1, [1 "ReceiveTime"], true false false;
-        LocalTime: ua::TimeZoneDataType, -1, [1 "LocalTime"], false false false;
-        Message: ua::LocalizedText, -1, [1 "Message"], true false false;
-        Severity: u16, -1, [1 "Severity"], true false false;
-        ConditionClassId: ua::NodeId, -1, [1 "ConditionClassId"], true false false;
-        ConditionClassName: ua::LocalizedText, -1, [1 "ConditionClassName"], true false false;
-        ConditionSubClassId: ua::NodeId, 1, [1 "ConditionSubClassId"], false false false;
-        ConditionSubClassName: ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
-        ConditionName: String, -1, [1 "ConditionName"], true false false;
-        BranchId: ua::NodeId, -1, [1 "BranchId"], true false false;
-        Retain: bool, -1, [1 "Retain"], true false false;
-        EnabledState: ua::LocalizedText, -1, [1 "EnabledState"], true false false;
-        Quality: ua::StatusCode, -1, [1 "Quality"], true false false;
-        LastSeverity: u16, -1, [1 "LastSeverity"], true false false;
-        Comment: ua::LocalizedText, -1, [1 "Comment"], true false false;
-        ClientUserId: String, -1, [1 "ClientUserId"], true false false;
-        AckedState: ua::LocalizedText, -1, [1 "AckedState"], true false false;
-        ConfirmedState: ua::LocalizedText, -1, [1 "ConfirmedState"], false false false;
-        ActiveState: ua::LocalizedText, -1, [1 "ActiveState"], true false false;
-        InputNode: ua::NodeId, -1, [1 "InputNode"], true false false;
-        SuppressedState: ua::LocalizedText, -1, [1 "SuppressedState"], false false false;
-        OutOfServiceState: ua::LocalizedText, -1, [1 "OutOfServiceState"], false false false;
-        ShelvingState__CurrentState: ua::LocalizedText, -1, [1 "ShelvingState", 1 "CurrentState"], false false false;
-        ShelvingState__LastTransition: ua::LocalizedText, -1, [1 "ShelvingState", 1 "LastTransition"], false false false;
-        ShelvingState__AvailableStates: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableStates"], false false false;
-        ShelvingState__AvailableTransitions: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableTransitions"], false false false;
-        ShelvingState__UnshelveTime: f64, -1, [1 "ShelvingState", 1 "UnshelveTime"], false false false;
-        SuppressedOrShelved: bool, -1, [1 "SuppressedOrShelved"], true false false;
-        MaxTimeShelved: f64, -1, [1 "MaxTimeShelved"], false false false;
-        AudibleEnabled: bool, -1, [1 "AudibleEnabled"], false false false;
-        AudibleSound: ua::ByteString, -1, [1 "AudibleSound"], false false false;
-        SilenceState: ua::LocalizedText, -1, [1 "SilenceState"], false false false;
-        OnDelay: f64, -1, [1 "OnDelay"], false false false;
-        OffDelay: f64, -1, [1 "OffDelay"], false false false;
-        FirstInGroupFlag: bool, -1, [1 "FirstInGroupFlag"], false false false;
-        LatchedState: ua::LocalizedText, -1, [1 "LatchedState"], false false false;
-        ReAlarmTime: f64, -1, [1 "ReAlarmTime"], false false false;
-        ReAlarmRepeatCount: i16, -1, [1 "ReAlarmRepeatCount"], false false false;
-        NormalState: ua::NodeId, -1, [1 "NormalState"], true false false;
     }
     t::object_members! {
-        FileSystemLoadingType;
+        FileSystemLoadingType: super::SoftwareLoadingType;
         required: [];
-        UpdateKey: String, -1, [0 "UpdateKey"], false false false;
     }
     t::object_members! {
         FunctionalGroupType;
@@ -2643,7 +2506,7 @@ pub mod members {
         InstallationDelay: f64, -1, [0 "InstallationDelay"], false false false;
     }
     t::object_members! {
-        LengthIndicationType;
+        LengthIndicationType: super::BaseLifetimeIndicationType;
         required: [];
     }
     t::object_members! {
@@ -2660,7 +2523,7 @@ pub mod members {
         RemainingLockTime: f64, -1, [0 "RemainingLockTime"], true false false;
     }
     t::object_members! {
-        MaintenanceRequiredAlarmType;
+        MaintenanceRequiredAlarmType: super::DeviceHealthDiagnosticAlarmType;
         required: [
             ("EventId", "the mandatory variable `EventId` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
             ("EventType", "the mandatory variable `EventType` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
@@ -2686,50 +2549,6 @@ pub mod members {
             ("SuppressedOrShelved", "the mandatory variable `SuppressedOrShelved` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SuppressedOrShelved\")]"),
             ("NormalState", "the mandatory variable `NormalState` of MaintenanceRequiredAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NormalState\")]"),
         ];
-        EventId: ua::ByteString, -1, [1 "EventId"], true false false;
-        EventType: ua::NodeId, -1, [1 "EventType"], true false false;
-        SourceNode: ua::NodeId, -1, [1 "SourceNode"], true false false;
-        SourceName: String, -1, [1 "SourceName"], true false false;
-        Time: ua::DateTime, -1, [1 "Time"], true false false;
-        ReceiveTime: ua::DateTime, -1, [1 "ReceiveTime"], true false false;
-        LocalTime: ua::TimeZoneDataType, -1, [1 "LocalTime"], false false false;
-        Message: ua::LocalizedText, -1, [1 "Message"], true false false;
-        Severity: u16, -1, [1 "Severity"], true false false;
-        ConditionClassId: ua::NodeId, -1, [1 "ConditionClassId"], true false false;
-        ConditionClassName: ua::LocalizedText, -1, [1 "ConditionClassName"], true false false;
-        ConditionSubClassId: ua::NodeId, 1, [1 "ConditionSubClassId"], false false false;
-        ConditionSubClassName: ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
-        ConditionName: String, -1, [1 "ConditionName"], true false false;
-        BranchId: ua::NodeId, -1, [1 "BranchId"], true false false;
-        Retain: bool, -1, [1 "Retain"], true false false;
-        EnabledState: ua::LocalizedText, -1, [1 "EnabledState"], true false false;
-        Quality: ua::StatusCode, -1, [1 "Quality"], true false false;
-        LastSeverity: u16, -1, [1 "LastSeverity"], true false false;
-        Comment: ua::LocalizedText, -1, [1 "Comment"], true false false;
-        ClientUserId: String, -1, [1 "ClientUserId"], true false false;
-        AckedState: ua::LocalizedText, -1, [1 "AckedState"], true false false;
-        ConfirmedState: ua::LocalizedText, -1, [1 "ConfirmedState"], false false false;
-        ActiveState: ua::LocalizedText, -1, [1 "ActiveState"], true false false;
-        InputNode: ua::NodeId, -1, [1 "InputNode"], true false false;
-        SuppressedState: ua::LocalizedText, -1, [1 "SuppressedState"], false false false;
-        OutOfServiceState: ua::LocalizedText, -1, [1 "OutOfServiceState"], false false false;
-        ShelvingState__CurrentState: ua::LocalizedText, -1, [1 "ShelvingState", 1 "CurrentState"], false false false;
-        ShelvingState__LastTransition: ua::LocalizedText, -1, [1 "ShelvingState", 1 "LastTransition"], false false false;
-        ShelvingState__AvailableStates: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableStates"], false false false;
-        ShelvingState__AvailableTransitions: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableTransitions"], false false false;
-        ShelvingState__UnshelveTime: f64, -1, [1 "ShelvingState", 1 "UnshelveTime"], false false false;
-        SuppressedOrShelved: bool, -1, [1 "SuppressedOrShelved"], true false false;
-        MaxTimeShelved: f64, -1, [1 "MaxTimeShelved"], false false false;
-        AudibleEnabled: bool, -1, [1 "AudibleEnabled"], false false false;
-        AudibleSound: ua::ByteString, -1, [1 "AudibleSound"], false false false;
-        SilenceState: ua::LocalizedText, -1, [1 "SilenceState"], false false false;
-        OnDelay: f64, -1, [1 "OnDelay"], false false false;
-        OffDelay: f64, -1, [1 "OffDelay"], false false false;
-        FirstInGroupFlag: bool, -1, [1 "FirstInGroupFlag"], false false false;
-        LatchedState: ua::LocalizedText, -1, [1 "LatchedState"], false false false;
-        ReAlarmTime: f64, -1, [1 "ReAlarmTime"], false false false;
-        ReAlarmRepeatCount: i16, -1, [1 "ReAlarmRepeatCount"], false false false;
-        NormalState: ua::NodeId, -1, [1 "NormalState"], true false false;
     }
     t::object_members! {
         NetworkType;
@@ -2740,15 +2559,15 @@ pub mod members {
         Lock__RemainingLockTime: f64, -1, [0 "Lock", 0 "RemainingLockTime"], false false false;
     }
     t::object_members! {
-        NumberOfPartsIndicationType;
+        NumberOfPartsIndicationType: super::BaseLifetimeIndicationType;
         required: [];
     }
     t::object_members! {
-        NumberOfUsagesIndicationType;
+        NumberOfUsagesIndicationType: super::BaseLifetimeIndicationType;
         required: [];
     }
     t::object_members! {
-        OffSpecAlarmType;
+        OffSpecAlarmType: super::DeviceHealthDiagnosticAlarmType;
         required: [
             ("EventId", "the mandatory variable `EventId` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
             ("EventType", "the mandatory variable `EventType` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
@@ -2774,53 +2593,9 @@ pub mod members {
             ("SuppressedOrShelved", "the mandatory variable `SuppressedOrShelved` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SuppressedOrShelved\")]"),
             ("NormalState", "the mandatory variable `NormalState` of OffSpecAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NormalState\")]"),
         ];
-        EventId: ua::ByteString, -1, [1 "EventId"], true false false;
-        EventType: ua::NodeId, -1, [1 "EventType"], true false false;
-        SourceNode: ua::NodeId, -1, [1 "SourceNode"], true false false;
-        SourceName: String, -1, [1 "SourceName"], true false false;
-        Time: ua::DateTime, -1, [1 "Time"], true false false;
-        ReceiveTime: ua::DateTime, -1, [1 "ReceiveTime"], true false false;
-        LocalTime: ua::TimeZoneDataType, -1, [1 "LocalTime"], false false false;
-        Message: ua::LocalizedText, -1, [1 "Message"], true false false;
-        Severity: u16, -1, [1 "Severity"], true false false;
-        ConditionClassId: ua::NodeId, -1, [1 "ConditionClassId"], true false false;
-        ConditionClassName: ua::LocalizedText, -1, [1 "ConditionClassName"], true false false;
-        ConditionSubClassId: ua::NodeId, 1, [1 "ConditionSubClassId"], false false false;
-        ConditionSubClassName: ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
-        ConditionName: String, -1, [1 "ConditionName"], true false false;
-        BranchId: ua::NodeId, -1, [1 "BranchId"], true false false;
-        Retain: bool, -1, [1 "Retain"], true false false;
-        EnabledState: ua::LocalizedText, -1, [1 "EnabledState"], true false false;
-        Quality: ua::StatusCode, -1, [1 "Quality"], true false false;
-        LastSeverity: u16, -1, [1 "LastSeverity"], true false false;
-        Comment: ua::LocalizedText, -1, [1 "Comment"], true false false;
-        ClientUserId: String, -1, [1 "ClientUserId"], true false false;
-        AckedState: ua::LocalizedText, -1, [1 "AckedState"], true false false;
-        ConfirmedState: ua::LocalizedText, -1, [1 "ConfirmedState"], false false false;
-        ActiveState: ua::LocalizedText, -1, [1 "ActiveState"], true false false;
-        InputNode: ua::NodeId, -1, [1 "InputNode"], true false false;
-        SuppressedState: ua::LocalizedText, -1, [1 "SuppressedState"], false false false;
-        OutOfServiceState: ua::LocalizedText, -1, [1 "OutOfServiceState"], false false false;
-        ShelvingState__CurrentState: ua::LocalizedText, -1, [1 "ShelvingState", 1 "CurrentState"], false false false;
-        ShelvingState__LastTransition: ua::LocalizedText, -1, [1 "ShelvingState", 1 "LastTransition"], false false false;
-        ShelvingState__AvailableStates: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableStates"], false false false;
-        ShelvingState__AvailableTransitions: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableTransitions"], false false false;
-        ShelvingState__UnshelveTime: f64, -1, [1 "ShelvingState", 1 "UnshelveTime"], false false false;
-        SuppressedOrShelved: bool, -1, [1 "SuppressedOrShelved"], true false false;
-        MaxTimeShelved: f64, -1, [1 "MaxTimeShelved"], false false false;
-        AudibleEnabled: bool, -1, [1 "AudibleEnabled"], false false false;
-        AudibleSound: ua::ByteString, -1, [1 "AudibleSound"], false false false;
-        SilenceState: ua::LocalizedText, -1, [1 "SilenceState"], false false false;
-        OnDelay: f64, -1, [1 "OnDelay"], false false false;
-        OffDelay: f64, -1, [1 "OffDelay"], false false false;
-        FirstInGroupFlag: bool, -1, [1 "FirstInGroupFlag"], false false false;
-        LatchedState: ua::LocalizedText, -1, [1 "LatchedState"], false false false;
-        ReAlarmTime: f64, -1, [1 "ReAlarmTime"], false false false;
-        ReAlarmRepeatCount: i16, -1, [1 "ReAlarmRepeatCount"], false false false;
-        NormalState: ua::NodeId, -1, [1 "NormalState"], true false false;
     }
     t::object_members! {
-        PackageLoadingType;
+        PackageLoadingType: super::SoftwareLoadingType;
         required: [
             ("CurrentVersion/Manufacturer", "the mandatory variable `CurrentVersion/Manufacturer` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/Manufacturer\")]"),
             ("CurrentVersion/ManufacturerUri", "the mandatory variable `CurrentVersion/ManufacturerUri` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/ManufacturerUri\")]"),
@@ -2828,7 +2603,6 @@ pub mod members {
             ("FileTransfer/ClientProcessingTimeout", "the mandatory variable `FileTransfer/ClientProcessingTimeout` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"FileTransfer/ClientProcessingTimeout\")]"),
             ("ErrorMessage", "the mandatory variable `ErrorMessage` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ErrorMessage\")]"),
         ];
-        UpdateKey: String, -1, [0 "UpdateKey"], false false false;
         CurrentVersion__Manufacturer: ua::LocalizedText, -1, [0 "CurrentVersion", 0 "Manufacturer"], true false false;
         CurrentVersion__ManufacturerUri: String, -1, [0 "CurrentVersion", 0 "ManufacturerUri"], true false false;
         CurrentVersion__SoftwareRevision: String, -1, [0 "CurrentVersion", 0 "SoftwareRevision"], true false false;
@@ -2878,31 +2652,15 @@ pub mod members {
         UpdateKey: String, -1, [0 "UpdateKey"], false false false;
     }
     t::object_members! {
-        SoftwareType;
+        SoftwareType: super::ComponentType;
         required: [
             ("Manufacturer", "the mandatory variable `Manufacturer` of SoftwareType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
             ("Model", "the mandatory variable `Model` of SoftwareType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
             ("SoftwareRevision", "the mandatory variable `SoftwareRevision` of SoftwareType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SoftwareRevision\")]"),
         ];
-        Identification__UIElement: ua::Variant, -1, [0 "Identification", 0 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [0 "Lock", 0 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [0 "Lock", 0 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [0 "Lock", 0 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [0 "Lock", 0 "RemainingLockTime"], false false false;
         Manufacturer: ua::LocalizedText, -1, [0 "Manufacturer"], true false false;
-        ManufacturerUri: String, -1, [0 "ManufacturerUri"], false false false;
         Model: ua::LocalizedText, -1, [0 "Model"], true false false;
-        HardwareRevision: String, -1, [0 "HardwareRevision"], false false false;
         SoftwareRevision: String, -1, [0 "SoftwareRevision"], true false false;
-        DeviceRevision: String, -1, [0 "DeviceRevision"], false false false;
-        ProductCode: String, -1, [0 "ProductCode"], false false false;
-        DeviceManual: String, -1, [0 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [0 "DeviceClass"], false false false;
-        SerialNumber: String, -1, [0 "SerialNumber"], false false false;
-        ProductInstanceUri: String, -1, [0 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [0 "RevisionCounter"], false false false;
-        AssetId: String, -1, [0 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [0 "ComponentName"], false false false;
     }
     t::object_members! {
         SoftwareUpdateType;
@@ -2952,11 +2710,11 @@ pub mod members {
         Hash: ua::ByteString, -1, [0 "Hash"], false false false;
     }
     t::object_members! {
-        SubstanceVolumeIndicationType;
+        SubstanceVolumeIndicationType: super::BaseLifetimeIndicationType;
         required: [];
     }
     t::object_members! {
-        TimeIndicationType;
+        TimeIndicationType: super::BaseLifetimeIndicationType;
         required: [];
     }
     t::object_members! {

@@ -276,7 +276,7 @@ pub mod members {
     #[allow(unused_imports)]
     use super::t;
     t::object_members! {
-        DrillHoleSkillType;
+        DrillHoleSkillType: super::super::super::super::common_skills::objects::members::CompositeSkillType;
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
@@ -291,21 +291,12 @@ pub mod members {
             ("InputParameterSet/ClampForce", "the mandatory variable `InputParameterSet/ClampForce` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/ClampForce\")]"),
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
-        Deletable: bool, -1, [2 "Deletable"], true false false;
-        AutoDelete: bool, -1, [2 "AutoDelete"], true false false;
-        RecycleCount: i32, -1, [2 "RecycleCount"], true false false;
-        ProgramDiagnostic: ua::ExtensionObject, -1, [2 "ProgramDiagnostic"], false false false;
         InputParameterSet__InsertionDistance: f64, -1, [1 "InputParameterSet", 0 "InsertionDistance"], true false true;
         InputParameterSet__HoleDiameter: f64, -1, [1 "InputParameterSet", 0 "HoleDiameter"], true false true;
         InputParameterSet__Depth: f64, -1, [1 "InputParameterSet", 0 "Depth"], true false true;
         InputParameterSet__FeedRate: f64, -1, [1 "InputParameterSet", 0 "FeedRate"], true false true;
         InputParameterSet__SpindleSpeed: f64, -1, [1 "InputParameterSet", 0 "SpindleSpeed"], true false true;
         InputParameterSet__ClampForce: f64, -1, [1 "InputParameterSet", 0 "ClampForce"], true false true;
-        OutputParameterSet__Result: ua::StatusCode, -1, [1 "OutputParameterSet", 1 "Result"], true false false;
     }
     t::object_members! {
         DrillingCellType;
@@ -361,7 +352,7 @@ pub mod members {
         SkillSet__DrillHole__OutputParameterSet__Result: ua::StatusCode, -1, [1 "SkillSet", 0 "DrillHole", 1 "OutputParameterSet", 1 "Result"], true false false;
     }
     t::object_members! {
-        ReferenceDrillBushSkillType;
+        ReferenceDrillBushSkillType: super::super::super::super::common_skills::objects::members::CompositeSkillType;
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
@@ -373,17 +364,8 @@ pub mod members {
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
             ("OutputParameterSet/ReferencedHolePosition", "the mandatory variable `OutputParameterSet/ReferencedHolePosition` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/ReferencedHolePosition\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
-        Deletable: bool, -1, [2 "Deletable"], true false false;
-        AutoDelete: bool, -1, [2 "AutoDelete"], true false false;
-        RecycleCount: i32, -1, [2 "RecycleCount"], true false false;
-        ProgramDiagnostic: ua::ExtensionObject, -1, [2 "ProgramDiagnostic"], false false false;
         InputParameterSet__HolePosition: ua::ThreeDFrame, -1, [1 "InputParameterSet", 0 "HolePosition"], true false true;
         InputParameterSet__ApproachDistance: f64, -1, [1 "InputParameterSet", 0 "ApproachDistance"], true false true;
-        OutputParameterSet__Result: ua::StatusCode, -1, [1 "OutputParameterSet", 1 "Result"], true false false;
         OutputParameterSet__ReferencedHolePosition: ua::ThreeDFrame, -1, [1 "OutputParameterSet", 0 "ReferencedHolePosition"], true false false;
     }
 }

@@ -773,19 +773,17 @@ pub mod members {
         SignalOn: bool, -1, [0 "SignalOn"], true false true;
     }
     t::object_members! {
-        DynamicCalibrationTargetCategoryType;
+        DynamicCalibrationTargetCategoryType: super::BaseCalibrationTargetCategoryType;
         required: [];
     }
     t::object_members! {
-        IAggregateStatisticsType;
+        IAggregateStatisticsType: super::IStatisticsType;
         required: [];
-        StartTime: ua::DateTime, -1, [0 "StartTime"], false false true;
         ResetCondition: String, -1, [0 "ResetCondition"], false false true;
     }
     t::object_members! {
-        IRollingStatisticsType;
+        IRollingStatisticsType: super::IStatisticsType;
         required: [];
-        StartTime: ua::DateTime, -1, [0 "StartTime"], false false true;
         WindowDuration: f64, -1, [0 "WindowDuration"], false false true;
         WindowNumberOfValues: u32, -1, [0 "WindowNumberOfValues"], false false true;
     }
@@ -795,38 +793,32 @@ pub mod members {
         StartTime: ua::DateTime, -1, [0 "StartTime"], false false true;
     }
     t::object_members! {
-        OneTimeCalibrationTargetCategoryType;
+        OneTimeCalibrationTargetCategoryType: super::BaseCalibrationTargetCategoryType;
         required: [];
     }
     t::object_members! {
-        ReusableCalibrationTargetCategoryType;
+        ReusableCalibrationTargetCategoryType: super::BaseCalibrationTargetCategoryType;
         required: [];
     }
     t::object_members! {
-        ReusableDeviceCalibrationTargetCategoryType;
+        ReusableDeviceCalibrationTargetCategoryType: super::ReusableCalibrationTargetCategoryType;
         required: [];
     }
     t::object_members! {
-        StackElementAcousticType;
+        StackElementAcousticType: super::StackElementType;
         required: [
             ("NumberInList", "the mandatory variable `NumberInList` of StackElementAcousticType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NumberInList\")]"),
             ("OperationMode", "the mandatory variable `OperationMode` of StackElementAcousticType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OperationMode\")]"),
         ];
-        IsPartOfBase: bool, -1, [0 "IsPartOfBase"], false false true;
-        NumberInList: ua::Variant, -1, [1 "NumberInList"], true false false;
-        SignalOn: bool, -1, [0 "SignalOn"], false false true;
         AcousticSignals__NodeVersion: String, -1, [0 "AcousticSignals", 1 "NodeVersion"], false false false;
         Intensity: f32, -1, [0 "Intensity"], false false true;
         OperationMode: ua::Variant, -1, [0 "OperationMode"], true false true;
     }
     t::object_members! {
-        StackElementLightType;
+        StackElementLightType: super::StackElementType;
         required: [
             ("NumberInList", "the mandatory variable `NumberInList` of StackElementLightType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NumberInList\")]"),
         ];
-        IsPartOfBase: bool, -1, [0 "IsPartOfBase"], false false true;
-        NumberInList: ua::Variant, -1, [1 "NumberInList"], true false false;
-        SignalOn: bool, -1, [0 "SignalOn"], false false true;
         Intensity: f32, -1, [0 "Intensity"], false false true;
         SignalColor: super::super::super::types::SignalColor, -1, [0 "SignalColor"], false false true;
         SignalMode: super::super::super::types::SignalModeLight, -1, [0 "SignalMode"], false false true;
@@ -855,14 +847,10 @@ pub mod members {
         required: [];
     }
     t::object_members! {
-        StacklightType;
+        StacklightType: super::BasicStacklightType;
         required: [
             ("StacklightMode", "the mandatory variable `StacklightMode` of StacklightType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"StacklightMode\")]"),
         ];
-        NodeVersion: String, -1, [1 "NodeVersion"], false false false;
-        StackLevel__DisplayMode: super::super::super::types::LevelDisplayMode, -1, [0 "StackLevel", 0 "DisplayMode"], false false true;
-        StackLevel__LevelPercent: f32, -1, [0 "StackLevel", 0 "LevelPercent"], false false true;
-        StacklightMode: super::super::super::types::StacklightOperationMode, -1, [0 "StacklightMode"], true false true;
         DeviceHealth: super::super::super::super::di::types::DeviceHealthEnumeration, -1, [2 "DeviceHealth"], false false true;
     }
 }

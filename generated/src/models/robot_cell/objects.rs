@@ -624,7 +624,7 @@ pub mod members {
     #[allow(unused_imports)]
     use super::t;
     t::object_members! {
-        DrillingEndEffectorType;
+        DrillingEndEffectorType: super::super::super::super::di::objects::members::ComponentType;
         required: [
             ("Manufacturer", "the mandatory variable `Manufacturer` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
             ("Model", "the mandatory variable `Model` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
@@ -641,25 +641,9 @@ pub mod members {
             ("SkillSet/TemplateDrilling/InputParameterSet/ClampForce", "the mandatory variable `SkillSet/TemplateDrilling/InputParameterSet/ClampForce` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/InputParameterSet/ClampForce\")]"),
             ("SkillSet/TemplateDrilling/OutputParameterSet/Result", "the mandatory variable `SkillSet/TemplateDrilling/OutputParameterSet/Result` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/TemplateDrilling/OutputParameterSet/Result\")]"),
         ];
-        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
         Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], true false false;
-        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
         Model: ua::LocalizedText, -1, [1 "Model"], true false false;
-        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
-        ProductCode: String, -1, [1 "ProductCode"], false false false;
-        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
         SerialNumber: String, -1, [1 "SerialNumber"], true false false;
-        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
-        AssetId: String, -1, [1 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
         SkillSet__TemplateDrilling__CurrentState: ua::LocalizedText, -1, [2 "SkillSet", 0 "TemplateDrilling", 3 "CurrentState"], true false false;
         SkillSet__TemplateDrilling__LastTransition: ua::LocalizedText, -1, [2 "SkillSet", 0 "TemplateDrilling", 3 "LastTransition"], true false false;
         SkillSet__TemplateDrilling__AvailableStates: ua::NodeId, 1, [2 "SkillSet", 0 "TemplateDrilling", 3 "AvailableStates"], false false false;
@@ -676,27 +660,8 @@ pub mod members {
         SkillSet__TemplateDrilling__OutputParameterSet__Result: ua::StatusCode, -1, [2 "SkillSet", 0 "TemplateDrilling", 2 "OutputParameterSet", 2 "Result"], true false false;
     }
     t::object_members! {
-        LwrSystemType;
+        LwrSystemType: super::super::super::super::di::objects::members::ComponentType;
         required: [];
-        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
-        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
-        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
-        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
-        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
-        ProductCode: String, -1, [1 "ProductCode"], false false false;
-        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
-        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
-        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
-        AssetId: String, -1, [1 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
         MotionDeviceSystem__Identification__UIElement: ua::Variant, -1, [0 "MotionDeviceSystem", 1 "Identification", 1 "UIElement"], false false false;
         MotionDeviceSystem__Lock__Locked: bool, -1, [0 "MotionDeviceSystem", 1 "Lock", 1 "Locked"], false false false;
         MotionDeviceSystem__Lock__LockingClient: String, -1, [0 "MotionDeviceSystem", 1 "Lock", 1 "LockingClient"], false false false;
@@ -718,7 +683,7 @@ pub mod members {
         MotionDeviceSystem__ComponentName: ua::LocalizedText, -1, [0 "MotionDeviceSystem", 1 "ComponentName"], false false false;
     }
     t::object_members! {
-        TemplateDrillingLwrSystemType;
+        TemplateDrillingLwrSystemType: super::LwrSystemType;
         required: [
             ("DrillingEndEffector/Manufacturer", "the mandatory variable `DrillingEndEffector/Manufacturer` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/Manufacturer\")]"),
             ("DrillingEndEffector/Model", "the mandatory variable `DrillingEndEffector/Model` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/Model\")]"),
@@ -735,44 +700,6 @@ pub mod members {
             ("DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/ClampForce", "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/ClampForce` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/InputParameterSet/ClampForce\")]"),
             ("DrillingEndEffector/SkillSet/TemplateDrilling/OutputParameterSet/Result", "the mandatory variable `DrillingEndEffector/SkillSet/TemplateDrilling/OutputParameterSet/Result` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/SkillSet/TemplateDrilling/OutputParameterSet/Result\")]"),
         ];
-        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
-        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
-        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
-        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
-        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
-        ProductCode: String, -1, [1 "ProductCode"], false false false;
-        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
-        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
-        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
-        AssetId: String, -1, [1 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
-        MotionDeviceSystem__Identification__UIElement: ua::Variant, -1, [0 "MotionDeviceSystem", 1 "Identification", 1 "UIElement"], false false false;
-        MotionDeviceSystem__Lock__Locked: bool, -1, [0 "MotionDeviceSystem", 1 "Lock", 1 "Locked"], false false false;
-        MotionDeviceSystem__Lock__LockingClient: String, -1, [0 "MotionDeviceSystem", 1 "Lock", 1 "LockingClient"], false false false;
-        MotionDeviceSystem__Lock__LockingUser: String, -1, [0 "MotionDeviceSystem", 1 "Lock", 1 "LockingUser"], false false false;
-        MotionDeviceSystem__Lock__RemainingLockTime: f64, -1, [0 "MotionDeviceSystem", 1 "Lock", 1 "RemainingLockTime"], false false false;
-        MotionDeviceSystem__Manufacturer: ua::LocalizedText, -1, [0 "MotionDeviceSystem", 1 "Manufacturer"], false false false;
-        MotionDeviceSystem__ManufacturerUri: String, -1, [0 "MotionDeviceSystem", 1 "ManufacturerUri"], false false false;
-        MotionDeviceSystem__Model: ua::LocalizedText, -1, [0 "MotionDeviceSystem", 1 "Model"], false false false;
-        MotionDeviceSystem__HardwareRevision: String, -1, [0 "MotionDeviceSystem", 1 "HardwareRevision"], false false false;
-        MotionDeviceSystem__SoftwareRevision: String, -1, [0 "MotionDeviceSystem", 1 "SoftwareRevision"], false false false;
-        MotionDeviceSystem__DeviceRevision: String, -1, [0 "MotionDeviceSystem", 1 "DeviceRevision"], false false false;
-        MotionDeviceSystem__ProductCode: String, -1, [0 "MotionDeviceSystem", 1 "ProductCode"], false false false;
-        MotionDeviceSystem__DeviceManual: String, -1, [0 "MotionDeviceSystem", 1 "DeviceManual"], false false false;
-        MotionDeviceSystem__DeviceClass: String, -1, [0 "MotionDeviceSystem", 1 "DeviceClass"], false false false;
-        MotionDeviceSystem__SerialNumber: String, -1, [0 "MotionDeviceSystem", 1 "SerialNumber"], false false false;
-        MotionDeviceSystem__ProductInstanceUri: String, -1, [0 "MotionDeviceSystem", 1 "ProductInstanceUri"], false false false;
-        MotionDeviceSystem__RevisionCounter: i32, -1, [0 "MotionDeviceSystem", 1 "RevisionCounter"], false false false;
-        MotionDeviceSystem__AssetId: String, -1, [0 "MotionDeviceSystem", 1 "AssetId"], false false false;
-        MotionDeviceSystem__ComponentName: ua::LocalizedText, -1, [0 "MotionDeviceSystem", 1 "ComponentName"], false false false;
         DrillingEndEffector__Identification__UIElement: ua::Variant, -1, [0 "DrillingEndEffector", 1 "Identification", 1 "UIElement"], false false false;
         DrillingEndEffector__Lock__Locked: bool, -1, [0 "DrillingEndEffector", 1 "Lock", 1 "Locked"], false false false;
         DrillingEndEffector__Lock__LockingClient: String, -1, [0 "DrillingEndEffector", 1 "Lock", 1 "LockingClient"], false false false;
@@ -808,7 +735,7 @@ pub mod members {
         DrillingEndEffector__SkillSet__TemplateDrilling__OutputParameterSet__Result: ua::StatusCode, -1, [0 "DrillingEndEffector", 2 "SkillSet", 0 "TemplateDrilling", 2 "OutputParameterSet", 2 "Result"], true false false;
     }
     t::object_members! {
-        TemplateDrillingSkillType;
+        TemplateDrillingSkillType: super::super::super::super::common_skills::objects::members::ProgramSkillStateMachineType;
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
@@ -822,23 +749,14 @@ pub mod members {
             ("InputParameterSet/ClampForce", "the mandatory variable `InputParameterSet/ClampForce` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/ClampForce\")]"),
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of TemplateDrillingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [3 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [3 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [3 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [3 "AvailableTransitions"], false false false;
-        Deletable: bool, -1, [3 "Deletable"], true false false;
-        AutoDelete: bool, -1, [3 "AutoDelete"], true false false;
-        RecycleCount: i32, -1, [3 "RecycleCount"], true false false;
-        ProgramDiagnostic: ua::ExtensionObject, -1, [3 "ProgramDiagnostic"], false false false;
         InputParameterSet__HoleDiameter: f64, -1, [2 "InputParameterSet", 0 "HoleDiameter"], true false true;
         InputParameterSet__Depth: f64, -1, [2 "InputParameterSet", 0 "Depth"], true false true;
         InputParameterSet__FeedRate: f64, -1, [2 "InputParameterSet", 0 "FeedRate"], true false true;
         InputParameterSet__SpindleSpeed: f64, -1, [2 "InputParameterSet", 0 "SpindleSpeed"], true false true;
         InputParameterSet__ClampForce: f64, -1, [2 "InputParameterSet", 0 "ClampForce"], true false true;
-        OutputParameterSet__Result: ua::StatusCode, -1, [2 "OutputParameterSet", 2 "Result"], true false false;
     }
     t::object_members! {
-        Ur10eSystemType;
+        Ur10eSystemType: super::super::super::super::robotics::objects::members::MotionDeviceSystemType;
         required: [
             ("Controllers/URController/ProductCode", "the mandatory variable `Controllers/URController/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/ProductCode\")]"),
             ("Controllers/URController/SerialNumber", "the mandatory variable `Controllers/URController/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SerialNumber\")]"),
@@ -905,25 +823,6 @@ pub mod members {
             ("SafetyStates/SafetyState/ParameterSet/OperationalMode", "the mandatory variable `SafetyStates/SafetyState/ParameterSet/OperationalMode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SafetyStates/SafetyState/ParameterSet/OperationalMode\")]"),
             ("SafetyStates/SafetyState/ParameterSet/ProtectiveStop", "the mandatory variable `SafetyStates/SafetyState/ParameterSet/ProtectiveStop` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SafetyStates/SafetyState/ParameterSet/ProtectiveStop\")]"),
         ];
-        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
-        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
-        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
-        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
-        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
-        ProductCode: String, -1, [1 "ProductCode"], false false false;
-        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
-        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
-        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
-        AssetId: String, -1, [1 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
         Controllers__URController__ParameterSet__CabinetFanSpeed: f64, -1, [4 "Controllers", 0 "URController", 1 "ParameterSet", 4 "CabinetFanSpeed"], false false false;
         Controllers__URController__ParameterSet__CPUFanSpeed: f64, -1, [4 "Controllers", 0 "URController", 1 "ParameterSet", 4 "CPUFanSpeed"], false false false;
         Controllers__URController__ParameterSet__InputVoltage: f64, -1, [4 "Controllers", 0 "URController", 1 "ParameterSet", 4 "InputVoltage"], false false false;

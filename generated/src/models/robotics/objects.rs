@@ -1889,32 +1889,14 @@ pub mod members {
     #[allow(unused_imports)]
     use super::t;
     t::object_members! {
-        AuxiliaryComponentType;
+        AuxiliaryComponentType: super::super::super::super::di::objects::members::ComponentType;
         required: [
             ("ProductCode", "the mandatory variable `ProductCode` of AuxiliaryComponentType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]"),
         ];
-        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
-        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
-        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
-        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
-        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
         ProductCode: String, -1, [1 "ProductCode"], true false false;
-        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
-        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
-        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
-        AssetId: String, -1, [1 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
     }
     t::object_members! {
-        AxisType;
+        AxisType: super::super::super::super::di::objects::members::ComponentType;
         required: [
             ("ParameterSet/ActualPosition", "the mandatory variable `ParameterSet/ActualPosition` of AxisType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/ActualPosition\")]"),
             ("MotionProfile", "the mandatory variable `MotionProfile` of AxisType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionProfile\")]"),
@@ -1922,32 +1904,13 @@ pub mod members {
         ParameterSet__ActualAcceleration: f64, -1, [1 "ParameterSet", 0 "ActualAcceleration"], false false false;
         ParameterSet__ActualPosition: f64, -1, [1 "ParameterSet", 0 "ActualPosition"], true false false;
         ParameterSet__ActualSpeed: f64, -1, [1 "ParameterSet", 0 "ActualSpeed"], false false false;
-        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
-        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
-        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
-        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
-        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
-        ProductCode: String, -1, [1 "ProductCode"], false false false;
-        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
-        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
-        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
-        AssetId: String, -1, [1 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
         AdditionalLoad__CenterOfMass: ua::ThreeDFrame, -1, [0 "AdditionalLoad", 0 "CenterOfMass"], false false false;
         AdditionalLoad__Inertia: ua::ThreeDVector, -1, [0 "AdditionalLoad", 0 "Inertia"], false false false;
         AdditionalLoad__Mass: f64, -1, [0 "AdditionalLoad", 0 "Mass"], false false false;
         MotionProfile: super::super::super::types::AxisMotionProfileEnumeration, -1, [0 "MotionProfile"], true false false;
     }
     t::object_members! {
-        ControllerType;
+        ControllerType: super::super::super::super::di::objects::members::ComponentType;
         required: [
             ("Manufacturer", "the mandatory variable `Manufacturer` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
             ("Model", "the mandatory variable `Model` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
@@ -1963,25 +1926,10 @@ pub mod members {
         ParameterSet__TotalEnergyConsumption: f64, -1, [1 "ParameterSet", 0 "TotalEnergyConsumption"], false false false;
         ParameterSet__TotalPowerOnTime: String, -1, [1 "ParameterSet", 0 "TotalPowerOnTime"], false false false;
         ParameterSet__UpsState: String, -1, [1 "ParameterSet", 0 "UpsState"], false false false;
-        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
         Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], true false false;
-        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
         Model: ua::LocalizedText, -1, [1 "Model"], true false false;
-        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
         ProductCode: String, -1, [1 "ProductCode"], true false false;
-        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
         SerialNumber: String, -1, [1 "SerialNumber"], true false false;
-        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
-        AssetId: String, -1, [1 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
         CurrentUser__Level: String, -1, [0 "CurrentUser", 0 "Level"], true false false;
         CurrentUser__Name: String, -1, [0 "CurrentUser", 0 "Name"], false false false;
         SystemOperation__SystemOperationStateMachine__CurrentState: ua::LocalizedText, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 2 "CurrentState"], false false false;
@@ -2003,29 +1951,11 @@ pub mod members {
         SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__LastTransitionReason: i16, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 0 "LastTransitionReason"], false false true;
     }
     t::object_members! {
-        DriveType;
+        DriveType: super::super::super::super::di::objects::members::ComponentType;
         required: [
             ("ProductCode", "the mandatory variable `ProductCode` of DriveType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]"),
         ];
-        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
-        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
-        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
-        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
-        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
         ProductCode: String, -1, [1 "ProductCode"], true false false;
-        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
-        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
-        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
-        AssetId: String, -1, [1 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
     }
     t::object_members! {
         EmergencyStopFunctionType;
@@ -2050,7 +1980,7 @@ pub mod members {
         LastTransitionReason: i16, -1, [0 "LastTransitionReason"], true false true;
     }
     t::object_members! {
-        GearType;
+        GearType: super::super::super::super::di::objects::members::ComponentType;
         required: [
             ("Manufacturer", "the mandatory variable `Manufacturer` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
             ("Model", "the mandatory variable `Model` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
@@ -2058,25 +1988,10 @@ pub mod members {
             ("SerialNumber", "the mandatory variable `SerialNumber` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
             ("GearRatio", "the mandatory variable `GearRatio` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"GearRatio\")]"),
         ];
-        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
         Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], true false false;
-        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
         Model: ua::LocalizedText, -1, [1 "Model"], true false false;
-        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
         ProductCode: String, -1, [1 "ProductCode"], true false false;
-        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
         SerialNumber: String, -1, [1 "SerialNumber"], true false false;
-        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
-        AssetId: String, -1, [1 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
         GearRatio: ua::RationalNumber, -1, [0 "GearRatio"], true false false;
         Pitch: f64, -1, [0 "Pitch"], false false false;
     }
@@ -2103,30 +2018,11 @@ pub mod members {
         Mass: f64, -1, [0 "Mass"], true false false;
     }
     t::object_members! {
-        MotionDeviceSystemType;
+        MotionDeviceSystemType: super::super::super::super::di::objects::members::ComponentType;
         required: [];
-        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
-        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
-        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
-        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
-        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
-        ProductCode: String, -1, [1 "ProductCode"], false false false;
-        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
-        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
-        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
-        AssetId: String, -1, [1 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
     }
     t::object_members! {
-        MotionDeviceType;
+        MotionDeviceType: super::super::super::super::di::objects::members::ComponentType;
         required: [
             ("ParameterSet/SpeedOverride", "the mandatory variable `ParameterSet/SpeedOverride` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/SpeedOverride\")]"),
             ("Manufacturer", "the mandatory variable `Manufacturer` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
@@ -2138,25 +2034,10 @@ pub mod members {
         ParameterSet__InControl: bool, -1, [1 "ParameterSet", 0 "InControl"], false false false;
         ParameterSet__OnPath: bool, -1, [1 "ParameterSet", 0 "OnPath"], false false false;
         ParameterSet__SpeedOverride: f64, -1, [1 "ParameterSet", 0 "SpeedOverride"], true false false;
-        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
         Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], true false false;
-        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
         Model: ua::LocalizedText, -1, [1 "Model"], true false false;
-        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
         ProductCode: String, -1, [1 "ProductCode"], true false false;
-        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
         SerialNumber: String, -1, [1 "SerialNumber"], true false false;
-        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
-        AssetId: String, -1, [1 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
         FlangeLoad__CenterOfMass: ua::ThreeDFrame, -1, [0 "FlangeLoad", 0 "CenterOfMass"], false false false;
         FlangeLoad__Inertia: ua::ThreeDVector, -1, [0 "FlangeLoad", 0 "Inertia"], false false false;
         FlangeLoad__Mass: f64, -1, [0 "FlangeLoad", 0 "Mass"], false false false;
@@ -2164,7 +2045,7 @@ pub mod members {
         TaskControlReference: ua::NodeId, -1, [0 "TaskControlReference"], false false false;
     }
     t::object_members! {
-        MotorType;
+        MotorType: super::super::super::super::di::objects::members::ComponentType;
         required: [
             ("ParameterSet/MotorTemperature", "the mandatory variable `ParameterSet/MotorTemperature` of MotorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/MotorTemperature\")]"),
             ("Manufacturer", "the mandatory variable `Manufacturer` of MotorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
@@ -2175,25 +2056,10 @@ pub mod members {
         ParameterSet__BrakeReleased: bool, -1, [1 "ParameterSet", 0 "BrakeReleased"], false false false;
         ParameterSet__EffectiveLoadRate: u16, -1, [1 "ParameterSet", 0 "EffectiveLoadRate"], false false false;
         ParameterSet__MotorTemperature: f64, -1, [1 "ParameterSet", 0 "MotorTemperature"], true false false;
-        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
         Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], true false false;
-        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
         Model: ua::LocalizedText, -1, [1 "Model"], true false false;
-        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
         ProductCode: String, -1, [1 "ProductCode"], true false false;
-        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
         SerialNumber: String, -1, [1 "SerialNumber"], true false false;
-        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
-        AssetId: String, -1, [1 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
     }
     t::object_members! {
         MultiAcknowledgeableConditionType;
@@ -2260,27 +2126,8 @@ pub mod members {
         PossibleStopModes: ua::EnumValueType, 1, [0 "PossibleStopModes"], false true true;
     }
     t::object_members! {
-        PowerTrainType;
+        PowerTrainType: super::super::super::super::di::objects::members::ComponentType;
         required: [];
-        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
-        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
-        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
-        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
-        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
-        ProductCode: String, -1, [1 "ProductCode"], false false false;
-        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
-        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
-        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
-        AssetId: String, -1, [1 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
     }
     t::object_members! {
         ProtectiveStopFunctionType;
@@ -2307,7 +2154,7 @@ pub mod members {
         LastTransitionReason: i16, -1, [0 "LastTransitionReason"], true false true;
     }
     t::object_members! {
-        SafetyStateType;
+        SafetyStateType: super::super::super::super::di::objects::members::ComponentType;
         required: [
             ("ParameterSet/EmergencyStop", "the mandatory variable `ParameterSet/EmergencyStop` of SafetyStateType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/EmergencyStop\")]"),
             ("ParameterSet/OperationalMode", "the mandatory variable `ParameterSet/OperationalMode` of SafetyStateType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/OperationalMode\")]"),
@@ -2316,40 +2163,14 @@ pub mod members {
         ParameterSet__EmergencyStop: bool, -1, [1 "ParameterSet", 0 "EmergencyStop"], true false false;
         ParameterSet__OperationalMode: super::super::super::types::OperationalModeEnumeration, -1, [1 "ParameterSet", 0 "OperationalMode"], true false false;
         ParameterSet__ProtectiveStop: bool, -1, [1 "ParameterSet", 0 "ProtectiveStop"], true false false;
-        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
-        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
-        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
-        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
-        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
-        ProductCode: String, -1, [1 "ProductCode"], false false false;
-        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
-        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
-        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
-        AssetId: String, -1, [1 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], false false false;
     }
     t::object_members! {
-        SystemOperationStateMachineType;
+        SystemOperationStateMachineType: super::OperationStateMachineType;
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of SystemOperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of SystemOperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
             ("LastTransitionReason", "the mandatory variable `LastTransitionReason` of SystemOperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
-        ConfiguredDefaultStopMode: i16, -1, [0 "ConfiguredDefaultStopMode"], false false true;
-        LastTransitionReason: i16, -1, [0 "LastTransitionReason"], true false true;
-        PossibleStopModes: ua::EnumValueType, 1, [0 "PossibleStopModes"], false true true;
         ExecutingSubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "ExecutingSubstateMachine", 2 "CurrentState"], false false false;
         ExecutingSubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "ExecutingSubstateMachine", 2 "LastTransition"], false false false;
         ExecutingSubstateMachine__AvailableStates: ua::NodeId, 1, [0 "ExecutingSubstateMachine", 2 "AvailableStates"], false false false;
@@ -2408,19 +2229,12 @@ pub mod members {
         TaskControlStateMachine__ReadySubstateMachine__LastTransitionReason: i16, -1, [0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 0 "LastTransitionReason"], false false true;
     }
     t::object_members! {
-        TaskControlStateMachineType;
+        TaskControlStateMachineType: super::OperationStateMachineType;
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of TaskControlStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of TaskControlStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
             ("LastTransitionReason", "the mandatory variable `LastTransitionReason` of TaskControlStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
-        ConfiguredDefaultStopMode: i16, -1, [0 "ConfiguredDefaultStopMode"], false false true;
-        LastTransitionReason: i16, -1, [0 "LastTransitionReason"], true false true;
-        PossibleStopModes: ua::EnumValueType, 1, [0 "PossibleStopModes"], false true true;
         ReadySubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "ReadySubstateMachine", 2 "CurrentState"], false false false;
         ReadySubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "ReadySubstateMachine", 2 "LastTransition"], false false false;
         ReadySubstateMachine__AvailableStates: ua::NodeId, 1, [0 "ReadySubstateMachine", 2 "AvailableStates"], false false false;
@@ -2428,7 +2242,7 @@ pub mod members {
         ReadySubstateMachine__LastTransitionReason: i16, -1, [0 "ReadySubstateMachine", 0 "LastTransitionReason"], false false true;
     }
     t::object_members! {
-        TaskControlType;
+        TaskControlType: super::super::super::super::di::objects::members::ComponentType;
         required: [
             ("ParameterSet/TaskProgramLoaded", "the mandatory variable `ParameterSet/TaskProgramLoaded` of TaskControlType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/TaskProgramLoaded\")]"),
             ("ParameterSet/TaskProgramName", "the mandatory variable `ParameterSet/TaskProgramName` of TaskControlType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/TaskProgramName\")]"),
@@ -2437,24 +2251,6 @@ pub mod members {
         ParameterSet__ExecutionMode: super::super::super::types::ExecutionModeEnumeration, -1, [1 "ParameterSet", 0 "ExecutionMode"], false false false;
         ParameterSet__TaskProgramLoaded: bool, -1, [1 "ParameterSet", 0 "TaskProgramLoaded"], true false false;
         ParameterSet__TaskProgramName: String, -1, [1 "ParameterSet", 0 "TaskProgramName"], true false false;
-        Identification__UIElement: ua::Variant, -1, [1 "Identification", 1 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [1 "Lock", 1 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [1 "Lock", 1 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [1 "Lock", 1 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [1 "Lock", 1 "RemainingLockTime"], false false false;
-        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], false false false;
-        ManufacturerUri: String, -1, [1 "ManufacturerUri"], false false false;
-        Model: ua::LocalizedText, -1, [1 "Model"], false false false;
-        HardwareRevision: String, -1, [1 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [1 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [1 "DeviceRevision"], false false false;
-        ProductCode: String, -1, [1 "ProductCode"], false false false;
-        DeviceManual: String, -1, [1 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [1 "DeviceClass"], false false false;
-        SerialNumber: String, -1, [1 "SerialNumber"], false false false;
-        ProductInstanceUri: String, -1, [1 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [1 "RevisionCounter"], false false false;
-        AssetId: String, -1, [1 "AssetId"], false false false;
         ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], true false false;
         TaskControlOperation__MotionDevicesUnderControl: ua::NodeId, 1, [0 "TaskControlOperation", 0 "MotionDevicesUnderControl"], false false false;
         TaskControlOperation__TaskControlStateMachine__CurrentState: ua::LocalizedText, -1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 2 "CurrentState"], false false false;

@@ -24,7 +24,7 @@ use quote::quote;
 
 use super::programs::Item;
 use super::{doc, ident, lit, path, Gen};
-use crate::model::{DataTypeKind, ModellingRule, NodeIx};
+use crate::model::{DataTypeKind, Model, ModellingRule, NodeIx};
 use crate::nodeid::Identifier;
 use crate::names::{Case, Scope, Target};
 use crate::raw::NodeClass;
@@ -72,13 +72,32 @@ struct Field {
     doc: String,
 }
 
-/// A variable reachable from an instance, for the markers.
-struct Reach {
+/// One member marker of a type: a variable reachable from an instance, not crossing placeholders.
+struct Marker {
+    /// The marker's name (`ParameterSet__ActualPosition`).
+    name: String,
+    /// BrowseNames along the path.
     path: Vec<String>,
-    /// (namespace index into NS, name) per segment.
-    qpath: Vec<(usize, String)>,
+    /// (model namespace, name) per segment.
+    qpath: Vec<(u16, String)>,
     node: NodeIx,
     mandatory: bool,
+}
+
+impl Marker {
+    /// What the marker's constant says: two markers with the same key are the same constant, whichever
+    /// type declares them (an override that changes nothing the marker holds keeps its supertype's).
+    fn key(&self, model: &Model) -> impl PartialEq {
+        let n = model.node(self.node);
+        (
+            self.qpath.clone(),
+            n.attrs.data_type,
+            n.attrs.value_rank.unwrap_or(-1),
+            self.mandatory,
+            n.value.is_some(),
+            n.attrs.access_level.unwrap_or(1) & 2 != 0,
+        )
+    }
 }
 
 impl Gen<'_> {
@@ -491,41 +510,87 @@ impl Gen<'_> {
         }
     }
 
-    /// The `object_members!` invocation of a type, as text: one marker per line (a table, like the node
-    /// rows of nodes.rs, which prettyplease would fold into a paragraph).
-    fn markers(&self, type_name: &str, members: &[(NodeIx, NodeIx)], uris: &mut BTreeMap<String, usize>) -> String {
+    /// The markers of a type with these members, in order. A name two paths map to is left out (the derive
+    /// cannot name either): order-independent. So is one that would be the module's `REQUIRED`.
+    fn marker_list(&self, members: &[(NodeIx, NodeIx)]) -> Vec<Marker> {
         let model = self.model;
         let mut found = Vec::new();
         self.reach(members, &mut Vec::new(), &mut found);
-        let reach: Vec<Reach> = found
+        let all: Vec<Marker> = found
             .into_iter()
-            .map(|(p, node, mandatory)| Reach {
-                path: p.iter().map(|&s| model.node(s).browse_name.name.clone()).collect(),
-                qpath: p
-                    .iter()
-                    .map(|&s| (self.ns_index(uris, model.node(s).browse_name.ns), model.node(s).browse_name.name.clone()))
-                    .collect(),
-                node,
-                mandatory,
+            .map(|(p, node, mandatory)| {
+                let path: Vec<String> = p.iter().map(|&s| model.node(s).browse_name.name.clone()).collect();
+                let segs: Vec<&str> = path.iter().map(String::as_str).collect();
+                Marker {
+                    name: marker_name(&segs),
+                    qpath: p.iter().map(|&s| (model.node(s).browse_name.ns, model.node(s).browse_name.name.clone())).collect(),
+                    path,
+                    node,
+                    mandatory,
+                }
             })
             .collect();
-        // A marker name two paths map to is left out (the derive cannot name either): order-independent. So
-        // is one that would be the module's `REQUIRED`.
-        let mut count: BTreeMap<String, usize> = BTreeMap::new();
-        for r in &reach {
-            let segs: Vec<&str> = r.path.iter().map(String::as_str).collect();
-            *count.entry(marker_name(&segs)).or_default() += 1;
+        let mut count: BTreeMap<&str, usize> = BTreeMap::new();
+        for m in &all {
+            *count.entry(m.name.as_str()).or_default() += 1;
+        }
+        let keep: Vec<bool> = all.iter().map(|m| count[m.name.as_str()] == 1 && m.name != "REQUIRED").collect();
+        all.into_iter().zip(keep).filter_map(|(m, k)| k.then_some(m)).collect()
+    }
+
+    /// The `object_members!` invocation of a type, as text: one marker per line (a table, like the node
+    /// rows of nodes.rs, which prettyplease would fold into a paragraph).
+    ///
+    /// `base` is the nearest supertype with a handle, and the path of that handle. When the type has every
+    /// marker of that supertype, its module re-exports the supertype's (`pub use`, which costs the compiler
+    /// next to nothing) and declares only the markers that are new or say something else; a declared marker
+    /// shadows the re-exported one of its name. Otherwise (a supertype's marker name became ambiguous here)
+    /// it declares them all.
+    fn markers(
+        &self,
+        type_name: &str,
+        members: &[(NodeIx, NodeIx)],
+        base: Option<(NodeIx, &TokenStream)>,
+        uris: &mut BTreeMap<String, usize>,
+    ) -> String {
+        let model = self.model;
+        let list = self.marker_list(members);
+        let mut inherited = None;
+        if let Some((b, handle)) = base {
+            let theirs = self.marker_list(&self.type_members(b));
+            let ours: BTreeMap<&str, &Marker> = list.iter().map(|m| (m.name.as_str(), m)).collect();
+            if theirs.iter().all(|m| ours.contains_key(m.name.as_str())) {
+                let same: BTreeSet<&str> = theirs
+                    .iter()
+                    .filter(|m| ours[m.name.as_str()].key(model) == m.key(model))
+                    .map(|m| m.name.as_str())
+                    .collect();
+                // `Name` or `path::objects::Name`, seen from objects.rs; the markers are in `members::Name`,
+                // and seen from `members::<Owner>`, two modules down.
+                let text = handle.to_string().replace(' ', "");
+                let module = match text.rsplit_once("::") {
+                    None => format!("super::{text}"),
+                    Some((m, last)) if m.starts_with("super::") => format!("super::super::{m}::members::{last}"),
+                    Some((m, last)) => format!("{m}::members::{last}"),
+                };
+                inherited = Some((module, same.into_iter().map(str::to_owned).collect::<BTreeSet<String>>()));
+            }
         }
         let mut items = String::new();
         let mut required = String::new();
-        let mut seen = BTreeSet::new();
-        for r in &reach {
-            let segs: Vec<&str> = r.path.iter().map(String::as_str).collect();
-            let mname = marker_name(&segs);
-            if count[&mname] > 1 || mname == "REQUIRED" || !seen.insert(mname.clone()) {
+        for r in &list {
+            let n = model.node(r.node);
+            let has_default = n.value.is_some();
+            if r.mandatory && !has_default {
+                let p = r.path.join("/");
+                let msg = format!(
+                    "the mandatory variable `{p}` of {type_name} has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"{p}\")]"
+                );
+                let _ = writeln!(required, "            ({}, {}),", Literal::string(&p), Literal::string(&msg));
+            }
+            if inherited.as_ref().is_some_and(|(_, same)| same.contains(&r.name)) {
                 continue;
             }
-            let n = model.node(r.node);
             let rank = n.attrs.value_rank.unwrap_or(-1);
             let scalar = type_text(&self.value_type(n.attrs.data_type, -1));
             let scalar = if scalar.contains("Variant") {
@@ -536,25 +601,23 @@ impl Gen<'_> {
             } else {
                 scalar
             };
-            let has_default = n.value.is_some();
             let writable = n.attrs.access_level.unwrap_or(1) & 2 != 0;
-            let path: Vec<String> = r.qpath.iter().map(|(k, s)| format!("{k} {}", Literal::string(s))).collect();
+            let path: Vec<String> =
+                r.qpath.iter().map(|(ns, s)| format!("{} {}", self.ns_index(uris, *ns), Literal::string(s))).collect();
             let _ = writeln!(
                 items,
-                "        {mname}: {scalar}, {rank}, [{}], {} {has_default} {writable};",
+                "        {}: {scalar}, {rank}, [{}], {} {has_default} {writable};",
+                r.name,
                 path.join(", "),
                 r.mandatory
             );
-            if r.mandatory && !has_default {
-                let p = r.path.join("/");
-                let msg = format!(
-                    "the mandatory variable `{p}` of {type_name} has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"{p}\")]"
-                );
-                let _ = writeln!(required, "            ({}, {}),", Literal::string(&p), Literal::string(&msg));
-            }
         }
         let required = if required.is_empty() { "[]".to_string() } else { format!("[\n{required}        ]") };
-        format!("    t::object_members! {{\n        {type_name};\n        required: {required};\n{items}    }}\n")
+        let head = match &inherited {
+            Some((module, _)) => format!("{type_name}: {module}"),
+            None => type_name.to_string(),
+        };
+        format!("    t::object_members! {{\n        {head};\n        required: {required};\n{items}    }}\n")
     }
 
     pub(super) fn objects_file(&mut self) -> OutFile {
@@ -588,6 +651,7 @@ impl Gen<'_> {
                     }
                     None => all.clone(),
                 };
+                let base_for_markers = base.clone();
                 let body = self.handle_struct(name, &text, None, base.map(|(_, p)| p), &own, &names, &mut uris, nested_prefix(name), 0);
                 let machine = self.state_machine_items(t, name, &names, &item_names, &mut uris);
                 items.push(quote! {
@@ -595,7 +659,7 @@ impl Gen<'_> {
                     t::object_type!(#sname, #tid, #bname);
                     #machine
                 });
-                markers.push(self.markers(name, &all, &mut uris));
+                markers.push(self.markers(name, &all, base_for_markers.as_ref().map(|(s, p)| (*s, p)), &mut uris));
             } else {
                 let vt = self.value_type(n.attrs.data_type, n.attrs.value_rank.unwrap_or(-2));
                 let body = self.handle_struct(name, &text, Some(quote! { t::Variable<#vt> }), None, &all, &names, &mut uris, nested_prefix(name), 0);
