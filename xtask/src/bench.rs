@@ -1641,10 +1641,11 @@ mod rust {
         print_builds(RUNTIME_CRATE, &r.runtime_only, None);
         print_builds("DI + IA + Robotics", &r.three, None);
         if let Some(Ok(peer)) = r.peer.as_ref().map(|p| &p.debug) {
-            // The scaled target above takes the issue's 2.7 s, measured for DI + Robotics (36,714 lines, an older
-            // Robotics without IA), as if it were this run's peer crate, which has IA too (about a quarter
-            // more lines): that flatters us. The issue's target as a ratio to the peer on the same inputs
-            // has no such gap.
+            // The issue's target as a ratio to the peer (1.5 s against its 2.7 s), judged for each of our crates.
+            // For nodeset-models this is the scaled target above said another way; for the CLI's DI + IA +
+            // Robotics it is the comparison on the peer's own inputs. (The "N x as slow" above overstates the
+            // host's slowdown: this peer crate has IA too, about a quarter more lines than the DI + Robotics
+            // crate the issue timed at 2.7 s. The ratio on the same inputs does not depend on that.)
             let limit = CRATE_BUILD_S / PEER_BUILD_STATED_S;
             println!(
                 "   {:<16} the target as a ratio, {CRATE_BUILD_S} s / {PEER_BUILD_STATED_S} s = {limit:.3}x the peer's cold build:",
