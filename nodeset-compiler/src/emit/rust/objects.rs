@@ -560,10 +560,10 @@ impl Gen<'_> {
             let theirs = self.marker_list(&self.type_members(b));
             let ours: BTreeMap<&str, &Marker> = list.iter().map(|m| (m.name.as_str(), m)).collect();
             if theirs.iter().all(|m| ours.contains_key(m.name.as_str())) {
-                let same: BTreeSet<&str> = theirs
-                    .iter()
+                let same: BTreeSet<String> = theirs
+                    .into_iter()
                     .filter(|m| ours[m.name.as_str()].key(model) == m.key(model))
-                    .map(|m| m.name.as_str())
+                    .map(|m| m.name)
                     .collect();
                 // `Name` or `path::objects::Name`, seen from objects.rs; the markers are in `members::Name`,
                 // and seen from `members::<Owner>`, two modules down.
@@ -573,7 +573,7 @@ impl Gen<'_> {
                     Some((m, last)) if m.starts_with("super::") => format!("super::super::{m}::members::{last}"),
                     Some((m, last)) => format!("{m}::members::{last}"),
                 };
-                inherited = Some((module, same.into_iter().map(str::to_owned).collect::<BTreeSet<String>>()));
+                inherited = Some((module, same));
             }
         }
         let mut items = String::new();
