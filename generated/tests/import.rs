@@ -7,7 +7,7 @@ use common::serve;
 use nodeset_models::runtime::demo::{self, ids, DemoMode, DemoPoint};
 use nodeset_models::runtime::import::parse_date_time;
 use nodeset_models::runtime::server::ServerConfig;
-use nodeset_models::runtime::table::{Def, FieldRow, Id, Kind, NodeRow, NodeSetTable, Ref, StructureKind, Val};
+use nodeset_models::runtime::table::{Def, FieldRow, Id, Kind, NodeRow, NodeSetTable, Nodes, Ref, StructureKind, Val};
 use opcua::nodes::TypeTree;
 use opcua::types::{
     Argument, AttributeId, BrowseDirection, EnumDefinition, EnumValueType, LocalizedText, NodeId, QualifiedName,
@@ -182,7 +182,7 @@ static EDGE_TABLE: NodeSetTable = NodeSetTable {
     publication_date: "not a date",
     namespaces: &["http://opcfoundation.org/UA/", "urn:test:edge", "urn:test:other"],
     own: 1,
-    nodes: &[
+    nodes: Nodes::Rows(&[
         edge_row(
             EDGE,
             "Good",
@@ -238,7 +238,7 @@ static EDGE_TABLE: NodeSetTable = NodeSetTable {
         ),
         NodeRow { browse_name: (0, "Default Binary"), ..edge_row(Id::numeric(1, 7), "Default Binary", OBJECT, &[]) },
         NodeRow { browse_name: (0, "Default XML"), ..edge_row(Id::numeric(1, 9), "Default XML", OBJECT, &[]) },
-    ],
+    ]),
 };
 
 /// A table whose own namespace index is 0 imports nothing.
@@ -248,7 +248,7 @@ static NS0_TABLE: NodeSetTable = NodeSetTable {
     publication_date: "2020-01-01",
     namespaces: &["http://opcfoundation.org/UA/"],
     own: 0,
-    nodes: &[edge_row(Id::ns0(99999), "Intruder", OBJECT, &[])],
+    nodes: Nodes::Rows(&[edge_row(Id::ns0(99999), "Intruder", OBJECT, &[])]),
 };
 
 #[tokio::test]
@@ -294,12 +294,12 @@ static TABLE_A: NodeSetTable = NodeSetTable {
     publication_date: "2020-01-01T00:00:00Z",
     namespaces: &["http://opcfoundation.org/UA/", "urn:test:a"],
     own: 1,
-    nodes: &[edge_row(
+    nodes: Nodes::Rows(&[edge_row(
         Id::numeric(1, 100),
         "AType",
         Kind::ObjectType { is_abstract: true },
         &[Ref { reference_type: Id::ns0(45), target: Id::ns0(58), forward: false }],
-    )],
+    )]),
 };
 static TABLE_B: NodeSetTable = NodeSetTable {
     namespace_uri: "urn:test:b",
@@ -307,7 +307,7 @@ static TABLE_B: NodeSetTable = NodeSetTable {
     publication_date: "2021-01-01",
     namespaces: &["http://opcfoundation.org/UA/", "urn:test:missing", "urn:test:a", "urn:test:b"],
     own: 3,
-    nodes: &[NodeRow {
+    nodes: Nodes::Rows(&[NodeRow {
         browse_name: (3, "BType"),
         ..edge_row(
             Id::numeric(3, 200),
@@ -318,7 +318,7 @@ static TABLE_B: NodeSetTable = NodeSetTable {
                 Ref { reference_type: Id::ns0(47), target: Id::numeric(1, 5), forward: true },
             ],
         )
-    }],
+    }]),
 };
 
 #[tokio::test]

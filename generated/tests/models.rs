@@ -32,7 +32,8 @@ async fn generated_tables_import_completely() {
     for table in TABLES {
         let map = m.namespace_map(table.namespace_uri).expect("the table is served");
         let missing: Vec<_> = table
-            .nodes
+            .rows()
+            .expect("the table decodes")
             .iter()
             .map(|row| map.try_id(row.id).expect("every row's namespace is registered"))
             .filter(|id| running.attribute(id, AttributeId::NodeClass).is_none())
@@ -70,7 +71,8 @@ async fn skill_tables_import_completely() {
         assert_eq!(m.namespace_index(table.namespace_uri), Some(i as u16 + 2), "{}", table.namespace_uri);
         let map = m.namespace_map(table.namespace_uri).expect("the table is served");
         let missing: Vec<_> = table
-            .nodes
+            .rows()
+            .expect("the table decodes")
             .iter()
             .map(|row| map.try_id(row.id).expect("every row's namespace is registered"))
             .filter(|id| running.attribute(id, AttributeId::NodeClass).is_none())

@@ -1704,6 +1704,12 @@ mod rust {
                 );
                 print_yardstick(r.yard_import.as_ref(), median, IMPORT_MS, "ms");
                 println!(
+                    "   decode   {:.3} ms once per process (the tables' packed text into rows, on first use; not in \
+                     the median); a process's first import, decode included: {:.3} ms",
+                    i.f("decode_ms"),
+                    i.f("first_import_ms")
+                );
+                println!(
                     "   types    load_into_type_tree afterwards: median {:.3} ms   min {:.3} ms (not in the import figure)",
                     i.f("type_tree_median_ms"),
                     i.f("type_tree_min_ms")

@@ -13,7 +13,7 @@ use opcua::types::{
     binary_decode_to_enc, ExpandedMessageInfo, ExpandedNodeId, StaticTypeLoader, TypeLoaderInstance, UAString,
 };
 
-use super::table::{ArgRow, Def, EnumRow, FieldRow, Id, Kind, NodeRow, NodeSetTable, Ref, StructureKind, Val};
+use super::table::{ArgRow, Def, EnumRow, FieldRow, Id, Kind, NodeRow, NodeSetTable, Nodes, Ref, StructureKind, Val};
 use super::NsNodeId;
 
 /// The demo namespace URI.
@@ -217,7 +217,7 @@ pub static TABLE: NodeSetTable = NodeSetTable {
     publication_date: "2024-01-01T00:00:00Z",
     namespaces: &["http://opcfoundation.org/UA/", NAMESPACE_URI],
     own: 1,
-    nodes: &[
+    nodes: Nodes::Rows(&[
         // Types.
         NodeRow {
             description: Some("A point with a label."),
@@ -514,5 +514,5 @@ pub static TABLE: NodeSetTable = NodeSetTable {
             Kind::Object { event_notifier: 0 },
             &[inv(ORGANIZES, OBJECTS_FOLDER), fwd(HAS_TYPE_DEFINITION, own(ids::PUMP_TYPE))],
         ),
-    ],
+    ]),
 };

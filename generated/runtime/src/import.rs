@@ -19,7 +19,7 @@ use opcua::types::{
     ExpandedNodeId, ExtensionObject, Guid, LocalizedText, NodeClass, NodeId, QualifiedName, StatusCode,
     StructureDefinition, StructureField, StructureType, UAString, Variant, VariantScalarTypeId,
 };
-use tracing::warn;
+use tracing::{error, warn};
 
 use super::table::{ArgRow, Def, EnumRow, FieldRow, Id, Kind, NodeRow, NodeSetTable, Ref, StructureKind, Val};
 use super::NamespaceMap;
@@ -81,7 +81,14 @@ impl NodeSetImport for TableImport {
         if table.own == 0 {
             return Box::new(std::iter::empty());
         }
-        Box::new(table.nodes.iter().filter_map(move |row| build_item(table, row, &map)))
+        let rows = match table.rows() {
+            Ok(rows) => rows,
+            Err(e) => {
+                error!("{e}; nothing of it is imported");
+                return Box::new(std::iter::empty());
+            }
+        };
+        Box::new(rows.iter().filter_map(move |row| build_item(table, row, &map)))
     }
 }
 
@@ -309,7 +316,7 @@ impl Ctx<'_> {
         row.references()
             .filter(|r| r.forward && r.reference_type == Id::ns0(HAS_ENCODING))
             .map(|r| r.target)
-            .find(|t| self.table.nodes.iter().any(|n| n.id == *t && n.browse_name.1 == "Default Binary"))
+            .find(|t| self.table.rows().unwrap_or_default().iter().any(|n| n.id == *t && n.browse_name.1 == "Default Binary"))
     }
 
     fn field(&self, f: &FieldRow, node: &NodeId) -> StructureField {

@@ -1,9 +1,56 @@
 //! The static tables generated code fills: one [`NodeSetTable`] per namespace.
 //!
-//! Everything here is `const`-constructible, so a generated namespace is data the compiler barely looks at,
-//! not one function per node. NodeIds in a table use table-local namespace indices (an index into
-//! [`NodeSetTable::namespaces`]); they are mapped to the server's indices when the table is imported, so no
-//! generated code ever hard-codes a server namespace index.
+//! A generated namespace is data, not one function per node. Its rows are one string, [`Packed`] text with
+//! one line per node (format below), which the compiler reads as a single literal; it is decoded into
+//! [`NodeRow`]s the first time the table is used, once per process. Hand-written tables (tests, the demo
+//! namespace) can give the rows directly as `const` [`NodeRow`]s ([`Nodes::Rows`]). NodeIds in a table use
+//! table-local namespace indices (an index into [`NodeSetTable::namespaces`]); they are mapped to the
+//! server's indices when the table is imported, so no generated code ever hard-codes a server namespace
+//! index.
+//!
+//! # The packed format
+//!
+//! One line per node; empty lines are ignored. Items are separated by one space. A line is
+//!
+//! ```text
+//! Class Id BrowseName DisplayName Description WriteMask UserWriteMask <attributes of Class> Ref*
+//! ```
+//!
+//! - `Id` is `ns:123` (numeric), `ns:s"text"` (string), `ns:g` and 32 hex digits (GUID, the 16 bytes of
+//!   [`IdKind::Guid`]) or `ns:b` and hex digits (opaque), with `ns` the table-local namespace index.
+//! - `BrowseName` is `ns:"name"`. `DisplayName` is `=` (the BrowseName's name) or a string. `Description` and
+//!   every other optional string are `~` (none) or a string.
+//! - A string is quoted; inside, `\"`, `\\`, `\n`, `\r`, `\t` and `\u{hex}` (any other control character)
+//!   are escaped. Booleans are `0` and `1`; numbers are decimal, floats as Rust prints and parses them
+//!   (`1.5`, `-0`, `NaN`, `inf`). Array dimensions are `[]` or `[2,3]`. A list is `{ item item }`, or `{ }`.
+//! - The attributes by class (after the name, the fields of [`Kind`] in order):
+//!   - `Object event_notifier`, `ObjectType is_abstract`, `Method executable user_executable`,
+//!     `View event_notifier contains_no_loops`, `ReferenceType symmetric is_abstract inverse_name`;
+//!   - `Variable data_type value_rank array_dimensions access_level user_access_level historizing
+//!     minimum_sampling_interval value` (the interval is `~` or a float);
+//!   - `VariableType data_type value_rank array_dimensions is_abstract value`;
+//!   - `DataType is_abstract definition`, where a definition is `~`, `Enum { EnumRow* }`, or the structure
+//!     kind (`Structure`, `StructureWithOptionalFields`, `Union`), then `base default_encoding { FieldRow* }`
+//!     with the encoding `~` if none. A `FieldRow` is `name description data_type value_rank
+//!     array_dimensions max_string_length is_optional`; an `EnumRow` is `value name display_name
+//!     description` (the display name `=` when it is the name).
+//! - A value ([`Val`]) is `~` or `Tag:payload`, the tag a variant name: `Boolean:1`, `Int32:-5`,
+//!   `Double:0.5`, `String:"text"`, `DateTime:"2025-11-15T00:00:00Z"`, `Guid:` and 32 hex digits,
+//!   `ByteString:` and hex digits, `NodeId:Id`, `ExpandedNodeId:Id`, `StatusCode:0`, `QualifiedName:ns:"name"`,
+//!   `LocalizedText:locale:"text"` (the locale `~` or a string), `Array:type { Val* }` (`type` the ns0
+//!   DataType number), `Arguments:{ ArgRow* }` with an `ArgRow` `name data_type value_rank
+//!   array_dimensions description`, and `EnumValues:{ EnumRow* }`. [`Val::Struct`] has no text form.
+//! - A reference is `ReferenceTypeId>TargetId` (forward) or `ReferenceTypeId<TargetId` (inverse), in the
+//!   nodeset's order.
+//!
+//! For example, a property and a structure data type of DI:
+//!
+//! ```text
+//! Variable 1:15002 0:"NamespaceUri" = ~ 0 0 0:12 -1 [] 1 1 0 ~ String:"http://opcfoundation.org/UA/DI/" 0:40>0:68
+//! DataType 1:15888 1:"TransferResultErrorDataType" = ~ 0 0 0 Structure 1:6522 1:15891 { "Status" ~ 0:6 -1 [] 0 0 "Diagnostics" ~ 0:25 -1 [] 0 0 } 0:45<1:6522
+//! ```
+
+use std::sync::OnceLock;
 
 /// The identifier part of a NodeId in a table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -215,7 +262,600 @@ pub struct NodeSetTable {
     pub namespaces: &'static [&'static str],
     /// The index of `namespace_uri` in `namespaces`.
     pub own: u16,
-    pub nodes: &'static [NodeRow],
+    /// The rows; read them with [`NodeSetTable::rows`].
+    pub nodes: Nodes,
+}
+
+impl NodeSetTable {
+    /// Every node of the table, one row per node. Packed rows are decoded on the first call (once per
+    /// process, kept for the process's lifetime); an error names the line of the text that does not
+    /// decode, and is returned again on every later call.
+    pub fn rows(&self) -> Result<&[NodeRow], TableError> {
+        match &self.nodes {
+            Nodes::Rows(rows) => Ok(rows),
+            Nodes::Packed(p) => match p.rows.get_or_init(|| decode(p.text)) {
+                Ok(rows) => Ok(rows),
+                Err((line, column, message)) => Err(TableError {
+                    namespace_uri: self.namespace_uri,
+                    line: *line,
+                    column: *column,
+                    message: message.clone(),
+                }),
+            },
+        }
+    }
+}
+
+/// The rows of a [`NodeSetTable`].
+#[derive(Debug)]
+pub enum Nodes {
+    /// Rows written as Rust values.
+    Rows(&'static [NodeRow]),
+    /// Rows as text in the packed format of this module's documentation (what the generator writes).
+    Packed(Packed),
+}
+
+/// Rows as packed text, decoded once.
+#[derive(Debug)]
+pub struct Packed {
+    text: &'static str,
+    rows: OnceLock<Result<Box<[NodeRow]>, (usize, usize, String)>>,
+}
+
+impl Packed {
+    /// Packed text, decoded on first use.
+    pub const fn new(text: &'static str) -> Packed {
+        Packed { text, rows: OnceLock::new() }
+    }
+
+    /// The text as the table holds it.
+    pub fn text(&self) -> &'static str {
+        self.text
+    }
+}
+
+/// A packed table whose text does not decode (the generated file was edited, or comes from an
+/// incompatible generator version).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TableError {
+    pub namespace_uri: &'static str,
+    /// 1-based line and column (in characters) within the table's text.
+    pub line: usize,
+    pub column: usize,
+    pub message: String,
+}
+
+impl std::fmt::Display for TableError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "the node table of {} does not decode at line {}, column {}: {}; regenerate the module with \
+             nodeset-compiler (generated files must not be edited)",
+            self.namespace_uri, self.line, self.column, self.message
+        )
+    }
+}
+
+impl std::error::Error for TableError {}
+
+/// Decodes packed text into rows. Strings without escapes are slices of `text`; everything else the rows
+/// point to is allocated once and leaked, because rows are `'static` data and a table is decoded once per
+/// process. An error is (line, column, message).
+pub fn decode(text: &'static str) -> Result<Box<[NodeRow]>, (usize, usize, String)> {
+    let mut rows = Vec::with_capacity(text.len() / 128);
+    // Numeric references of all rows in one allocation; each row's range is filled in at the end.
+    let mut nrefs: Vec<NumRef> = Vec::with_capacity(text.len() / 48);
+    let mut ranges: Vec<(usize, usize)> = Vec::with_capacity(text.len() / 128);
+    let mut refs: Vec<Ref> = Vec::new();
+    for (n, line) in text.split('\n').enumerate() {
+        if line.is_empty() {
+            continue;
+        }
+        let mut c = Cursor { s: line, b: line.as_bytes(), i: 0 };
+        refs.clear();
+        match c.row(&mut refs) {
+            Ok(mut row) => {
+                let numeric = |id: &Id| match id.id {
+                    IdKind::Numeric(v) => Some((id.ns, v)),
+                    _ => None,
+                };
+                let start = nrefs.len();
+                let all_numeric = refs.iter().all(|r| numeric(&r.reference_type).is_some() && numeric(&r.target).is_some());
+                if all_numeric {
+                    nrefs.extend(refs.iter().filter_map(|r| {
+                        let ((rns, rid), (tns, tid)) = (numeric(&r.reference_type)?, numeric(&r.target)?);
+                        Some((rns, rid, tns, tid, r.forward))
+                    }));
+                } else {
+                    row.refs = leak(refs.clone());
+                }
+                ranges.push((start, nrefs.len()));
+                rows.push(row);
+            }
+            Err(message) => {
+                let column = line.get(..c.i.min(line.len())).map_or(c.i, |p| p.chars().count()) + 1;
+                return Err((n + 1, column, message));
+            }
+        }
+    }
+    let nrefs: &'static [NumRef] = leak(nrefs);
+    for (row, (a, b)) in rows.iter_mut().zip(ranges) {
+        row.nrefs = &nrefs[a..b];
+    }
+    Ok(rows.into_boxed_slice())
+}
+
+fn leak<T>(v: Vec<T>) -> &'static [T] {
+    Box::leak(v.into_boxed_slice())
+}
+
+type Res<T> = Result<T, String>;
+
+/// A position in one line of packed text.
+struct Cursor {
+    s: &'static str,
+    b: &'static [u8],
+    i: usize,
+}
+
+impl Cursor {
+    fn peek(&self) -> Option<u8> {
+        self.b.get(self.i).copied()
+    }
+
+    fn eat(&mut self, c: u8) -> bool {
+        let hit = self.peek() == Some(c);
+        if hit {
+            self.i += 1;
+        }
+        hit
+    }
+
+    fn expect(&mut self, c: u8) -> Res<()> {
+        if self.eat(c) {
+            Ok(())
+        } else {
+            Err(match self.peek() {
+                Some(f) => format!("expected `{}`, found `{}`", c as char, f as char),
+                None => format!("expected `{}`, found the end of the line", c as char),
+            })
+        }
+    }
+
+    /// `' '` then the next item.
+    fn sp(&mut self) -> Res<()> {
+        self.expect(b' ')
+    }
+
+    /// A word of ASCII letters and digits (a class, a tag such as `Int32`).
+    fn word(&mut self) -> &'static str {
+        let start = self.i;
+        while self.peek().is_some_and(|c| c.is_ascii_alphanumeric()) {
+            self.i += 1;
+        }
+        &self.s[start..self.i]
+    }
+
+    fn int(&mut self) -> Res<i128> {
+        let neg = self.eat(b'-');
+        let start = self.i;
+        let mut v: i128 = 0;
+        while let Some(d) = self.peek().filter(u8::is_ascii_digit) {
+            v = v.checked_mul(10).and_then(|v| v.checked_add(i128::from(d - b'0'))).ok_or("number too large")?;
+            self.i += 1;
+        }
+        if self.i == start {
+            return Err("expected a number".into());
+        }
+        Ok(if neg { -v } else { v })
+    }
+
+    fn num<T: TryFrom<i128>>(&mut self, what: &str) -> Res<T> {
+        let start = self.i;
+        let v = self.int()?;
+        T::try_from(v).map_err(|_| {
+            self.i = start;
+            format!("{v} is out of range for {what}")
+        })
+    }
+
+    fn bool(&mut self) -> Res<bool> {
+        match self.peek() {
+            Some(b'0') => {
+                self.i += 1;
+                Ok(false)
+            }
+            Some(b'1') => {
+                self.i += 1;
+                Ok(true)
+            }
+            _ => Err("expected a boolean, `0` or `1`".into()),
+        }
+    }
+
+    /// Text up to the next delimiter, for floats.
+    fn token(&mut self) -> &'static str {
+        let start = self.i;
+        while self.peek().is_some_and(|c| !matches!(c, b' ' | b'}' | b']' | b',')) {
+            self.i += 1;
+        }
+        &self.s[start..self.i]
+    }
+
+    fn f64(&mut self) -> Res<f64> {
+        let t = self.token();
+        t.parse().map_err(|_| format!("`{t}` is not a number"))
+    }
+
+    fn f32(&mut self) -> Res<f32> {
+        let t = self.token();
+        t.parse().map_err(|_| format!("`{t}` is not a number"))
+    }
+
+    /// Pairs of hex digits.
+    fn hex(&mut self) -> Res<Vec<u8>> {
+        let digit = |c: u8| (c as char).to_digit(16).map(|d| d as u8);
+        let mut out = Vec::new();
+        while let Some(hi) = self.peek().and_then(digit) {
+            self.i += 1;
+            let lo = self.peek().and_then(digit).ok_or("odd number of hex digits")?;
+            self.i += 1;
+            out.push(hi << 4 | lo);
+        }
+        Ok(out)
+    }
+
+    fn guid(&mut self) -> Res<[u8; 16]> {
+        self.hex()?.try_into().map_err(|_| "a GUID is 32 hex digits".into())
+    }
+
+    fn string(&mut self) -> Res<&'static str> {
+        self.expect(b'"')?;
+        let start = self.i;
+        loop {
+            match self.peek() {
+                None => return Err("unterminated string".into()),
+                Some(b'"') => {
+                    self.i += 1;
+                    return Ok(&self.s[start..self.i - 1]);
+                }
+                Some(b'\\') => break,
+                Some(_) => self.i += 1,
+            }
+        }
+        let mut out = String::from(&self.s[start..self.i]);
+        loop {
+            match self.peek() {
+                None => return Err("unterminated string".into()),
+                Some(b'"') => {
+                    self.i += 1;
+                    return Ok(Box::leak(out.into_boxed_str()));
+                }
+                Some(b'\\') => {
+                    self.i += 1;
+                    let e = self.peek().ok_or("unterminated string")?;
+                    self.i += 1;
+                    out.push(match e {
+                        b'"' => '"',
+                        b'\\' => '\\',
+                        b'n' => '\n',
+                        b'r' => '\r',
+                        b't' => '\t',
+                        b'u' => {
+                            self.expect(b'{')?;
+                            let start = self.i;
+                            while self.peek().is_some_and(|c| c.is_ascii_hexdigit()) {
+                                self.i += 1;
+                            }
+                            let code = u32::from_str_radix(&self.s[start..self.i], 16).map_err(|_| "bad `\\u{..}` escape")?;
+                            self.expect(b'}')?;
+                            char::from_u32(code).ok_or("`\\u{..}` is not a character")?
+                        }
+                        e => return Err(format!("unknown escape `\\{}`", e as char)),
+                    });
+                }
+                Some(_) => {
+                    let start = self.i;
+                    while self.peek().is_some_and(|c| c != b'"' && c != b'\\') {
+                        self.i += 1;
+                    }
+                    out.push_str(&self.s[start..self.i]);
+                }
+            }
+        }
+    }
+
+    fn opt_string(&mut self) -> Res<Option<&'static str>> {
+        if self.eat(b'~') {
+            Ok(None)
+        } else {
+            self.string().map(Some)
+        }
+    }
+
+    /// A string, or `=` for `same`.
+    fn string_or(&mut self, same: &'static str) -> Res<&'static str> {
+        if self.eat(b'=') {
+            Ok(same)
+        } else {
+            self.string()
+        }
+    }
+
+    fn id(&mut self) -> Res<Id> {
+        let ns = self.num("a namespace index")?;
+        self.expect(b':')?;
+        let id = match self.peek() {
+            Some(b's') => {
+                self.i += 1;
+                IdKind::String(self.string()?)
+            }
+            Some(b'g') => {
+                self.i += 1;
+                IdKind::Guid(self.guid()?)
+            }
+            Some(b'b') => {
+                self.i += 1;
+                IdKind::Opaque(leak(self.hex()?))
+            }
+            _ => IdKind::Numeric(self.num("a numeric identifier")?),
+        };
+        Ok(Id { ns, id })
+    }
+
+    fn opt_id(&mut self) -> Res<Option<Id>> {
+        if self.eat(b'~') {
+            Ok(None)
+        } else {
+            self.id().map(Some)
+        }
+    }
+
+    /// `ns:"name"`.
+    fn qualified(&mut self) -> Res<(u16, &'static str)> {
+        let ns = self.num("a namespace index")?;
+        self.expect(b':')?;
+        Ok((ns, self.string()?))
+    }
+
+    fn dims(&mut self) -> Res<&'static [u32]> {
+        self.expect(b'[')?;
+        if self.eat(b']') {
+            return Ok(&[]);
+        }
+        let mut v = Vec::new();
+        loop {
+            v.push(self.num("an array dimension")?);
+            if self.eat(b']') {
+                return Ok(leak(v));
+            }
+            self.expect(b',')?;
+        }
+    }
+
+    /// `{ item item }` or `{ }`.
+    fn list<T>(&mut self, mut item: impl FnMut(&mut Self) -> Res<T>) -> Res<&'static [T]> {
+        self.expect(b'{')?;
+        let mut v = Vec::new();
+        loop {
+            self.sp()?;
+            if self.eat(b'}') {
+                return Ok(leak(v));
+            }
+            v.push(item(self)?);
+        }
+    }
+
+    fn enum_row(&mut self) -> Res<EnumRow> {
+        let value = self.num("an enumeration value")?;
+        self.sp()?;
+        let name = self.string()?;
+        self.sp()?;
+        let display_name = self.string_or(name)?;
+        self.sp()?;
+        Ok(EnumRow { value, name, display_name, description: self.opt_string()? })
+    }
+
+    fn field_row(&mut self) -> Res<FieldRow> {
+        let name = self.string()?;
+        self.sp()?;
+        let description = self.opt_string()?;
+        self.sp()?;
+        let data_type = self.id()?;
+        self.sp()?;
+        let value_rank = self.num("a ValueRank")?;
+        self.sp()?;
+        let array_dimensions = self.dims()?;
+        self.sp()?;
+        let max_string_length = self.num("a MaxStringLength")?;
+        self.sp()?;
+        Ok(FieldRow { name, description, data_type, value_rank, array_dimensions, max_string_length, is_optional: self.bool()? })
+    }
+
+    fn arg_row(&mut self) -> Res<ArgRow> {
+        let name = self.string()?;
+        self.sp()?;
+        let data_type = self.id()?;
+        self.sp()?;
+        let value_rank = self.num("a ValueRank")?;
+        self.sp()?;
+        let array_dimensions = self.dims()?;
+        self.sp()?;
+        Ok(ArgRow { name, data_type, value_rank, array_dimensions, description: self.opt_string()? })
+    }
+
+    fn definition(&mut self) -> Res<Option<Def>> {
+        if self.eat(b'~') {
+            return Ok(None);
+        }
+        let kind = match self.word() {
+            "Enum" => {
+                self.sp()?;
+                return Ok(Some(Def::Enum { fields: self.list(Self::enum_row)? }));
+            }
+            "Structure" => StructureKind::Structure,
+            "StructureWithOptionalFields" => StructureKind::StructureWithOptionalFields,
+            "Union" => StructureKind::Union,
+            w => return Err(format!("unknown definition `{w}`")),
+        };
+        self.sp()?;
+        let base = self.id()?;
+        self.sp()?;
+        let default_encoding = self.opt_id()?;
+        self.sp()?;
+        Ok(Some(Def::Structure { base, default_encoding, kind, fields: self.list(Self::field_row)? }))
+    }
+
+    fn value(&mut self) -> Res<Val> {
+        if self.eat(b'~') {
+            return Ok(Val::None);
+        }
+        let tag = self.word();
+        self.expect(b':')?;
+        Ok(match tag {
+            "Boolean" => Val::Boolean(self.bool()?),
+            "SByte" => Val::SByte(self.num("SByte")?),
+            "Byte" => Val::Byte(self.num("Byte")?),
+            "Int16" => Val::Int16(self.num("Int16")?),
+            "UInt16" => Val::UInt16(self.num("UInt16")?),
+            "Int32" => Val::Int32(self.num("Int32")?),
+            "UInt32" => Val::UInt32(self.num("UInt32")?),
+            "Int64" => Val::Int64(self.num("Int64")?),
+            "UInt64" => Val::UInt64(self.num("UInt64")?),
+            "Float" => Val::Float(self.f32()?),
+            "Double" => Val::Double(self.f64()?),
+            "String" => Val::String(self.string()?),
+            "DateTime" => Val::DateTime(self.string()?),
+            "Guid" => Val::Guid(self.guid()?),
+            "ByteString" => Val::ByteString(leak(self.hex()?)),
+            "NodeId" => Val::NodeId(self.id()?),
+            "ExpandedNodeId" => Val::ExpandedNodeId(self.id()?),
+            "StatusCode" => Val::StatusCode(self.num("a StatusCode")?),
+            "QualifiedName" => {
+                let (ns, name) = self.qualified()?;
+                Val::QualifiedName(ns, name)
+            }
+            "LocalizedText" => {
+                let locale = self.opt_string()?;
+                self.expect(b':')?;
+                Val::LocalizedText(locale, self.string()?)
+            }
+            "Array" => {
+                let ty = self.num("a DataType number")?;
+                self.sp()?;
+                Val::Array(ty, self.list(Self::value)?)
+            }
+            "Arguments" => Val::Arguments(self.list(Self::arg_row)?),
+            "EnumValues" => Val::EnumValues(self.list(Self::enum_row)?),
+            t => return Err(format!("unknown value tag `{t}`")),
+        })
+    }
+
+    /// One line; its references go to `refs`.
+    fn row(&mut self, refs: &mut Vec<Ref>) -> Res<NodeRow> {
+        let class = self.word();
+        if !matches!(
+            class,
+            "Object" | "ObjectType" | "Variable" | "VariableType" | "Method" | "ReferenceType" | "DataType" | "View"
+        ) {
+            self.i = 0;
+            return Err(format!("unknown node class `{class}`"));
+        }
+        self.sp()?;
+        let id = self.id()?;
+        self.sp()?;
+        let browse_name = self.qualified()?;
+        self.sp()?;
+        let display_name = self.string_or(browse_name.1)?;
+        self.sp()?;
+        let description = self.opt_string()?;
+        self.sp()?;
+        let write_mask = self.num("a WriteMask")?;
+        self.sp()?;
+        let user_write_mask = self.num("a UserWriteMask")?;
+        self.sp()?;
+        let kind = match class {
+            "Object" => Kind::Object { event_notifier: self.num("an EventNotifier")? },
+            "ObjectType" => Kind::ObjectType { is_abstract: self.bool()? },
+            "Variable" | "VariableType" => {
+                let data_type = self.id()?;
+                self.sp()?;
+                let value_rank = self.num("a ValueRank")?;
+                self.sp()?;
+                let array_dimensions = self.dims()?;
+                self.sp()?;
+                if class == "Variable" {
+                    let access_level = self.num("an AccessLevel")?;
+                    self.sp()?;
+                    let user_access_level = self.num("a UserAccessLevel")?;
+                    self.sp()?;
+                    let historizing = self.bool()?;
+                    self.sp()?;
+                    let minimum_sampling_interval = if self.eat(b'~') { None } else { Some(self.f64()?) };
+                    self.sp()?;
+                    Kind::Variable {
+                        data_type,
+                        value_rank,
+                        array_dimensions,
+                        access_level,
+                        user_access_level,
+                        historizing,
+                        minimum_sampling_interval,
+                        value: self.value()?,
+                    }
+                } else {
+                    let is_abstract = self.bool()?;
+                    self.sp()?;
+                    Kind::VariableType { data_type, value_rank, array_dimensions, is_abstract, value: self.value()? }
+                }
+            }
+            "Method" => {
+                let executable = self.bool()?;
+                self.sp()?;
+                Kind::Method { executable, user_executable: self.bool()? }
+            }
+            "ReferenceType" => {
+                let symmetric = self.bool()?;
+                self.sp()?;
+                let is_abstract = self.bool()?;
+                self.sp()?;
+                Kind::ReferenceType { symmetric, is_abstract, inverse_name: self.opt_string()? }
+            }
+            "DataType" => {
+                let is_abstract = self.bool()?;
+                self.sp()?;
+                Kind::DataType { is_abstract, definition: self.definition()? }
+            }
+            "View" => {
+                let event_notifier = self.num("an EventNotifier")?;
+                self.sp()?;
+                Kind::View { event_notifier, contains_no_loops: self.bool()? }
+            }
+            c => return Err(format!("unknown node class `{c}`")),
+        };
+        while self.i < self.b.len() {
+            self.sp()?;
+            let reference_type = self.id()?;
+            let forward = match self.peek() {
+                Some(b'>') => true,
+                Some(b'<') => false,
+                _ => return Err("expected `>` or `<` between a reference's type and target".into()),
+            };
+            self.i += 1;
+            refs.push(Ref { reference_type, target: self.id()?, forward });
+        }
+        Ok(NodeRow {
+            id,
+            browse_name,
+            display_name,
+            description,
+            write_mask,
+            user_write_mask,
+            kind,
+            refs: &[],
+            nrefs: &[],
+        })
+    }
 }
 
 #[cfg(test)]
@@ -247,6 +887,229 @@ mod tests {
                 Ref { reference_type: Id::numeric(2, 4002), target: Id::numeric(1, 1003), forward: false },
             ]
         );
+    }
+
+    /// Lines as the generator writes them, one per node class, with every kind of identifier and escape.
+    const TEXT: &str = r#"
+Object 1:5 1:"Cell \"A\" > 1#" "Zelle\tA" "line\nbreak \\ \u{1} ü" 3 4 1 0:47>1:s"a b>c" 0:40<0:58
+ObjectType 1:g000102030405060708090a0b0c0d0e0f 0:"T" = ~ 0 0 1 0:45<0:58 0:47>1:6
+Variable 1:b00ff 0:"V" = ~ 0 0 0:11 1 [2,3] 3 1 1 250.5 Array:11 { Double:NaN Double:-0 Double:inf Double:0.0000001 }
+VariableType 1:7 1:"VT" = ~ 0 0 1:3001 -2 [] 1 LocalizedText:"en":"Hallo"
+Method 1:8 1:"Start" = ~ 0 0 1 0 0:46>1:9
+Variable 1:9 0:"InputArguments" = ~ 0 0 0:296 1 [0] 1 1 0 ~ Arguments:{ "Speed" 0:11 -1 [] "mm/s" "Axes" 1:s"Id" 1 [6] ~ }
+ReferenceType 1:10 1:"Feeds" = ~ 0 0 0 1 "FedBy"
+DataType 1:11 1:"Mode" = ~ 0 0 0 Enum { -1 "Off" = ~ 5 "On" "Running" "the axis moves" } 0:45<0:29
+DataType 1:12 1:"Point" = ~ 0 0 0 StructureWithOptionalFields 0:22 1:13 { "X" ~ 0:11 -1 [] 0 0 "Label" "a name" 0:12 -1 [] 40 1 }
+DataType 1:14 1:"Abstract" = ~ 0 0 1 ~
+View 1:15 1:"Overview" = ~ 0 0 1 1
+"#;
+
+    #[test]
+    fn packed_rows_decode_every_construct() {
+        let rows = decode(TEXT).expect("the text decodes");
+        assert_eq!(rows.len(), 11);
+        let cell = &rows[0];
+        assert_eq!(cell.id, Id::numeric(1, 5));
+        assert_eq!(cell.browse_name, (1, "Cell \"A\" > 1#"));
+        assert_eq!(cell.display_name, "Zelle\tA");
+        assert_eq!(cell.description, Some("line\nbreak \\ \u{1} ü"));
+        assert_eq!((cell.write_mask, cell.user_write_mask), (3, 4));
+        assert!(matches!(cell.kind, Kind::Object { event_notifier: 1 }));
+        // A string identifier among the references: all of the row's references are general ones.
+        assert!(cell.nrefs.is_empty());
+        assert_eq!(
+            cell.refs,
+            [
+                Ref { reference_type: Id::ns0(47), target: Id { ns: 1, id: IdKind::String("a b>c") }, forward: true },
+                Ref { reference_type: Id::ns0(40), target: Id::ns0(58), forward: false },
+            ]
+        );
+
+        let t = &rows[1];
+        let guid: [u8; 16] = std::array::from_fn(|i| i as u8);
+        assert_eq!(t.id, Id { ns: 1, id: IdKind::Guid(guid) });
+        assert_eq!((t.browse_name, t.display_name, t.description), ((0, "T"), "T", None));
+        assert!(matches!(t.kind, Kind::ObjectType { is_abstract: true }));
+        assert!(t.refs.is_empty());
+        assert_eq!(t.nrefs, [(0, 45, 0, 58, false), (0, 47, 1, 6, true)]);
+
+        let v = &rows[2];
+        assert_eq!(v.id, Id { ns: 1, id: IdKind::Opaque(&[0x00, 0xff]) });
+        let Kind::Variable {
+            data_type,
+            value_rank,
+            array_dimensions,
+            access_level,
+            user_access_level,
+            historizing,
+            minimum_sampling_interval,
+            value: Val::Array(11, items),
+        } = v.kind
+        else {
+            panic!("a Variable with an array value: {:?}", v.kind)
+        };
+        assert_eq!((data_type, value_rank, array_dimensions), (Id::ns0(11), 1, &[2, 3][..]));
+        assert_eq!((access_level, user_access_level, historizing, minimum_sampling_interval), (3, 1, true, Some(250.5)));
+        let doubles: Vec<f64> = items
+            .iter()
+            .map(|i| match i {
+                Val::Double(x) => *x,
+                other => panic!("not a Double: {other:?}"),
+            })
+            .collect();
+        assert!(doubles[0].is_nan());
+        assert!(doubles[1] == 0.0 && doubles[1].is_sign_negative());
+        assert_eq!(doubles[2..], [f64::INFINITY, 1e-7]);
+
+        assert!(matches!(
+            rows[3].kind,
+            Kind::VariableType { data_type: Id { ns: 1, id: IdKind::Numeric(3001) }, value_rank: -2, is_abstract: true, value: Val::LocalizedText(Some("en"), "Hallo"), .. }
+        ));
+        assert!(matches!(rows[4].kind, Kind::Method { executable: true, user_executable: false }));
+        let Kind::Variable { value: Val::Arguments(args), .. } = rows[5].kind else { panic!("arguments: {:?}", rows[5].kind) };
+        assert_eq!(
+            args,
+            [
+                ArgRow { name: "Speed", data_type: Id::ns0(11), value_rank: -1, array_dimensions: &[], description: Some("mm/s") },
+                ArgRow {
+                    name: "Axes",
+                    data_type: Id { ns: 1, id: IdKind::String("Id") },
+                    value_rank: 1,
+                    array_dimensions: &[6],
+                    description: None
+                },
+            ]
+        );
+        assert!(matches!(rows[6].kind, Kind::ReferenceType { symmetric: false, is_abstract: true, inverse_name: Some("FedBy") }));
+        let Kind::DataType { is_abstract: false, definition: Some(Def::Enum { fields }) } = rows[7].kind else { panic!("{:?}", rows[7].kind) };
+        assert_eq!(
+            fields,
+            [
+                EnumRow { value: -1, name: "Off", display_name: "Off", description: None },
+                EnumRow { value: 5, name: "On", display_name: "Running", description: Some("the axis moves") },
+            ]
+        );
+        let Kind::DataType { definition: Some(Def::Structure { base, default_encoding, kind, fields }), .. } = rows[8].kind else {
+            panic!("{:?}", rows[8].kind)
+        };
+        assert_eq!((base, default_encoding, kind), (Id::ns0(22), Some(Id::numeric(1, 13)), StructureKind::StructureWithOptionalFields));
+        assert_eq!(fields.len(), 2);
+        assert_eq!(
+            fields[1],
+            FieldRow {
+                name: "Label",
+                description: Some("a name"),
+                data_type: Id::ns0(12),
+                value_rank: -1,
+                array_dimensions: &[],
+                max_string_length: 40,
+                is_optional: true
+            }
+        );
+        assert!(matches!(rows[9].kind, Kind::DataType { is_abstract: true, definition: None }));
+        assert!(matches!(rows[10].kind, Kind::View { event_notifier: 1, contains_no_loops: true }));
+    }
+
+    /// Every scalar value tag, each as a Variable's value.
+    #[test]
+    fn packed_values_of_every_tag() {
+        let values = [
+            "~",
+            "Boolean:1",
+            "SByte:-128",
+            "Byte:255",
+            "Int16:-32768",
+            "UInt16:65535",
+            "Int32:-2147483648",
+            "UInt32:4294967295",
+            "Int64:-9223372036854775808",
+            "UInt64:18446744073709551615",
+            "Float:1.5",
+            "Double:-2.25",
+            "String:\"\"",
+            "DateTime:\"2025-11-15T00:00:00Z\"",
+            "Guid:ffeeddccbbaa99887766554433221100",
+            "ByteString:",
+            "NodeId:2:s\"Pump\"",
+            "ExpandedNodeId:0:85",
+            "StatusCode:2147483648",
+            "QualifiedName:1:\"Name\"",
+            "LocalizedText:~:\"\"",
+            "Array:21 { }",
+            "EnumValues:{ 0 \"A\" = ~ }",
+        ];
+        let text: String =
+            values.iter().enumerate().map(|(i, v)| format!("Variable 1:{i} 1:\"V\" = ~ 0 0 0:24 -1 [] 1 1 0 ~ {v}\n")).collect();
+        let rows = decode(Box::leak(text.into_boxed_str())).expect("every value decodes");
+        let got: Vec<String> = rows
+            .iter()
+            .map(|r| match r.kind {
+                Kind::Variable { value, .. } => format!("{value:?}"),
+                _ => unreachable!(),
+            })
+            .collect();
+        assert_eq!(
+            got,
+            [
+                "None",
+                "Boolean(true)",
+                "SByte(-128)",
+                "Byte(255)",
+                "Int16(-32768)",
+                "UInt16(65535)",
+                "Int32(-2147483648)",
+                "UInt32(4294967295)",
+                "Int64(-9223372036854775808)",
+                "UInt64(18446744073709551615)",
+                "Float(1.5)",
+                "Double(-2.25)",
+                "String(\"\")",
+                "DateTime(\"2025-11-15T00:00:00Z\")",
+                "Guid([255, 238, 221, 204, 187, 170, 153, 136, 119, 102, 85, 68, 51, 34, 17, 0])",
+                "ByteString([])",
+                "NodeId(Id { ns: 2, id: String(\"Pump\") })",
+                "ExpandedNodeId(Id { ns: 0, id: Numeric(85) })",
+                "StatusCode(2147483648)",
+                "QualifiedName(1, \"Name\")",
+                "LocalizedText(None, \"\")",
+                "Array(21, [])",
+                "EnumValues([EnumRow { value: 0, name: \"A\", display_name: \"A\", description: None }])",
+            ]
+        );
+    }
+
+    #[test]
+    fn bad_packed_text_names_line_column_and_cause() {
+        let cases: [(&'static str, (usize, usize, &str)); 7] = [
+            ("\nObject 1:5 1:\"N\" = ~ 0 0 x", (2, 26, "expected a number")),
+            ("Object 1:5 1:\"N\" = ~ 0 0 300", (1, 26, "300 is out of range for an EventNotifier")),
+            ("Thing 1:5 1:\"N\" = ~ 0 0 0", (1, 1, "unknown node class `Thing`")),
+            ("Object 1:5 1:\"N", (1, 16, "unterminated string")),
+            ("Object 1:5 1:\"N\\q\" = ~ 0 0 0", (1, 18, "unknown escape `\\q`")),
+            ("Object 1:5 1:\"N\" = ~ 0 0 0 0:47=1:6", (1, 32, "expected `>` or `<` between a reference's type and target")),
+            ("ObjectType 1:gabcd 0:\"T\" = ~ 0 0 1", (1, 19, "a GUID is 32 hex digits")),
+        ];
+        for (text, (line, column, message)) in cases {
+            assert_eq!(decode(text).err(), Some((line, column, message.to_owned())), "{text:?}");
+        }
+    }
+
+    static BROKEN: NodeSetTable = NodeSetTable {
+        namespace_uri: "urn:broken",
+        version: "",
+        publication_date: "",
+        namespaces: &["http://opcfoundation.org/UA/", "urn:broken"],
+        own: 1,
+        nodes: Nodes::Packed(Packed::new("Object 1:1 1:\"A\" = ~ 0 0 0\nObject 1:2")),
+    };
+
+    #[test]
+    fn a_table_that_does_not_decode_says_where_every_time() {
+        for _ in 0..2 {
+            let e = BROKEN.rows().expect_err("line 2 is cut short");
+            assert_eq!((e.namespace_uri, e.line, e.column), ("urn:broken", 2, 11));
+            assert!(e.to_string().contains("urn:broken does not decode at line 2, column 11: expected ` `"), "{e}");
+        }
     }
 
     #[test]

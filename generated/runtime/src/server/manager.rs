@@ -20,7 +20,7 @@ use opcua::types::{
     Argument, AttributeId, BrowseDirection, DataEncoding, DataValue, NodeId, NumericRange, QualifiedName, StatusCode,
     TimestampsToReturn, Variant,
 };
-use tracing::warn;
+use tracing::{error, warn};
 
 use super::check::Types;
 use crate::import::{build_map, parse_date_time, TableImport, OPC_UA_NAMESPACE, UNMAPPED};
@@ -165,6 +165,10 @@ impl ModelNodes {
             .filter(|t| {
                 if t.own == 0 {
                     warn!("the table of {} claims namespace 0; it is not served", t.namespace_uri);
+                    return false;
+                }
+                if let Err(e) = t.rows() {
+                    error!("{e}; the table is not served");
                     return false;
                 }
                 let fresh = seen.insert(t.namespace_uri);

@@ -9,8 +9,9 @@
 //!   (`Option<T>` with the encoding mask), unions (enums with one-field variants), enumerations with the
 //!   nodeset's values, OptionSets as bit flags of the right width, simple subtypes as aliases, plus the
 //!   encoding ids and a type loader so servers and clients decode them;
-//! - `nodes.rs`: the address space as one static [`NodeSetTable`] (data, one row per node), which the
-//!   hand-written runtime imports into a server with the namespace indices of that server;
+//! - `nodes.rs`: the address space as one static [`NodeSetTable`] (data: one line of packed text per node,
+//!   decoded on first use), which the hand-written runtime imports into a server with the namespace
+//!   indices of that server;
 //! - `objects.rs`: typed handles of the ObjectTypes and VariableTypes and member markers (`objects`), the
 //!   state tables of state machine types, and the typed inputs and outputs of program types (`programs`).
 //!
@@ -20,7 +21,7 @@
 //!
 //! Code is built with quote and printed by prettyplease. Three tables are written as text instead, because
 //! building and parsing token trees for data cost most of the generation time: the node rows of `nodes.rs`
-//! (one line each), the NodeId constants of `ids.rs` (in prettyplease's own layout; the tests
+//! (one line of packed text each, inside one raw string literal), the NodeId constants of `ids.rs` (in prettyplease's own layout; the tests
 //! `ids_text_is_what_prettyplease_prints` and `generated_code_is_in_prettyplease_layout` hold it to that),
 //! and the member markers at the end of `objects.rs` (one line each).
 //!

@@ -1,17 +1,16 @@
-//! `nodes.rs`: the address space of a namespace as one static table, one row per node.
+//! `nodes.rs`: the address space of a namespace as one static table, one line of text per node.
 //!
-//! The rows are data, not code: a few thousand struct literals of a fixed shape. They are written straight
-//! into the output text, one line per row, with the spacing a person would use
-//! (`rt::table::Id { ns: 2, id: rt::IdKind::Numeric(6027) }`). Building them as token trees first and printing
-//! those cost about 70% of the whole Rust generation. Literals are still printed by proc-macro2's `Literal`, so
-//! strings, byte strings and floats are escaped exactly as the token-based parts of the emitter escape them.
-//! The few lines around the rows (the module head and the table header) go through quote and prettyplease.
+//! The rows are data, not code. They are written in the runtime's packed format (documented in the
+//! runtime's `table` module, which decodes it on first use) inside one raw string literal, so the Rust
+//! compiler reads a namespace's whole address space as a single token. Written as struct literals
+//! instead (the previous form, one `rt::table::NodeRow { .. }` per node), the rows were about a tenth of
+//! the generated crate's compile time: every literal is parsed, type-checked, const-evaluated and emitted
+//! with its relocations.
 //!
-//! A row's references are written as tuples of numbers, `(0, 45, 2, 3008, false)` (reference type namespace
-//! and number, target namespace and number, forward), when all of them are numeric: references are most of a
-//! table's expressions, and a tuple of literals is 6 expressions where `rt::table::Ref { .. }` with its two
-//! `Id`s is 11. For DI + IA + Robotics the table text shrinks from 1,077 KB to 660 KB, and a crate of only
-//! their three tables builds with 19% less rustc self time (2.54 -> 2.06 s, mean of three clean builds).
+//! The format is positional, one item per space, so a row reads like the nodeset's attributes in order:
+//! `Variable 1:15002 0:"NamespaceUri" = ~ 0 0 0:12 -1 [] 1 1 0 ~ String:"http://..." 0:40>0:68`. Strings are
+//! quoted with `"`, `\`, line breaks and control characters escaped; floats are printed the way Rust parses
+//! them back to the same value.
 
 use super::{lit, path, Gen};
 use crate::diag::{Code, Diagnostic};
@@ -26,111 +25,109 @@ use std::collections::BTreeSet;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
-/// Appends a string literal.
+/// Appends a string in the packed format: quoted, with `"`, `\`, line breaks, tabs and other control
+/// characters escaped (so a row stays on one line and the Rust raw string around the text stays valid).
 fn str_lit(out: &mut String, s: &str) {
-    out.push_str(&Literal::string(s).to_string());
+    out.push('"');
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            '\r' => out.push_str("\\r"),
+            '\t' => out.push_str("\\t"),
+            c if c.is_control() => {
+                let _ = write!(out, "\\u{{{:x}}}", c as u32);
+            }
+            c => out.push(c),
+        }
+    }
+    out.push('"');
 }
 
-/// Appends `Some("...")` or `None`.
+/// Appends a string, or `~`.
 fn opt_str(out: &mut String, s: Option<&str>) {
     match s {
-        Some(s) => {
-            out.push_str("Some(");
-            str_lit(out, s);
-            out.push(')');
-        }
-        None => out.push_str("None"),
+        Some(s) => str_lit(out, s),
+        None => out.push('~'),
     }
 }
 
-/// Appends `&[a, b, c]` with each item written by `item`.
+/// Appends `=` if `s` is `same`, else the string.
+fn str_or_same(out: &mut String, s: &str, same: &str) {
+    if s == same {
+        out.push('=');
+    } else {
+        str_lit(out, s);
+    }
+}
+
+/// Appends `{ a b c }` (or `{ }`) with each item written by `item`.
 fn list<T>(out: &mut String, items: impl IntoIterator<Item = T>, mut item: impl FnMut(&mut String, T)) {
-    out.push_str("&[");
-    for (i, x) in items.into_iter().enumerate() {
-        if i > 0 {
-            out.push_str(", ");
-        }
+    out.push('{');
+    for x in items {
+        out.push(' ');
         item(out, x);
     }
-    out.push(']');
-}
-
-/// Appends `&[1u32, 2u32]`.
-fn dims(out: &mut String, d: &[u32]) {
-    list(out, d, |out, x| {
-        let _ = write!(out, "{x}u32");
-    });
-}
-
-/// Appends the bytes of a GUID, `[1, 2, ...]`.
-fn guid(out: &mut String, g: &[u8; 16]) {
-    out.push('[');
-    for (i, b) in g.iter().enumerate() {
-        if i > 0 {
-            out.push_str(", ");
-        }
-        let _ = write!(out, "{b}");
-    }
-    out.push(']');
-}
-
-/// Appends an `rt::IdKind`.
-fn id_kind(out: &mut String, id: &Identifier) {
-    match id {
-        Identifier::Numeric(v) => {
-            let _ = write!(out, "rt::IdKind::Numeric({v})");
-        }
-        Identifier::String(s) => {
-            out.push_str("rt::IdKind::String(");
-            str_lit(out, s);
-            out.push(')');
-        }
-        Identifier::Guid(g) => {
-            out.push_str("rt::IdKind::Guid(");
-            guid(out, g);
-            out.push(')');
-        }
-        Identifier::Opaque(b) => {
-            out.push_str("rt::IdKind::Opaque(");
-            out.push_str(&Literal::byte_string(b).to_string());
-            out.push(')');
-        }
-    }
-}
-
-/// Appends an `rt::table::Id` whose namespace is written `ns` (`2` for node ids of the table, `2u16` for
-/// node ids inside values: both forms are kept so that the output does not change with this rewrite).
-fn table_id(out: &mut String, ns: u16, suffixed: bool, id: &Identifier) {
-    let _ = write!(out, "rt::table::Id {{ ns: {ns}{}, id: ", if suffixed { "u16" } else { "" });
-    id_kind(out, id);
     out.push_str(" }");
 }
 
-/// Appends a float value (`Val::Float(1.5f32)`, `Val::Double(f64::NAN)`).
-fn float(out: &mut String, x: f64, single: bool) {
-    let special = if x.is_nan() {
-        Some("f64::NAN")
-    } else if x.is_infinite() {
-        Some(if x > 0.0 { "f64::INFINITY" } else { "f64::NEG_INFINITY" })
-    } else {
-        None
-    };
-    if single {
-        out.push_str("rt::table::Val::Float(");
-        match special {
-            Some(s) => {
-                let _ = write!(out, "({s})as f32");
-            }
-            None => out.push_str(&Literal::f32_suffixed(x as f32).to_string()),
+/// Appends `[]` or `[2,3]`.
+fn dims(out: &mut String, d: &[u32]) {
+    out.push('[');
+    for (i, x) in d.iter().enumerate() {
+        if i > 0 {
+            out.push(',');
         }
-    } else {
-        out.push_str("rt::table::Val::Double(");
-        match special {
-            Some(s) => out.push_str(s),
-            None => out.push_str(&Literal::f64_suffixed(x).to_string()),
+        let _ = write!(out, "{x}");
+    }
+    out.push(']');
+}
+
+/// Appends bytes as hex digits.
+fn hex(out: &mut String, bytes: &[u8]) {
+    for b in bytes {
+        let _ = write!(out, "{b:02x}");
+    }
+}
+
+/// Appends a boolean, `0` or `1`.
+fn flag(out: &mut String, b: bool) {
+    out.push(if b { '1' } else { '0' });
+}
+
+/// Appends a NodeId with its table-local namespace index: `2:6027`, `2:s"Pump"`, `2:g<hex>`, `2:b<hex>`.
+fn table_id(out: &mut String, ns: u16, id: &Identifier) {
+    let _ = write!(out, "{ns}:");
+    match id {
+        Identifier::Numeric(v) => {
+            let _ = write!(out, "{v}");
+        }
+        Identifier::String(s) => {
+            out.push('s');
+            str_lit(out, s);
+        }
+        Identifier::Guid(g) => {
+            out.push('g');
+            hex(out, g);
+        }
+        Identifier::Opaque(b) => {
+            out.push('b');
+            hex(out, b);
         }
     }
-    out.push(')');
+}
+
+/// The raw string literal around packed text: `r#"` .. `"#` with one `#` more than any run of `#` that
+/// follows a `"` in the text.
+fn raw_string(text: &str) -> String {
+    let mut most = 0;
+    for (i, _) in text.match_indices('"') {
+        let run = text[i + 1..].bytes().take_while(|&b| b == b'#').count();
+        most = most.max(run);
+    }
+    let hashes = "#".repeat(most + 1);
+    format!("r{hashes}\"{text}\"{hashes}")
 }
 
 impl Gen<'_> {
@@ -157,7 +154,7 @@ impl Gen<'_> {
         let locals: Vec<u16> = std::iter::once(0).chain(used.iter().copied()).collect();
         let local = |g: u16| locals.iter().position(|&l| l == g).unwrap_or(0) as u16;
 
-        let mut rows = String::with_capacity(mine.len() * 400);
+        let mut rows = String::with_capacity(mine.len() * 160);
         let mut dropped_values = 0usize;
         let mut value = String::new();
         for &ix in &mine {
@@ -165,127 +162,94 @@ impl Gen<'_> {
             let out = &mut rows;
             let id_of = |out: &mut String, ix: NodeIx| {
                 let id = &model.node(ix).id;
-                table_id(out, local(id.ns), false, &id.id);
+                table_id(out, local(id.ns), &id.id);
             };
-            out.push_str("        rt::table::NodeRow { id: ");
+            out.push_str(match n.class {
+                NodeClass::Object => "Object ",
+                NodeClass::ObjectType => "ObjectType ",
+                NodeClass::Variable => "Variable ",
+                NodeClass::VariableType => "VariableType ",
+                NodeClass::Method => "Method ",
+                NodeClass::ReferenceType => "ReferenceType ",
+                NodeClass::DataType => "DataType ",
+                NodeClass::View => "View ",
+            });
             id_of(out, ix);
-            let _ = write!(out, ", browse_name: ({}, ", local(n.browse_name.ns));
+            let _ = write!(out, " {}:", local(n.browse_name.ns));
             str_lit(out, &n.browse_name.name);
-            out.push_str("), display_name: ");
-            str_lit(out, n.display());
-            out.push_str(", description: ");
+            out.push(' ');
+            str_or_same(out, n.display(), &n.browse_name.name);
+            out.push(' ');
             opt_str(out, n.doc());
-            let _ = write!(
-                out,
-                ", write_mask: {}u32, user_write_mask: {}u32, kind: ",
-                n.attrs.write_mask.unwrap_or(0),
-                n.attrs.user_write_mask.unwrap_or(0)
-            );
+            let _ = write!(out, " {} {} ", n.attrs.write_mask.unwrap_or(0), n.attrs.user_write_mask.unwrap_or(0));
             match n.class {
                 NodeClass::Object => {
-                    let _ = write!(out, "rt::table::Kind::Object {{ event_notifier: {}u8 }}", n.attrs.event_notifier.unwrap_or(0));
+                    let _ = write!(out, "{}", n.attrs.event_notifier.unwrap_or(0));
                 }
-                NodeClass::ObjectType => {
-                    let _ = write!(out, "rt::table::Kind::ObjectType {{ is_abstract: {} }}", n.is_abstract());
-                }
+                NodeClass::ObjectType => flag(out, n.is_abstract()),
                 NodeClass::Variable | NodeClass::VariableType => {
                     value.clear();
                     if !self.value_text(&mut value, ix, &local) {
                         dropped_values += 1;
                         value.clear();
-                        value.push_str("rt::table::Val::None");
+                        value.push('~');
                     }
-                    let variable = n.class == NodeClass::Variable;
-                    out.push_str(if variable { "rt::table::Kind::Variable { data_type: " } else { "rt::table::Kind::VariableType { data_type: " });
                     match n.attrs.data_type {
                         Some(dt) => id_of(out, dt),
-                        None => out.push_str("rt::table::Id::ns0(24)"),
+                        None => out.push_str("0:24"),
                     }
-                    let _ = write!(out, ", value_rank: {}i32, array_dimensions: ", n.attrs.value_rank.unwrap_or(-1));
+                    let _ = write!(out, " {} ", n.attrs.value_rank.unwrap_or(-1));
                     dims(out, &n.attrs.array_dimensions);
-                    if variable {
+                    if n.class == NodeClass::Variable {
                         let al = n.attrs.access_level.unwrap_or(1);
                         let ual = n.attrs.user_access_level.unwrap_or(al);
-                        let _ = write!(
-                            out,
-                            ", access_level: {al}u8, user_access_level: {ual}u8, historizing: {}, minimum_sampling_interval: ",
-                            n.attrs.historizing.unwrap_or(false)
-                        );
+                        let _ = write!(out, " {al} {ual} ");
+                        flag(out, n.attrs.historizing.unwrap_or(false));
                         match n.attrs.minimum_sampling_interval {
                             Some(v) => {
-                                let _ = write!(out, "Some({})", Literal::f64_suffixed(v));
+                                let _ = write!(out, " {v}");
                             }
-                            None => out.push_str("None"),
+                            None => out.push_str(" ~"),
                         }
                     } else {
-                        let _ = write!(out, ", is_abstract: {}", n.is_abstract());
+                        out.push(' ');
+                        flag(out, n.is_abstract());
                     }
-                    out.push_str(", value: ");
+                    out.push(' ');
                     out.push_str(&value);
-                    out.push_str(" }");
                 }
                 NodeClass::Method => {
                     let e = n.attrs.executable.unwrap_or(true);
-                    let ue = n.attrs.user_executable.unwrap_or(e);
-                    let _ = write!(out, "rt::table::Kind::Method {{ executable: {e}, user_executable: {ue} }}");
+                    flag(out, e);
+                    out.push(' ');
+                    flag(out, n.attrs.user_executable.unwrap_or(e));
                 }
                 NodeClass::ReferenceType => {
-                    let _ = write!(
-                        out,
-                        "rt::table::Kind::ReferenceType {{ symmetric: {}, is_abstract: {}, inverse_name: ",
-                        n.attrs.symmetric.unwrap_or(false),
-                        n.is_abstract()
-                    );
+                    flag(out, n.attrs.symmetric.unwrap_or(false));
+                    out.push(' ');
+                    flag(out, n.is_abstract());
+                    out.push(' ');
                     opt_str(out, n.attrs.inverse_name.first().map(|t| t.text.as_str()));
-                    out.push_str(" }");
                 }
                 NodeClass::DataType => {
-                    let _ = write!(out, "rt::table::Kind::DataType {{ is_abstract: {}, definition: ", n.is_abstract());
+                    flag(out, n.is_abstract());
+                    out.push(' ');
                     self.definition_text(out, ix, &id_of);
-                    out.push_str(" }");
                 }
                 NodeClass::View => {
-                    let _ = write!(
-                        out,
-                        "rt::table::Kind::View {{ event_notifier: {}u8, contains_no_loops: {} }}",
-                        n.attrs.event_notifier.unwrap_or(0),
-                        n.attrs.contains_no_loops.unwrap_or(false)
-                    );
+                    let _ = write!(out, "{} ", n.attrs.event_notifier.unwrap_or(0));
+                    flag(out, n.attrs.contains_no_loops.unwrap_or(false));
                 }
             }
-            // References go to `nrefs` as tuples of numbers when all of them are numeric (nearly always), else
-            // all to `refs`, so that the order is the nodeset's either way.
-            let declared = || n.references.iter().filter(|r| r.declared);
-            let numeric = |ix: NodeIx| match model.node(ix).id.id {
-                Identifier::Numeric(v) => Some(v),
-                _ => None,
-            };
-            if declared().all(|r| numeric(r.reference_type).is_some() && numeric(r.target).is_some()) {
-                out.push_str(", refs: &[], nrefs: ");
-                list(out, declared(), |out, r| {
-                    let (rt, target) = (model.node(r.reference_type), model.node(r.target));
-                    let _ = write!(
-                        out,
-                        "({}, {}, {}, {}, {})",
-                        local(rt.id.ns),
-                        numeric(r.reference_type).unwrap_or(0),
-                        local(target.id.ns),
-                        numeric(r.target).unwrap_or(0),
-                        r.forward
-                    );
-                });
-            } else {
-                out.push_str(", refs: ");
-                list(out, declared(), |out, r| {
-                    out.push_str("rt::table::Ref { reference_type: ");
-                    id_of(out, r.reference_type);
-                    out.push_str(", target: ");
-                    id_of(out, r.target);
-                    let _ = write!(out, ", forward: {} }}", r.forward);
-                });
-                out.push_str(", nrefs: &[]");
+            // The references the row's file declares, in its order: `type>target` forward, `type<target`
+            // inverse.
+            for r in n.references.iter().filter(|r| r.declared) {
+                out.push(' ');
+                id_of(out, r.reference_type);
+                out.push(if r.forward { '>' } else { '<' });
+                id_of(out, r.target);
             }
-            out.push_str(" }, \n");
+            out.push('\n');
         }
         if dropped_values > 0 {
             self.diags.push(
@@ -305,8 +269,6 @@ impl Gen<'_> {
         let runtime = path(&self.cfg.runtime_path);
         let head = quote! {
             //! The address space of this namespace as data, imported into a server by the runtime.
-            #[allow(unused_imports)]
-            use super::types;
             use #runtime as rt;
         };
         let head_file: syn::File = syn::parse2(head).expect("internal error: the table head does not parse");
@@ -318,74 +280,64 @@ impl Gen<'_> {
                 publication_date: #date,
                 namespaces: &[#(#ns_uris),*],
                 own: #own,
-                nodes: &[ ROWS ],
+                nodes: rt::table::Nodes::Packed(rt::table::Packed::new(ROWS)),
             };
         };
         let table_file: syn::File = syn::parse2(table_head).expect("internal error: table does not parse");
         let table_text = prettyplease::unparse(&table_file);
-        let table_text = table_text.replacen("ROWS", &format!("\n{rows}    "), 1);
+        let table_text = table_text.replacen("ROWS", &raw_string(&format!("\n{rows}")), 1);
         text.push('\n');
-        text.push_str("/// Every node of this namespace, one row per node.\n");
+        text.push_str(
+            "/// Every node of this namespace, one line per node, in the packed format of [`rt::table`] (decoded on\n\
+             /// first use).\n",
+        );
         text.push_str(&table_text);
         OutFile { path: PathBuf::from(&self.module).join("nodes.rs"), contents: format!("{}{text}", self.header("Address space")) }
     }
 
-    /// Appends the `Def` of a data type, or `None`.
+    /// Appends the definition of a data type, or `~`.
     fn definition_text(&self, out: &mut String, t: NodeIx, id_of: &dyn Fn(&mut String, NodeIx)) {
         let model = self.model;
         let Some(info) = model.data_types.get(&t) else {
-            out.push_str("None");
+            out.push('~');
             return;
         };
         match &info.kind {
             DataTypeKind::Structure { kind, fields, has_definition: true } => {
-                out.push_str("Some(rt::table::Def::Structure { base: ");
+                out.push_str(match kind {
+                    StructureKind::Structure => "Structure ",
+                    StructureKind::StructureWithOptionalFields => "StructureWithOptionalFields ",
+                    StructureKind::Union => "Union ",
+                });
                 match model.node(t).super_type {
                     Some(s) => id_of(out, s),
-                    None => out.push_str("rt::table::Id::ns0(22)"),
+                    None => out.push_str("0:22"),
                 }
-                out.push_str(", default_encoding: ");
+                out.push(' ');
                 match info.encodings.iter().find(|(n, _)| n == "Default Binary") {
-                    Some((_, e)) => {
-                        out.push_str("Some(");
-                        id_of(out, *e);
-                        out.push(')');
-                    }
-                    None => out.push_str("None"),
+                    Some((_, e)) => id_of(out, *e),
+                    None => out.push('~'),
                 }
-                out.push_str(", kind: rt::table::StructureKind::");
-                out.push_str(match kind {
-                    StructureKind::Structure => "Structure",
-                    StructureKind::StructureWithOptionalFields => "StructureWithOptionalFields",
-                    StructureKind::Union => "Union",
-                });
-                out.push_str(", fields: ");
+                out.push(' ');
                 list(out, fields, |out, f| {
-                    out.push_str("rt::table::FieldRow { name: ");
                     str_lit(out, &f.name);
-                    out.push_str(", description: ");
+                    out.push(' ');
                     opt_str(out, f.description.as_deref());
-                    out.push_str(", data_type: ");
+                    out.push(' ');
                     id_of(out, f.data_type);
-                    let _ = write!(out, ", value_rank: {}i32, array_dimensions: ", f.value_rank);
+                    let _ = write!(out, " {} ", f.value_rank);
                     dims(out, &f.array_dimensions);
-                    let _ = write!(
-                        out,
-                        ", max_string_length: {}u32, is_optional: {} }}",
-                        f.max_string_length.unwrap_or(0),
-                        f.is_optional
-                    );
+                    let _ = write!(out, " {} ", f.max_string_length.unwrap_or(0));
+                    flag(out, f.is_optional);
                 });
-                out.push_str(" })");
             }
             DataTypeKind::Enumeration { values, .. } | DataTypeKind::OptionSet { bits: values, .. } => {
-                out.push_str("Some(rt::table::Def::Enum { fields: ");
+                out.push_str("Enum ");
                 list(out, values, |out, v| {
                     enum_row(out, v.value, &v.name, v.display_name.as_deref().unwrap_or(&v.name), v.description.as_deref());
                 });
-                out.push_str(" })");
             }
-            _ => out.push_str("None"),
+            _ => out.push('~'),
         }
     }
 
@@ -394,7 +346,7 @@ impl Gen<'_> {
     fn value_text(&self, out: &mut String, ix: NodeIx, local: &dyn Fn(u16) -> u16) -> bool {
         match self.model.value(ix) {
             None => {
-                out.push_str("rt::table::Val::None");
+                out.push('~');
                 true
             }
             Some(Ok(v)) => self.val_text(out, &v, local),
@@ -403,96 +355,92 @@ impl Gen<'_> {
     }
 
     fn val_text(&self, out: &mut String, v: &Variant, local: &dyn Fn(u16) -> u16) -> bool {
-        let nid = |out: &mut String, id: &NodeId| table_id(out, local(id.ns), true, &id.id);
+        let nid = |out: &mut String, id: &NodeId| table_id(out, local(id.ns), &id.id);
         match v {
             Variant::Boolean(b) => {
-                let _ = write!(out, "rt::table::Val::Boolean({b})");
+                out.push_str("Boolean:");
+                flag(out, *b);
             }
             Variant::SByte(x) => {
-                let _ = write!(out, "rt::table::Val::SByte({x}i8)");
+                let _ = write!(out, "SByte:{x}");
             }
             Variant::Byte(x) => {
-                let _ = write!(out, "rt::table::Val::Byte({x}u8)");
+                let _ = write!(out, "Byte:{x}");
             }
             Variant::Int16(x) => {
-                let _ = write!(out, "rt::table::Val::Int16({x}i16)");
+                let _ = write!(out, "Int16:{x}");
             }
             Variant::UInt16(x) => {
-                let _ = write!(out, "rt::table::Val::UInt16({x}u16)");
+                let _ = write!(out, "UInt16:{x}");
             }
             Variant::Int32(x) => {
-                let _ = write!(out, "rt::table::Val::Int32({x}i32)");
+                let _ = write!(out, "Int32:{x}");
             }
             Variant::UInt32(x) => {
-                let _ = write!(out, "rt::table::Val::UInt32({x}u32)");
+                let _ = write!(out, "UInt32:{x}");
             }
             Variant::Int64(x) => {
-                let _ = write!(out, "rt::table::Val::Int64({x}i64)");
+                let _ = write!(out, "Int64:{x}");
             }
             Variant::UInt64(x) => {
-                let _ = write!(out, "rt::table::Val::UInt64({x}u64)");
+                let _ = write!(out, "UInt64:{x}");
             }
-            Variant::Float(x) => float(out, f64::from(*x), true),
-            Variant::Double(x) => float(out, *x, false),
+            // Rust prints floats so that they parse back to the same value (`NaN`, `inf` and `-0` included).
+            Variant::Float(x) => {
+                let _ = write!(out, "Float:{x}");
+            }
+            Variant::Double(x) => {
+                let _ = write!(out, "Double:{x}");
+            }
             Variant::String(s) => {
-                out.push_str("rt::table::Val::String(");
+                out.push_str("String:");
                 str_lit(out, s);
-                out.push(')');
             }
             Variant::DateTime(s) => {
-                out.push_str("rt::table::Val::DateTime(");
+                out.push_str("DateTime:");
                 str_lit(out, s);
-                out.push(')');
             }
             Variant::Guid(g) => {
-                out.push_str("rt::table::Val::Guid(");
-                guid(out, g);
-                out.push(')');
+                out.push_str("Guid:");
+                hex(out, g);
             }
             Variant::ByteString(b) => {
-                out.push_str("rt::table::Val::ByteString(");
-                out.push_str(&Literal::byte_string(b).to_string());
-                out.push(')');
+                out.push_str("ByteString:");
+                hex(out, b);
             }
             Variant::NodeId(id) => {
-                out.push_str("rt::table::Val::NodeId(");
+                out.push_str("NodeId:");
                 nid(out, id);
-                out.push(')');
             }
             Variant::ExpandedNodeId(id) => {
-                out.push_str("rt::table::Val::ExpandedNodeId(");
+                out.push_str("ExpandedNodeId:");
                 nid(out, id);
-                out.push(')');
             }
             Variant::StatusCode(c) => {
-                let _ = write!(out, "rt::table::Val::StatusCode({c}u32)");
+                let _ = write!(out, "StatusCode:{c}");
             }
             Variant::QualifiedName(q) => {
-                let _ = write!(out, "rt::table::Val::QualifiedName({}u16, ", local(q.ns));
+                let _ = write!(out, "QualifiedName:{}:", local(q.ns));
                 str_lit(out, &q.name);
-                out.push(')');
             }
             Variant::LocalizedText(t) => {
-                out.push_str("rt::table::Val::LocalizedText(");
+                out.push_str("LocalizedText:");
                 opt_str(out, t.locale.as_deref());
-                out.push_str(", ");
+                out.push(':');
                 str_lit(out, &t.text);
-                out.push(')');
             }
             Variant::Array(b, items) => {
                 if *b == BuiltinType::ExtensionObject {
                     return self.struct_array_text(out, items, local);
                 }
-                let _ = write!(out, "rt::table::Val::Array({}u32, &[", b.id());
-                for (i, item) in items.iter().enumerate() {
-                    if i > 0 {
-                        out.push_str(", ");
-                    }
+                let _ = write!(out, "Array:{} {{", b.id());
+                for item in items {
+                    out.push(' ');
                     if !self.val_text(out, item, local) {
                         return false;
                     }
                 }
-                out.push_str("])");
+                out.push_str(" }");
             }
             Variant::ExtensionObject(_) => return self.struct_array_text(out, std::slice::from_ref(v), local),
             Variant::Variant(inner) => return self.val_text(out, inner, local),
@@ -535,39 +483,34 @@ impl Gen<'_> {
         match kind {
             ids::ARGUMENT => {
                 // On failure the caller discards what was written.
-                out.push_str("rt::table::Val::Arguments(&[");
-                for (i, b) in bodies.iter().enumerate() {
+                out.push_str("Arguments:{");
+                for b in &bodies {
                     let dt_text = b.child("DataType").and_then(|d| d.child_text("Identifier")).unwrap_or("i=24");
                     let Some(dt) = self.map_value_node_id(dt_text) else { return false };
-                    if i > 0 {
-                        out.push_str(", ");
-                    }
-                    out.push_str("rt::table::ArgRow { name: ");
+                    out.push(' ');
                     str_lit(out, b.child_text("Name").unwrap_or("").trim());
-                    out.push_str(", data_type: ");
-                    table_id(out, local(dt.ns), true, &dt.id);
+                    out.push(' ');
+                    table_id(out, local(dt.ns), &dt.id);
                     let vr: i32 = b.child_text("ValueRank").and_then(|t| t.trim().parse().ok()).unwrap_or(-1);
-                    let _ = write!(out, ", value_rank: {vr}i32, array_dimensions: ");
+                    let _ = write!(out, " {vr} ");
                     let d: Vec<u32> = b
                         .child("ArrayDimensions")
                         .map(|a| a.children.iter().filter_map(|c| c.text.trim().parse().ok()).collect())
                         .unwrap_or_default();
                     dims(out, &d);
-                    out.push_str(", description: ");
+                    out.push(' ');
                     opt_str(out, description(b).as_deref());
-                    out.push_str(" }");
                 }
-                out.push_str("])");
+                out.push_str(" }");
                 true
             }
             ids::ENUM_VALUE_TYPE => {
-                out.push_str("rt::table::Val::EnumValues(");
+                out.push_str("EnumValues:");
                 list(out, &bodies, |out, b| {
                     let value: i64 = b.child_text("Value").and_then(|t| t.trim().parse().ok()).unwrap_or(0);
                     let dn = b.child("DisplayName").and_then(|d| d.child_text("Text")).unwrap_or("");
                     enum_row(out, value, dn, dn, description(b).as_deref());
                 });
-                out.push(')');
                 true
             }
             _ => false,
@@ -575,13 +518,12 @@ impl Gen<'_> {
     }
 }
 
-/// Appends an `rt::table::EnumRow`.
+/// Appends an enumeration row: `value name display_name description`.
 fn enum_row(out: &mut String, value: i64, name: &str, display_name: &str, description: Option<&str>) {
-    let _ = write!(out, "rt::table::EnumRow {{ value: {value}i64, name: ");
+    let _ = write!(out, "{value} ");
     str_lit(out, name);
-    out.push_str(", display_name: ");
-    str_lit(out, display_name);
-    out.push_str(", description: ");
+    out.push(' ');
+    str_or_same(out, display_name, name);
+    out.push(' ');
     opt_str(out, description);
-    out.push_str(" }");
 }
