@@ -516,6 +516,10 @@ fn print_table(reports: &[Report], split: bool, yard: Option<&Result<rust::Yards
 ///    needs the XML schemas of ns0 and of each model, taken from the UA-Nodeset tree). Its output is built as
 ///    the crate `codegen-peer-models` in the same target folder, with a `lib.rs` written here that only
 ///    declares the generated modules. A failing peer step is reported in the table, never fatal.
+/// 6. Interleaved: `--runs-build` rounds (at least 3) of cold debug builds of the peer's crate,
+///    nodeset-models and the DI + IA + Robotics crate, back to back. The crate-build target (0.556x the
+///    peer) is judged by the median of the per-round ratios: steps 3 and 5 time each crate's runs together,
+///    minutes apart, and this host's speed drifts too much for a ratio across them.
 mod rust {
     use super::{build, parse_report, release_dir, verdict, Args, Report};
     use crate::util::display_path;
@@ -646,6 +650,13 @@ mod rust {
             .fold(Size::default(), |a, (_, s)| a + *s)
     }
 
+    /// Cold debug builds (wall, CPU) per round, in the order peer, nodeset-models, DI + IA + Robotics.
+    struct Interleaved {
+        peer: Vec<(f64, f64)>,
+        models: Vec<(f64, f64)>,
+        three: Vec<(f64, f64)>,
+    }
+
     /// What the peer produced; every part may be missing, with the reason.
     struct Peer {
         exe: Step<PathBuf>,
@@ -671,6 +682,9 @@ mod rust {
         runtime_size: Step<Size>,
         import: Step<Report>,
         peer: Option<Peer>,
+        /// Cold debug builds of the peer's crate and ours back to back, round after round (None: no peer or
+        /// a build above failed).
+        interleaved: Option<Step<Interleaved>>,
         /// The peer's whole DI + Robotics run around the generation and around the import (None: --no-peer).
         yard_gen: Option<Step<Yardstick>>,
         yard_import: Option<Step<Yardstick>>,
@@ -837,7 +851,26 @@ mod rust {
         let peer =
             (!args.no_peer).then(|| run_peer(args, root, tree, &vendor, &bench_target, &bench));
 
+        // 6. The ratio that the target is judged by, taken where the host is the same for both sides: the
+        // cold builds of the peer's crate, nodeset-models and the DI + IA + Robotics crate, one after the
+        // other, round after round. The sections above time each crate's runs together, minutes apart
+        // from the peer's, and this host's speed drifts by half within an hour.
+        let interleaved = match (&peer, &debug, &three) {
+            (Some(Peer { debug: Ok(_), .. }), Ok(_), Ok(_)) => {
+                let rounds = args.runs_build.max(3);
+                eprintln!("rust: {rounds} round(s) of cold debug builds, the peer's crate and ours back to back ...");
+                let entries = [
+                    (bench_target.join("peer"), PEER_CRATE),
+                    (root.to_path_buf(), CRATE),
+                    (bench_target.join("ours-cli"), THREE_CRATE),
+                ];
+                Some(interleave(&bench, &bench_target, &entries, rounds))
+            }
+            _ => None,
+        };
+
         let results = Results {
+            interleaved,
             gen,
             cli,
             disk,
@@ -1373,6 +1406,35 @@ mod rust {
         }
     }
 
+    /// Per round, for each (folder, package) in order: an untimed build, a clean of the package alone and a
+    /// timed cold debug build.
+    fn interleave(bench: &Path, target: &Path, entries: &[(PathBuf, &str); 3], rounds: usize) -> Step<Interleaved> {
+        let cargo_exe = PathBuf::from(env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
+        let target_env = target.display().to_string();
+        let mut got: [Vec<(f64, f64)>; 3] = Default::default();
+        for _ in 0..rounds {
+            for ((dir, package), times) in entries.iter().zip(got.iter_mut()) {
+                // The three crates are in different workspaces sharing one target folder; building one can
+                // leave a dependency of another stale (a first round measured 3.4x for that reason). An
+                // untimed build first brings the dependencies up to date, so the timed build compiles the
+                // package alone.
+                cargo(dir, Some(target), &["build", "-p", package])?;
+                cargo(dir, Some(target), &["clean", "-p", package])?;
+                let r = exec(
+                    bench,
+                    1,
+                    dir,
+                    &[("CARGO_TARGET_DIR", &target_env)],
+                    &cargo_exe,
+                    &["--quiet".to_string(), "build".into(), "-p".into(), package.to_string()],
+                )?;
+                times.push((r.f("wall_median_ms") / 1e3, r.f("cpu_per_run_ms") / 1e3));
+            }
+        }
+        let [peer, models, three] = got;
+        Ok(Interleaved { peer, models, three })
+    }
+
     /// Warm-up, no-op, then per run a clean of `package` alone, a timed (cold) build, and unless `touched`
     /// is None, a touch of it and a timed (incremental) build.
     ///
@@ -1664,6 +1726,32 @@ mod rust {
                     );
                 }
             }
+        }
+        match &r.interleaved {
+            Some(Ok(i)) => {
+                let limit = CRATE_BUILD_S / PEER_BUILD_STATED_S;
+                println!(
+                    "   {:<16} {} round(s) of cold debug builds back to back (peer, nodeset-models, DI + IA + Robotics); \
+                     the peer took {} s; ratio per round, median:",
+                    "interleaved",
+                    i.peer.len(),
+                    i.peer.iter().map(|t| format!("{:.2}", t.0)).collect::<Vec<_>>().join(" ")
+                );
+                for (label, ours) in [("DI + IA + Robotics", &i.three), (CRATE, &i.models)] {
+                    let wall: Vec<f64> = ours.iter().zip(&i.peer).map(|(o, p)| o.0 / p.0).collect();
+                    let cpu: Vec<f64> = ours.iter().zip(&i.peer).map(|(o, p)| o.1 / p.1).collect();
+                    let x = median(&wall);
+                    println!(
+                        "   {:<16}   {label:<20} {x:.3}x (rounds {}; CPU {:.3}x)  {}",
+                        "",
+                        wall.iter().map(|w| format!("{w:.3}")).collect::<Vec<_>>().join(" "),
+                        median(&cpu),
+                        verdict(x, limit)
+                    );
+                }
+            }
+            Some(Err(e)) => println!("   {:<16} the interleaved builds failed: {e}", "interleaved"),
+            None => {}
         }
         if let (Ok(all), Ok(rt), Ok(rt_size), Ok(disk)) =
             (&r.debug, &r.runtime_only, &r.runtime_size, &r.disk)
