@@ -1409,8 +1409,6 @@ mod rust {
     /// Per round, for each (folder, package) in order: an untimed build, a clean of the package alone and a
     /// timed cold debug build.
     fn interleave(bench: &Path, target: &Path, entries: &[(PathBuf, &str); 3], rounds: usize) -> Step<Interleaved> {
-        let cargo_exe = PathBuf::from(env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
-        let target_env = target.display().to_string();
         let mut got: [Vec<(f64, f64)>; 3] = Default::default();
         for _ in 0..rounds {
             for ((dir, package), times) in entries.iter().zip(got.iter_mut()) {
@@ -1420,19 +1418,22 @@ mod rust {
                 // package alone.
                 cargo(dir, Some(target), &["build", "-p", package])?;
                 cargo(dir, Some(target), &["clean", "-p", package])?;
-                let r = exec(
-                    bench,
-                    1,
-                    dir,
-                    &[("CARGO_TARGET_DIR", &target_env)],
-                    &cargo_exe,
-                    &["--quiet".to_string(), "build".into(), "-p".into(), package.to_string()],
-                )?;
-                times.push((r.f("wall_median_ms") / 1e3, r.f("cpu_per_run_ms") / 1e3));
+                times.push(timed_build(bench, dir, target, &["build", "-p", package])?);
             }
         }
         let [peer, models, three] = got;
         Ok(Interleaved { peer, models, three })
+    }
+
+    /// One `cargo --quiet <args>` in `dir` with `target` as its target folder, under `rust_bench exec`, which
+    /// also takes the CPU time of cargo and rustc: (wall s, CPU s).
+    fn timed_build(bench: &Path, dir: &Path, target: &Path, args: &[&str]) -> Step<(f64, f64)> {
+        let cargo_exe = PathBuf::from(env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
+        let target_env = target.display().to_string();
+        let mut timed_args = vec!["--quiet".to_string()];
+        timed_args.extend(args.iter().map(|a| a.to_string()));
+        let r = exec(bench, 1, dir, &[("CARGO_TARGET_DIR", &target_env)], &cargo_exe, &timed_args)?;
+        Ok((r.f("wall_median_ms") / 1e3, r.f("cpu_per_run_ms") / 1e3))
     }
 
     /// Warm-up, no-op, then per run a clean of `package` alone, a timed (cold) build, and unless `touched`
@@ -1454,21 +1455,7 @@ mod rust {
             build_args.push("--release");
             clean_args.push("--release");
         }
-        let cargo_exe = PathBuf::from(env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
-        let target_env = target.display().to_string();
-        let mut timed_args = vec!["--quiet".to_string()];
-        timed_args.extend(build_args.iter().map(|a| a.to_string()));
-        let timed = || -> Step<(f64, f64)> {
-            let r = exec(
-                bench,
-                1,
-                dir,
-                &[("CARGO_TARGET_DIR", &target_env)],
-                &cargo_exe,
-                &timed_args,
-            )?;
-            Ok((r.f("wall_median_ms") / 1e3, r.f("cpu_per_run_ms") / 1e3))
-        };
+        let timed = || timed_build(bench, dir, target, &build_args);
         let warm = cargo(dir, Some(target), &build_args)?;
         let (mut noop, mut cold, mut incr) = (Vec::new(), Vec::new(), Vec::new());
         for _ in 0..runs.max(1) {
