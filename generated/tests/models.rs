@@ -198,14 +198,18 @@ fn subtype_markers_inherit_and_override() {
     use di::objects::members::ComponentType as Component;
     use robotics::objects::members::{AuxiliaryComponentType as Auxiliary, AxisType as Axis};
     // Inherited from DI's ComponentType: the same constant, with DI's namespace in the path.
-    assert_eq!(Axis::SerialNumber.path, Component::SerialNumber.path);
-    assert_eq!(Axis::SerialNumber.path, &[(di::NAMESPACE_URI, "SerialNumber")]);
-    assert_eq!(Axis::AssetId.path, Component::AssetId.path);
+    let segments = |m: nodeset_models::runtime::typed::MemberPath| m.segments().expect("a generated marker path decodes");
+    assert_eq!(Axis::SerialNumber.browse_path(), Component::SerialNumber.browse_path());
+    assert_eq!(segments(Axis::SerialNumber.browse_path()), [(di::NAMESPACE_URI, "SerialNumber".to_string())]);
+    assert_eq!(Axis::AssetId.browse_path(), Component::AssetId.browse_path());
     // Robotics makes ProductCode mandatory on AuxiliaryComponentType; ComponentType has it optional.
     assert!(!Component::ProductCode.mandatory);
     assert!(Auxiliary::ProductCode.mandatory);
     assert!(Auxiliary::REQUIRED.iter().any(|(p, _)| *p == "ProductCode"));
     assert!(!Component::REQUIRED.iter().any(|(p, _)| *p == "ProductCode"));
     // AxisType's own members are declared in its own module.
-    assert_eq!(Axis::ParameterSet__ActualPosition.path, &[(di::NAMESPACE_URI, "ParameterSet"), (robotics::NAMESPACE_URI, "ActualPosition")]);
+    assert_eq!(
+        segments(Axis::ParameterSet__ActualPosition.browse_path()),
+        [(di::NAMESPACE_URI, "ParameterSet".to_string()), (robotics::NAMESPACE_URI, "ActualPosition".to_string())]
+    );
 }

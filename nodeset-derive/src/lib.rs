@@ -241,7 +241,7 @@ fn expand(input: &DeriveInput) -> syn::Result<TokenStream2> {
             #t::model::FieldBinding {
                 field: #field_name,
                 path: #p,
-                browse_path: #marker_path.path,
+                browse_path: #marker_path.browse_path(),
                 writable: #marker_path.writable,
             }
         });

@@ -441,6 +441,7 @@ fn names() {
             "input",
             "Model",
             "Frame",
+            "In/Out\\Level",
             "UR Robot",
             "<AxisIdentifier>"
         ]

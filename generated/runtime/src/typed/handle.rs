@@ -29,6 +29,9 @@ pub enum BindError {
     ValueRank { node: NodeId, value_rank: i32, rust_value_rank: i32 },
     /// A namespace a handle names is not registered in the server.
     UnknownNamespace(String),
+    /// A member marker's browse path does not follow [`MemberPath`](super::MemberPath)'s format (generated
+    /// markers always do; this is for hand-written ones).
+    BadMemberPath(super::BadMemberPath),
 }
 
 impl fmt::Display for BindError {
@@ -46,11 +49,18 @@ impl fmt::Display for BindError {
                 "variable {node} has ValueRank {value_rank}, which a Rust type of ValueRank {rust_value_rank} cannot hold"
             ),
             BindError::UnknownNamespace(uri) => write!(f, "the server has no namespace `{uri}`"),
+            BindError::BadMemberPath(e) => e.fmt(f),
         }
     }
 }
 
 impl std::error::Error for BindError {}
+
+impl From<super::BadMemberPath> for BindError {
+    fn from(e: super::BadMemberPath) -> Self {
+        BindError::BadMemberPath(e)
+    }
+}
 
 /// A typed handle to a node: generated handle structs, [`ObjectNode`], [`Variable<T>`], [`Method<I, O>`].
 pub trait Handle: Sized {

@@ -68,10 +68,13 @@ pub trait VariableType: Handle {
 /// variables against the module's `REQUIRED`.
 ///
 /// A marker is a value, not a type with trait impls: a namespace has about a thousand of them, and one
-/// constant each is what the compiler checks fastest.
+/// constant each is what the compiler checks fastest. Its browse path is one string (see [`MemberPath`]):
+/// a constant of scalars and string literals costs rustc a fraction of one holding a slice of pairs.
 pub struct VariableMember<S> {
-    /// BrowseNames from the instance down to the variable, each with its namespace URI.
-    pub path: &'static [(&'static str, &'static str)],
+    /// The namespace URIs that `path`'s indices refer to (the generated module's `NS`).
+    pub ns: &'static [&'static str],
+    /// The BrowseNames from the instance down to the variable, in [`MemberPath`]'s text form.
+    pub path: &'static str,
     /// The variable's ValueRank.
     pub value_rank: i32,
     /// Whether every instance has it (Mandatory, all the way down).
@@ -81,8 +84,77 @@ pub struct VariableMember<S> {
     /// Whether clients may write it (CurrentWrite in its AccessLevel).
     pub writable: bool,
     /// `S`: the Rust type of one value of the variable's DataType. (Public so that a marker is a struct
-    /// literal: its `path` is then a `'static` slice in place, which a `const fn` argument would not be.)
+    /// literal, which rustc checks faster than a `const fn` call.)
     pub scalar: PhantomData<fn() -> S>,
+}
+
+/// A browse path as generated code writes it: each BrowseName as `index:name`, where `index` is a position
+/// in `ns` (the namespace URIs of the generated module), joined by `/`; a `/` or `\` in a name is escaped
+/// with `\`. With `ns = ["…/Robotics/", "…/DI/"]`, `1:ParameterSet/0:ActualPosition` is DI's
+/// `ParameterSet`, then Robotics' `ActualPosition`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MemberPath {
+    /// The namespace URIs the indices refer to.
+    pub ns: &'static [&'static str],
+    /// The path text.
+    pub text: &'static str,
+}
+
+/// A [`MemberPath`] whose text does not follow the format.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BadMemberPath {
+    /// The path text.
+    pub text: &'static str,
+    /// What is wrong.
+    pub reason: String,
+}
+
+impl std::fmt::Display for BadMemberPath {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "member path `{}`: {}", self.text, self.reason)
+    }
+}
+
+impl std::error::Error for BadMemberPath {}
+
+impl MemberPath {
+    /// The BrowseNames along the path, each with its namespace URI.
+    pub fn segments(&self) -> Result<Vec<(&'static str, String)>, BadMemberPath> {
+        let bad = |reason: String| BadMemberPath { text: self.text, reason };
+        let mut out = Vec::new();
+        if self.text.is_empty() {
+            return Err(bad("the path is empty".into()));
+        }
+        let mut rest = self.text;
+        loop {
+            let (index, after) = rest.split_once(':').ok_or_else(|| bad(format!("segment {} has no `index:`", out.len() + 1)))?;
+            let index: usize = index.parse().map_err(|_| bad(format!("segment {}: `{index}` is not an index", out.len() + 1)))?;
+            let uri = *self.ns.get(index).ok_or_else(|| {
+                bad(format!("segment {}: namespace index {index}, but there are {} URIs", out.len() + 1, self.ns.len()))
+            })?;
+            let mut name = String::new();
+            let mut chars = after.char_indices();
+            let mut next = None;
+            while let Some((i, c)) = chars.next() {
+                match c {
+                    '\\' => match chars.next() {
+                        Some((_, e @ ('/' | '\\'))) => name.push(e),
+                        _ => return Err(bad(format!("segment {}: `\\` escapes only `/` and `\\`", out.len() + 1))),
+                    },
+                    '/' => {
+                        next = Some(&after[i + 1..]);
+                        break;
+                    }
+                    c => name.push(c),
+                }
+            }
+            out.push((uri, name));
+            match next {
+                Some(r) => rest = r,
+                None => return Ok(out),
+            }
+        }
+    }
 }
 
 impl<S> VariableMember<S> {
@@ -90,6 +162,11 @@ impl<S> VariableMember<S> {
     /// each bound field). A method, so that `S` is the marker's and only `F` is named: the check is then
     /// `F: Holds<S>` with both known, and fails with [`Holds`]'s message.
     pub fn holds<F: Holds<S>>(&self) {}
+
+    /// The marker's browse path.
+    pub const fn browse_path(&self) -> MemberPath {
+        MemberPath { ns: self.ns, text: self.path }
+    }
 }
 
 impl<S> std::fmt::Debug for VariableMember<S> {
@@ -170,14 +247,14 @@ pub use crate::__nodeset_ua_struct as ua_struct;
 /// Declares the member markers of an ObjectType (generated `members` modules use it): a module named
 /// after the handle that re-exports the markers of its supertype's module when one is given (`Owner: path;`;
 /// a marker declared here shadows the supertype's of that name), with, for each variable member declared
-/// here, a [`VariableMember`] constant given the marker name,
-/// the Rust scalar type, the ValueRank, the browse path as (index into `NS`, name) pairs, and whether it
-/// is mandatory, has a default value, and is writable; and `REQUIRED`, the mandatory variables without a
+/// here, a [`VariableMember`] constant given the marker name, the Rust scalar type, the ValueRank, the
+/// browse path (a [`MemberPath`] text over the `NS` of the module two levels up), and whether it is
+/// mandatory, has a default value, and is writable; and `REQUIRED`, the mandatory variables without a
 /// default, with the message for a derive that leaves one unbound.
 #[doc(hidden)]
 #[macro_export]
 macro_rules! __nodeset_object_members {
-    ($owner:ident $(: $base:path)?; required: [$(($rp:literal, $rm:literal)),* $(,)?]; $($m:ident: $scalar:ty, $rank:literal, [$($k:literal $name:literal),*], $mandatory:literal $default:literal $writable:literal;)*) => {
+    ($owner:ident $(: $base:path)?; required: [$(($rp:literal, $rm:literal)),* $(,)?]; $($m:ident: $scalar:ty, $rank:literal, $path:literal, $mandatory:literal $default:literal $writable:literal;)*) => {
         #[doc = concat!(" Member markers of [`", stringify!($owner), "`](super::", stringify!($owner), ") for `nodeset-derive`.")]
         #[allow(non_upper_case_globals)]
         pub mod $owner {
@@ -188,9 +265,10 @@ macro_rules! __nodeset_object_members {
                 pub use $base::*;
             )?
             $(
-                #[doc = concat!(" The variable `", $($name, "/",)* "`.")]
+                #[doc = concat!(" The variable `", $path, "`.")]
                 pub const $m: $crate::typed::VariableMember<$scalar> = $crate::typed::VariableMember {
-                    path: &[$((super::super::NS[$k], $name)),*],
+                    ns: super::super::NS,
+                    path: $path,
                     value_rank: $rank,
                     mandatory: $mandatory,
                     has_default: $default,
@@ -286,3 +364,44 @@ ua_struct!(
     opcua::types::TimeZoneDataType,
     opcua::types::XVType,
 );
+
+#[cfg(test)]
+mod tests {
+    use super::{BadMemberPath, MemberPath};
+
+    const NS: &[&str] = &["urn:a", "urn:b"];
+
+    fn segments(text: &'static str) -> Result<Vec<(&'static str, String)>, BadMemberPath> {
+        MemberPath { ns: NS, text }.segments()
+    }
+
+    #[test]
+    fn member_paths_decode_with_their_namespaces() {
+        assert_eq!(segments("0:Manufacturer").unwrap(), [("urn:a", "Manufacturer".to_string())]);
+        assert_eq!(
+            segments("1:ParameterSet/0:ActualPosition").unwrap(),
+            [("urn:b", "ParameterSet".to_string()), ("urn:a", "ActualPosition".to_string())]
+        );
+        // A name may hold `:` (only the first one ends the index), and escaped `/` and `\`.
+        assert_eq!(
+            segments(r"0:a:b\/c\\d/1:<Axis>").unwrap(),
+            [("urn:a", r"a:b/c\d".to_string()), ("urn:b", "<Axis>".to_string())]
+        );
+        assert_eq!(segments("1:").unwrap(), [("urn:b", String::new())]);
+    }
+
+    #[test]
+    fn bad_member_paths_say_what_is_wrong() {
+        let reason = |text| segments(text).unwrap_err().reason;
+        assert_eq!(reason(""), "the path is empty");
+        assert_eq!(reason("Manufacturer"), "segment 1 has no `index:`");
+        assert_eq!(reason("0:A/x:B"), "segment 2: `x` is not an index");
+        assert_eq!(reason("0:A/2:B"), "segment 2: namespace index 2, but there are 2 URIs");
+        assert_eq!(reason(r"0:A\n"), r"segment 1: `\` escapes only `/` and `\`");
+        assert_eq!(reason("0:A\\"), r"segment 1: `\` escapes only `/` and `\`");
+        assert_eq!(
+            segments("0:A/").unwrap_err().to_string(),
+            "member path `0:A/`: segment 2 has no `index:`"
+        );
+    }
+}

@@ -10,7 +10,7 @@ use std::sync::{Arc, Mutex};
 pub use opcua::types::Variant;
 use opcua::types::{NodeId, QualifiedName, StatusCode};
 
-use super::{BindError, Binder, Instantiate, InstantiateError, ObjectType};
+use super::{BindError, Binder, Instantiate, InstantiateError, MemberPath, ObjectType};
 use crate::server::ModelManager;
 
 /// One field of a derived struct and the variable it binds.
@@ -20,8 +20,8 @@ pub struct FieldBinding {
     pub field: &'static str,
     /// The browse path as written (`ParameterSet/SpeedOverride`).
     pub path: &'static str,
-    /// The browse path with namespace URIs.
-    pub browse_path: &'static [(&'static str, &'static str)],
+    /// The browse path with namespace URIs (the marker's).
+    pub browse_path: MemberPath,
     /// Whether clients may write the variable.
     pub writable: bool,
 }
@@ -104,10 +104,10 @@ impl<S: ObjectModel> Bound<S> {
                 .iter()
                 .map(|f| {
                     let mut node = root.clone();
-                    for (uri, name) in f.browse_path {
-                        node = b.find_child(&node, uri, name)?.ok_or_else(|| BindError::MissingChild {
+                    for (uri, name) in f.browse_path.segments()? {
+                        node = b.find_child(&node, uri, &name)?.ok_or_else(|| BindError::MissingChild {
                             parent: node.clone(),
-                            browse_name: (*name).to_owned(),
+                            browse_name: name,
                         })?;
                     }
                     Ok(node)

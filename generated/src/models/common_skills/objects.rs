@@ -782,7 +782,7 @@ pub mod members {
             ("InputParameterSet/TargetPose", "the mandatory variable `InputParameterSet/TargetPose` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/TargetPose\")]"),
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of AbsoluteCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
         ];
-        InputParameterSet__TargetPose: ua::ThreeDFrame, -1, [0 "InputParameterSet", 0 "TargetPose"], true false true;
+        InputParameterSet__TargetPose: ua::ThreeDFrame, -1, "0:InputParameterSet/0:TargetPose", true false true;
     }
     t::object_members! {
         AbsoluteJointPtpMoveSkillType: super::MoveSkillType;
@@ -797,7 +797,7 @@ pub mod members {
             ("InputParameterSet/TargetJointPositions", "the mandatory variable `InputParameterSet/TargetJointPositions` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/TargetJointPositions\")]"),
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of AbsoluteJointPtpMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
         ];
-        InputParameterSet__TargetJointPositions: f64, 1, [0 "InputParameterSet", 0 "TargetJointPositions"], true false true;
+        InputParameterSet__TargetJointPositions: f64, 1, "0:InputParameterSet/0:TargetJointPositions", true false true;
     }
     t::object_members! {
         CompositeSkillType: super::ProgramSkillStateMachineType;
@@ -822,8 +822,8 @@ pub mod members {
             ("InputParameterSet/GripForce", "the mandatory variable `InputParameterSet/GripForce` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/GripForce\")]"),
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of GrippingSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
         ];
-        InputParameterSet__Action: super::super::super::types::GripperActionEnumeration, -1, [0 "InputParameterSet", 0 "Action"], true false true;
-        InputParameterSet__GripForce: f64, -1, [0 "InputParameterSet", 0 "GripForce"], true false true;
+        InputParameterSet__Action: super::super::super::types::GripperActionEnumeration, -1, "0:InputParameterSet/0:Action", true false true;
+        InputParameterSet__GripForce: f64, -1, "0:InputParameterSet/0:GripForce", true false true;
     }
     t::object_members! {
         ISkillSetType;
@@ -841,8 +841,8 @@ pub mod members {
             ("InputParameterSet/Acceleration", "the mandatory variable `InputParameterSet/Acceleration` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/Acceleration\")]"),
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of MoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
         ];
-        InputParameterSet__Speed: f64, -1, [0 "InputParameterSet", 0 "Speed"], true false true;
-        InputParameterSet__Acceleration: f64, -1, [0 "InputParameterSet", 0 "Acceleration"], true false true;
+        InputParameterSet__Speed: f64, -1, "0:InputParameterSet/0:Speed", true false true;
+        InputParameterSet__Acceleration: f64, -1, "0:InputParameterSet/0:Acceleration", true false true;
     }
     t::object_members! {
         ProgramSkillStateMachineType;
@@ -854,15 +854,15 @@ pub mod members {
             ("RecycleCount", "the mandatory variable `RecycleCount` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RecycleCount\")]"),
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
-        Deletable: bool, -1, [1 "Deletable"], true false false;
-        AutoDelete: bool, -1, [1 "AutoDelete"], true false false;
-        RecycleCount: i32, -1, [1 "RecycleCount"], true false false;
-        ProgramDiagnostic: ua::ExtensionObject, -1, [1 "ProgramDiagnostic"], false false false;
-        OutputParameterSet__Result: ua::StatusCode, -1, [0 "OutputParameterSet", 0 "Result"], true false false;
+        CurrentState: ua::LocalizedText, -1, "1:CurrentState", true false false;
+        LastTransition: ua::LocalizedText, -1, "1:LastTransition", true false false;
+        AvailableStates: ua::NodeId, 1, "1:AvailableStates", false false false;
+        AvailableTransitions: ua::NodeId, 1, "1:AvailableTransitions", false false false;
+        Deletable: bool, -1, "1:Deletable", true false false;
+        AutoDelete: bool, -1, "1:AutoDelete", true false false;
+        RecycleCount: i32, -1, "1:RecycleCount", true false false;
+        ProgramDiagnostic: ua::ExtensionObject, -1, "1:ProgramDiagnostic", false false false;
+        OutputParameterSet__Result: ua::StatusCode, -1, "0:OutputParameterSet/0:Result", true false false;
     }
     t::object_members! {
         RelativeCartesianLinearMoveSkillType: super::MoveSkillType;
@@ -877,7 +877,7 @@ pub mod members {
             ("InputParameterSet/PoseOffset", "the mandatory variable `InputParameterSet/PoseOffset` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/PoseOffset\")]"),
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of RelativeCartesianLinearMoveSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
         ];
-        InputParameterSet__PoseOffset: ua::ThreeDFrame, -1, [0 "InputParameterSet", 0 "PoseOffset"], true false true;
+        InputParameterSet__PoseOffset: ua::ThreeDFrame, -1, "0:InputParameterSet/0:PoseOffset", true false true;
     }
     t::object_members! {
         SkillTransitionEventType;
@@ -896,23 +896,23 @@ pub mod members {
             ("IntermediateResult", "the mandatory variable `IntermediateResult` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"IntermediateResult\")]"),
             ("SkillName", "the mandatory variable `SkillName` of SkillTransitionEventType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillName\")]"),
         ];
-        EventId: ua::ByteString, -1, [1 "EventId"], true false false;
-        EventType: ua::NodeId, -1, [1 "EventType"], true false false;
-        SourceNode: ua::NodeId, -1, [1 "SourceNode"], true false false;
-        SourceName: String, -1, [1 "SourceName"], true false false;
-        Time: ua::DateTime, -1, [1 "Time"], true false false;
-        ReceiveTime: ua::DateTime, -1, [1 "ReceiveTime"], true false false;
-        LocalTime: ua::TimeZoneDataType, -1, [1 "LocalTime"], false false false;
-        Message: ua::LocalizedText, -1, [1 "Message"], true false false;
-        Severity: u16, -1, [1 "Severity"], true false false;
-        ConditionClassId: ua::NodeId, -1, [1 "ConditionClassId"], false false false;
-        ConditionClassName: ua::LocalizedText, -1, [1 "ConditionClassName"], false false false;
-        ConditionSubClassId: ua::NodeId, 1, [1 "ConditionSubClassId"], false false false;
-        ConditionSubClassName: ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
-        Transition: ua::LocalizedText, -1, [1 "Transition"], true false false;
-        FromState: ua::LocalizedText, -1, [1 "FromState"], true false false;
-        ToState: ua::LocalizedText, -1, [1 "ToState"], true false false;
-        IntermediateResult: ua::Variant, -1, [1 "IntermediateResult"], true false false;
-        SkillName: String, -1, [0 "SkillName"], true false false;
+        EventId: ua::ByteString, -1, "1:EventId", true false false;
+        EventType: ua::NodeId, -1, "1:EventType", true false false;
+        SourceNode: ua::NodeId, -1, "1:SourceNode", true false false;
+        SourceName: String, -1, "1:SourceName", true false false;
+        Time: ua::DateTime, -1, "1:Time", true false false;
+        ReceiveTime: ua::DateTime, -1, "1:ReceiveTime", true false false;
+        LocalTime: ua::TimeZoneDataType, -1, "1:LocalTime", false false false;
+        Message: ua::LocalizedText, -1, "1:Message", true false false;
+        Severity: u16, -1, "1:Severity", true false false;
+        ConditionClassId: ua::NodeId, -1, "1:ConditionClassId", false false false;
+        ConditionClassName: ua::LocalizedText, -1, "1:ConditionClassName", false false false;
+        ConditionSubClassId: ua::NodeId, 1, "1:ConditionSubClassId", false false false;
+        ConditionSubClassName: ua::LocalizedText, 1, "1:ConditionSubClassName", false false false;
+        Transition: ua::LocalizedText, -1, "1:Transition", true false false;
+        FromState: ua::LocalizedText, -1, "1:FromState", true false false;
+        ToState: ua::LocalizedText, -1, "1:ToState", true false false;
+        IntermediateResult: ua::Variant, -1, "1:IntermediateResult", true false false;
+        SkillName: String, -1, "0:SkillName", true false false;
     }
 }

@@ -2196,11 +2196,11 @@ pub mod members {
     t::object_members! {
         BlockType: super::TopologyElementType;
         required: [];
-        RevisionCounter: i32, -1, [0 "RevisionCounter"], false false false;
-        ActualMode: ua::LocalizedText, -1, [0 "ActualMode"], false false false;
-        PermittedMode: ua::LocalizedText, 1, [0 "PermittedMode"], false false false;
-        NormalMode: ua::LocalizedText, 1, [0 "NormalMode"], false false false;
-        TargetMode: ua::LocalizedText, 1, [0 "TargetMode"], false false false;
+        RevisionCounter: i32, -1, "0:RevisionCounter", false false false;
+        ActualMode: ua::LocalizedText, -1, "0:ActualMode", false false false;
+        PermittedMode: ua::LocalizedText, 1, "0:PermittedMode", false false false;
+        NormalMode: ua::LocalizedText, 1, "0:NormalMode", false false false;
+        TargetMode: ua::LocalizedText, 1, "0:TargetMode", false false false;
     }
     t::object_members! {
         CachedLoadingType: super::PackageLoadingType;
@@ -2214,20 +2214,20 @@ pub mod members {
             ("PendingVersion/ManufacturerUri", "the mandatory variable `PendingVersion/ManufacturerUri` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"PendingVersion/ManufacturerUri\")]"),
             ("PendingVersion/SoftwareRevision", "the mandatory variable `PendingVersion/SoftwareRevision` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"PendingVersion/SoftwareRevision\")]"),
         ];
-        PendingVersion__Manufacturer: ua::LocalizedText, -1, [0 "PendingVersion", 0 "Manufacturer"], true false false;
-        PendingVersion__ManufacturerUri: String, -1, [0 "PendingVersion", 0 "ManufacturerUri"], true false false;
-        PendingVersion__SoftwareRevision: String, -1, [0 "PendingVersion", 0 "SoftwareRevision"], true false false;
-        PendingVersion__PatchIdentifiers: String, 1, [0 "PendingVersion", 0 "PatchIdentifiers"], false false false;
-        PendingVersion__ReleaseDate: ua::DateTime, -1, [0 "PendingVersion", 0 "ReleaseDate"], false false false;
-        PendingVersion__ChangeLogReference: String, -1, [0 "PendingVersion", 0 "ChangeLogReference"], false false false;
-        PendingVersion__Hash: ua::ByteString, -1, [0 "PendingVersion", 0 "Hash"], false false false;
-        FallbackVersion__Manufacturer: ua::LocalizedText, -1, [0 "FallbackVersion", 0 "Manufacturer"], false false false;
-        FallbackVersion__ManufacturerUri: String, -1, [0 "FallbackVersion", 0 "ManufacturerUri"], false false false;
-        FallbackVersion__SoftwareRevision: String, -1, [0 "FallbackVersion", 0 "SoftwareRevision"], false false false;
-        FallbackVersion__PatchIdentifiers: String, 1, [0 "FallbackVersion", 0 "PatchIdentifiers"], false false false;
-        FallbackVersion__ReleaseDate: ua::DateTime, -1, [0 "FallbackVersion", 0 "ReleaseDate"], false false false;
-        FallbackVersion__ChangeLogReference: String, -1, [0 "FallbackVersion", 0 "ChangeLogReference"], false false false;
-        FallbackVersion__Hash: ua::ByteString, -1, [0 "FallbackVersion", 0 "Hash"], false false false;
+        PendingVersion__Manufacturer: ua::LocalizedText, -1, "0:PendingVersion/0:Manufacturer", true false false;
+        PendingVersion__ManufacturerUri: String, -1, "0:PendingVersion/0:ManufacturerUri", true false false;
+        PendingVersion__SoftwareRevision: String, -1, "0:PendingVersion/0:SoftwareRevision", true false false;
+        PendingVersion__PatchIdentifiers: String, 1, "0:PendingVersion/0:PatchIdentifiers", false false false;
+        PendingVersion__ReleaseDate: ua::DateTime, -1, "0:PendingVersion/0:ReleaseDate", false false false;
+        PendingVersion__ChangeLogReference: String, -1, "0:PendingVersion/0:ChangeLogReference", false false false;
+        PendingVersion__Hash: ua::ByteString, -1, "0:PendingVersion/0:Hash", false false false;
+        FallbackVersion__Manufacturer: ua::LocalizedText, -1, "0:FallbackVersion/0:Manufacturer", false false false;
+        FallbackVersion__ManufacturerUri: String, -1, "0:FallbackVersion/0:ManufacturerUri", false false false;
+        FallbackVersion__SoftwareRevision: String, -1, "0:FallbackVersion/0:SoftwareRevision", false false false;
+        FallbackVersion__PatchIdentifiers: String, 1, "0:FallbackVersion/0:PatchIdentifiers", false false false;
+        FallbackVersion__ReleaseDate: ua::DateTime, -1, "0:FallbackVersion/0:ReleaseDate", false false false;
+        FallbackVersion__ChangeLogReference: String, -1, "0:FallbackVersion/0:ChangeLogReference", false false false;
+        FallbackVersion__Hash: ua::ByteString, -1, "0:FallbackVersion/0:Hash", false false false;
     }
     t::object_members! {
         CheckFunctionAlarmType: super::DeviceHealthDiagnosticAlarmType;
@@ -2260,20 +2260,20 @@ pub mod members {
     t::object_members! {
         ComponentType: super::TopologyElementType;
         required: [];
-        Manufacturer: ua::LocalizedText, -1, [0 "Manufacturer"], false false false;
-        ManufacturerUri: String, -1, [0 "ManufacturerUri"], false false false;
-        Model: ua::LocalizedText, -1, [0 "Model"], false false false;
-        HardwareRevision: String, -1, [0 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [0 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [0 "DeviceRevision"], false false false;
-        ProductCode: String, -1, [0 "ProductCode"], false false false;
-        DeviceManual: String, -1, [0 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [0 "DeviceClass"], false false false;
-        SerialNumber: String, -1, [0 "SerialNumber"], false false false;
-        ProductInstanceUri: String, -1, [0 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [0 "RevisionCounter"], false false false;
-        AssetId: String, -1, [0 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [0 "ComponentName"], false false false;
+        Manufacturer: ua::LocalizedText, -1, "0:Manufacturer", false false false;
+        ManufacturerUri: String, -1, "0:ManufacturerUri", false false false;
+        Model: ua::LocalizedText, -1, "0:Model", false false false;
+        HardwareRevision: String, -1, "0:HardwareRevision", false false false;
+        SoftwareRevision: String, -1, "0:SoftwareRevision", false false false;
+        DeviceRevision: String, -1, "0:DeviceRevision", false false false;
+        ProductCode: String, -1, "0:ProductCode", false false false;
+        DeviceManual: String, -1, "0:DeviceManual", false false false;
+        DeviceClass: String, -1, "0:DeviceClass", false false false;
+        SerialNumber: String, -1, "0:SerialNumber", false false false;
+        ProductInstanceUri: String, -1, "0:ProductInstanceUri", false false false;
+        RevisionCounter: i32, -1, "0:RevisionCounter", false false false;
+        AssetId: String, -1, "0:AssetId", false false false;
+        ComponentName: ua::LocalizedText, -1, "0:ComponentName", false false false;
     }
     t::object_members! {
         ConfigurableObjectType;
@@ -2285,16 +2285,16 @@ pub mod members {
             ("CurrentState", "the mandatory variable `CurrentState` of ConfirmationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("ConfirmationTimeout", "the mandatory variable `ConfirmationTimeout` of ConfirmationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConfirmationTimeout\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], false false false;
-        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
-        ConfirmationTimeout: f64, -1, [0 "ConfirmationTimeout"], true false false;
+        CurrentState: ua::LocalizedText, -1, "1:CurrentState", true false false;
+        LastTransition: ua::LocalizedText, -1, "1:LastTransition", false false false;
+        AvailableStates: ua::NodeId, 1, "1:AvailableStates", false false false;
+        AvailableTransitions: ua::NodeId, 1, "1:AvailableTransitions", false false false;
+        ConfirmationTimeout: f64, -1, "0:ConfirmationTimeout", true false false;
     }
     t::object_members! {
         ConnectionPointType: super::TopologyElementType;
         required: [];
-        NetworkAddress__UIElement: ua::Variant, -1, [0 "NetworkAddress", 0 "UIElement"], false false false;
+        NetworkAddress__UIElement: ua::Variant, -1, "0:NetworkAddress/0:UIElement", false false false;
     }
     t::object_members! {
         DeviceHealthDiagnosticAlarmType;
@@ -2323,50 +2323,50 @@ pub mod members {
             ("SuppressedOrShelved", "the mandatory variable `SuppressedOrShelved` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SuppressedOrShelved\")]"),
             ("NormalState", "the mandatory variable `NormalState` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NormalState\")]"),
         ];
-        EventId: ua::ByteString, -1, [1 "EventId"], true false false;
-        EventType: ua::NodeId, -1, [1 "EventType"], true false false;
-        SourceNode: ua::NodeId, -1, [1 "SourceNode"], true false false;
-        SourceName: String, -1, [1 "SourceName"], true false false;
-        Time: ua::DateTime, -1, [1 "Time"], true false false;
-        ReceiveTime: ua::DateTime, -1, [1 "ReceiveTime"], true false false;
-        LocalTime: ua::TimeZoneDataType, -1, [1 "LocalTime"], false false false;
-        Message: ua::LocalizedText, -1, [1 "Message"], true false false;
-        Severity: u16, -1, [1 "Severity"], true false false;
-        ConditionClassId: ua::NodeId, -1, [1 "ConditionClassId"], true false false;
-        ConditionClassName: ua::LocalizedText, -1, [1 "ConditionClassName"], true false false;
-        ConditionSubClassId: ua::NodeId, 1, [1 "ConditionSubClassId"], false false false;
-        ConditionSubClassName: ua::LocalizedText, 1, [1 "ConditionSubClassName"], false false false;
-        ConditionName: String, -1, [1 "ConditionName"], true false false;
-        BranchId: ua::NodeId, -1, [1 "BranchId"], true false false;
-        Retain: bool, -1, [1 "Retain"], true false false;
-        EnabledState: ua::LocalizedText, -1, [1 "EnabledState"], true false false;
-        Quality: ua::StatusCode, -1, [1 "Quality"], true false false;
-        LastSeverity: u16, -1, [1 "LastSeverity"], true false false;
-        Comment: ua::LocalizedText, -1, [1 "Comment"], true false false;
-        ClientUserId: String, -1, [1 "ClientUserId"], true false false;
-        AckedState: ua::LocalizedText, -1, [1 "AckedState"], true false false;
-        ConfirmedState: ua::LocalizedText, -1, [1 "ConfirmedState"], false false false;
-        ActiveState: ua::LocalizedText, -1, [1 "ActiveState"], true false false;
-        InputNode: ua::NodeId, -1, [1 "InputNode"], true false false;
-        SuppressedState: ua::LocalizedText, -1, [1 "SuppressedState"], false false false;
-        OutOfServiceState: ua::LocalizedText, -1, [1 "OutOfServiceState"], false false false;
-        ShelvingState__CurrentState: ua::LocalizedText, -1, [1 "ShelvingState", 1 "CurrentState"], false false false;
-        ShelvingState__LastTransition: ua::LocalizedText, -1, [1 "ShelvingState", 1 "LastTransition"], false false false;
-        ShelvingState__AvailableStates: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableStates"], false false false;
-        ShelvingState__AvailableTransitions: ua::NodeId, 1, [1 "ShelvingState", 1 "AvailableTransitions"], false false false;
-        ShelvingState__UnshelveTime: f64, -1, [1 "ShelvingState", 1 "UnshelveTime"], false false false;
-        SuppressedOrShelved: bool, -1, [1 "SuppressedOrShelved"], true false false;
-        MaxTimeShelved: f64, -1, [1 "MaxTimeShelved"], false false false;
-        AudibleEnabled: bool, -1, [1 "AudibleEnabled"], false false false;
-        AudibleSound: ua::ByteString, -1, [1 "AudibleSound"], false false false;
-        SilenceState: ua::LocalizedText, -1, [1 "SilenceState"], false false false;
-        OnDelay: f64, -1, [1 "OnDelay"], false false false;
-        OffDelay: f64, -1, [1 "OffDelay"], false false false;
-        FirstInGroupFlag: bool, -1, [1 "FirstInGroupFlag"], false false false;
-        LatchedState: ua::LocalizedText, -1, [1 "LatchedState"], false false false;
-        ReAlarmTime: f64, -1, [1 "ReAlarmTime"], false false false;
-        ReAlarmRepeatCount: i16, -1, [1 "ReAlarmRepeatCount"], false false false;
-        NormalState: ua::NodeId, -1, [1 "NormalState"], true false false;
+        EventId: ua::ByteString, -1, "1:EventId", true false false;
+        EventType: ua::NodeId, -1, "1:EventType", true false false;
+        SourceNode: ua::NodeId, -1, "1:SourceNode", true false false;
+        SourceName: String, -1, "1:SourceName", true false false;
+        Time: ua::DateTime, -1, "1:Time", true false false;
+        ReceiveTime: ua::DateTime, -1, "1:ReceiveTime", true false false;
+        LocalTime: ua::TimeZoneDataType, -1, "1:LocalTime", false false false;
+        Message: ua::LocalizedText, -1, "1:Message", true false false;
+        Severity: u16, -1, "1:Severity", true false false;
+        ConditionClassId: ua::NodeId, -1, "1:ConditionClassId", true false false;
+        ConditionClassName: ua::LocalizedText, -1, "1:ConditionClassName", true false false;
+        ConditionSubClassId: ua::NodeId, 1, "1:ConditionSubClassId", false false false;
+        ConditionSubClassName: ua::LocalizedText, 1, "1:ConditionSubClassName", false false false;
+        ConditionName: String, -1, "1:ConditionName", true false false;
+        BranchId: ua::NodeId, -1, "1:BranchId", true false false;
+        Retain: bool, -1, "1:Retain", true false false;
+        EnabledState: ua::LocalizedText, -1, "1:EnabledState", true false false;
+        Quality: ua::StatusCode, -1, "1:Quality", true false false;
+        LastSeverity: u16, -1, "1:LastSeverity", true false false;
+        Comment: ua::LocalizedText, -1, "1:Comment", true false false;
+        ClientUserId: String, -1, "1:ClientUserId", true false false;
+        AckedState: ua::LocalizedText, -1, "1:AckedState", true false false;
+        ConfirmedState: ua::LocalizedText, -1, "1:ConfirmedState", false false false;
+        ActiveState: ua::LocalizedText, -1, "1:ActiveState", true false false;
+        InputNode: ua::NodeId, -1, "1:InputNode", true false false;
+        SuppressedState: ua::LocalizedText, -1, "1:SuppressedState", false false false;
+        OutOfServiceState: ua::LocalizedText, -1, "1:OutOfServiceState", false false false;
+        ShelvingState__CurrentState: ua::LocalizedText, -1, "1:ShelvingState/1:CurrentState", false false false;
+        ShelvingState__LastTransition: ua::LocalizedText, -1, "1:ShelvingState/1:LastTransition", false false false;
+        ShelvingState__AvailableStates: ua::NodeId, 1, "1:ShelvingState/1:AvailableStates", false false false;
+        ShelvingState__AvailableTransitions: ua::NodeId, 1, "1:ShelvingState/1:AvailableTransitions", false false false;
+        ShelvingState__UnshelveTime: f64, -1, "1:ShelvingState/1:UnshelveTime", false false false;
+        SuppressedOrShelved: bool, -1, "1:SuppressedOrShelved", true false false;
+        MaxTimeShelved: f64, -1, "1:MaxTimeShelved", false false false;
+        AudibleEnabled: bool, -1, "1:AudibleEnabled", false false false;
+        AudibleSound: ua::ByteString, -1, "1:AudibleSound", false false false;
+        SilenceState: ua::LocalizedText, -1, "1:SilenceState", false false false;
+        OnDelay: f64, -1, "1:OnDelay", false false false;
+        OffDelay: f64, -1, "1:OffDelay", false false false;
+        FirstInGroupFlag: bool, -1, "1:FirstInGroupFlag", false false false;
+        LatchedState: ua::LocalizedText, -1, "1:LatchedState", false false false;
+        ReAlarmTime: f64, -1, "1:ReAlarmTime", false false false;
+        ReAlarmRepeatCount: i16, -1, "1:ReAlarmRepeatCount", false false false;
+        NormalState: ua::NodeId, -1, "1:NormalState", true false false;
     }
     t::object_members! {
         DeviceType: super::ComponentType;
@@ -2380,15 +2380,15 @@ pub mod members {
             ("SerialNumber", "the mandatory variable `SerialNumber` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
             ("RevisionCounter", "the mandatory variable `RevisionCounter` of DeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RevisionCounter\")]"),
         ];
-        Manufacturer: ua::LocalizedText, -1, [0 "Manufacturer"], true false false;
-        Model: ua::LocalizedText, -1, [0 "Model"], true false false;
-        HardwareRevision: String, -1, [0 "HardwareRevision"], true false false;
-        SoftwareRevision: String, -1, [0 "SoftwareRevision"], true false false;
-        DeviceRevision: String, -1, [0 "DeviceRevision"], true false false;
-        DeviceManual: String, -1, [0 "DeviceManual"], true false false;
-        SerialNumber: String, -1, [0 "SerialNumber"], true false false;
-        RevisionCounter: i32, -1, [0 "RevisionCounter"], true false false;
-        DeviceHealth: super::super::super::types::DeviceHealthEnumeration, -1, [0 "DeviceHealth"], false false false;
+        Manufacturer: ua::LocalizedText, -1, "0:Manufacturer", true false false;
+        Model: ua::LocalizedText, -1, "0:Model", true false false;
+        HardwareRevision: String, -1, "0:HardwareRevision", true false false;
+        SoftwareRevision: String, -1, "0:SoftwareRevision", true false false;
+        DeviceRevision: String, -1, "0:DeviceRevision", true false false;
+        DeviceManual: String, -1, "0:DeviceManual", true false false;
+        SerialNumber: String, -1, "0:SerialNumber", true false false;
+        RevisionCounter: i32, -1, "0:RevisionCounter", true false false;
+        DeviceHealth: super::super::super::types::DeviceHealthEnumeration, -1, "0:DeviceHealth", false false false;
     }
     t::object_members! {
         DiameterIndicationType: super::BaseLifetimeIndicationType;
@@ -2404,8 +2404,8 @@ pub mod members {
             ("ErrorMessage", "the mandatory variable `ErrorMessage` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ErrorMessage\")]"),
             ("UpdateBehavior", "the mandatory variable `UpdateBehavior` of DirectLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"UpdateBehavior\")]"),
         ];
-        UpdateBehavior: super::super::super::types::UpdateBehavior, -1, [0 "UpdateBehavior"], true false false;
-        WriteTimeout: f64, -1, [0 "WriteTimeout"], false false false;
+        UpdateBehavior: super::super::super::types::UpdateBehavior, -1, "0:UpdateBehavior", true false false;
+        WriteTimeout: f64, -1, "0:WriteTimeout", false false false;
     }
     t::object_members! {
         FailureAlarmType: super::DeviceHealthDiagnosticAlarmType;
@@ -2442,28 +2442,28 @@ pub mod members {
     t::object_members! {
         FunctionalGroupType;
         required: [];
-        UIElement: ua::Variant, -1, [0 "UIElement"], false false false;
+        UIElement: ua::Variant, -1, "0:UIElement", false false false;
     }
     t::object_members! {
         IAssetLocationIndicationType;
         required: [
             ("IsIndicating", "the mandatory variable `IsIndicating` of IAssetLocationIndicationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"IsIndicating\")]"),
         ];
-        IsIndicating: bool, -1, [0 "IsIndicating"], true false false;
-        UsedIndicationType: super::super::super::types::LocationIndicationType, -1, [0 "UsedIndicationType"], false false false;
-        SupportedIndicationTypes: super::super::super::types::LocationIndicationType, -1, [0 "SupportedIndicationTypes"], false false false;
+        IsIndicating: bool, -1, "0:IsIndicating", true false false;
+        UsedIndicationType: super::super::super::types::LocationIndicationType, -1, "0:UsedIndicationType", false false false;
+        SupportedIndicationTypes: super::super::super::types::LocationIndicationType, -1, "0:SupportedIndicationTypes", false false false;
     }
     t::object_members! {
         IDeviceHealthType;
         required: [];
-        DeviceHealth: super::super::super::types::DeviceHealthEnumeration, -1, [0 "DeviceHealth"], false false false;
+        DeviceHealth: super::super::super::types::DeviceHealthEnumeration, -1, "0:DeviceHealth", false false false;
     }
     t::object_members! {
         IOperationCounterType;
         required: [];
-        PowerOnDuration: f64, -1, [0 "PowerOnDuration"], false false false;
-        OperationDuration: f64, -1, [0 "OperationDuration"], false false false;
-        OperationCycleCounter: ua::Variant, -1, [0 "OperationCycleCounter"], false false false;
+        PowerOnDuration: f64, -1, "0:PowerOnDuration", false false false;
+        OperationDuration: f64, -1, "0:OperationDuration", false false false;
+        OperationCycleCounter: ua::Variant, -1, "0:OperationCycleCounter", false false false;
     }
     t::object_members! {
         ISupportInfoType;
@@ -2472,38 +2472,38 @@ pub mod members {
     t::object_members! {
         ITagNameplateType;
         required: [];
-        AssetId: String, -1, [0 "AssetId"], false false false;
-        ComponentName: ua::LocalizedText, -1, [0 "ComponentName"], false false false;
+        AssetId: String, -1, "0:AssetId", false false false;
+        ComponentName: ua::LocalizedText, -1, "0:ComponentName", false false false;
     }
     t::object_members! {
         IVendorNameplateType;
         required: [];
-        Manufacturer: ua::LocalizedText, -1, [0 "Manufacturer"], false false false;
-        ManufacturerUri: String, -1, [0 "ManufacturerUri"], false false false;
-        Model: ua::LocalizedText, -1, [0 "Model"], false false false;
-        HardwareRevision: String, -1, [0 "HardwareRevision"], false false false;
-        SoftwareRevision: String, -1, [0 "SoftwareRevision"], false false false;
-        DeviceRevision: String, -1, [0 "DeviceRevision"], false false false;
-        ProductCode: String, -1, [0 "ProductCode"], false false false;
-        DeviceManual: String, -1, [0 "DeviceManual"], false false false;
-        DeviceClass: String, -1, [0 "DeviceClass"], false false false;
-        SerialNumber: String, -1, [0 "SerialNumber"], false false false;
-        ProductInstanceUri: String, -1, [0 "ProductInstanceUri"], false false false;
-        RevisionCounter: i32, -1, [0 "RevisionCounter"], false false false;
-        SoftwareReleaseDate: ua::DateTime, -1, [0 "SoftwareReleaseDate"], false false false;
-        PatchIdentifiers: String, 1, [0 "PatchIdentifiers"], false false false;
+        Manufacturer: ua::LocalizedText, -1, "0:Manufacturer", false false false;
+        ManufacturerUri: String, -1, "0:ManufacturerUri", false false false;
+        Model: ua::LocalizedText, -1, "0:Model", false false false;
+        HardwareRevision: String, -1, "0:HardwareRevision", false false false;
+        SoftwareRevision: String, -1, "0:SoftwareRevision", false false false;
+        DeviceRevision: String, -1, "0:DeviceRevision", false false false;
+        ProductCode: String, -1, "0:ProductCode", false false false;
+        DeviceManual: String, -1, "0:DeviceManual", false false false;
+        DeviceClass: String, -1, "0:DeviceClass", false false false;
+        SerialNumber: String, -1, "0:SerialNumber", false false false;
+        ProductInstanceUri: String, -1, "0:ProductInstanceUri", false false false;
+        RevisionCounter: i32, -1, "0:RevisionCounter", false false false;
+        SoftwareReleaseDate: ua::DateTime, -1, "0:SoftwareReleaseDate", false false false;
+        PatchIdentifiers: String, 1, "0:PatchIdentifiers", false false false;
     }
     t::object_members! {
         InstallationStateMachineType;
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of InstallationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], false false false;
-        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
-        PercentComplete: u8, -1, [0 "PercentComplete"], false false false;
-        InstallationDelay: f64, -1, [0 "InstallationDelay"], false false false;
+        CurrentState: ua::LocalizedText, -1, "1:CurrentState", true false false;
+        LastTransition: ua::LocalizedText, -1, "1:LastTransition", false false false;
+        AvailableStates: ua::NodeId, 1, "1:AvailableStates", false false false;
+        AvailableTransitions: ua::NodeId, 1, "1:AvailableTransitions", false false false;
+        PercentComplete: u8, -1, "0:PercentComplete", false false false;
+        InstallationDelay: f64, -1, "0:InstallationDelay", false false false;
     }
     t::object_members! {
         LengthIndicationType: super::BaseLifetimeIndicationType;
@@ -2517,10 +2517,10 @@ pub mod members {
             ("LockingUser", "the mandatory variable `LockingUser` of LockingServicesType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LockingUser\")]"),
             ("RemainingLockTime", "the mandatory variable `RemainingLockTime` of LockingServicesType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"RemainingLockTime\")]"),
         ];
-        Locked: bool, -1, [0 "Locked"], true false false;
-        LockingClient: String, -1, [0 "LockingClient"], true false false;
-        LockingUser: String, -1, [0 "LockingUser"], true false false;
-        RemainingLockTime: f64, -1, [0 "RemainingLockTime"], true false false;
+        Locked: bool, -1, "0:Locked", true false false;
+        LockingClient: String, -1, "0:LockingClient", true false false;
+        LockingUser: String, -1, "0:LockingUser", true false false;
+        RemainingLockTime: f64, -1, "0:RemainingLockTime", true false false;
     }
     t::object_members! {
         MaintenanceRequiredAlarmType: super::DeviceHealthDiagnosticAlarmType;
@@ -2553,10 +2553,10 @@ pub mod members {
     t::object_members! {
         NetworkType;
         required: [];
-        Lock__Locked: bool, -1, [0 "Lock", 0 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [0 "Lock", 0 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [0 "Lock", 0 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [0 "Lock", 0 "RemainingLockTime"], false false false;
+        Lock__Locked: bool, -1, "0:Lock/0:Locked", false false false;
+        Lock__LockingClient: String, -1, "0:Lock/0:LockingClient", false false false;
+        Lock__LockingUser: String, -1, "0:Lock/0:LockingUser", false false false;
+        Lock__RemainingLockTime: f64, -1, "0:Lock/0:RemainingLockTime", false false false;
     }
     t::object_members! {
         NumberOfPartsIndicationType: super::BaseLifetimeIndicationType;
@@ -2603,37 +2603,37 @@ pub mod members {
             ("FileTransfer/ClientProcessingTimeout", "the mandatory variable `FileTransfer/ClientProcessingTimeout` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"FileTransfer/ClientProcessingTimeout\")]"),
             ("ErrorMessage", "the mandatory variable `ErrorMessage` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ErrorMessage\")]"),
         ];
-        CurrentVersion__Manufacturer: ua::LocalizedText, -1, [0 "CurrentVersion", 0 "Manufacturer"], true false false;
-        CurrentVersion__ManufacturerUri: String, -1, [0 "CurrentVersion", 0 "ManufacturerUri"], true false false;
-        CurrentVersion__SoftwareRevision: String, -1, [0 "CurrentVersion", 0 "SoftwareRevision"], true false false;
-        CurrentVersion__PatchIdentifiers: String, 1, [0 "CurrentVersion", 0 "PatchIdentifiers"], false false false;
-        CurrentVersion__ReleaseDate: ua::DateTime, -1, [0 "CurrentVersion", 0 "ReleaseDate"], false false false;
-        CurrentVersion__ChangeLogReference: String, -1, [0 "CurrentVersion", 0 "ChangeLogReference"], false false false;
-        CurrentVersion__Hash: ua::ByteString, -1, [0 "CurrentVersion", 0 "Hash"], false false false;
-        FileTransfer__ClientProcessingTimeout: f64, -1, [0 "FileTransfer", 1 "ClientProcessingTimeout"], true false false;
-        ErrorMessage: ua::LocalizedText, -1, [0 "ErrorMessage"], true false false;
-        WriteBlockSize: u32, -1, [0 "WriteBlockSize"], false false false;
+        CurrentVersion__Manufacturer: ua::LocalizedText, -1, "0:CurrentVersion/0:Manufacturer", true false false;
+        CurrentVersion__ManufacturerUri: String, -1, "0:CurrentVersion/0:ManufacturerUri", true false false;
+        CurrentVersion__SoftwareRevision: String, -1, "0:CurrentVersion/0:SoftwareRevision", true false false;
+        CurrentVersion__PatchIdentifiers: String, 1, "0:CurrentVersion/0:PatchIdentifiers", false false false;
+        CurrentVersion__ReleaseDate: ua::DateTime, -1, "0:CurrentVersion/0:ReleaseDate", false false false;
+        CurrentVersion__ChangeLogReference: String, -1, "0:CurrentVersion/0:ChangeLogReference", false false false;
+        CurrentVersion__Hash: ua::ByteString, -1, "0:CurrentVersion/0:Hash", false false false;
+        FileTransfer__ClientProcessingTimeout: f64, -1, "0:FileTransfer/1:ClientProcessingTimeout", true false false;
+        ErrorMessage: ua::LocalizedText, -1, "0:ErrorMessage", true false false;
+        WriteBlockSize: u32, -1, "0:WriteBlockSize", false false false;
     }
     t::object_members! {
         PowerCycleStateMachineType;
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of PowerCycleStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], false false false;
-        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
+        CurrentState: ua::LocalizedText, -1, "1:CurrentState", true false false;
+        LastTransition: ua::LocalizedText, -1, "1:LastTransition", false false false;
+        AvailableStates: ua::NodeId, 1, "1:AvailableStates", false false false;
+        AvailableTransitions: ua::NodeId, 1, "1:AvailableTransitions", false false false;
     }
     t::object_members! {
         PrepareForUpdateStateMachineType;
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of PrepareForUpdateStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [1 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [1 "LastTransition"], false false false;
-        AvailableStates: ua::NodeId, 1, [1 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [1 "AvailableTransitions"], false false false;
-        PercentComplete: u8, -1, [0 "PercentComplete"], false false false;
+        CurrentState: ua::LocalizedText, -1, "1:CurrentState", true false false;
+        LastTransition: ua::LocalizedText, -1, "1:LastTransition", false false false;
+        AvailableStates: ua::NodeId, 1, "1:AvailableStates", false false false;
+        AvailableTransitions: ua::NodeId, 1, "1:AvailableTransitions", false false false;
+        PercentComplete: u8, -1, "0:PercentComplete", false false false;
     }
     t::object_members! {
         ProtocolType;
@@ -2644,12 +2644,12 @@ pub mod members {
         required: [
             ("SoftwareClass", "the mandatory variable `SoftwareClass` of SoftwareFolderType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SoftwareClass\")]"),
         ];
-        SoftwareClass: super::super::super::types::SoftwareClass, -1, [0 "SoftwareClass"], true false false;
+        SoftwareClass: super::super::super::types::SoftwareClass, -1, "0:SoftwareClass", true false false;
     }
     t::object_members! {
         SoftwareLoadingType;
         required: [];
-        UpdateKey: String, -1, [0 "UpdateKey"], false false false;
+        UpdateKey: String, -1, "0:UpdateKey", false false false;
     }
     t::object_members! {
         SoftwareType: super::ComponentType;
@@ -2658,41 +2658,41 @@ pub mod members {
             ("Model", "the mandatory variable `Model` of SoftwareType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
             ("SoftwareRevision", "the mandatory variable `SoftwareRevision` of SoftwareType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SoftwareRevision\")]"),
         ];
-        Manufacturer: ua::LocalizedText, -1, [0 "Manufacturer"], true false false;
-        Model: ua::LocalizedText, -1, [0 "Model"], true false false;
-        SoftwareRevision: String, -1, [0 "SoftwareRevision"], true false false;
+        Manufacturer: ua::LocalizedText, -1, "0:Manufacturer", true false false;
+        Model: ua::LocalizedText, -1, "0:Model", true false false;
+        SoftwareRevision: String, -1, "0:SoftwareRevision", true false false;
     }
     t::object_members! {
         SoftwareUpdateType;
         required: [];
-        Loading__UpdateKey: String, -1, [0 "Loading", 0 "UpdateKey"], false false false;
-        PrepareForUpdate__CurrentState: ua::LocalizedText, -1, [0 "PrepareForUpdate", 1 "CurrentState"], false false false;
-        PrepareForUpdate__LastTransition: ua::LocalizedText, -1, [0 "PrepareForUpdate", 1 "LastTransition"], false false false;
-        PrepareForUpdate__AvailableStates: ua::NodeId, 1, [0 "PrepareForUpdate", 1 "AvailableStates"], false false false;
-        PrepareForUpdate__AvailableTransitions: ua::NodeId, 1, [0 "PrepareForUpdate", 1 "AvailableTransitions"], false false false;
-        PrepareForUpdate__PercentComplete: u8, -1, [0 "PrepareForUpdate", 0 "PercentComplete"], false false false;
-        Installation__CurrentState: ua::LocalizedText, -1, [0 "Installation", 1 "CurrentState"], false false false;
-        Installation__LastTransition: ua::LocalizedText, -1, [0 "Installation", 1 "LastTransition"], false false false;
-        Installation__AvailableStates: ua::NodeId, 1, [0 "Installation", 1 "AvailableStates"], false false false;
-        Installation__AvailableTransitions: ua::NodeId, 1, [0 "Installation", 1 "AvailableTransitions"], false false false;
-        Installation__PercentComplete: u8, -1, [0 "Installation", 0 "PercentComplete"], false false false;
-        Installation__InstallationDelay: f64, -1, [0 "Installation", 0 "InstallationDelay"], false false false;
-        PowerCycle__CurrentState: ua::LocalizedText, -1, [0 "PowerCycle", 1 "CurrentState"], false false false;
-        PowerCycle__LastTransition: ua::LocalizedText, -1, [0 "PowerCycle", 1 "LastTransition"], false false false;
-        PowerCycle__AvailableStates: ua::NodeId, 1, [0 "PowerCycle", 1 "AvailableStates"], false false false;
-        PowerCycle__AvailableTransitions: ua::NodeId, 1, [0 "PowerCycle", 1 "AvailableTransitions"], false false false;
-        Confirmation__CurrentState: ua::LocalizedText, -1, [0 "Confirmation", 1 "CurrentState"], false false false;
-        Confirmation__LastTransition: ua::LocalizedText, -1, [0 "Confirmation", 1 "LastTransition"], false false false;
-        Confirmation__AvailableStates: ua::NodeId, 1, [0 "Confirmation", 1 "AvailableStates"], false false false;
-        Confirmation__AvailableTransitions: ua::NodeId, 1, [0 "Confirmation", 1 "AvailableTransitions"], false false false;
-        Confirmation__ConfirmationTimeout: f64, -1, [0 "Confirmation", 0 "ConfirmationTimeout"], false false false;
-        Parameters__ClientProcessingTimeout: f64, -1, [0 "Parameters", 1 "ClientProcessingTimeout"], false false false;
-        UpdateStatus: ua::LocalizedText, -1, [0 "UpdateStatus"], false false false;
-        SoftwareClass: super::super::super::types::SoftwareClass, -1, [0 "SoftwareClass"], false false false;
-        SoftwareSubclass: String, -1, [0 "SoftwareSubclass"], false false false;
-        SoftwareName: String, -1, [0 "SoftwareName"], false false false;
-        UnsignedPackageAllowed: bool, -1, [0 "UnsignedPackageAllowed"], false false false;
-        VendorErrorCode: i32, -1, [0 "VendorErrorCode"], false false false;
+        Loading__UpdateKey: String, -1, "0:Loading/0:UpdateKey", false false false;
+        PrepareForUpdate__CurrentState: ua::LocalizedText, -1, "0:PrepareForUpdate/1:CurrentState", false false false;
+        PrepareForUpdate__LastTransition: ua::LocalizedText, -1, "0:PrepareForUpdate/1:LastTransition", false false false;
+        PrepareForUpdate__AvailableStates: ua::NodeId, 1, "0:PrepareForUpdate/1:AvailableStates", false false false;
+        PrepareForUpdate__AvailableTransitions: ua::NodeId, 1, "0:PrepareForUpdate/1:AvailableTransitions", false false false;
+        PrepareForUpdate__PercentComplete: u8, -1, "0:PrepareForUpdate/0:PercentComplete", false false false;
+        Installation__CurrentState: ua::LocalizedText, -1, "0:Installation/1:CurrentState", false false false;
+        Installation__LastTransition: ua::LocalizedText, -1, "0:Installation/1:LastTransition", false false false;
+        Installation__AvailableStates: ua::NodeId, 1, "0:Installation/1:AvailableStates", false false false;
+        Installation__AvailableTransitions: ua::NodeId, 1, "0:Installation/1:AvailableTransitions", false false false;
+        Installation__PercentComplete: u8, -1, "0:Installation/0:PercentComplete", false false false;
+        Installation__InstallationDelay: f64, -1, "0:Installation/0:InstallationDelay", false false false;
+        PowerCycle__CurrentState: ua::LocalizedText, -1, "0:PowerCycle/1:CurrentState", false false false;
+        PowerCycle__LastTransition: ua::LocalizedText, -1, "0:PowerCycle/1:LastTransition", false false false;
+        PowerCycle__AvailableStates: ua::NodeId, 1, "0:PowerCycle/1:AvailableStates", false false false;
+        PowerCycle__AvailableTransitions: ua::NodeId, 1, "0:PowerCycle/1:AvailableTransitions", false false false;
+        Confirmation__CurrentState: ua::LocalizedText, -1, "0:Confirmation/1:CurrentState", false false false;
+        Confirmation__LastTransition: ua::LocalizedText, -1, "0:Confirmation/1:LastTransition", false false false;
+        Confirmation__AvailableStates: ua::NodeId, 1, "0:Confirmation/1:AvailableStates", false false false;
+        Confirmation__AvailableTransitions: ua::NodeId, 1, "0:Confirmation/1:AvailableTransitions", false false false;
+        Confirmation__ConfirmationTimeout: f64, -1, "0:Confirmation/0:ConfirmationTimeout", false false false;
+        Parameters__ClientProcessingTimeout: f64, -1, "0:Parameters/1:ClientProcessingTimeout", false false false;
+        UpdateStatus: ua::LocalizedText, -1, "0:UpdateStatus", false false false;
+        SoftwareClass: super::super::super::types::SoftwareClass, -1, "0:SoftwareClass", false false false;
+        SoftwareSubclass: String, -1, "0:SoftwareSubclass", false false false;
+        SoftwareName: String, -1, "0:SoftwareName", false false false;
+        UnsignedPackageAllowed: bool, -1, "0:UnsignedPackageAllowed", false false false;
+        VendorErrorCode: i32, -1, "0:VendorErrorCode", false false false;
     }
     t::object_members! {
         SoftwareVersionType;
@@ -2701,13 +2701,13 @@ pub mod members {
             ("ManufacturerUri", "the mandatory variable `ManufacturerUri` of SoftwareVersionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ManufacturerUri\")]"),
             ("SoftwareRevision", "the mandatory variable `SoftwareRevision` of SoftwareVersionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SoftwareRevision\")]"),
         ];
-        Manufacturer: ua::LocalizedText, -1, [0 "Manufacturer"], true false false;
-        ManufacturerUri: String, -1, [0 "ManufacturerUri"], true false false;
-        SoftwareRevision: String, -1, [0 "SoftwareRevision"], true false false;
-        PatchIdentifiers: String, 1, [0 "PatchIdentifiers"], false false false;
-        ReleaseDate: ua::DateTime, -1, [0 "ReleaseDate"], false false false;
-        ChangeLogReference: String, -1, [0 "ChangeLogReference"], false false false;
-        Hash: ua::ByteString, -1, [0 "Hash"], false false false;
+        Manufacturer: ua::LocalizedText, -1, "0:Manufacturer", true false false;
+        ManufacturerUri: String, -1, "0:ManufacturerUri", true false false;
+        SoftwareRevision: String, -1, "0:SoftwareRevision", true false false;
+        PatchIdentifiers: String, 1, "0:PatchIdentifiers", false false false;
+        ReleaseDate: ua::DateTime, -1, "0:ReleaseDate", false false false;
+        ChangeLogReference: String, -1, "0:ChangeLogReference", false false false;
+        Hash: ua::ByteString, -1, "0:Hash", false false false;
     }
     t::object_members! {
         SubstanceVolumeIndicationType: super::BaseLifetimeIndicationType;
@@ -2720,11 +2720,11 @@ pub mod members {
     t::object_members! {
         TopologyElementType;
         required: [];
-        Identification__UIElement: ua::Variant, -1, [0 "Identification", 0 "UIElement"], false false false;
-        Lock__Locked: bool, -1, [0 "Lock", 0 "Locked"], false false false;
-        Lock__LockingClient: String, -1, [0 "Lock", 0 "LockingClient"], false false false;
-        Lock__LockingUser: String, -1, [0 "Lock", 0 "LockingUser"], false false false;
-        Lock__RemainingLockTime: f64, -1, [0 "Lock", 0 "RemainingLockTime"], false false false;
+        Identification__UIElement: ua::Variant, -1, "0:Identification/0:UIElement", false false false;
+        Lock__Locked: bool, -1, "0:Lock/0:Locked", false false false;
+        Lock__LockingClient: String, -1, "0:Lock/0:LockingClient", false false false;
+        Lock__LockingUser: String, -1, "0:Lock/0:LockingUser", false false false;
+        Lock__RemainingLockTime: f64, -1, "0:Lock/0:RemainingLockTime", false false false;
     }
     t::object_members! {
         TransferServicesType;

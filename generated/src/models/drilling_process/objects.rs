@@ -291,12 +291,12 @@ pub mod members {
             ("InputParameterSet/ClampForce", "the mandatory variable `InputParameterSet/ClampForce` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"InputParameterSet/ClampForce\")]"),
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of DrillHoleSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
         ];
-        InputParameterSet__InsertionDistance: f64, -1, [1 "InputParameterSet", 0 "InsertionDistance"], true false true;
-        InputParameterSet__HoleDiameter: f64, -1, [1 "InputParameterSet", 0 "HoleDiameter"], true false true;
-        InputParameterSet__Depth: f64, -1, [1 "InputParameterSet", 0 "Depth"], true false true;
-        InputParameterSet__FeedRate: f64, -1, [1 "InputParameterSet", 0 "FeedRate"], true false true;
-        InputParameterSet__SpindleSpeed: f64, -1, [1 "InputParameterSet", 0 "SpindleSpeed"], true false true;
-        InputParameterSet__ClampForce: f64, -1, [1 "InputParameterSet", 0 "ClampForce"], true false true;
+        InputParameterSet__InsertionDistance: f64, -1, "1:InputParameterSet/0:InsertionDistance", true false true;
+        InputParameterSet__HoleDiameter: f64, -1, "1:InputParameterSet/0:HoleDiameter", true false true;
+        InputParameterSet__Depth: f64, -1, "1:InputParameterSet/0:Depth", true false true;
+        InputParameterSet__FeedRate: f64, -1, "1:InputParameterSet/0:FeedRate", true false true;
+        InputParameterSet__SpindleSpeed: f64, -1, "1:InputParameterSet/0:SpindleSpeed", true false true;
+        InputParameterSet__ClampForce: f64, -1, "1:InputParameterSet/0:ClampForce", true false true;
     }
     t::object_members! {
         DrillingCellType;
@@ -323,33 +323,33 @@ pub mod members {
             ("SkillSet/DrillHole/InputParameterSet/ClampForce", "the mandatory variable `SkillSet/DrillHole/InputParameterSet/ClampForce` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/InputParameterSet/ClampForce\")]"),
             ("SkillSet/DrillHole/OutputParameterSet/Result", "the mandatory variable `SkillSet/DrillHole/OutputParameterSet/Result` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/DrillHole/OutputParameterSet/Result\")]"),
         ];
-        SkillSet__ReferenceDrillBush__CurrentState: ua::LocalizedText, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "CurrentState"], true false false;
-        SkillSet__ReferenceDrillBush__LastTransition: ua::LocalizedText, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "LastTransition"], true false false;
-        SkillSet__ReferenceDrillBush__AvailableStates: ua::NodeId, 1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "AvailableStates"], false false false;
-        SkillSet__ReferenceDrillBush__AvailableTransitions: ua::NodeId, 1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "AvailableTransitions"], false false false;
-        SkillSet__ReferenceDrillBush__Deletable: bool, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "Deletable"], true false false;
-        SkillSet__ReferenceDrillBush__AutoDelete: bool, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "AutoDelete"], true false false;
-        SkillSet__ReferenceDrillBush__RecycleCount: i32, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "RecycleCount"], true false false;
-        SkillSet__ReferenceDrillBush__ProgramDiagnostic: ua::ExtensionObject, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 2 "ProgramDiagnostic"], false false false;
-        SkillSet__ReferenceDrillBush__InputParameterSet__HolePosition: ua::ThreeDFrame, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 1 "InputParameterSet", 0 "HolePosition"], true false true;
-        SkillSet__ReferenceDrillBush__InputParameterSet__ApproachDistance: f64, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 1 "InputParameterSet", 0 "ApproachDistance"], true false true;
-        SkillSet__ReferenceDrillBush__OutputParameterSet__Result: ua::StatusCode, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 1 "OutputParameterSet", 1 "Result"], true false false;
-        SkillSet__ReferenceDrillBush__OutputParameterSet__ReferencedHolePosition: ua::ThreeDFrame, -1, [1 "SkillSet", 0 "ReferenceDrillBush", 1 "OutputParameterSet", 0 "ReferencedHolePosition"], true false false;
-        SkillSet__DrillHole__CurrentState: ua::LocalizedText, -1, [1 "SkillSet", 0 "DrillHole", 2 "CurrentState"], true false false;
-        SkillSet__DrillHole__LastTransition: ua::LocalizedText, -1, [1 "SkillSet", 0 "DrillHole", 2 "LastTransition"], true false false;
-        SkillSet__DrillHole__AvailableStates: ua::NodeId, 1, [1 "SkillSet", 0 "DrillHole", 2 "AvailableStates"], false false false;
-        SkillSet__DrillHole__AvailableTransitions: ua::NodeId, 1, [1 "SkillSet", 0 "DrillHole", 2 "AvailableTransitions"], false false false;
-        SkillSet__DrillHole__Deletable: bool, -1, [1 "SkillSet", 0 "DrillHole", 2 "Deletable"], true false false;
-        SkillSet__DrillHole__AutoDelete: bool, -1, [1 "SkillSet", 0 "DrillHole", 2 "AutoDelete"], true false false;
-        SkillSet__DrillHole__RecycleCount: i32, -1, [1 "SkillSet", 0 "DrillHole", 2 "RecycleCount"], true false false;
-        SkillSet__DrillHole__ProgramDiagnostic: ua::ExtensionObject, -1, [1 "SkillSet", 0 "DrillHole", 2 "ProgramDiagnostic"], false false false;
-        SkillSet__DrillHole__InputParameterSet__InsertionDistance: f64, -1, [1 "SkillSet", 0 "DrillHole", 1 "InputParameterSet", 0 "InsertionDistance"], true false true;
-        SkillSet__DrillHole__InputParameterSet__HoleDiameter: f64, -1, [1 "SkillSet", 0 "DrillHole", 1 "InputParameterSet", 0 "HoleDiameter"], true false true;
-        SkillSet__DrillHole__InputParameterSet__Depth: f64, -1, [1 "SkillSet", 0 "DrillHole", 1 "InputParameterSet", 0 "Depth"], true false true;
-        SkillSet__DrillHole__InputParameterSet__FeedRate: f64, -1, [1 "SkillSet", 0 "DrillHole", 1 "InputParameterSet", 0 "FeedRate"], true false true;
-        SkillSet__DrillHole__InputParameterSet__SpindleSpeed: f64, -1, [1 "SkillSet", 0 "DrillHole", 1 "InputParameterSet", 0 "SpindleSpeed"], true false true;
-        SkillSet__DrillHole__InputParameterSet__ClampForce: f64, -1, [1 "SkillSet", 0 "DrillHole", 1 "InputParameterSet", 0 "ClampForce"], true false true;
-        SkillSet__DrillHole__OutputParameterSet__Result: ua::StatusCode, -1, [1 "SkillSet", 0 "DrillHole", 1 "OutputParameterSet", 1 "Result"], true false false;
+        SkillSet__ReferenceDrillBush__CurrentState: ua::LocalizedText, -1, "1:SkillSet/0:ReferenceDrillBush/2:CurrentState", true false false;
+        SkillSet__ReferenceDrillBush__LastTransition: ua::LocalizedText, -1, "1:SkillSet/0:ReferenceDrillBush/2:LastTransition", true false false;
+        SkillSet__ReferenceDrillBush__AvailableStates: ua::NodeId, 1, "1:SkillSet/0:ReferenceDrillBush/2:AvailableStates", false false false;
+        SkillSet__ReferenceDrillBush__AvailableTransitions: ua::NodeId, 1, "1:SkillSet/0:ReferenceDrillBush/2:AvailableTransitions", false false false;
+        SkillSet__ReferenceDrillBush__Deletable: bool, -1, "1:SkillSet/0:ReferenceDrillBush/2:Deletable", true false false;
+        SkillSet__ReferenceDrillBush__AutoDelete: bool, -1, "1:SkillSet/0:ReferenceDrillBush/2:AutoDelete", true false false;
+        SkillSet__ReferenceDrillBush__RecycleCount: i32, -1, "1:SkillSet/0:ReferenceDrillBush/2:RecycleCount", true false false;
+        SkillSet__ReferenceDrillBush__ProgramDiagnostic: ua::ExtensionObject, -1, "1:SkillSet/0:ReferenceDrillBush/2:ProgramDiagnostic", false false false;
+        SkillSet__ReferenceDrillBush__InputParameterSet__HolePosition: ua::ThreeDFrame, -1, "1:SkillSet/0:ReferenceDrillBush/1:InputParameterSet/0:HolePosition", true false true;
+        SkillSet__ReferenceDrillBush__InputParameterSet__ApproachDistance: f64, -1, "1:SkillSet/0:ReferenceDrillBush/1:InputParameterSet/0:ApproachDistance", true false true;
+        SkillSet__ReferenceDrillBush__OutputParameterSet__Result: ua::StatusCode, -1, "1:SkillSet/0:ReferenceDrillBush/1:OutputParameterSet/1:Result", true false false;
+        SkillSet__ReferenceDrillBush__OutputParameterSet__ReferencedHolePosition: ua::ThreeDFrame, -1, "1:SkillSet/0:ReferenceDrillBush/1:OutputParameterSet/0:ReferencedHolePosition", true false false;
+        SkillSet__DrillHole__CurrentState: ua::LocalizedText, -1, "1:SkillSet/0:DrillHole/2:CurrentState", true false false;
+        SkillSet__DrillHole__LastTransition: ua::LocalizedText, -1, "1:SkillSet/0:DrillHole/2:LastTransition", true false false;
+        SkillSet__DrillHole__AvailableStates: ua::NodeId, 1, "1:SkillSet/0:DrillHole/2:AvailableStates", false false false;
+        SkillSet__DrillHole__AvailableTransitions: ua::NodeId, 1, "1:SkillSet/0:DrillHole/2:AvailableTransitions", false false false;
+        SkillSet__DrillHole__Deletable: bool, -1, "1:SkillSet/0:DrillHole/2:Deletable", true false false;
+        SkillSet__DrillHole__AutoDelete: bool, -1, "1:SkillSet/0:DrillHole/2:AutoDelete", true false false;
+        SkillSet__DrillHole__RecycleCount: i32, -1, "1:SkillSet/0:DrillHole/2:RecycleCount", true false false;
+        SkillSet__DrillHole__ProgramDiagnostic: ua::ExtensionObject, -1, "1:SkillSet/0:DrillHole/2:ProgramDiagnostic", false false false;
+        SkillSet__DrillHole__InputParameterSet__InsertionDistance: f64, -1, "1:SkillSet/0:DrillHole/1:InputParameterSet/0:InsertionDistance", true false true;
+        SkillSet__DrillHole__InputParameterSet__HoleDiameter: f64, -1, "1:SkillSet/0:DrillHole/1:InputParameterSet/0:HoleDiameter", true false true;
+        SkillSet__DrillHole__InputParameterSet__Depth: f64, -1, "1:SkillSet/0:DrillHole/1:InputParameterSet/0:Depth", true false true;
+        SkillSet__DrillHole__InputParameterSet__FeedRate: f64, -1, "1:SkillSet/0:DrillHole/1:InputParameterSet/0:FeedRate", true false true;
+        SkillSet__DrillHole__InputParameterSet__SpindleSpeed: f64, -1, "1:SkillSet/0:DrillHole/1:InputParameterSet/0:SpindleSpeed", true false true;
+        SkillSet__DrillHole__InputParameterSet__ClampForce: f64, -1, "1:SkillSet/0:DrillHole/1:InputParameterSet/0:ClampForce", true false true;
+        SkillSet__DrillHole__OutputParameterSet__Result: ua::StatusCode, -1, "1:SkillSet/0:DrillHole/1:OutputParameterSet/1:Result", true false false;
     }
     t::object_members! {
         ReferenceDrillBushSkillType: super::super::super::super::common_skills::objects::members::CompositeSkillType;
@@ -364,8 +364,8 @@ pub mod members {
             ("OutputParameterSet/Result", "the mandatory variable `OutputParameterSet/Result` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/Result\")]"),
             ("OutputParameterSet/ReferencedHolePosition", "the mandatory variable `OutputParameterSet/ReferencedHolePosition` of ReferenceDrillBushSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OutputParameterSet/ReferencedHolePosition\")]"),
         ];
-        InputParameterSet__HolePosition: ua::ThreeDFrame, -1, [1 "InputParameterSet", 0 "HolePosition"], true false true;
-        InputParameterSet__ApproachDistance: f64, -1, [1 "InputParameterSet", 0 "ApproachDistance"], true false true;
-        OutputParameterSet__ReferencedHolePosition: ua::ThreeDFrame, -1, [1 "OutputParameterSet", 0 "ReferencedHolePosition"], true false false;
+        InputParameterSet__HolePosition: ua::ThreeDFrame, -1, "1:InputParameterSet/0:HolePosition", true false true;
+        InputParameterSet__ApproachDistance: f64, -1, "1:InputParameterSet/0:ApproachDistance", true false true;
+        OutputParameterSet__ReferencedHolePosition: ua::ThreeDFrame, -1, "1:OutputParameterSet/0:ReferencedHolePosition", true false false;
     }
 }

@@ -720,8 +720,8 @@ pub mod members {
         required: [
             ("NumberInList", "the mandatory variable `NumberInList` of AcousticSignalType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NumberInList\")]"),
         ];
-        AudioSample: ua::ByteString, -1, [0 "AudioSample"], false false true;
-        NumberInList: ua::Variant, -1, [1 "NumberInList"], true false true;
+        AudioSample: ua::ByteString, -1, "0:AudioSample", false false true;
+        NumberInList: ua::Variant, -1, "1:NumberInList", true false true;
     }
     t::object_members! {
         BaseCalibrationTargetCategoryType;
@@ -732,33 +732,33 @@ pub mod members {
         required: [
             ("StacklightMode", "the mandatory variable `StacklightMode` of BasicStacklightType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"StacklightMode\")]"),
         ];
-        NodeVersion: String, -1, [1 "NodeVersion"], false false false;
-        StackLevel__DisplayMode: super::super::super::types::LevelDisplayMode, -1, [0 "StackLevel", 0 "DisplayMode"], false false true;
-        StackLevel__LevelPercent: f32, -1, [0 "StackLevel", 0 "LevelPercent"], false false true;
-        StacklightMode: super::super::super::types::StacklightOperationMode, -1, [0 "StacklightMode"], true false true;
+        NodeVersion: String, -1, "1:NodeVersion", false false false;
+        StackLevel__DisplayMode: super::super::super::types::LevelDisplayMode, -1, "0:StackLevel/0:DisplayMode", false false true;
+        StackLevel__LevelPercent: f32, -1, "0:StackLevel/0:LevelPercent", false false true;
+        StacklightMode: super::super::super::types::StacklightOperationMode, -1, "0:StacklightMode", true false true;
     }
     t::object_members! {
         CalibrationTargetType;
         required: [];
-        CertificateUri: String, -1, [0 "CertificateUri"], false false true;
-        Identification__UIElement: ua::Variant, -1, [2 "Identification", 2 "UIElement"], false false false;
-        Identification__AssetId: String, -1, [2 "Identification", 2 "AssetId"], false false true;
-        Identification__ComponentName: ua::LocalizedText, -1, [2 "Identification", 2 "ComponentName"], false false true;
-        Identification__DeviceClass: String, -1, [2 "Identification", 2 "DeviceClass"], false false true;
-        Identification__DeviceManual: String, -1, [2 "Identification", 2 "DeviceManual"], false false true;
-        Identification__DeviceRevision: String, -1, [2 "Identification", 2 "DeviceRevision"], false false true;
-        Identification__HardwareRevision: String, -1, [2 "Identification", 2 "HardwareRevision"], false false true;
-        Identification__Manufacturer: ua::LocalizedText, -1, [2 "Identification", 2 "Manufacturer"], false false true;
-        Identification__ManufacturerUri: String, -1, [2 "Identification", 2 "ManufacturerUri"], false false true;
-        Identification__Model: ua::LocalizedText, -1, [2 "Identification", 2 "Model"], false false true;
-        Identification__ProductCode: String, -1, [2 "Identification", 2 "ProductCode"], false false true;
-        Identification__ProductInstanceUri: String, -1, [2 "Identification", 2 "ProductInstanceUri"], false false true;
-        Identification__RevisionCounter: i32, -1, [2 "Identification", 2 "RevisionCounter"], false false true;
-        Identification__SerialNumber: String, -1, [2 "Identification", 2 "SerialNumber"], false false true;
-        Identification__SoftwareRevision: String, -1, [2 "Identification", 2 "SoftwareRevision"], false false true;
-        LastValidationDate: ua::DateTime, -1, [0 "LastValidationDate"], false false true;
-        NextValidationDate: ua::DateTime, -1, [0 "NextValidationDate"], false false true;
-        Quality: u8, -1, [0 "Quality"], false false true;
+        CertificateUri: String, -1, "0:CertificateUri", false false true;
+        Identification__UIElement: ua::Variant, -1, "2:Identification/2:UIElement", false false false;
+        Identification__AssetId: String, -1, "2:Identification/2:AssetId", false false true;
+        Identification__ComponentName: ua::LocalizedText, -1, "2:Identification/2:ComponentName", false false true;
+        Identification__DeviceClass: String, -1, "2:Identification/2:DeviceClass", false false true;
+        Identification__DeviceManual: String, -1, "2:Identification/2:DeviceManual", false false true;
+        Identification__DeviceRevision: String, -1, "2:Identification/2:DeviceRevision", false false true;
+        Identification__HardwareRevision: String, -1, "2:Identification/2:HardwareRevision", false false true;
+        Identification__Manufacturer: ua::LocalizedText, -1, "2:Identification/2:Manufacturer", false false true;
+        Identification__ManufacturerUri: String, -1, "2:Identification/2:ManufacturerUri", false false true;
+        Identification__Model: ua::LocalizedText, -1, "2:Identification/2:Model", false false true;
+        Identification__ProductCode: String, -1, "2:Identification/2:ProductCode", false false true;
+        Identification__ProductInstanceUri: String, -1, "2:Identification/2:ProductInstanceUri", false false true;
+        Identification__RevisionCounter: i32, -1, "2:Identification/2:RevisionCounter", false false true;
+        Identification__SerialNumber: String, -1, "2:Identification/2:SerialNumber", false false true;
+        Identification__SoftwareRevision: String, -1, "2:Identification/2:SoftwareRevision", false false true;
+        LastValidationDate: ua::DateTime, -1, "0:LastValidationDate", false false true;
+        NextValidationDate: ua::DateTime, -1, "0:NextValidationDate", false false true;
+        Quality: u8, -1, "0:Quality", false false true;
     }
     t::object_members! {
         ControlChannelType;
@@ -767,10 +767,10 @@ pub mod members {
             ("SignalMode", "the mandatory variable `SignalMode` of ControlChannelType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SignalMode\")]"),
             ("SignalOn", "the mandatory variable `SignalOn` of ControlChannelType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SignalOn\")]"),
         ];
-        ChannelColor: super::super::super::types::SignalColor, -1, [0 "ChannelColor"], true false true;
-        Intensity: f32, -1, [0 "Intensity"], false false true;
-        SignalMode: super::super::super::types::SignalModeLight, -1, [0 "SignalMode"], true false true;
-        SignalOn: bool, -1, [0 "SignalOn"], true false true;
+        ChannelColor: super::super::super::types::SignalColor, -1, "0:ChannelColor", true false true;
+        Intensity: f32, -1, "0:Intensity", false false true;
+        SignalMode: super::super::super::types::SignalModeLight, -1, "0:SignalMode", true false true;
+        SignalOn: bool, -1, "0:SignalOn", true false true;
     }
     t::object_members! {
         DynamicCalibrationTargetCategoryType: super::BaseCalibrationTargetCategoryType;
@@ -779,18 +779,18 @@ pub mod members {
     t::object_members! {
         IAggregateStatisticsType: super::IStatisticsType;
         required: [];
-        ResetCondition: String, -1, [0 "ResetCondition"], false false true;
+        ResetCondition: String, -1, "0:ResetCondition", false false true;
     }
     t::object_members! {
         IRollingStatisticsType: super::IStatisticsType;
         required: [];
-        WindowDuration: f64, -1, [0 "WindowDuration"], false false true;
-        WindowNumberOfValues: u32, -1, [0 "WindowNumberOfValues"], false false true;
+        WindowDuration: f64, -1, "0:WindowDuration", false false true;
+        WindowNumberOfValues: u32, -1, "0:WindowNumberOfValues", false false true;
     }
     t::object_members! {
         IStatisticsType;
         required: [];
-        StartTime: ua::DateTime, -1, [0 "StartTime"], false false true;
+        StartTime: ua::DateTime, -1, "0:StartTime", false false true;
     }
     t::object_members! {
         OneTimeCalibrationTargetCategoryType: super::BaseCalibrationTargetCategoryType;
@@ -810,28 +810,28 @@ pub mod members {
             ("NumberInList", "the mandatory variable `NumberInList` of StackElementAcousticType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NumberInList\")]"),
             ("OperationMode", "the mandatory variable `OperationMode` of StackElementAcousticType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"OperationMode\")]"),
         ];
-        AcousticSignals__NodeVersion: String, -1, [0 "AcousticSignals", 1 "NodeVersion"], false false false;
-        Intensity: f32, -1, [0 "Intensity"], false false true;
-        OperationMode: ua::Variant, -1, [0 "OperationMode"], true false true;
+        AcousticSignals__NodeVersion: String, -1, "0:AcousticSignals/1:NodeVersion", false false false;
+        Intensity: f32, -1, "0:Intensity", false false true;
+        OperationMode: ua::Variant, -1, "0:OperationMode", true false true;
     }
     t::object_members! {
         StackElementLightType: super::StackElementType;
         required: [
             ("NumberInList", "the mandatory variable `NumberInList` of StackElementLightType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NumberInList\")]"),
         ];
-        Intensity: f32, -1, [0 "Intensity"], false false true;
-        SignalColor: super::super::super::types::SignalColor, -1, [0 "SignalColor"], false false true;
-        SignalMode: super::super::super::types::SignalModeLight, -1, [0 "SignalMode"], false false true;
-        SignalRGBWValue: super::super::super::types::RgbwDataType, -1, [0 "SignalRGBWValue"], false false true;
+        Intensity: f32, -1, "0:Intensity", false false true;
+        SignalColor: super::super::super::types::SignalColor, -1, "0:SignalColor", false false true;
+        SignalMode: super::super::super::types::SignalModeLight, -1, "0:SignalMode", false false true;
+        SignalRGBWValue: super::super::super::types::RgbwDataType, -1, "0:SignalRGBWValue", false false true;
     }
     t::object_members! {
         StackElementType;
         required: [
             ("NumberInList", "the mandatory variable `NumberInList` of StackElementType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"NumberInList\")]"),
         ];
-        IsPartOfBase: bool, -1, [0 "IsPartOfBase"], false false true;
-        NumberInList: ua::Variant, -1, [1 "NumberInList"], true false false;
-        SignalOn: bool, -1, [0 "SignalOn"], false false true;
+        IsPartOfBase: bool, -1, "0:IsPartOfBase", false false true;
+        NumberInList: ua::Variant, -1, "1:NumberInList", true false false;
+        SignalOn: bool, -1, "0:SignalOn", false false true;
     }
     t::object_members! {
         StackLevelType;
@@ -839,8 +839,8 @@ pub mod members {
             ("DisplayMode", "the mandatory variable `DisplayMode` of StackLevelType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DisplayMode\")]"),
             ("LevelPercent", "the mandatory variable `LevelPercent` of StackLevelType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LevelPercent\")]"),
         ];
-        DisplayMode: super::super::super::types::LevelDisplayMode, -1, [0 "DisplayMode"], true false true;
-        LevelPercent: f32, -1, [0 "LevelPercent"], true false true;
+        DisplayMode: super::super::super::types::LevelDisplayMode, -1, "0:DisplayMode", true false true;
+        LevelPercent: f32, -1, "0:LevelPercent", true false true;
     }
     t::object_members! {
         StackRunningType;
@@ -851,6 +851,6 @@ pub mod members {
         required: [
             ("StacklightMode", "the mandatory variable `StacklightMode` of StacklightType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"StacklightMode\")]"),
         ];
-        DeviceHealth: super::super::super::super::di::types::DeviceHealthEnumeration, -1, [2 "DeviceHealth"], false false true;
+        DeviceHealth: super::super::super::super::di::types::DeviceHealthEnumeration, -1, "2:DeviceHealth", false false true;
     }
 }

@@ -1893,7 +1893,7 @@ pub mod members {
         required: [
             ("ProductCode", "the mandatory variable `ProductCode` of AuxiliaryComponentType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]"),
         ];
-        ProductCode: String, -1, [1 "ProductCode"], true false false;
+        ProductCode: String, -1, "1:ProductCode", true false false;
     }
     t::object_members! {
         AxisType: super::super::super::super::di::objects::members::ComponentType;
@@ -1901,13 +1901,13 @@ pub mod members {
             ("ParameterSet/ActualPosition", "the mandatory variable `ParameterSet/ActualPosition` of AxisType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/ActualPosition\")]"),
             ("MotionProfile", "the mandatory variable `MotionProfile` of AxisType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionProfile\")]"),
         ];
-        ParameterSet__ActualAcceleration: f64, -1, [1 "ParameterSet", 0 "ActualAcceleration"], false false false;
-        ParameterSet__ActualPosition: f64, -1, [1 "ParameterSet", 0 "ActualPosition"], true false false;
-        ParameterSet__ActualSpeed: f64, -1, [1 "ParameterSet", 0 "ActualSpeed"], false false false;
-        AdditionalLoad__CenterOfMass: ua::ThreeDFrame, -1, [0 "AdditionalLoad", 0 "CenterOfMass"], false false false;
-        AdditionalLoad__Inertia: ua::ThreeDVector, -1, [0 "AdditionalLoad", 0 "Inertia"], false false false;
-        AdditionalLoad__Mass: f64, -1, [0 "AdditionalLoad", 0 "Mass"], false false false;
-        MotionProfile: super::super::super::types::AxisMotionProfileEnumeration, -1, [0 "MotionProfile"], true false false;
+        ParameterSet__ActualAcceleration: f64, -1, "1:ParameterSet/0:ActualAcceleration", false false false;
+        ParameterSet__ActualPosition: f64, -1, "1:ParameterSet/0:ActualPosition", true false false;
+        ParameterSet__ActualSpeed: f64, -1, "1:ParameterSet/0:ActualSpeed", false false false;
+        AdditionalLoad__CenterOfMass: ua::ThreeDFrame, -1, "0:AdditionalLoad/0:CenterOfMass", false false false;
+        AdditionalLoad__Inertia: ua::ThreeDVector, -1, "0:AdditionalLoad/0:Inertia", false false false;
+        AdditionalLoad__Mass: f64, -1, "0:AdditionalLoad/0:Mass", false false false;
+        MotionProfile: super::super::super::types::AxisMotionProfileEnumeration, -1, "0:MotionProfile", true false false;
     }
     t::object_members! {
         ControllerType: super::super::super::super::di::objects::members::ComponentType;
@@ -1918,44 +1918,44 @@ pub mod members {
             ("SerialNumber", "the mandatory variable `SerialNumber` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
             ("CurrentUser/Level", "the mandatory variable `CurrentUser/Level` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentUser/Level\")]"),
         ];
-        ParameterSet__CabinetFanSpeed: f64, -1, [1 "ParameterSet", 0 "CabinetFanSpeed"], false false false;
-        ParameterSet__CPUFanSpeed: f64, -1, [1 "ParameterSet", 0 "CPUFanSpeed"], false false false;
-        ParameterSet__InputVoltage: f64, -1, [1 "ParameterSet", 0 "InputVoltage"], false false false;
-        ParameterSet__StartUpTime: ua::DateTime, -1, [1 "ParameterSet", 0 "StartUpTime"], false false false;
-        ParameterSet__Temperature: f64, -1, [1 "ParameterSet", 0 "Temperature"], false false false;
-        ParameterSet__TotalEnergyConsumption: f64, -1, [1 "ParameterSet", 0 "TotalEnergyConsumption"], false false false;
-        ParameterSet__TotalPowerOnTime: String, -1, [1 "ParameterSet", 0 "TotalPowerOnTime"], false false false;
-        ParameterSet__UpsState: String, -1, [1 "ParameterSet", 0 "UpsState"], false false false;
-        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], true false false;
-        Model: ua::LocalizedText, -1, [1 "Model"], true false false;
-        ProductCode: String, -1, [1 "ProductCode"], true false false;
-        SerialNumber: String, -1, [1 "SerialNumber"], true false false;
-        CurrentUser__Level: String, -1, [0 "CurrentUser", 0 "Level"], true false false;
-        CurrentUser__Name: String, -1, [0 "CurrentUser", 0 "Name"], false false false;
-        SystemOperation__SystemOperationStateMachine__CurrentState: ua::LocalizedText, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 2 "CurrentState"], false false false;
-        SystemOperation__SystemOperationStateMachine__LastTransition: ua::LocalizedText, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 2 "LastTransition"], false false false;
-        SystemOperation__SystemOperationStateMachine__AvailableStates: ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 2 "AvailableStates"], false false false;
-        SystemOperation__SystemOperationStateMachine__AvailableTransitions: ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 2 "AvailableTransitions"], false false false;
-        SystemOperation__SystemOperationStateMachine__ConfiguredDefaultStopMode: i16, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "ConfiguredDefaultStopMode"], false false true;
-        SystemOperation__SystemOperationStateMachine__LastTransitionReason: i16, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "LastTransitionReason"], false false true;
-        SystemOperation__SystemOperationStateMachine__PossibleStopModes: ua::EnumValueType, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "PossibleStopModes"], false true true;
-        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "CurrentState"], false false false;
-        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "LastTransition"], false false false;
-        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__AvailableStates: ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "AvailableStates"], false false false;
-        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "AvailableTransitions"], false false false;
-        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__LastTransitionReason: i16, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 0 "LastTransitionReason"], false false true;
-        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "CurrentState"], false false false;
-        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "LastTransition"], false false false;
-        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__AvailableStates: ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "AvailableStates"], false false false;
-        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "AvailableTransitions"], false false false;
-        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__LastTransitionReason: i16, -1, [0 "SystemOperation", 0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 0 "LastTransitionReason"], false false true;
+        ParameterSet__CabinetFanSpeed: f64, -1, "1:ParameterSet/0:CabinetFanSpeed", false false false;
+        ParameterSet__CPUFanSpeed: f64, -1, "1:ParameterSet/0:CPUFanSpeed", false false false;
+        ParameterSet__InputVoltage: f64, -1, "1:ParameterSet/0:InputVoltage", false false false;
+        ParameterSet__StartUpTime: ua::DateTime, -1, "1:ParameterSet/0:StartUpTime", false false false;
+        ParameterSet__Temperature: f64, -1, "1:ParameterSet/0:Temperature", false false false;
+        ParameterSet__TotalEnergyConsumption: f64, -1, "1:ParameterSet/0:TotalEnergyConsumption", false false false;
+        ParameterSet__TotalPowerOnTime: String, -1, "1:ParameterSet/0:TotalPowerOnTime", false false false;
+        ParameterSet__UpsState: String, -1, "1:ParameterSet/0:UpsState", false false false;
+        Manufacturer: ua::LocalizedText, -1, "1:Manufacturer", true false false;
+        Model: ua::LocalizedText, -1, "1:Model", true false false;
+        ProductCode: String, -1, "1:ProductCode", true false false;
+        SerialNumber: String, -1, "1:SerialNumber", true false false;
+        CurrentUser__Level: String, -1, "0:CurrentUser/0:Level", true false false;
+        CurrentUser__Name: String, -1, "0:CurrentUser/0:Name", false false false;
+        SystemOperation__SystemOperationStateMachine__CurrentState: ua::LocalizedText, -1, "0:SystemOperation/0:SystemOperationStateMachine/2:CurrentState", false false false;
+        SystemOperation__SystemOperationStateMachine__LastTransition: ua::LocalizedText, -1, "0:SystemOperation/0:SystemOperationStateMachine/2:LastTransition", false false false;
+        SystemOperation__SystemOperationStateMachine__AvailableStates: ua::NodeId, 1, "0:SystemOperation/0:SystemOperationStateMachine/2:AvailableStates", false false false;
+        SystemOperation__SystemOperationStateMachine__AvailableTransitions: ua::NodeId, 1, "0:SystemOperation/0:SystemOperationStateMachine/2:AvailableTransitions", false false false;
+        SystemOperation__SystemOperationStateMachine__ConfiguredDefaultStopMode: i16, -1, "0:SystemOperation/0:SystemOperationStateMachine/0:ConfiguredDefaultStopMode", false false true;
+        SystemOperation__SystemOperationStateMachine__LastTransitionReason: i16, -1, "0:SystemOperation/0:SystemOperationStateMachine/0:LastTransitionReason", false false true;
+        SystemOperation__SystemOperationStateMachine__PossibleStopModes: ua::EnumValueType, 1, "0:SystemOperation/0:SystemOperationStateMachine/0:PossibleStopModes", false true true;
+        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__CurrentState: ua::LocalizedText, -1, "0:SystemOperation/0:SystemOperationStateMachine/0:ExecutingSubstateMachine/2:CurrentState", false false false;
+        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__LastTransition: ua::LocalizedText, -1, "0:SystemOperation/0:SystemOperationStateMachine/0:ExecutingSubstateMachine/2:LastTransition", false false false;
+        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__AvailableStates: ua::NodeId, 1, "0:SystemOperation/0:SystemOperationStateMachine/0:ExecutingSubstateMachine/2:AvailableStates", false false false;
+        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__AvailableTransitions: ua::NodeId, 1, "0:SystemOperation/0:SystemOperationStateMachine/0:ExecutingSubstateMachine/2:AvailableTransitions", false false false;
+        SystemOperation__SystemOperationStateMachine__ExecutingSubstateMachine__LastTransitionReason: i16, -1, "0:SystemOperation/0:SystemOperationStateMachine/0:ExecutingSubstateMachine/0:LastTransitionReason", false false true;
+        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__CurrentState: ua::LocalizedText, -1, "0:SystemOperation/0:SystemOperationStateMachine/0:IdleSubstateMachine/2:CurrentState", false false false;
+        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__LastTransition: ua::LocalizedText, -1, "0:SystemOperation/0:SystemOperationStateMachine/0:IdleSubstateMachine/2:LastTransition", false false false;
+        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__AvailableStates: ua::NodeId, 1, "0:SystemOperation/0:SystemOperationStateMachine/0:IdleSubstateMachine/2:AvailableStates", false false false;
+        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__AvailableTransitions: ua::NodeId, 1, "0:SystemOperation/0:SystemOperationStateMachine/0:IdleSubstateMachine/2:AvailableTransitions", false false false;
+        SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__LastTransitionReason: i16, -1, "0:SystemOperation/0:SystemOperationStateMachine/0:IdleSubstateMachine/0:LastTransitionReason", false false true;
     }
     t::object_members! {
         DriveType: super::super::super::super::di::objects::members::ComponentType;
         required: [
             ("ProductCode", "the mandatory variable `ProductCode` of DriveType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]"),
         ];
-        ProductCode: String, -1, [1 "ProductCode"], true false false;
+        ProductCode: String, -1, "1:ProductCode", true false false;
     }
     t::object_members! {
         EmergencyStopFunctionType;
@@ -1963,8 +1963,8 @@ pub mod members {
             ("Active", "the mandatory variable `Active` of EmergencyStopFunctionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Active\")]"),
             ("Name", "the mandatory variable `Name` of EmergencyStopFunctionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Name\")]"),
         ];
-        Active: bool, -1, [0 "Active"], true false false;
-        Name: String, -1, [0 "Name"], true false false;
+        Active: bool, -1, "0:Active", true false false;
+        Name: String, -1, "0:Name", true false false;
     }
     t::object_members! {
         ExecutingSubstateMachineType;
@@ -1973,11 +1973,11 @@ pub mod members {
             ("LastTransition", "the mandatory variable `LastTransition` of ExecutingSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
             ("LastTransitionReason", "the mandatory variable `LastTransitionReason` of ExecutingSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
-        LastTransitionReason: i16, -1, [0 "LastTransitionReason"], true false true;
+        CurrentState: ua::LocalizedText, -1, "2:CurrentState", true false false;
+        LastTransition: ua::LocalizedText, -1, "2:LastTransition", true false false;
+        AvailableStates: ua::NodeId, 1, "2:AvailableStates", false false false;
+        AvailableTransitions: ua::NodeId, 1, "2:AvailableTransitions", false false false;
+        LastTransitionReason: i16, -1, "0:LastTransitionReason", true false true;
     }
     t::object_members! {
         GearType: super::super::super::super::di::objects::members::ComponentType;
@@ -1988,12 +1988,12 @@ pub mod members {
             ("SerialNumber", "the mandatory variable `SerialNumber` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
             ("GearRatio", "the mandatory variable `GearRatio` of GearType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"GearRatio\")]"),
         ];
-        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], true false false;
-        Model: ua::LocalizedText, -1, [1 "Model"], true false false;
-        ProductCode: String, -1, [1 "ProductCode"], true false false;
-        SerialNumber: String, -1, [1 "SerialNumber"], true false false;
-        GearRatio: ua::RationalNumber, -1, [0 "GearRatio"], true false false;
-        Pitch: f64, -1, [0 "Pitch"], false false false;
+        Manufacturer: ua::LocalizedText, -1, "1:Manufacturer", true false false;
+        Model: ua::LocalizedText, -1, "1:Model", true false false;
+        ProductCode: String, -1, "1:ProductCode", true false false;
+        SerialNumber: String, -1, "1:SerialNumber", true false false;
+        GearRatio: ua::RationalNumber, -1, "0:GearRatio", true false false;
+        Pitch: f64, -1, "0:Pitch", false false false;
     }
     t::object_members! {
         IdleSubstateMachineType;
@@ -2002,20 +2002,20 @@ pub mod members {
             ("LastTransition", "the mandatory variable `LastTransition` of IdleSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
             ("LastTransitionReason", "the mandatory variable `LastTransitionReason` of IdleSubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
-        LastTransitionReason: i16, -1, [0 "LastTransitionReason"], true false true;
+        CurrentState: ua::LocalizedText, -1, "2:CurrentState", true false false;
+        LastTransition: ua::LocalizedText, -1, "2:LastTransition", true false false;
+        AvailableStates: ua::NodeId, 1, "2:AvailableStates", false false false;
+        AvailableTransitions: ua::NodeId, 1, "2:AvailableTransitions", false false false;
+        LastTransitionReason: i16, -1, "0:LastTransitionReason", true false true;
     }
     t::object_members! {
         LoadType;
         required: [
             ("Mass", "the mandatory variable `Mass` of LoadType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Mass\")]"),
         ];
-        CenterOfMass: ua::ThreeDFrame, -1, [0 "CenterOfMass"], false false false;
-        Inertia: ua::ThreeDVector, -1, [0 "Inertia"], false false false;
-        Mass: f64, -1, [0 "Mass"], true false false;
+        CenterOfMass: ua::ThreeDFrame, -1, "0:CenterOfMass", false false false;
+        Inertia: ua::ThreeDVector, -1, "0:Inertia", false false false;
+        Mass: f64, -1, "0:Mass", true false false;
     }
     t::object_members! {
         MotionDeviceSystemType: super::super::super::super::di::objects::members::ComponentType;
@@ -2031,18 +2031,18 @@ pub mod members {
             ("SerialNumber", "the mandatory variable `SerialNumber` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
             ("MotionDeviceCategory", "the mandatory variable `MotionDeviceCategory` of MotionDeviceType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"MotionDeviceCategory\")]"),
         ];
-        ParameterSet__InControl: bool, -1, [1 "ParameterSet", 0 "InControl"], false false false;
-        ParameterSet__OnPath: bool, -1, [1 "ParameterSet", 0 "OnPath"], false false false;
-        ParameterSet__SpeedOverride: f64, -1, [1 "ParameterSet", 0 "SpeedOverride"], true false false;
-        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], true false false;
-        Model: ua::LocalizedText, -1, [1 "Model"], true false false;
-        ProductCode: String, -1, [1 "ProductCode"], true false false;
-        SerialNumber: String, -1, [1 "SerialNumber"], true false false;
-        FlangeLoad__CenterOfMass: ua::ThreeDFrame, -1, [0 "FlangeLoad", 0 "CenterOfMass"], false false false;
-        FlangeLoad__Inertia: ua::ThreeDVector, -1, [0 "FlangeLoad", 0 "Inertia"], false false false;
-        FlangeLoad__Mass: f64, -1, [0 "FlangeLoad", 0 "Mass"], false false false;
-        MotionDeviceCategory: super::super::super::types::MotionDeviceCategoryEnumeration, -1, [0 "MotionDeviceCategory"], true false false;
-        TaskControlReference: ua::NodeId, -1, [0 "TaskControlReference"], false false false;
+        ParameterSet__InControl: bool, -1, "1:ParameterSet/0:InControl", false false false;
+        ParameterSet__OnPath: bool, -1, "1:ParameterSet/0:OnPath", false false false;
+        ParameterSet__SpeedOverride: f64, -1, "1:ParameterSet/0:SpeedOverride", true false false;
+        Manufacturer: ua::LocalizedText, -1, "1:Manufacturer", true false false;
+        Model: ua::LocalizedText, -1, "1:Model", true false false;
+        ProductCode: String, -1, "1:ProductCode", true false false;
+        SerialNumber: String, -1, "1:SerialNumber", true false false;
+        FlangeLoad__CenterOfMass: ua::ThreeDFrame, -1, "0:FlangeLoad/0:CenterOfMass", false false false;
+        FlangeLoad__Inertia: ua::ThreeDVector, -1, "0:FlangeLoad/0:Inertia", false false false;
+        FlangeLoad__Mass: f64, -1, "0:FlangeLoad/0:Mass", false false false;
+        MotionDeviceCategory: super::super::super::types::MotionDeviceCategoryEnumeration, -1, "0:MotionDeviceCategory", true false false;
+        TaskControlReference: ua::NodeId, -1, "0:TaskControlReference", false false false;
     }
     t::object_members! {
         MotorType: super::super::super::super::di::objects::members::ComponentType;
@@ -2053,13 +2053,13 @@ pub mod members {
             ("ProductCode", "the mandatory variable `ProductCode` of MotorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ProductCode\")]"),
             ("SerialNumber", "the mandatory variable `SerialNumber` of MotorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SerialNumber\")]"),
         ];
-        ParameterSet__BrakeReleased: bool, -1, [1 "ParameterSet", 0 "BrakeReleased"], false false false;
-        ParameterSet__EffectiveLoadRate: u16, -1, [1 "ParameterSet", 0 "EffectiveLoadRate"], false false false;
-        ParameterSet__MotorTemperature: f64, -1, [1 "ParameterSet", 0 "MotorTemperature"], true false false;
-        Manufacturer: ua::LocalizedText, -1, [1 "Manufacturer"], true false false;
-        Model: ua::LocalizedText, -1, [1 "Model"], true false false;
-        ProductCode: String, -1, [1 "ProductCode"], true false false;
-        SerialNumber: String, -1, [1 "SerialNumber"], true false false;
+        ParameterSet__BrakeReleased: bool, -1, "1:ParameterSet/0:BrakeReleased", false false false;
+        ParameterSet__EffectiveLoadRate: u16, -1, "1:ParameterSet/0:EffectiveLoadRate", false false false;
+        ParameterSet__MotorTemperature: f64, -1, "1:ParameterSet/0:MotorTemperature", true false false;
+        Manufacturer: ua::LocalizedText, -1, "1:Manufacturer", true false false;
+        Model: ua::LocalizedText, -1, "1:Model", true false false;
+        ProductCode: String, -1, "1:ProductCode", true false false;
+        SerialNumber: String, -1, "1:SerialNumber", true false false;
     }
     t::object_members! {
         MultiAcknowledgeableConditionType;
@@ -2085,30 +2085,30 @@ pub mod members {
             ("AckedState", "the mandatory variable `AckedState` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"AckedState\")]"),
             ("ConditionDescriptions", "the mandatory variable `ConditionDescriptions` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConditionDescriptions\")]"),
         ];
-        EventId: ua::ByteString, -1, [2 "EventId"], true false false;
-        EventType: ua::NodeId, -1, [2 "EventType"], true false false;
-        SourceNode: ua::NodeId, -1, [2 "SourceNode"], true false false;
-        SourceName: String, -1, [2 "SourceName"], true false false;
-        Time: ua::DateTime, -1, [2 "Time"], true false false;
-        ReceiveTime: ua::DateTime, -1, [2 "ReceiveTime"], true false false;
-        LocalTime: ua::TimeZoneDataType, -1, [2 "LocalTime"], false false false;
-        Message: ua::LocalizedText, -1, [2 "Message"], true false false;
-        Severity: u16, -1, [2 "Severity"], true false false;
-        ConditionClassId: ua::NodeId, -1, [2 "ConditionClassId"], true false false;
-        ConditionClassName: ua::LocalizedText, -1, [2 "ConditionClassName"], true false false;
-        ConditionSubClassId: ua::NodeId, 1, [2 "ConditionSubClassId"], false false false;
-        ConditionSubClassName: ua::LocalizedText, 1, [2 "ConditionSubClassName"], false false false;
-        ConditionName: String, -1, [2 "ConditionName"], true false false;
-        BranchId: ua::NodeId, -1, [2 "BranchId"], true false false;
-        Retain: bool, -1, [2 "Retain"], true false false;
-        EnabledState: ua::LocalizedText, -1, [2 "EnabledState"], true false false;
-        Quality: ua::StatusCode, -1, [2 "Quality"], true false false;
-        LastSeverity: u16, -1, [2 "LastSeverity"], true false false;
-        Comment: ua::LocalizedText, -1, [2 "Comment"], true false false;
-        ClientUserId: String, -1, [2 "ClientUserId"], true false false;
-        AckedState: ua::LocalizedText, -1, [2 "AckedState"], true false false;
-        ConfirmedState: ua::LocalizedText, -1, [2 "ConfirmedState"], false false false;
-        ConditionDescriptions: ua::LocalizedText, 1, [0 "ConditionDescriptions"], true false true;
+        EventId: ua::ByteString, -1, "2:EventId", true false false;
+        EventType: ua::NodeId, -1, "2:EventType", true false false;
+        SourceNode: ua::NodeId, -1, "2:SourceNode", true false false;
+        SourceName: String, -1, "2:SourceName", true false false;
+        Time: ua::DateTime, -1, "2:Time", true false false;
+        ReceiveTime: ua::DateTime, -1, "2:ReceiveTime", true false false;
+        LocalTime: ua::TimeZoneDataType, -1, "2:LocalTime", false false false;
+        Message: ua::LocalizedText, -1, "2:Message", true false false;
+        Severity: u16, -1, "2:Severity", true false false;
+        ConditionClassId: ua::NodeId, -1, "2:ConditionClassId", true false false;
+        ConditionClassName: ua::LocalizedText, -1, "2:ConditionClassName", true false false;
+        ConditionSubClassId: ua::NodeId, 1, "2:ConditionSubClassId", false false false;
+        ConditionSubClassName: ua::LocalizedText, 1, "2:ConditionSubClassName", false false false;
+        ConditionName: String, -1, "2:ConditionName", true false false;
+        BranchId: ua::NodeId, -1, "2:BranchId", true false false;
+        Retain: bool, -1, "2:Retain", true false false;
+        EnabledState: ua::LocalizedText, -1, "2:EnabledState", true false false;
+        Quality: ua::StatusCode, -1, "2:Quality", true false false;
+        LastSeverity: u16, -1, "2:LastSeverity", true false false;
+        Comment: ua::LocalizedText, -1, "2:Comment", true false false;
+        ClientUserId: String, -1, "2:ClientUserId", true false false;
+        AckedState: ua::LocalizedText, -1, "2:AckedState", true false false;
+        ConfirmedState: ua::LocalizedText, -1, "2:ConfirmedState", false false false;
+        ConditionDescriptions: ua::LocalizedText, 1, "0:ConditionDescriptions", true false true;
     }
     t::object_members! {
         OperationStateMachineType;
@@ -2117,13 +2117,13 @@ pub mod members {
             ("LastTransition", "the mandatory variable `LastTransition` of OperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
             ("LastTransitionReason", "the mandatory variable `LastTransitionReason` of OperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
-        ConfiguredDefaultStopMode: i16, -1, [0 "ConfiguredDefaultStopMode"], false false true;
-        LastTransitionReason: i16, -1, [0 "LastTransitionReason"], true false true;
-        PossibleStopModes: ua::EnumValueType, 1, [0 "PossibleStopModes"], false true true;
+        CurrentState: ua::LocalizedText, -1, "2:CurrentState", true false false;
+        LastTransition: ua::LocalizedText, -1, "2:LastTransition", true false false;
+        AvailableStates: ua::NodeId, 1, "2:AvailableStates", false false false;
+        AvailableTransitions: ua::NodeId, 1, "2:AvailableTransitions", false false false;
+        ConfiguredDefaultStopMode: i16, -1, "0:ConfiguredDefaultStopMode", false false true;
+        LastTransitionReason: i16, -1, "0:LastTransitionReason", true false true;
+        PossibleStopModes: ua::EnumValueType, 1, "0:PossibleStopModes", false true true;
     }
     t::object_members! {
         PowerTrainType: super::super::super::super::di::objects::members::ComponentType;
@@ -2136,9 +2136,9 @@ pub mod members {
             ("Enabled", "the mandatory variable `Enabled` of ProtectiveStopFunctionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Enabled\")]"),
             ("Name", "the mandatory variable `Name` of ProtectiveStopFunctionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Name\")]"),
         ];
-        Active: bool, -1, [0 "Active"], true false false;
-        Enabled: bool, -1, [0 "Enabled"], true false false;
-        Name: String, -1, [0 "Name"], true false false;
+        Active: bool, -1, "0:Active", true false false;
+        Enabled: bool, -1, "0:Enabled", true false false;
+        Name: String, -1, "0:Name", true false false;
     }
     t::object_members! {
         ReadySubstateMachineType;
@@ -2147,11 +2147,11 @@ pub mod members {
             ("LastTransition", "the mandatory variable `LastTransition` of ReadySubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
             ("LastTransitionReason", "the mandatory variable `LastTransitionReason` of ReadySubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]"),
         ];
-        CurrentState: ua::LocalizedText, -1, [2 "CurrentState"], true false false;
-        LastTransition: ua::LocalizedText, -1, [2 "LastTransition"], true false false;
-        AvailableStates: ua::NodeId, 1, [2 "AvailableStates"], false false false;
-        AvailableTransitions: ua::NodeId, 1, [2 "AvailableTransitions"], false false false;
-        LastTransitionReason: i16, -1, [0 "LastTransitionReason"], true false true;
+        CurrentState: ua::LocalizedText, -1, "2:CurrentState", true false false;
+        LastTransition: ua::LocalizedText, -1, "2:LastTransition", true false false;
+        AvailableStates: ua::NodeId, 1, "2:AvailableStates", false false false;
+        AvailableTransitions: ua::NodeId, 1, "2:AvailableTransitions", false false false;
+        LastTransitionReason: i16, -1, "0:LastTransitionReason", true false true;
     }
     t::object_members! {
         SafetyStateType: super::super::super::super::di::objects::members::ComponentType;
@@ -2160,9 +2160,9 @@ pub mod members {
             ("ParameterSet/OperationalMode", "the mandatory variable `ParameterSet/OperationalMode` of SafetyStateType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/OperationalMode\")]"),
             ("ParameterSet/ProtectiveStop", "the mandatory variable `ParameterSet/ProtectiveStop` of SafetyStateType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/ProtectiveStop\")]"),
         ];
-        ParameterSet__EmergencyStop: bool, -1, [1 "ParameterSet", 0 "EmergencyStop"], true false false;
-        ParameterSet__OperationalMode: super::super::super::types::OperationalModeEnumeration, -1, [1 "ParameterSet", 0 "OperationalMode"], true false false;
-        ParameterSet__ProtectiveStop: bool, -1, [1 "ParameterSet", 0 "ProtectiveStop"], true false false;
+        ParameterSet__EmergencyStop: bool, -1, "1:ParameterSet/0:EmergencyStop", true false false;
+        ParameterSet__OperationalMode: super::super::super::types::OperationalModeEnumeration, -1, "1:ParameterSet/0:OperationalMode", true false false;
+        ParameterSet__ProtectiveStop: bool, -1, "1:ParameterSet/0:ProtectiveStop", true false false;
     }
     t::object_members! {
         SystemOperationStateMachineType: super::OperationStateMachineType;
@@ -2171,16 +2171,16 @@ pub mod members {
             ("LastTransition", "the mandatory variable `LastTransition` of SystemOperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
             ("LastTransitionReason", "the mandatory variable `LastTransitionReason` of SystemOperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]"),
         ];
-        ExecutingSubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "ExecutingSubstateMachine", 2 "CurrentState"], false false false;
-        ExecutingSubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "ExecutingSubstateMachine", 2 "LastTransition"], false false false;
-        ExecutingSubstateMachine__AvailableStates: ua::NodeId, 1, [0 "ExecutingSubstateMachine", 2 "AvailableStates"], false false false;
-        ExecutingSubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "ExecutingSubstateMachine", 2 "AvailableTransitions"], false false false;
-        ExecutingSubstateMachine__LastTransitionReason: i16, -1, [0 "ExecutingSubstateMachine", 0 "LastTransitionReason"], false false true;
-        IdleSubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "IdleSubstateMachine", 2 "CurrentState"], false false false;
-        IdleSubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "IdleSubstateMachine", 2 "LastTransition"], false false false;
-        IdleSubstateMachine__AvailableStates: ua::NodeId, 1, [0 "IdleSubstateMachine", 2 "AvailableStates"], false false false;
-        IdleSubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "IdleSubstateMachine", 2 "AvailableTransitions"], false false false;
-        IdleSubstateMachine__LastTransitionReason: i16, -1, [0 "IdleSubstateMachine", 0 "LastTransitionReason"], false false true;
+        ExecutingSubstateMachine__CurrentState: ua::LocalizedText, -1, "0:ExecutingSubstateMachine/2:CurrentState", false false false;
+        ExecutingSubstateMachine__LastTransition: ua::LocalizedText, -1, "0:ExecutingSubstateMachine/2:LastTransition", false false false;
+        ExecutingSubstateMachine__AvailableStates: ua::NodeId, 1, "0:ExecutingSubstateMachine/2:AvailableStates", false false false;
+        ExecutingSubstateMachine__AvailableTransitions: ua::NodeId, 1, "0:ExecutingSubstateMachine/2:AvailableTransitions", false false false;
+        ExecutingSubstateMachine__LastTransitionReason: i16, -1, "0:ExecutingSubstateMachine/0:LastTransitionReason", false false true;
+        IdleSubstateMachine__CurrentState: ua::LocalizedText, -1, "0:IdleSubstateMachine/2:CurrentState", false false false;
+        IdleSubstateMachine__LastTransition: ua::LocalizedText, -1, "0:IdleSubstateMachine/2:LastTransition", false false false;
+        IdleSubstateMachine__AvailableStates: ua::NodeId, 1, "0:IdleSubstateMachine/2:AvailableStates", false false false;
+        IdleSubstateMachine__AvailableTransitions: ua::NodeId, 1, "0:IdleSubstateMachine/2:AvailableTransitions", false false false;
+        IdleSubstateMachine__LastTransitionReason: i16, -1, "0:IdleSubstateMachine/0:LastTransitionReason", false false true;
     }
     t::object_members! {
         SystemOperationType;
@@ -2189,23 +2189,23 @@ pub mod members {
             ("SystemOperationStateMachine/LastTransition", "the mandatory variable `SystemOperationStateMachine/LastTransition` of SystemOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SystemOperationStateMachine/LastTransition\")]"),
             ("SystemOperationStateMachine/LastTransitionReason", "the mandatory variable `SystemOperationStateMachine/LastTransitionReason` of SystemOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SystemOperationStateMachine/LastTransitionReason\")]"),
         ];
-        SystemOperationStateMachine__CurrentState: ua::LocalizedText, -1, [0 "SystemOperationStateMachine", 2 "CurrentState"], true false false;
-        SystemOperationStateMachine__LastTransition: ua::LocalizedText, -1, [0 "SystemOperationStateMachine", 2 "LastTransition"], true false false;
-        SystemOperationStateMachine__AvailableStates: ua::NodeId, 1, [0 "SystemOperationStateMachine", 2 "AvailableStates"], false false false;
-        SystemOperationStateMachine__AvailableTransitions: ua::NodeId, 1, [0 "SystemOperationStateMachine", 2 "AvailableTransitions"], false false false;
-        SystemOperationStateMachine__ConfiguredDefaultStopMode: i16, -1, [0 "SystemOperationStateMachine", 0 "ConfiguredDefaultStopMode"], false false true;
-        SystemOperationStateMachine__LastTransitionReason: i16, -1, [0 "SystemOperationStateMachine", 0 "LastTransitionReason"], true false true;
-        SystemOperationStateMachine__PossibleStopModes: ua::EnumValueType, 1, [0 "SystemOperationStateMachine", 0 "PossibleStopModes"], false true true;
-        SystemOperationStateMachine__ExecutingSubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "CurrentState"], false false false;
-        SystemOperationStateMachine__ExecutingSubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "LastTransition"], false false false;
-        SystemOperationStateMachine__ExecutingSubstateMachine__AvailableStates: ua::NodeId, 1, [0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "AvailableStates"], false false false;
-        SystemOperationStateMachine__ExecutingSubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 2 "AvailableTransitions"], false false false;
-        SystemOperationStateMachine__ExecutingSubstateMachine__LastTransitionReason: i16, -1, [0 "SystemOperationStateMachine", 0 "ExecutingSubstateMachine", 0 "LastTransitionReason"], false false true;
-        SystemOperationStateMachine__IdleSubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "CurrentState"], false false false;
-        SystemOperationStateMachine__IdleSubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "LastTransition"], false false false;
-        SystemOperationStateMachine__IdleSubstateMachine__AvailableStates: ua::NodeId, 1, [0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "AvailableStates"], false false false;
-        SystemOperationStateMachine__IdleSubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 2 "AvailableTransitions"], false false false;
-        SystemOperationStateMachine__IdleSubstateMachine__LastTransitionReason: i16, -1, [0 "SystemOperationStateMachine", 0 "IdleSubstateMachine", 0 "LastTransitionReason"], false false true;
+        SystemOperationStateMachine__CurrentState: ua::LocalizedText, -1, "0:SystemOperationStateMachine/2:CurrentState", true false false;
+        SystemOperationStateMachine__LastTransition: ua::LocalizedText, -1, "0:SystemOperationStateMachine/2:LastTransition", true false false;
+        SystemOperationStateMachine__AvailableStates: ua::NodeId, 1, "0:SystemOperationStateMachine/2:AvailableStates", false false false;
+        SystemOperationStateMachine__AvailableTransitions: ua::NodeId, 1, "0:SystemOperationStateMachine/2:AvailableTransitions", false false false;
+        SystemOperationStateMachine__ConfiguredDefaultStopMode: i16, -1, "0:SystemOperationStateMachine/0:ConfiguredDefaultStopMode", false false true;
+        SystemOperationStateMachine__LastTransitionReason: i16, -1, "0:SystemOperationStateMachine/0:LastTransitionReason", true false true;
+        SystemOperationStateMachine__PossibleStopModes: ua::EnumValueType, 1, "0:SystemOperationStateMachine/0:PossibleStopModes", false true true;
+        SystemOperationStateMachine__ExecutingSubstateMachine__CurrentState: ua::LocalizedText, -1, "0:SystemOperationStateMachine/0:ExecutingSubstateMachine/2:CurrentState", false false false;
+        SystemOperationStateMachine__ExecutingSubstateMachine__LastTransition: ua::LocalizedText, -1, "0:SystemOperationStateMachine/0:ExecutingSubstateMachine/2:LastTransition", false false false;
+        SystemOperationStateMachine__ExecutingSubstateMachine__AvailableStates: ua::NodeId, 1, "0:SystemOperationStateMachine/0:ExecutingSubstateMachine/2:AvailableStates", false false false;
+        SystemOperationStateMachine__ExecutingSubstateMachine__AvailableTransitions: ua::NodeId, 1, "0:SystemOperationStateMachine/0:ExecutingSubstateMachine/2:AvailableTransitions", false false false;
+        SystemOperationStateMachine__ExecutingSubstateMachine__LastTransitionReason: i16, -1, "0:SystemOperationStateMachine/0:ExecutingSubstateMachine/0:LastTransitionReason", false false true;
+        SystemOperationStateMachine__IdleSubstateMachine__CurrentState: ua::LocalizedText, -1, "0:SystemOperationStateMachine/0:IdleSubstateMachine/2:CurrentState", false false false;
+        SystemOperationStateMachine__IdleSubstateMachine__LastTransition: ua::LocalizedText, -1, "0:SystemOperationStateMachine/0:IdleSubstateMachine/2:LastTransition", false false false;
+        SystemOperationStateMachine__IdleSubstateMachine__AvailableStates: ua::NodeId, 1, "0:SystemOperationStateMachine/0:IdleSubstateMachine/2:AvailableStates", false false false;
+        SystemOperationStateMachine__IdleSubstateMachine__AvailableTransitions: ua::NodeId, 1, "0:SystemOperationStateMachine/0:IdleSubstateMachine/2:AvailableTransitions", false false false;
+        SystemOperationStateMachine__IdleSubstateMachine__LastTransitionReason: i16, -1, "0:SystemOperationStateMachine/0:IdleSubstateMachine/0:LastTransitionReason", false false true;
     }
     t::object_members! {
         TaskControlOperationType;
@@ -2214,19 +2214,19 @@ pub mod members {
             ("TaskControlStateMachine/LastTransition", "the mandatory variable `TaskControlStateMachine/LastTransition` of TaskControlOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"TaskControlStateMachine/LastTransition\")]"),
             ("TaskControlStateMachine/LastTransitionReason", "the mandatory variable `TaskControlStateMachine/LastTransitionReason` of TaskControlOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"TaskControlStateMachine/LastTransitionReason\")]"),
         ];
-        MotionDevicesUnderControl: ua::NodeId, 1, [0 "MotionDevicesUnderControl"], false false false;
-        TaskControlStateMachine__CurrentState: ua::LocalizedText, -1, [0 "TaskControlStateMachine", 2 "CurrentState"], true false false;
-        TaskControlStateMachine__LastTransition: ua::LocalizedText, -1, [0 "TaskControlStateMachine", 2 "LastTransition"], true false false;
-        TaskControlStateMachine__AvailableStates: ua::NodeId, 1, [0 "TaskControlStateMachine", 2 "AvailableStates"], false false false;
-        TaskControlStateMachine__AvailableTransitions: ua::NodeId, 1, [0 "TaskControlStateMachine", 2 "AvailableTransitions"], false false false;
-        TaskControlStateMachine__ConfiguredDefaultStopMode: i16, -1, [0 "TaskControlStateMachine", 0 "ConfiguredDefaultStopMode"], false false true;
-        TaskControlStateMachine__LastTransitionReason: i16, -1, [0 "TaskControlStateMachine", 0 "LastTransitionReason"], true false true;
-        TaskControlStateMachine__PossibleStopModes: ua::EnumValueType, 1, [0 "TaskControlStateMachine", 0 "PossibleStopModes"], false true true;
-        TaskControlStateMachine__ReadySubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "CurrentState"], false false false;
-        TaskControlStateMachine__ReadySubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "LastTransition"], false false false;
-        TaskControlStateMachine__ReadySubstateMachine__AvailableStates: ua::NodeId, 1, [0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "AvailableStates"], false false false;
-        TaskControlStateMachine__ReadySubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "AvailableTransitions"], false false false;
-        TaskControlStateMachine__ReadySubstateMachine__LastTransitionReason: i16, -1, [0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 0 "LastTransitionReason"], false false true;
+        MotionDevicesUnderControl: ua::NodeId, 1, "0:MotionDevicesUnderControl", false false false;
+        TaskControlStateMachine__CurrentState: ua::LocalizedText, -1, "0:TaskControlStateMachine/2:CurrentState", true false false;
+        TaskControlStateMachine__LastTransition: ua::LocalizedText, -1, "0:TaskControlStateMachine/2:LastTransition", true false false;
+        TaskControlStateMachine__AvailableStates: ua::NodeId, 1, "0:TaskControlStateMachine/2:AvailableStates", false false false;
+        TaskControlStateMachine__AvailableTransitions: ua::NodeId, 1, "0:TaskControlStateMachine/2:AvailableTransitions", false false false;
+        TaskControlStateMachine__ConfiguredDefaultStopMode: i16, -1, "0:TaskControlStateMachine/0:ConfiguredDefaultStopMode", false false true;
+        TaskControlStateMachine__LastTransitionReason: i16, -1, "0:TaskControlStateMachine/0:LastTransitionReason", true false true;
+        TaskControlStateMachine__PossibleStopModes: ua::EnumValueType, 1, "0:TaskControlStateMachine/0:PossibleStopModes", false true true;
+        TaskControlStateMachine__ReadySubstateMachine__CurrentState: ua::LocalizedText, -1, "0:TaskControlStateMachine/0:ReadySubstateMachine/2:CurrentState", false false false;
+        TaskControlStateMachine__ReadySubstateMachine__LastTransition: ua::LocalizedText, -1, "0:TaskControlStateMachine/0:ReadySubstateMachine/2:LastTransition", false false false;
+        TaskControlStateMachine__ReadySubstateMachine__AvailableStates: ua::NodeId, 1, "0:TaskControlStateMachine/0:ReadySubstateMachine/2:AvailableStates", false false false;
+        TaskControlStateMachine__ReadySubstateMachine__AvailableTransitions: ua::NodeId, 1, "0:TaskControlStateMachine/0:ReadySubstateMachine/2:AvailableTransitions", false false false;
+        TaskControlStateMachine__ReadySubstateMachine__LastTransitionReason: i16, -1, "0:TaskControlStateMachine/0:ReadySubstateMachine/0:LastTransitionReason", false false true;
     }
     t::object_members! {
         TaskControlStateMachineType: super::OperationStateMachineType;
@@ -2235,11 +2235,11 @@ pub mod members {
             ("LastTransition", "the mandatory variable `LastTransition` of TaskControlStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
             ("LastTransitionReason", "the mandatory variable `LastTransitionReason` of TaskControlStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransitionReason\")]"),
         ];
-        ReadySubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "ReadySubstateMachine", 2 "CurrentState"], false false false;
-        ReadySubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "ReadySubstateMachine", 2 "LastTransition"], false false false;
-        ReadySubstateMachine__AvailableStates: ua::NodeId, 1, [0 "ReadySubstateMachine", 2 "AvailableStates"], false false false;
-        ReadySubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "ReadySubstateMachine", 2 "AvailableTransitions"], false false false;
-        ReadySubstateMachine__LastTransitionReason: i16, -1, [0 "ReadySubstateMachine", 0 "LastTransitionReason"], false false true;
+        ReadySubstateMachine__CurrentState: ua::LocalizedText, -1, "0:ReadySubstateMachine/2:CurrentState", false false false;
+        ReadySubstateMachine__LastTransition: ua::LocalizedText, -1, "0:ReadySubstateMachine/2:LastTransition", false false false;
+        ReadySubstateMachine__AvailableStates: ua::NodeId, 1, "0:ReadySubstateMachine/2:AvailableStates", false false false;
+        ReadySubstateMachine__AvailableTransitions: ua::NodeId, 1, "0:ReadySubstateMachine/2:AvailableTransitions", false false false;
+        ReadySubstateMachine__LastTransitionReason: i16, -1, "0:ReadySubstateMachine/0:LastTransitionReason", false false true;
     }
     t::object_members! {
         TaskControlType: super::super::super::super::di::objects::members::ComponentType;
@@ -2248,39 +2248,39 @@ pub mod members {
             ("ParameterSet/TaskProgramName", "the mandatory variable `ParameterSet/TaskProgramName` of TaskControlType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/TaskProgramName\")]"),
             ("ComponentName", "the mandatory variable `ComponentName` of TaskControlType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ComponentName\")]"),
         ];
-        ParameterSet__ExecutionMode: super::super::super::types::ExecutionModeEnumeration, -1, [1 "ParameterSet", 0 "ExecutionMode"], false false false;
-        ParameterSet__TaskProgramLoaded: bool, -1, [1 "ParameterSet", 0 "TaskProgramLoaded"], true false false;
-        ParameterSet__TaskProgramName: String, -1, [1 "ParameterSet", 0 "TaskProgramName"], true false false;
-        ComponentName: ua::LocalizedText, -1, [1 "ComponentName"], true false false;
-        TaskControlOperation__MotionDevicesUnderControl: ua::NodeId, 1, [0 "TaskControlOperation", 0 "MotionDevicesUnderControl"], false false false;
-        TaskControlOperation__TaskControlStateMachine__CurrentState: ua::LocalizedText, -1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 2 "CurrentState"], false false false;
-        TaskControlOperation__TaskControlStateMachine__LastTransition: ua::LocalizedText, -1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 2 "LastTransition"], false false false;
-        TaskControlOperation__TaskControlStateMachine__AvailableStates: ua::NodeId, 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 2 "AvailableStates"], false false false;
-        TaskControlOperation__TaskControlStateMachine__AvailableTransitions: ua::NodeId, 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 2 "AvailableTransitions"], false false false;
-        TaskControlOperation__TaskControlStateMachine__ConfiguredDefaultStopMode: i16, -1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "ConfiguredDefaultStopMode"], false false true;
-        TaskControlOperation__TaskControlStateMachine__LastTransitionReason: i16, -1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "LastTransitionReason"], false false true;
-        TaskControlOperation__TaskControlStateMachine__PossibleStopModes: ua::EnumValueType, 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "PossibleStopModes"], false true true;
-        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__CurrentState: ua::LocalizedText, -1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "CurrentState"], false false false;
-        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__LastTransition: ua::LocalizedText, -1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "LastTransition"], false false false;
-        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__AvailableStates: ua::NodeId, 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "AvailableStates"], false false false;
-        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__AvailableTransitions: ua::NodeId, 1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 2 "AvailableTransitions"], false false false;
-        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__LastTransitionReason: i16, -1, [0 "TaskControlOperation", 0 "TaskControlStateMachine", 0 "ReadySubstateMachine", 0 "LastTransitionReason"], false false true;
+        ParameterSet__ExecutionMode: super::super::super::types::ExecutionModeEnumeration, -1, "1:ParameterSet/0:ExecutionMode", false false false;
+        ParameterSet__TaskProgramLoaded: bool, -1, "1:ParameterSet/0:TaskProgramLoaded", true false false;
+        ParameterSet__TaskProgramName: String, -1, "1:ParameterSet/0:TaskProgramName", true false false;
+        ComponentName: ua::LocalizedText, -1, "1:ComponentName", true false false;
+        TaskControlOperation__MotionDevicesUnderControl: ua::NodeId, 1, "0:TaskControlOperation/0:MotionDevicesUnderControl", false false false;
+        TaskControlOperation__TaskControlStateMachine__CurrentState: ua::LocalizedText, -1, "0:TaskControlOperation/0:TaskControlStateMachine/2:CurrentState", false false false;
+        TaskControlOperation__TaskControlStateMachine__LastTransition: ua::LocalizedText, -1, "0:TaskControlOperation/0:TaskControlStateMachine/2:LastTransition", false false false;
+        TaskControlOperation__TaskControlStateMachine__AvailableStates: ua::NodeId, 1, "0:TaskControlOperation/0:TaskControlStateMachine/2:AvailableStates", false false false;
+        TaskControlOperation__TaskControlStateMachine__AvailableTransitions: ua::NodeId, 1, "0:TaskControlOperation/0:TaskControlStateMachine/2:AvailableTransitions", false false false;
+        TaskControlOperation__TaskControlStateMachine__ConfiguredDefaultStopMode: i16, -1, "0:TaskControlOperation/0:TaskControlStateMachine/0:ConfiguredDefaultStopMode", false false true;
+        TaskControlOperation__TaskControlStateMachine__LastTransitionReason: i16, -1, "0:TaskControlOperation/0:TaskControlStateMachine/0:LastTransitionReason", false false true;
+        TaskControlOperation__TaskControlStateMachine__PossibleStopModes: ua::EnumValueType, 1, "0:TaskControlOperation/0:TaskControlStateMachine/0:PossibleStopModes", false true true;
+        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__CurrentState: ua::LocalizedText, -1, "0:TaskControlOperation/0:TaskControlStateMachine/0:ReadySubstateMachine/2:CurrentState", false false false;
+        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__LastTransition: ua::LocalizedText, -1, "0:TaskControlOperation/0:TaskControlStateMachine/0:ReadySubstateMachine/2:LastTransition", false false false;
+        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__AvailableStates: ua::NodeId, 1, "0:TaskControlOperation/0:TaskControlStateMachine/0:ReadySubstateMachine/2:AvailableStates", false false false;
+        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__AvailableTransitions: ua::NodeId, 1, "0:TaskControlOperation/0:TaskControlStateMachine/0:ReadySubstateMachine/2:AvailableTransitions", false false false;
+        TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__LastTransitionReason: i16, -1, "0:TaskControlOperation/0:TaskControlStateMachine/0:ReadySubstateMachine/0:LastTransitionReason", false false true;
     }
     t::object_members! {
         TaskModuleType;
         required: [
             ("Name", "the mandatory variable `Name` of TaskModuleType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Name\")]"),
         ];
-        IsReferenced: bool, -1, [0 "IsReferenced"], false false true;
-        Name: String, -1, [0 "Name"], true false true;
-        Version: String, -1, [0 "Version"], false false true;
+        IsReferenced: bool, -1, "0:IsReferenced", false false true;
+        Name: String, -1, "0:Name", true false true;
+        Version: String, -1, "0:Version", false false true;
     }
     t::object_members! {
         UserType;
         required: [
             ("Level", "the mandatory variable `Level` of UserType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Level\")]"),
         ];
-        Level: String, -1, [0 "Level"], true false false;
-        Name: String, -1, [0 "Name"], false false false;
+        Level: String, -1, "0:Level", true false false;
+        Name: String, -1, "0:Name", false false false;
     }
 }

@@ -45,6 +45,6 @@ fn main() {
     let axis: Vec<&str> = Axis::FIELDS.iter().map(|f| f.path).collect();
     assert_eq!(axis, ["ParameterSet/ActualPosition", "MotionProfile"]);
     assert_eq!(PowerTrain::FIELDS.len(), 3);
-    assert_eq!(Controller::FIELDS[5].browse_path.len(), 3);
+    assert_eq!(Controller::FIELDS[5].browse_path.segments().map(|s| s.len()), Ok(3));
     let _: fn() -> (Option<AxisType>, Option<PowerTrainType>, Option<ControllerType>) = || (None, None, None);
 }

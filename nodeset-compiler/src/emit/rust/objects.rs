@@ -64,6 +64,19 @@ pub fn marker_name(segments: &[&str]) -> String {
     name
 }
 
+/// A BrowseName as a segment of a marker's path text (`runtime::typed::MemberPath`): `/` and `\` get a
+/// `\` before them.
+fn escape_segment(name: &str) -> String {
+    let mut out = String::with_capacity(name.len());
+    for c in name.chars() {
+        if c == '/' || c == '\\' {
+            out.push('\\');
+        }
+        out.push(c);
+    }
+    out
+}
+
 /// One member as a field of a handle struct.
 struct Field {
     name: String,
@@ -602,13 +615,12 @@ impl Gen<'_> {
                 scalar
             };
             let writable = n.attrs.access_level.unwrap_or(1) & 2 != 0;
-            let path: Vec<String> =
-                r.qpath.iter().map(|(ns, s)| format!("{} {}", self.ns_index(uris, *ns), Literal::string(s))).collect();
+            let path: Vec<String> = r.qpath.iter().map(|(ns, s)| format!("{}:{}", self.ns_index(uris, *ns), escape_segment(s))).collect();
             let _ = writeln!(
                 items,
-                "        {}: {scalar}, {rank}, [{}], {} {has_default} {writable};",
+                "        {}: {scalar}, {rank}, {}, {} {has_default} {writable};",
                 r.name,
-                path.join(", "),
+                Literal::string(&path.join("/")),
                 r.mandatory
             );
         }
