@@ -31,6 +31,7 @@ pub struct AbsoluteCartesianLinearMoveSkillType {
 }
 t::debug_handle!(AbsoluteCartesianLinearMoveSkillType);
 impl t::Handle for AbsoluteCartesianLinearMoveSkillType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -55,6 +56,7 @@ pub struct AbsoluteCartesianLinearMoveSkillType_InputParameterSet {
 }
 t::debug_handle!(AbsoluteCartesianLinearMoveSkillType_InputParameterSet);
 impl t::Handle for AbsoluteCartesianLinearMoveSkillType_InputParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -110,6 +112,7 @@ pub struct AbsoluteJointPtpMoveSkillType {
 }
 t::debug_handle!(AbsoluteJointPtpMoveSkillType);
 impl t::Handle for AbsoluteJointPtpMoveSkillType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -134,6 +137,7 @@ pub struct AbsoluteJointPtpMoveSkillType_InputParameterSet {
 }
 t::debug_handle!(AbsoluteJointPtpMoveSkillType_InputParameterSet);
 impl t::Handle for AbsoluteJointPtpMoveSkillType_InputParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -192,6 +196,7 @@ pub struct CompositeSkillType {
 }
 t::debug_handle!(CompositeSkillType);
 impl t::Handle for CompositeSkillType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -231,6 +236,7 @@ pub struct GrippingSkillType {
 }
 t::debug_handle!(GrippingSkillType);
 impl t::Handle for GrippingSkillType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -253,6 +259,7 @@ pub struct GrippingSkillType_InputParameterSet {
 }
 t::debug_handle!(GrippingSkillType_InputParameterSet);
 impl t::Handle for GrippingSkillType_InputParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -301,6 +308,7 @@ pub struct ISkillSetType {
 }
 t::debug_handle!(ISkillSetType);
 impl t::Handle for ISkillSetType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -324,6 +332,7 @@ pub struct MoveSkillType {
 }
 t::debug_handle!(MoveSkillType);
 impl t::Handle for MoveSkillType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -346,6 +355,7 @@ pub struct MoveSkillType_InputParameterSet {
 }
 t::debug_handle!(MoveSkillType_InputParameterSet);
 impl t::Handle for MoveSkillType_InputParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -422,6 +432,7 @@ pub struct ProgramSkillStateMachineType {
 }
 t::debug_handle!(ProgramSkillStateMachineType);
 impl t::Handle for ProgramSkillStateMachineType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -455,6 +466,7 @@ pub struct ProgramSkillStateMachineType_OutputParameterSet {
 }
 t::debug_handle!(ProgramSkillStateMachineType_OutputParameterSet);
 impl t::Handle for ProgramSkillStateMachineType_OutputParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -624,6 +636,7 @@ pub struct RelativeCartesianLinearMoveSkillType {
 }
 t::debug_handle!(RelativeCartesianLinearMoveSkillType);
 impl t::Handle for RelativeCartesianLinearMoveSkillType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -648,6 +661,7 @@ pub struct RelativeCartesianLinearMoveSkillType_InputParameterSet {
 }
 t::debug_handle!(RelativeCartesianLinearMoveSkillType_InputParameterSet);
 impl t::Handle for RelativeCartesianLinearMoveSkillType_InputParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -735,6 +749,7 @@ pub struct SkillTransitionEventType {
 }
 t::debug_handle!(SkillTransitionEventType);
 impl t::Handle for SkillTransitionEventType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),

@@ -24,6 +24,7 @@ pub struct BaseLifetimeIndicationType {
 }
 t::debug_handle!(BaseLifetimeIndicationType);
 impl t::Handle for BaseLifetimeIndicationType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self { node: b.build_this(id) }
     }
@@ -53,6 +54,7 @@ pub struct BlockType {
 }
 t::debug_handle!(BlockType);
 impl t::Handle for BlockType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -87,6 +89,7 @@ pub struct CachedLoadingType {
 }
 t::debug_handle!(CachedLoadingType);
 impl t::Handle for CachedLoadingType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -112,6 +115,7 @@ pub struct CheckFunctionAlarmType {
 }
 t::debug_handle!(CheckFunctionAlarmType);
 impl t::Handle for CheckFunctionAlarmType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -162,6 +166,7 @@ pub struct ComponentType {
 }
 t::debug_handle!(ComponentType);
 impl t::Handle for ComponentType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -198,6 +203,7 @@ pub struct ConfigurableObjectType {
 }
 t::debug_handle!(ConfigurableObjectType);
 impl t::Handle for ConfigurableObjectType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -230,6 +236,7 @@ pub struct ConfirmationStateMachineType {
 }
 t::debug_handle!(ConfirmationStateMachineType);
 impl t::Handle for ConfirmationStateMachineType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -306,6 +313,7 @@ pub struct ConnectionPointType {
 }
 t::debug_handle!(ConnectionPointType);
 impl t::Handle for ConnectionPointType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -447,6 +455,7 @@ pub struct DeviceHealthDiagnosticAlarmType {
 }
 t::debug_handle!(DeviceHealthDiagnosticAlarmType);
 impl t::Handle for DeviceHealthDiagnosticAlarmType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -544,6 +553,7 @@ pub struct DeviceHealthDiagnosticAlarmType_ShelvingState {
 }
 t::debug_handle!(DeviceHealthDiagnosticAlarmType_ShelvingState);
 impl t::Handle for DeviceHealthDiagnosticAlarmType_ShelvingState {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -614,6 +624,7 @@ pub struct DeviceType {
 }
 t::debug_handle!(DeviceType);
 impl t::Handle for DeviceType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -652,6 +663,7 @@ pub struct DeviceType_DeviceTypeImage {
 }
 t::debug_handle!(DeviceType_DeviceTypeImage);
 impl t::Handle for DeviceType_DeviceTypeImage {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -670,6 +682,7 @@ pub struct DeviceType_Documentation {
 }
 t::debug_handle!(DeviceType_Documentation);
 impl t::Handle for DeviceType_Documentation {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -689,6 +702,7 @@ pub struct DeviceType_ProtocolSupport {
 }
 t::debug_handle!(DeviceType_ProtocolSupport);
 impl t::Handle for DeviceType_ProtocolSupport {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -708,6 +722,7 @@ pub struct DeviceType_ImageSet {
 }
 t::debug_handle!(DeviceType_ImageSet);
 impl t::Handle for DeviceType_ImageSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -729,6 +744,7 @@ pub struct DiameterIndicationType {
 }
 t::debug_handle!(DiameterIndicationType);
 impl t::Handle for DiameterIndicationType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -755,6 +771,7 @@ pub struct DirectLoadingType {
 }
 t::debug_handle!(DirectLoadingType);
 impl t::Handle for DirectLoadingType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -779,6 +796,7 @@ pub struct FailureAlarmType {
 }
 t::debug_handle!(FailureAlarmType);
 impl t::Handle for FailureAlarmType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -810,6 +828,7 @@ pub struct FileSystemLoadingType {
 }
 t::debug_handle!(FileSystemLoadingType);
 impl t::Handle for FileSystemLoadingType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -842,6 +861,7 @@ pub struct FileSystemLoadingType_FileSystem {
 }
 t::debug_handle!(FileSystemLoadingType_FileSystem);
 impl t::Handle for FileSystemLoadingType_FileSystem {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -871,6 +891,7 @@ pub struct FunctionalGroupType {
 }
 t::debug_handle!(FunctionalGroupType);
 impl t::Handle for FunctionalGroupType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -904,6 +925,7 @@ pub struct IAssetLocationIndicationType {
 }
 t::debug_handle!(IAssetLocationIndicationType);
 impl t::Handle for IAssetLocationIndicationType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -934,6 +956,7 @@ pub struct IDeviceHealthType {
 }
 t::debug_handle!(IDeviceHealthType);
 impl t::Handle for IDeviceHealthType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -962,6 +985,7 @@ pub struct IOperationCounterType {
 }
 t::debug_handle!(IOperationCounterType);
 impl t::Handle for IOperationCounterType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -993,6 +1017,7 @@ pub struct ISupportInfoType {
 }
 t::debug_handle!(ISupportInfoType);
 impl t::Handle for ISupportInfoType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1015,6 +1040,7 @@ pub struct ISupportInfoType_DeviceTypeImage {
 }
 t::debug_handle!(ISupportInfoType_DeviceTypeImage);
 impl t::Handle for ISupportInfoType_DeviceTypeImage {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1033,6 +1059,7 @@ pub struct ISupportInfoType_Documentation {
 }
 t::debug_handle!(ISupportInfoType_Documentation);
 impl t::Handle for ISupportInfoType_Documentation {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1052,6 +1079,7 @@ pub struct ISupportInfoType_DocumentationFiles {
 }
 t::debug_handle!(ISupportInfoType_DocumentationFiles);
 impl t::Handle for ISupportInfoType_DocumentationFiles {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1071,6 +1099,7 @@ pub struct ISupportInfoType_ProtocolSupport {
 }
 t::debug_handle!(ISupportInfoType_ProtocolSupport);
 impl t::Handle for ISupportInfoType_ProtocolSupport {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1090,6 +1119,7 @@ pub struct ISupportInfoType_ImageSet {
 }
 t::debug_handle!(ISupportInfoType_ImageSet);
 impl t::Handle for ISupportInfoType_ImageSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1113,6 +1143,7 @@ pub struct ITagNameplateType {
 }
 t::debug_handle!(ITagNameplateType);
 impl t::Handle for ITagNameplateType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1161,6 +1192,7 @@ pub struct IVendorNameplateType {
 }
 t::debug_handle!(IVendorNameplateType);
 impl t::Handle for IVendorNameplateType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1215,6 +1247,7 @@ pub struct InstallationStateMachineType {
 }
 t::debug_handle!(InstallationStateMachineType);
 impl t::Handle for InstallationStateMachineType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1323,6 +1356,7 @@ pub struct LengthIndicationType {
 }
 t::debug_handle!(LengthIndicationType);
 impl t::Handle for LengthIndicationType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1367,6 +1401,7 @@ pub struct LifetimeVariableType {
 }
 t::debug_handle!(LifetimeVariableType);
 impl t::Handle for LifetimeVariableType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1413,6 +1448,7 @@ pub struct LockingServicesType {
 }
 t::debug_handle!(LockingServicesType);
 impl t::Handle for LockingServicesType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1441,6 +1477,7 @@ pub struct MaintenanceRequiredAlarmType {
 }
 t::debug_handle!(MaintenanceRequiredAlarmType);
 impl t::Handle for MaintenanceRequiredAlarmType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1466,6 +1503,7 @@ pub struct NetworkType {
 }
 t::debug_handle!(NetworkType);
 impl t::Handle for NetworkType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1489,6 +1527,7 @@ pub struct NumberOfPartsIndicationType {
 }
 t::debug_handle!(NumberOfPartsIndicationType);
 impl t::Handle for NumberOfPartsIndicationType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1514,6 +1553,7 @@ pub struct NumberOfUsagesIndicationType {
 }
 t::debug_handle!(NumberOfUsagesIndicationType);
 impl t::Handle for NumberOfUsagesIndicationType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1537,6 +1577,7 @@ pub struct OffSpecAlarmType {
 }
 t::debug_handle!(OffSpecAlarmType);
 impl t::Handle for OffSpecAlarmType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1567,6 +1608,7 @@ pub struct PackageLoadingType {
 }
 t::debug_handle!(PackageLoadingType);
 impl t::Handle for PackageLoadingType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1598,6 +1640,7 @@ pub struct PackageLoadingType_FileTransfer {
 }
 t::debug_handle!(PackageLoadingType_FileTransfer);
 impl t::Handle for PackageLoadingType_FileTransfer {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1630,6 +1673,7 @@ pub struct PowerCycleStateMachineType {
 }
 t::debug_handle!(PowerCycleStateMachineType);
 impl t::Handle for PowerCycleStateMachineType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1714,6 +1758,7 @@ pub struct PrepareForUpdateStateMachineType {
 }
 t::debug_handle!(PrepareForUpdateStateMachineType);
 impl t::Handle for PrepareForUpdateStateMachineType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1827,6 +1872,7 @@ pub struct ProtocolType {
 }
 t::debug_handle!(ProtocolType);
 impl t::Handle for ProtocolType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self { node: b.build_this(id) }
     }
@@ -1847,6 +1893,7 @@ pub struct SoftwareFolderType {
 }
 t::debug_handle!(SoftwareFolderType);
 impl t::Handle for SoftwareFolderType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1870,6 +1917,7 @@ pub struct SoftwareLoadingType {
 }
 t::debug_handle!(SoftwareLoadingType);
 impl t::Handle for SoftwareLoadingType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1897,6 +1945,7 @@ pub struct SoftwareType {
 }
 t::debug_handle!(SoftwareType);
 impl t::Handle for SoftwareType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1942,6 +1991,7 @@ pub struct SoftwareUpdateType {
 }
 t::debug_handle!(SoftwareUpdateType);
 impl t::Handle for SoftwareUpdateType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1980,6 +2030,7 @@ pub struct SoftwareUpdateType_Parameters {
 }
 t::debug_handle!(SoftwareUpdateType_Parameters);
 impl t::Handle for SoftwareUpdateType_Parameters {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -2020,6 +2071,7 @@ pub struct SoftwareVersionType {
 }
 t::debug_handle!(SoftwareVersionType);
 impl t::Handle for SoftwareVersionType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -2050,6 +2102,7 @@ pub struct SubstanceVolumeIndicationType {
 }
 t::debug_handle!(SubstanceVolumeIndicationType);
 impl t::Handle for SubstanceVolumeIndicationType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -2075,6 +2128,7 @@ pub struct TimeIndicationType {
 }
 t::debug_handle!(TimeIndicationType);
 impl t::Handle for TimeIndicationType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -2105,6 +2159,7 @@ pub struct TopologyElementType {
 }
 t::debug_handle!(TopologyElementType);
 impl t::Handle for TopologyElementType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -2128,6 +2183,7 @@ pub struct TopologyElementType_ParameterSet {
 }
 t::debug_handle!(TopologyElementType_ParameterSet);
 impl t::Handle for TopologyElementType_ParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -2157,6 +2213,7 @@ pub struct TransferServicesType {
 }
 t::debug_handle!(TransferServicesType);
 impl t::Handle for TransferServicesType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -2179,6 +2236,7 @@ pub struct UIElementType {
 }
 t::debug_handle!(UIElementType);
 impl t::Handle for UIElementType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self { node: b.build_this(id) }
     }

@@ -32,6 +32,7 @@ pub struct DrillHoleSkillType {
 }
 t::debug_handle!(DrillHoleSkillType);
 impl t::Handle for DrillHoleSkillType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -64,6 +65,7 @@ pub struct DrillHoleSkillType_InputParameterSet {
 }
 t::debug_handle!(DrillHoleSkillType_InputParameterSet);
 impl t::Handle for DrillHoleSkillType_InputParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -126,6 +128,7 @@ pub struct DrillingCellType {
 }
 t::debug_handle!(DrillingCellType);
 impl t::Handle for DrillingCellType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -146,6 +149,7 @@ pub struct DrillingCellType_SkillSet {
 }
 t::debug_handle!(DrillingCellType_SkillSet);
 impl t::Handle for DrillingCellType_SkillSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -174,6 +178,7 @@ pub struct ReferenceDrillBushSkillType {
 }
 t::debug_handle!(ReferenceDrillBushSkillType);
 impl t::Handle for ReferenceDrillBushSkillType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -200,6 +205,7 @@ pub struct ReferenceDrillBushSkillType_InputParameterSet {
 }
 t::debug_handle!(ReferenceDrillBushSkillType_InputParameterSet);
 impl t::Handle for ReferenceDrillBushSkillType_InputParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -221,6 +227,7 @@ pub struct ReferenceDrillBushSkillType_OutputParameterSet {
 }
 t::debug_handle!(ReferenceDrillBushSkillType_OutputParameterSet);
 impl t::Handle for ReferenceDrillBushSkillType_OutputParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),

@@ -32,6 +32,7 @@ pub struct AcousticSignalType {
 }
 t::debug_handle!(AcousticSignalType);
 impl t::Handle for AcousticSignalType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -54,6 +55,7 @@ pub struct BaseCalibrationTargetCategoryType {
 }
 t::debug_handle!(BaseCalibrationTargetCategoryType);
 impl t::Handle for BaseCalibrationTargetCategoryType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self { node: b.build_this(id) }
     }
@@ -83,6 +85,7 @@ pub struct BasicStacklightType {
 }
 t::debug_handle!(BasicStacklightType);
 impl t::Handle for BasicStacklightType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -124,6 +127,7 @@ pub struct CalibrationTargetType {
 }
 t::debug_handle!(CalibrationTargetType);
 impl t::Handle for CalibrationTargetType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -153,6 +157,7 @@ pub struct CalibrationTargetType_CalibrationTargetFeatures {
 }
 t::debug_handle!(CalibrationTargetType_CalibrationTargetFeatures);
 impl t::Handle for CalibrationTargetType_CalibrationTargetFeatures {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -205,6 +210,7 @@ pub struct CalibrationTargetType_Identification {
 }
 t::debug_handle!(CalibrationTargetType_Identification);
 impl t::Handle for CalibrationTargetType_Identification {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -248,6 +254,7 @@ pub struct CalibrationValueType {
 }
 t::debug_handle!(CalibrationValueType);
 impl t::Handle for CalibrationValueType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -279,6 +286,7 @@ pub struct CapacityRangeType {
 }
 t::debug_handle!(CapacityRangeType);
 impl t::Handle for CapacityRangeType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -311,6 +319,7 @@ pub struct ControlChannelType {
 }
 t::debug_handle!(ControlChannelType);
 impl t::Handle for ControlChannelType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -337,6 +346,7 @@ pub struct DynamicCalibrationTargetCategoryType {
 }
 t::debug_handle!(DynamicCalibrationTargetCategoryType);
 impl t::Handle for DynamicCalibrationTargetCategoryType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -366,6 +376,7 @@ pub struct IAggregateStatisticsType {
 }
 t::debug_handle!(IAggregateStatisticsType);
 impl t::Handle for IAggregateStatisticsType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -396,6 +407,7 @@ pub struct IRollingStatisticsType {
 }
 t::debug_handle!(IRollingStatisticsType);
 impl t::Handle for IRollingStatisticsType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -424,6 +436,7 @@ pub struct IStatisticsType {
 }
 t::debug_handle!(IStatisticsType);
 impl t::Handle for IStatisticsType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -446,6 +459,7 @@ pub struct OneTimeCalibrationTargetCategoryType {
 }
 t::debug_handle!(OneTimeCalibrationTargetCategoryType);
 impl t::Handle for OneTimeCalibrationTargetCategoryType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -473,6 +487,7 @@ pub struct ReusableCalibrationTargetCategoryType {
 }
 t::debug_handle!(ReusableCalibrationTargetCategoryType);
 impl t::Handle for ReusableCalibrationTargetCategoryType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -500,6 +515,7 @@ pub struct ReusableDeviceCalibrationTargetCategoryType {
 }
 t::debug_handle!(ReusableDeviceCalibrationTargetCategoryType);
 impl t::Handle for ReusableDeviceCalibrationTargetCategoryType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -533,6 +549,7 @@ pub struct StackElementAcousticType {
 }
 t::debug_handle!(StackElementAcousticType);
 impl t::Handle for StackElementAcousticType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -557,6 +574,7 @@ pub struct StackElementAcousticType_AcousticSignals {
 }
 t::debug_handle!(StackElementAcousticType_AcousticSignals);
 impl t::Handle for StackElementAcousticType_AcousticSignals {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -592,6 +610,7 @@ pub struct StackElementLightType {
 }
 t::debug_handle!(StackElementLightType);
 impl t::Handle for StackElementLightType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -626,6 +645,7 @@ pub struct StackElementType {
 }
 t::debug_handle!(StackElementType);
 impl t::Handle for StackElementType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -653,6 +673,7 @@ pub struct StackLevelType {
 }
 t::debug_handle!(StackLevelType);
 impl t::Handle for StackLevelType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -673,6 +694,7 @@ pub struct StackRunningType {
 }
 t::debug_handle!(StackRunningType);
 impl t::Handle for StackRunningType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self { node: b.build_this(id) }
     }
@@ -699,6 +721,7 @@ pub struct StacklightType {
 }
 t::debug_handle!(StacklightType);
 impl t::Handle for StacklightType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),

@@ -40,6 +40,7 @@ pub struct DrillingEndEffectorType {
 }
 t::debug_handle!(DrillingEndEffectorType);
 impl t::Handle for DrillingEndEffectorType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -63,6 +64,7 @@ pub struct DrillingEndEffectorType_SkillSet {
 }
 t::debug_handle!(DrillingEndEffectorType_SkillSet);
 impl t::Handle for DrillingEndEffectorType_SkillSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -91,6 +93,7 @@ pub struct LwrSystemType {
 }
 t::debug_handle!(LwrSystemType);
 impl t::Handle for LwrSystemType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -156,6 +159,7 @@ pub struct LwrSystemType_MotionDeviceSystem {
 }
 t::debug_handle!(LwrSystemType_MotionDeviceSystem);
 impl t::Handle for LwrSystemType_MotionDeviceSystem {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -196,6 +200,7 @@ pub struct LwrSystemType_MotionDeviceSystem_ParameterSet {
 }
 t::debug_handle!(LwrSystemType_MotionDeviceSystem_ParameterSet);
 impl t::Handle for LwrSystemType_MotionDeviceSystem_ParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -220,6 +225,7 @@ pub struct TemplateDrillingLwrSystemType {
 }
 t::debug_handle!(TemplateDrillingLwrSystemType);
 impl t::Handle for TemplateDrillingLwrSystemType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -248,6 +254,7 @@ pub struct TemplateDrillingSkillType {
 }
 t::debug_handle!(TemplateDrillingSkillType);
 impl t::Handle for TemplateDrillingSkillType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -279,6 +286,7 @@ pub struct TemplateDrillingSkillType_InputParameterSet {
 }
 t::debug_handle!(TemplateDrillingSkillType_InputParameterSet);
 impl t::Handle for TemplateDrillingSkillType_InputParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -345,6 +353,7 @@ pub struct Ur10eSystemType {
 }
 t::debug_handle!(Ur10eSystemType);
 impl t::Handle for Ur10eSystemType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -369,6 +378,7 @@ pub struct Ur10eSystemType_Controllers {
 }
 t::debug_handle!(Ur10eSystemType_Controllers);
 impl t::Handle for Ur10eSystemType_Controllers {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -449,6 +459,7 @@ pub struct Ur10eSystemType_Controllers_URController {
 }
 t::debug_handle!(Ur10eSystemType_Controllers_URController);
 impl t::Handle for Ur10eSystemType_Controllers_URController {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -497,6 +508,7 @@ pub struct Ur10eSystemType_MotionDevices {
 }
 t::debug_handle!(Ur10eSystemType_MotionDevices);
 impl t::Handle for Ur10eSystemType_MotionDevices {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -567,6 +579,7 @@ pub struct Ur10eSystemType_MotionDevices_Manipulator {
 }
 t::debug_handle!(Ur10eSystemType_MotionDevices_Manipulator);
 impl t::Handle for Ur10eSystemType_MotionDevices_Manipulator {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -610,6 +623,7 @@ pub struct Ur10eSystemType_SafetyStates {
 }
 t::debug_handle!(Ur10eSystemType_SafetyStates);
 impl t::Handle for Ur10eSystemType_SafetyStates {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),

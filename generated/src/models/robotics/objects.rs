@@ -34,6 +34,7 @@ pub struct AuxiliaryComponentType {
 }
 t::debug_handle!(AuxiliaryComponentType);
 impl t::Handle for AuxiliaryComponentType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -70,6 +71,7 @@ pub struct AxisType {
 }
 t::debug_handle!(AxisType);
 impl t::Handle for AxisType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -99,6 +101,7 @@ pub struct AxisType_ParameterSet {
 }
 t::debug_handle!(AxisType_ParameterSet);
 impl t::Handle for AxisType_ParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -154,6 +157,7 @@ pub struct ControllerType {
 }
 t::debug_handle!(ControllerType);
 impl t::Handle for ControllerType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -205,6 +209,7 @@ pub struct ControllerType_ParameterSet {
 }
 t::debug_handle!(ControllerType_ParameterSet);
 impl t::Handle for ControllerType_ParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -231,6 +236,7 @@ pub struct ControllerType_Components {
 }
 t::debug_handle!(ControllerType_Components);
 impl t::Handle for ControllerType_Components {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -260,6 +266,7 @@ pub struct ControllerType_Programs {
 }
 t::debug_handle!(ControllerType_Programs);
 impl t::Handle for ControllerType_Programs {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -284,6 +291,7 @@ pub struct ControllerType_Software {
 }
 t::debug_handle!(ControllerType_Software);
 impl t::Handle for ControllerType_Software {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -303,6 +311,7 @@ pub struct ControllerType_TaskControls {
 }
 t::debug_handle!(ControllerType_TaskControls);
 impl t::Handle for ControllerType_TaskControls {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -329,6 +338,7 @@ pub struct DriveType {
 }
 t::debug_handle!(DriveType);
 impl t::Handle for DriveType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -355,6 +365,7 @@ pub struct EmergencyStopFunctionType {
 }
 t::debug_handle!(EmergencyStopFunctionType);
 impl t::Handle for EmergencyStopFunctionType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -386,6 +397,7 @@ pub struct ExecutingSubstateMachineType {
 }
 t::debug_handle!(ExecutingSubstateMachineType);
 impl t::Handle for ExecutingSubstateMachineType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -464,6 +476,7 @@ pub struct GearType {
 }
 t::debug_handle!(GearType);
 impl t::Handle for GearType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -499,6 +512,7 @@ pub struct IdleSubstateMachineType {
 }
 t::debug_handle!(IdleSubstateMachineType);
 impl t::Handle for IdleSubstateMachineType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -576,6 +590,7 @@ pub struct LoadType {
 }
 t::debug_handle!(LoadType);
 impl t::Handle for LoadType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -607,6 +622,7 @@ pub struct MotionDeviceSystemType {
 }
 t::debug_handle!(MotionDeviceSystemType);
 impl t::Handle for MotionDeviceSystemType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -630,6 +646,7 @@ pub struct MotionDeviceSystemType_Controllers {
 }
 t::debug_handle!(MotionDeviceSystemType_Controllers);
 impl t::Handle for MotionDeviceSystemType_Controllers {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -649,6 +666,7 @@ pub struct MotionDeviceSystemType_MotionDevices {
 }
 t::debug_handle!(MotionDeviceSystemType_MotionDevices);
 impl t::Handle for MotionDeviceSystemType_MotionDevices {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -668,6 +686,7 @@ pub struct MotionDeviceSystemType_SafetyStates {
 }
 t::debug_handle!(MotionDeviceSystemType_SafetyStates);
 impl t::Handle for MotionDeviceSystemType_SafetyStates {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -722,6 +741,7 @@ pub struct MotionDeviceType {
 }
 t::debug_handle!(MotionDeviceType);
 impl t::Handle for MotionDeviceType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -759,6 +779,7 @@ pub struct MotionDeviceType_ParameterSet {
 }
 t::debug_handle!(MotionDeviceType_ParameterSet);
 impl t::Handle for MotionDeviceType_ParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -779,6 +800,7 @@ pub struct MotionDeviceType_AdditionalComponents {
 }
 t::debug_handle!(MotionDeviceType_AdditionalComponents);
 impl t::Handle for MotionDeviceType_AdditionalComponents {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -798,6 +820,7 @@ pub struct MotionDeviceType_Axes {
 }
 t::debug_handle!(MotionDeviceType_Axes);
 impl t::Handle for MotionDeviceType_Axes {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -817,6 +840,7 @@ pub struct MotionDeviceType_PowerTrains {
 }
 t::debug_handle!(MotionDeviceType_PowerTrains);
 impl t::Handle for MotionDeviceType_PowerTrains {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -855,6 +879,7 @@ pub struct MotorType {
 }
 t::debug_handle!(MotorType);
 impl t::Handle for MotorType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -885,6 +910,7 @@ pub struct MotorType_ParameterSet {
 }
 t::debug_handle!(MotorType_ParameterSet);
 impl t::Handle for MotorType_ParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -962,6 +988,7 @@ pub struct MultiAcknowledgeableConditionType {
 }
 t::debug_handle!(MultiAcknowledgeableConditionType);
 impl t::Handle for MultiAcknowledgeableConditionType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1029,6 +1056,7 @@ pub struct OperationStateMachineType {
 }
 t::debug_handle!(OperationStateMachineType);
 impl t::Handle for OperationStateMachineType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1160,6 +1188,7 @@ pub struct PowerTrainType {
 }
 t::debug_handle!(PowerTrainType);
 impl t::Handle for PowerTrainType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1195,6 +1224,7 @@ pub struct ProtectiveStopFunctionType {
 }
 t::debug_handle!(ProtectiveStopFunctionType);
 impl t::Handle for ProtectiveStopFunctionType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1229,6 +1259,7 @@ pub struct ReadySubstateMachineType {
 }
 t::debug_handle!(ReadySubstateMachineType);
 impl t::Handle for ReadySubstateMachineType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1311,6 +1342,7 @@ pub struct SafetyStateType {
 }
 t::debug_handle!(SafetyStateType);
 impl t::Handle for SafetyStateType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1340,6 +1372,7 @@ pub struct SafetyStateType_ParameterSet {
 }
 t::debug_handle!(SafetyStateType_ParameterSet);
 impl t::Handle for SafetyStateType_ParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1360,6 +1393,7 @@ pub struct SafetyStateType_EmergencyStopFunctions {
 }
 t::debug_handle!(SafetyStateType_EmergencyStopFunctions);
 impl t::Handle for SafetyStateType_EmergencyStopFunctions {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1379,6 +1413,7 @@ pub struct SafetyStateType_ProtectiveStopFunctions {
 }
 t::debug_handle!(SafetyStateType_ProtectiveStopFunctions);
 impl t::Handle for SafetyStateType_ProtectiveStopFunctions {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1419,6 +1454,7 @@ pub struct SystemOperationStateMachineType {
 }
 t::debug_handle!(SystemOperationStateMachineType);
 impl t::Handle for SystemOperationStateMachineType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1544,6 +1580,7 @@ pub struct SystemOperationType {
 }
 t::debug_handle!(SystemOperationType);
 impl t::Handle for SystemOperationType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1564,6 +1601,7 @@ pub struct SystemOperationType_Conditions {
 }
 t::debug_handle!(SystemOperationType_Conditions);
 impl t::Handle for SystemOperationType_Conditions {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1588,6 +1626,7 @@ pub struct TaskControlOperationType {
 }
 t::debug_handle!(TaskControlOperationType);
 impl t::Handle for TaskControlOperationType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1637,6 +1676,7 @@ pub struct TaskControlStateMachineType {
 }
 t::debug_handle!(TaskControlStateMachineType);
 impl t::Handle for TaskControlStateMachineType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1777,6 +1817,7 @@ pub struct TaskControlType {
 }
 t::debug_handle!(TaskControlType);
 impl t::Handle for TaskControlType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1806,6 +1847,7 @@ pub struct TaskControlType_ParameterSet {
 }
 t::debug_handle!(TaskControlType_ParameterSet);
 impl t::Handle for TaskControlType_ParameterSet {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1826,6 +1868,7 @@ pub struct TaskControlType_TaskModules {
 }
 t::debug_handle!(TaskControlType_TaskModules);
 impl t::Handle for TaskControlType_TaskModules {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1849,6 +1892,7 @@ pub struct TaskModuleType {
 }
 t::debug_handle!(TaskModuleType);
 impl t::Handle for TaskModuleType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
@@ -1874,6 +1918,7 @@ pub struct UserType {
 }
 t::debug_handle!(UserType);
 impl t::Handle for UserType {
+    #[inline]
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
