@@ -29,7 +29,10 @@
 //! of both), which the foundation issue measured at 250 ms on this machine, is timed just before and just
 //! after our measurement; its median over 250 ms is the host's slowdown, and each time target is printed
 //! as given and scaled by it. The crate-build target is scaled by the peer's own crate build against the
-//! 2.7 s the Rust back-end issue measured. `--no-peer` leaves the targets unscaled.
+//! 2.7 s the Rust back-end issue measured. `--no-peer` leaves the targets unscaled. Two targets are judged
+//! from rounds that alternate our measure and the peer's, so that both sample the same stretch of time:
+//! the crate build (cold builds of both crates, back to back) and the import (the peer's run, then an
+//! import_bench process), each by the median of its per-round ratios.
 
 use std::collections::BTreeMap;
 use std::env;
@@ -688,6 +691,39 @@ mod rust {
         /// The peer's whole DI + Robotics run around the generation and around the import (None: --no-peer).
         yard_gen: Option<Step<Yardstick>>,
         yard_import: Option<Step<Yardstick>>,
+        /// Rounds of [the peer's run, a few imports] (None: --no-peer or no import).
+        import_rounds: Option<Step<ImportRounds>>,
+    }
+
+    /// The import and the yardstick sampled over the same stretch of time: round after round, one run of the
+    /// peer, then one import_bench process of a few runs.
+    struct ImportRounds {
+        /// Per round: the median import of its process, ms.
+        import_ms: Vec<f64>,
+        /// Per round: the peer's run, ms.
+        peer_ms: Vec<f64>,
+    }
+
+    /// Rounds of the import against the yardstick.
+    const IMPORT_ROUNDS: usize = 9;
+    /// Import runs per round.
+    const IMPORT_ROUND_RUNS: usize = 20;
+
+    /// Runs a few rounds of [the peer's DI + Robotics run, `import_bench --runs IMPORT_ROUND_RUNS`].
+    fn import_rounds(yardsticks: &Yardsticks, exe: &Path) -> Option<Step<ImportRounds>> {
+        let peer = yardsticks.peer.as_ref()?;
+        Some((|| {
+            let peer = peer.as_ref().map_err(Clone::clone)?;
+            eprintln!("rust: {IMPORT_ROUNDS} rounds of [the peer's run, {IMPORT_ROUND_RUNS} imports] ...");
+            let mut rounds = ImportRounds { import_ms: Vec::new(), peer_ms: Vec::new() };
+            for _ in 0..IMPORT_ROUNDS {
+                let y = exec(&peer.bench, 1, &peer.dir, &[("RUST_LOG", "warn")], &peer.exe, std::slice::from_ref(&peer.config))?;
+                rounds.peer_ms.push(y.f("wall_median_ms"));
+                let i = run_report(Command::new(exe).arg("--runs").arg(IMPORT_ROUND_RUNS.to_string()))?;
+                rounds.import_ms.push(i.f("import_median_ms"));
+            }
+            Ok(rounds)
+        })())
     }
 
     /// Runs the scenario and prints its table; an error means one of our own steps failed.
@@ -759,6 +795,7 @@ mod rust {
         let mut three = skipped();
         let mut import = Err("skipped (--no-builds)".to_string());
         let mut yard_import = None;
+        let mut import_rounds_result = None;
         let runtime_size = count_rs(&root.join("generated/runtime/src"));
         if !args.no_builds {
             let touched = root.join(TOUCHED);
@@ -823,12 +860,13 @@ mod rust {
                 let (r, y) = yardsticks.around("the import", || {
                     eprintln!("rust: import ({} run(s)) ...", args.runs_import.max(1));
                     run_report(
-                        Command::new(exe)
+                        Command::new(&exe)
                             .arg("--runs")
                             .arg(args.runs_import.max(1).to_string()),
                     )
                 });
                 yard_import = y;
+                import_rounds_result = import_rounds(&yardsticks, &exe);
                 r
             });
             release = if args.no_release {
@@ -884,6 +922,7 @@ mod rust {
             peer,
             yard_gen,
             yard_import,
+            import_rounds: import_rounds_result,
         };
         print(
             &results,
@@ -1778,24 +1817,36 @@ mod rust {
                     verdict(median, IMPORT_MS)
                 );
                 print_yardstick(r.yard_import.as_ref(), median, IMPORT_MS, "ms");
-                if let Some(Ok(y)) = r.yard_import.as_ref() {
-                    // The verdict. One import takes about 2 ms, and on this host a 2 ms task runs at half speed
-                    // for stretches of tens of runs and then at full speed again (per-run traces: medians of
-                    // 1.8 to 3.1 ms in consecutive processes, mins of 1.52 to 1.58 ms). The peer's 0.65 s run
-                    // spans many such stretches, a burst of 2 ms imports does not, so their medians see
-                    // different hosts; their fastest runs are each's least disturbed figure.
-                    let slowdown = y.min_ms / PEER_RUN_STATED_MS;
-                    println!(
-                        "   verdict  least disturbed figures: import min {:.3} ms; the peer's fastest run around it {:.1} ms, \
-                         host {slowdown:.2}x as slow, {}",
-                        i.f("import_min_ms"),
-                        y.min_ms,
-                        scaled(i.f("import_min_ms"), IMPORT_MS, slowdown, "ms")
-                    );
-                    println!(
-                        "            (a 2 ms import swings 2x in stretches of tens of runs on this host, which a 0.65 s run \
-                         averages out: the medians above see different hosts, the mins the same one)"
-                    );
+                match &r.import_rounds {
+                    Some(Ok(rounds)) => {
+                        // The verdict. A 2 ms import runs at half speed on this host for stretches of tens of
+                        // runs, and for minutes at a time at other moments; the peer's 0.65 s run averages
+                        // short stretches out. Sampled in alternation over the same stretch of time, both see
+                        // the same host.
+                        let ratios: Vec<f64> = rounds
+                            .import_ms
+                            .iter()
+                            .zip(&rounds.peer_ms)
+                            .map(|(i, p)| i / (IMPORT_MS * p / PEER_RUN_STATED_MS))
+                            .collect();
+                        let (import, peer) = (self::median(&rounds.import_ms), self::median(&rounds.peer_ms));
+                        let shown: Vec<String> = ratios.iter().map(|x| format!("{x:.2}")).collect();
+                        let verdict_ratio = self::median(&ratios);
+                        println!(
+                            "   verdict  {} rounds of [the peer's run, {IMPORT_ROUND_RUNS} imports], alternating; import / scaled target \
+                             per round: {}; median {verdict_ratio:.2}  {}",
+                            ratios.len(),
+                            shown.join(" "),
+                            verdict(verdict_ratio, 1.0)
+                        );
+                        println!(
+                            "            (medians over the rounds: import {import:.3} ms, the peer's run {peer:.1} ms, host {:.2}x as \
+                             slow; the figures above were taken minutes apart, these in the same stretch of time)",
+                            peer / PEER_RUN_STATED_MS
+                        );
+                    }
+                    Some(Err(e)) => println!("   verdict  (the alternating rounds failed: {e})"),
+                    None => {}
                 }
                 println!(
                     "   decode   {:.3} ms once per process (the tables' packed text into rows, on first use; not in \
