@@ -717,7 +717,7 @@ mod rust {
             eprintln!("rust: {IMPORT_ROUNDS} rounds of [the peer's run, {IMPORT_ROUND_RUNS} imports] ...");
             let mut rounds = ImportRounds { import_ms: Vec::new(), peer_ms: Vec::new() };
             for _ in 0..IMPORT_ROUNDS {
-                let y = exec(&peer.bench, 1, &peer.dir, &[("RUST_LOG", "warn")], &peer.exe, std::slice::from_ref(&peer.config))?;
+                let y = peer.time(1)?;
                 rounds.peer_ms.push(y.f("wall_median_ms"));
                 let i = run_report(Command::new(exe).arg("--runs").arg(IMPORT_ROUND_RUNS.to_string()))?;
                 rounds.import_ms.push(i.f("import_median_ms"));
@@ -1144,14 +1144,7 @@ mod rust {
                 self.peer.as_ref().map(|peer| {
                     let peer = peer.as_ref().map_err(Clone::clone)?;
                     eprintln!("the peer's DI + Robotics run as a yardstick ({when} {what}) ...");
-                    exec(
-                        &peer.bench,
-                        self.runs,
-                        &peer.dir,
-                        &[("RUST_LOG", "warn")],
-                        &peer.exe,
-                        std::slice::from_ref(&peer.config),
-                    )
+                    peer.time(self.runs)
                 })
             };
             let before = time("before");
@@ -1162,6 +1155,11 @@ mod rust {
     }
 
     impl PeerRun {
+        /// `runs` timed runs of the peer on DI + Robotics.
+        fn time(&self, runs: usize) -> Step<Report> {
+            exec(&self.bench, runs, &self.dir, &[("RUST_LOG", "warn")], &self.exe, std::slice::from_ref(&self.config))
+        }
+
         fn prepare(root: &Path, tree: &Path) -> Step<PeerRun> {
             let (exe, _) = ensure_peer(root);
             let exe = exe?;
