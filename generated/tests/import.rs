@@ -198,6 +198,11 @@ static EDGE_TABLE: NodeSetTable = NodeSetTable {
                 Ref { reference_type: HAS_COMPONENT, target: Id::numeric(1, 2), forward: true },
             ],
         ),
+        // The same damage in the numeric reference list, which the import reads on a path of its own.
+        NodeRow {
+            nrefs: &[(0, 35, 0, 85, false), (0, 47, 1, 11, true), (0, 47, 7, 5, true), (9, 1, 1, 2, true), (0, 47, 2, 10, true), (0, 47, 1, 2, true)],
+            ..edge_row(Id::numeric(1, 11), "Numeric", OBJECT, &[])
+        },
         // Nodes outside the table's own namespace.
         edge_row(Id::numeric(2, 3), "Foreign", OBJECT, &[]),
         edge_row(Id::numeric(5, 4), "Unregistered", OBJECT, &[]),
@@ -283,6 +288,17 @@ async fn malformed_tables_import_without_panics() {
             .collect();
         assert!(components.contains(&id(2)) && components.contains(&NodeId::new(other, 10u32)));
         assert_eq!(components.len(), 2, "the self reference and the unregistered ones are skipped: {components:?}");
+        let numeric: Vec<NodeId> = space
+            .find_references(&id(11), Some((NodeId::new(0, 47u32), false)), &*tree, BrowseDirection::Forward)
+            .map(|r| r.target_node.clone())
+            .collect();
+        assert!(numeric.contains(&id(2)) && numeric.contains(&NodeId::new(other, 10u32)));
+        assert_eq!(numeric.len(), 2, "numeric references: the self reference and the unregistered ones are skipped: {numeric:?}");
+        let organized_by: Vec<NodeId> = space
+            .find_references(&id(11), Some((NodeId::new(0, 35u32), false)), &*tree, BrowseDirection::Inverse)
+            .map(|r| r.target_node.clone())
+            .collect();
+        assert_eq!(organized_by, [NodeId::new(0, 85u32)]);
     }
     running.stop().await;
 }

@@ -21,7 +21,7 @@ use opcua::types::{
 };
 use tracing::{error, warn};
 
-use super::table::{ArgRow, Def, EnumRow, FieldRow, Id, Kind, NodeRow, NodeSetTable, Ref, StructureKind, Val};
+use super::table::{ArgRow, Def, EnumRow, FieldRow, Id, Kind, NodeRow, NodeSetTable, NumRef, Ref, StructureKind, Val};
 use super::NamespaceMap;
 
 /// The OPC UA namespace, always index 0.
@@ -88,7 +88,9 @@ impl NodeSetImport for TableImport {
                 return Box::new(std::iter::empty());
             }
         };
-        Box::new(rows.iter().filter_map(move |row| build_item(table, row, &map)))
+        // One timestamp for every value of the import: the values are as of the moment the table is loaded.
+        let now = DateTime::now();
+        Box::new(rows.iter().filter_map(move |row| build_item(table, row, &map, now)))
     }
 }
 
@@ -123,8 +125,8 @@ pub(crate) fn build_map(table: &NodeSetTable, server_index: impl Fn(u16, &str) -
 pub(crate) const UNMAPPED: u16 = u16::MAX;
 
 /// Builds one node with its references, or `None` (with a warning) if the row cannot be imported.
-fn build_item(table: &NodeSetTable, row: &NodeRow, map: &NamespaceMap) -> Option<ImportedItem> {
-    let ctx = Ctx { table, map };
+fn build_item(table: &NodeSetTable, row: &NodeRow, map: &NamespaceMap, now: DateTime) -> Option<ImportedItem> {
+    let ctx = Ctx { table, map, now };
     if row.id.ns != table.own {
         warn!(
             "table {}: node {:?} is not in the table's own namespace (index {}); skipped",
@@ -161,7 +163,7 @@ fn build_item(table: &NodeSetTable, row: &NodeRow, map: &NamespaceMap) -> Option
             minimum_sampling_interval,
             value,
         } => {
-            let value = ctx.value(value, &node_id).map(DataValue::new_now).unwrap_or_else(DataValue::null);
+            let value = ctx.value(value, &node_id).map(|v| ctx.data_value(v)).unwrap_or_else(DataValue::null);
             Variable::new_full(
                 base,
                 ctx.node_id(*data_type, &node_id, "DataType"),
@@ -180,7 +182,7 @@ fn build_item(table: &NodeSetTable, row: &NodeRow, map: &NamespaceMap) -> Option
             ctx.node_id(*data_type, &node_id, "DataType"),
             *is_abstract,
             *value_rank,
-            ctx.value(value, &node_id).map(DataValue::new_now),
+            ctx.value(value, &node_id).map(|v| ctx.data_value(v)),
             dims(array_dimensions),
         )
         .into(),
@@ -197,7 +199,9 @@ fn build_item(table: &NodeSetTable, row: &NodeRow, map: &NamespaceMap) -> Option
             View::new_full(base, EventNotifier::from_bits_truncate(*event_notifier), *contains_no_loops).into()
         }
     };
-    let references = row.references().filter_map(|r| ctx.reference(&r, &node_id)).collect();
+    let mut references = Vec::with_capacity(row.refs.len() + row.nrefs.len());
+    references.extend(row.refs.iter().filter_map(|r| ctx.reference(r, &node_id)));
+    references.extend(row.nrefs.iter().filter_map(|r| ctx.numeric_reference(r, &node_id)));
     Some(ImportedItem { node, references })
 }
 
@@ -228,6 +232,8 @@ fn dims(d: &[u32]) -> Option<Vec<u32>> {
 struct Ctx<'a> {
     table: &'a NodeSetTable,
     map: &'a NamespaceMap,
+    /// The source and server timestamp of every value.
+    now: DateTime,
 }
 
 impl Ctx<'_> {
@@ -241,6 +247,19 @@ impl Ctx<'_> {
             );
             NodeId::null()
         })
+    }
+
+    /// A Good value with the import's timestamps (what `DataValue::new_now` gives, without reading the clock
+    /// once per variable).
+    fn data_value(&self, value: Variant) -> DataValue {
+        DataValue {
+            value: Some(value),
+            status: Some(StatusCode::Good),
+            source_timestamp: Some(self.now),
+            source_picoseconds: Some(0),
+            server_timestamp: Some(self.now),
+            server_picoseconds: Some(0),
+        }
     }
 
     fn qualified_name(&self, ns: u16, name: &str, node: &NodeId) -> QualifiedName {
@@ -269,6 +288,20 @@ impl Ctx<'_> {
             return None;
         }
         Some(ImportedReference { target_id, type_id, is_forward: r.forward })
+    }
+
+    /// [`Ctx::reference`] for a [`NumRef`], without the detour through [`Id`].
+    #[inline]
+    fn numeric_reference(&self, &(rns, rid, tns, tid, forward): &NumRef, source: &NodeId) -> Option<ImportedReference> {
+        let slow = || self.reference(&Ref::from_numeric(&(rns, rid, tns, tid, forward)), source);
+        let (Some(target_ns), Some(type_ns)) = (self.map.try_index(tns), self.map.try_index(rns)) else {
+            return slow();
+        };
+        let target_id = NodeId::new(target_ns, tid);
+        if &target_id == source {
+            return slow();
+        }
+        Some(ImportedReference { target_id, type_id: NodeId::new(type_ns, rid), is_forward: forward })
     }
 
     fn text(s: Option<&str>) -> LocalizedText {

@@ -45,6 +45,7 @@ impl NsNodeId {
 }
 
 /// Builds an async-opcua NodeId from a namespace index and an identifier.
+#[inline]
 pub fn make_node_id(ns: u16, id: IdKind) -> NodeId {
     match id {
         IdKind::Numeric(n) => NodeId::new(ns, n),
@@ -75,11 +76,13 @@ impl NamespaceMap {
     }
 
     /// The server NodeId of a table NodeId, `None` if its namespace is not registered.
+    #[inline]
     pub fn try_id(&self, id: Id) -> Option<NodeId> {
         Some(make_node_id(self.try_index(id.ns)?, id.id))
     }
 
     /// The server namespace index of a table-local index, `None` if it is not registered.
+    #[inline]
     pub fn try_index(&self, local: u16) -> Option<u16> {
         if local == 0 {
             return Some(0);

@@ -92,6 +92,13 @@ pub struct Ref {
 /// [`Id`]s is 11.
 pub type NumRef = (u16, u32, u16, u32, bool);
 
+impl Ref {
+    /// The reference a [`NumRef`] stands for.
+    pub fn from_numeric(&(rns, rid, tns, tid, forward): &NumRef) -> Ref {
+        Ref { reference_type: Id::numeric(rns, rid), target: Id::numeric(tns, tid), forward }
+    }
+}
+
 /// A field of a structure's DataTypeDefinition.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FieldRow {
@@ -242,11 +249,7 @@ pub struct NodeRow {
 impl NodeRow {
     /// Every reference of the row: `refs`, then `nrefs`.
     pub fn references(&self) -> impl Iterator<Item = Ref> + '_ {
-        self.refs.iter().copied().chain(self.nrefs.iter().map(|&(rns, rid, tns, tid, forward)| Ref {
-            reference_type: Id::numeric(rns, rid),
-            target: Id::numeric(tns, tid),
-            forward,
-        }))
+        self.refs.iter().copied().chain(self.nrefs.iter().map(Ref::from_numeric))
     }
 }
 
