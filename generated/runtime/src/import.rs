@@ -201,7 +201,11 @@ fn build_item(table: &NodeSetTable, row: &NodeRow, map: &NamespaceMap, now: Date
     };
     let mut references = Vec::with_capacity(row.refs.len() + row.nrefs.len());
     references.extend(row.refs.iter().filter_map(|r| ctx.reference(r, &node_id)));
-    references.extend(row.nrefs.iter().filter_map(|r| ctx.numeric_reference(r, &node_id)));
+    for r in row.nrefs {
+        if let Some(r) = ctx.numeric_reference(r, &node_id) {
+            references.push(r);
+        }
+    }
     Some(ImportedItem { node, references })
 }
 
@@ -290,18 +294,26 @@ impl Ctx<'_> {
         Some(ImportedReference { target_id, type_id, is_forward: r.forward })
     }
 
-    /// [`Ctx::reference`] for a [`NumRef`], without the detour through [`Id`].
-    #[inline]
-    fn numeric_reference(&self, &(rns, rid, tns, tid, forward): &NumRef, source: &NodeId) -> Option<ImportedReference> {
-        let slow = || self.reference(&Ref::from_numeric(&(rns, rid, tns, tid, forward)), source);
+    /// [`Ctx::reference`] for a [`NumRef`], without the detour through [`Id`]; inlined into the loop over a
+    /// row's references, so that the result is not passed through memory.
+    #[inline(always)]
+    fn numeric_reference(&self, r: &NumRef, source: &NodeId) -> Option<ImportedReference> {
+        let &(rns, rid, tns, tid, forward) = r;
         let (Some(target_ns), Some(type_ns)) = (self.map.try_index(tns), self.map.try_index(rns)) else {
-            return slow();
+            return self.damaged_numeric_reference(r, source);
         };
         let target_id = NodeId::new(target_ns, tid);
         if &target_id == source {
-            return slow();
+            return self.damaged_numeric_reference(r, source);
         }
         Some(ImportedReference { target_id, type_id: NodeId::new(type_ns, rid), is_forward: forward })
+    }
+
+    /// A [`NumRef`] the fast path does not take (an unregistered namespace, a reference to itself).
+    #[cold]
+    #[inline(never)]
+    fn damaged_numeric_reference(&self, r: &NumRef, source: &NodeId) -> Option<ImportedReference> {
+        self.reference(&Ref::from_numeric(r), source)
     }
 
     fn text(s: Option<&str>) -> LocalizedText {
