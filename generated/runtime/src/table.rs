@@ -445,10 +445,7 @@ impl Cursor {
         let neg = self.eat(b'-');
         let start = self.i;
         let mut v: u64 = 0;
-        while let Some(&d) = self.b.get(self.i) {
-            if !d.is_ascii_digit() {
-                break;
-            }
+        while let Some(d) = self.peek().filter(u8::is_ascii_digit) {
             v = v.checked_mul(10).and_then(|v| v.checked_add(u64::from(d - b'0'))).ok_or("number too large")?;
             self.i += 1;
         }
