@@ -5,7 +5,7 @@ usage: .venv/bin/python tests/interop/robotics_check.py --url opc.tcp://127.0.0.
 
 Suites:
 
-* ``demo``: the runtime's demo namespace (``cargo run -p nodeset-models --example server -- --demo``):
+* ``demo``: the runtime's demo namespace (``cargo run -p nodeset-examples --example server -- --demo``):
   browsing, attributes, references in both directions, DataTypeDefinitions decoded with
   ``load_data_type_definitions``, writes and method calls with their status codes, a subscription.
 * ``robotics``: the generated DI, IA and Robotics namespaces, checked against the NodeSet2 files

@@ -2,7 +2,7 @@
 
 usage: .venv/bin/python tests/interop/skills_check.py --robot URL --unit URL --cell URL
 
-The three servers of ``cargo run -p nodeset-models --example robot_cell``: the robot's move skills, the
+The three servers of ``cargo run -p nodeset-examples --example robot_cell``: the robot's move skills, the
 drilling unit's TemplateDrilling and the cell's composite skills. Everything is found by browsing names
 from the Objects folder; no NodeId is written here except ns0's well-known ones.
 

@@ -1,5 +1,5 @@
 //! Interoperability: a real third-party OPC UA client (python asyncua, from `.venv`) against the example
-//! server of `nodeset-models`, run as its own process.
+//! server of `nodeset-examples`, run as its own process.
 //!
 //! The test builds the example (`cargo build --workspace --example server`, a no-op when it is
 //! fresh), starts it on a free port, runs `tests/interop/robotics_check.py` with the suites below, and
@@ -27,7 +27,7 @@ fn python() -> PathBuf {
     python
 }
 
-/// Builds an example of nodeset-models and returns the path of its executable.
+/// Builds an example of nodeset-examples and returns the path of its executable.
 fn build_server(example: &str) -> PathBuf {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
     let output = Command::new(cargo)

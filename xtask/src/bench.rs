@@ -3,7 +3,7 @@
 //!
 //! The measured programs are examples: `nodeset-compiler/examples/load_bench.rs` (front end),
 //! `nodeset-compiler/examples/rust_bench.rs` (Rust generation, and a stopwatch for other programs) and
-//! `generated/examples/import_bench.rs` (address-space import). This task builds them in release mode, runs
+//! `nodeset-examples/examples/import_bench.rs` (address-space import). This task builds them in release mode, runs
 //! every scenario in its own process (so that the peak resident memory, `VmHWM`, belongs to that scenario
 //! alone), reads the `BENCH key=value ...` line each prints and shows a table. It is a report, not a test:
 //! a missed target prints `OVER` but the task still succeeds; it fails only when one of our own steps fails.
@@ -508,12 +508,12 @@ fn print_table(reports: &[Report], split: bool, yard: Option<&Result<rust::Yards
 ///    run, `cargo clean -p nodeset-models` and a timed build (cold, our crate alone), then
 ///    `generated/src/models/robotics/types.rs` is touched and the build timed again (incremental). A no-op
 ///    build shows cargo's own share of these wall times. Debug builds run `--runs-build` times, release
-///    builds once. The hand-written runtime is the crate `nodeset-runtime` (`generated/runtime/`), a
+///    builds once. The hand-written runtime is the crate `nodeset-runtime` (`nodeset-runtime/`), a
 ///    dependency built once like async-opcua; its cold build is timed the same way, so that what a user
 ///    compiles in all from a clean target is also shown. nodeset-models holds six namespaces; the CLI's
 ///    output of step 1 (DI + IA + Robotics, the peer's inputs) is built the same way as the crate
 ///    `nodeset-models-di-ia-robotics` on nodeset-runtime, the figure to set beside the peer's crate.
-/// 4. Import: `generated/examples/import_bench.rs` (release), which says what it includes.
+/// 4. Import: `nodeset-examples/examples/import_bench.rs` (release), which says what it includes.
 /// 5. Peer: async-opcua-codegen 0.19.0, installed once into `target/bench-tools`, with a config written to
 ///    `target/bench-build/peer/codegen.yml` (a `types` and a `nodes` target per namespace; the nodes target
 ///    needs the XML schemas of ns0 and of each model, taken from the UA-Nodeset tree). Its output is built as
@@ -796,7 +796,7 @@ mod rust {
         let mut import = Err("skipped (--no-builds)".to_string());
         let mut yard_import = None;
         let mut import_rounds_result = None;
-        let runtime_size = count_rs(&root.join("generated/runtime/src"));
+        let runtime_size = count_rs(&root.join("nodeset-runtime/src"));
         if !args.no_builds {
             let touched = root.join(TOUCHED);
             eprintln!(
@@ -848,7 +848,7 @@ mod rust {
                     "build",
                     "--release",
                     "-p",
-                    CRATE,
+                    "nodeset-examples",
                     "--example",
                     "import_bench",
                 ],
@@ -1234,7 +1234,7 @@ mod rust {
                  [lib]\npath = \"lib.rs\"\n\n[workspace]\n\n[features]\njson = [\"async-opcua/json\"]\nxml = [\"async-opcua/xml\"]\n\n\
                  [dependencies]\nnodeset-runtime = {{ path = {:?} }}\n\
                  async-opcua = {{ version = \"=0.19.0\", features = [\"server\", \"client\"] }}\nbitflags = \"2\"\n\n{PROFILES}",
-                root.join("generated/runtime").display().to_string()
+                root.join("nodeset-runtime").display().to_string()
             ),
         )?;
         write(

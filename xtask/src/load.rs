@@ -1,6 +1,6 @@
 //! `cargo xtask load`: the generated server under client load (issue "Reliability", item 5).
 //!
-//! Builds the `robot` and `load` examples of `nodeset-models`, starts the robot (six axes updated at 100 Hz)
+//! Builds the `robot` and `load` examples of `nodeset-examples`, starts the robot (six axes updated at 100 Hz)
 //! on a free loopback port, runs the load client against it (`--sessions` sessions, each subscribed to every
 //! axis variable at `--publishing-ms`, plus one session writing a writable variable, for `--seconds`), then
 //! stops the robot with SIGTERM, which must end it cleanly. The load client prints the report (notifications
@@ -32,7 +32,7 @@ pub struct Args {
     pub release: bool,
 }
 
-/// Builds examples of nodeset-models and returns the folder of their executables.
+/// Builds examples of nodeset-examples and returns the folder of their executables.
 pub(crate) fn build(root: &Path, release: bool, examples: &[&str]) -> Result<PathBuf, String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut cmd = Command::new(cargo);

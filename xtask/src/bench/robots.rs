@@ -1,4 +1,4 @@
-//! The `robots` scenario: the typed API at scale (issue "Typed ObjectTypes"): `generated/examples/robot_bench.rs`
+//! The `robots` scenario: the typed API at scale (issue "Typed ObjectTypes"): `nodeset-examples/examples/robot_bench.rs`
 //! instantiates N six-axis Robotics robots in one running server and updates every joint position at a fixed
 //! rate through typed handles; this task builds it in release mode, runs it once and shows its figures.
 
@@ -14,7 +14,7 @@ pub(super) fn run(root: &Path, robots: usize, hz: u32, seconds: u64) -> Result<(
     let cargo = env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let status = Command::new(cargo)
         .current_dir(root)
-        .args(["build", "--quiet", "--release", "-p", "nodeset-models", "--example", "robot_bench"])
+        .args(["build", "--quiet", "--release", "-p", "nodeset-examples", "--example", "robot_bench"])
         .status()
         .map_err(|e| format!("cannot run cargo: {e}"))?;
     if !status.success() {

@@ -4,7 +4,7 @@
 //! It can also be run by hand:
 //!
 //! ```text
-//! cargo run --release -p nodeset-models --example import_bench -- --runs 50
+//! cargo run --release -p nodeset-examples --example import_bench -- --runs 50
 //! ```
 //!
 //! It does what the runtime's node manager (`runtime/server/manager.rs`) does when a server is built, in a

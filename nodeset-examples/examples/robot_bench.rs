@@ -3,7 +3,7 @@
 //! typed `Variable<f64>` handles.
 //!
 //! ```text
-//! cargo run --release -p nodeset-models --example robot_bench -- [--robots 100] [--hz 100] [--seconds 10]
+//! cargo run --release -p nodeset-examples --example robot_bench -- [--robots 100] [--hz 100] [--seconds 10]
 //! ```
 //!
 //! `cargo xtask bench --scenario robots` builds and runs it. It reports, on one `BENCH key=value ...` line:

@@ -1,7 +1,7 @@
 //! The Commands2 drilling cell as three OPC UA servers on loopback, started by one command:
 //!
 //! ```text
-//! cargo run -p nodeset-models --example robot_cell -- [--port 4861] [--motion-ms 1000] [--seconds N]
+//! cargo run -p nodeset-examples --example robot_cell -- [--port 4861] [--motion-ms 1000] [--seconds N]
 //! ```
 //!
 //! - the **robot** (port P): the UR10e of `TemplateDrillingLwrSystem`; its controller's SkillSet serves the

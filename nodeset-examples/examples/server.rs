@@ -1,7 +1,7 @@
 //! An OPC UA server with the generated companion specifications.
 //!
 //! ```text
-//! cargo run -p nodeset-models --example server -- [--port 4855] [--seconds N] [--demo]
+//! cargo run -p nodeset-examples --example server -- [--port 4855] [--seconds N] [--demo]
 //! ```
 //!
 //! It serves the OPC UA namespace and the generated DI, IA and Robotics namespaces on
@@ -19,7 +19,7 @@ use std::io::Write;
 use std::process::ExitCode;
 use std::time::Duration;
 
-use nodeset_models::runtime::demo::{self, DemoMode, DemoPoint};
+use nodeset_examples::demo::{self, DemoMode, DemoPoint};
 use nodeset_models::runtime::server::{MethodError, MethodInvocation, ModelManager, ServerConfig};
 use opcua::types::{StatusCode, TryFromVariant, Variant};
 

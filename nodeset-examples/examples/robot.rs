@@ -1,7 +1,7 @@
 //! A simulated six-axis robot, served over OPC UA with the typed API and `#[derive(ObjectModel)]`.
 //!
 //! ```text
-//! cargo run -p nodeset-models --example robot -- [--port 4856] [--seconds N]
+//! cargo run -p nodeset-examples --example robot -- [--port 4856] [--seconds N]
 //! ```
 //!
 //! It instantiates a Robotics `MotionDeviceSystemType` named `Robot` under the Objects folder: one

@@ -3,7 +3,7 @@
 //! writable variable. Loopback only, bounded in time; it stops by itself.
 //!
 //! ```text
-//! cargo run --release -p nodeset-models --example load -- --url opc.tcp://127.0.0.1:4856/ \
+//! cargo run --release -p nodeset-examples --example load -- --url opc.tcp://127.0.0.1:4856/ \
 //!     [--sessions 50] [--seconds 300] [--publishing-ms 100] [--server-pid PID]
 //! ```
 //!

@@ -8,7 +8,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use common::{connect, disconnect, read, serve};
-use nodeset_models::runtime::demo::{self, ids, DemoMode, DemoPoint};
+use nodeset_examples::demo::{self, ids, DemoMode, DemoPoint};
 use nodeset_models::runtime::server::{MethodError, MethodInvocation, ServerConfig};
 use opcua::client::DataChangeCallback;
 use opcua::types::{

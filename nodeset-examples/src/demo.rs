@@ -13,8 +13,8 @@ use opcua::types::{
     binary_decode_to_enc, ExpandedMessageInfo, ExpandedNodeId, StaticTypeLoader, TypeLoaderInstance, UAString,
 };
 
-use super::table::{ArgRow, Def, EnumRow, FieldRow, Id, Kind, NodeRow, NodeSetTable, Nodes, Ref, StructureKind, Val};
-use super::NsNodeId;
+use nodeset_runtime::table::{ArgRow, Def, EnumRow, FieldRow, Id, Kind, NodeRow, NodeSetTable, Nodes, Ref, StructureKind, Val};
+use nodeset_runtime::NsNodeId;
 
 /// The demo namespace URI.
 pub const NAMESPACE_URI: &str = "urn:nodeset-models:demo";
@@ -206,7 +206,7 @@ const fn property(id: u32, name: &'static str, data_type: Id, value: Val) -> Nod
 
 const PROPERTY_REFS: &[Ref] = &[fwd(HAS_TYPE_DEFINITION, PROPERTY_TYPE)];
 
-fn position(_: &super::NamespaceMap) -> opcua::types::Variant {
+fn position(_: &nodeset_runtime::NamespaceMap) -> opcua::types::Variant {
     DemoPoint { x: 3.0, y: 4.0, label: "home".into(), mode: DemoMode::Fast }.into()
 }
 

@@ -4,7 +4,7 @@
 mod common;
 
 use common::serve;
-use nodeset_models::runtime::demo::{self, ids, DemoMode, DemoPoint};
+use nodeset_examples::demo::{self, ids, DemoMode, DemoPoint};
 use nodeset_models::runtime::import::parse_date_time;
 use nodeset_models::runtime::server::ServerConfig;
 use nodeset_models::runtime::table::{Def, FieldRow, Id, Kind, NodeRow, NodeSetTable, Nodes, Ref, StructureKind, Val};

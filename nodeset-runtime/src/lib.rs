@@ -5,7 +5,6 @@
 
 #![cfg_attr(test, deny(warnings))]
 
-pub mod demo;
 pub mod import;
 pub mod remote;
 pub mod server;

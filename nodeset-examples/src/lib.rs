@@ -1,0 +1,8 @@
+//! What the examples and the integration tests of the runtime share: the hand-written [`demo`] namespace.
+//!
+//! The examples themselves are under `examples/` (`cargo run -p nodeset-examples --example robot`), the tests
+//! of the runtime with the generated models under `tests/`.
+
+#![cfg_attr(test, deny(warnings))]
+
+pub mod demo;
