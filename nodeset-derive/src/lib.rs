@@ -35,6 +35,8 @@
 use std::collections::BTreeMap;
 
 use heck::ToUpperCamelCase;
+// The marker naming rule the generated code follows (one definition for both crates).
+use nodeset_markers::marker_name;
 use proc_macro::TokenStream;
 use proc_macro2::{Span, TokenStream as TokenStream2};
 use quote::{format_ident, quote, quote_spanned};
@@ -74,23 +76,6 @@ struct Binding {
     path: String,
     /// Where the path came from (the attribute's literal, or the field name).
     span: Span,
-}
-
-/// The marker name of a browse path, exactly as nodeset-compiler names it (`emit::rust::marker_name`).
-fn marker_name(segments: &[&str]) -> String {
-    let mut parts = Vec::new();
-    for s in segments {
-        let mut p: String = s.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' }).collect();
-        if p.is_empty() || p.starts_with(|c: char| c.is_ascii_digit()) {
-            p.insert(0, '_');
-        }
-        parts.push(p);
-    }
-    let mut name = parts.join("__");
-    if syn::parse_str::<syn::Ident>(&name).is_err() {
-        name.push('_');
-    }
-    name
 }
 
 fn expand(input: &DeriveInput) -> syn::Result<TokenStream2> {

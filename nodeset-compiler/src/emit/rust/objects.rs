@@ -50,24 +50,8 @@ const MAX_DEPTH: usize = 6;
 /// How deep nested handle structs go (below, members are typed by their TypeDefinition's handle).
 const NESTED_DEPTH: usize = 2;
 
-/// The marker name of a browse path, as `nodeset-derive` computes it from a `path = "A/B"` attribute:
-/// every character that cannot be in an identifier becomes `_`, a leading digit gets a `_` before it,
-/// segments are joined by `__`, and a Rust keyword gets a trailing `_`.
-pub fn marker_name(segments: &[&str]) -> String {
-    let mut parts = Vec::new();
-    for s in segments {
-        let mut p: String = s.chars().map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' }).collect();
-        if p.is_empty() || p.starts_with(|c: char| c.is_ascii_digit()) {
-            p.insert(0, '_');
-        }
-        parts.push(p);
-    }
-    let mut name = parts.join("__");
-    if syn::parse_str::<syn::Ident>(&name).is_err() {
-        name.push('_');
-    }
-    name
-}
+/// The marker name of a browse path: the rule `nodeset-derive` uses too, defined once in `nodeset-markers`.
+pub use nodeset_markers::marker_name;
 
 /// A BrowseName as a segment of a marker's path text (`runtime::typed::MemberPath`): `/` and `\` get a
 /// `\` before them.
