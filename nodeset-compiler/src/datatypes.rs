@@ -104,7 +104,7 @@ fn structure(model: &Model, t: NodeIx, done: &BTreeMap<NodeIx, DataTypeInfo>, di
     for f in &def.fields {
         let data_type = match &f.data_type {
             None => model.ns0(ids::BASE_DATA_TYPE),
-            Some(dt) => match crate::resolve::resolve_in(ctx, model, &dt.value, dt.span, diags) {
+            Some(dt) => match ctx.resolve(model, &dt.value, dt.span, diags) {
                 Ok(id) => match model.lookup(&id) {
                     Some(ix) if model.node(ix).class == NodeClass::DataType => Some(ix),
                     found => {

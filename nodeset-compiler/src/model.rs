@@ -333,6 +333,38 @@ pub struct FileContext {
     pub aliases: FxHashMap<String, Spanned<String>>,
 }
 
+impl FileContext {
+    /// Resolves a NodeId or alias written in this file. An alias the file forgot to declare that is the
+    /// BrowseName of a base DataType or ReferenceType (`IdType`, `NumericRange`) resolves to it, with a
+    /// warning: official nodesets contain such omissions and every lenient server accepts them.
+    ///
+    /// Here rather than in `resolve` because `datatypes` needs it too, and `resolve` calls `datatypes`.
+    pub(crate) fn resolve(
+        &self,
+        model: &Model,
+        s: &str,
+        span: Span,
+        diags: &mut crate::diag::Diagnostics,
+    ) -> Result<NodeId, crate::diag::Diagnostic> {
+        use crate::diag::{Code, Diagnostic};
+        match crate::load::resolve_node_id_str(&self.ns_map, &self.aliases, s, span, &model.namespaces) {
+            Err(d) if d.code == Code::UnknownAlias => match model.ns0_type_names.get(s.trim()) {
+                Some(&ix) => {
+                    let id = model.node(ix).id.clone();
+                    diags.push(
+                        Diagnostic::new(Code::AliasByBrowseName, format!("alias `{}` is not declared; using the base type `{}` ({id})", s.trim(), s.trim()))
+                            .at(span)
+                            .help(format!("declare it: <Alias Alias=\"{}\">{id}</Alias>", s.trim())),
+                    );
+                    Ok(id)
+                }
+                None => Err(d),
+            },
+            other => other,
+        }
+    }
+}
+
 /// One model of every loaded file.
 #[derive(Debug)]
 pub struct Model {

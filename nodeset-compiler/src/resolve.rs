@@ -398,7 +398,7 @@ impl Pass2<'_> {
                         let cached = numeric.or_else(|| cache.get(rt_text).copied());
                         let found = match cached {
                             Some(t) => Ok(Some(t)),
-                            None => resolve_in(ctx, model, rt_text, r.reference_type.span, diags).map(|id| model.lookup(&id)),
+                            None => ctx.resolve(model, rt_text, r.reference_type.span, diags).map(|id| model.lookup(&id)),
                         };
                         match found {
                             Ok(Some(t)) if model.nodes[t.index()].class == NodeClass::ReferenceType => {
@@ -445,39 +445,12 @@ impl Pass2<'_> {
             if let Some(p) = &raw.parent_node_id {
                 parent = match fast.then(|| numeric_node(model, ctx, p)).flatten() {
                     Some(p) => Some(p),
-                    None => resolve_in(ctx, model, p.get(text), p.span, diags).ok().and_then(|id| model.lookup(&id)),
+                    None => ctx.resolve(model, p.get(text), p.span, diags).ok().and_then(|id| model.lookup(&id)),
                 };
             }
             out.nodes.push(NodeLinks { array_dimensions, data_type, method_declaration, references_end: out.references.len() as u32, parent });
         }
         out
-    }
-}
-
-/// Resolves a NodeId or alias written in a file. An alias the file forgot to declare that is the BrowseName
-/// of a base DataType or ReferenceType (`IdType`, `NumericRange`) resolves to it, with a warning: official
-/// nodesets contain such omissions and every lenient server accepts them.
-pub(crate) fn resolve_in(
-    ctx: &FileContext,
-    model: &Model,
-    s: &str,
-    span: Span,
-    diags: &mut Diagnostics,
-) -> Result<NodeId, Diagnostic> {
-    match crate::load::resolve_node_id_str(&ctx.ns_map, &ctx.aliases, s, span, &model.namespaces) {
-        Err(d) if d.code == Code::UnknownAlias => match model.ns0_type_names.get(s.trim()) {
-            Some(&ix) => {
-                let id = model.node(ix).id.clone();
-                diags.push(
-                    Diagnostic::new(Code::AliasByBrowseName, format!("alias `{}` is not declared; using the base type `{}` ({id})", s.trim(), s.trim()))
-                        .at(span)
-                        .help(format!("declare it: <Alias Alias=\"{}\">{id}</Alias>", s.trim())),
-                );
-                Ok(id)
-            }
-            None => Err(d),
-        },
-        other => other,
     }
 }
 
@@ -511,7 +484,7 @@ fn resolve_cached<'s>(
     if let Some(&t) = cache.get(s) {
         return Some(t);
     }
-    match resolve_in(ctx, model, s, span, diags) {
+    match ctx.resolve(model, s, span, diags) {
         Ok(id) => match model.lookup(&id) {
             Some(t) => {
                 cache.insert(s, t);
