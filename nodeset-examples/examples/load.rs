@@ -46,6 +46,10 @@ struct Options {
     server_pid: Option<u32>,
 }
 
+/// `--encrypt USER`: Basic256Sha256 SignAndEncrypt as USER, the password read from the environment
+/// variable `NODESET_LOAD_PASSWORD` (never from the command line); `None` uses SecurityPolicy None.
+static ENCRYPT: std::sync::OnceLock<Option<(String, String)>> = std::sync::OnceLock::new();
+
 fn options() -> Result<Options, String> {
     let mut o = Options { url: String::new(), sessions: 50, seconds: 300, publishing_ms: 100, server_pid: None };
     let mut args = std::env::args().skip(1);
@@ -57,6 +61,12 @@ fn options() -> Result<Options, String> {
             "--seconds" => o.seconds = value("--seconds")?.parse().map_err(|e| format!("--seconds: {e}"))?,
             "--publishing-ms" => o.publishing_ms = value("--publishing-ms")?.parse().map_err(|e| format!("--publishing-ms: {e}"))?,
             "--server-pid" => o.server_pid = Some(value("--server-pid")?.parse().map_err(|e| format!("--server-pid: {e}"))?),
+            "--encrypt" => {
+                let user = value("--encrypt")?;
+                let password = std::env::var("NODESET_LOAD_PASSWORD")
+                    .map_err(|_| "--encrypt needs the password in the environment variable NODESET_LOAD_PASSWORD")?;
+                let _ = ENCRYPT.set(Some((user, password)));
+            }
             other => return Err(format!("unknown argument {other:?}")),
         }
     }
@@ -152,13 +162,22 @@ async fn connect(url: &str, name: &str, keypair: bool) -> Result<(Arc<Session>, 
         .application_uri(format!("urn:nodeset-models:load:{name}"))
         .pki_dir(std::env::temp_dir().join("nodeset-models-load-pki"))
         .create_sample_keypair(keypair)
+        // A load tool on loopback: it trusts the server it was pointed at (the server still checks it).
         .trust_server_certs(true)
         .session_retry_limit(0)
         .session_timeout(60_000)
         .client()
         .map_err(|e| format!("client config: {e:?}"))?;
+    let (policy, mode, identity) = match ENCRYPT.get() {
+        Some(Some((user, password))) => (
+            SecurityPolicy::Basic256Sha256,
+            MessageSecurityMode::SignAndEncrypt,
+            IdentityToken::new_user_name(user.clone(), opcua::client::Password::new(password.clone())),
+        ),
+        _ => (SecurityPolicy::None, MessageSecurityMode::None, IdentityToken::Anonymous),
+    };
     let (session, event_loop) = client
-        .connect_to_matching_endpoint((url, SecurityPolicy::None.to_str(), MessageSecurityMode::None), IdentityToken::Anonymous)
+        .connect_to_matching_endpoint((url, policy.to_str(), mode), identity)
         .await
         .map_err(|e| format!("{name}: cannot connect to {url}: {e}"))?;
     let event_loop = event_loop.spawn();
@@ -320,6 +339,17 @@ async fn write_loop(url: String, node: NodeId, until: Instant) -> Result<(u64, V
     Ok((writes, errors))
 }
 
+/// The CPU time (user + system) a process has used, in seconds, from `/proc/PID/stat`.
+fn cpu_seconds(pid: u32) -> Option<f64> {
+    let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok()?;
+    // The fields after the command name (which may hold spaces) start after the last ')'.
+    let fields: Vec<&str> = stat.rsplit_once(')')?.1.split_whitespace().collect();
+    let utime: f64 = fields.get(11)?.parse().ok()?;
+    let stime: f64 = fields.get(12)?.parse().ok()?;
+    // USER_HZ is 100 on Linux.
+    Some((utime + stime) / 100.0)
+}
+
 async fn run(o: Options) -> Result<bool, String> {
     let rss_start = o.server_pid.and_then(rss_kib);
     let publishing = Duration::from_millis(o.publishing_ms);
@@ -357,6 +387,7 @@ async fn run(o: Options) -> Result<bool, String> {
         }
     }
     let rss_subscribed = o.server_pid.and_then(rss_kib);
+    let cpu_start = o.server_pid.and_then(cpu_seconds);
     let started = Instant::now();
     let until = started + Duration::from_secs(o.seconds);
     let writer = tokio::spawn(write_loop(o.url.clone(), stop_mode, until));
@@ -372,6 +403,10 @@ async fn run(o: Options) -> Result<bool, String> {
     // One more publishing interval for the last notifications, then measure and close.
     tokio::time::sleep(publishing * 2).await;
     let elapsed = started.elapsed().as_secs_f64();
+    let cpu = match (cpu_start, o.server_pid.and_then(cpu_seconds)) {
+        (Some(a), Some(b)) => format!("{:.1}", 100.0 * (b - a) / elapsed),
+        _ => "?".to_owned(),
+    };
     let end = Instant::now();
     let rss_end = o.server_pid.and_then(rss_kib);
 
@@ -418,9 +453,14 @@ async fn run(o: Options) -> Result<bool, String> {
         kib(rss_subscribed),
         kib(rss_end)
     );
+    let security = if matches!(ENCRYPT.get(), Some(Some(_))) { "Basic256Sha256/SignAndEncrypt" } else { "None" };
+    let rate = totals.notifications as f64 / elapsed;
+    println!("security                  {security}");
+    println!("notifications per second  {rate:.0}");
+    println!("server CPU                {cpu}% of one core while subscribed");
     println!(
-        "LOAD sessions={} items={} seconds={elapsed:.1} received={} expected={expected} ratio={ratio:.4} gaps={} errors={errors} \
-         writes={writes} rss_start_kib={} rss_subscribed_kib={} rss_end_kib={}",
+        "LOAD security={security} sessions={} items={} seconds={elapsed:.1} received={} expected={expected} ratio={ratio:.4} gaps={} errors={errors} \
+         writes={writes} notifications_per_s={rate:.0} server_cpu_pct={cpu} rss_start_kib={} rss_subscribed_kib={} rss_end_kib={}",
         o.sessions,
         variables.len(),
         totals.notifications,

@@ -26,6 +26,7 @@ use std::time::{Duration, Instant};
 use nodeset_models::models::robotics::objects::MotionDeviceSystemType;
 use nodeset_models::models::robotics::types::MotionDeviceCategoryEnumeration;
 use nodeset_models::models::{di, ia, robotics};
+use nodeset_examples::secure::{SecureArgs, USAGE};
 use nodeset_models::runtime::server::{MethodError, ServerConfig};
 use nodeset_models::runtime::typed::{Bound, Instantiate, ObjectType};
 use nodeset_models::ObjectModel;
@@ -66,18 +67,21 @@ struct ControllerSettings {
 /// The axes and their simulated motion.
 const AXES: [&str; 6] = ["A1", "A2", "A3", "A4", "A5", "A6"];
 
-fn options() -> Result<(u16, Option<u64>), String> {
-    let (mut port, mut seconds) = (4856, None);
+fn options() -> Result<(u16, Option<u64>, SecureArgs), String> {
+    let (mut port, mut seconds, mut secure) = (4856, None, SecureArgs::default());
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
+        if secure.take(&arg, &mut args)? {
+            continue;
+        }
         let mut value = |name: &str| args.next().ok_or(format!("{name} needs a value"));
         match arg.as_str() {
             "--port" => port = value("--port")?.parse().map_err(|e| format!("--port: {e}"))?,
             "--seconds" => seconds = Some(value("--seconds")?.parse().map_err(|e| format!("--seconds: {e}"))?),
-            other => return Err(format!("unknown argument {other:?} (usage: robot [--port 4856] [--seconds N])")),
+            other => return Err(format!("unknown argument {other:?} (usage: robot [--port 4856] [--seconds N] {USAGE})")),
         }
     }
-    Ok((port, seconds))
+    Ok((port, seconds, secure))
 }
 
 /// What `Instantiate` needs for the robot: the names of every placeholder instance.
@@ -101,8 +105,10 @@ fn robot_options() -> Instantiate {
     o
 }
 
-async fn run(port: u16, seconds: Option<u64>) -> Result<(), String> {
-    let server = ServerConfig::new("Six-axis robot")
+async fn run(port: u16, seconds: Option<u64>, secure: SecureArgs) -> Result<(), String> {
+    let config = ServerConfig::new("Six-axis robot");
+    let server = secure
+        .apply(config, "robot")?
         .port(port)
         .table(&di::TABLE)
         .type_loader(di::TypeLoader)
@@ -231,7 +237,7 @@ async fn shutdown_signal() {
 fn main() -> ExitCode {
     let filter = std::env::var("RUST_LOG").unwrap_or_else(|_| "warn,opcua_server=error,opcua_nodes=error,opcua_crypto=off,opcua_core=error,opcua_core::comms::secure_channel=off".into());
     let _ = tracing_subscriber::fmt().with_env_filter(filter).with_writer(std::io::stderr).try_init();
-    let (port, seconds) = match options() {
+    let (port, seconds, secure) = match options() {
         Ok(o) => o,
         Err(e) => {
             eprintln!("error: {e}");
@@ -245,7 +251,7 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
-    match runtime.block_on(run(port, seconds)) {
+    match runtime.block_on(run(port, seconds, secure)) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e}");

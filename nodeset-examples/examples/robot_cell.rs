@@ -20,11 +20,19 @@
 //! Ready there and answer Start with `BadNotImplemented`. Each basic skill takes `--motion-ms` (in steps of
 //! at most 10 ms, each a point where a Suspend parks it).
 //!
+//! Security: every server is secure by default (see `nodeset_examples::secure` for `--pki`, `--users`,
+//! `--trust-on-first-use` and `--insecure`, which adds a None endpoint for loopback clients). The cell's
+//! composite skills always reach the robot and the drilling unit over Basic256Sha256 SignAndEncrypt as
+//! user `cell` (Operator there; a random password drawn at each start, stored only as an Argon2id hash),
+//! and verify their certificates: the process puts each device's certificate into the trust list of the
+//! cell's client (`<pki>/cell-client/trusted/`) and the client's into the devices' (`<pki>/<device>/trusted/`).
+//!
 //! `--port 0` takes free ports. It prints `robot listening on <url>`, `drilling unit listening on <url>`,
 //! `cell listening on <url>`, then `cell ready` once the cell found the basic skills; it stops on SIGINT,
 //! SIGTERM or after `--seconds N`, printing `server stopped cleanly`.
 
 use std::io::Write;
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -41,8 +49,10 @@ use nodeset_models::models::drilling_process::objects::{
 use nodeset_models::models::robot_cell::objects::{TemplateDrillingSkillType, TemplateDrillingSkillTypeInputs};
 use nodeset_models::models::robotics::objects::AxisType;
 use nodeset_models::models;
-use nodeset_models::runtime::remote::RemoteServer;
-use nodeset_models::runtime::server::{ModelServer as Server, ServerConfig};
+use nodeset_examples::secure::{SecureArgs, USAGE};
+use nodeset_models::runtime::remote::{ClientSecurity, RemoteServer};
+use nodeset_models::runtime::server::users::random_password;
+use nodeset_models::runtime::server::{security, ModelServer as Server, Role, ServerConfig};
 use nodeset_models::runtime::typed::{Control, Program};
 use opcua::server::ServerHandle;
 use opcua::types::{StatusCode, ThreeDCartesianCoordinates, ThreeDFrame, ThreeDOrientation};
@@ -59,12 +69,16 @@ struct Options {
     port: u16,
     motion: Duration,
     seconds: Option<u64>,
+    secure: SecureArgs,
 }
 
 fn options() -> Result<Options, String> {
-    let mut o = Options { port: 4861, motion: Duration::from_millis(1000), seconds: None };
+    let mut o = Options { port: 4861, motion: Duration::from_millis(1000), seconds: None, secure: SecureArgs::default() };
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
+        if o.secure.take(&arg, &mut args)? {
+            continue;
+        }
         let mut value = |name: &str| args.next().ok_or(format!("{name} needs a value"));
         match arg.as_str() {
             "--port" => o.port = value("--port")?.parse().map_err(|e| format!("--port: {e}"))?,
@@ -74,7 +88,7 @@ fn options() -> Result<Options, String> {
             "--seconds" => o.seconds = Some(value("--seconds")?.parse().map_err(|e| format!("--seconds: {e}"))?),
             other => {
                 return Err(format!(
-                    "unknown argument {other:?} (usage: robot_cell [--port 4861] [--motion-ms 1000] [--seconds N])"
+                    "unknown argument {other:?} (usage: robot_cell [--port 4861] [--motion-ms 1000] [--seconds N] {USAGE})"
                 ))
             }
         }
@@ -82,9 +96,18 @@ fn options() -> Result<Options, String> {
     Ok(o)
 }
 
-fn config(name: &str, port: u16) -> ServerConfig {
+/// The PKI folder of the cell below `--pki` (default `pki/robot_cell`): one folder per server, and
+/// `cell-client` for the composite skills' client.
+fn pki(secure: &SecureArgs, sub: &str) -> PathBuf {
+    secure.pki.clone().unwrap_or_else(|| PathBuf::from("pki/robot_cell")).join(sub)
+}
+
+fn config(name: &str, port: u16, secure: &SecureArgs, sub: &str) -> Result<ServerConfig, String> {
     // Each step of a composite skill ends with a transition event of a basic skill: publish quickly.
-    models::register(ServerConfig::new(name).port(port).min_publishing_interval_ms(10))
+    let config = models::register(ServerConfig::new(name).port(port).min_publishing_interval_ms(10));
+    let mut own = secure.clone();
+    own.pki = Some(pki(secure, sub));
+    own.apply(config, sub)
 }
 
 /// A server that runs.
@@ -223,10 +246,10 @@ fn frame(x: f64, y: f64, z: f64) -> ThreeDFrame {
 }
 
 /// The cell: DrillHole and ReferenceDrillBush, composed of the skills of the robot and the drilling unit.
-async fn cell(server: &Server, robot_url: &str, unit_url: &str) -> Result<Vec<Program>, String> {
+async fn cell(server: &Server, robot_url: &str, unit_url: &str, client: &ClientSecurity) -> Result<Vec<Program>, String> {
     let e = |e: nodeset_models::runtime::remote::RemoteError| e.to_string();
-    let robot = RemoteServer::connect(robot_url).await.map_err(e)?;
-    let unit = RemoteServer::connect(unit_url).await.map_err(e)?;
+    let robot = RemoteServer::connect_secure(robot_url, client).await.map_err(e)?;
+    let unit = RemoteServer::connect_secure(unit_url, client).await.map_err(e)?;
     let skills = format!("{SYSTEM}/{CONTROLLER_SKILLS}");
     let relative = Arc::new(robot.skill(&format!("{skills}/RelativeCartesianLinearMove")).await.map_err(e)?);
     let absolute = Arc::new(robot.skill(&format!("{skills}/AbsoluteCartesianLinearMove")).await.map_err(e)?);
@@ -288,15 +311,33 @@ async fn cell(server: &Server, robot_url: &str, unit_url: &str) -> Result<Vec<Pr
 
 async fn run(o: Options) -> Result<(), String> {
     let next = |k: u16| if o.port == 0 { 0 } else { o.port + k };
-    let robot_server = config("UR10e robot", o.port).build()?;
-    let unit_server = config("Drilling unit", next(1)).build()?;
-    let cell_server = config("Drilling cell", next(2)).build()?;
+    // The composite skills reach the devices over SignAndEncrypt as user `cell` (Operator on the devices, with
+    // a password drawn at each start and kept only hashed there), and verify the devices' certificates: the
+    // cell provisions the trust both ways, as an administrator would by moving certificates into trusted/.
+    let password = random_password();
+    let client_pki = pki(&o.secure, "cell-client");
+    let client = ClientSecurity::new(&client_pki).user("cell", password.clone());
+    let client_cert = security::prepare_pki(&client_pki, "nodeset-models composite skill", &client.application_uri, &[])
+        .map_err(|e| e.to_string())?
+        .cert;
+    let device = |name: &str, port: u16, sub: &str| -> Result<Server, String> {
+        let mut config = config(name, port, &o.secure, sub)?;
+        config.users.set_password("cell", vec![Role::Operator], &password)?;
+        let server = config.build()?;
+        security::trust_certificate(&pki(&o.secure, sub), &client_cert).map_err(|e| e.to_string())?;
+        let own = security::own_certificate(&pki(&o.secure, sub)).map_err(|e| e.to_string())?;
+        security::trust_certificate(&client_pki, &own).map_err(|e| e.to_string())?;
+        Ok(server)
+    };
+    let robot_server = device("UR10e robot", o.port, "robot")?;
+    let unit_server = device("Drilling unit", next(1), "drilling-unit")?;
+    let cell_server = config("Drilling cell", next(2), &o.secure, "cell")?.build()?;
     let (robot_url, unit_url) = (robot_server.endpoint_url().to_owned(), unit_server.endpoint_url().to_owned());
 
     let robot_skills = robot(&robot_server, o.motion)?;
     let drilling = drilling_unit(&unit_server, o.motion)?;
     let servers = vec![start("robot", robot_server), start("drilling unit", unit_server)];
-    let cell_skills = cell(&cell_server, &robot_url, &unit_url).await?;
+    let cell_skills = cell(&cell_server, &robot_url, &unit_url, &client).await?;
     let mut servers = servers;
     servers.push(start("cell", cell_server));
     println!("cell ready");

@@ -5,7 +5,9 @@
 //! ```
 //!
 //! It serves the OPC UA namespace and the generated DI, IA and Robotics namespaces on
-//! `opc.tcp://127.0.0.1:<port>/` (SecurityPolicy None, anonymous users). `--port 0` picks a free port; the
+//! `opc.tcp://127.0.0.1:<port>/` (Basic256Sha256, Aes128_Sha256_RsaOaep, Aes256_Sha256_RsaPss in Sign and
+//! SignAndEncrypt; `--insecure` adds SecurityPolicy None; see `nodeset_examples::secure` for `--pki`,
+//! `--users`, `--trust-on-first-use`). `--port 0` picks a free port; the
 //! first line on stdout is always `listening on <url>`. `--demo` adds the runtime's demo namespace with
 //! live handlers (a range-checked Speed, the Start and Move methods, a Counter that ticks every 500 ms).
 //! The server stops cleanly on SIGINT or SIGTERM, or after `--seconds N`, and then prints
@@ -20,31 +22,36 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use nodeset_examples::demo::{self, DemoMode, DemoPoint};
+use nodeset_examples::secure::{SecureArgs, USAGE};
 use nodeset_models::runtime::server::{MethodError, MethodInvocation, ModelManager, ServerConfig};
 use opcua::types::{StatusCode, TryFromVariant, Variant};
 
 /// Command line options.
 struct Options {
     port: u16,
+    secure: SecureArgs,
     seconds: Option<u64>,
     demo: bool,
 }
 
 fn options() -> Result<Options, String> {
-    let mut options = Options { port: 4855, seconds: None, demo: false };
+    let mut options = Options { port: 4855, seconds: None, demo: false, secure: SecureArgs::default() };
     let mut args = std::env::args().skip(1);
     while let Some(arg) = args.next() {
+        if options.secure.take(&arg, &mut args)? {
+            continue;
+        }
         let mut value = |name: &str| args.next().ok_or(format!("{name} needs a value"));
         match arg.as_str() {
             "--port" => options.port = value("--port")?.parse().map_err(|e| format!("--port: {e}"))?,
             "--seconds" => options.seconds = Some(value("--seconds")?.parse().map_err(|e| format!("--seconds: {e}"))?),
             "--demo" => options.demo = true,
             "--help" | "-h" => {
-                println!("usage: server [--port 4855] [--seconds N] [--demo]");
+                println!("usage: server [--port 4855] [--seconds N] [--demo] {USAGE}");
                 std::process::exit(0);
             }
             other => {
-                return Err(format!("unknown argument {other:?} (usage: server [--port 4855] [--seconds N] [--demo])"))
+                return Err(format!("unknown argument {other:?} (usage: server [--port 4855] [--seconds N] [--demo] {USAGE})"))
             }
         }
     }
@@ -81,7 +88,8 @@ async fn main() -> ExitCode {
 async fn run() -> Result<(), String> {
     let options = options()?;
     let demo = options.demo;
-    let mut config = generated_models(ServerConfig::new("nodeset-models example server").port(options.port));
+    let config = ServerConfig::new("nodeset-models example server");
+    let mut config = generated_models(options.secure.apply(config, "server")?.port(options.port));
     if demo {
         config = config.table(&demo::TABLE).type_loader(demo::TypeLoader);
     }

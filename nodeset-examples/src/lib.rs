@@ -6,3 +6,4 @@
 #![cfg_attr(test, deny(warnings))]
 
 pub mod demo;
+pub mod secure;

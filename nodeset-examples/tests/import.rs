@@ -370,7 +370,7 @@ async fn namespaces_follow_the_order_of_the_tables() {
 #[tokio::test]
 async fn values_are_checked_before_the_server_runs() {
     common::init_tracing();
-    let server = ServerConfig::new("early").table(&demo::TABLE).build().unwrap();
+    let server = ServerConfig::new("early").table(&demo::TABLE).insecure_only().build().unwrap();
     let m = server.manager();
     let limit = m.resolve(demo::node(ids::PUMP1_LIMIT)).unwrap();
     let speed = m.resolve(demo::node(ids::PUMP1_SPEED)).unwrap();

@@ -78,6 +78,8 @@ pub enum RemoteError {
     Path { below: String, segment: String, matches: usize },
     /// The skill lacks a node a run needs (`CurrentState`, `Start`, ...).
     Missing { skill: String, what: String },
+    /// The client's PKI folder cannot be used (why).
+    Pki(String),
 }
 
 impl std::fmt::Display for RemoteError {
@@ -90,6 +92,7 @@ impl std::fmt::Display for RemoteError {
                 write!(f, "`{below}` has {matches} children named `{segment}`; name one by its namespace URI: `{{uri}}{segment}`")
             }
             RemoteError::Missing { skill, what } => write!(f, "skill `{skill}` has no {what}"),
+            RemoteError::Pki(e) => write!(f, "the client's PKI folder: {e}"),
         }
     }
 }
@@ -142,6 +145,63 @@ fn connect_no_delay(url: String, options: DecodingOptions) -> Connecting {
     })
 }
 
+/// How a composite skill's client connects: security policy and mode, user, PKI folder.
+#[derive(Clone, Debug)]
+pub struct ClientSecurity {
+    /// The security policy (Basic256Sha256 by default).
+    pub policy: SecurityPolicy,
+    /// The message security mode (SignAndEncrypt by default).
+    pub mode: MessageSecurityMode,
+    /// User name and password; `None` connects anonymously.
+    pub user: Option<(String, String)>,
+    /// The client's PKI folder: its certificate (`own/cert.der`, created on first use) and the server
+    /// certificates it trusts (`trusted/`). Defaults to a folder in the temporary directory.
+    pub pki_dir: Option<std::path::PathBuf>,
+    /// The ApplicationUri of the client, which its certificate carries.
+    pub application_uri: String,
+    /// Trusts an unknown server certificate on first use (development only).
+    pub trust_server_on_first_use: bool,
+}
+
+impl ClientSecurity {
+    /// Basic256Sha256, SignAndEncrypt, anonymous, with its PKI folder at `pki_dir`.
+    pub fn new(pki_dir: impl Into<std::path::PathBuf>) -> ClientSecurity {
+        ClientSecurity {
+            policy: SecurityPolicy::Basic256Sha256,
+            mode: MessageSecurityMode::SignAndEncrypt,
+            user: None,
+            pki_dir: Some(pki_dir.into()),
+            application_uri: "urn:nodeset-models:composite-skill".to_owned(),
+            trust_server_on_first_use: false,
+        }
+    }
+
+    /// SecurityPolicy None, anonymous: for servers started with `insecure`.
+    pub fn none() -> ClientSecurity {
+        ClientSecurity {
+            policy: SecurityPolicy::None,
+            mode: MessageSecurityMode::None,
+            user: None,
+            pki_dir: None,
+            application_uri: "urn:nodeset-models:composite-skill".to_owned(),
+            trust_server_on_first_use: false,
+        }
+    }
+
+    /// Sets the user name and password.
+    pub fn user(mut self, name: impl Into<String>, password: impl Into<String>) -> ClientSecurity {
+        self.user = Some((name.into(), password.into()));
+        self
+    }
+
+    /// Sets the policy and mode.
+    pub fn policy(mut self, policy: SecurityPolicy, mode: MessageSecurityMode) -> ClientSecurity {
+        self.policy = policy;
+        self.mode = mode;
+        self
+    }
+}
+
 /// A session to another server.
 pub struct RemoteServer {
     session: Arc<Session>,
@@ -150,15 +210,37 @@ pub struct RemoteServer {
 }
 
 impl RemoteServer {
-    /// Opens a session (SecurityPolicy None, anonymous) to the server at `url` and reads its namespaces.
+    /// Opens a session with SecurityPolicy None and no user (anonymous) to the server at `url` and reads its
+    /// namespaces: only for servers started with `insecure`, on loopback. Use [`RemoteServer::connect_secure`]
+    /// otherwise.
     pub async fn connect(url: &str) -> Result<RemoteServer, RemoteError> {
+        RemoteServer::open(url, &ClientSecurity::none()).await
+    }
+
+    /// Opens a session as `security` says (policy, mode, user, PKI folder), verifying the server's
+    /// certificate against the `trusted/` folder of the client's PKI folder, and reads the namespaces.
+    pub async fn connect_secure(url: &str, security: &ClientSecurity) -> Result<RemoteServer, RemoteError> {
+        RemoteServer::open(url, security).await
+    }
+
+    async fn open(url: &str, security: &ClientSecurity) -> Result<RemoteServer, RemoteError> {
         let connect_error = |s: StatusCode| RemoteError::Connect(url.to_owned(), s);
+        let secure = security.policy != SecurityPolicy::None;
+        let pki = security.pki_dir.clone().unwrap_or_else(|| std::env::temp_dir().join("nodeset-models-pki-remote"));
+        if secure {
+            crate::server::security::prepare_pki(&pki, "nodeset-models composite skill", &security.application_uri, &[])
+                .map_err(|e| RemoteError::Pki(e.to_string()))?;
+        }
         let client = ClientBuilder::new()
             .application_name("nodeset-models composite skill")
-            .application_uri("urn:nodeset-models:composite-skill")
-            .pki_dir(std::env::temp_dir().join("nodeset-models-pki-remote"))
+            .application_uri(&security.application_uri)
+            .product_uri(&security.application_uri)
+            .pki_dir(pki)
             .create_sample_keypair(false)
-            .trust_server_certs(true)
+            .certificate_path("own/cert.der")
+            .private_key_path("private/private.pem")
+            .trust_server_certs(!secure || security.trust_server_on_first_use)
+            .verify_server_certs(secure)
             .session_retry_limit(3)
             .client()
             .map_err(|_| connect_error(StatusCode::BadConfigurationError))?;
@@ -166,9 +248,12 @@ impl RemoteServer {
         let (session, event_loop) = client
             .session_builder()
             .with_endpoints(endpoints)
-            .connect_to_matching_endpoint((url, SecurityPolicy::None.to_str(), MessageSecurityMode::None))
+            .connect_to_matching_endpoint((url, security.policy.to_str(), security.mode))
             .map_err(|e| connect_error(e.status()))?
-            .user_identity_token(IdentityToken::Anonymous)
+            .user_identity_token(match &security.user {
+                Some((user, password)) => IdentityToken::new_user_name(user.clone(), opcua::client::Password::new(password.clone())),
+                None => IdentityToken::Anonymous,
+            })
             .with_connector(NoDelay)
             .build(client.certificate_store().clone())
             .map_err(|e| connect_error(e.status()))?;

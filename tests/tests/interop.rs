@@ -115,7 +115,9 @@ impl Server {
 fn asyncua_client_against_the_example_server() {
     let python = python();
     let exe = build_server("server");
-    let (server, url) = Server::start(&exe, &["--demo"]);
+    // This test checks the model, not security: the None endpoint, deliberately (`--insecure`).
+    let pki = temp_dir("example-server");
+    let (server, url) = Server::start(&exe, &["--demo", "--insecure", "--pki", pki.to_str().unwrap()]);
     let script = root().join("tests/interop/robotics_check.py");
     let mut check = Command::new(&python);
     check.arg(&script).args(["--url", &url]).args(["--nodesets"]).arg(root().join("nodesets/vendor"));
@@ -134,7 +136,9 @@ fn asyncua_client_against_the_example_server() {
 fn asyncua_client_against_the_robot_example() {
     let python = python();
     let exe = build_server("robot");
-    let (server, url) = Server::start(&exe, &[]);
+    // The model and typed handles, not security: the None endpoint, deliberately (`--insecure`).
+    let pki = temp_dir("robot");
+    let (server, url) = Server::start(&exe, &["--insecure", "--pki", pki.to_str().unwrap()]);
     let mut check = Command::new(&python);
     check.arg(root().join("tests/interop/robot_check.py")).args(["--url", &url]);
     run_check(check);
@@ -153,7 +157,10 @@ fn asyncua_client_against_the_robot_example() {
 fn asyncua_client_against_the_robot_cell() {
     let python = python();
     let exe = build_server("robot_cell");
-    let server = Server::spawn(&exe, &["--motion-ms", "600"]);
+    // The python client uses the None endpoint (`--insecure`); the cell's composite skills still reach the
+    // other two servers over SignAndEncrypt with a user name, and verify their certificates.
+    let pki = temp_dir("robot-cell");
+    let server = Server::spawn(&exe, &["--motion-ms", "600", "--insecure", "--pki", pki.to_str().unwrap()]);
     let mut urls = Vec::new();
     for label in ["robot", "drilling unit", "cell"] {
         let line = server.line();
@@ -166,6 +173,51 @@ fn asyncua_client_against_the_robot_cell() {
     check.args(["--robot", &urls[0], "--unit", &urls[1], "--cell", &urls[2]]);
     run_check(check);
     server.stop();
+}
+
+/// A fresh folder in the system's temporary directory for one test's PKI folders and files.
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("nodeset-interop-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("the temporary folder can be created");
+    dir
+}
+
+/// The example server, secure by default, against `security_check.py`: endpoints (no None), an untrusted
+/// client certificate refused and stored in `rejected/`, SignAndEncrypt with the three policies and a user
+/// name, a wrong password, anonymous read allowed and write/call refused with BadUserAccessDenied, an
+/// Operator's write and call accepted, an Observer's refused. Then the same server with `--insecure`
+/// offers a None endpoint.
+#[test]
+fn asyncua_client_against_a_secure_server() {
+    use nodeset_runtime::server::{Role, Users};
+    let python = python();
+    let exe = build_server("server");
+    let dir = temp_dir("secure");
+    let mut users = Users::default();
+    users.set_password("op", vec![Role::Operator], "op-secret-1").unwrap();
+    users.set_password("obs", vec![Role::Observer], "obs-secret-2").unwrap();
+    let users_file = dir.join("users.txt");
+    std::fs::write(&users_file, users.to_text()).unwrap();
+    let pki = dir.join("pki");
+    let args = ["--demo", "--pki", pki.to_str().unwrap(), "--users", users_file.to_str().unwrap()];
+    let (server, url) = Server::start(&exe, &args);
+    let mut check = Command::new(&python);
+    check.arg(root().join("tests/interop/security_check.py")).args(["--url", &url]).arg("--pki").arg(&pki);
+    check.arg("--work").arg(dir.join("client"));
+    check.args(["--user", "op", "--password", "op-secret-1", "--observer", "obs", "--observer-password", "obs-secret-2"]);
+    run_check(check);
+    server.stop();
+
+    let (server, url) = Server::start(&exe, &[&args[..], &["--insecure"]].concat());
+    let mut check = Command::new(&python);
+    check.arg(root().join("tests/interop/security_check.py")).args(["--url", &url]).arg("--pki").arg(&pki);
+    check.arg("--work").arg(dir.join("client"));
+    check.args(["--user", "op", "--password", "op-secret-1", "--observer", "obs", "--observer-password", "obs-secret-2"]);
+    check.arg("--expect-none");
+    run_check(check);
+    server.stop();
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Runs a check script; fails unless it ends with `N passed, 0 failed`.

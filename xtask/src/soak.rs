@@ -28,7 +28,12 @@ pub fn run(args: Args) -> Result<(), String> {
     let python = crate::venv::ensure_venv()?;
     let examples = build(&root, args.release, &["robot_cell"])?;
     let motion = args.motion_ms.to_string();
-    let cell = Example::spawn(&examples.join("robot_cell"), &["--port", "0", "--motion-ms", &motion])?;
+    // The soak client (python asyncua) uses the None endpoint that `--insecure` adds; the composite skills of
+    // the cell reach the robot and the drilling unit over SignAndEncrypt with a user name, as always.
+    let pki = std::env::temp_dir().join(format!("nodeset-soak-pki-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&pki);
+    let pki_arg = pki.to_string_lossy().into_owned();
+    let cell = Example::spawn(&examples.join("robot_cell"), &["--port", "0", "--motion-ms", &motion, "--insecure", "--pki", &pki_arg])?;
     let mut urls = Vec::new();
     for label in ["robot", "drilling unit", "cell"] {
         let line = cell.line()?;

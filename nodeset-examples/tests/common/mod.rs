@@ -33,7 +33,8 @@ pub struct Running {
 /// Builds and starts a server.
 pub async fn serve(config: ServerConfig) -> Running {
     init_tracing();
-    let server = config.port(0).build().expect("the server builds");
+    // These tests exercise the runtime, not security: they use the None endpoint only, deliberately.
+    let server = config.port(0).insecure_only().build().expect("the server builds");
     let manager = server.manager().clone();
     let handle = server.handle().clone();
     let url = server.endpoint_url().to_owned();

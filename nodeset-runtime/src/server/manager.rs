@@ -50,6 +50,9 @@ pub struct MethodInvocation {
     pub arguments: Vec<Variant>,
     /// The manager, to read and set values from the handler.
     pub manager: ModelManager,
+    /// The calling session's user: its user name (or the name of its user certificate), `None` if it is
+    /// anonymous (for an audit line, or to record who started a skill).
+    pub user: Option<String>,
 }
 
 /// Why a method call failed.
@@ -462,6 +465,7 @@ impl InMemoryNodeManagerImpl for ModelNodes {
                 method_id: call.method_id().clone(),
                 arguments: call.arguments().to_vec(),
                 manager: manager.clone(),
+                user: Some(context.user_token().0.clone()).filter(|u| u != opcua::server::ANONYMOUS_USER_TOKEN_ID),
             };
             match handler.call(invocation).await {
                 Ok(outputs) => {

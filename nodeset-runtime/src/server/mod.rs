@@ -1,7 +1,9 @@
 //! An OPC UA server for generated namespaces.
 //!
 //! [`ServerConfig`] builds an async-opcua server with the OPC UA namespace (ns0), the generated tables and
-//! their type loaders, on one SecurityPolicy None endpoint that accepts anonymous users:
+//! their type loaders, on encrypted endpoints (Basic256Sha256, Aes128_Sha256_RsaOaep, Aes256_Sha256_RsaPss in
+//! Sign and SignAndEncrypt), with a PKI folder, users and roles ([`security`], [`users`], [`access`]); a
+//! SecurityPolicy None endpoint only when [`ServerConfig::insecure`] asks for one:
 //!
 //! ```no_run
 //! # async fn demo(table: &'static nodeset_runtime::table::NodeSetTable) -> Result<(), String> {
@@ -28,15 +30,23 @@
 //! The node manager behind it ([`ModelNodes`], reached through [`ModelManager`]) can also be added to a
 //! server configured by hand, with [`model_node_manager`].
 
+pub mod access;
 mod check;
 mod manager;
+pub mod security;
+pub mod users;
 
 use std::net::TcpListener;
 use std::path::PathBuf;
 use std::sync::Arc;
 
-use opcua::server::{Server, ServerBuilder, ServerHandle};
-use opcua::types::TypeLoader;
+use opcua::crypto::SecurityPolicy;
+use opcua::server::{Server, ServerBuilder, ServerEndpoint, ServerHandle, ANONYMOUS_USER_TOKEN_ID};
+use opcua::types::{MessageSecurityMode, TypeLoader};
+
+pub use access::{AccessPolicy, Permissions, Role};
+pub use security::{PkiError, Security};
+pub use users::{Caller, ModelAuth, Users};
 
 pub use manager::{
     model_node_manager, model_node_manager_with_instances, MethodError, DEFAULT_INSTANCE_NAMESPACE, MethodHandler, MethodInvocation, MethodResult, ModelManager, ModelNodeManager,
@@ -75,9 +85,19 @@ pub struct ServerConfig {
     /// the composite skills of other servers wants less: `runtime::remote` learns that a basic skill ended
     /// from its transition event, so each step of a composite skill waits for a publish.
     pub min_publishing_interval_ms: u64,
-    /// Where async-opcua keeps certificates. The endpoint needs none; the default is a folder in the
-    /// system's temporary directory, so that nothing is written beside the program.
+    /// The PKI folder (own, private, trusted, rejected, issuers; see [`security`]). Defaults to
+    /// `pki/<name>` below the working directory; the certificate is created there on first start.
     pub pki_dir: PathBuf,
+    /// The endpoints' security: the three secure policies in Sign and SignAndEncrypt by default, no None
+    /// endpoint unless [`ServerConfig::insecure`] asks for one.
+    pub security: Security,
+    /// The users and their roles (none by default: anonymous sessions only, which may read but not write
+    /// or call).
+    pub users: Users,
+    /// Which roles may read, write and call (see [`AccessPolicy`]).
+    pub access: AccessPolicy,
+    /// Host names and addresses the certificate names besides `host` (created certificates only).
+    pub host_names: Vec<String>,
     /// How many client sessions the server accepts at once; more get `BadTooManySessions`. Defaults to
     /// [`DEFAULT_MAX_SESSIONS`] (async-opcua's own default, 20, is too few for a cell whose devices are
     /// watched by dashboards, HMIs and the composite skills of other servers at the same time).
@@ -105,7 +125,11 @@ impl ServerConfig {
             instance_namespace: None,
             min_sampling_interval_ms: 0.0,
             min_publishing_interval_ms: 100,
-            pki_dir: std::env::temp_dir().join("nodeset-models-pki"),
+            pki_dir: PathBuf::from("pki").join(&slug),
+            security: Security::default(),
+            users: Users::default(),
+            access: AccessPolicy::default(),
+            host_names: Vec::new(),
             max_sessions: DEFAULT_MAX_SESSIONS,
         }
     }
@@ -119,6 +143,45 @@ impl ServerConfig {
     /// Sets the port (0 picks a free one).
     pub fn port(mut self, port: u16) -> ServerConfig {
         self.port = port;
+        self
+    }
+
+    /// Sets the PKI folder.
+    pub fn pki_dir(mut self, dir: impl Into<PathBuf>) -> ServerConfig {
+        self.pki_dir = dir.into();
+        self
+    }
+
+    /// Adds the SecurityPolicy None endpoint, on which anonymous sessions act as Operator: for loopback
+    /// testing only. The secure endpoints stay.
+    pub fn insecure(mut self) -> ServerConfig {
+        self.security.insecure = true;
+        self
+    }
+
+    /// Serves only the SecurityPolicy None endpoint, with anonymous sessions acting as Operator, and
+    /// touches no PKI folder: for tests of the runtime on loopback.
+    pub fn insecure_only(mut self) -> ServerConfig {
+        self.security.insecure = true;
+        self.security.policies.clear();
+        self
+    }
+
+    /// Trusts unknown client certificates on first use (development only).
+    pub fn trust_on_first_use(mut self) -> ServerConfig {
+        self.security.trust_on_first_use = true;
+        self
+    }
+
+    /// Sets the users.
+    pub fn users(mut self, users: Users) -> ServerConfig {
+        self.users = users;
+        self
+    }
+
+    /// Sets the access policy.
+    pub fn access(mut self, access: AccessPolicy) -> ServerConfig {
+        self.access = access;
         self
     }
 
@@ -160,24 +223,64 @@ impl ServerConfig {
 
     /// Binds the port and builds the server, importing every table.
     ///
-    /// Fails if the port cannot be bound or async-opcua rejects the configuration.
+    /// Fails if the PKI folder cannot be used (see [`security::prepare_pki`]), the port cannot be bound or
+    /// async-opcua rejects the configuration.
     pub fn build(self) -> Result<ModelServer, String> {
+        let secure = !self.security.policies.is_empty();
+        if !secure && !self.security.insecure {
+            return Err("the configuration has no endpoint: give it a security policy or ask for `insecure`".into());
+        }
+        let mut hosts = vec![self.host.clone()];
+        hosts.extend(self.host_names.iter().filter(|h| **h != self.host).cloned());
+        if secure {
+            security::prepare_pki(&self.pki_dir, &self.application_name, &self.application_uri, &hosts)
+                .map_err(|e| e.to_string())?;
+        }
         let listener = TcpListener::bind((self.host.as_str(), self.port))
             .map_err(|e| format!("cannot listen on {}:{}: {e}", self.host, self.port))?;
         let instance_namespace =
             self.instance_namespace.clone().unwrap_or_else(|| format!("{}:instances", self.application_uri));
         let port = listener.local_addr().map_err(|e| format!("cannot read the bound address: {e}"))?.port();
-        let mut builder = ServerBuilder::new_anonymous(self.application_name)
+        let mut users = self.users;
+        if self.security.insecure {
+            users.anonymous_roles.push(Role::Operator);
+        }
+        let anonymous = self.security.anonymous || self.security.insecure;
+        let auth = std::sync::Arc::new(ModelAuth::new(users, self.access, anonymous));
+        let mut builder = ServerBuilder::new()
+            .application_name(self.application_name)
             .application_uri(&self.application_uri)
             .product_uri(&self.application_uri)
             .host(&self.host)
             .port(port)
             .pki_dir(self.pki_dir)
             .create_sample_keypair(false)
+            .certificate_path("own/cert.der")
+            .private_key_path("private/private.pem")
+            .trust_client_certs(self.security.trust_on_first_use)
+            .with_authenticator(auth)
             .max_sessions(self.max_sessions)
             .with_node_manager(model_node_manager_with_instances(self.tables, &instance_namespace));
         for loader in self.type_loaders {
             builder = builder.with_type_loader(loader);
+        }
+        let anonymous_ids = [ANONYMOUS_USER_TOKEN_ID.to_owned()];
+        let mut first = None;
+        for &policy in &self.security.policies {
+            for &mode in &self.security.modes {
+                let id = security::endpoint_id(policy, mode);
+                first.get_or_insert_with(|| id.clone());
+                builder = builder.add_endpoint(&id, ServerEndpoint::new("/", policy, mode, &anonymous_ids));
+            }
+        }
+        if self.security.insecure {
+            let id = security::endpoint_id(SecurityPolicy::None, MessageSecurityMode::None);
+            first.get_or_insert_with(|| id.clone());
+            builder =
+                builder.add_endpoint(&id, ServerEndpoint::new("/", SecurityPolicy::None, MessageSecurityMode::None, &anonymous_ids));
+        }
+        if let Some(id) = first {
+            builder = builder.default_endpoint(id);
         }
         builder.limits_mut().subscriptions.min_sampling_interval_ms = self.min_sampling_interval_ms;
         builder.limits_mut().subscriptions.min_publishing_interval_ms = self.min_publishing_interval_ms as f64;

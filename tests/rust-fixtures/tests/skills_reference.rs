@@ -53,6 +53,7 @@ async fn an_example_skill_follows_its_state_machine() {
         .type_loader(skills::TypeLoader)
         .table(&linear_axis_with_gripper::TABLE)
         .type_loader(linear_axis_with_gripper::TypeLoader)
+        .insecure_only()
         .build()
         .expect("the server builds");
     let m = server.manager().clone();
