@@ -21,28 +21,29 @@
 //! output file is replaced atomically (written as `.<file>.tmp-<pid>` beside it, then renamed over it); on
 //! any error the previous output stays as it was and the error lists the diagnostics.
 
-use crate::emit::rust::{self as rust_emit, RustConfig, RustNamespace};
+use crate::diag::{Level, Severities};
 use crate::load::Input;
-use crate::{compile, Options};
-use std::collections::BTreeMap;
+use crate::{compile, Error, Options, RustOptions};
 use std::path::PathBuf;
 
+/// The configuration of one generation from a build script; methods chain, [`Builder::generate`] runs it.
 #[derive(Clone, Debug, Default)]
 pub struct Builder {
     files: Vec<PathBuf>,
-    model_dirs: Vec<PathBuf>,
-    modules: BTreeMap<String, String>,
-    extern_paths: BTreeMap<String, String>,
-    runtime_path: Option<String>,
+    options: Options,
+    rust: RustOptions,
+    /// Severity settings by name, checked when generating (so that the chain needs no `?`).
+    levels: Vec<(Level, String)>,
     out_dir: Option<PathBuf>,
     out_file: Option<String>,
     cargo_output: bool,
-    deny_warnings: bool,
 }
 
 impl Builder {
+    /// A builder that prints `cargo:` lines and generates nothing yet.
     pub fn new() -> Builder {
-        Builder { cargo_output: true, ..Builder::default() }
+        let rust = RustOptions { command: "cargo build (build.rs)".into(), ..RustOptions::default() };
+        Builder { cargo_output: true, rust, ..Builder::default() }
     }
 
     /// A NodeSet2 file whose models are generated.
@@ -53,25 +54,25 @@ impl Builder {
 
     /// A folder searched recursively for the models the files require.
     pub fn models_dir(mut self, path: impl Into<PathBuf>) -> Self {
-        self.model_dirs.push(path.into());
+        self.options.model_dirs.push(path.into());
         self
     }
 
     /// The module name of a namespace (default: the last segment of its URI in snake case).
     pub fn module_name(mut self, uri: &str, module: &str) -> Self {
-        self.modules.insert(uri.into(), module.into());
+        self.rust.modules.insert(uri.into(), module.into());
         self
     }
 
     /// A namespace generated elsewhere: its module's Rust path. Its types are used, not generated again.
     pub fn extern_namespace(mut self, uri: &str, rust_path: &str) -> Self {
-        self.extern_paths.insert(uri.into(), rust_path.into());
+        self.rust.extern_paths.insert(uri.into(), rust_path.into());
         self
     }
 
     /// The path of the runtime module (default `nodeset_models::runtime`).
     pub fn runtime_path(mut self, path: &str) -> Self {
-        self.runtime_path = Some(path.into());
+        self.rust.runtime_path = path.into();
         self
     }
 
@@ -93,67 +94,74 @@ impl Builder {
         self
     }
 
-    /// Turn warnings into errors.
+    /// Turn warnings into errors (`--deny warnings`).
     pub fn deny_warnings(mut self, on: bool) -> Self {
-        self.deny_warnings = on;
+        self.options.severities.deny_warnings(on);
         self
     }
 
+    /// Drop the diagnostics of `code` (`--allow CODE`); an error with a recovery then recovers silently.
+    pub fn allow(mut self, code: &str) -> Self {
+        self.levels.push((Level::Allow, code.into()));
+        self
+    }
+
+    /// Report `code` as a warning (`--warn NS0202`); an error with a recovery then recovers.
+    pub fn warn(mut self, code: &str) -> Self {
+        self.levels.push((Level::Warn, code.into()));
+        self
+    }
+
+    /// Report `code` as an error (`--deny CODE`, or `"warnings"` for every warning).
+    pub fn deny(mut self, code: &str) -> Self {
+        self.levels.push((Level::Deny, code.into()));
+        self
+    }
+
+    /// The severity settings, checked: an unknown code or a demoted error with no recovery is refused.
+    fn severities(&self) -> Result<Severities, Error> {
+        let mut s = self.options.severities.clone();
+        for (level, code) in &self.levels {
+            s.set_named(*level, code)?;
+        }
+        Ok(s)
+    }
+
     /// Compiles, generates and writes. Returns the path written.
-    pub fn generate(self) -> Result<PathBuf, String> {
+    pub fn generate(self) -> Result<PathBuf, Error> {
         let out_dir = match self.out_dir.clone() {
             Some(d) => d,
-            None => PathBuf::from(std::env::var_os("OUT_DIR").ok_or("OUT_DIR is not set; call out_dir() outside build scripts")?),
+            None => PathBuf::from(
+                std::env::var_os("OUT_DIR").ok_or(Error::Config("OUT_DIR is not set; call out_dir() outside build scripts".into()))?,
+            ),
         };
+        let opts = Options { severities: self.severities()?, ..self.options.clone() };
         let inputs: Vec<Input> = self.files.iter().cloned().map(Input::Path).collect();
-        let opts = Options { model_dirs: self.model_dirs.clone(), deny_warnings: self.deny_warnings, ..Options::default() };
-        let out = compile(inputs, &opts);
+        let mut out = compile(inputs, &opts);
         if self.cargo_output {
             for (_, f) in out.model.sources.files() {
                 println!("cargo:rerun-if-changed={}", f.path.display());
             }
-            for d in &self.model_dirs {
+            for d in &opts.model_dirs {
                 println!("cargo:rerun-if-changed={}", d.display());
             }
         }
-        if !out.ok() {
-            return Err(format!("nodeset-compiler: the NodeSet2 files do not compile:\n{}", out.render_diagnostics()));
-        }
+        out.checked(&opts.severities)?;
         let model = &out.model;
-        let named: Vec<&crate::load::ModelInfo> =
-            model.models.iter().filter(|m| model.sources.get(m.file).named).collect();
-        let namespaces: Vec<RustNamespace> = named
-            .iter()
-            .map(|m| RustNamespace {
-                uri: m.uri.clone(),
-                module: self.modules.get(&m.uri).cloned().unwrap_or_else(|| rust_emit::default_module_name(&m.uri)),
-            })
-            .collect();
-        let cfg = RustConfig {
-            namespaces: namespaces.clone(),
-            extern_paths: self.extern_paths.clone(),
-            runtime_path: self.runtime_path.clone().unwrap_or_else(|| "nodeset_models::runtime".into()),
-            command: "cargo build (build.rs)".into(),
-        };
-        let mut gen = rust_emit::generate(model, &cfg);
-        if self.deny_warnings {
-            gen.diagnostics.deny_warnings();
-        }
-        gen.diagnostics.sort(&model.sources);
-        if gen.diagnostics.has_errors() {
-            return Err(format!("nodeset-compiler: generation failed:\n{}", gen.diagnostics.render(&model.sources)));
-        }
+        let cfg = self.rust.config(model);
+        let mut gen = crate::emit::rust::generate(model, &cfg);
+        gen.diagnostics.finalize(&opts.severities, &model.sources, "Rust generation failed")?;
         if self.cargo_output {
-            for d in &gen.diagnostics.items {
+            for d in out.diagnostics.items.iter().chain(&gen.diagnostics.items) {
                 let first = d.render(&model.sources).lines().next().unwrap_or_default().to_string();
                 let at = d.span.map(|s| model.sources.location(s)).unwrap_or_default();
                 println!("cargo:warning={first} ({at})");
             }
         }
-        let text = rust_emit::inline(&gen.files, &namespaces);
+        let text = crate::emit::rust::inline(&gen.files, &cfg.namespaces);
         let name = self.out_file.clone().unwrap_or_else(|| "nodesets.rs".into());
         let path = out_dir.join(&name);
-        std::fs::create_dir_all(&out_dir).map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
+        std::fs::create_dir_all(&out_dir).map_err(|e| Error::Write(format!("cannot create {}: {e}", out_dir.display())))?;
         // The text goes to a temporary file beside the output, which is then renamed over it: readers see
         // the old file or the new one, and a failure leaves the old one and no temporary file.
         let tmp = out_dir.join(format!(".{name}.tmp-{}", std::process::id()));
@@ -163,6 +171,6 @@ impl Builder {
         if written.is_err() {
             let _ = std::fs::remove_file(&tmp);
         }
-        written.map(|()| path)
+        written.map(|()| path).map_err(Error::Write)
     }
 }

@@ -55,7 +55,7 @@ pub(crate) fn classify(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeI
                 })
                 .unwrap_or_default();
             let spans: Vec<Span> = def.map(|d| d.fields.iter().map(|f| f.span).collect()).unwrap_or_default();
-            check_unique(model, t, &bits, &spans, diags);
+            let bits = check_unique(model, t, bits, &spans, diags);
             DataTypeKind::OptionSet { base, bits }
         } else if ns0_in_chain(ids::STRUCTURE) {
             structure(model, t, &out, diags)
@@ -179,26 +179,65 @@ fn structure(model: &Model, t: NodeIx, done: &BTreeMap<NodeIx, DataTypeInfo>, di
     DataTypeKind::Structure { kind, fields, has_definition: true }
 }
 
+/// An enumeration's values. The definition's fields give them, a field without `Value` being -1 as
+/// UANodeSet.xsd says; where the DataType also has an EnumValues or EnumStrings property and the two
+/// disagree (a missing Value colliding with a real one, or another value), the property decides and NS0219
+/// names the choice. Without fields, the property alone gives them.
 fn enumeration(model: &Model, t: NodeIx, diags: &mut Diagnostics) -> DataTypeKind {
     let node = model.node(t);
+    let property = enum_property(model, t);
     if let Some(def) = &node.definition {
         if !def.fields.is_empty() {
-            let values: Vec<EnumValue> = def
+            let mut values: Vec<EnumValue> = def
                 .fields
                 .iter()
-                .enumerate()
-                .map(|(i, f)| EnumValue {
+                .map(|f| EnumValue {
                     name: f.name.clone(),
-                    value: f.value.unwrap_or(i as i64),
+                    value: f.value.unwrap_or(-1),
                     display_name: f.display_names.first().map(|d| d.text.clone()),
                     description: f.descriptions.first().map(|d| d.text.clone()).filter(|d| !d.is_empty()),
                 })
                 .collect();
-            let spans: Vec<Span> = def.fields.iter().map(|f| f.span).collect();
-            check_unique(model, t, &values, &spans, diags);
+            let mut spans: Vec<Span> = def.fields.iter().map(|f| f.span).collect();
+            if let Some(p) = &property {
+                let differ: Vec<usize> =
+                    (0..values.len().max(p.values.len())).filter(|&i| values.get(i).map(|v| v.value) != p.values.get(i).map(|v| v.value)).collect();
+                if !differ.is_empty() {
+                    diags.push(enum_choice(node, &def.fields, &values, p, &differ, &spans));
+                    if values.len() == p.values.len() {
+                        // Same entries: the definition's names, the property's values.
+                        for (v, pv) in values.iter_mut().zip(&p.values) {
+                            v.value = pv.value;
+                        }
+                    } else {
+                        values = p.values.clone();
+                        spans = p.spans.clone();
+                    }
+                }
+            }
+            let values = check_unique(model, t, values, &spans, diags);
             return DataTypeKind::Enumeration { values, source: EnumSource::Definition };
         }
     }
+    match property {
+        Some(p) => {
+            let values = check_unique(model, t, p.values, &p.spans, diags);
+            DataTypeKind::Enumeration { values, source: p.source }
+        }
+        None => DataTypeKind::Enumeration { values: Vec::new(), source: EnumSource::Definition },
+    }
+}
+
+/// The values an enumeration's EnumStrings or EnumValues property gives, with the span of each entry.
+struct EnumProperty {
+    values: Vec<EnumValue>,
+    spans: Vec<Span>,
+    source: EnumSource,
+    /// The property node's span.
+    span: Span,
+}
+
+fn enum_property(model: &Model, t: NodeIx) -> Option<EnumProperty> {
     for (_, child) in model.children(t) {
         let c = model.node(child);
         if c.browse_name.ns != 0 {
@@ -238,19 +277,62 @@ fn enumeration(model: &Model, t: NodeIx, diags: &mut Diagnostics) -> DataTypeKin
                 spans.push(item_spans.get(i).copied().unwrap_or(c.span));
             }
         }
-        check_unique(model, t, &values, &spans, diags);
         let source = if which == "EnumStrings" { EnumSource::EnumStrings } else { EnumSource::EnumValues };
-        return DataTypeKind::Enumeration { values, source };
+        return Some(EnumProperty { values, spans, source, span: c.span });
     }
-    DataTypeKind::Enumeration { values: Vec::new(), source: EnumSource::Definition }
+    None
 }
 
-fn check_unique(model: &Model, t: NodeIx, values: &[EnumValue], spans: &[Span], diags: &mut Diagnostics) {
+/// NS0219: the definition and the property disagree at the positions `differ`; the property decides.
+fn enum_choice(
+    node: &Node,
+    fields: &[crate::raw::RawField],
+    values: &[EnumValue],
+    p: &EnumProperty,
+    differ: &[usize],
+    spans: &[Span],
+) -> Diagnostic {
+    let prop = if p.source == EnumSource::EnumStrings { "EnumStrings" } else { "EnumValues" };
+    let show = |i: usize| {
+        let def = match (values.get(i), fields.get(i)) {
+            (Some(_), Some(f)) if f.value.is_none() => "-1 (no Value) in the definition".to_string(),
+            (Some(v), _) => format!("{} in the definition", v.value),
+            (None, _) => "absent from the definition".to_string(),
+        };
+        let name = values.get(i).map(|v| v.name.as_str()).or_else(|| p.values.get(i).map(|v| v.name.as_str())).unwrap_or("");
+        let by_prop = p.values.get(i).map_or_else(|| format!("absent from {prop}"), |v| format!("{} in {prop}", v.value));
+        format!("`{name}` is {def} and {by_prop}")
+    };
+    let mut list: Vec<String> = differ.iter().take(3).map(|&i| show(i)).collect();
+    if differ.len() > 3 {
+        list.push(format!("{} more", differ.len() - 3));
+    }
+    let first = differ[0];
+    let at = spans.get(first).copied().or(node.definition.as_ref().map(|d| d.span)).unwrap_or(node.span);
+    let how = if values.len() == p.values.len() {
+        format!("the {prop} property decides: the values are {prop}'s, the names the definition's")
+    } else {
+        format!("the {prop} property decides: its {} entries are used", p.values.len())
+    };
+    Diagnostic::new(
+        Code::EnumValueChoice,
+        format!("enumeration `{}`: its definition and its {prop} property disagree: {}", node.browse_name.name, list.join("; ")),
+    )
+    .at(at)
+    .with_span_label("the definition says otherwise")
+    .label(p.span, format!("{prop} is used"))
+    .note(how)
+    .help("give every field a Value that matches the property (a field without Value is -1 in UANodeSet.xsd)")
+}
+
+/// Reports repeated values and names, and returns the entries without the later repetitions (NS0208's recovery).
+fn check_unique(model: &Model, t: NodeIx, values: Vec<EnumValue>, spans: &[Span], diags: &mut Diagnostics) -> Vec<EnumValue> {
     let node = model.node(t);
     let fallback = node.definition.as_ref().map(|d| d.span).unwrap_or(node.span);
     let span_of = |i: usize| spans.get(i).copied().unwrap_or(fallback);
     let mut by_value: HashMap<i64, usize> = HashMap::new();
     let mut by_name: HashMap<&str, usize> = HashMap::new();
+    let mut keep = vec![true; values.len()];
     for (i, v) in values.iter().enumerate() {
         if let Some(&j) = by_value.get(&v.value) {
             diags.push(
@@ -263,6 +345,7 @@ fn check_unique(model: &Model, t: NodeIx, values: &[EnumValue], spans: &[Span], 
                 .label(span_of(j), format!("first used by `{}`", values[j].name))
                 .help("each enumeration value and option bit must be distinct"),
             );
+            keep[i] = false;
         } else {
             by_value.insert(v.value, i);
         }
@@ -277,8 +360,10 @@ fn check_unique(model: &Model, t: NodeIx, values: &[EnumValue], spans: &[Span], 
                 .label(span_of(j), "first entry with this name")
                 .help("each enumeration name must be distinct"),
             );
+            keep[i] = false;
         } else {
             by_name.insert(&v.name, i);
         }
     }
+    values.iter().zip(keep).filter(|(_, k)| *k).map(|(v, _)| v.clone()).collect()
 }

@@ -25,71 +25,229 @@ impl Severity {
 }
 
 macro_rules! codes {
-    ($($variant:ident = $code:literal, $sev:ident, $title:literal;)*) => {
-        /// Every diagnostic the compiler can emit, with its stable code and default severity.
+    ($($variant:ident = $code:literal, $sev:ident, $title:literal, $recovery:expr;)*) => {
+        /// Every diagnostic the compiler can emit, with its stable code, default severity and recovery.
         #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-        pub enum Code { $($variant),* }
+        pub enum Code { $(#[doc = $title] $variant),* }
 
         impl Code {
+            /// Every code, in the order of the table.
             pub const ALL: &'static [Code] = &[$(Code::$variant),*];
             /// The stable code, such as `NS0201`.
             pub fn as_str(self) -> &'static str { match self { $(Code::$variant => $code),* } }
-            /// The severity this diagnostic has unless promoted by `--deny warnings`.
+            /// The severity this diagnostic has unless a [`Severities`] setting changes it.
             pub fn default_severity(self) -> Severity { match self { $(Code::$variant => Severity::$sev),* } }
             /// One line saying what the code means.
             pub fn title(self) -> &'static str { match self { $(Code::$variant => $title),* } }
+            /// What the compiler does instead when it meets the problem, so that it can go on: for a warning,
+            /// what it always does; for an error, what it does when the error is demoted (`--warn CODE`).
+            /// `None` for an error with no safe recovery, which cannot be demoted.
+            pub fn recovery(self) -> Option<&'static str> { match self { $(Code::$variant => $recovery),* } }
         }
     };
 }
 
+const NO: Option<&str> = None;
+
 codes! {
     // Reading and parsing one file.
-    Io = "NS0001", Error, "the file cannot be read";
-    Encoding = "NS0002", Error, "the file is not UTF-8";
-    XmlSyntax = "NS0003", Error, "the file is not well-formed XML";
-    Truncated = "NS0004", Error, "the file ends inside an element";
-    Doctype = "NS0005", Error, "DOCTYPE declarations are rejected";
-    NotNodeSet = "NS0006", Error, "the root element is not UANodeSet";
-    TooDeep = "NS0007", Error, "elements are nested too deeply";
-    BadAttribute = "NS0008", Error, "an attribute value is malformed";
-    MissingAttribute = "NS0009", Error, "a required attribute is missing";
-    UnknownElement = "NS0010", Warning, "an element is not part of UANodeSet.xsd and is ignored";
-    TooLarge = "NS0011", Error, "a value exceeds a size limit";
+    Io = "NS0001", Error, "the file cannot be read", NO;
+    Encoding = "NS0002", Error, "the file is not UTF-8", NO;
+    XmlSyntax = "NS0003", Error, "the file is not well-formed XML", NO;
+    Truncated = "NS0004", Error, "the file ends inside an element", NO;
+    Doctype = "NS0005", Error, "DOCTYPE declarations are rejected", NO;
+    NotNodeSet = "NS0006", Error, "the root element is not UANodeSet", NO;
+    TooDeep = "NS0007", Error, "elements are nested too deeply", NO;
+    BadAttribute = "NS0008", Error, "an attribute value is malformed",
+        Some("the attribute is read as absent, so its default applies (a malformed ArrayDimensions entry is skipped)");
+    MissingAttribute = "NS0009", Error, "a required attribute is missing", NO;
+    UnknownElement = "NS0010", Warning, "an element is not part of UANodeSet.xsd and is ignored", Some("the element is ignored");
+    TooLarge = "NS0011", Error, "a value exceeds a size limit", NO;
+    AccessLevelRange = "NS0012", Error, "an AccessLevel or UserAccessLevel does not fit in a Byte",
+        Some("the value is masked to its low byte (the bits above it belong to AccessLevelEx)");
     // Loading a set of files.
-    MissingModel = "NS0101", Error, "a required model is not available";
-    ModelTooOld = "NS0102", Error, "a required model is available only in an older version";
-    ModelDateOlder = "NS0103", Warning, "a required model is older than the required publication date";
-    DuplicateModel = "NS0104", Error, "two input files define the same model";
-    ModelCycle = "NS0105", Error, "models require each other in a cycle";
-    UnknownNamespaceIndex = "NS0106", Error, "a namespace index is not declared in NamespaceUris";
-    MalformedNodeId = "NS0107", Error, "a NodeId is malformed";
-    UnknownAlias = "NS0108", Error, "an alias is not declared";
-    NoModel = "NS0109", Warning, "the file declares no model";
-    DuplicateAlias = "NS0110", Error, "an alias is declared twice with different targets";
-    MalformedQualifiedName = "NS0111", Error, "a QualifiedName is malformed";
-    UnknownNamespaceUri = "NS0112", Error, "a namespace URI names no loaded model";
-    AliasByBrowseName = "NS0113", Warning, "an undeclared alias was resolved by the BrowseName of a base type";
+    MissingModel = "NS0101", Error, "a required model is not available", NO;
+    ModelTooOld = "NS0102", Error, "a required model is available only in an older version", NO;
+    ModelDateOlder = "NS0103", Warning, "a required model is older than the required publication date",
+        Some("the older model is used");
+    DuplicateModel = "NS0104", Error, "two input files define the same model", NO;
+    ModelCycle = "NS0105", Error, "models require each other in a cycle", NO;
+    UnknownNamespaceIndex = "NS0106", Error, "a namespace index is not declared in NamespaceUris", NO;
+    MalformedNodeId = "NS0107", Error, "a NodeId is malformed", NO;
+    UnknownAlias = "NS0108", Error, "an alias is not declared", NO;
+    NoModel = "NS0109", Warning, "the file declares no model", Some("the file's nodes join the models it names by URI");
+    DuplicateAlias = "NS0110", Error, "an alias is declared twice with different targets", Some("the first declaration is kept");
+    MalformedQualifiedName = "NS0111", Error, "a QualifiedName is malformed", NO;
+    UnknownNamespaceUri = "NS0112", Error, "a namespace URI names no loaded model", NO;
+    AliasByBrowseName = "NS0113", Warning, "an undeclared alias was resolved by the BrowseName of a base type",
+        Some("the base DataType or ReferenceType of that BrowseName is used");
     // Resolving one model of all files.
-    DuplicateNodeId = "NS0201", Error, "a NodeId is defined twice";
-    DanglingReference = "NS0202", Error, "a reference points to a node that does not exist";
-    BadReferenceType = "NS0203", Error, "a reference type is not a ReferenceType node";
-    SubtypeCycle = "NS0204", Error, "a type is its own supertype";
-    BadTypeDefinition = "NS0205", Error, "a TypeDefinition has the wrong node class";
-    BrowseNameCollision = "NS0206", Warning, "two children of one node share a BrowseName";
-    UnknownFieldType = "NS0207", Error, "a structure field has an unknown DataType";
-    DuplicateEnumValue = "NS0208", Error, "an enumeration, OptionSet or structure repeats a value or a name";
-    ValueTypeMismatch = "NS0209", Warning, "a value contradicts its DataType";
-    BadSubtype = "NS0210", Error, "a HasSubtype reference joins nodes of different classes";
-    MissingTypeDefinition = "NS0211", Warning, "an instance has no TypeDefinition";
-    BadDataType = "NS0212", Error, "a DataType attribute does not name a DataType node";
-    BadArgument = "NS0213", Warning, "a method argument cannot be decoded";
-    BadValue = "NS0214", Warning, "a value cannot be decoded";
-    DanglingForeignReference = "NS0215", Warning, "a reference points to a missing node of another model";
-    BadModellingRule = "NS0216", Warning, "a ModellingRule reference names no known rule";
-    StateMachine = "NS0217", Warning, "a state machine's states or transitions are inconsistent";
+    DuplicateNodeId = "NS0201", Error, "a NodeId is defined twice", Some("the first definition is kept and the second is ignored");
+    DanglingReference = "NS0202", Error, "a reference points to a node that does not exist", Some("the reference is dropped");
+    BadReferenceType = "NS0203", Error, "a reference type is not a ReferenceType node", Some("the reference is dropped");
+    SubtypeCycle = "NS0204", Error, "a type is its own supertype",
+        Some("the cycle is broken: the type the diagnostic points at loses its supertype");
+    BadTypeDefinition = "NS0205", Error, "a TypeDefinition has the wrong node class",
+        Some("the TypeDefinition is ignored, as if the instance had none");
+    BrowseNameCollision = "NS0206", Warning, "two children of one node share a BrowseName", Some("both children are kept");
+    UnknownFieldType = "NS0207", Error, "a structure field has an unknown DataType", NO;
+    DuplicateEnumValue = "NS0208", Error, "an enumeration, OptionSet or structure repeats a value or a name",
+        Some("the later entry is dropped");
+    ValueTypeMismatch = "NS0209", Warning, "a value contradicts its DataType", Some("the value is kept as written");
+    BadSubtype = "NS0210", Error, "a HasSubtype reference joins nodes of different classes",
+        Some("the wrong supertype is ignored (of several supertypes, the first is used)");
+    MissingTypeDefinition = "NS0211", Warning, "an instance has no TypeDefinition", Some("the instance is generated without a type");
+    BadDataType = "NS0212", Error, "a DataType attribute does not name a DataType node",
+        Some("the DataType attribute is ignored, so the variable takes any value (BaseDataType)");
+    BadArgument = "NS0213", Warning, "a method argument cannot be decoded", Some("the argument list is left empty");
+    BadValue = "NS0214", Warning, "a value cannot be decoded", Some("the value is left out");
+    DanglingForeignReference = "NS0215", Warning, "a reference points to a missing node of another model", Some("the reference is dropped");
+    BadModellingRule = "NS0216", Warning, "a ModellingRule reference names no known rule", Some("the ModellingRule is ignored");
+    StateMachine = "NS0217", Warning, "a state machine's states or transitions are inconsistent",
+        Some("the inconsistent states or transitions are left out of the state machine");
+    IdenticalRedefinition = "NS0218", Warning, "a node is defined again, identically, by another file",
+        Some("the copy is ignored; the node loaded first is used");
+    EnumValueChoice = "NS0219", Warning, "an enumeration's definition disagrees with its EnumValues or EnumStrings property",
+        Some("the property decides the values");
     // Generating code.
-    NameCollision = "NS0301", Warning, "two names map to one identifier in generated code";
-    UnsupportedFeature = "NS0302", Warning, "a model feature has no faithful representation in generated code";
+    NameCollision = "NS0301", Warning, "two names map to one identifier in generated code", Some("the names are told apart by a suffix");
+    UnsupportedFeature = "NS0302", Warning, "a model feature has no faithful representation in generated code",
+        Some("the feature is left out of the generated code");
+}
+
+impl Code {
+    /// Whether `--warn CODE` and `--allow CODE` are accepted: every warning, and every error with a recovery.
+    pub fn demotable(self) -> bool {
+        self.default_severity() != Severity::Error || self.recovery().is_some()
+    }
+
+    /// The code named `text` (`NS0201`, case-insensitive).
+    pub fn parse(text: &str) -> Option<Code> {
+        Code::ALL.iter().copied().find(|c| c.as_str().eq_ignore_ascii_case(text.trim()))
+    }
+
+    /// The table of codes as `nodeset-compiler codes` prints it: code, default severity, meaning, and what
+    /// the compiler does instead (or that the error cannot be demoted).
+    pub fn table() -> String {
+        let mut out = String::new();
+        for c in Code::ALL {
+            let _ = writeln!(out, "{} {:<7} {}", c.as_str(), c.default_severity().as_str(), c.title());
+            match (c.recovery(), c.default_severity()) {
+                (Some(r), Severity::Error) => {
+                    let _ = writeln!(out, "       demotable: with --warn {} or --allow {}, {r}", c.as_str(), c.as_str());
+                }
+                (Some(r), _) => {
+                    let _ = writeln!(out, "       recovery: {r}");
+                }
+                (None, _) => {
+                    let _ = writeln!(out, "       cannot be demoted: there is no safe recovery");
+                }
+            }
+        }
+        out
+    }
+}
+
+/// A severity setting for one code, as rustc's lint levels: `--allow`, `--warn`, `--deny`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Level {
+    /// Drop the diagnostic (an error only when it has a recovery, which then happens silently).
+    Allow,
+    /// Report it as a warning (an error only when it has a recovery, which then happens).
+    Warn,
+    /// Report it as an error: the stage fails.
+    Deny,
+}
+
+impl Level {
+    /// The flag that sets this level: `allow`, `warn` or `deny`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Level::Allow => "allow",
+            Level::Warn => "warn",
+            Level::Deny => "deny",
+        }
+    }
+}
+
+/// Why a severity setting was refused.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SeverityError {
+    /// The text names no code.
+    UnknownCode(String),
+    /// The code is an error with no safe recovery, so it cannot be warned about or allowed.
+    NotDemotable { code: Code, level: Level },
+}
+
+impl std::fmt::Display for SeverityError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SeverityError::UnknownCode(t) => {
+                write!(f, "`{t}` is not a diagnostic code (codes look like NS0201; `nodeset-compiler codes` lists them)")
+            }
+            SeverityError::NotDemotable { code, level } => write!(
+                f,
+                "--{} {} is refused: {} ({}) is an error with no safe recovery, so it cannot be demoted",
+                level.as_str(),
+                code.as_str(),
+                code.as_str(),
+                code.title()
+            ),
+        }
+    }
+}
+
+impl std::error::Error for SeverityError {}
+
+/// How severe each diagnostic is, beyond its code's default: the `--allow`, `--warn` and `--deny` settings of
+/// every front door (the command line, [`crate::build::Builder`], `cargo xtask generate`).
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Severities {
+    levels: std::collections::BTreeMap<Code, Level>,
+    deny_warnings: bool,
+}
+
+impl Severities {
+    /// The defaults: every code at its default severity.
+    pub fn new() -> Severities {
+        Severities::default()
+    }
+
+    /// Sets the level of one code. A later setting of the same code replaces an earlier one. Refuses to
+    /// demote an error that has no recovery.
+    pub fn set(&mut self, code: Code, level: Level) -> Result<(), SeverityError> {
+        if level != Level::Deny && !code.demotable() {
+            return Err(SeverityError::NotDemotable { code, level });
+        }
+        self.levels.insert(code, level);
+        Ok(())
+    }
+
+    /// Sets a level from its command-line text: a code such as `NS0202`, or `warnings` with [`Level::Deny`]
+    /// (`--deny warnings`).
+    pub fn set_named(&mut self, level: Level, what: &str) -> Result<(), SeverityError> {
+        if level == Level::Deny && what.trim() == "warnings" {
+            self.deny_warnings = true;
+            return Ok(());
+        }
+        let code = Code::parse(what).ok_or_else(|| SeverityError::UnknownCode(what.to_string()))?;
+        self.set(code, level)
+    }
+
+    /// Turns every warning into an error (`--deny warnings`), except codes given a level of their own.
+    pub fn deny_warnings(&mut self, on: bool) {
+        self.deny_warnings = on;
+    }
+
+    /// Whether `--deny warnings` is set.
+    pub fn denies_warnings(&self) -> bool {
+        self.deny_warnings
+    }
+
+    /// The level set for `code`, if any.
+    pub fn level(&self, code: Code) -> Option<Level> {
+        self.levels.get(&code).copied()
+    }
 }
 
 /// A secondary position with a message.
@@ -247,13 +405,40 @@ impl Diagnostics {
         self.items.iter().filter(|d| d.severity == Severity::Warning).count()
     }
 
-    /// Turns every warning into an error (`--deny warnings`).
-    pub fn deny_warnings(&mut self) {
-        for d in &mut self.items {
-            if d.severity == Severity::Warning {
-                d.severity = Severity::Error;
+    /// Gives every diagnostic the severity `severities` sets for it: `--allow CODE` drops it, `--warn CODE`
+    /// makes it a warning, `--deny CODE` an error, and `--deny warnings` turns every other warning into an
+    /// error. A setting for a code outranks `--deny warnings`. Applying the same settings twice changes nothing.
+    pub fn apply(&mut self, severities: &Severities) {
+        self.items.retain_mut(|d| match severities.level(d.code) {
+            Some(Level::Allow) => false,
+            Some(Level::Warn) => {
+                d.severity = Severity::Warning;
+                true
             }
+            Some(Level::Deny) => {
+                d.severity = Severity::Error;
+                true
+            }
+            None => {
+                if severities.deny_warnings && d.severity == Severity::Warning {
+                    d.severity = Severity::Error;
+                }
+                true
+            }
+        });
+    }
+
+    /// The end of every stage and front door: applies `severities`, sorts, renders, and fails when errors
+    /// remain. Returns the rendered diagnostics either way (the caller prints or passes them on); `stage`
+    /// says what failed (`"the NodeSet2 files do not compile"`).
+    pub fn finalize(&mut self, severities: &Severities, sources: &SourceMap, stage: &str) -> Result<String, crate::Error> {
+        self.apply(severities);
+        self.sort(sources);
+        let rendered = self.render(sources);
+        if self.has_errors() {
+            return Err(crate::Error::Diagnostics { stage: stage.to_string(), errors: self.error_count(), rendered });
         }
+        Ok(rendered)
     }
 
     /// Sorts by file, position, then code, so that output does not depend on the order checks ran in.

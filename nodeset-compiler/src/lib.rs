@@ -37,34 +37,102 @@ pub mod summary;
 pub mod value;
 pub mod write;
 
-use diag::{Diagnostics, Severity};
+use diag::{Diagnostics, Severities, Severity};
 use load::{Input, LoadOptions};
+use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-/// What [`compile`] does.
+/// What [`compile`] does: the configuration every front door (the command line, [`build::Builder`],
+/// `cargo xtask generate`) fills in, each from its own flags or methods.
 #[derive(Clone, Debug, Default)]
 pub struct Options {
     /// Folders searched recursively for required models.
     pub model_dirs: Vec<PathBuf>,
-    /// Turn warnings into errors.
-    pub deny_warnings: bool,
+    /// `--allow`/`--warn`/`--deny CODE` and `--deny warnings`, applied to every stage's diagnostics.
+    pub severities: Severities,
     /// Also report warnings of files that were only loaded as dependencies.
     pub all_warnings: bool,
+    /// Size limits of the XML reader.
     pub limits: parse::Limits,
+}
+
+/// Everything that can stop a front door, typed so that callers can tell a bad input from a bad setting
+/// from a failed write.
+#[derive(Debug)]
+pub enum Error {
+    /// A stage found errors in the input: `stage` says which, `rendered` holds every diagnostic as rustc
+    /// would print them.
+    Diagnostics {
+        /// What failed, such as "the NodeSet2 files do not compile".
+        stage: String,
+        /// The number of errors.
+        errors: usize,
+        /// The rendered diagnostics, warnings included.
+        rendered: String,
+    },
+    /// A severity setting was refused (an unknown code, or an error that cannot be demoted).
+    Severity(diag::SeverityError),
+    /// A setting is malformed or missing (`--extern` without `=`, no `OUT_DIR`).
+    Config(String),
+    /// Writing or comparing the output failed.
+    Write(String),
+    /// Check mode found output that differs from what would be generated.
+    Stale(String),
+}
+
+impl Error {
+    /// The rendered diagnostics an [`Error::Diagnostics`] carries (empty for the other kinds).
+    pub fn diagnostics(&self) -> &str {
+        match self {
+            Error::Diagnostics { rendered, .. } => rendered,
+            _ => "",
+        }
+    }
+}
+
+impl std::fmt::Display for Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Error::Diagnostics { stage, errors, rendered } => {
+                write!(f, "{stage} ({errors} error(s)); nothing was written:\n{rendered}")
+            }
+            Error::Severity(e) => e.fmt(f),
+            Error::Config(m) | Error::Write(m) | Error::Stale(m) => f.write_str(m),
+        }
+    }
+}
+
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Error::Severity(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+impl From<diag::SeverityError> for Error {
+    fn from(e: diag::SeverityError) -> Error {
+        Error::Severity(e)
+    }
 }
 
 /// The model and everything said about it.
 #[derive(Debug)]
 pub struct Compiled {
+    /// The resolved model (with every recovery made, whether or not errors remain).
     pub model: model::Model,
+    /// What every stage said, with the severity settings applied, sorted.
     pub diagnostics: Diagnostics,
 }
 
 impl Compiled {
+    /// Whether no error remains (after the severity settings were applied).
     pub fn ok(&self) -> bool {
         !self.diagnostics.has_errors()
     }
 
+    /// Every diagnostic, rendered like rustc's.
     pub fn render_diagnostics(&self) -> String {
         self.diagnostics.render(&self.model.sources)
     }
@@ -76,11 +144,90 @@ pub fn compile(inputs: Vec<Input>, opts: &Options) -> Compiled {
     let mut diags = Diagnostics::new();
     let load_opts = LoadOptions { model_dirs: opts.model_dirs.clone(), limits: opts.limits.clone() };
     let mut loaded = load::load(inputs, &load_opts, &mut diags);
+    // Demoted errors of loading (`--warn NS0110`) do not stop it.
+    diags.apply(&opts.severities);
     if diags.has_errors() {
         loaded.files.clear();
     }
     let model = resolve::resolve(loaded, &mut diags);
     finish(model, diags, opts)
+}
+
+/// How the Rust back end is configured by a front door: module names, namespaces generated elsewhere, the
+/// runtime's path. [`RustOptions::config`] turns it into the emitter's [`emit::rust::RustConfig`] for a model.
+#[derive(Clone, Debug)]
+pub struct RustOptions {
+    /// Module names by namespace URI (default: [`emit::rust::default_module_name`]).
+    pub modules: BTreeMap<String, String>,
+    /// Namespaces generated elsewhere: URI -> Rust path of their module (`--extern URI=PATH`).
+    pub extern_paths: BTreeMap<String, String>,
+    /// The Rust path of the runtime module.
+    pub runtime_path: String,
+    /// The command named in the generated files' headers.
+    pub command: String,
+}
+
+impl Default for RustOptions {
+    fn default() -> RustOptions {
+        RustOptions {
+            modules: BTreeMap::new(),
+            extern_paths: BTreeMap::new(),
+            runtime_path: "nodeset_models::runtime".into(),
+            command: "nodeset-compiler rust ...".into(),
+        }
+    }
+}
+
+impl RustOptions {
+    /// The emitter's configuration for `model`: one module for each model of a file the user named.
+    pub fn config(&self, model: &model::Model) -> emit::rust::RustConfig {
+        let namespaces = model
+            .models
+            .iter()
+            .filter(|m| model.sources.get(m.file).named)
+            .map(|m| emit::rust::RustNamespace {
+                uri: m.uri.clone(),
+                module: self.modules.get(&m.uri).cloned().unwrap_or_else(|| emit::rust::default_module_name(&m.uri)),
+            })
+            .collect();
+        emit::rust::RustConfig {
+            namespaces,
+            extern_paths: self.extern_paths.clone(),
+            runtime_path: self.runtime_path.clone(),
+            command: self.command.clone(),
+        }
+    }
+}
+
+impl Compiled {
+    /// The front doors' check after compiling: fails with [`Error::Diagnostics`] when errors remain, and
+    /// returns the rendered warnings otherwise.
+    pub fn checked(&mut self, severities: &Severities) -> Result<String, Error> {
+        self.diagnostics.finalize(severities, &self.model.sources, "the NodeSet2 files do not compile")
+    }
+}
+
+/// Generates Rust for `model` and finalises the emitter's diagnostics: the files and the rendered warnings,
+/// or [`Error::Diagnostics`].
+pub fn generate_rust(
+    model: &model::Model,
+    cfg: &emit::rust::RustConfig,
+    severities: &Severities,
+) -> Result<(Vec<write::OutFile>, String), Error> {
+    let mut gen = emit::rust::generate(model, cfg);
+    let rendered = gen.diagnostics.finalize(severities, &model.sources, "Rust generation failed")?;
+    Ok((gen.files, rendered))
+}
+
+/// Generates Modelica for `model` and finalises the emitter's diagnostics, like [`generate_rust`].
+pub fn generate_modelica(
+    model: &model::Model,
+    cfg: &emit::modelica::ModelicaConfig,
+    severities: &Severities,
+) -> Result<(Vec<write::OutFile>, String), Error> {
+    let mut gen = emit::modelica::generate_with_diagnostics(model, cfg);
+    let rendered = gen.diagnostics.finalize(severities, &model.sources, "Modelica generation failed")?;
+    Ok((gen.files, rendered))
 }
 
 /// The number of threads the compiler uses: the cores this process may run on.
@@ -138,9 +285,7 @@ fn finish(model: model::Model, mut diags: Diagnostics, opts: &Options) -> Compil
             d.severity == Severity::Error || d.span.is_none_or(|s| model.sources.get(s.file).named)
         });
     }
-    if opts.deny_warnings {
-        diags.deny_warnings();
-    }
+    diags.apply(&opts.severities);
     diags.sort(&model.sources);
     Compiled { model, diagnostics: diags }
 }

@@ -1,9 +1,11 @@
 //! The `nodeset-compiler` command.
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
+use nodeset_compiler::diag::{Code, Level, Severities};
 use nodeset_compiler::load::Input;
-use nodeset_compiler::{compile, summary, Options};
-use std::path::PathBuf;
+use nodeset_compiler::write::{write_tree, Mode, OutFile};
+use nodeset_compiler::{compile, summary, Compiled, Error, Options, RustOptions};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -13,19 +15,50 @@ struct Cli {
     command: Command,
 }
 
+/// What every command that reads NodeSet2 files takes: the files, where their models are found, and how
+/// severe each diagnostic is.
+#[derive(Args)]
+struct Common {
+    /// NodeSet2 files whose models are checked or generated.
+    #[arg(required = true)]
+    files: Vec<PathBuf>,
+    /// Folders searched recursively for the models the files require.
+    #[arg(long = "models", value_name = "DIR")]
+    models: Vec<PathBuf>,
+    /// Drop the diagnostics of CODE; an error with a recovery (see `nodeset-compiler codes`) then recovers
+    /// silently.
+    #[arg(long = "allow", short = 'A', value_name = "CODE")]
+    allow: Vec<String>,
+    /// Report CODE as a warning; an error with a recovery then recovers (e.g. `--warn NS0202` drops dangling
+    /// references).
+    #[arg(long = "warn", short = 'W', value_name = "CODE")]
+    warn: Vec<String>,
+    /// Report CODE as an error; `--deny warnings` turns every warning without a level of its own into an error.
+    #[arg(long = "deny", short = 'D', value_name = "CODE|warnings")]
+    deny: Vec<String>,
+}
+
+impl Common {
+    /// The compile options these flags say. Levels are applied allow, then warn, then deny: when one code is
+    /// named twice, the stricter level wins.
+    fn options(&self) -> Result<(Vec<Input>, Options), Error> {
+        let mut severities = Severities::new();
+        for (level, list) in [(Level::Allow, &self.allow), (Level::Warn, &self.warn), (Level::Deny, &self.deny)] {
+            for what in list {
+                severities.set_named(level, what)?;
+            }
+        }
+        let inputs = self.files.iter().cloned().map(Input::Path).collect();
+        Ok((inputs, Options { model_dirs: self.models.clone(), severities, ..Options::default() }))
+    }
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Parse, load and resolve NodeSet2 files; print diagnostics and a per-namespace summary.
     Check {
-        /// NodeSet2 files to check.
-        #[arg(required = true)]
-        files: Vec<PathBuf>,
-        /// Folders searched recursively for the models the files require.
-        #[arg(long = "models", value_name = "DIR")]
-        models: Vec<PathBuf>,
-        /// `--deny warnings` turns warnings into errors.
-        #[arg(long, value_name = "WHAT", value_parser = ["warnings"])]
-        deny: Option<String>,
+        #[command(flatten)]
+        common: Common,
         /// Also report warnings of model files that were loaded only as dependencies.
         #[arg(long)]
         all_warnings: bool,
@@ -38,12 +71,8 @@ enum Command {
     },
     /// Generate Rust for async-opcua 0.19 from NodeSet2 files: one module folder per namespace.
     Rust {
-        /// NodeSet2 files whose models are generated.
-        #[arg(required = true)]
-        files: Vec<PathBuf>,
-        /// Folders searched recursively for the models the files require.
-        #[arg(long = "models", value_name = "DIR")]
-        models: Vec<PathBuf>,
+        #[command(flatten)]
+        common: Common,
         /// Output folder (replaced atomically; it must hold only generated files).
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
@@ -59,99 +88,57 @@ enum Command {
         /// Compare with the output folder instead of writing; fail if it differs.
         #[arg(long)]
         check: bool,
-        /// `--deny warnings` turns warnings into errors.
-        #[arg(long, value_name = "WHAT", value_parser = ["warnings"])]
-        deny: Option<String>,
     },
     /// Generate Modelica component skeletons from NodeSet2 files: one package per namespace, the used part
     /// of the base namespace (`OpcUa`) and `OpcUaSupport`.
     Modelica {
-        /// NodeSet2 files whose models are generated.
-        #[arg(required = true)]
-        files: Vec<PathBuf>,
-        /// Folders searched recursively for the models the files require.
-        #[arg(long = "models", value_name = "DIR")]
-        models: Vec<PathBuf>,
+        #[command(flatten)]
+        common: Common,
         /// Output folder (replaced atomically; it must hold only generated files).
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
         /// Compare with the output folder instead of writing; fail if it differs.
         #[arg(long)]
         check: bool,
-        /// `--deny warnings` turns warnings into errors.
-        #[arg(long, value_name = "WHAT", value_parser = ["warnings"])]
-        deny: Option<String>,
+    },
+    /// Print the table of diagnostic codes: default severity, meaning, and what the compiler does instead
+    /// when an error is demoted (or that it cannot be).
+    Codes {
+        /// Only these codes.
+        codes: Vec<String>,
     },
 }
 
-fn pairs(items: &[String], what: &str) -> Result<Vec<(String, String)>, String> {
+fn pairs(items: &[String], what: &str) -> Result<Vec<(String, String)>, Error> {
     items
         .iter()
         .map(|i| {
             // URIs contain `=` rarely but `:` always; split at the last `=`.
             i.rsplit_once('=')
                 .map(|(a, b)| (a.to_string(), b.to_string()))
-                .ok_or_else(|| format!("--{what} takes URI=VALUE, got `{i}`"))
+                .ok_or_else(|| Error::Config(format!("--{what} takes URI=VALUE, got `{i}`")))
         })
         .collect()
 }
 
-fn rust_command(
-    files: Vec<PathBuf>,
-    models: Vec<PathBuf>,
-    out: PathBuf,
-    externs: Vec<String>,
-    modules: Vec<String>,
-    runtime: String,
-    check: bool,
-    deny: bool,
-) -> Result<(), String> {
-    use nodeset_compiler::emit::rust::{self as r, RustConfig, RustNamespace};
-    use nodeset_compiler::write::{write_tree, Mode};
-    let externs = pairs(&externs, "extern")?;
-    let modules = pairs(&modules, "module")?;
-    let opts = Options { model_dirs: models, deny_warnings: deny, ..Options::default() };
-    let compiled = compile(files.into_iter().map(Input::Path).collect(), &opts);
-    eprint!("{}", compiled.render_diagnostics());
-    if !compiled.ok() {
-        return Err("the NodeSet2 files do not compile; nothing was written".into());
-    }
-    let model = &compiled.model;
-    let namespaces: Vec<RustNamespace> = model
-        .models
-        .iter()
-        .filter(|m| model.sources.get(m.file).named)
-        .map(|m| RustNamespace {
-            uri: m.uri.clone(),
-            module: modules.iter().find(|(u, _)| *u == m.uri).map(|(_, n)| n.clone()).unwrap_or_else(|| r::default_module_name(&m.uri)),
-        })
-        .collect();
-    let cfg = RustConfig {
-        namespaces: namespaces.clone(),
-        extern_paths: externs.into_iter().collect(),
-        runtime_path: runtime,
-        command: "nodeset-compiler rust ...".into(),
-    };
-    let mut gen = r::generate(model, &cfg);
-    if deny {
-        gen.diagnostics.deny_warnings();
-    }
-    gen.diagnostics.sort(&model.sources);
-    eprint!("{}", gen.diagnostics.render(&model.sources));
-    if gen.diagnostics.has_errors() {
-        return Err("generation failed; nothing was written".into());
-    }
-    let list: Vec<(String, String)> = namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
-    gen.files.push(r::models_mod(&list, &cfg.runtime_path, "nodeset-compiler rust ..."));
-    gen.files.push(r::rustfmt_toml());
-    let report = write_tree(&out, &gen.files, if check { Mode::Check } else { Mode::Write })?;
+/// Compiles the inputs and prints the warnings; fails when errors remain.
+fn compile_checked(common: &Common) -> Result<(Compiled, Options), Error> {
+    let (inputs, opts) = common.options()?;
+    let mut compiled = compile(inputs, &opts);
+    eprint!("{}", compiled.checked(&opts.severities)?);
+    Ok((compiled, opts))
+}
+
+/// Writes (or with `check` compares) the output folder and prints what changed.
+fn write_out(out: &Path, files: &[OutFile], check: bool) -> Result<(), Error> {
+    let report = write_tree(out, files, if check { Mode::Check } else { Mode::Write }).map_err(Error::Write)?;
     if check && !report.is_clean() {
-        return Err(format!("{} is stale:\n{}", out.display(), report.describe(&out)));
+        return Err(Error::Stale(format!("{} is stale:\n{}", out.display(), report.describe(out))));
     }
     eprintln!(
         "{}: {} file(s), {} new, {} changed, {} removed, {} unchanged",
         out.display(),
-        gen.files.len(),
+        files.len(),
         report.added.len(),
         report.changed.len(),
         report.removed.len(),
@@ -160,84 +147,92 @@ fn rust_command(
     Ok(())
 }
 
-fn modelica_command(files: Vec<PathBuf>, models: Vec<PathBuf>, out: PathBuf, check: bool, deny: bool) -> Result<(), String> {
-    use nodeset_compiler::emit::modelica::{generate_with_diagnostics, ModelicaConfig};
-    use nodeset_compiler::write::{write_tree, Mode};
-    let opts = Options { model_dirs: models, deny_warnings: deny, ..Options::default() };
-    let compiled = compile(files.into_iter().map(Input::Path).collect(), &opts);
-    eprint!("{}", compiled.render_diagnostics());
-    if !compiled.ok() {
-        return Err("the NodeSet2 files do not compile; nothing was written".into());
-    }
+fn rust_command(common: &Common, out: &Path, externs: &[String], modules: &[String], runtime: &str, check: bool) -> Result<(), Error> {
+    use nodeset_compiler::emit::rust as r;
+    let rust = RustOptions {
+        modules: pairs(modules, "module")?.into_iter().collect(),
+        extern_paths: pairs(externs, "extern")?.into_iter().collect(),
+        runtime_path: runtime.to_string(),
+        command: "nodeset-compiler rust ...".into(),
+    };
+    let (compiled, opts) = compile_checked(common)?;
     let model = &compiled.model;
-    let mut gen = generate_with_diagnostics(model, &ModelicaConfig::new());
-    if deny {
-        gen.diagnostics.deny_warnings();
+    let cfg = rust.config(model);
+    let (mut files, warnings) = nodeset_compiler::generate_rust(model, &cfg, &opts.severities)?;
+    eprint!("{warnings}");
+    let list: Vec<(String, String)> = cfg.namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
+    files.push(r::models_mod(&list, &cfg.runtime_path, &cfg.command));
+    files.push(r::rustfmt_toml());
+    write_out(out, &files, check)
+}
+
+fn modelica_command(common: &Common, out: &Path, check: bool) -> Result<(), Error> {
+    use nodeset_compiler::emit::modelica::ModelicaConfig;
+    let (compiled, opts) = compile_checked(common)?;
+    let (files, warnings) = nodeset_compiler::generate_modelica(&compiled.model, &ModelicaConfig::new(), &opts.severities)?;
+    eprint!("{warnings}");
+    write_out(out, &files, check)
+}
+
+fn check_command(common: &Common, all_warnings: bool, show: &[String], depth: usize) -> Result<(), Error> {
+    let (inputs, mut opts) = common.options()?;
+    opts.all_warnings = all_warnings;
+    let out = compile(inputs, &opts);
+    eprint!("{}", out.render_diagnostics());
+    print!("{}", summary::render(&out.model));
+    for q in show {
+        let hits = out.model.find(q);
+        match hits.first() {
+            Some(&t) => print!("\n{}", summary::show_type(&out.model, t, depth)),
+            None => eprintln!("error: `{q}` names no node (try a BrowseName, `URI#Name` or `ns=N;i=M`)"),
+        }
     }
-    gen.diagnostics.sort(&model.sources);
-    eprint!("{}", gen.diagnostics.render(&model.sources));
-    if gen.diagnostics.has_errors() {
-        return Err("generation failed; nothing was written".into());
+    let (e, w) = (out.diagnostics.error_count(), out.diagnostics.warning_count());
+    eprintln!("{e} error(s), {w} warning(s)");
+    if e > 0 {
+        // The diagnostics were printed above, with the summary.
+        return Err(Error::Diagnostics { stage: "the NodeSet2 files do not compile".into(), errors: e, rendered: String::new() });
     }
-    let report = write_tree(&out, &gen.files, if check { Mode::Check } else { Mode::Write })?;
-    if check && !report.is_clean() {
-        return Err(format!("{} is stale:\n{}", out.display(), report.describe(&out)));
+    Ok(())
+}
+
+fn codes_command(codes: &[String]) -> Result<(), Error> {
+    let table = Code::table();
+    if codes.is_empty() {
+        print!("{table}");
+        return Ok(());
     }
-    eprintln!(
-        "{}: {} file(s), {} new, {} changed, {} removed, {} unchanged",
-        out.display(),
-        gen.files.len(),
-        report.added.len(),
-        report.changed.len(),
-        report.removed.len(),
-        report.unchanged
-    );
+    for c in codes {
+        let code = Code::parse(c).ok_or_else(|| Error::Severity(nodeset_compiler::diag::SeverityError::UnknownCode(c.clone())))?;
+        // An entry is its line and the indented line below it.
+        let mut lines = table.lines().skip_while(|l| !l.starts_with(code.as_str()));
+        for l in lines.by_ref().take(2) {
+            println!("{l}");
+        }
+    }
     Ok(())
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    match cli.command {
-        Command::Rust { files, models, out, externs, modules, runtime, check, deny } => {
-            match rust_command(files, models, out, externs, modules, runtime, check, deny.is_some()) {
-                Ok(()) => ExitCode::SUCCESS,
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::FAILURE
-                }
+    let result = match &cli.command {
+        Command::Rust { common, out, externs, modules, runtime, check } => rust_command(common, out, externs, modules, runtime, *check),
+        Command::Modelica { common, out, check } => modelica_command(common, out, *check),
+        Command::Check { common, all_warnings, show, depth } => check_command(common, *all_warnings, show, *depth),
+        Command::Codes { codes } => codes_command(codes),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Error::Diagnostics { stage, rendered, .. }) => {
+            eprint!("{rendered}");
+            if !rendered.is_empty() {
+                eprintln!("error: {stage}; nothing was written");
             }
+            ExitCode::FAILURE
         }
-        Command::Modelica { files, models, out, check, deny } => match modelica_command(files, models, out, check, deny.is_some()) {
-            Ok(()) => ExitCode::SUCCESS,
-            Err(e) => {
-                eprintln!("error: {e}");
-                ExitCode::FAILURE
-            }
-        },
-        Command::Check { files, models, deny, all_warnings, show, depth } => {
-            let opts = Options {
-                model_dirs: models,
-                deny_warnings: deny.is_some(),
-                all_warnings,
-                ..Options::default()
-            };
-            let out = compile(files.into_iter().map(Input::Path).collect(), &opts);
-            eprint!("{}", out.render_diagnostics());
-            print!("{}", summary::render(&out.model));
-            for q in &show {
-                let hits = out.model.find(q);
-                match hits.first() {
-                    Some(&t) => print!("\n{}", summary::show_type(&out.model, t, depth)),
-                    None => eprintln!("error: `{q}` names no node (try a BrowseName, `URI#Name` or `ns=N;i=M`)"),
-                }
-            }
-            let (e, w) = (out.diagnostics.error_count(), out.diagnostics.warning_count());
-            eprintln!("{e} error(s), {w} warning(s)");
-            if e > 0 {
-                ExitCode::FAILURE
-            } else {
-                ExitCode::SUCCESS
-            }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
         }
     }
 }

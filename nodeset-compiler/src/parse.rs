@@ -866,6 +866,23 @@ impl<'a, 'd> Parser<'a, 'd> {
         }
     }
 
+    /// An AccessLevel is a Byte; files that write their AccessLevelEx there (`771`) get NS0012 and the low byte
+    /// (the error's recovery, kept when it is demoted).
+    fn access_level(&mut self, a: &Attr<'a>) -> Option<u8> {
+        match a.value.trim().parse::<u32>() {
+            Ok(v) if v > 0xFF => {
+                self.diags.push(
+                    Diagnostic::new(Code::AccessLevelRange, format!("{}=\"{}\" does not fit in a Byte", a.key, a.value))
+                        .at(a.span)
+                        .with_span_label(format!("read as {} (the low byte)", v & 0xFF))
+                        .help("AccessLevel is a Byte (0 to 255); bits above it belong in AccessLevelEx"),
+                );
+                Some((v & 0xFF) as u8)
+            }
+            _ => self.number(a),
+        }
+    }
+
     fn boolean(&mut self, a: &Attr<'a>) -> Option<bool> {
         match a.value.trim() {
             "true" | "1" => Some(true),
@@ -910,8 +927,8 @@ impl<'a, 'd> Parser<'a, 'd> {
                 "DataType" => node.data_type = Some(raw()),
                 "ValueRank" => node.value_rank = self.number(a),
                 "ArrayDimensions" => node.array_dimensions = Some(spanned()),
-                "AccessLevel" => node.access_level = self.number(a),
-                "UserAccessLevel" => node.user_access_level = self.number(a),
+                "AccessLevel" => node.access_level = self.access_level(a),
+                "UserAccessLevel" => node.user_access_level = self.access_level(a),
                 "AccessLevelEx" => node.access_level_ex = self.number(a),
                 "MinimumSamplingInterval" => node.minimum_sampling_interval = self.number(a),
                 "Historizing" => node.historizing = self.boolean(a),

@@ -53,6 +53,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
     let numeric_fast: Vec<bool> =
         contexts.iter().map(|c| !c.aliases.keys().any(|a| crate::nodeid::looks_like_node_id(a))).collect();
     let mut pending: Vec<(NodeIx, u32, u32)> = Vec::with_capacity(total);
+    let mut redefined: Vec<Redefinition> = Vec::new();
     for (fi, f) in files.iter_mut().enumerate() {
         let file = f.raw.file;
         let text = sources.get(file).text.as_str();
@@ -106,14 +107,8 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 }
             };
             if let Some(&prev) = model.index.get(&id) {
-                let p = &model.nodes[prev.index()];
-                diags.push(
-                    Diagnostic::new(Code::DuplicateNodeId, format!("NodeId `{}` is defined twice", display_id(&model, &id)))
-                        .at(raw.node_id.span)
-                        .with_span_label("defined again here")
-                        .label(p.node_id_span, "first defined here")
-                        .help("every node needs its own NodeId; the second definition is ignored"),
-                );
+                // Judged after this pass, when both raw nodes can be read: an identical copy is a warning.
+                redefined.push(Redefinition { prev, file: fi as u32, node: ni as u32, id, browse_name });
                 continue;
             }
             let ix = NodeIx(model.nodes.len() as u32);
@@ -170,6 +165,10 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
             });
             pending.push((ix, fi as u32, ni as u32));
         }
+    }
+
+    for r in &redefined {
+        diags.push(redefinition(&model, &files, &contexts, &sources, &value_arenas, &pending, r));
     }
 
     // Pass 2: attributes that name nodes, and references. The raw nodes are only read from here on. Two
@@ -499,6 +498,95 @@ fn resolve_cached<'s>(
             diags.push(d);
             None
         }
+    }
+}
+
+/// A node whose NodeId was already defined (NS0201, or NS0218 when the copy is identical).
+struct Redefinition {
+    /// The node defined first.
+    prev: NodeIx,
+    /// Where the second definition is: file and node index of the raw node.
+    file: u32,
+    node: u32,
+    id: NodeId,
+    browse_name: QualifiedName,
+}
+
+/// The diagnostic for a second definition of a NodeId: a warning when it is an identical copy (same class,
+/// names, attributes, DataType, references, definition and value; files without `<Models>` often carry
+/// their own copy of part of ns0), the error NS0201 with both locations otherwise. Either way the first
+/// definition is kept.
+fn redefinition(
+    model: &Model,
+    files: &[crate::load::LoadedFile],
+    contexts: &[FileContext],
+    sources: &SourceMap,
+    values: &[ValueArena],
+    pending: &[(NodeIx, u32, u32)],
+    r: &Redefinition,
+) -> Diagnostic {
+    let p = &model.nodes[r.prev.index()];
+    let (_, pfi, pni) = pending[r.prev.index()];
+    let node_of = |fi: u32, ni: u32| &files[fi as usize].raw.nodes[ni as usize];
+    let (a, b) = (node_of(pfi, pni), node_of(r.file, r.node));
+    let b_span = b.node_id.span;
+    let resolve = |fi: u32, text: &str, span: Span| {
+        let ctx = &contexts[fi as usize];
+        crate::load::resolve_node_id_str(&ctx.ns_map, &ctx.aliases, text, span, &model.namespaces).ok()
+    };
+    let text_of = |fi: u32| sources.get(files[fi as usize].raw.file).text.as_str();
+    let refs = |fi: u32, n: &crate::raw::RawNode| {
+        let text = text_of(fi);
+        let mut list: Vec<Option<(NodeId, NodeId, bool)>> = files[fi as usize]
+            .raw
+            .references_of(n)
+            .iter()
+            .map(|x| {
+                Some((resolve(fi, x.reference_type.get(text), x.reference_type.span)?, resolve(fi, x.target.get(text), x.target.span)?, x.is_forward))
+            })
+            .collect();
+        list.sort();
+        list.dedup();
+        list
+    };
+    let data_type = |fi: u32, n: &crate::raw::RawNode| n.data_type.as_ref().map(|d| resolve(fi, d.get(text_of(fi)), d.span));
+    let value = |fi: u32, n: &crate::raw::RawNode| {
+        let file = files[fi as usize].raw.file;
+        n.value.map(|v| {
+            let text = sources.get(file).text.as_str();
+            let e = values[file.0 as usize].element(v, text);
+            let span = e.span();
+            text.get(span.start as usize..span.end as usize).unwrap_or("").split_whitespace().collect::<String>()
+        })
+    };
+    let fields = |d: Option<&crate::raw::RawDefinition>| {
+        d.map(|d| {
+            let list: Vec<_> = d.fields.iter().map(|f| (f.name.clone(), f.value, f.data_type.as_ref().map(|t| t.value.clone()), f.value_rank, f.is_optional)).collect();
+            (d.name.clone(), d.is_union, d.is_option_set, list)
+        })
+    };
+    let identical = p.class == b.class
+        && p.browse_name == r.browse_name
+        && p.display_name == b.display_names
+        && (a.value_rank, a.access_level, a.user_access_level, a.is_abstract, a.symmetric, a.event_notifier, a.executable)
+            == (b.value_rank, b.access_level, b.user_access_level, b.is_abstract, b.symmetric, b.event_notifier, b.executable)
+        && data_type(pfi, a) == data_type(r.file, b)
+        && refs(pfi, a) == refs(r.file, b)
+        && value(pfi, a) == value(r.file, b)
+        && fields(p.definition.as_deref()) == fields(b.definition.as_deref());
+    if identical {
+        Diagnostic::new(Code::IdenticalRedefinition, format!("NodeId `{}` is defined again, identically", display_id(model, &r.id)))
+            .at(b_span)
+            .with_span_label("an identical copy")
+            .label(p.node_id_span, "first defined here")
+            .note("the copy is ignored; the node loaded first is used")
+            .help("remove the copy from the file, or load the file that defines the node without it")
+    } else {
+        Diagnostic::new(Code::DuplicateNodeId, format!("NodeId `{}` is defined twice", display_id(model, &r.id)))
+            .at(b_span)
+            .with_span_label("defined again here, differently")
+            .label(p.node_id_span, "first defined here")
+            .help("every node needs its own NodeId; the second definition is ignored")
     }
 }
 

@@ -1,5 +1,6 @@
-//! Generates every one-feature fixture of tests/fixtures through the build.rs API (bad inputs excepted), and
-//! the two public skill reference models of ../shared/nodesets/skills-reference.
+//! Generates every one-feature fixture of tests/fixtures through the build.rs API (bad inputs excepted), the
+//! recovery fixtures of tests/fixtures/recover with every demotable error demoted (`--warn CODE`), and the two
+//! public skill reference models of ../shared/nodesets/skills-reference.
 
 fn main() {
     let fixtures = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fixtures");
@@ -9,7 +10,7 @@ fn main() {
         .expect("tests/fixtures exists")
         .flatten()
         .map(|e| e.path())
-        .filter(|p| p.is_dir() && p.file_name().is_some_and(|n| n != "bad"))
+        .filter(|p| p.is_dir() && p.file_name().is_some_and(|n| n != "bad" && n != "recover"))
         .collect();
     cases.sort();
     for case in cases {
@@ -18,6 +19,21 @@ fn main() {
         for f in files.into_iter().filter(|f| f.extension().is_some_and(|x| x == "xml")) {
             builder = builder.file(f);
         }
+    }
+    builder.generate().unwrap_or_else(|e| panic!("{e}"));
+
+    // The recovery fixtures, each error demoted: what the compiler does instead must compile too.
+    let recover = fixtures.join("recover");
+    let mut builder = nodeset_compiler::build::Builder::new().models_dir(&vendor).out_file("recovered.rs");
+    for code in nodeset_compiler::diag::Code::ALL {
+        if code.default_severity() == nodeset_compiler::diag::Severity::Error && code.recovery().is_some() {
+            builder = builder.warn(code.as_str());
+        }
+    }
+    let mut files: Vec<_> = std::fs::read_dir(&recover).expect("tests/fixtures/recover exists").flatten().map(|e| e.path()).collect();
+    files.sort();
+    for f in files.into_iter().filter(|f| f.extension().is_some_and(|x| x == "xml")) {
+        builder = builder.file(f);
     }
     builder.generate().unwrap_or_else(|e| panic!("{e}"));
 

@@ -52,12 +52,11 @@ pub fn plan_into(crate_dir: &Path, extra_inputs: &[PathBuf], deny_warnings: bool
         .map(|(f, _)| Input::Path(root.join("nodesets").join(f)))
         .chain(extra_inputs.iter().cloned().map(Input::Path))
         .collect();
-    let out = compile(inputs, &Options { model_dirs: vec![vendor.clone()], deny_warnings, ..Options::default() });
-    let rendered = out.render_diagnostics();
-    if !out.ok() {
-        return Err(format!("{rendered}the pinned nodesets do not compile; generated/ is left as it was"));
-    }
-    eprint!("{rendered}");
+    let mut opts = Options { model_dirs: vec![vendor.clone()], ..Options::default() };
+    opts.severities.deny_warnings(deny_warnings);
+    let left = |e: nodeset_compiler::Error| format!("{e}generated/ is left as it was");
+    let mut out = compile(inputs, &opts);
+    eprint!("{}", out.checked(&opts.severities).map_err(left)?);
     let model = &out.model;
 
     let mut namespaces = Vec::new();
@@ -75,34 +74,18 @@ pub fn plan_into(crate_dir: &Path, extra_inputs: &[PathBuf], deny_warnings: bool
         runtime_path: "crate::runtime".into(),
         command: COMMAND.into(),
     };
-    let mut rust = rust_emit::generate(model, &cfg);
-    let mut diags = rust.diagnostics;
-    if deny_warnings {
-        diags.deny_warnings();
-    }
-    diags.sort(&model.sources);
-    eprint!("{}", diags.render(&model.sources));
-    if diags.has_errors() {
-        return Err("Rust generation failed; generated/ is left as it was".into());
-    }
+    let (mut rust, warnings) = nodeset_compiler::generate_rust(model, &cfg, &opts.severities).map_err(left)?;
+    eprint!("{warnings}");
     let modules: Vec<(String, String)> = namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
-    rust.files.push(rust_emit::models_mod(&modules, &cfg.runtime_path, COMMAND));
-    rust.files.push(rust_emit::rustfmt_toml());
+    rust.push(rust_emit::models_mod(&modules, &cfg.runtime_path, COMMAND));
+    rust.push(rust_emit::rustfmt_toml());
     // Modelica: one package per namespace (and the used part of ns0, and the support package).
     let mcfg = namespaces
         .iter()
         .fold(nodeset_compiler::emit::modelica::ModelicaConfig::new(), |c, n| c.namespace(n.uri.clone()));
-    let modelica = nodeset_compiler::emit::modelica::generate_with_diagnostics(model, &mcfg);
-    let mut mdiags = modelica.diagnostics;
-    if deny_warnings {
-        mdiags.deny_warnings();
-    }
-    mdiags.sort(&model.sources);
-    eprint!("{}", mdiags.render(&model.sources));
-    if mdiags.has_errors() {
-        return Err("Modelica generation failed; generated/ is left as it was".into());
-    }
-    Ok(vec![(crate_dir.join("src/models"), rust.files), (crate_dir.join("modelica"), modelica.files)])
+    let (modelica, warnings) = nodeset_compiler::generate_modelica(model, &mcfg, &opts.severities).map_err(left)?;
+    eprint!("{warnings}");
+    Ok(vec![(crate_dir.join("src/models"), rust), (crate_dir.join("modelica"), modelica)])
 }
 
 pub fn run(args: Args) -> Result<(), String> {

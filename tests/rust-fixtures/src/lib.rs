@@ -7,3 +7,8 @@ include!(concat!(env!("OUT_DIR"), "/nodesets.rs"));
 pub mod skills_reference {
     include!(concat!(env!("OUT_DIR"), "/skills_reference.rs"));
 }
+
+/// The recovery fixtures of tests/fixtures/recover, generated with every demotable error demoted.
+pub mod recovered {
+    include!(concat!(env!("OUT_DIR"), "/recovered.rs"));
+}
