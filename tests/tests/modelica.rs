@@ -210,42 +210,75 @@ fn companion_specs_and_the_example_pass_rumoca_and_the_example_simulates() {
 
     // The example: the axis follows its target with a first-order lag, and the generated OPC UA variable
     // ParameterSet/ActualPosition carries the position.
-    let sim = |model: &str, at: &str| -> Vec<(String, f64, f64)> {
-        let out = Command::new(python())
-            .arg(root().join("tests/modelica/simulate.py"))
-            .arg(&target)
-            .arg(model)
-            .arg(at)
-            .output()
-            .expect("cannot run tests/modelica/simulate.py");
-        let text = String::from_utf8_lossy(&out.stdout).into_owned();
-        assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
-        assert!(text.contains(&format!("simulated {model}")), "{text}");
-        text.lines()
-            .filter_map(|l| {
-                let mut parts = l.split_whitespace();
-                let name = parts.next()?.to_string();
-                let at: f64 = parts.next()?.split('@').next()?.parse().ok()?;
-                let end: f64 = parts.next()?.split('@').next()?.parse().ok()?;
-                Some((name, at, end))
-            })
-            .collect()
-    };
-    let value = |vars: &[(String, f64, f64)], name: &str| -> (f64, f64) {
-        vars.iter()
-            .find(|v| v.0 == name)
-            .map(|v| (v.1, v.2))
-            .unwrap_or_else(|| panic!("no variable {name} in {vars:?}"))
-    };
-    let axis = sim("RoboticsExample.AxisDemo", "0.2");
+    let axis = simulate(&target, "RoboticsExample.AxisDemo", "0.2");
     let (at_t, end) = value(&axis, "axis.parameterSet.actualPosition");
     let expected = 1.0 - (-1.0f64).exp();
     assert!((at_t - expected).abs() < 1e-3, "ActualPosition at t = T is {at_t}, expected {expected}");
     assert!((end - 1.0).abs() < 1e-3, "ActualPosition at the end is {end}");
-    let robot = sim("RoboticsExample.RobotDemo", "0.1");
+    let robot = simulate(&target, "RoboticsExample.RobotDemo", "0.1");
     let (_, a1) = value(&robot, "robot.axes.axisIdentifier[1].position");
     let (_, a2) = value(&robot, "robot.axes.axisIdentifier[2].position");
     assert!((a1 - 1.0).abs() < 1e-2 && (a2 + 0.5).abs() < 1e-2, "the robot's axes end at {a1} and {a2}");
+    // Each axis inside the motion device keeps its own ParameterSet class (AxisType_ParameterSet, with
+    // ActualPosition), not the motion device's: rumoca would otherwise let MotionDeviceType's redeclaration of
+    // ParameterSet replace it (see tests/modelica/RumocaBehaviour).
+    for (i, target_pos) in [(1, 1.0), (2, -0.5)] {
+        let (_, p) = value(&robot, &format!("robot.axes.axisIdentifier[{i}].parameterSet.actualPosition"));
+        assert!((p - target_pos).abs() < 1e-2, "axis {i}: ParameterSet/ActualPosition ends at {p}");
+    }
+}
+
+/// Simulates `model` below `root` with `tests/modelica/simulate.py`; (name, value at `at`, final value).
+fn simulate(root_dir: &Path, model: &str, at: &str) -> Vec<(String, f64, f64)> {
+    let out = Command::new(python())
+        .arg(root().join("tests/modelica/simulate.py"))
+        .arg(root_dir)
+        .arg(model)
+        .arg(at)
+        .output()
+        .expect("cannot run tests/modelica/simulate.py");
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains(&format!("simulated {model}")), "{text}");
+    text.lines()
+        .filter_map(|l| {
+            let mut parts = l.split_whitespace();
+            let name = parts.next()?.to_string();
+            let at: f64 = parts.next()?.split('@').next()?.parse().ok()?;
+            let end: f64 = parts.next()?.split('@').next()?.parse().ok()?;
+            Some((name, at, end))
+        })
+        .collect()
+}
+
+/// The value of variable `name` in a [`simulate`] result: (at the requested time, at the end).
+fn value(vars: &[(String, f64, f64)], name: &str) -> (f64, f64) {
+    vars.iter()
+        .find(|v| v.0 == name)
+        .map(|v| (v.1, v.2))
+        .unwrap_or_else(|| panic!("no variable {name} in {vars:?}"))
+}
+
+/// What rumoca 0.10.2 does with redeclarations, reproduced with small hand-written models
+/// (`tests/modelica/RumocaBehaviour`, which documents each case). The generator works around the first one
+/// (`Mod::Pin`); if a rumoca release fixes it, this test fails and the workaround can be reconsidered.
+#[test]
+fn rumoca_behaviour_is_as_reproduced() {
+    let dir = root().join("tests/modelica");
+    let names = |vars: &[(String, f64, f64)]| vars.iter().map(|v| v.0.clone()).collect::<Vec<_>>();
+    // An enclosing instance's redeclaration of an inherited alias replaces the nested class's own choice.
+    let leak = simulate(&dir, "RumocaBehaviour.LeakDemo", "1");
+    assert!(names(&leak).contains(&"r.a.ps.speed".to_string()), "the leak is gone: {:?}", names(&leak));
+    assert!(!names(&leak).contains(&"r.a.ps.pos".to_string()), "the leak is gone: {:?}", names(&leak));
+    // Repeating the choice on the component (what the generator writes) keeps the nested class's own.
+    let pinned = simulate(&dir, "RumocaBehaviour.PinnedDemo", "1");
+    let (_, pos) = value(&pinned, "r.a.ps.pos");
+    assert!((pos - (1.0 - (-5.0f64).exp())).abs() < 1e-3, "r.a.ps.pos ends at {pos}");
+    assert!(!names(&pinned).contains(&"r.a.ps.speed".to_string()), "{:?}", names(&pinned));
+    // A replaceable component redeclared two extends levels below its declaration is dropped.
+    let dropped = simulate(&dir, "RumocaBehaviour.DroppedDemo", "1");
+    assert!(names(&dropped).contains(&"a.y".to_string()), "{:?}", names(&dropped));
+    assert!(!names(&dropped).contains(&"a.ps.pos".to_string()), "rumoca keeps the component now: {:?}", names(&dropped));
 }
 
 /// Generates the models of each file (with everything it requires, ns0 as a subset) and checks each output

@@ -5,12 +5,16 @@ model DrillingCellType_SkillSet "SkillSet: The process skills of the cell (ISkil
   extends OpcUa.ObjectTypes.FolderType;
   replaceable model ReferenceDrillBush = NodesetCompilerDrillingProcess.ObjectTypes.ReferenceDrillBushSkillType
     "Class of ReferenceDrillBush; redeclare it to use a model of your own";
-  ReferenceDrillBush referenceDrillBush
+  ReferenceDrillBush referenceDrillBush(
+      redeclare model InputParameterSet = NodesetCompilerDrillingProcess.Declarations.ReferenceDrillBushSkillType_InputParameterSet,
+      redeclare model OutputParameterSet = NodesetCompilerDrillingProcess.Declarations.ReferenceDrillBushSkillType_OutputParameterSet)
     "ReferenceDrillBush: Positions the end effector in front of the next drill bush."
     annotation (__OPCUA(browsePath="ReferenceDrillBush", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=3002", typeDefinition="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1000"));
   replaceable model DrillHole = NodesetCompilerDrillingProcess.ObjectTypes.DrillHoleSkillType
     "Class of DrillHole; redeclare it to use a model of your own";
-  DrillHole drillHole
+  DrillHole drillHole(
+      redeclare model InputParameterSet = NodesetCompilerDrillingProcess.Declarations.DrillHoleSkillType_InputParameterSet,
+      redeclare model OutputParameterSet = NodesetCompilerCommonSkills.Declarations.ProgramSkillStateMachineType_OutputParameterSet)
     "DrillHole: Drills the hole of the drill bush the end effector is in front of."
     annotation (__OPCUA(browsePath="DrillHole", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=3045", typeDefinition="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=2000"));
   annotation (

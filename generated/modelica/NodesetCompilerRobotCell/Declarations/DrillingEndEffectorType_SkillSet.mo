@@ -5,7 +5,9 @@ model DrillingEndEffectorType_SkillSet "SkillSet: The skills of the end effector
   extends OpcUa.ObjectTypes.FolderType;
   replaceable model TemplateDrilling = NodesetCompilerRobotCell.ObjectTypes.TemplateDrillingSkillType
     "Class of TemplateDrilling; redeclare it to use a model of your own";
-  TemplateDrilling templateDrilling
+  TemplateDrilling templateDrilling(
+      redeclare model InputParameterSet = NodesetCompilerRobotCell.Declarations.TemplateDrillingSkillType_InputParameterSet,
+      redeclare model OutputParameterSet = NodesetCompilerCommonSkills.Declarations.ProgramSkillStateMachineType_OutputParameterSet)
     "TemplateDrilling: Drills one hole through the drill bush the end effector sits in."
     annotation (__OPCUA(browsePath="TemplateDrilling", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=2005", typeDefinition="nsu=http://nodeset-compiler.dev/RobotCell/;i=1000"));
   annotation (

@@ -5,7 +5,10 @@ model UR10eSystemType_Controllers "Controllers: The controller of the UR10e."
   extends OpcUaRobotics.Declarations.MotionDeviceSystemType_Controllers;
   replaceable model URController = NodesetCompilerRobotCell.Declarations.UR10eSystemType_ControllersURController
     "Class of URController; redeclare it to use a model of your own";
-  URController urController
+  URController urController(
+      redeclare model ParameterSet = OpcUaRobotics.Declarations.ControllerType_ParameterSet,
+      redeclare model Software = NodesetCompilerRobotCell.Declarations.UR10eSystemType_ControllersURControllerSoftware,
+      redeclare model TaskControls = NodesetCompilerRobotCell.Declarations.UR10eSystemType_ControllersURControllerTaskControls)
     "URController: The UR10e control box. Besides the Robotics controller data it offers the basic move skills of the robot in SkillSet (ISkillSetType)."
     annotation (__OPCUA(browsePath="URController", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4002", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1003"));
   annotation (

@@ -5,17 +5,23 @@ model UR10eSystemType_ControllersURControllerSkillSet "SkillSet: The basic move 
   extends OpcUa.ObjectTypes.FolderType;
   replaceable model AbsoluteJointPTPMove = NodesetCompilerCommonSkills.ObjectTypes.AbsoluteJointPTPMoveSkillType
     "Class of AbsoluteJointPTPMove; redeclare it to use a model of your own";
-  AbsoluteJointPTPMove absoluteJointPTPMove
+  AbsoluteJointPTPMove absoluteJointPTPMove(
+      redeclare model InputParameterSet = NodesetCompilerCommonSkills.Declarations.AbsoluteJointPTPMoveSkillType_InputParameterSet,
+      redeclare model OutputParameterSet = NodesetCompilerCommonSkills.Declarations.ProgramSkillStateMachineType_OutputParameterSet)
     "AbsoluteJointPTPMove: Moves the six joints point to point to TargetJointPositions."
     annotation (__OPCUA(browsePath="AbsoluteJointPTPMove", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4021", typeDefinition="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1600"));
   replaceable model RelativeCartesianLinearMove = NodesetCompilerCommonSkills.ObjectTypes.RelativeCartesianLinearMoveSkillType
     "Class of RelativeCartesianLinearMove; redeclare it to use a model of your own";
-  RelativeCartesianLinearMove relativeCartesianLinearMove
+  RelativeCartesianLinearMove relativeCartesianLinearMove(
+      redeclare model InputParameterSet = NodesetCompilerCommonSkills.Declarations.RelativeCartesianLinearMoveSkillType_InputParameterSet,
+      redeclare model OutputParameterSet = NodesetCompilerCommonSkills.Declarations.ProgramSkillStateMachineType_OutputParameterSet)
     "RelativeCartesianLinearMove: Moves the tool centre point on a straight line by PoseOffset in the tool frame."
     annotation (__OPCUA(browsePath="RelativeCartesianLinearMove", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4044", typeDefinition="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1700"));
   replaceable model AbsoluteCartesianLinearMove = NodesetCompilerCommonSkills.ObjectTypes.AbsoluteCartesianLinearMoveSkillType
     "Class of AbsoluteCartesianLinearMove; redeclare it to use a model of your own";
-  AbsoluteCartesianLinearMove absoluteCartesianLinearMove
+  AbsoluteCartesianLinearMove absoluteCartesianLinearMove(
+      redeclare model InputParameterSet = NodesetCompilerCommonSkills.Declarations.AbsoluteCartesianLinearMoveSkillType_InputParameterSet,
+      redeclare model OutputParameterSet = NodesetCompilerCommonSkills.Declarations.ProgramSkillStateMachineType_OutputParameterSet)
     "AbsoluteCartesianLinearMove: Moves the tool centre point on a straight line to TargetPose in the base frame."
     annotation (__OPCUA(browsePath="AbsoluteCartesianLinearMove", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4076", typeDefinition="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1800"));
   annotation (

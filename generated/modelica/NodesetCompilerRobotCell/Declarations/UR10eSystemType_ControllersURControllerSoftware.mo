@@ -5,7 +5,10 @@ model UR10eSystemType_ControllersURControllerSoftware "Software: The software ru
   extends OpcUaRobotics.Declarations.ControllerType_Software;
   replaceable model PolyScope = OpcUaDI.ObjectTypes.SoftwareType
     "Class of PolyScope; redeclare it to use a model of your own";
-  PolyScope polyScope(manufacturer="Universal Robots A/S", model_="PolyScope")
+  PolyScope polyScope(
+      redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType,
+      manufacturer="Universal Robots A/S",
+      model_="PolyScope")
     "PolyScope: The robot operating software of the controller."
     annotation (__OPCUA(browsePath="PolyScope", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4010", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=15106"));
   annotation (

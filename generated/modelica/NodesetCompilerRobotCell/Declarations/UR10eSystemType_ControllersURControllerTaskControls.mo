@@ -5,7 +5,7 @@ model UR10eSystemType_ControllersURControllerTaskControls "TaskControls: The pro
   extends OpcUaRobotics.Declarations.ControllerType_TaskControls;
   replaceable model ProgramTask = OpcUaRobotics.ObjectTypes.TaskControlType
     "Class of ProgramTask; redeclare it to use a model of your own";
-  ProgramTask programTask
+  ProgramTask programTask(redeclare model ParameterSet = OpcUaRobotics.Declarations.TaskControlType_ParameterSet)
     "ProgramTask: The one program task of the controller; the skills run through it."
     annotation (__OPCUA(browsePath="ProgramTask", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4015", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1011"));
   annotation (

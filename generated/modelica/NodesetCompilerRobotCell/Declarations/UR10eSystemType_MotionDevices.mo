@@ -5,7 +5,10 @@ model UR10eSystemType_MotionDevices "MotionDevices: The arm of the UR10e."
   extends OpcUaRobotics.Declarations.MotionDeviceSystemType_MotionDevices;
   replaceable model Manipulator = NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulator
     "Class of Manipulator; redeclare it to use a model of your own";
-  Manipulator manipulator
+  Manipulator manipulator(
+      redeclare model ParameterSet = OpcUaRobotics.Declarations.MotionDeviceType_ParameterSet,
+      redeclare model Axes = NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorAxes,
+      redeclare model PowerTrains = NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrains)
     "Manipulator: The six-joint UR10e arm."
     annotation (__OPCUA(browsePath="Manipulator", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4109", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1004"));
   annotation (

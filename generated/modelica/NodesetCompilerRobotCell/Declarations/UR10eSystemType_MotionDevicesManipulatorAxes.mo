@@ -6,6 +6,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
   replaceable model Base = OpcUaRobotics.ObjectTypes.AxisType
     "Class of Base; redeclare it to use a model of your own";
   Base base(
+      redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
       parameterSet(actualPosition(unit="deg")),
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Base: Joint 1 of the UR10e (base), rotary, limited to ±360°."
@@ -13,6 +14,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
   replaceable model Shoulder = OpcUaRobotics.ObjectTypes.AxisType
     "Class of Shoulder; redeclare it to use a model of your own";
   Shoulder shoulder(
+      redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
       parameterSet(actualPosition(unit="deg")),
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Shoulder: Joint 2 of the UR10e (shoulder), rotary, limited to ±360°."
@@ -20,6 +22,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
   replaceable model Elbow = OpcUaRobotics.ObjectTypes.AxisType
     "Class of Elbow; redeclare it to use a model of your own";
   Elbow elbow(
+      redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
       parameterSet(actualPosition(unit="deg")),
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Elbow: Joint 3 of the UR10e (elbow), rotary, limited to ±360°."
@@ -27,6 +30,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
   replaceable model Wrist1 = OpcUaRobotics.ObjectTypes.AxisType
     "Class of Wrist1; redeclare it to use a model of your own";
   Wrist1 wrist1(
+      redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
       parameterSet(actualPosition(unit="deg")),
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Wrist1: Joint 4 of the UR10e (wrist 1), rotary, limited to ±360°."
@@ -34,6 +38,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
   replaceable model Wrist2 = OpcUaRobotics.ObjectTypes.AxisType
     "Class of Wrist2; redeclare it to use a model of your own";
   Wrist2 wrist2(
+      redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
       parameterSet(actualPosition(unit="deg")),
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Wrist2: Joint 5 of the UR10e (wrist 2), rotary, limited to ±360°."
@@ -41,6 +46,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
   replaceable model Wrist3 = OpcUaRobotics.ObjectTypes.AxisType
     "Class of Wrist3; redeclare it to use a model of your own";
   Wrist3 wrist3(
+      redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
       parameterSet(actualPosition(unit="deg")),
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Wrist3: Joint 6 of the UR10e (wrist 3), rotary, limited to ±360°."

@@ -5,7 +5,7 @@ model UR10eSystemType_SafetyStates "SafetyStates: The safety state of the UR10e.
   extends OpcUaRobotics.Declarations.MotionDeviceSystemType_SafetyStates;
   replaceable model SafetyState = OpcUaRobotics.ObjectTypes.SafetyStateType
     "Class of SafetyState; redeclare it to use a model of your own";
-  SafetyState safetyState
+  SafetyState safetyState(redeclare model ParameterSet = OpcUaRobotics.Declarations.SafetyStateType_ParameterSet)
     "SafetyState: Emergency stop, protective stop and operational mode of the UR10e."
     annotation (__OPCUA(browsePath="SafetyState", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4204", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1013"));
   annotation (

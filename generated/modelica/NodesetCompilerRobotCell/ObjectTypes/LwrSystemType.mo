@@ -5,7 +5,11 @@ model LwrSystemType "LwrSystemType: A lightweight robot system: a collaborative 
   extends OpcUaDI.ObjectTypes.ComponentType;
   replaceable model MotionDeviceSystem = OpcUaRobotics.ObjectTypes.MotionDeviceSystemType
     "Class of MotionDeviceSystem; redeclare it to use a model of your own";
-  MotionDeviceSystem motionDeviceSystem
+  MotionDeviceSystem motionDeviceSystem(
+      redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType,
+      redeclare model Controllers = OpcUaRobotics.Declarations.MotionDeviceSystemType_Controllers,
+      redeclare model MotionDevices = OpcUaRobotics.Declarations.MotionDeviceSystemType_MotionDevices,
+      redeclare model SafetyStates = OpcUaRobotics.Declarations.MotionDeviceSystemType_SafetyStates)
     "MotionDeviceSystem: The robot: its controllers, manipulators and safety states. Any MotionDeviceSystemType; instances use the subtype of their robot, such as UR10eSystemType."
     annotation (__OPCUA(browsePath="MotionDeviceSystem", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=3001", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1002"));
   replaceable model SkillSet = OpcUa.ObjectTypes.FolderType

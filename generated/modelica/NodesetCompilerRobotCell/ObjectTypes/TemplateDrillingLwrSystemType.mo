@@ -5,7 +5,7 @@ model TemplateDrillingLwrSystemType "TemplateDrillingLwrSystemType: A lightweigh
   extends NodesetCompilerRobotCell.ObjectTypes.LwrSystemType;
   replaceable model DrillingEndEffector = NodesetCompilerRobotCell.ObjectTypes.DrillingEndEffectorType
     "Class of DrillingEndEffector; redeclare it to use a model of your own";
-  DrillingEndEffector drillingEndEffector
+  DrillingEndEffector drillingEndEffector(redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
     "DrillingEndEffector: The drilling end effector mounted on the flange of the robot."
     annotation (__OPCUA(browsePath="DrillingEndEffector", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=5001", typeDefinition="nsu=http://nodeset-compiler.dev/RobotCell/;i=2000"));
   annotation (

@@ -16,7 +16,7 @@ partial model DeviceType "DeviceType"
     annotation (Evaluate=true);
   replaceable model CPIdentifier = OpcUaDI.ObjectTypes.ConnectionPointType
     "Class of <CPIdentifier>; redeclare it to use a model of your own";
-  CPIdentifier cpIdentifier[nCpIdentifier]
+  CPIdentifier cpIdentifier[nCpIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
     "<CPIdentifier>"
     annotation (__OPCUA(browsePath="<CPIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6571", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=6308"));
   parameter Boolean use_deviceHealth = false

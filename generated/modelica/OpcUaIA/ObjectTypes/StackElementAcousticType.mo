@@ -5,7 +5,8 @@ model StackElementAcousticType "StackElementAcousticType: Represents an acoustic
   extends OpcUaIA.ObjectTypes.StackElementType;
   replaceable model AcousticSignals = OpcUaIA.Declarations.StackElementAcousticType_AcousticSignals
     "Class of AcousticSignals; redeclare it to use a model of your own";
-  AcousticSignals acousticSignals
+  AcousticSignals acousticSignals(
+      redeclare model OrderedObject = OpcUaIA.Declarations.StackElementAcousticType_AcousticSignalsOrderedObject)
     "AcousticSignals: Contains a list of audio signals used by this acoustic stacklight element."
     annotation (__OPCUA(browsePath="AcousticSignals", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=5003", typeDefinition="i=23518"));
   parameter Boolean use_intensity = false

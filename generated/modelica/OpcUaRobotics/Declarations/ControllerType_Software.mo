@@ -8,7 +8,7 @@ model ControllerType_Software "Software: Software is a container for one or more
     annotation (Evaluate=true);
   replaceable model SoftwareIdentifier = OpcUaDI.ObjectTypes.SoftwareType
     "Class of <SoftwareIdentifier>; redeclare it to use a model of your own";
-  SoftwareIdentifier softwareIdentifier[nSoftwareIdentifier]
+  SoftwareIdentifier softwareIdentifier[nSoftwareIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
     "<SoftwareIdentifier>"
     annotation (__OPCUA(browsePath="<SoftwareIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18847", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=15106"));
   annotation (

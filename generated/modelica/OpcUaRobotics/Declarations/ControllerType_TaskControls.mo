@@ -8,7 +8,7 @@ model ControllerType_TaskControls "TaskControls: TaskControls is a container for
     annotation (Evaluate=true);
   replaceable model TaskControlIdentifier = OpcUaRobotics.ObjectTypes.TaskControlType
     "Class of <TaskControlIdentifier>; redeclare it to use a model of your own";
-  TaskControlIdentifier taskControlIdentifier[nTaskControlIdentifier]
+  TaskControlIdentifier taskControlIdentifier[nTaskControlIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.TaskControlType_ParameterSet)
     "<TaskControlIdentifier>"
     annotation (__OPCUA(browsePath="<TaskControlIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18881", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1011"));
   annotation (

@@ -8,7 +8,10 @@ model MotionDeviceSystemType_Controllers "Controllers: Contains the set of contr
     annotation (Evaluate=true);
   replaceable model ControllerIdentifier = OpcUaRobotics.ObjectTypes.ControllerType
     "Class of <ControllerIdentifier>; redeclare it to use a model of your own";
-  ControllerIdentifier controllerIdentifier[nControllerIdentifier]
+  ControllerIdentifier controllerIdentifier[nControllerIdentifier](
+      redeclare model ParameterSet = OpcUaRobotics.Declarations.ControllerType_ParameterSet,
+      redeclare model Software = OpcUaRobotics.Declarations.ControllerType_Software,
+      redeclare model TaskControls = OpcUaRobotics.Declarations.ControllerType_TaskControls)
     "<ControllerIdentifier>"
     annotation (__OPCUA(browsePath="<ControllerIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15405", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1003"));
   annotation (

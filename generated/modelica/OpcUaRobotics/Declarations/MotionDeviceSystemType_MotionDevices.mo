@@ -8,7 +8,10 @@ model MotionDeviceSystemType_MotionDevices "MotionDevices: Contains any kinemati
     annotation (Evaluate=true);
   replaceable model MotionDeviceIdentifier = OpcUaRobotics.ObjectTypes.MotionDeviceType
     "Class of <MotionDeviceIdentifier>; redeclare it to use a model of your own";
-  MotionDeviceIdentifier motionDeviceIdentifier[nMotionDeviceIdentifier]
+  MotionDeviceIdentifier motionDeviceIdentifier[nMotionDeviceIdentifier](
+      redeclare model ParameterSet = OpcUaRobotics.Declarations.MotionDeviceType_ParameterSet,
+      redeclare model Axes = OpcUaRobotics.Declarations.MotionDeviceType_Axes,
+      redeclare model PowerTrains = OpcUaRobotics.Declarations.MotionDeviceType_PowerTrains)
     "<MotionDeviceIdentifier>"
     annotation (__OPCUA(browsePath="<MotionDeviceIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15008", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1004"));
   annotation (

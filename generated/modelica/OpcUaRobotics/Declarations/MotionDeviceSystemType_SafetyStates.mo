@@ -8,7 +8,7 @@ model MotionDeviceSystemType_SafetyStates "SafetyStates: Contains safety-related
     annotation (Evaluate=true);
   replaceable model SafetyStateIdentifier = OpcUaRobotics.ObjectTypes.SafetyStateType
     "Class of <SafetyStateIdentifier>; redeclare it to use a model of your own";
-  SafetyStateIdentifier safetyStateIdentifier[nSafetyStateIdentifier]
+  SafetyStateIdentifier safetyStateIdentifier[nSafetyStateIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.SafetyStateType_ParameterSet)
     "<SafetyStateIdentifier>"
     annotation (__OPCUA(browsePath="<SafetyStateIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15697", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1013"));
   annotation (

@@ -8,7 +8,7 @@ model MotionDeviceType_Axes "Axes: Axes is a container for one or more instances
     annotation (Evaluate=true);
   replaceable model AxisIdentifier = OpcUaRobotics.ObjectTypes.AxisType
     "Class of <AxisIdentifier>; redeclare it to use a model of your own";
-  AxisIdentifier axisIdentifier[nAxisIdentifier]
+  AxisIdentifier axisIdentifier[nAxisIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet)
     "<AxisIdentifier>"
     annotation (__OPCUA(browsePath="<AxisIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15743", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
   annotation (

@@ -8,7 +8,7 @@ model MotionDeviceType_PowerTrains "PowerTrains: PowerTrains is a container for 
     annotation (Evaluate=true);
   replaceable model PowerTrainIdentifier = OpcUaRobotics.ObjectTypes.PowerTrainType
     "Class of <PowerTrainIdentifier>; redeclare it to use a model of your own";
-  PowerTrainIdentifier powerTrainIdentifier[nPowerTrainIdentifier]
+  PowerTrainIdentifier powerTrainIdentifier[nPowerTrainIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
     "<PowerTrainIdentifier>"
     annotation (__OPCUA(browsePath="<PowerTrainIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15905", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16794"));
   annotation (

@@ -8,7 +8,7 @@ model PowerTrainType "PowerTrainType: The PowerTrainType represents instances of
     annotation (Evaluate=true);
   replaceable model AxisIdentifier = OpcUaRobotics.Declarations.PowerTrainType_AxisIdentifier
     "Class of <AxisIdentifier>; redeclare it to use a model of your own";
-  AxisIdentifier axisIdentifier[nAxisIdentifier]
+  AxisIdentifier axisIdentifier[nAxisIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet)
     "<AxisIdentifier>: Moves is a reference to provide the relationship of powertrains to axes. For complex kinematics this does not need to be a one to one relationship, because a powertrain might influence the motion of more than one axis. This reference connects all axis to a powertrain that that move when only this powertrain moves and all other powertrains stand still."
     annotation (__OPCUA(browsePath="<AxisIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18536", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
   parameter Integer nGearIdentifier(min=0) = 0
@@ -16,7 +16,7 @@ model PowerTrainType "PowerTrainType: The PowerTrainType represents instances of
     annotation (Evaluate=true);
   replaceable model GearIdentifier = OpcUaRobotics.ObjectTypes.GearType
     "Class of <GearIdentifier>; redeclare it to use a model of your own";
-  GearIdentifier gearIdentifier[nGearIdentifier]
+  GearIdentifier gearIdentifier[nGearIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
     "<GearIdentifier>"
     annotation (__OPCUA(browsePath="<GearIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16041", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1022"));
   parameter Integer nMotorIdentifier(min=0) = 0
@@ -24,7 +24,7 @@ model PowerTrainType "PowerTrainType: The PowerTrainType represents instances of
     annotation (Evaluate=true);
   replaceable model MotorIdentifier = OpcUaRobotics.ObjectTypes.MotorType
     "Class of <MotorIdentifier>; redeclare it to use a model of your own";
-  MotorIdentifier motorIdentifier[nMotorIdentifier]
+  MotorIdentifier motorIdentifier[nMotorIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.MotorType_ParameterSet)
     "<MotorIdentifier>"
     annotation (__OPCUA(browsePath="<MotorIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15998", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1019"));
   parameter Integer nPowerTrainIdentifier(min=0) = 0
@@ -32,7 +32,7 @@ model PowerTrainType "PowerTrainType: The PowerTrainType represents instances of
     annotation (Evaluate=true);
   replaceable model PowerTrainIdentifier = OpcUaRobotics.Declarations.PowerTrainType_PowerTrainIdentifier
     "Class of <PowerTrainIdentifier>; redeclare it to use a model of your own";
-  PowerTrainIdentifier powerTrainIdentifier[nPowerTrainIdentifier]
+  PowerTrainIdentifier powerTrainIdentifier[nPowerTrainIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
     "<PowerTrainIdentifier>: HasSlave is a reference to provide the master-slave relationship of powertrains which provide torque for a common axis. The InverseName is IsSlaveOf."
     annotation (__OPCUA(browsePath="<PowerTrainIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18613", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16794"));
   annotation (

@@ -89,6 +89,9 @@ pub struct Ctx<'a> {
     /// How many class bodies are being planned inside each other (see [`MAX_NESTING`]).
     pub nesting: usize,
     pub deferred: Vec<Deferred>,
+    /// The replaceable class aliases that some planned class redeclares (filled once planning is done). A
+    /// component repeats its class's choice for each of them ([`Mod::Pin`](super::objects::Mod::Pin)).
+    pub redeclared: BTreeSet<String>,
 }
 
 impl<'a> Ctx<'a> {
@@ -113,6 +116,7 @@ impl<'a> Ctx<'a> {
             depth: 0,
             nesting: 0,
             deferred: Vec::new(),
+            redeclared: BTreeSet::new(),
         }
     }
 

@@ -113,7 +113,11 @@
 //! like the alias it replaces (`redeclare model X = P.X` is ignored); a redeclaration's class has local
 //! replaceable elements only when its constraining class has some (rumoca's reading of MLS 6.4); no
 //! `redeclare model extends` (it crashes rumoca); record arrays get explicit sizes and array literals rather
-//! than `fill` (`expression shape mismatch`).
+//! than `fill` (`expression shape mismatch`). rumoca lets an enclosing instance's redeclaration of an inherited
+//! alias replace a nested component's own (a MotionDeviceType's `ParameterSet` would replace the one of each
+//! AxisType in its Axes), so every object component repeats its class's choice for each alias that some class
+//! redeclares (`Axis axis(redeclare model ParameterSet = ...AxisType_ParameterSet)`, [`objects::Mod::Pin`]);
+//! `tests/modelica/RumocaBehaviour` reproduces both the leak and the fix.
 //!
 //! # Limits
 //!
@@ -138,7 +142,7 @@ use crate::names::{is_valid, Case, Scope, Target};
 use crate::raw::NodeClass;
 use crate::write::OutFile;
 use ctx::{Ctx, Need, Owner};
-use objects::{ClassPlan, Item, Mod, TypeRef};
+use objects::{ClassPlan, ElemKind, Item, Mod, OwnerPlan, TypeRef};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 use text::string_literal;
@@ -332,6 +336,7 @@ pub fn generate_with_diagnostics(model: &Model, cfg: &ModelicaConfig) -> Generat
     for &ns in &full {
         plan_namespace(&mut ctx, ns);
     }
+    ctx.redeclared = redeclared_aliases(&ctx.plans);
     let mut out = Output::default();
     let mut done_needs: BTreeSet<Need> = BTreeSet::new();
     for &ns in &full {
@@ -646,7 +651,51 @@ fn render_mod(ctx: &mut Ctx, m: &Mod) -> String {
             format!("{ident}({})", inner.join(", "))
         }
         Mod::Redeclare { ident, class } => format!("redeclare model {ident} = {}", type_ref(ctx, class)),
+        Mod::Pin { class } => pinned(ctx, class).join(", "),
     }
+}
+
+/// The redeclarations a [`Mod::Pin`] on a component of `class` stands for, one per alias.
+fn pinned(ctx: &mut Ctx, class: &ctx::ClassKey) -> Vec<String> {
+    let Some(info) = ctx.class_infos.get(class).cloned() else { return Vec::new() };
+    let mut parts = Vec::new();
+    for e in &info.elements {
+        if let (Some(alias), ElemKind::Object { class: k }) = (&e.alias, &e.kind) {
+            if ctx.redeclared.contains(alias) {
+                parts.push(format!("redeclare model {alias} = {}", ctx.class_path(k)));
+            }
+        }
+    }
+    parts
+}
+
+/// The aliases that some class redeclares (`redeclare model X = ...` in any modification of any plan).
+fn redeclared_aliases(plans: &BTreeMap<Owner, OwnerPlan>) -> BTreeSet<String> {
+    fn walk(mods: &[Mod], out: &mut BTreeSet<String>) {
+        for m in mods {
+            match m {
+                Mod::Redeclare { ident, .. } => {
+                    out.insert(ident.clone());
+                }
+                Mod::Nested { mods, .. } => walk(mods, out),
+                Mod::Value { .. } | Mod::Pin { .. } => {}
+            }
+        }
+    }
+    let mut out = BTreeSet::new();
+    for plan in plans.values() {
+        for class in plan.main.iter().chain(plan.decls.iter().map(|(_, c)| c)) {
+            if let Some((_, mods)) = &class.extends {
+                walk(mods, &mut out);
+            }
+            for item in &class.items {
+                if let Item::Decl { mods, .. } = item {
+                    walk(mods, &mut out);
+                }
+            }
+        }
+    }
+    out
 }
 
 /// A modification list: inline when short, else one modifier per line.
@@ -654,7 +703,16 @@ fn render_mods(ctx: &mut Ctx, mods: &[Mod], indent: usize) -> String {
     if mods.is_empty() {
         return String::new();
     }
-    let parts: Vec<String> = mods.iter().map(|x| render_mod(ctx, x)).collect();
+    let parts: Vec<String> = mods
+        .iter()
+        .flat_map(|x| match x {
+            Mod::Pin { class } => pinned(ctx, class),
+            _ => vec![render_mod(ctx, x)],
+        })
+        .collect();
+    if parts.is_empty() {
+        return String::new();
+    }
     let inline = parts.join(", ");
     if inline.len() + indent <= 90 && !inline.contains('\n') {
         format!("({inline})")

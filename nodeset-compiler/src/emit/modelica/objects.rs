@@ -91,6 +91,13 @@ pub enum Mod {
         ident: String,
         class: TypeRef,
     },
+    /// On a component of `class`: the class's own choice for each of its replaceable aliases that some class
+    /// redeclares, repeated as `redeclare model <Alias> = <class of Alias in class>` (see
+    /// [`Ctx::redeclared`](super::ctx::Ctx::redeclared)). Equivalent Modelica; rumoca 0.10.2 needs it, because it
+    /// lets an enclosing instance's redeclaration of an alias replace the nested class's own.
+    Pin {
+        class: ClassKey,
+    },
 }
 
 #[derive(Debug, Clone)]
@@ -922,6 +929,9 @@ impl Ctx<'_> {
                     }
                     None => TypeRef::Class(class.clone()),
                 };
+                if !event {
+                    mods.insert(0, Mod::Pin { class: class.clone() });
+                }
                 body.items.push(Item::Decl {
                     prefix: String::new(),
                     ty,

@@ -1,0 +1,4 @@
+within RumocaBehaviour;
+model Axis "Chooses InnerPS"
+  extends Base(redeclare model PS = InnerPS);
+end Axis;

@@ -1,0 +1,5 @@
+within RumocaBehaviour;
+model InnerPS "The class the axis chooses: one input"
+  extends Empty;
+  RealInput pos "Position";
+end InnerPS;

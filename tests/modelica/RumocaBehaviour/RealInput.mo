@@ -1,0 +1,2 @@
+within RumocaBehaviour;
+connector RealInput = input Real "An input signal";

@@ -1,0 +1,2 @@
+within RumocaBehaviour;
+connector RealOutput = output Real "An output signal";
