@@ -184,7 +184,7 @@ fn enumeration_values() {
     assert_eq!(choices, 2, "Mode and Level disagree with their properties:\n{}", out.render_diagnostics());
     insta::assert_snapshot!("enum_values_diagnostics", relative(&out.render_diagnostics()));
     let text = generate("enum_values", &[]).unwrap_or_else(|e| panic!("{e}"));
-    for want in ["NotAvailable = -1", "SensorOk = 0", "Test5 = -1", "Four = 4", "Auto = 0", "Service = 2", "Low = 10", "High = 20"] {
+    for want in ["NotAvailable = -1", "SensorOK = 0", "Test5 = -1", "Four = 4", "Auto = 0", "Service = 2", "Low = 10", "High = 20"] {
         assert!(text.contains(want), "the generated enumerations lack `{want}`");
     }
     insta::assert_snapshot!("enum_values_rust", text);
@@ -206,7 +206,7 @@ fn redefinitions() {
         "<UADataType NodeId=\"i=3\" BrowseName=\"Byte\" IsAbstract=\"true\">",
     );
     let opts = Options { model_dirs: vec![vendor()], ..Options::default() };
-    let out = compile(vec![Input::Text { name: "generated/redefinition_differs.xml".into(), text }], &opts);
+    let out = compile(vec![Input::Text { name: "in-memory/redefinition_differs.xml".into(), text }], &opts);
     let d = out.diagnostics.items.iter().find(|d| d.code == Code::DuplicateNodeId).expect("NS0201 for the differing copy");
     assert!(d.is_error() && d.labels.len() == 1, "both locations are shown");
     assert_eq!(out.diagnostics.items.iter().filter(|d| d.code == Code::IdenticalRedefinition).count(), 1, "String is still identical");

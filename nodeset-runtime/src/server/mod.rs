@@ -247,7 +247,9 @@ impl ServerConfig {
         }
         let anonymous = self.security.anonymous || self.security.insecure;
         let auth = std::sync::Arc::new(ModelAuth::new(users, self.access, anonymous));
+        let endpoint_url = format!("opc.tcp://{}:{port}/", self.host);
         let mut builder = ServerBuilder::new()
+            .discovery_urls(vec![endpoint_url.clone()])
             .application_name(self.application_name)
             .application_uri(&self.application_uri)
             .product_uri(&self.application_uri)
@@ -287,7 +289,6 @@ impl ServerConfig {
         builder = builder.subscription_poll_interval_ms(self.min_publishing_interval_ms.min(100));
         let (server, handle) = builder.build()?;
         let manager = ModelManager::from_handle(&handle).ok_or("the model node manager is missing from the server")?;
-        let endpoint_url = format!("opc.tcp://{}:{port}/", self.host);
         Ok(ModelServer { server, handle, manager, listener, endpoint_url })
     }
 }

@@ -9,7 +9,7 @@
 
 use std::path::{Path, PathBuf};
 
-use opcua::crypto::{CertificateStore, PrivateKey, SecurityPolicy, X509Data, X509};
+use opcua::crypto::{CertificateStore, KeySize, PrivateKey, SecurityPolicy, X509Data, X509};
 use opcua::types::MessageSecurityMode;
 
 /// The secure policies a server offers by default.
@@ -177,7 +177,8 @@ pub fn prepare_pki(
 fn check_pair(cert: &X509, key: &PrivateKey) -> Result<(), String> {
     let public = cert.public_key().map_err(|e| format!("cannot read the certificate's public key: {e}"))?;
     let data = b"nodeset-runtime key check";
-    let mut signature = vec![0u8; 1024];
+    // An RSA signature is exactly as long as the key's modulus.
+    let mut signature = vec![0u8; key.size()];
     let n = key.sign_sha256(data, &mut signature).map_err(|e| format!("cannot sign with the key: {e}"))?;
     match public.verify_sha256(data, &signature[..n]) {
         Ok(true) => Ok(()),

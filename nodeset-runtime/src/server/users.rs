@@ -415,7 +415,7 @@ mod tests {
             ("user alice Operator\n", 1, 20, "expected 4 fields"),
             ("# c\nuser bob Root $argon2id$v=19$m=19456,t=2,p=1$c2FsdHNhbHQ$aGFzaGhhc2hoYXNoaGFzaA\n", 2, 10, "unknown role `Root`"),
             ("user carol Operator plaintextpassword\n", 1, 21, "not in PHC form"),
-            ("user dan Operator $pbkdf2-sha256$i=1000$c2FsdA$aGFzaA\n", 1, 19, "only argon2id"),
+            ("user dan Operator $pbkdf2-sha256$i=1000$c2FsdHNhbHQ$aGFzaGhhc2hoYXNoaGFzaA\n", 1, 19, "only argon2id"),
             ("cert hmi Operator 12ab\n", 1, 19, "40 hex digits"),
             ("root eve Operator x\n", 1, 1, "unknown kind `root`"),
         ];
