@@ -199,6 +199,7 @@ impl ModelNodes {
             space.load_into_type_tree(&mut tree);
         }
         let mut namespaces = namespace_metadata(&served);
+        super::namespace_objects::fold_into(space, &context.type_tree.read(), &mut namespaces);
         if !namespaces.iter().any(|m| m.namespace_index == instance_ns) {
             namespaces.push(NamespaceMetadata {
                 namespace_uri: instance_namespace.to_owned(),

@@ -30,6 +30,7 @@
 
 mod check;
 mod manager;
+mod namespace_objects;
 
 use std::net::TcpListener;
 use std::path::PathBuf;
