@@ -8,7 +8,8 @@
 //! MotionDevice `Arm` with six Axes `A1`..`A6` and their PowerTrains `PT1`..`PT6` (each with a Motor and a
 //! Gear), a Controller and a SafetyState, every mandatory child as the types prescribe. The arm's DI
 //! identification (Manufacturer, Model, ProductCode, SerialNumber, ...) comes from a struct bound with the
-//! derive. The controller is bound to a second struct whose `default_stop_mode` field is the writable
+//! derive; its AssetId, user writable in DI, is writable by clients, and a client's write lands in that
+//! struct and is printed (`AssetId written by a client: <value>`). The controller is bound to a second struct whose `default_stop_mode` field is the writable
 //! `SystemOperation/SystemOperationStateMachine/ConfiguredDefaultStopMode`: a client's write lands in that
 //! struct and is printed (`ConfiguredDefaultStopMode written by a client: <value>`). Joint positions
 //! (`Axes/<axis>/ParameterSet/ActualPosition`) move along sine curves, updated at 100 Hz through the typed
@@ -30,6 +31,8 @@ use nodeset_examples::secure::{SecureArgs, USAGE};
 use nodeset_models::runtime::server::{MethodError, ServerConfig};
 use nodeset_models::runtime::typed::{Bound, Instantiate, ObjectType};
 use nodeset_models::ObjectModel;
+use opcua::nodes::NodeType;
+use opcua::server::address_space::AccessLevel;
 use opcua::types::{LocalizedText, NodeId, ObjectId, StatusCode};
 
 /// The arm's identification, bound to the Robotics MotionDeviceType (and the DI members it inherits).
@@ -41,7 +44,7 @@ struct ArmIdentity {
     product_code: String,
     serial_number: String,
     motion_device_category: MotionDeviceCategoryEnumeration,
-    /// Writable by clients (DI AssetId).
+    /// Writable by clients: DI's AssetId is user writable, and `run` grants CurrentWrite to the instance.
     asset_id: String,
     #[opcua(path = "ParameterSet/SpeedOverride")]
     speed_override: f64,
@@ -121,6 +124,16 @@ async fn run(port: u16, seconds: Option<u64>, secure: SecureArgs) -> Result<(), 
     let objects: NodeId = ObjectId::ObjectsFolder.into();
     let robot = MotionDeviceSystemType::instantiate(&manager, &objects, "Robot", &robot_options()).map_err(|e| e.to_string())?;
     let arm = robot.motion_devices.motion_device_identifier.get("Arm").ok_or("the robot has no arm")?.clone();
+    // DI (OPC 10000-100, 4.5.3) makes AssetId "user writable"; the nodesets declare it with the default
+    // AccessLevel (CurrentRead only), which the instance copies, so the server grants the write here.
+    let asset_id = arm.asset_id.as_ref().ok_or("the arm has no AssetId")?;
+    match manager.node_manager().address_space().write().find_mut(asset_id.id()) {
+        Some(NodeType::Variable(v)) => {
+            v.set_access_level(AccessLevel::CURRENT_READ | AccessLevel::CURRENT_WRITE);
+            v.set_user_access_level(AccessLevel::CURRENT_READ | AccessLevel::CURRENT_WRITE);
+        }
+        _ => return Err("the arm's AssetId is not a variable".into()),
+    }
 
     let identity = ArmIdentity {
         manufacturer: LocalizedText::new("en", "nodeset-compiler robotics"),
@@ -147,22 +160,34 @@ async fn run(port: u16, seconds: Option<u64>, secure: SecureArgs) -> Result<(), 
     // The Lock methods, typed: InitLock(Context: String) -> InitLockStatus: Int32.
     if let Some(lock) = &arm.lock {
         let holder = Arc::new(Mutex::new(None::<String>));
-        let h = holder.clone();
+        let (h, locked) = (holder.clone(), lock.locked.clone());
         lock.init_lock.implement(move |_ctx, (context,): (String,)| {
-            let h = h.clone();
+            let (h, locked) = (h.clone(), locked.clone());
             async move {
                 if context.is_empty() {
                     return Err(MethodError::Status(StatusCode::BadInvalidArgument));
                 }
                 let mut held = h.lock().unwrap_or_else(|e| e.into_inner());
-                // DI: 0 = OK, -1 = E_AlreadyLocked.
-                Ok((if held.is_some() { -1 } else { *held = Some(context); 0 },))
+                if held.is_some() {
+                    // DI: -1 = E_AlreadyLocked.
+                    return Ok((-1,));
+                }
+                // Locked shows the lock to every client (DI LockingServicesType).
+                locked.set(true).map_err(MethodError::Status)?;
+                *held = Some(context);
+                Ok((0,))
             }
         });
-        let h = holder.clone();
+        let (h, locked) = (holder.clone(), lock.locked.clone());
         lock.exit_lock.implement(move |_ctx, ()| {
-            let h = h.clone();
-            async move { Ok((if h.lock().unwrap_or_else(|e| e.into_inner()).take().is_some() { 0 } else { -1 },)) }
+            let (h, locked) = (h.clone(), locked.clone());
+            async move {
+                if h.lock().unwrap_or_else(|e| e.into_inner()).take().is_none() {
+                    return Ok((-1,));
+                }
+                locked.set(false).map_err(MethodError::Status)?;
+                Ok((0,))
+            }
         });
         lock.locked.set(false).map_err(|s| s.to_string())?;
     }

@@ -319,14 +319,31 @@ def parse_nodeset(path: Path, only_reference_types: bool = False) -> tuple[str, 
     return model_uri, nodes
 
 
+HAS_TYPE_DEFINITION = (UA_NS, "i=40")
+HAS_PROPERTY = (UA_NS, "i=46")
+NAMESPACE_METADATA_TYPE = (UA_NS, "i=11616")
+
+
 class Model:
     """DI, IA and Robotics from their NodeSet2 files, and the ns0 reference type hierarchy."""
 
     def __init__(self, folder: Path) -> None:
         self.files = {}
         self.nodes: dict = {}
+        # Each file's NamespaceMetadata object (under Server/Namespaces) and its properties: the server folds
+        # them into the object it keeps for every namespace it serves (defects_check.py checks that one).
+        self.folded: set = set()
+        self.folded_objects: list = []
         for name in ["Opc.Ua.Di.NodeSet2.xml", "Opc.Ua.IA.NodeSet2.xml", "Opc.Ua.Robotics.NodeSet2.xml"]:
             uri, nodes = parse_nodeset(folder / name)
+            for k, x in list(nodes.items()):
+                if (HAS_TYPE_DEFINITION, NAMESPACE_METADATA_TYPE, True) in x.refs:
+                    self.folded_objects.append(k)
+                    props = {t for (r, t, fwd) in x.refs if r == HAS_PROPERTY and fwd}
+                    props |= {p for p, y in nodes.items() if (HAS_PROPERTY, k, False) in y.refs}
+                    for gone in {k} | props:
+                        self.folded.add(gone)
+                        nodes.pop(gone, None)
             self.files[uri] = nodes
             self.nodes.update(nodes)
         _, ns0_refs = parse_nodeset(folder / "Opc.Ua.NodeSet2.xml", only_reference_types=True)
@@ -440,6 +457,9 @@ async def check_robotics(client: Client, report: Report, ns_array: list[str], ar
             problems.append(f"{k}: BrowseName {n.Value.Value.to_string()}, expected {x.browse_name}")
         if d.Value.Value.Text != x.display_name:
             problems.append(f"{k}: DisplayName {d.Value.Value.Text!r}, expected {x.display_name!r}")
+    report.check("one NamespaceMetadata object per file (DI, IA, Robotics) is left to the server's own",
+                 sorted(u for (u, _) in model.folded_objects) == sorted([DI_NS, IA_NS, ROBOTICS_NS]),
+                 f"objects {model.folded_objects}")
     report.all("NodeClass, BrowseName and DisplayName of every Robotics node", problems, len(keys))
 
     var_keys = [k for k in keys if robotics[k].data_type is not None]

@@ -106,7 +106,9 @@ struct ServedTable {
 ///
 /// - a write of a variable's value is refused with `BadNotWritable` if the variable's AccessLevel lacks
 ///   CurrentWrite, with `BadUserAccessDenied` if only the UserAccessLevel does, with `BadTypeMismatch` if
-///   the value does not fit the DataType and ValueRank; then the node's [`WriteHandler`], if any, decides;
+///   the value does not fit the DataType and ValueRank, with the status of the range (`BadIndexRangeNoData`
+///   on a scalar, ...) if an IndexRange does not fit the stored value; only then the node's [`WriteHandler`],
+///   if any, decides;
 ///   the stored value is reported to subscriptions;
 /// - other attributes are writable only where the node's WriteMask allows it (async-opcua's rules);
 /// - a method call is refused if the method's Executable attribute is false (async-opcua's in-memory node
@@ -200,6 +202,7 @@ impl ModelNodes {
             space.load_into_type_tree(&mut tree);
         }
         let mut namespaces = namespace_metadata(&served);
+        super::namespace_objects::fold_into(space, &context.type_tree.read(), &mut namespaces);
         if !namespaces.iter().any(|m| m.namespace_index == instance_ns) {
             namespaces.push(NamespaceMetadata {
                 namespace_uri: instance_namespace.to_owned(),
@@ -251,6 +254,13 @@ impl ModelNodes {
         let value = write.value.value.clone().unwrap_or_default();
         if let (NodeType::Variable(var), AttributeId::Value) = (node, write.attribute_id) {
             types.check(&value, &var.data_type(), var.value_rank(), write.index_range.has_range())?;
+            if write.index_range.has_range() {
+                // async-opcua applies the range only when it stores the value; try it on a copy now, so that
+                // a write it will refuse (BadIndexRangeNoData on a scalar, ...) never reaches the handler.
+                let stored = var.value(TimestampsToReturn::Neither, &NumericRange::None, &DataEncoding::Binary, 0.0);
+                let mut stored = stored.value.ok_or(StatusCode::BadIndexRangeInvalid)?;
+                stored.set_range_of(&write.index_range, &value)?;
+            }
         }
         Ok(value)
     }

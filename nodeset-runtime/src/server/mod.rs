@@ -33,6 +33,7 @@
 pub mod access;
 mod check;
 mod manager;
+mod namespace_objects;
 pub mod security;
 pub mod users;
 

@@ -8,6 +8,7 @@
 use std::sync::{Arc, Mutex};
 
 pub use opcua::types::Variant;
+use opcua::nodes::{AccessLevel, NodeType};
 use opcua::types::{NodeId, QualifiedName, StatusCode};
 
 use super::{BindError, Binder, Instantiate, InstantiateError, MemberPath, ObjectType};
@@ -97,7 +98,9 @@ impl<S: ObjectModel> Bound<S> {
     }
 
     /// Binds the struct to an existing instance (one from a nodeset, say), publishes every field and routes
-    /// client writes into the struct.
+    /// client writes into the struct: writes of the variables the nodeset declares writable, and of those
+    /// the instance was granted CurrentWrite before binding (DI's AssetId, which the nodesets declare
+    /// CurrentRead although DI makes it user writable, is one).
     pub fn bind(manager: &ModelManager, root: &NodeId, value: S) -> Result<Bound<S>, BindError> {
         let nodes = manager.bind_with(|b: &Binder<'_>| {
             S::FIELDS
@@ -122,8 +125,12 @@ impl<S: ObjectModel> Bound<S> {
             manager: manager.clone(),
         };
         bound.publish();
+        let granted = |id: &NodeId| {
+            matches!(manager.node_manager().address_space().read().find(id),
+                Some(NodeType::Variable(v)) if v.access_level().contains(AccessLevel::CURRENT_WRITE))
+        };
         for (i, f) in S::FIELDS.iter().enumerate() {
-            if !f.writable {
+            if !f.writable && !granted(&bound.nodes[i]) {
                 continue;
             }
             let shared = Arc::downgrade(&bound.shared);

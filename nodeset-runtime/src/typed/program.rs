@@ -272,8 +272,6 @@ struct Variables {
 #[derive(Clone, Debug)]
 struct EventSetup {
     event_type: NodeId,
-    /// The event type and its supertypes (a select clause may name any of them).
-    chain: Vec<NodeId>,
     /// Extra fields: (browse path, value), for the event types of our models (`SkillName`).
     extra: Vec<(Vec<QualifiedName>, Variant)>,
 }
@@ -440,7 +438,9 @@ impl Core {
             }
         }
         fields.extend(setup.extra.iter().cloned());
-        let event = TransitionEvent { event_type: setup.event_type.clone(), chain: setup.chain.clone(), time: now, fields };
+        // The chain again: the one of `setup` may have been taken before ns0's types were loaded.
+        let chain = supertypes(&self.manager, &setup.event_type);
+        let event = TransitionEvent { event_type: setup.event_type.clone(), chain, time: now, fields };
         // async-opcua reports an event of any node to the clients that monitor the Server object, too.
         self.manager.notify_event(&event, std::slice::from_ref(&self.node));
     }
@@ -502,16 +502,7 @@ fn variables(b: &Binder<'_>, node: &NodeId) -> Result<Variables, BindError> {
 
 /// The event type's chain of supertypes, and the fields our own event types add.
 fn event_setup(manager: &ModelManager, event_type: NodeId, instance_name: &str) -> EventSetup {
-    let mut chain = vec![event_type.clone()];
-    {
-        let tree = manager.type_tree().read();
-        while let Some(parent) = chain.last().and_then(|c| tree.get_supertype(c)) {
-            if chain.contains(parent) {
-                break;
-            }
-            chain.push(parent.clone());
-        }
-    }
+    let chain = supertypes(manager, &event_type);
     let mut extra = Vec::new();
     // CommonSkills' SkillTransitionEventType names the skill (its BrowseName) in `SkillName`.
     let skills = SKILL_TRANSITION_EVENT_TYPE;
@@ -520,7 +511,22 @@ fn event_setup(manager: &ModelManager, event_type: NodeId, instance_name: &str) 
             extra.push((vec![QualifiedName::new(ns, "SkillName")], Variant::from(instance_name)));
         }
     }
-    EventSetup { event_type, chain, extra }
+    EventSetup { event_type, extra }
+}
+
+/// `event_type` and its supertypes, as far as the server's type tree knows them now. Before the server runs
+/// the tree holds only the tables' types (async-opcua loads ns0's when it starts), so the chain of a skill's
+/// event type ends at ns0's ProgramTransitionEventType then, and is taken again for every event.
+fn supertypes(manager: &ModelManager, event_type: &NodeId) -> Vec<NodeId> {
+    let mut chain = vec![event_type.clone()];
+    let tree = manager.type_tree().read();
+    while let Some(parent) = chain.last().and_then(|c| tree.get_supertype(c)) {
+        if chain.contains(parent) {
+            break;
+        }
+        chain.push(parent.clone());
+    }
+    chain
 }
 
 /// CommonSkills' `SkillTransitionEventType` (nodesets/CommonSkills.NodeSet2.xml, i=1100). Named here rather
