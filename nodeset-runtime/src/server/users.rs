@@ -242,6 +242,10 @@ pub struct ModelAuth {
     users: Users,
     policy: AccessPolicy,
     anonymous: bool,
+    /// Password checks in progress at once. Argon2id needs 19 MiB per check by design, so 50 sessions
+    /// logging in together would hold nearly 1 GiB (measured with `cargo xtask load`); checks beyond the
+    /// machine's parallelism could not run sooner anyway, so they wait their turn.
+    verifying: std::sync::Arc<tokio::sync::Semaphore>,
 }
 
 /// The user token of anonymous sessions in async-opcua (its `ANONYMOUS_USER_TOKEN_ID`).
@@ -250,7 +254,8 @@ const ANONYMOUS: &str = opcua::server::ANONYMOUS_USER_TOKEN_ID;
 impl ModelAuth {
     /// An authenticator; `anonymous` offers the anonymous identity token on every endpoint.
     pub fn new(users: Users, policy: AccessPolicy, anonymous: bool) -> ModelAuth {
-        ModelAuth { users, policy, anonymous }
+        let parallel = std::thread::available_parallelism().map_or(1, |n| n.get());
+        ModelAuth { users, policy, anonymous, verifying: std::sync::Arc::new(tokio::sync::Semaphore::new(parallel)) }
     }
 
     /// The caller behind a user token.
@@ -301,8 +306,12 @@ impl AuthManager for ModelAuth {
             }
         };
         let password = password.get().to_owned();
+        let Ok(permit) = self.verifying.clone().acquire_owned().await else {
+            return Err(Self::rejected("the server is shutting down"));
+        };
         // Argon2 takes tens of milliseconds on purpose: keep it off the server's event loop.
         let ok = tokio::task::spawn_blocking(move || {
+            let _permit = permit;
             PasswordHash::new(&hash).is_ok_and(|h| Argon2::default().verify_password(password.as_bytes(), &h).is_ok())
         })
         .await
