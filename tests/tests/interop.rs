@@ -1,8 +1,8 @@
 //! Interoperability: a real third-party OPC UA client (python asyncua, from `.venv`) against the example
 //! server of `nodeset-examples`, run as its own process.
 //!
-//! The test builds the example (`cargo build --workspace --example server`, a no-op when it is
-//! fresh), starts it on a free port, runs `tests/interop/robotics_check.py` with the suites below, and
+//! The test takes the example from `cargo test --workspace --no-run` (a no-op after `cargo test
+//! --workspace`, which builds the examples with the same features), starts it on a free port, runs `tests/interop/robotics_check.py` with the suites below, and
 //! stops the server with SIGTERM, which must end it cleanly. It fails, never skips, when the venv is
 //! missing: run `cargo xtask venv`.
 
@@ -28,21 +28,23 @@ fn python() -> PathBuf {
 }
 
 /// Builds an example of nodeset-examples and returns the path of its executable.
+///
+/// `cargo test --workspace --no-run` is the build `cargo test --workspace` has just done, so nothing is
+/// compiled again; `cargo build --example` resolves features differently and rebuilt async-opcua (9 min).
 fn build_server(example: &str) -> PathBuf {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
     let output = Command::new(cargo)
         .current_dir(root())
-        // --workspace resolves features as `cargo test --workspace` does, so no dependency is built twice.
-        .args(["build", "--workspace", "--example", example, "--message-format=json-render-diagnostics"])
+        .args(["test", "--workspace", "--no-run", "--message-format=json-render-diagnostics"])
         .stderr(Stdio::inherit())
         .output()
         .expect("cargo runs");
-    assert!(output.status.success(), "cargo build --workspace --example {example} failed");
+    assert!(output.status.success(), "cargo test --workspace --no-run failed");
     let stdout = String::from_utf8_lossy(&output.stdout);
     let line = stdout
         .lines()
         .filter(|l| l.contains("\"reason\":\"compiler-artifact\"") && l.contains("\"executable\":\""))
-        .find(|l| l.contains(&format!("\"name\":\"{example}\"")))
+        .find(|l| l.contains("\"kind\":[\"example\"]") && l.contains(&format!("\"name\":\"{example}\"")))
         .expect("cargo reports the example's executable");
     let start = line.find("\"executable\":\"").unwrap() + "\"executable\":\"".len();
     let end = start + line[start..].find('"').unwrap();

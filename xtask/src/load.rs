@@ -36,16 +36,11 @@ pub struct Args {
     pub release: bool,
 }
 
-/// Adds a password user to a user file with the runtime's `nodeset-users` command (built here).
-fn add_user(root: &Path, release: bool, file: &Path, name: &str, roles: &str, password: &str) -> Result<(), String> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let mut cmd = Command::new(cargo);
-    cmd.current_dir(root).args(["run", "--quiet", "-p", "nodeset-runtime", "--bin", "nodeset-users"]);
-    if release {
-        cmd.arg("--release");
-    }
+/// Adds a password user to a user file with the runtime's `nodeset-users` command, from the folder
+/// [`build`] left it in (`target/<profile>`).
+fn add_user(bins: &Path, file: &Path, name: &str, roles: &str, password: &str) -> Result<(), String> {
+    let mut cmd = Command::new(bins.join("nodeset-users"));
     let mut child = cmd
-        .arg("--")
         .arg("add")
         .arg(file)
         .args([name, roles])
@@ -66,13 +61,17 @@ fn add_user(root: &Path, release: bool, file: &Path, name: &str, roles: &str, pa
 pub(crate) fn build(root: &Path, release: bool, examples: &[&str]) -> Result<PathBuf, String> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let mut cmd = Command::new(cargo);
-    // --workspace resolves features as `cargo test --workspace` does, so nothing is built twice.
-    cmd.current_dir(root).args(["build", "--quiet", "--workspace"]);
-    for e in examples {
-        cmd.args(["--example", e]);
-    }
+    cmd.current_dir(root);
     if release {
-        cmd.arg("--release");
+        cmd.args(["build", "--quiet", "--release", "-p", "nodeset-examples", "-p", "nodeset-runtime", "--bins"]);
+        for e in examples {
+            cmd.args(["--example", e]);
+        }
+    } else {
+        // The build `cargo test --workspace` has just done (examples and the runtime's `nodeset-users`
+        // included), so nothing is compiled again: `cargo build --example` or `cargo run -p` resolve
+        // features differently and rebuilt async-opcua.
+        cmd.args(["test", "--quiet", "--workspace", "--no-run"]);
     }
     let status = cmd.status().map_err(|e| format!("cannot run cargo: {e}"))?;
     if !status.success() {
@@ -153,7 +152,7 @@ pub fn run(args: Args) -> Result<(), String> {
     std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     let users = dir.join("users.txt");
     let password = format!("load-{}-{}", std::process::id(), std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_nanos()).unwrap_or_default());
-    add_user(&root, args.release, &users, "load", "Operator", &password)?;
+    add_user(examples.parent().ok_or("the examples folder has a parent")?, &users, "load", "Operator", &password)?;
     // The robot serves both phases in the same run: `--insecure` adds the None endpoint of the first, and
     // `--trust-on-first-use` lets the load client's certificate in without an administrator (a test harness).
     let pki = dir.join("pki").to_string_lossy().into_owned();
