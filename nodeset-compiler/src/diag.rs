@@ -109,6 +109,8 @@ codes! {
         Some("the copy is ignored; the node loaded first is used");
     EnumValueChoice = "NS0219", Warning, "an enumeration's definition disagrees with its EnumValues or EnumStrings property",
         Some("the property decides the values");
+    BadRolePermission = "NS0220", Error, "a RolePermission names a node that is not a role",
+        Some("the entry is dropped: the node grants that role nothing");
     // Generating code.
     NameCollision = "NS0301", Warning, "two names map to one identifier in generated code", Some("the names are told apart by a suffix");
     UnsupportedFeature = "NS0302", Warning, "a model feature has no faithful representation in generated code",

@@ -154,6 +154,9 @@ pub struct Attributes {
     pub symmetric: Option<bool>,
     pub inverse_name: Vec<LocalizedText>,
     pub role_permissions: Vec<RawRolePermission>,
+    /// The RolePermissions resolved: the role object and its `PermissionType` bits, in the file's order.
+    /// An entry whose role names no Object is left out (NS0220).
+    pub roles: Vec<(NodeIx, u32)>,
     pub category: Vec<String>,
     pub documentation: Option<String>,
     pub method_declaration: Option<NodeIx>,

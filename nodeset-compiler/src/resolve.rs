@@ -137,6 +137,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
                 symmetric: raw.symmetric,
                 inverse_name: std::mem::take(&mut raw.inverse_names),
                 role_permissions: std::mem::take(&mut raw.role_permissions),
+                roles: Vec::new(),
                 category: std::mem::take(&mut raw.category),
                 documentation: raw.documentation.take(),
                 method_declaration: None,
@@ -265,6 +266,7 @@ fn link(model: &mut Model, own: OwnReferences, incoming: Vec<(NodeIx, Reference)
         node.attrs.array_dimensions = found.array_dimensions;
         node.attrs.data_type = found.data_type;
         node.attrs.method_declaration = found.method_declaration;
+        node.attrs.roles = found.roles;
         node.parent = found.parent;
         let declared = &own[start..end as usize];
         let inverse = &sorted[starts[i] as usize..starts[i + 1] as usize];
@@ -332,6 +334,7 @@ struct NodeLinks {
     array_dimensions: Vec<u32>,
     data_type: Option<NodeIx>,
     method_declaration: Option<NodeIx>,
+    roles: Vec<(NodeIx, u32)>,
     /// Where the node's references end in [`Links::references`] (they start where the previous node's end).
     references_end: u32,
     parent: Option<NodeIx>,
@@ -447,7 +450,28 @@ impl Pass2<'_> {
                     None => ctx.resolve(model, p.get(text), p.span, diags).ok().and_then(|id| model.lookup(&id)),
                 };
             }
-            out.nodes.push(NodeLinks { array_dimensions, data_type, method_declaration, references_end: out.references.len() as u32, parent });
+            let mut roles = Vec::new();
+            for p in &model.nodes[ix.index()].attrs.role_permissions {
+                let Ok(id) = ctx.resolve(model, &p.role.value, p.role.span, diags) else { continue };
+                match model.lookup(&id).map(|r| (r, model.nodes[r.index()].class)) {
+                    Some((r, NodeClass::Object)) => roles.push((r, p.permissions)),
+                    found => {
+                        let what = match found {
+                            Some((_, class)) => format!("{} {}", article(class.name()), class.name()),
+                            None => "no loaded node".to_owned(),
+                        };
+                        diags.push(
+                            Diagnostic::new(
+                                Code::BadRolePermission,
+                                format!("RolePermission names `{}`, {what}, not a role", p.role.value),
+                            )
+                            .at(p.role.span)
+                            .help("name a role object, such as a well-known role of the base namespace (Operator is i=15680)"),
+                        );
+                    }
+                }
+            }
+            out.nodes.push(NodeLinks { array_dimensions, data_type, method_declaration, roles, references_end: out.references.len() as u32, parent });
         }
         out
     }

@@ -42,6 +42,9 @@
 //!   array_dimensions description`, and `EnumValues:{ EnumRow* }`. [`Val::Struct`] has no text form.
 //! - A reference is `ReferenceTypeId>TargetId` (forward) or `ReferenceTypeId<TargetId` (inverse), in the
 //!   nodeset's order.
+//! - A node with RolePermissions or AccessRestrictions in its nodeset has a second line after its row,
+//!   `Access Id restrictions Role=permissions*`: the AccessRestrictions bits or `~`, then each role
+//!   object's Id and its `PermissionType` bits, in the nodeset's order ([`AccessRow`]).
 //!
 //! For example, a property and a structure data type of DI:
 //!
@@ -289,6 +292,71 @@ impl NodeSetTable {
     }
 }
 
+impl NodeSetTable {
+    /// The nodes whose nodeset gives RolePermissions or AccessRestrictions, in table order (none for
+    /// [`Nodes::Rows`]). Decoded on the first call, like [`NodeSetTable::rows`].
+    pub fn access(&self) -> Result<&[AccessRow], TableError> {
+        match &self.nodes {
+            Nodes::Rows(_) => Ok(&[]),
+            Nodes::Packed(p) => match p.access.get_or_init(|| decode_access(p.text)) {
+                Ok(rows) => Ok(rows),
+                Err((line, column, message)) => Err(TableError {
+                    namespace_uri: self.namespace_uri,
+                    line: *line,
+                    column: *column,
+                    message: message.clone(),
+                }),
+            },
+        }
+    }
+}
+
+/// The RolePermissions and AccessRestrictions a nodeset gives one node.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct AccessRow {
+    pub id: Id,
+    /// The `AccessRestrictionType` bits, if the nodeset gives them.
+    pub restrictions: Option<u16>,
+    /// Each role object (a well-known role of the base namespace, or a role of the nodeset) and its
+    /// `PermissionType` bits.
+    pub roles: Vec<(Id, u32)>,
+}
+
+/// Decodes the `Access` lines of packed text.
+pub fn decode_access(text: &'static str) -> Result<Box<[AccessRow]>, (usize, usize, String)> {
+    let mut out = Vec::new();
+    for (n, line) in text.split('\n').enumerate() {
+        let Some(rest) = line.strip_prefix(ACCESS) else { continue };
+        let mut c = Cursor { s: line, b: line.as_bytes(), i: line.len() - rest.len() };
+        let row = (|| {
+            let id = c.id()?;
+            c.sp()?;
+            let restrictions = if c.eat(b'~') { None } else { Some(c.num("AccessRestrictions")?) };
+            let mut roles = Vec::new();
+            while c.eat(b' ') {
+                let role = c.id()?;
+                c.expect(b'=')?;
+                roles.push((role, c.num("PermissionType bits")?));
+            }
+            match c.peek() {
+                None => Ok(AccessRow { id, restrictions, roles }),
+                Some(f) => Err(format!("unexpected `{}` after the access row", f as char)),
+            }
+        })();
+        match row {
+            Ok(row) => out.push(row),
+            Err(message) => {
+                let column = line.get(..c.i.min(line.len())).map_or(c.i, |p| p.chars().count()) + 1;
+                return Err((n + 1, column, message));
+            }
+        }
+    }
+    Ok(out.into_boxed_slice())
+}
+
+/// How the line of a node's RolePermissions and AccessRestrictions starts.
+const ACCESS: &str = "Access ";
+
 /// The rows of a [`NodeSetTable`].
 #[derive(Debug)]
 pub enum Nodes {
@@ -303,12 +371,13 @@ pub enum Nodes {
 pub struct Packed {
     text: &'static str,
     rows: OnceLock<Result<Box<[NodeRow]>, (usize, usize, String)>>,
+    access: OnceLock<Result<Box<[AccessRow]>, (usize, usize, String)>>,
 }
 
 impl Packed {
     /// Packed text, decoded on first use.
     pub const fn new(text: &'static str) -> Packed {
-        Packed { text, rows: OnceLock::new() }
+        Packed { text, rows: OnceLock::new(), access: OnceLock::new() }
     }
 
     /// The text as the table holds it.
@@ -351,7 +420,7 @@ pub fn decode(text: &'static str) -> Result<Box<[NodeRow]>, (usize, usize, Strin
     let mut ranges: Vec<(usize, usize)> = Vec::with_capacity(text.len() / 128);
     let mut refs: Vec<Ref> = Vec::new();
     for (n, line) in text.split('\n').enumerate() {
-        if line.is_empty() {
+        if line.is_empty() || line.starts_with(ACCESS) {
             continue;
         }
         let mut c = Cursor { s: line, b: line.as_bytes(), i: 0 };
@@ -867,6 +936,28 @@ impl Cursor {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn access_lines_decode_and_rows_skip_them() {
+        let text = "\nVariable 1:6001 1:\"Setpoint\" = ~ 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63\nAccess 1:6001 ~ 0:15680=97 0:15668=33\nMethod 1:7002 1:\"Reset\" = ~ 0 0 1 1\nAccess 1:7002 2 0:15692=4097\n";
+        let rows = decode(text).unwrap();
+        assert_eq!(rows.len(), 2, "the Access lines are not rows");
+        let access = decode_access(text).unwrap();
+        assert_eq!(
+            access.as_ref(),
+            [
+                AccessRow { id: Id::numeric(1, 6001), restrictions: None, roles: vec![(Id::ns0(15680), 97), (Id::ns0(15668), 33)] },
+                AccessRow { id: Id::numeric(1, 7002), restrictions: Some(2), roles: vec![(Id::ns0(15692), 4097)] },
+            ]
+        );
+        assert!(decode_access("Object 1:1 1:\"A\" = ~ 0 0 0\n").unwrap().is_empty());
+        // A damaged line names its line and column.
+        let (line, column, message) = decode_access("\nAccess 1:6001 ~ 0:15680-97\n").unwrap_err();
+        assert_eq!((line, column), (2, 24), "{message}");
+        assert!(message.contains("expected `=`"), "{message}");
+        let (_, _, message) = decode_access("Access 1:6001 70000\n").unwrap_err();
+        assert!(message.contains("out of range"), "{message}");
+    }
 
     const fn row(refs: &'static [Ref], nrefs: &'static [NumRef]) -> NodeRow {
         NodeRow {

@@ -222,6 +222,45 @@ fn asyncua_client_against_a_secure_server() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The `roles` fixture's RolePermissions, obeyed node by node (`roles_check.py`, which reads the expectations
+/// from the fixture itself): for anonymous, an Operator, an Observer, an Engineer and a Supervisor, each
+/// variable's UserAccessLevel, reads and writes and each method's UserExecutable and calls. The calls that
+/// reach the server's code are exactly the allowed ones, with the caller's name.
+#[test]
+fn asyncua_finds_the_role_permissions_obeyed() {
+    use nodeset_runtime::server::{Role, Users};
+    let python = python();
+    let exe = build_server("roles_server");
+    let dir = temp_dir("roles");
+    let people = [("op", Role::Operator), ("obs", Role::Observer), ("eng", Role::Engineer), ("sup", Role::Supervisor)];
+    let mut users = Users::default();
+    for (name, role) in people {
+        users.set_password(name, vec![role], &format!("{name}-secret")).unwrap();
+    }
+    let users_file = dir.join("users.txt");
+    std::fs::write(&users_file, users.to_text()).unwrap();
+    let pki = dir.join("pki");
+    // Certificates are not what this test is about: the client's is trusted on first use.
+    let args = ["--pki", pki.to_str().unwrap(), "--users", users_file.to_str().unwrap(), "--trust-on-first-use"];
+    let (server, url) = Server::start(&exe, &args);
+    let mut check = Command::new(&python);
+    check.arg(root().join("tests/interop/roles_check.py")).args(["--url", &url]);
+    check.arg("--nodeset").arg(root().join("tests/fixtures/roles/Example.Roles.NodeSet2.xml"));
+    check.arg("--work").arg(dir.join("client"));
+    for (name, role) in people {
+        check.args(["--user", &format!("{name}={role}:{name}-secret")]);
+    }
+    run_check(check);
+    let printed = server.stop();
+    let calls: Vec<&String> = printed.iter().filter(|l| l.contains(" called by ")).collect();
+    assert_eq!(
+        calls,
+        ["Start called by op", "Start called by sup", "Reset called by sup"],
+        "the calls that reached the server's code: {printed:?}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Runs a check script; fails unless it ends with `N passed, 0 failed`.
 fn run_check(mut check: Command) {
     let mut child = check.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().expect("python runs");

@@ -37,6 +37,8 @@ const CASES: &[(&str, &str, &str, &str)] = &[
     ("subtype_of_other_class", "NS0210", "PUMP_TYPE", "BaseDataVariable"),
     // The DataType i=58 is ignored: Speed takes a Variant.
     ("bad_data_type", "NS0212", "SPEED", "BaseObjectType"),
+    // The entry naming i=63 is dropped; Operator's (i=15680, Browse, Read and Write) stays.
+    ("bad_role", "NS0220", "Access 1:1001 ~ 0:15680=97\n", "0:63=97"),
 ];
 
 fn fixture(case: &str) -> PathBuf {

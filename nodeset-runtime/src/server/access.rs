@@ -13,6 +13,9 @@ use std::str::FromStr;
 
 use opcua::types::NodeId;
 
+use super::ModelManager;
+use crate::table::NodeSetTable;
+
 /// A well-known role of the base namespace (Part 3, 4.9.2; Part 18).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Role {
@@ -173,6 +176,44 @@ impl AccessPolicy {
         let table = self.nodes.get(node).unwrap_or(&self.default);
         roles.iter().filter_map(|r| table.get(r)).fold(Permissions::NONE, |a, &b| a | b)
     }
+}
+
+/// The RolePermissions the tables' nodesets give their nodes, as [`AccessPolicy::nodes`] entries with server
+/// NodeIds, each with whether the node is a Variable (whose Value the Read permission guards; the attributes
+/// of other nodes are guarded by Browse). A node entry names only the well-known roles: a role object of a nodeset is no role any session
+/// has here, so it grants nothing. AccessRestrictions are carried by the tables but not evaluated (the
+/// authenticator does not see a session's security mode).
+pub(crate) fn table_permissions(
+    manager: &ModelManager,
+    tables: &[&'static NodeSetTable],
+) -> Result<Vec<(NodeId, BTreeMap<Role, Permissions>, bool)>, String> {
+    let mut out = Vec::new();
+    for table in tables {
+        let rows = table.access().map_err(|e| e.to_string())?;
+        let variables: std::collections::HashSet<crate::table::Id> = table
+            .rows()
+            .map_err(|e| e.to_string())?
+            .iter()
+            .filter(|r| matches!(r.kind, crate::table::Kind::Variable { .. }))
+            .map(|r| r.id)
+            .collect();
+        let Some(map) = manager.namespace_map(table.namespace_uri) else { continue };
+        for row in rows.iter().filter(|r| !r.roles.is_empty()) {
+            let Some(node) = map.try_id(row.id) else { continue };
+            let mut permissions: BTreeMap<Role, Permissions> = BTreeMap::new();
+            for &(role, bits) in &row.roles {
+                match map.try_id(role).as_ref().and_then(Role::from_node_id) {
+                    Some(role) => {
+                        let p = permissions.entry(role).or_default();
+                        *p = *p | Permissions(bits);
+                    }
+                    None => tracing::warn!("{node}: RolePermissions name {role:?}, which is not a well-known role; it grants nothing"),
+                }
+            }
+            out.push((node, permissions, variables.contains(&row.id)));
+        }
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

@@ -248,6 +248,7 @@ impl ServerConfig {
         }
         let anonymous = self.security.anonymous || self.security.insecure;
         let auth = std::sync::Arc::new(ModelAuth::new(users, self.access, anonymous));
+        let tables = self.tables.clone();
         let endpoint_url = format!("opc.tcp://{}:{port}/", self.host);
         let mut builder = ServerBuilder::new()
             .discovery_urls(vec![endpoint_url.clone()])
@@ -261,7 +262,7 @@ impl ServerConfig {
             .certificate_path("own/cert.der")
             .private_key_path("private/private.pem")
             .trust_client_certs(self.security.trust_on_first_use)
-            .with_authenticator(auth)
+            .with_authenticator(auth.clone())
             .max_sessions(self.max_sessions)
             .with_node_manager(model_node_manager_with_instances(self.tables, &instance_namespace));
         for loader in self.type_loaders {
@@ -290,6 +291,7 @@ impl ServerConfig {
         builder = builder.subscription_poll_interval_ms(self.min_publishing_interval_ms.min(100));
         let (server, handle) = builder.build()?;
         let manager = ModelManager::from_handle(&handle).ok_or("the model node manager is missing from the server")?;
+        auth.add_node_permissions(access::table_permissions(&manager, &tables)?);
         Ok(ModelServer { server, handle, manager, listener, endpoint_url })
     }
 }

@@ -240,7 +240,13 @@ pub struct Caller {
 /// UserAccessLevel and UserExecutable with an [`AccessPolicy`].
 pub struct ModelAuth {
     users: Users,
-    policy: AccessPolicy,
+    /// The configured policy, then the RolePermissions of the tables' nodes (added once the server is
+    /// built, where the configuration gives the node no entry of its own).
+    policy: std::sync::RwLock<AccessPolicy>,
+    /// The nodes of the tables with RolePermissions that are not Variables: async-opcua asks for their
+    /// CurrentRead before any attribute is read, which their Browse permission decides (Read is about a
+    /// Variable's Value).
+    browse_read: std::sync::RwLock<std::collections::HashSet<NodeId>>,
     anonymous: bool,
     /// Password checks in progress at once. Argon2id needs 19 MiB per check by design, so 50 sessions
     /// logging in together would hold nearly 1 GiB (measured with `cargo xtask load`); checks beyond the
@@ -255,7 +261,25 @@ impl ModelAuth {
     /// An authenticator; `anonymous` offers the anonymous identity token on every endpoint.
     pub fn new(users: Users, policy: AccessPolicy, anonymous: bool) -> ModelAuth {
         let parallel = std::thread::available_parallelism().map_or(1, |n| n.get());
-        ModelAuth { users, policy, anonymous, verifying: std::sync::Arc::new(tokio::sync::Semaphore::new(parallel)) }
+        ModelAuth { users, policy: std::sync::RwLock::new(policy), browse_read: Default::default(), anonymous, verifying: std::sync::Arc::new(tokio::sync::Semaphore::new(parallel)) }
+    }
+
+    /// Adds the RolePermissions of single nodes (and whether each is a Variable), keeping the entries the
+    /// configuration already gives.
+    pub fn add_node_permissions(&self, nodes: impl IntoIterator<Item = (NodeId, BTreeMap<Role, Permissions>, bool)>) {
+        let mut policy = self.policy.write().unwrap_or_else(|e| e.into_inner());
+        let mut browse_read = self.browse_read.write().unwrap_or_else(|e| e.into_inner());
+        for (node, permissions, variable) in nodes {
+            if !variable {
+                browse_read.insert(node.clone());
+            }
+            policy.nodes.entry(node).or_insert(permissions);
+        }
+    }
+
+    /// What a session with this user token may do on `node`.
+    pub fn permissions(&self, token: &UserToken, node: &NodeId) -> Permissions {
+        self.policy.read().unwrap_or_else(|e| e.into_inner()).permissions(&self.roles(token), node)
     }
 
     /// The caller behind a user token.
@@ -342,9 +366,14 @@ impl AuthManager for ModelAuth {
     }
 
     fn effective_user_access_level(&self, token: &UserToken, user_access_level: AccessLevel, node_id: &NodeId) -> AccessLevel {
-        let permissions = self.policy.permissions(&self.roles(token), node_id);
+        let permissions = self.permissions(token, node_id);
         let mut level = user_access_level;
-        if !permissions.contains(Permissions::READ) {
+        let read = if self.browse_read.read().unwrap_or_else(|e| e.into_inner()).contains(node_id) {
+            Permissions::BROWSE
+        } else {
+            Permissions::READ
+        };
+        if !permissions.contains(read) {
             level.remove(AccessLevel::CURRENT_READ);
         }
         if !permissions.contains(Permissions::WRITE) {
@@ -354,7 +383,7 @@ impl AuthManager for ModelAuth {
     }
 
     fn is_user_executable(&self, token: &UserToken, method_id: &NodeId) -> bool {
-        self.policy.permissions(&self.roles(token), method_id).contains(Permissions::CALL)
+        self.permissions(token, method_id).contains(Permissions::CALL)
     }
 
     fn user_token_policies(&self, endpoint: &ServerEndpoint) -> Vec<UserTokenPolicy> {

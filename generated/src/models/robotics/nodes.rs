@@ -539,7 +539,9 @@ Variable 2:18176 2:"Level" = "Provides information about the access rights and d
 Variable 2:18177 2:"Name" = "The name for the current user within the control system." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
 Object 2:15011 2:"http://opcfoundation.org/UA/Robotics/" = ~ 0 0 0 0:47<0:11715 0:40>0:11616
 Variable 2:15585 0:"DefaultAccessRestrictions" = ~ 0 0 0:95 -1 [] 1 1 0 ~ ~ 0:46<2:15011 0:40>0:68
+Access 2:15585 ~ 0:15704=98 0:15644=1
 Variable 2:15583 0:"DefaultRolePermissions" = ~ 0 0 0:96 1 [] 1 1 0 ~ ~ 0:46<2:15011 0:40>0:68
+Access 2:15583 ~ 0:15704=98 0:15644=1
 Variable 2:15584 0:"DefaultUserRolePermissions" = ~ 0 0 0:96 1 [] 1 1 0 ~ ~ 0:46<2:15011 0:40>0:68
 Variable 2:15114 0:"IsNamespaceSubset" = ~ 0 0 0:1 -1 [] 1 1 0 ~ Boolean:0 0:46<2:15011 0:40>0:68
 Variable 2:15091 0:"NamespacePublicationDate" = ~ 0 0 0:13 -1 [] 1 1 0 ~ DateTime:"2025-09-08T00:00:00Z" 0:46<2:15011 0:40>0:68

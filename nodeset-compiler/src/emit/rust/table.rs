@@ -149,6 +149,9 @@ impl Gen<'_> {
             if let Some(dt) = n.attrs.data_type {
                 used.insert(model.node(dt).id.ns);
             }
+            for &(role, _) in &n.attrs.roles {
+                used.insert(model.node(role).id.ns);
+            }
         }
         used.remove(&0);
         let locals: Vec<u16> = std::iter::once(0).chain(used.iter().copied()).collect();
@@ -250,6 +253,24 @@ impl Gen<'_> {
                 id_of(out, r.target);
             }
             out.push('\n');
+            // RolePermissions and AccessRestrictions, on a line of their own after the row, only where the
+            // nodeset gives them: `Access ID RESTRICTIONS ROLE=PERMISSIONS ...` (`~` for no restrictions).
+            if !n.attrs.roles.is_empty() || n.attrs.access_restrictions.is_some() {
+                out.push_str("Access ");
+                id_of(out, ix);
+                match n.attrs.access_restrictions {
+                    Some(r) => {
+                        let _ = write!(out, " {r}");
+                    }
+                    None => out.push_str(" ~"),
+                }
+                for &(role, permissions) in &n.attrs.roles {
+                    out.push(' ');
+                    id_of(out, role);
+                    let _ = write!(out, "={permissions}");
+                }
+                out.push('\n');
+            }
         }
         if dropped_values > 0 {
             self.diags.push(
