@@ -279,15 +279,7 @@ impl NodeSetTable {
     pub fn rows(&self) -> Result<&[NodeRow], TableError> {
         match &self.nodes {
             Nodes::Rows(rows) => Ok(rows),
-            Nodes::Packed(p) => match p.rows.get_or_init(|| decode(p.text)) {
-                Ok(rows) => Ok(rows),
-                Err((line, column, message)) => Err(TableError {
-                    namespace_uri: self.namespace_uri,
-                    line: *line,
-                    column: *column,
-                    message: message.clone(),
-                }),
-            },
+            Nodes::Packed(p) => p.rows.get_or_init(|| decode(p.text)).as_deref().map_err(|e| self.error(e)),
         }
     }
 }
@@ -298,16 +290,13 @@ impl NodeSetTable {
     pub fn access(&self) -> Result<&[AccessRow], TableError> {
         match &self.nodes {
             Nodes::Rows(_) => Ok(&[]),
-            Nodes::Packed(p) => match p.access.get_or_init(|| decode_access(p.text)) {
-                Ok(rows) => Ok(rows),
-                Err((line, column, message)) => Err(TableError {
-                    namespace_uri: self.namespace_uri,
-                    line: *line,
-                    column: *column,
-                    message: message.clone(),
-                }),
-            },
+            Nodes::Packed(p) => p.access.get_or_init(|| decode_access(p.text)).as_deref().map_err(|e| self.error(e)),
         }
+    }
+
+    /// The error of packed text that does not decode, as the table reports it.
+    fn error(&self, (line, column, message): &(usize, usize, String)) -> TableError {
+        TableError { namespace_uri: self.namespace_uri, line: *line, column: *column, message: message.clone() }
     }
 }
 

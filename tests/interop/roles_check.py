@@ -14,7 +14,7 @@ role browses and reads, Operator, Engineer, Supervisor and ConfigureAdmin also w
 - a method's UserExecutable (its attributes unreadable, BadUserAccessDenied, without Browse), and whether
   a call is accepted or refused with BadUserAccessDenied.
 
-It prints one line per check and ends with `N passed, M failed`.
+It prints one line per check (report.py) and ends with `N passed, M failed`.
 """
 
 import argparse
@@ -27,6 +27,8 @@ from asyncua import Client, ua
 from asyncua.crypto import cert_gen, security_policies
 from cryptography.x509.oid import ExtendedKeyUsageOID
 
+from report import Report
+
 XSD = "{http://opcfoundation.org/UA/2011/03/UANodeSet.xsd}"
 APP_URI = "urn:nodeset-tests:roles-check"
 BROWSE, READ, WRITE, CALL = 0x1, 0x20, 0x40, 0x1000
@@ -35,20 +37,6 @@ ROLES = {15644: "Anonymous", 15656: "AuthenticatedUser", 15668: "Observer", 1568
 LOOK = 0x1 | READ | 0x800
 DEFAULT = {r: (LOOK | WRITE | CALL) if r in ("Operator", "Engineer", "Supervisor", "ConfigureAdmin") else LOOK
            for r in ROLES.values()}
-
-
-class Report:
-    def __init__(self) -> None:
-        self.passed = 0
-        self.failed = 0
-
-    def check(self, name: str, ok: bool, detail: str = "") -> None:
-        if ok:
-            self.passed += 1
-            print(f"ok   {name}")
-        else:
-            self.failed += 1
-            print(f"FAIL {name}: {detail}")
 
 
 def fixture(path: Path):
