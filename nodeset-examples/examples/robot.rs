@@ -14,7 +14,10 @@
 //! struct and is printed (`ConfiguredDefaultStopMode written by a client: <value>`). Joint positions
 //! (`Axes/<axis>/ParameterSet/ActualPosition`) move along sine curves, updated at 100 Hz through the typed
 //! handles. The arm's `Lock` object (DI LockingServicesType) has typed methods: `InitLock(Context)` locks
-//! for a client, `ExitLock` unlocks.
+//! for a client (Locked, LockingClient and LockingUser show who holds it), `ExitLock` unlocks. The
+//! controller's SystemOperationStateMachine is served as a state machine: it comes up Idle and takes
+//! IdleToReady. Every other variable a client may browse has a value too (`describe`): nameplates of motors,
+//! gears and software, gear ratios, engineering units, motion profiles, the safety state and the task.
 //!
 //! The first line on stdout is `listening on <url>`; the server stops on SIGINT, SIGTERM or after
 //! `--seconds N`, printing `server stopped cleanly`.
@@ -25,15 +28,17 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use nodeset_models::models::robotics::objects::MotionDeviceSystemType;
-use nodeset_models::models::robotics::types::MotionDeviceCategoryEnumeration;
+use nodeset_models::models::robotics::types::{
+    AxisMotionProfileEnumeration, MotionDeviceCategoryEnumeration, OperationalModeEnumeration,
+};
 use nodeset_models::models::{di, ia, robotics};
 use nodeset_examples::secure::{SecureArgs, USAGE};
-use nodeset_models::runtime::server::{MethodError, ServerConfig};
-use nodeset_models::runtime::typed::{Bound, Instantiate, ObjectType};
+use nodeset_models::runtime::server::{MethodError, ModelManager, ServerConfig};
+use nodeset_models::runtime::typed::{Bound, Instantiate, Machine, ObjectType, Variable};
 use nodeset_models::ObjectModel;
 use opcua::nodes::NodeType;
 use opcua::server::address_space::AccessLevel;
-use opcua::types::{LocalizedText, NodeId, ObjectId, StatusCode};
+use opcua::types::{EUInformation, LocalizedText, NodeId, ObjectId, RationalNumber, StatusCode};
 
 /// The arm's identification, bound to the Robotics MotionDeviceType (and the DI members it inherits).
 #[derive(Clone, Debug, ObjectModel)]
@@ -157,12 +162,20 @@ async fn run(port: u16, seconds: Option<u64>, secure: SecureArgs) -> Result<(), 
     };
     let settings = Bound::bind(&manager, controller.node.id(), settings).map_err(|e| e.to_string())?;
 
+    describe(&manager, &robot)?;
+    // The controller comes up Idle and makes itself Ready (a transition the system takes by itself).
+    let operation = controller.system_operation.as_ref().ok_or("the controller has no SystemOperation")?;
+    let machine = &operation.system_operation_state_machine;
+    let system = Machine::serve_from(machine.as_ref(), "Idle").map_err(|e| e.to_string())?;
+    machine.last_transition_reason.set(LAST_TRANSITION_REASON_SYSTEM).map_err(|s| s.to_string())?;
+    system.transition("Ready").map_err(|s| s.to_string())?;
+
     // The Lock methods, typed: InitLock(Context: String) -> InitLockStatus: Int32.
     if let Some(lock) = &arm.lock {
         let holder = Arc::new(Mutex::new(None::<String>));
-        let (h, locked) = (holder.clone(), lock.locked.clone());
-        lock.init_lock.implement(move |_ctx, (context,): (String,)| {
-            let (h, locked) = (h.clone(), locked.clone());
+        let (h, shown) = (holder.clone(), LockShown::of(lock));
+        lock.init_lock.implement(move |ctx, (context,): (String,)| {
+            let (h, shown) = (h.clone(), shown.clone());
             async move {
                 if context.is_empty() {
                     return Err(MethodError::Status(StatusCode::BadInvalidArgument));
@@ -172,24 +185,23 @@ async fn run(port: u16, seconds: Option<u64>, secure: SecureArgs) -> Result<(), 
                     // DI: -1 = E_AlreadyLocked.
                     return Ok((-1,));
                 }
-                // Locked shows the lock to every client (DI LockingServicesType).
-                locked.set(true).map_err(MethodError::Status)?;
+                shown.show(Some((&ctx.client, ctx.user.as_deref().unwrap_or("")))).map_err(MethodError::Status)?;
                 *held = Some(context);
                 Ok((0,))
             }
         });
-        let (h, locked) = (holder.clone(), lock.locked.clone());
+        let (h, shown) = (holder.clone(), LockShown::of(lock));
         lock.exit_lock.implement(move |_ctx, ()| {
-            let (h, locked) = (h.clone(), locked.clone());
+            let (h, shown) = (h.clone(), shown.clone());
             async move {
                 if h.lock().unwrap_or_else(|e| e.into_inner()).take().is_none() {
                     return Ok((-1,));
                 }
-                locked.set(false).map_err(MethodError::Status)?;
+                shown.show(None).map_err(MethodError::Status)?;
                 Ok((0,))
             }
         });
-        lock.locked.set(false).map_err(|s| s.to_string())?;
+        LockShown::of(lock).show(None).map_err(|s| s.to_string())?;
     }
 
     let axes: Vec<_> = arm.axes.axis_identifier.values().map(|a| a.parameter_set.actual_position.clone()).collect();
@@ -240,6 +252,106 @@ async fn run(port: u16, seconds: Option<u64>, secure: SecureArgs) -> Result<(), 
     task.await.map_err(|e| e.to_string())??;
     println!("server stopped cleanly");
     Ok(())
+}
+
+/// Robotics' LastTransitionReason 3: "System", the system took the transition by itself.
+const LAST_TRANSITION_REASON_SYSTEM: i16 = 3;
+
+/// Gives every mandatory variable the instantiation left empty a value, so that a browsing client sees the
+/// whole robot: nameplates of motors, gears and software, gear ratios, engineering units, motion profiles,
+/// the safety state and the task.
+fn describe(manager: &ModelManager, robot: &MotionDeviceSystemType) -> Result<(), String> {
+    let err = |s: StatusCode| s.to_string();
+    let maker = LocalizedText::new("en", "nodeset-compiler robotics");
+    let arm = robot.motion_devices.motion_device_identifier.get("Arm").ok_or("the robot has no arm")?;
+    for (i, axis) in arm.axes.axis_identifier.values().enumerate() {
+        axis.motion_profile.set(AxisMotionProfileEnumeration::Rotary).map_err(err)?;
+        engineering_units(manager, axis.parameter_set.actual_position.id(), DEGREE)?;
+        let pt = arm.power_trains.power_train_identifier.values().nth(i).ok_or("an axis has no power train")?;
+        for (motor, n) in pt.motor_identifier.values().zip(1..) {
+            motor.manufacturer.set(maker.clone()).map_err(err)?;
+            motor.model.set(LocalizedText::new("en", "SIX-M")).map_err(err)?;
+            motor.product_code.set("SIX-M-400".into()).map_err(err)?;
+            motor.serial_number.set(format!("M-{:04}", 10 * (i + 1) + n)).map_err(err)?;
+            motor.parameter_set.motor_temperature.set(35.0 + i as f64).map_err(err)?;
+            engineering_units(manager, motor.parameter_set.motor_temperature.id(), DEGREE_CELSIUS)?;
+        }
+        for (gear, n) in pt.gear_identifier.values().zip(1..) {
+            gear.manufacturer.set(maker.clone()).map_err(err)?;
+            gear.model.set(LocalizedText::new("en", "SIX-G")).map_err(err)?;
+            gear.product_code.set("SIX-G-121".into()).map_err(err)?;
+            gear.serial_number.set(format!("G-{:04}", 10 * (i + 1) + n)).map_err(err)?;
+            // Motor turns per output turn; the RationalNumberType children follow the value.
+            gear.gear_ratio.set(RationalNumber { numerator: 121, denominator: 1 }).map_err(err)?;
+        }
+    }
+    let controller = robot.controllers.controller_identifier.get("Controller").ok_or("the robot has no controller")?;
+    for software in controller.software.software_identifier.values() {
+        software.manufacturer.set(maker.clone()).map_err(err)?;
+        software.model.set(LocalizedText::new("en", "SIX-OS")).map_err(err)?;
+        software.software_revision.set(env!("CARGO_PKG_VERSION").into()).map_err(err)?;
+    }
+    for task in controller.task_controls.task_control_identifier.values() {
+        task.component_name.set(LocalizedText::new("en", "Main task")).map_err(err)?;
+        task.parameter_set.task_program_name.set("idle.prg".into()).map_err(err)?;
+        task.parameter_set.task_program_loaded.set(true).map_err(err)?;
+    }
+    for safety in robot.safety_states.safety_state_identifier.values() {
+        safety.parameter_set.emergency_stop.set(false).map_err(err)?;
+        safety.parameter_set.protective_stop.set(false).map_err(err)?;
+        safety.parameter_set.operational_mode.set(OperationalModeEnumeration::Automatic).map_err(err)?;
+    }
+    Ok(())
+}
+
+/// UNECE Recommendation 20 units, as OPC 10000-8 encodes them (the code's letters as the UnitId).
+const UNECE: &str = "http://www.opcfoundation.org/UA/units/un/cefact";
+const DEGREE: (&str, &str, &str) = ("DD", "°", "degree");
+const DEGREE_CELSIUS: (&str, &str, &str) = ("CEL", "°C", "degree Celsius");
+
+/// Sets the EngineeringUnits property of an analog variable.
+fn engineering_units(manager: &ModelManager, variable: &NodeId, (code, symbol, name): (&str, &str, &str)) -> Result<(), String> {
+    let units: Variable<EUInformation> = manager
+        .bind_with(|b| b.child(variable, "http://opcfoundation.org/UA/", "EngineeringUnits"))
+        .map_err(|e| e.to_string())?;
+    let unit_id = code.bytes().fold(0i32, |id, c| (id << 8) | i32::from(c));
+    let eu = EUInformation {
+        namespace_uri: UNECE.into(),
+        unit_id,
+        display_name: LocalizedText::new("", symbol),
+        description: LocalizedText::new("en", name),
+    };
+    units.set(eu).map_err(|s| s.to_string())
+}
+
+/// What DI's LockingServicesType shows of a lock: Locked, LockingClient, LockingUser, RemainingLockTime.
+#[derive(Clone)]
+struct LockShown {
+    locked: Variable<bool>,
+    client: Variable<String>,
+    user: Variable<String>,
+    remaining: Variable<f64>,
+}
+
+impl LockShown {
+    fn of(lock: &di::objects::LockingServicesType) -> LockShown {
+        LockShown {
+            locked: lock.locked.clone(),
+            client: lock.locking_client.clone(),
+            user: lock.locking_user.clone(),
+            remaining: lock.remaining_lock_time.clone(),
+        }
+    }
+
+    /// Shows the lock held by `(client ApplicationUri, user)`, or no lock. This lock does not expire: DI
+    /// gives RemainingLockTime 0 for a lock without timeout, and for no lock.
+    fn show(&self, holder: Option<(&str, &str)>) -> Result<(), StatusCode> {
+        let (client, user) = holder.unwrap_or(("", ""));
+        self.client.set(client.into())?;
+        self.user.set(user.into())?;
+        self.remaining.set(0.0)?;
+        self.locked.set(holder.is_some())
+    }
 }
 
 async fn shutdown_signal() {

@@ -10,7 +10,12 @@ usage: .venv/bin/python tests/interop/defects_check.py --robot URL
   rejected values: the example prints every value its struct receives);
 - AssetId is user writable (OPC 10000-100, 4.5.3): a write is stored (the Rust test checks that it reached
   the derived struct);
-- Server/Namespaces has one NamespaceMetadata object per namespace URI.
+- Server/Namespaces has one NamespaceMetadata object per namespace URI;
+- no variable of the robot is null: nameplates of motors, gears and software, GearRatio, EngineeringUnits,
+  the SafetyState, SystemOperationStateMachine (Ready, after IdleToReady), the task, the Lock's variables;
+- a variable whose structure ns0 shows as children (GearRatio: Numerator, Denominator) and its children
+  agree;
+- InitLock shows the lock (Locked, LockingClient = the client's ApplicationUri) and ExitLock clears it.
 
 --cell (the robot cell's composite server):
 - a select clause that names TransitionEventType (i=2311), the type that declares Transition, FromState and
@@ -19,7 +24,9 @@ usage: .venv/bin/python tests/interop/defects_check.py --robot URL
   transition events; asyncua's default where clause, `EventType InList [the type and its subtypes]`, gets
   none from async-opcua 0.19 (its InList compares only numbers and Booleans, and evaluates before any code
   of ours sees the event): the check records that, and fails once async-opcua compares NodeIds;
-- Server/Namespaces has one object per namespace URI.
+- Server/Namespaces has one object per namespace URI;
+- after a client writes a 3DFrame to ReferenceDrillBush's HolePosition, its children CartesianCoordinates and
+  Orientation, and theirs (X, Y, Z, A, B, C), equal the frame's fields.
 
 Every check prints PASS or FAIL; the last line is ``N passed, N failed``; the exit status is 1 if any
 check failed.
@@ -73,6 +80,52 @@ async def namespaces_once(report: Report, client: Client, server: str) -> None:
     report.check(f"{server}: Server/Namespaces has an object for every namespace of the NamespaceArray", not missing, f"missing {missing}")
 
 
+async def variables(client: Client, root) -> list[tuple[str, object, object, ua.DataValue]]:
+    """Every variable below `root` (outside ns0) as (path, node, parent variable or None, DataValue)."""
+    seen: set[str] = set()
+    out = []
+
+    async def walk(node, path: str, parent_variable) -> None:
+        refs = await node.get_references(refs=ua.ObjectIds.HierarchicalReferences, direction=ua.BrowseDirection.Forward)
+        for ref in refs:
+            key = ref.NodeId.to_string()
+            if key in seen or ref.NodeId.NamespaceIndex == 0:
+                continue
+            seen.add(key)
+            kid = client.get_node(ref.NodeId)
+            kid_path = f"{path}/{ref.BrowseName.Name}"
+            if ref.NodeClass == ua.NodeClass.Variable:
+                out.append((kid_path, kid, parent_variable, await kid.read_data_value(raise_on_bad_status=False)))
+                await walk(kid, kid_path, kid)
+            else:
+                await walk(kid, kid_path, None)
+
+    is_variable = await root.read_node_class() == ua.NodeClass.Variable
+    await walk(root, (await root.read_browse_name()).Name, root if is_variable else None)
+    return out
+
+
+def is_null(value: ua.DataValue) -> bool:
+    return value.Value is None or value.Value.Value is None
+
+
+def fields_agree(report: Report, found, label: str) -> None:
+    """Each child named like a field of its parent variable's structured value holds that field's value."""
+    values = {id(node): dv for _, node, _, dv in found}
+    checked = 0
+    for path, node, parent, dv in found:
+        if parent is None or is_null(values[id(parent)]):
+            continue
+        name = path.rsplit("/", 1)[1]
+        parent_value = values[id(parent)].Value.Value
+        if not hasattr(parent_value, name):
+            continue
+        checked += 1
+        field = getattr(parent_value, name)
+        report.check(f"{label}: {path} has its parent's field {name}", not is_null(dv) and dv.Value.Value == field, f"{None if is_null(dv) else dv.Value.Value} != {field}")
+    report.check(f"{label}: some children of structured variables were compared", checked > 0, "none found")
+
+
 async def robot(url: str) -> Report:
     report = Report()
     async with Client(url, timeout=30) as client:
@@ -108,6 +161,27 @@ async def robot(url: str) -> Report:
             report.check("a client's write of AssetId is accepted", False, str(e))
         await asyncio.sleep(0.2)
         await namespaces_once(report, client, "robot")
+
+        found = await variables(client, system)
+        nulls = sorted(p for p, _, _, dv in found if is_null(dv))
+        report.check(f"no variable of the robot is null ({len(found)} variables)", not nulls, f"{len(nulls)} null: {nulls[:12]}")
+        fields_agree(report, found, "robot")
+        machine = await path(controller, "SystemOperation", "SystemOperationStateMachine")
+        report.equal("SystemOperationStateMachine is Ready", (await (await child(machine, "CurrentState")).read_value()).Text, "Ready")
+        report.equal("its LastTransition is IdleToReady", (await (await child(machine, "LastTransition")).read_value()).Text, "IdleToReady")
+        units = await path(system, "MotionDevices", "Arm", "Axes", "A1", "ParameterSet", "ActualPosition", "EngineeringUnits")
+        report.equal("ActualPosition's EngineeringUnits is UNECE DD (degree)", (await units.read_value()).UnitId, 17476)
+
+        lock = await path(system, "MotionDevices", "Arm", "Lock")
+        shown = {n: await child(lock, n) for n in ["Locked", "LockingClient", "LockingUser", "RemainingLockTime"]}
+        status = await lock.call_method(await child(lock, "InitLock"), ua.Variant("defects check", ua.VariantType.String))
+        report.equal("InitLock succeeds", status, 0)
+        report.equal("after InitLock, Locked is true", await shown["Locked"].read_value(), True)
+        report.equal("after InitLock, LockingClient is the client's ApplicationUri", await shown["LockingClient"].read_value(), client.application_uri)
+        status = await lock.call_method(await child(lock, "ExitLock"))
+        report.equal("ExitLock succeeds", status, 0)
+        report.equal("after ExitLock, Locked is false", await shown["Locked"].read_value(), False)
+        report.equal("after ExitLock, LockingClient is empty", await shown["LockingClient"].read_value(), "")
     return report
 
 
@@ -201,6 +275,16 @@ async def cell(url: str) -> Report:
             0,
         )
         await namespaces_once(report, client, "cell")
+
+        # A client's write of a 3DFrame: the frame's children show its fields.
+        hole = await path(skill, "InputParameterSet", "HolePosition")
+        frame = ua.ThreeDFrame(
+            CartesianCoordinates=ua.ThreeDCartesianCoordinates(X=100.0, Y=200.0, Z=5.0),
+            Orientation=ua.ThreeDOrientation(A=0.0, B=180.0, C=90.0),
+        )
+        await hole.write_value(ua.DataValue(ua.Variant(frame, ua.VariantType.ExtensionObject)))
+        found = await variables(client, hole)
+        fields_agree(report, [("HolePosition", hole, None, await hole.read_data_value())] + found, "cell")
     return report
 
 

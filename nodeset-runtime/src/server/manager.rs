@@ -23,6 +23,7 @@ use opcua::types::{
 use tracing::{error, warn};
 
 use super::check::Types;
+use super::fields::field_children;
 use crate::import::{build_map, parse_date_time, TableImport, OPC_UA_NAMESPACE, UNMAPPED};
 use crate::table::NodeSetTable;
 use crate::typed::instance::{Planner, Spaces};
@@ -53,6 +54,8 @@ pub struct MethodInvocation {
     /// The calling session's user: its user name (or the name of its user certificate), `None` if it is
     /// anonymous (for an audit line, or to record who started a skill).
     pub user: Option<String>,
+    /// The ApplicationUri the calling client gave when it created its session (empty if it gave none).
+    pub client: String,
 }
 
 /// Why a method call failed.
@@ -410,6 +413,7 @@ impl InMemoryNodeManagerImpl for ModelNodes {
             };
             to_store.push((i, value));
         }
+        let tree = context.type_tree.read();
         let mut space = address_space.write();
         let mut changed = Vec::new();
         for (i, value) in to_store {
@@ -423,6 +427,9 @@ impl InMemoryNodeManagerImpl for ModelNodes {
             match write_node_value(node, &parsed) {
                 Ok(()) => {
                     write.set_status(StatusCode::Good);
+                    if parsed.attribute_id == AttributeId::Value {
+                        mirror_fields(&mut space, &tree, &parsed.node_id, &parsed.value, &mut changed);
+                    }
                     changed.push((parsed.node_id, parsed.attribute_id));
                 }
                 Err(status) => write.set_status(status),
@@ -476,6 +483,7 @@ impl InMemoryNodeManagerImpl for ModelNodes {
                 arguments: call.arguments().to_vec(),
                 manager: manager.clone(),
                 user: Some(context.user_token().0.clone()).filter(|u| u != opcua::server::ANONYMOUS_USER_TOKEN_ID),
+                client: context.session().read().application_description().application_uri.as_ref().to_owned(),
             };
             match handler.call(invocation).await {
                 Ok(outputs) => {
@@ -684,7 +692,38 @@ impl ModelManager {
 
     /// Sets a variable's whole DataValue (value, status, timestamps) unchecked, and reports it to
     /// subscriptions.
+    ///
+    /// A structured value whose fields ns0 shows as child variables (a 3DFrame, a RationalNumber, ...) sets
+    /// those children too (see [`super::fields`]).
     pub fn set_data_value(&self, node: &NodeId, value: DataValue) -> Result<(), StatusCode> {
-        self.node_manager.set_value(&self.nodes().subscriptions, node, None, value)
+        let children = {
+            let tree = self.nodes().type_tree.read();
+            let space = self.node_manager.address_space().read();
+            field_children(&space, &tree, node, &value)
+        };
+        self.node_manager.set_value(&self.nodes().subscriptions, node, None, value)?;
+        for (child, value) in children {
+            self.set_data_value(&child, value)?;
+        }
+        Ok(())
+    }
+}
+
+/// Sets the children that show the fields of `node`'s new value (and theirs, down the tree), within the
+/// write lock of a client's write; each one set is added to `changed` for the subscriptions.
+fn mirror_fields(
+    space: &mut AddressSpace,
+    tree: &DefaultTypeTree,
+    node: &NodeId,
+    value: &DataValue,
+    changed: &mut Vec<(NodeId, AttributeId)>,
+) {
+    let mut pending = field_children(space, tree, node, value);
+    while let Some((child, value)) = pending.pop() {
+        pending.extend(field_children(space, tree, &child, &value));
+        if let Some(NodeType::Variable(var)) = space.find_mut(&child) {
+            var.set_data_value(value);
+            changed.push((child, AttributeId::Value));
+        }
     }
 }

@@ -32,6 +32,7 @@
 
 pub mod access;
 mod check;
+mod fields;
 mod manager;
 mod namespace_objects;
 pub mod security;

@@ -505,6 +505,10 @@ pub struct CallContext {
     pub method_id: NodeId,
     /// The manager, to read and set values.
     pub manager: ModelManager,
+    /// The calling session's user name (or the name of its user certificate); `None` if anonymous.
+    pub user: Option<String>,
+    /// The calling client's ApplicationUri (empty if it gave none).
+    pub client: String,
 }
 
 /// A method whose input arguments are `I` and output arguments `O` (tuples of [`UaValue`]s, as its
@@ -553,6 +557,8 @@ impl<I: Arguments, O: Arguments> Method<I, O> {
                     object_id: invocation.object_id,
                     method_id: invocation.method_id,
                     manager: invocation.manager,
+                    user: invocation.user,
+                    client: invocation.client,
                 };
                 f(context, input).await.map(O::into_variants)
             }
