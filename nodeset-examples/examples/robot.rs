@@ -28,17 +28,16 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use nodeset_models::models::robotics::objects::MotionDeviceSystemType;
-use nodeset_models::models::robotics::types::{
-    AxisMotionProfileEnumeration, MotionDeviceCategoryEnumeration, OperationalModeEnumeration,
-};
+use nodeset_models::models::robotics::types::MotionDeviceCategoryEnumeration;
 use nodeset_models::models::{di, ia, robotics};
+use nodeset_examples::describe::describe;
 use nodeset_examples::secure::{SecureArgs, USAGE};
-use nodeset_models::runtime::server::{MethodError, ModelManager, ServerConfig};
+use nodeset_models::runtime::server::{MethodError, ServerConfig};
 use nodeset_models::runtime::typed::{Bound, Instantiate, Machine, ObjectType, Variable};
 use nodeset_models::ObjectModel;
 use opcua::nodes::NodeType;
 use opcua::server::address_space::AccessLevel;
-use opcua::types::{EUInformation, LocalizedText, NodeId, ObjectId, RationalNumber, StatusCode};
+use opcua::types::{LocalizedText, NodeId, ObjectId, StatusCode};
 
 /// The arm's identification, bound to the Robotics MotionDeviceType (and the DI members it inherits).
 #[derive(Clone, Debug, ObjectModel)]
@@ -256,73 +255,6 @@ async fn run(port: u16, seconds: Option<u64>, secure: SecureArgs) -> Result<(), 
 
 /// Robotics' LastTransitionReason 3: "System", the system took the transition by itself.
 const LAST_TRANSITION_REASON_SYSTEM: i16 = 3;
-
-/// Gives every mandatory variable the instantiation left empty a value, so that a browsing client sees the
-/// whole robot: nameplates of motors, gears and software, gear ratios, engineering units, motion profiles,
-/// the safety state and the task.
-fn describe(manager: &ModelManager, robot: &MotionDeviceSystemType) -> Result<(), String> {
-    let err = |s: StatusCode| s.to_string();
-    let maker = LocalizedText::new("en", "nodeset-compiler robotics");
-    let arm = robot.motion_devices.motion_device_identifier.get("Arm").ok_or("the robot has no arm")?;
-    for (i, axis) in arm.axes.axis_identifier.values().enumerate() {
-        axis.motion_profile.set(AxisMotionProfileEnumeration::Rotary).map_err(err)?;
-        engineering_units(manager, axis.parameter_set.actual_position.id(), DEGREE)?;
-        let pt = arm.power_trains.power_train_identifier.values().nth(i).ok_or("an axis has no power train")?;
-        for (motor, n) in pt.motor_identifier.values().zip(1..) {
-            motor.manufacturer.set(maker.clone()).map_err(err)?;
-            motor.model.set(LocalizedText::new("en", "SIX-M")).map_err(err)?;
-            motor.product_code.set("SIX-M-400".into()).map_err(err)?;
-            motor.serial_number.set(format!("M-{:04}", 10 * (i + 1) + n)).map_err(err)?;
-            motor.parameter_set.motor_temperature.set(35.0 + i as f64).map_err(err)?;
-            engineering_units(manager, motor.parameter_set.motor_temperature.id(), DEGREE_CELSIUS)?;
-        }
-        for (gear, n) in pt.gear_identifier.values().zip(1..) {
-            gear.manufacturer.set(maker.clone()).map_err(err)?;
-            gear.model.set(LocalizedText::new("en", "SIX-G")).map_err(err)?;
-            gear.product_code.set("SIX-G-121".into()).map_err(err)?;
-            gear.serial_number.set(format!("G-{:04}", 10 * (i + 1) + n)).map_err(err)?;
-            // Motor turns per output turn; the RationalNumberType children follow the value.
-            gear.gear_ratio.set(RationalNumber { numerator: 121, denominator: 1 }).map_err(err)?;
-        }
-    }
-    let controller = robot.controllers.controller_identifier.get("Controller").ok_or("the robot has no controller")?;
-    for software in controller.software.software_identifier.values() {
-        software.manufacturer.set(maker.clone()).map_err(err)?;
-        software.model.set(LocalizedText::new("en", "SIX-OS")).map_err(err)?;
-        software.software_revision.set(env!("CARGO_PKG_VERSION").into()).map_err(err)?;
-    }
-    for task in controller.task_controls.task_control_identifier.values() {
-        task.component_name.set(LocalizedText::new("en", "Main task")).map_err(err)?;
-        task.parameter_set.task_program_name.set("idle.prg".into()).map_err(err)?;
-        task.parameter_set.task_program_loaded.set(true).map_err(err)?;
-    }
-    for safety in robot.safety_states.safety_state_identifier.values() {
-        safety.parameter_set.emergency_stop.set(false).map_err(err)?;
-        safety.parameter_set.protective_stop.set(false).map_err(err)?;
-        safety.parameter_set.operational_mode.set(OperationalModeEnumeration::Automatic).map_err(err)?;
-    }
-    Ok(())
-}
-
-/// UNECE Recommendation 20 units, as OPC 10000-8 encodes them (the code's letters as the UnitId).
-const UNECE: &str = "http://www.opcfoundation.org/UA/units/un/cefact";
-const DEGREE: (&str, &str, &str) = ("DD", "°", "degree");
-const DEGREE_CELSIUS: (&str, &str, &str) = ("CEL", "°C", "degree Celsius");
-
-/// Sets the EngineeringUnits property of an analog variable.
-fn engineering_units(manager: &ModelManager, variable: &NodeId, (code, symbol, name): (&str, &str, &str)) -> Result<(), String> {
-    let units: Variable<EUInformation> = manager
-        .bind_with(|b| b.child(variable, "http://opcfoundation.org/UA/", "EngineeringUnits"))
-        .map_err(|e| e.to_string())?;
-    let unit_id = code.bytes().fold(0i32, |id, c| (id << 8) | i32::from(c));
-    let eu = EUInformation {
-        namespace_uri: UNECE.into(),
-        unit_id,
-        display_name: LocalizedText::new("", symbol),
-        description: LocalizedText::new("en", name),
-    };
-    units.set(eu).map_err(|s| s.to_string())
-}
 
 /// What DI's LockingServicesType shows of a lock: Locked, LockingClient, LockingUser, RemainingLockTime.
 #[derive(Clone)]

@@ -47,8 +47,10 @@ use nodeset_models::models::drilling_process::objects::{
     ReferenceDrillBushSkillTypeOutputs,
 };
 use nodeset_models::models::robot_cell::objects::{TemplateDrillingSkillType, TemplateDrillingSkillTypeInputs};
-use nodeset_models::models::robotics::objects::AxisType;
+use nodeset_models::models::di::objects::ComponentType;
+use nodeset_models::models::robotics::objects::{AxisType, MotionDeviceSystemType};
 use nodeset_models::models;
+use nodeset_examples::describe::{describe, nameplate};
 use nodeset_examples::secure::{SecureArgs, USAGE};
 use nodeset_models::runtime::remote::{ClientSecurity, RemoteServer};
 use nodeset_models::runtime::server::users::random_password;
@@ -223,6 +225,17 @@ fn lerp(a: &ThreeDFrame, b: &ThreeDFrame, t: f64) -> ThreeDFrame {
     }
 }
 
+/// Gives the variables of the cell's devices that RobotCell.NodeSet2.xml leaves without a value one
+/// (nameplates, units, the safety state, ...: see `nodeset_examples::describe`), on every server, since each
+/// shows the whole cell.
+fn describe_cell(server: &Server) -> Result<(), String> {
+    let m = server.manager();
+    let system: MotionDeviceSystemType = m.bind_path(&format!("{SYSTEM}/MotionDeviceSystem")).map_err(|e| e.to_string())?;
+    describe(m, &system)?;
+    let unit: ComponentType = m.bind_path(&format!("{SYSTEM}/DrillingEndEffector")).map_err(|e| e.to_string())?;
+    nameplate(&unit, "DU-8", "DU-8-400", "D-0001")
+}
+
 /// The drilling unit: TemplateDrilling.
 fn drilling_unit(server: &Server, motion: Duration) -> Result<Program, String> {
     let drill: TemplateDrillingSkillType =
@@ -333,6 +346,9 @@ async fn run(o: Options) -> Result<(), String> {
     let unit_server = device("Drilling unit", next(1), "drilling-unit")?;
     let cell_server = config("Drilling cell", next(2), &o.secure, "cell")?.build()?;
     let (robot_url, unit_url) = (robot_server.endpoint_url().to_owned(), unit_server.endpoint_url().to_owned());
+    for server in [&robot_server, &unit_server, &cell_server] {
+        describe_cell(server)?;
+    }
 
     let robot_skills = robot(&robot_server, o.motion)?;
     let drilling = drilling_unit(&unit_server, o.motion)?;

@@ -25,6 +25,8 @@ usage: .venv/bin/python tests/interop/defects_check.py --robot URL
   none from async-opcua 0.19 (its InList compares only numbers and Booleans, and evaluates before any code
   of ours sees the event): the check records that, and fails once async-opcua compares NodeIds;
 - Server/Namespaces has one object per namespace URI;
+- no variable of the cell's devices is null, except a skill's parameters and LastTransition before its
+  first run, and the joint positions (simulated by the robot's server only);
 - after a client writes a 3DFrame to ReferenceDrillBush's HolePosition, its children CartesianCoordinates and
   Orientation, and theirs (X, Y, Z, A, B, C), equal the frame's fields.
 
@@ -275,6 +277,17 @@ async def cell(url: str) -> Report:
             0,
         )
         await namespaces_once(report, client, "cell")
+
+        # The devices: every variable has a value, except those only a skill's run gives one (its parameters,
+        # its LastTransition) and the joint positions, which only the robot's server simulates.
+        system = await path(client.nodes.objects, "DeviceSet", "TemplateDrillingLwrSystem")
+        found = await variables(client, system)
+        def waits_for_a_run(p: str) -> bool:
+            segments = p.split("/")
+            return bool({"InputParameterSet", "OutputParameterSet", "LastTransition"} & set(segments)) or segments[-1] == "ActualPosition"
+
+        nulls = sorted(p for p, _, _, dv in found if is_null(dv) and not waits_for_a_run(p))
+        report.check(f"no variable of the cell's devices is null outside skill runs ({len(found)} variables)", not nulls, f"{len(nulls)} null: {nulls[:12]}")
 
         # A client's write of a 3DFrame: the frame's children show its fields.
         hole = await path(skill, "InputParameterSet", "HolePosition")
