@@ -14,6 +14,10 @@ role browses and reads, Operator, Engineer, Supervisor and ConfigureAdmin also w
 - a method's UserExecutable (its attributes unreadable, BadUserAccessDenied, without Browse), and whether
   a call is accepted or refused with BadUserAccessDenied.
 
+Then each user connects again over Basic256Sha256 with mode Sign: a variable whose AccessRestrictions
+require encryption (bit 2) refuses a read, a write and a subscription of its value with
+BadSecurityModeInsufficient, while the variables without restrictions answer as over SignAndEncrypt.
+
 It prints one line per check (report.py) and ends with `N passed, M failed`.
 """
 
@@ -58,7 +62,8 @@ def fixture(path: Path):
                 name = ROLES[int(role.split("=", 1)[1])]
                 perms[name] = perms.get(name, 0) | int(p.get("Permissions"))
         ident = int(el.get("NodeId").split("i=", 1)[1])
-        nodes[ident] = (el.get("BrowseName").split(":", 1)[1], tag, int(el.get("AccessLevel", "1")), perms)
+        nodes[ident] = (el.get("BrowseName").split(":", 1)[1], tag, int(el.get("AccessLevel", "1")), perms,
+                        int(el.get("AccessRestrictions", "0")))
     return uri, nodes
 
 
@@ -79,7 +84,7 @@ def status_name(e: BaseException) -> str:
 async def session_checks(r: Report, client: Client, who: str, roles: list[str], uri: str, nodes: dict) -> None:
     ns = (await client.get_namespace_array()).index(uri)
     press = ua.NodeId(5001, ns)
-    for ident, (name, tag, access_level, perms) in sorted(nodes.items()):
+    for ident, (name, tag, access_level, perms, _) in sorted(nodes.items()):
         node = client.get_node(ua.NodeId(ident, ns))
         bits = allowed(perms, roles)
         if tag == "UAVariable":
@@ -119,6 +124,50 @@ async def session_checks(r: Report, client: Client, who: str, roles: list[str], 
             r.check(f"{who}: {name} call", got == ("Good" if bits & CALL else "BadUserAccessDenied"), got)
 
 
+ENCRYPTION_REQUIRED = 0x2
+
+
+class NoNotifications:
+    def datachange_notification(self, *args) -> None:
+        pass
+
+
+async def signed_only_checks(r: Report, client: Client, who: str, roles: list[str], uri: str, nodes: dict) -> int:
+    """Over a signed but unencrypted channel: restricted values refused, the others as the roles allow.
+    Returns how many restricted values the session could have read over SignAndEncrypt."""
+    ns = (await client.get_namespace_array()).index(uri)
+    restricted = 0
+    for ident, (name, tag, _, perms, restrictions) in sorted(nodes.items()):
+        if tag != "UAVariable" or not allowed(perms, roles) & READ:
+            continue
+        node = client.get_node(ua.NodeId(ident, ns))
+        try:
+            value = await node.read_value()
+            got = "Good"
+        except Exception as e:  # noqa: BLE001 - the status is what is checked
+            value, got = None, status_name(e)
+        if not restrictions & ENCRYPTION_REQUIRED:
+            r.check(f"{who} (Sign): {name} read", got == "Good", got)
+            continue
+        restricted += 1
+        r.check(f"{who} (Sign): {name} read refused (EncryptionRequired)", got == "BadSecurityModeInsufficient", got)
+        try:
+            await node.write_value(ua.DataValue(ua.Variant("steel-3mm", ua.VariantType.String)))
+            got = "Good"
+        except Exception as e:  # noqa: BLE001
+            got = status_name(e)
+        r.check(f"{who} (Sign): {name} write refused (EncryptionRequired)", got == "BadSecurityModeInsufficient", got)
+        sub = await client.create_subscription(50, NoNotifications())
+        try:
+            await sub.subscribe_data_change(node)
+            got = "Good"
+        except Exception as e:  # noqa: BLE001
+            got = status_name(e)
+        r.check(f"{who} (Sign): {name} subscription refused (EncryptionRequired)", got == "BadSecurityModeInsufficient", got)
+        await sub.delete()
+    return restricted
+
+
 async def main() -> int:
     p = argparse.ArgumentParser()
     p.add_argument("--url", required=True)
@@ -131,6 +180,7 @@ async def main() -> int:
     r = Report()
     r.check("the fixture gives RolePermissions to some nodes and leaves others to the default",
             any(v[3] for v in nodes.values()) and any(v[3] is None for v in nodes.values()), str(nodes))
+    r.check("the fixture requires encryption for some node", any(v[4] & ENCRYPTION_REQUIRED for v in nodes.values()), str(nodes))
     key, cert = a.work / "client.pem", a.work / "client.der"
     if not cert.exists():
         await cert_gen.setup_self_signed_certificate(
@@ -150,6 +200,19 @@ async def main() -> int:
                                   mode=ua.MessageSecurityMode.SignAndEncrypt)
         async with client:
             await session_checks(r, client, who, roles, uri, nodes)
+    restricted = 0
+    for who, roles, user, password in sessions:
+        if user is None:
+            continue
+        client = Client(a.url, timeout=10)
+        client.application_uri = APP_URI
+        client.set_user(user)
+        client.set_password(password)
+        await client.set_security(security_policies.SecurityPolicyBasic256Sha256, str(cert), str(key),
+                                  mode=ua.MessageSecurityMode.Sign)
+        async with client:
+            restricted += await signed_only_checks(r, client, who, roles, uri, nodes)
+    r.check("some user may read a variable that requires encryption (checked over Sign)", restricted > 0, "none")
     print(f"{r.passed} passed, {r.failed} failed")
     return 0 if r.failed == 0 else 1
 

@@ -224,8 +224,9 @@ fn asyncua_client_against_a_secure_server() {
 
 /// The `roles` fixture's RolePermissions, obeyed node by node (`roles_check.py`, which reads the expectations
 /// from the fixture itself): for anonymous, an Operator, an Observer, an Engineer and a Supervisor, each
-/// variable's UserAccessLevel, reads and writes and each method's UserExecutable and calls. The calls that
-/// reach the server's code are exactly the allowed ones, with the caller's name.
+/// variable's UserAccessLevel, reads and writes and each method's UserExecutable and calls; over a signed,
+/// unencrypted channel, the Recipe (AccessRestrictions EncryptionRequired) refuses reads, writes and
+/// subscriptions. The calls that reach the server's code are exactly the allowed ones, with the caller's name.
 #[test]
 fn asyncua_finds_the_role_permissions_obeyed() {
     use nodeset_runtime::server::{Role, Users};

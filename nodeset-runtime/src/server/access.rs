@@ -181,8 +181,8 @@ impl AccessPolicy {
 /// The RolePermissions the tables' nodesets give their nodes, as [`AccessPolicy::nodes`] entries with server
 /// NodeIds, each with whether the node is a Variable (whose Value the Read permission guards; the attributes
 /// of other nodes are guarded by Browse). A node entry names only the well-known roles: a role object of a nodeset is no role any session
-/// has here, so it grants nothing. AccessRestrictions are carried by the tables but not evaluated (the
-/// authenticator does not see a session's security mode).
+/// has here, so it grants nothing. The nodes' AccessRestrictions are evaluated by the node manager, which
+/// sees the session's security mode (see [`super::ModelNodes`]).
 pub(crate) fn table_permissions(
     manager: &ModelManager,
     tables: &[&'static NodeSetTable],

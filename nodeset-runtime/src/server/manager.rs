@@ -12,12 +12,13 @@ use opcua::server::node_manager::memory::{
     CoreNodeManager, InMemoryNodeManager, InMemoryNodeManagerBuilder, InMemoryNodeManagerImpl,
 };
 use opcua::server::node_manager::{
-    MethodCall, NodeManagerBuilder, NodeManagersRef, ParsedWriteValue, RequestContext, ServerContext, WriteNode,
+    MethodCall, NodeManagerBuilder, NodeManagersRef, ParsedReadValueId, ParsedWriteValue,
+    RequestContext, ServerContext, WriteNode,
 };
-use opcua::server::{ServerHandle, SubscriptionCache};
+use opcua::server::{CreateMonitoredItem, ServerHandle, SubscriptionCache};
 use opcua::sync::RwLock;
 use opcua::types::{
-    Argument, AttributeId, BrowseDirection, DataEncoding, DataValue, NodeId, NumericRange, QualifiedName, StatusCode,
+    AccessRestrictionType, Argument, AttributeId, BrowseDirection, DataEncoding, DataValue, NodeId, MessageSecurityMode, NumericRange, QualifiedName, StatusCode,
     TimestampsToReturn, Variant,
 };
 use tracing::{error, warn};
@@ -105,8 +106,11 @@ struct ServedTable {
 
 /// async-opcua's node manager implementation for generated namespaces (use it through [`ModelManager`]).
 ///
-/// It imports tables at server build time and answers writes and method calls:
+/// It imports tables at server build time and answers reads, writes and method calls:
 ///
+/// - a node whose AccessRestrictions (from its nodeset) require signing or encryption refuses the read of
+///   its value, a subscription to it, a write and a call with `BadSecurityModeInsufficient` on a channel
+///   that is not signed, or not encrypted (Browse and its other attributes stay open);
 /// - a write of a variable's value is refused with `BadNotWritable` if the variable's AccessLevel lacks
 ///   CurrentWrite, with `BadUserAccessDenied` if only the UserAccessLevel does, with `BadTypeMismatch` if
 ///   the value does not fit the DataType and ValueRank, with the status of the range (`BadIndexRangeNoData`
@@ -129,6 +133,8 @@ pub struct ModelNodes {
     type_tree: Arc<RwLock<DefaultTypeTree>>,
     write_handlers: RwLock<HashMap<NodeId, WriteHandler>>,
     method_handlers: RwLock<HashMap<NodeId, Arc<dyn MethodHandler>>>,
+    /// The AccessRestrictions the tables give their nodes (the nodes without any are not listed).
+    restrictions: HashMap<NodeId, AccessRestrictionType>,
 }
 
 /// The node manager type as async-opcua's `ServerHandle::node_managers()` holds it.
@@ -204,6 +210,7 @@ impl ModelNodes {
             // `ModelManager::set_value` check values against them before that.
             space.load_into_type_tree(&mut tree);
         }
+        let restrictions = access_restrictions(&served);
         let mut namespaces = namespace_metadata(&served);
         super::namespace_objects::fold_into(space, &context.type_tree.read(), &mut namespaces);
         if !namespaces.iter().any(|m| m.namespace_index == instance_ns) {
@@ -223,7 +230,22 @@ impl ModelNodes {
             type_tree: context.type_tree.clone(),
             write_handlers: Default::default(),
             method_handlers: Default::default(),
+            restrictions,
         }
+    }
+
+    /// Why the session of `context` may not read, write or call `node` (Part 3, 5.2.11): SigningRequired
+    /// needs a signed channel, EncryptionRequired an encrypted one (`BadSecurityModeInsufficient`).
+    /// SessionRequired always holds (every request here comes with a session); ApplyRestrictionsToBrowse is
+    /// not evaluated: Browse and the other attributes stay open.
+    fn restricted(&self, context: &RequestContext, node: &NodeId) -> Option<StatusCode> {
+        let r = self.restrictions.get(node)?;
+        let mode = context.session().read().message_security_mode();
+        let signed = matches!(mode, MessageSecurityMode::Sign | MessageSecurityMode::SignAndEncrypt);
+        let encrypted = mode == MessageSecurityMode::SignAndEncrypt;
+        let refused = (r.contains(AccessRestrictionType::SigningRequired) && !signed)
+            || (r.contains(AccessRestrictionType::EncryptionRequired) && !encrypted);
+        refused.then_some(StatusCode::BadSecurityModeInsufficient)
     }
 
     /// The [`ModelManager`] of this node manager, found among the server's node managers.
@@ -241,6 +263,9 @@ impl ModelNodes {
         types: &Types,
         write: &ParsedWriteValue,
     ) -> Result<Variant, StatusCode> {
+        if let Some(status) = self.restricted(context, &write.node_id) {
+            return Err(status);
+        }
         let space = types.space.ok_or(StatusCode::BadInternalError)?;
         let node = space.find(&write.node_id).ok_or(StatusCode::BadNodeIdUnknown)?;
         if write.attribute_id == AttributeId::Value {
@@ -377,6 +402,48 @@ impl InMemoryNodeManagerImpl for ModelNodes {
         self.namespaces.clone()
     }
 
+    async fn read_values(
+        &self,
+        context: &RequestContext,
+        address_space: &RwLock<AddressSpace>,
+        nodes: &[&ParsedReadValueId],
+        max_age: f64,
+        timestamps_to_return: TimestampsToReturn,
+    ) -> Vec<DataValue> {
+        let space = address_space.read();
+        nodes
+            .iter()
+            .map(|n| match self.restricted(context, &n.node_id) {
+                Some(status) => DataValue { status: Some(status), ..Default::default() },
+                None => space.read(context, n, max_age, timestamps_to_return),
+            })
+            .collect()
+    }
+
+    async fn create_value_monitored_items(
+        &self,
+        context: &RequestContext,
+        address_space: &RwLock<AddressSpace>,
+        items: &mut [&mut &mut CreateMonitoredItem],
+    ) {
+        // A restricted value is refused outright: notifications of later changes would bypass the check.
+        let mut open = Vec::new();
+        for item in items.iter_mut() {
+            match self.restricted(context, &item.item_to_monitor().node_id) {
+                Some(status) => item.set_status(status),
+                None => open.push(item),
+            }
+        }
+        let to_read: Vec<_> = open.iter().map(|i| i.item_to_monitor()).collect();
+        let values = self.read_values(context, address_space, &to_read, 0.0, TimestampsToReturn::Both).await;
+        for (value, item) in values.into_iter().zip(open) {
+            if value.status() != StatusCode::BadAttributeIdInvalid {
+                item.set_initial_value(value);
+            }
+            item.set_status(StatusCode::Good);
+        }
+    }
+
     async fn write(
         &self,
         context: &RequestContext,
@@ -456,6 +523,10 @@ impl InMemoryNodeManagerImpl for ModelNodes {
             let types = Types { tree: &tree, space: Some(&space) };
             let handlers = self.method_handlers.read();
             for (i, call) in methods_to_call.iter_mut().enumerate() {
+                if let Some(status) = self.restricted(context, call.method_id()) {
+                    call.set_status(status);
+                    continue;
+                }
                 match self.validate_call(&types, call) {
                     Err(MethodError::Status(status)) => call.set_status(status),
                     Err(MethodError::Arguments(results)) => call.set_argument_error(results),
@@ -694,7 +765,7 @@ impl ModelManager {
     /// subscriptions.
     ///
     /// A structured value whose fields ns0 shows as child variables (a 3DFrame, a RationalNumber, ...) sets
-    /// those children too (see [`super::fields`]).
+    /// those children too (the VariableTypes of OPC 10000-5 that show the fields of their structure).
     pub fn set_data_value(&self, node: &NodeId, value: DataValue) -> Result<(), StatusCode> {
         let children = {
             let tree = self.nodes().type_tree.read();
@@ -726,4 +797,21 @@ fn mirror_fields(
             changed.push((child, AttributeId::Value));
         }
     }
+}
+
+/// The AccessRestrictions the served tables give their nodes, by server NodeId.
+fn access_restrictions(served: &[ServedTable]) -> HashMap<NodeId, AccessRestrictionType> {
+    let mut out = HashMap::new();
+    for t in served {
+        // The table was checked when it was accepted; a damaged access row was reported by the access policy.
+        let Ok(rows) = t.table.access() else { continue };
+        for row in rows {
+            let (Some(bits), Some(node)) = (row.restrictions, t.map.try_id(row.id)) else { continue };
+            let bits = AccessRestrictionType::from_bits_truncate(bits as i16);
+            if !bits.is_empty() {
+                out.insert(node, bits);
+            }
+        }
+    }
+    out
 }
