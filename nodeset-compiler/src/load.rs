@@ -38,6 +38,10 @@ pub struct ModelInfo {
     /// Global namespace index of the model.
     pub ns: u16,
     pub required: Vec<RequiredInfo>,
+    /// The `<RolePermissions>` of the `<Model>` element: the namespace's DefaultRolePermissions.
+    pub default_role_permissions: Vec<crate::raw::RawRolePermission>,
+    /// The `AccessRestrictions` of the `<Model>` element: the namespace's DefaultAccessRestrictions.
+    pub default_access_restrictions: Option<u16>,
     pub span: Span,
 }
 
@@ -435,6 +439,8 @@ fn model_info(m: &RawModel, file: FileId, ns: u16) -> ModelInfo {
             .iter()
             .map(|r| RequiredInfo { uri: r.uri.clone(), version: r.version.clone(), publication_date: r.publication_date.clone(), span: r.span })
             .collect(),
+        default_role_permissions: m.role_permissions.clone(),
+        default_access_restrictions: m.access_restrictions,
         span: m.span,
     }
 }

@@ -10,7 +10,7 @@ use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::load::Loaded;
 use crate::model::*;
 use crate::nodeid::{parse_qualified_name, NodeId, QualifiedName};
-use crate::raw::{NodeClass, RawStr, ValueArena, ValueElement};
+use crate::raw::{NodeClass, RawRolePermission, RawStr, ValueArena, ValueElement};
 use crate::source::{SourceMap, Span};
 use crate::value::{BuiltinType, Content, Variant};
 use std::collections::{BTreeMap, HashSet};
@@ -277,6 +277,7 @@ fn link(model: &mut Model, own: OwnReferences, incoming: Vec<(NodeIx, Reference)
         start = end as usize;
     }
     drop((own, ends, sorted, starts, next));
+    model_defaults(model, diags);
 
     // Pass 3: hierarchy flags, supertypes, type definitions, modelling rules, parents.
     link_types(model, broken, diags);
@@ -450,30 +451,57 @@ impl Pass2<'_> {
                     None => ctx.resolve(model, p.get(text), p.span, diags).ok().and_then(|id| model.lookup(&id)),
                 };
             }
-            let mut roles = Vec::new();
-            for p in &model.nodes[ix.index()].attrs.role_permissions {
-                let Ok(id) = ctx.resolve(model, &p.role.value, p.role.span, diags) else { continue };
-                match model.lookup(&id).map(|r| (r, model.nodes[r.index()].class)) {
-                    Some((r, NodeClass::Object)) => roles.push((r, p.permissions)),
-                    found => {
-                        let what = match found {
-                            Some((_, class)) => format!("{} {}", article(class.name()), class.name()),
-                            None => "no loaded node".to_owned(),
-                        };
-                        diags.push(
-                            Diagnostic::new(
-                                Code::BadRolePermission,
-                                format!("RolePermission names `{}`, {what}, not a role", p.role.value),
-                            )
-                            .at(p.role.span)
-                            .help("name a role object, such as a well-known role of the base namespace (Operator is i=15680)"),
-                        );
-                    }
-                }
-            }
+            let roles = model.nodes[ix.index()].attrs.role_permissions.iter().filter_map(|p| role(model, ctx, p, diags)).collect();
             out.nodes.push(NodeLinks { array_dimensions, data_type, method_declaration, roles, references_end: out.references.len() as u32, parent });
         }
         out
+    }
+}
+
+/// The role object a RolePermission names, with its permissions; NS0220 (and `None`) if the node is not an
+/// Object.
+fn role(model: &Model, ctx: &FileContext, p: &RawRolePermission, diags: &mut Diagnostics) -> Option<(NodeIx, u32)> {
+    let id = ctx.resolve(model, &p.role.value, p.role.span, diags).ok()?;
+    match model.lookup(&id).map(|r| (r, model.nodes[r.index()].class)) {
+        Some((r, NodeClass::Object)) => Some((r, p.permissions)),
+        found => {
+            let what = match found {
+                Some((_, class)) => format!("{} {}", article(class.name()), class.name()),
+                None => "no loaded node".to_owned(),
+            };
+            diags.push(
+                Diagnostic::new(Code::BadRolePermission, format!("RolePermission names `{}`, {what}, not a role", p.role.value))
+                    .at(p.role.span)
+                    .help("name a role object, such as a well-known role of the base namespace (Operator is i=15680)"),
+            );
+            None
+        }
+    }
+}
+
+/// A model's DefaultRolePermissions and DefaultAccessRestrictions (the `<RolePermissions>` and
+/// `AccessRestrictions` of its `<Model>` element) given to every node of its namespace that has no
+/// RolePermissions, or no AccessRestrictions, of its own (OPC 10000-3, 5.2.9 and 5.2.11). The tables then
+/// carry them node by node, as if the nodeset had written them there.
+fn model_defaults(model: &mut Model, diags: &mut Diagnostics) {
+    for mi in 0..model.models.len() {
+        let info = &model.models[mi];
+        if info.default_role_permissions.is_empty() && info.default_access_restrictions.is_none() {
+            continue;
+        }
+        let Some(ctx) = model.files.get(&info.file) else { continue };
+        let roles: Vec<(NodeIx, u32)> =
+            info.default_role_permissions.iter().filter_map(|p| role(model, ctx, p, diags)).collect();
+        let (ns, restrictions, declared) =
+            (info.ns, info.default_access_restrictions, !info.default_role_permissions.is_empty());
+        for node in model.nodes.iter_mut().filter(|n| n.id.ns == ns) {
+            if declared && node.attrs.role_permissions.is_empty() {
+                node.attrs.roles = roles.clone();
+            }
+            if node.attrs.access_restrictions.is_none() {
+                node.attrs.access_restrictions = restrictions;
+            }
+        }
     }
 }
 
