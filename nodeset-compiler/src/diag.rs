@@ -90,6 +90,7 @@ codes! {
     // Generating code.
     NameCollision = "NS0301", Warning, "two names map to one identifier in generated code";
     UnsupportedFeature = "NS0302", Warning, "a model feature has no faithful representation in generated code";
+    Ns0Named = "NS0303", Error, "the base namespace is named for Rust, which async-opcua provides";
 }
 
 /// A secondary position with a message.

@@ -75,6 +75,9 @@ enum Command {
         /// Output folder (replaced atomically; it must hold only generated files).
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
+        /// A namespace whose package exists elsewhere, as URI=PACKAGE (not generated; classes extend PACKAGE).
+        #[arg(long = "extern", value_name = "URI=PACKAGE")]
+        externs: Vec<String>,
         /// Compare with the output folder instead of writing; fail if it differs.
         #[arg(long)]
         check: bool,
@@ -117,15 +120,14 @@ fn rust_command(
         return Err("the NodeSet2 files do not compile; nothing was written".into());
     }
     let model = &compiled.model;
-    let namespaces: Vec<RustNamespace> = model
-        .models
-        .iter()
-        .filter(|m| model.sources.get(m.file).named)
-        .map(|m| RustNamespace {
-            uri: m.uri.clone(),
-            module: modules.iter().find(|(u, _)| *u == m.uri).map(|(_, n)| n.clone()).unwrap_or_else(|| r::default_module_name(&m.uri)),
-        })
-        .collect();
+    // Every required model that is not mapped with --extern is generated too, so the output compiles alone.
+    let plan = nodeset_compiler::emit::plan::plan(model, &externs, true).map_err(|d| {
+        eprint!("{}", d.render(&model.sources));
+        "nothing was written".to_string()
+    })?;
+    let module_names = plan.module_names(&modules);
+    let module_of = |uri: &str| module_names.get(uri).cloned().unwrap_or_else(|| r::default_module_name(uri));
+    let namespaces: Vec<RustNamespace> = plan.generated.iter().map(|u| RustNamespace { uri: u.clone(), module: module_of(u) }).collect();
     let cfg = RustConfig {
         namespaces: namespaces.clone(),
         extern_paths: externs.into_iter().collect(),
@@ -148,6 +150,7 @@ fn rust_command(
     if check && !report.is_clean() {
         return Err(format!("{} is stale:\n{}", out.display(), report.describe(&out)));
     }
+    eprint!("{}", plan.describe(module_of));
     eprintln!(
         "{}: {} file(s), {} new, {} changed, {} removed, {} unchanged",
         out.display(),
@@ -160,7 +163,7 @@ fn rust_command(
     Ok(())
 }
 
-fn modelica_command(files: Vec<PathBuf>, models: Vec<PathBuf>, out: PathBuf, check: bool, deny: bool) -> Result<(), String> {
+fn modelica_command(files: Vec<PathBuf>, models: Vec<PathBuf>, out: PathBuf, externs: Vec<String>, check: bool, deny: bool) -> Result<(), String> {
     use nodeset_compiler::emit::modelica::{generate_with_diagnostics, ModelicaConfig};
     use nodeset_compiler::write::{write_tree, Mode};
     let opts = Options { model_dirs: models, deny_warnings: deny, ..Options::default() };
@@ -170,7 +173,16 @@ fn modelica_command(files: Vec<PathBuf>, models: Vec<PathBuf>, out: PathBuf, che
         return Err("the NodeSet2 files do not compile; nothing was written".into());
     }
     let model = &compiled.model;
-    let mut gen = generate_with_diagnostics(model, &ModelicaConfig::new());
+    // Every required model not mapped to an existing package is generated too (ns0: the part used, `OpcUa`).
+    let externs = pairs(&externs, "extern")?;
+    let plan = nodeset_compiler::emit::plan::plan(model, &externs, false).map_err(|d| d.render(&model.sources))?;
+    let mut cfg = ModelicaConfig::new();
+    cfg.namespaces = plan.generated.clone();
+    if model.models.iter().any(|m| m.uri == nodeset_compiler::load::NS0_URI && model.sources.get(m.file).named) {
+        cfg.namespaces.insert(0, nodeset_compiler::load::NS0_URI.to_string());
+    }
+    cfg.package_names = externs.iter().cloned().collect();
+    let mut gen = generate_with_diagnostics(model, &cfg);
     if deny {
         gen.diagnostics.deny_warnings();
     }
@@ -183,6 +195,7 @@ fn modelica_command(files: Vec<PathBuf>, models: Vec<PathBuf>, out: PathBuf, che
     if check && !report.is_clean() {
         return Err(format!("{} is stale:\n{}", out.display(), report.describe(&out)));
     }
+    eprint!("{}", plan.describe(|u| u.to_string()));
     eprintln!(
         "{}: {} file(s), {} new, {} changed, {} removed, {} unchanged",
         out.display(),
@@ -207,7 +220,7 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Modelica { files, models, out, check, deny } => match modelica_command(files, models, out, check, deny.is_some()) {
+        Command::Modelica { files, models, out, externs, check, deny } => match modelica_command(files, models, out, externs, check, deny.is_some()) {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("error: {e}");
