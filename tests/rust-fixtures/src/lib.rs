@@ -7,3 +7,8 @@ include!(concat!(env!("OUT_DIR"), "/nodesets.rs"));
 pub mod skills_reference {
     include!(concat!(env!("OUT_DIR"), "/skills_reference.rs"));
 }
+
+/// The name collision fixture's subtype generated without its dependency (inherited members inlined).
+pub mod name_collision_alone {
+    include!(concat!(env!("OUT_DIR"), "/name_collision_alone.rs"));
+}
