@@ -109,7 +109,7 @@ fn rust_command(
     check: bool,
     deny: bool,
 ) -> Result<(), String> {
-    use nodeset_compiler::emit::rust::{self as r, RustConfig, RustNamespace};
+    use nodeset_compiler::emit::rust as r;
     use nodeset_compiler::write::{write_tree, Mode};
     let externs = pairs(&externs, "extern")?;
     let modules = pairs(&modules, "module")?;
@@ -121,20 +121,12 @@ fn rust_command(
     }
     let model = &compiled.model;
     // Every required model that is not mapped with --extern is generated too, so the output compiles alone.
-    let plan = nodeset_compiler::emit::plan::plan(model, &externs, true).map_err(|d| {
-        eprint!("{}", d.render(&model.sources));
-        "nothing was written".to_string()
-    })?;
-    let module_names = plan.module_names(&modules);
+    let (plan, module_names, mut gen) =
+        nodeset_compiler::emit::plan::generate_rust(model, &externs, &modules, &runtime, "nodeset-compiler rust ...").map_err(|d| {
+            eprint!("{}", d.render(&model.sources));
+            "nothing was written".to_string()
+        })?;
     let module_of = |uri: &str| module_names.get(uri).cloned().unwrap_or_else(|| r::default_module_name(uri));
-    let namespaces: Vec<RustNamespace> = plan.generated.iter().map(|u| RustNamespace { uri: u.clone(), module: module_of(u) }).collect();
-    let cfg = RustConfig {
-        namespaces: namespaces.clone(),
-        extern_paths: externs.into_iter().collect(),
-        runtime_path: runtime,
-        command: "nodeset-compiler rust ...".into(),
-    };
-    let mut gen = r::generate(model, &cfg);
     if deny {
         gen.diagnostics.deny_warnings();
     }
@@ -143,9 +135,6 @@ fn rust_command(
     if gen.diagnostics.has_errors() {
         return Err("generation failed; nothing was written".into());
     }
-    let list: Vec<(String, String)> = namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
-    gen.files.push(r::models_mod(&list, &cfg.runtime_path, "nodeset-compiler rust ..."));
-    gen.files.push(r::rustfmt_toml());
     let report = write_tree(&out, &gen.files, if check { Mode::Check } else { Mode::Write })?;
     if check && !report.is_clean() {
         return Err(format!("{} is stale:\n{}", out.display(), report.describe(&out)));
@@ -195,7 +184,7 @@ fn modelica_command(files: Vec<PathBuf>, models: Vec<PathBuf>, out: PathBuf, ext
     if check && !report.is_clean() {
         return Err(format!("{} is stale:\n{}", out.display(), report.describe(&out)));
     }
-    eprint!("{}", plan.describe(|u| u.to_string()));
+    eprint!("{}", plan.describe(|_| String::new()));
     eprintln!(
         "{}: {} file(s), {} new, {} changed, {} removed, {} unchanged",
         out.display(),

@@ -84,11 +84,15 @@ impl Plan {
         out
     }
 
-    /// The summary a command prints: what was generated (with the name given to it) and what was mapped.
+    /// The summary a command prints: what was generated (with the name given to it, if `name_of` gives one)
+    /// and what was mapped.
     pub fn describe(&self, name_of: impl Fn(&str) -> String) -> String {
         let mut out = String::new();
         for u in &self.generated {
-            out.push_str(&format!("generated: {u} as `{}`\n", name_of(u)));
+            match name_of(u) {
+                n if n.is_empty() => out.push_str(&format!("generated: {u}\n")),
+                n => out.push_str(&format!("generated: {u} as `{n}`\n")),
+            }
         }
         for (u, p) in &self.mapped {
             out.push_str(&format!("mapped:    {u} to `{p}`\n"));
@@ -98,6 +102,33 @@ impl Plan {
         }
         out
     }
+}
+
+/// The Rust of a complete run, as `nodeset-compiler rust` writes it: every planned namespace (module names
+/// from [`Plan::module_names`]), the `mod.rs` that lists them and `rustfmt.toml`; with the plan, for the
+/// summary, and every diagnostic of planning and generation (sorted). `Err` when the plan fails (NS0303).
+pub fn generate_rust(
+    model: &Model,
+    externs: &[(String, String)],
+    modules: &[(String, String)],
+    runtime_path: &str,
+    command: &str,
+) -> Result<(Plan, std::collections::BTreeMap<String, String>, crate::emit::rust::RustOutput), Diagnostics> {
+    use crate::emit::rust::{self as r, RustConfig, RustNamespace};
+    let plan = plan(model, externs, true)?;
+    let names = plan.module_names(modules);
+    let namespaces: Vec<RustNamespace> = plan.generated.iter().map(|u| RustNamespace { uri: u.clone(), module: names[u].clone() }).collect();
+    let cfg = RustConfig {
+        namespaces: namespaces.clone(),
+        extern_paths: externs.iter().cloned().collect(),
+        runtime_path: runtime_path.to_string(),
+        command: command.to_string(),
+    };
+    let mut gen = r::generate(model, &cfg);
+    let list: Vec<(String, String)> = namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
+    gen.files.push(r::models_mod(&list, runtime_path, command));
+    gen.files.push(r::rustfmt_toml());
+    Ok((plan, names, gen))
 }
 
 #[cfg(test)]
