@@ -25,12 +25,12 @@ pub struct Args {
     out: Option<PathBuf>,
 }
 
-fn module_for(tree: &Path, file: &Path) -> String {
+pub(crate) fn module_for(tree: &Path, file: &Path) -> String {
     let rel = file.strip_prefix(tree).unwrap_or(file).to_string_lossy().replace(".NodeSet2.xml", "").replace(".nodeset2.xml", "");
     format!("m_{}", sanitize(&rel, Case::Snake, Target::Rust).trim_start_matches("r#"))
 }
 
-fn nodeset_files(dir: &Path, out: &mut Vec<PathBuf>) {
+pub(crate) fn nodeset_files(dir: &Path, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     for e in entries.flatten() {
         let p = e.path();
