@@ -10,6 +10,7 @@ use nodeset_compiler::load::Input;
 use nodeset_compiler::{compile, Options};
 use std::path::PathBuf;
 
+/// Options of `cargo xtask one-at-a-time`.
 #[derive(Debug, Default, clap::Args)]
 pub struct Args {
     /// The tree whose files are generated one at a time (default: ../shared/nodesets/ua-nodeset).
@@ -20,6 +21,7 @@ pub struct Args {
     out: Option<PathBuf>,
 }
 
+/// Generates every file of the tree on its own into one crate, prints the counts, and `cargo check`s it.
 pub fn run(args: Args) -> Result<(), String> {
     let root = workspace_root();
     let tree = args.tree.unwrap_or_else(|| root.join("../shared/nodesets/ua-nodeset"));
