@@ -19,10 +19,10 @@ use std::process::Command;
 pub struct Args {
     /// The tree to compile (default: ../shared/nodesets/ua-nodeset).
     #[arg(long)]
-    tree: Option<PathBuf>,
+    pub(crate) tree: Option<PathBuf>,
     /// Where to put the generated crate (default: target/corpus-crate).
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub(crate) out: Option<PathBuf>,
 }
 
 pub(crate) fn module_for(tree: &Path, file: &Path) -> String {

@@ -24,11 +24,11 @@ pub const HEADER: &str = "\
 #   version <exact package version>
 #   integrity <npm integrity string of the tarball, `sha512-` + base64>
 # followed by one block per file, opened by its `file` line:
-#   file <local file name in nodesets/vendor/>
+#   file <local path in nodesets/vendor/>
 #     path <path of the file inside the package, without the `package/` prefix>
 #     size <size in bytes>
 #     sha256 <SHA-256 of the file, lowercase hex>
-#     model-uri <ModelUri of the <Model> element the file defines>
+#     model-uri <ModelUri of the <Model> element the file defines, or `-` when it has none>
 #     model-version <Version attribute of that <Model>, or `-` when absent>
 #     publication-date <PublicationDate attribute of that <Model>, or `-`>
 #     requires <ModelUri> <Version or `-`>   (once per <RequiredModel>, in file order)
