@@ -34,25 +34,34 @@ pub fn run(args: Args) -> Result<(), String> {
     let vendor = root.join(crate::fetch::VENDOR_DIR).canonicalize().map_err(|e| format!("{}: {e}", crate::fetch::VENDOR_DIR))?;
     let out = args.out.unwrap_or_else(|| root.join("target/registry"));
     let files: Vec<PathBuf> = crate::fetch::SELECTION.iter().map(|w| vendor.join(w.name)).collect();
+    // The older files of `1.02/` declare no <Model>, so none of them can require another: they are named
+    // together (DI, ADI, FTNIR), as a user of that set must. Every current file is named alone.
+    let old_order = ["Opc.Ua.Di.NodeSet2.xml", "Opc.Ua.Adi.NodeSet2.xml", "FTNIR.NodeSet2.xml"];
+    let mut old: Vec<PathBuf> = files.iter().filter(|f| rel(&vendor, f).starts_with("1.02/")).cloned().collect();
+    old.sort_by_key(|f| old_order.iter().position(|n| f.ends_with(n)).unwrap_or(old_order.len()));
+    let mut units: Vec<Vec<PathBuf>> = files.iter().filter(|f| !old.contains(f)).map(|f| vec![f.clone()]).collect();
+    units.push(old);
+    let unit_name = |u: &[PathBuf]| u.iter().map(|f| rel(&vendor, f)).collect::<Vec<_>>().join(" + ");
 
     // 1. check.
     let t = Instant::now();
     let opts = Options { model_dirs: vec![vendor.clone()], ..Options::default() };
     let (mut errors, mut warnings, mut failed) = (0, 0, Vec::new());
-    for f in &files {
-        let compiled = compile(vec![Input::Path(f.clone())], &opts);
+    for u in &units {
+        let compiled = compile(u.iter().cloned().map(Input::Path).collect(), &opts);
         let (e, w) = (compiled.diagnostics.error_count(), compiled.diagnostics.warning_count());
-        println!("  check {}: {e} error(s), {w} warning(s)", rel(&vendor, f));
+        println!("  check {}: {e} error(s), {w} warning(s)", unit_name(u));
         errors += e;
         warnings += w;
         if e > 0 {
-            failed.push(format!("{}:\n{}", rel(&vendor, f), compiled.render_diagnostics()));
+            failed.push(format!("{}:\n{}", unit_name(u), compiled.render_diagnostics()));
         }
     }
     println!(
-        "registry check: {} files, {} resolve, {errors} error(s), {warnings} warning(s) in {:.1} s",
+        "registry check: {} files in {} runs, {} runs resolve, {errors} error(s), {warnings} warning(s) in {:.1} s",
         files.len(),
-        files.len() - failed.len(),
+        units.len(),
+        units.len() - failed.len(),
         t.elapsed().as_secs_f64()
     );
     if !failed.is_empty() {
@@ -67,10 +76,10 @@ pub fn run(args: Args) -> Result<(), String> {
     let modelica = out.join("modelica");
     let _ = std::fs::remove_dir_all(&modelica);
     let mut jobs: Vec<(String, PathBuf, usize)> = Vec::new();
-    for (i, f) in files.iter().enumerate() {
-        let compiled = compile(vec![Input::Path(f.clone())], &opts);
+    for (i, u) in units.iter().enumerate() {
+        let compiled = compile(u.iter().cloned().map(Input::Path).collect(), &opts);
         let run = nodeset_compiler::run_modelica(&compiled.model, &Default::default(), &Severities::new())
-            .map_err(|e| format!("{}: {e}", rel(&vendor, f)))?;
+            .map_err(|e| format!("{}: {e}", unit_name(u)))?;
         let dir = modelica.join(format!("{i:02}"));
         let mut classes = 0;
         for file in &run.files {
@@ -81,7 +90,7 @@ pub fn run(args: Args) -> Result<(), String> {
                 classes += 1;
             }
         }
-        jobs.push((rel(&vendor, f), dir, classes));
+        jobs.push((unit_name(u), dir, classes));
     }
     let generation = t.elapsed().as_secs_f64();
     let t = Instant::now();

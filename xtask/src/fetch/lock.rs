@@ -276,12 +276,18 @@ fn or_dash(value: &Option<String>) -> &str {
     value.as_deref().unwrap_or("-")
 }
 
-/// Accepts only plain file names, because the lock decides where files are written.
+/// Accepts only plain file names, or one folder and a plain file name (`1.02/FTNIR.NodeSet2.xml`), because
+/// the lock decides where files are written.
 fn validate_file_name(name: &str) -> Result<(), String> {
     let allowed = |c: char| c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-');
-    if name.starts_with('.') || !name.chars().all(allowed) {
+    let plain = |part: &str| !part.is_empty() && !part.starts_with('.') && part.chars().all(allowed);
+    let ok = match name.split_once('/') {
+        Some((folder, file)) => plain(folder) && plain(file),
+        None => plain(name),
+    };
+    if !ok {
         return Err(format!(
-            "file name `{name}` must use only letters, digits, `.`, `_` and `-`, and not start with `.`"
+            "file name `{name}` must use only letters, digits, `.`, `_` and `-`, and not start with `.` (one `folder/` before it is allowed)"
         ));
     }
     Ok(())
