@@ -115,6 +115,8 @@ codes! {
     NameCollision = "NS0301", Warning, "two names map to one identifier in generated code", Some("the names are told apart by a suffix");
     UnsupportedFeature = "NS0302", Warning, "a model feature has no faithful representation in generated code",
         Some("the feature is left out of the generated code");
+    Ns0Named = "NS0303", Error, "the base namespace is named for Rust, which async-opcua provides",
+        Some("the base namespace is not generated: generated code uses async-opcua's, as when its file is only in --models");
 }
 
 impl Code {

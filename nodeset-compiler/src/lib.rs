@@ -157,7 +157,7 @@ pub fn compile(inputs: Vec<Input>, opts: &Options) -> Compiled {
 /// runtime's path. [`RustOptions::config`] turns it into the emitter's [`emit::rust::RustConfig`] for a model.
 #[derive(Clone, Debug)]
 pub struct RustOptions {
-    /// Module names by namespace URI (default: [`emit::rust::default_module_name`]).
+    /// Module names by namespace URI (default: the rule of [`emit::plan::Plan::module_names`]).
     pub modules: BTreeMap<String, String>,
     /// Namespaces generated elsewhere: URI -> Rust path of their module (`--extern URI=PATH`).
     pub extern_paths: BTreeMap<String, String>,
@@ -179,16 +179,18 @@ impl Default for RustOptions {
 }
 
 impl RustOptions {
-    /// The emitter's configuration for `model`: one module for each model of a file the user named.
+    /// The emitter's configuration for `model`: one module for each model of a file the user named, named by
+    /// [`emit::plan::Plan::module_names`] (so two URIs that end alike get two modules).
     pub fn config(&self, model: &model::Model) -> emit::rust::RustConfig {
-        let namespaces = model
-            .models
+        let named = emit::plan::Plan {
+            generated: model.models.iter().filter(|m| model.sources.get(m.file).named).map(|m| m.uri.clone()).collect(),
+            ..emit::plan::Plan::default()
+        };
+        let modules = named.module_names(&self.modules);
+        let namespaces = named
+            .generated
             .iter()
-            .filter(|m| model.sources.get(m.file).named)
-            .map(|m| emit::rust::RustNamespace {
-                uri: m.uri.clone(),
-                module: self.modules.get(&m.uri).cloned().unwrap_or_else(|| emit::rust::default_module_name(&m.uri)),
-            })
+            .map(|u| emit::rust::RustNamespace { uri: u.clone(), module: modules[u].clone() })
             .collect();
         emit::rust::RustConfig {
             namespaces,
@@ -228,6 +230,76 @@ pub fn generate_modelica(
     let mut gen = emit::modelica::generate_with_diagnostics(model, cfg);
     let rendered = gen.diagnostics.finalize(severities, &model.sources, "Modelica generation failed")?;
     Ok((gen.files, rendered))
+}
+
+/// One complete run of the `rust` command: what the plan generated and mapped, the module name of each
+/// generated namespace, the files (with the `mod.rs` that lists the modules and `rustfmt.toml`) and the
+/// rendered warnings.
+#[derive(Debug)]
+pub struct RustRun {
+    /// Which namespaces were generated and which mapped to existing code (`--extern`).
+    pub plan: emit::plan::Plan,
+    /// Module names by namespace URI, of the generated namespaces.
+    pub modules: BTreeMap<String, String>,
+    /// The files to write.
+    pub files: Vec<write::OutFile>,
+    /// The warnings of planning and generation, rendered.
+    pub warnings: String,
+}
+
+/// The `rust` command's complete run over `model`: every loaded model that `rust` does not map
+/// (`extern_paths`) is generated beside the named ones, so that the output compiles on its own; the base
+/// namespace comes from async-opcua (naming its file is NS0303). Planning and generation end with the same
+/// severity settings as compiling ([`diag::Diagnostics::finalize`]); [`Error::Diagnostics`] when errors remain.
+pub fn run_rust(model: &model::Model, rust: &RustOptions, severities: &Severities) -> Result<RustRun, Error> {
+    const STAGE: &str = "Rust generation failed";
+    let (plan, mut planning) = emit::plan::plan(model, &rust.extern_paths, true);
+    // A refused plan (NS0303 not demoted) stops before anything is generated.
+    planning.finalize(severities, &model.sources, STAGE)?;
+    let modules = plan.module_names(&rust.modules);
+    let namespaces: Vec<emit::rust::RustNamespace> =
+        plan.generated.iter().map(|u| emit::rust::RustNamespace { uri: u.clone(), module: modules[u].clone() }).collect();
+    let list: Vec<(String, String)> = namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
+    let cfg = emit::rust::RustConfig {
+        namespaces,
+        extern_paths: rust.extern_paths.clone(),
+        runtime_path: rust.runtime_path.clone(),
+        command: rust.command.clone(),
+    };
+    let mut gen = emit::rust::generate(model, &cfg);
+    gen.diagnostics.extend(planning);
+    let warnings = gen.diagnostics.finalize(severities, &model.sources, STAGE)?;
+    let mut files = gen.files;
+    files.push(emit::rust::models_mod(&list, &cfg.runtime_path, &cfg.command));
+    files.push(emit::rust::rustfmt_toml());
+    Ok(RustRun { plan, modules, files, warnings })
+}
+
+/// One complete run of the `modelica` command: the plan, the files and the rendered warnings.
+#[derive(Debug)]
+pub struct ModelicaRun {
+    /// Which namespaces were generated and which mapped to existing packages (`--extern`).
+    pub plan: emit::plan::Plan,
+    /// The files to write.
+    pub files: Vec<write::OutFile>,
+    /// The warnings of generation, rendered.
+    pub warnings: String,
+}
+
+/// The `modelica` command's complete run over `model`: every loaded model not mapped to an existing package
+/// (`packages`: URI -> package name) is generated, the base namespace completely when its file is named and
+/// otherwise the part the packages use (`OpcUa`). Ends like [`run_rust`].
+pub fn run_modelica(model: &model::Model, packages: &BTreeMap<String, String>, severities: &Severities) -> Result<ModelicaRun, Error> {
+    // For Modelica the base namespace is a package like any other: the plan has nothing to refuse.
+    let (plan, _) = emit::plan::plan(model, packages, false);
+    let mut cfg = emit::modelica::ModelicaConfig::new();
+    cfg.namespaces = plan.generated.clone();
+    if model.models.iter().any(|m| m.uri == load::NS0_URI && model.sources.get(m.file).named) {
+        cfg.namespaces.insert(0, load::NS0_URI.to_string());
+    }
+    cfg.package_names = packages.clone();
+    let (files, warnings) = generate_modelica(model, &cfg, severities)?;
+    Ok(ModelicaRun { plan, files, warnings })
 }
 
 /// The number of threads the compiler uses: the cores this process may run on.

@@ -97,6 +97,9 @@ enum Command {
         /// Output folder (replaced atomically; it must hold only generated files).
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
+        /// A namespace whose package exists elsewhere, as URI=PACKAGE (not generated; classes extend PACKAGE).
+        #[arg(long = "extern", value_name = "URI=PACKAGE")]
+        externs: Vec<String>,
         /// Compare with the output folder instead of writing; fail if it differs.
         #[arg(long)]
         check: bool,
@@ -148,7 +151,6 @@ fn write_out(out: &Path, files: &[OutFile], check: bool) -> Result<(), Error> {
 }
 
 fn rust_command(common: &Common, out: &Path, externs: &[String], modules: &[String], runtime: &str, check: bool) -> Result<(), Error> {
-    use nodeset_compiler::emit::rust as r;
     let rust = RustOptions {
         modules: pairs(modules, "module")?.into_iter().collect(),
         extern_paths: pairs(externs, "extern")?.into_iter().collect(),
@@ -156,22 +158,23 @@ fn rust_command(common: &Common, out: &Path, externs: &[String], modules: &[Stri
         command: "nodeset-compiler rust ...".into(),
     };
     let (compiled, opts) = compile_checked(common)?;
-    let model = &compiled.model;
-    let cfg = rust.config(model);
-    let (mut files, warnings) = nodeset_compiler::generate_rust(model, &cfg, &opts.severities)?;
-    eprint!("{warnings}");
-    let list: Vec<(String, String)> = cfg.namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
-    files.push(r::models_mod(&list, &cfg.runtime_path, &cfg.command));
-    files.push(r::rustfmt_toml());
-    write_out(out, &files, check)
+    // Every required model that is not mapped with --extern is generated too, so the output compiles alone.
+    let run = nodeset_compiler::run_rust(&compiled.model, &rust, &opts.severities)?;
+    eprint!("{}", run.warnings);
+    write_out(out, &run.files, check)?;
+    eprint!("{}", run.plan.describe(|u| run.modules.get(u).cloned().unwrap_or_default()));
+    Ok(())
 }
 
-fn modelica_command(common: &Common, out: &Path, check: bool) -> Result<(), Error> {
-    use nodeset_compiler::emit::modelica::ModelicaConfig;
+fn modelica_command(common: &Common, out: &Path, externs: &[String], check: bool) -> Result<(), Error> {
+    let packages = pairs(externs, "extern")?.into_iter().collect();
     let (compiled, opts) = compile_checked(common)?;
-    let (files, warnings) = nodeset_compiler::generate_modelica(&compiled.model, &ModelicaConfig::new(), &opts.severities)?;
-    eprint!("{warnings}");
-    write_out(out, &files, check)
+    // Every required model not mapped to an existing package is generated too (ns0: the part used, `OpcUa`).
+    let run = nodeset_compiler::run_modelica(&compiled.model, &packages, &opts.severities)?;
+    eprint!("{}", run.warnings);
+    write_out(out, &run.files, check)?;
+    eprint!("{}", run.plan.describe(|_| String::new()));
+    Ok(())
 }
 
 fn check_command(common: &Common, all_warnings: bool, show: &[String], depth: usize) -> Result<(), Error> {
@@ -217,7 +220,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Rust { common, out, externs, modules, runtime, check } => rust_command(common, out, externs, modules, runtime, *check),
-        Command::Modelica { common, out, check } => modelica_command(common, out, *check),
+        Command::Modelica { common, out, externs, check } => modelica_command(common, out, externs, *check),
         Command::Check { common, all_warnings, show, depth } => check_command(common, *all_warnings, show, *depth),
         Command::Codes { codes } => codes_command(codes),
     };

@@ -37,6 +37,16 @@ fn main() {
     }
     builder.generate().unwrap_or_else(|e| panic!("{e}"));
 
+    // The name collision fixture's subtype alone, its dependency not generated: the inherited members are
+    // inlined, two of them named `Identification` (in two namespaces), as two nested structs of two names.
+    nodeset_compiler::build::Builder::new()
+        .models_dir(&vendor)
+        .models_dir(fixtures.join("name_collision"))
+        .file(fixtures.join("name_collision/Example.NameCollision.NodeSet2.xml"))
+        .out_file("name_collision_alone.rs")
+        .generate()
+        .unwrap_or_else(|e| panic!("{e}"));
+
     // The two public skill reference models (../shared/nodesets/skills-reference), on DI from nodeset-models.
     let reference = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/nodesets/skills-reference");
     let mut files: Vec<_> = std::fs::read_dir(&reference)

@@ -32,8 +32,133 @@ macro_rules! fixture {
 
 fixture!(
     structure, optional_fields, union, enum_gaps, option_set, abstract_base, arrays, names, method, event_type,
-    two_namespaces, state_machine, instances, variable_type
+    two_namespaces, state_machine, instances, variable_type, recursive, name_collision
 );
+
+/// Compiles the fixture folder `case` (its files named) with the vendor models, generates Rust for every
+/// model the plan generates, and returns the code of `module` and the rendered diagnostics of loading,
+/// planning and generation.
+fn generate_case(case: &str, only: Option<&str>) -> (String, String) {
+    use nodeset_compiler::emit::rust::{generate, RustConfig, RustNamespace};
+    use nodeset_compiler::load::Input;
+    use nodeset_compiler::{compile, Options};
+    let dir = root().join("tests/fixtures").join(case);
+    let mut files: Vec<_> = std::fs::read_dir(&dir).expect("fixture folder").flatten().map(|e| e.path()).collect();
+    files.sort();
+    files.retain(|f| only.is_none_or(|o| f.file_name().is_some_and(|n| n == o)));
+    let opts = Options { model_dirs: vec![vendor(), dir.clone()], ..Options::default() };
+    let compiled = compile(files.into_iter().map(Input::Path).collect(), &opts);
+    let mut text = compiled.render_diagnostics();
+    assert!(compiled.ok(), "{text}");
+    let model = &compiled.model;
+    let (plan, planning) = nodeset_compiler::emit::plan::plan(model, &Default::default(), true);
+    assert!(planning.items.is_empty(), "{}", planning.render(&model.sources));
+    let modules = plan.module_names(&Default::default());
+    let namespaces: Vec<RustNamespace> = plan.generated.iter().map(|u| RustNamespace { uri: u.clone(), module: modules[u].clone() }).collect();
+    text.push_str(&plan.describe(|u| modules[u].clone()));
+    let cfg = RustConfig {
+        namespaces,
+        extern_paths: Default::default(),
+        runtime_path: "nodeset_models::runtime".into(),
+        command: "test".into(),
+    };
+    let gen = generate(model, &cfg);
+    text.push_str(&gen.diagnostics.render(&model.sources));
+    let code: String = gen.files.iter().map(|f| format!("==> {}\n{}", f.path.display(), f.contents)).collect();
+    (code, text)
+}
+
+/// A structure that contains its own type by value is boxed on the cycle and only there: an optional field
+/// of the own type, a structure and a union that contain each other; not an array of the own type, nor a
+/// structure that merely holds a recursive one. The boxed types get the binary encoding of their box.
+#[test]
+fn recursive_structures_are_boxed_on_the_cycle() {
+    let (code, diagnostics) = generate_case("recursive", None);
+    insta::assert_snapshot!("recursive_diagnostics", diagnostics);
+    let types = code.split("==> ").find(|f| f.starts_with("recursive/types.rs")).expect("types.rs");
+    for expected in [
+        "pub referred_semantic_id: Option<Box<Reference>>,",
+        "pub next: Option<Box<Link>>,",
+        "Target(Box<Node>),",
+        "pub children: Option<Vec<Tree>>,",
+        "pub main: Reference,",
+        "impl opcua::types::BinaryEncodable for Box<Reference>",
+        "impl opcua::types::BinaryDecodable for Box<Link>",
+    ] {
+        assert!(types.contains(expected), "types.rs lacks `{expected}`:\n{types}");
+    }
+    for unexpected in ["for Box<Tree>", "for Box<Holder>"] {
+        assert!(!types.contains(unexpected), "types.rs has `{unexpected}`, off the cycle");
+    }
+}
+
+/// A type whose supertype's handle is not generated inlines the inherited members; two of them with one
+/// BrowseName text in different namespaces (`1:Identification`, `2:Identification`) get two nested structs
+/// of two names. Naming the subtype's file alone: its dependency is generated with it (the plan), so the
+/// handle reaches the supertype's and inlines nothing; the collision is forced by generating the subtype's
+/// namespace without its dependency's module.
+#[test]
+fn members_of_one_name_in_two_namespaces_get_two_struct_names() {
+    use nodeset_compiler::emit::rust::{generate, RustConfig, RustNamespace};
+    use nodeset_compiler::load::Input;
+    use nodeset_compiler::{compile, Options};
+    let (_, diagnostics) = generate_case("name_collision", Some("Example.NameCollision.NodeSet2.xml"));
+    insta::assert_snapshot!("name_collision_diagnostics", diagnostics);
+    let dir = root().join("tests/fixtures/name_collision");
+    let opts = Options { model_dirs: vec![vendor(), dir.clone()], ..Options::default() };
+    let compiled = compile(vec![Input::Path(dir.join("Example.NameCollision.NodeSet2.xml"))], &opts);
+    let cfg = RustConfig {
+        namespaces: vec![RustNamespace { uri: "http://example.com/fixtures/name_collision/".into(), module: "name_collision".into() }],
+        extern_paths: Default::default(),
+        runtime_path: "nodeset_models::runtime".into(),
+        command: "test".into(),
+    };
+    let gen = generate(&compiled.model, &cfg);
+    let objects = gen.files.iter().find(|f| f.path.ends_with("objects.rs")).expect("objects.rs");
+    insta::assert_snapshot!("name_collision_alone_objects", objects.contents);
+    let structs: Vec<&str> = objects.contents.lines().filter(|l| l.starts_with("pub struct ")).collect();
+    let mut unique = structs.clone();
+    unique.sort();
+    unique.dedup();
+    assert_eq!(structs.len(), unique.len(), "a struct name is defined twice: {structs:?}");
+    assert!(structs.iter().any(|s| s.starts_with("pub struct DozerType_Identification_2 ")), "{structs:?}");
+}
+
+/// Naming the base namespace's file for Rust is a diagnostic (async-opcua provides ns0), not code with
+/// thousands of type errors. Demoted (`--warn NS0303`), the run recovers: ns0 is left to async-opcua and the
+/// files that build on it are generated.
+#[test]
+fn naming_ns0_for_rust_is_a_diagnostic() {
+    use nodeset_compiler::diag::{Code, Level, Severities};
+    use nodeset_compiler::load::Input;
+    use nodeset_compiler::{compile, run_rust, Error, Options, RustOptions};
+    let compiled = compile(vec![Input::Path(vendor().join("Opc.Ua.NodeSet2.xml"))], &Options::default());
+    assert!(compiled.ok(), "{}", compiled.render_diagnostics());
+    let err = run_rust(&compiled.model, &RustOptions::default(), &Severities::new()).expect_err("ns0 named for Rust is refused");
+    assert!(matches!(err, Error::Diagnostics { errors: 1, .. }), "{err}");
+    let text = err.diagnostics().replace(&root().display().to_string(), "<root>");
+    assert!(text.contains("error[NS0303]"), "{text}");
+    insta::assert_snapshot!("ns0_named_diagnostics", text);
+    // For Modelica, where the base namespace is a package like any other, the plan accepts it.
+    let (_, planning) = nodeset_compiler::emit::plan::plan(&compiled.model, &Default::default(), false);
+    assert!(planning.items.is_empty(), "{}", planning.render(&compiled.model.sources));
+
+    // ns0 named beside a file that builds on it, NS0303 demoted: a warning, and the other file's module alone.
+    let structure = root().join("tests/fixtures/structure/Example.Structure.NodeSet2.xml");
+    let files = vec![Input::Path(vendor().join("Opc.Ua.NodeSet2.xml")), Input::Path(structure)];
+    let compiled = compile(files, &Options::default());
+    assert!(compiled.ok(), "{}", compiled.render_diagnostics());
+    let mut warn = Severities::new();
+    warn.set(Code::Ns0Named, Level::Warn).expect("NS0303 has a recovery");
+    let run = run_rust(&compiled.model, &RustOptions::default(), &warn).unwrap_or_else(|e| panic!("{e}"));
+    assert!(run.warnings.contains("warning[NS0303]"), "{}", run.warnings);
+    assert_eq!(run.plan.generated, ["http://example.com/fixtures/structure/"], "{:?}", run.plan);
+    assert_eq!(run.modules.keys().collect::<Vec<_>>(), ["http://example.com/fixtures/structure/"]);
+    // `--deny warnings` without `--warn NS0303` leaves it an error.
+    let mut deny = Severities::new();
+    deny.deny_warnings(true);
+    assert!(run_rust(&compiled.model, &RustOptions::default(), &deny).is_err());
+}
 
 /// Asserts that prettyplease prints `text` (a generated file, its `//` header aside) exactly as it stands.
 fn assert_prettyplease_layout(what: &str, text: &str) {

@@ -19,18 +19,18 @@ use std::process::Command;
 pub struct Args {
     /// The tree to compile (default: ../shared/nodesets/ua-nodeset).
     #[arg(long)]
-    tree: Option<PathBuf>,
+    pub(crate) tree: Option<PathBuf>,
     /// Where to put the generated crate (default: target/corpus-crate).
     #[arg(long)]
-    out: Option<PathBuf>,
+    pub(crate) out: Option<PathBuf>,
 }
 
-fn module_for(tree: &Path, file: &Path) -> String {
+pub(crate) fn module_for(tree: &Path, file: &Path) -> String {
     let rel = file.strip_prefix(tree).unwrap_or(file).to_string_lossy().replace(".NodeSet2.xml", "").replace(".nodeset2.xml", "");
     format!("m_{}", sanitize(&rel, Case::Snake, Target::Rust).trim_start_matches("r#"))
 }
 
-fn nodeset_files(dir: &Path, out: &mut Vec<PathBuf>) {
+pub(crate) fn nodeset_files(dir: &Path, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     for e in entries.flatten() {
         let p = e.path();
@@ -43,6 +43,19 @@ fn nodeset_files(dir: &Path, out: &mut Vec<PathBuf>) {
             }
         }
     }
+}
+
+/// The corpus crate's package name, unique per output folder. Cargo's fingerprint of a root package
+/// leaves out its path: two corpus crates of one name in one target folder would share it, and the second
+/// `cargo check` would pass on the first one's result without compiling anything.
+pub fn package_name(out: &Path) -> String {
+    let full = out.canonicalize().unwrap_or_else(|_| out.to_path_buf());
+    // FNV-1a: stable across runs and toolchains (std's hasher is not).
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in full.to_string_lossy().bytes() {
+        h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+    }
+    format!("nodeset-corpus-check-{h:016x}")
 }
 
 pub fn run(args: Args) -> Result<(), String> {
@@ -103,7 +116,8 @@ pub fn run(args: Args) -> Result<(), String> {
     std::fs::write(src.join("lib.rs"), lib).map_err(|e| e.to_string())?;
     let models_path = root.join("generated");
     let manifest = format!(
-        "[package]\nname = \"nodeset-corpus-check\"\nversion = \"0.0.0\"\nedition = \"2021\"\npublish = false\n\n[workspace]\n\n[dependencies]\nasync-opcua = {{ version = \"=0.19.0\", features = [\"server\"] }}\nbitflags = \"2\"\nnodeset-models = {{ path = \"{}\" }}\n",
+        "[package]\nname = \"{}\"\nversion = \"0.0.0\"\nedition = \"2021\"\npublish = false\n\n[workspace]\n\n[dependencies]\nasync-opcua = {{ version = \"=0.19.0\", features = [\"server\"] }}\nbitflags = \"2\"\nnodeset-models = {{ path = \"{}\" }}\n",
+        package_name(&out),
         models_path.display()
     );
     std::fs::write(out.join("Cargo.toml"), manifest).map_err(|e| e.to_string())?;
@@ -118,10 +132,18 @@ pub fn run(args: Args) -> Result<(), String> {
     for u in &unresolved {
         println!("  not resolvable: {}", u.display());
     }
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let start = std::time::Instant::now();
+    cargo_check(&root, &out)?;
+    println!("corpus: cargo check of {generated} generated modules passed in {:.1} s ({warnings} model warnings)", start.elapsed().as_secs_f64());
+    Ok(())
+}
+
+/// `cargo check` of a generated corpus crate in the workspace's target folder (its dependencies are
+/// shared with the workspace's build; the crate's own name is unique to `out`, see [`package_name`]).
+pub fn cargo_check(root: &Path, out: &Path) -> Result<(), String> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let status = Command::new(cargo)
-        .current_dir(&out)
+        .current_dir(out)
         .env("CARGO_TARGET_DIR", root.join("target"))
         .args(["check", "--quiet", "--message-format", "short"])
         .status()
@@ -129,6 +151,48 @@ pub fn run(args: Args) -> Result<(), String> {
     if !status.success() {
         return Err(format!("the generated corpus crate does not compile ({status}); see {}", out.display()));
     }
-    println!("corpus: cargo check of {generated} generated modules passed in {:.1} s ({warnings} model warnings)", start.elapsed().as_secs_f64());
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A tree of ns0 and the structure fixture, generated into a corpus crate.
+    fn small_tree(dir: &Path) -> PathBuf {
+        let root = workspace_root();
+        let tree = dir.join("tree");
+        std::fs::create_dir_all(&tree).unwrap();
+        for f in ["nodesets/vendor/Opc.Ua.NodeSet2.xml", "tests/fixtures/structure/Example.Structure.NodeSet2.xml"] {
+            let from = root.join(f);
+            std::fs::copy(&from, tree.join(from.file_name().unwrap())).unwrap();
+        }
+        tree
+    }
+
+    /// The corpus check compiles: a crate that compiles passes; then a second crate in another folder,
+    /// the same generated code with a compile error planted in one module, fails, although the first one's
+    /// build is in the same target folder (before package names were unique per folder, it passed).
+    #[test]
+    fn corpus_check_fails_on_a_planted_compile_error() {
+        let dir = std::env::temp_dir().join(format!("xtask-corpus-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let tree = small_tree(&dir);
+        let (good, bad) = (dir.join("good"), dir.join("bad"));
+        run(Args { tree: Some(tree.clone()), out: Some(good.clone()) }).expect("the structure fixture's corpus crate compiles");
+        run(Args { tree: Some(tree), out: Some(bad.clone()) }).expect("the same crate in a second folder compiles");
+        assert_ne!(package_name(&good), package_name(&bad), "two corpus folders, two package names");
+        let module = std::fs::read_dir(bad.join("src"))
+            .unwrap()
+            .flatten()
+            .map(|e| e.path())
+            .find(|p| p.file_name().is_some_and(|n| n != "lib.rs"))
+            .expect("a generated module");
+        let mut text = std::fs::read_to_string(&module).unwrap();
+        text.push_str("\nconst PLANTED: u8 = \"not a number\";\n");
+        std::fs::write(&module, text).unwrap();
+        let err = cargo_check(&workspace_root(), &bad).expect_err("a planted compile error fails the corpus check");
+        assert!(err.contains("does not compile"), "{err}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

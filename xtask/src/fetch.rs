@@ -30,50 +30,68 @@ const DEFAULT_VERSION: &str = "2.185.0";
 const LOCK_PATH: &str = "nodesets/node-opcua-nodesets.lock";
 
 /// The output folder, relative to the workspace root; it is git-ignored.
-const VENDOR_DIR: &str = "nodesets/vendor";
+pub(crate) const VENDOR_DIR: &str = "nodesets/vendor";
 
 /// A NodeSet2 file the project uses.
-struct Wanted {
+pub(crate) struct Wanted {
     /// The file name in `nodesets/vendor/`.
-    name: &'static str,
+    pub(crate) name: &'static str,
     /// The path inside the package, relative to the package root.
     path: &'static str,
     /// The ModelUri the file must define; guards against files moving inside the package.
     model_uri: &'static str,
 }
 
-/// The files the project uses: the base namespace, Robotics and the closure of
-/// its `<RequiredModel>` references, plus Machinery for later use.
+/// The model URI of a file that declares no `<Model>` (the older files of `nodesets/1.02/`).
+const NO_MODEL: &str = "-";
+
+/// The files the project uses: every NodeSet2 file of the package. The base namespace, DI, IA, Robotics and
+/// Machinery come first (the project's own models build on them); then the other current companion
+/// specifications; then the three older files of the package's `nodesets/1.02/` folder (FTNIR, and the ADI
+/// and DI they were written for), which declare no `<Model>` and keep their folder in `nodesets/vendor/1.02/`
+/// so that their names do not clash with the current ADI and DI. Every file goes through `check`, Rust and
+/// Modelica in `cargo xtask registry`.
 ///
 /// `--update-lock` fails if a file requires a model missing from this list.
-/// Note that the package also ships an old DI (2015, without a `<Models>`
-/// element) under `nodesets/1.02/`, which must not be picked by mistake.
-const SELECTION: &[Wanted] = &[
-    Wanted {
-        name: "Opc.Ua.NodeSet2.xml",
-        path: "nodesets/Opc.Ua.NodeSet2.xml",
-        model_uri: "http://opcfoundation.org/UA/",
-    },
-    Wanted {
-        name: "Opc.Ua.Di.NodeSet2.xml",
-        path: "nodesets/Opc.Ua.Di.NodeSet2.xml",
-        model_uri: "http://opcfoundation.org/UA/DI/",
-    },
-    Wanted {
-        name: "Opc.Ua.IA.NodeSet2.xml",
-        path: "nodesets/Opc.Ua.IA.NodeSet2.xml",
-        model_uri: "http://opcfoundation.org/UA/IA/",
-    },
-    Wanted {
-        name: "Opc.Ua.Robotics.NodeSet2.xml",
-        path: "nodesets/Opc.Ua.Robotics.NodeSet2.xml",
-        model_uri: "http://opcfoundation.org/UA/Robotics/",
-    },
-    Wanted {
-        name: "Opc.Ua.Machinery.NodeSet2.xml",
-        path: "nodesets/Opc.Ua.Machinery.NodeSet2.xml",
-        model_uri: "http://opcfoundation.org/UA/Machinery/",
-    },
+pub(crate) const SELECTION: &[Wanted] = &[
+    Wanted { name: "Opc.Ua.NodeSet2.xml", path: "nodesets/Opc.Ua.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/" },
+    Wanted { name: "Opc.Ua.Di.NodeSet2.xml", path: "nodesets/Opc.Ua.Di.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/DI/" },
+    Wanted { name: "Opc.Ua.IA.NodeSet2.xml", path: "nodesets/Opc.Ua.IA.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/IA/" },
+    Wanted { name: "Opc.Ua.Robotics.NodeSet2.xml", path: "nodesets/Opc.Ua.Robotics.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/Robotics/" },
+    Wanted { name: "Opc.Ua.Machinery.NodeSet2.xml", path: "nodesets/Opc.Ua.Machinery.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/Machinery/" },
+    Wanted { name: "Opc.ISA95.NodeSet2.xml", path: "nodesets/Opc.ISA95.NodeSet2.xml", model_uri: "http://www.OPCFoundation.org/UA/2013/01/ISA95" },
+    Wanted { name: "Opc.Ua.Adi.NodeSet2.xml", path: "nodesets/Opc.Ua.Adi.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/ADI/" },
+    Wanted { name: "Opc.Ua.AMB.NodeSet2.xml", path: "nodesets/Opc.Ua.AMB.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/AMB/" },
+    Wanted { name: "Opc.Ua.AutoID.NodeSet2.xml", path: "nodesets/Opc.Ua.AutoID.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/AutoID/" },
+    Wanted { name: "Opc.Ua.CNC.NodeSet.xml", path: "nodesets/Opc.Ua.CNC.NodeSet.xml", model_uri: "http://opcfoundation.org/UA/CNC" },
+    Wanted { name: "Opc.Ua.CommercialKitchenEquipment.NodeSet2.xml", path: "nodesets/Opc.Ua.CommercialKitchenEquipment.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/CommercialKitchenEquipment/" },
+    Wanted { name: "Opc.Ua.Eumabois.Nodeset2.xml", path: "nodesets/Opc.Ua.Eumabois.Nodeset2.xml", model_uri: "http://opcfoundation.org/UA/Eumabois/" },
+    Wanted { name: "Opc.Ua.Gds.NodeSet2.xml", path: "nodesets/Opc.Ua.Gds.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/GDS/" },
+    Wanted { name: "Opc.Ua.Glass.NodeSet2.xml", path: "nodesets/Opc.Ua.Glass.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/Glass/Flat/" },
+    Wanted { name: "Opc.Ua.I4AAS.NodeSet2.xml", path: "nodesets/Opc.Ua.I4AAS.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/I4AAS/" },
+    Wanted { name: "Opc.Ua.Ijt.Base.NodeSet2.xml", path: "nodesets/Opc.Ua.Ijt.Base.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/IJT/Base/" },
+    Wanted { name: "Opc.Ua.Ijt.Tightening.NodeSet2.xml", path: "nodesets/Opc.Ua.Ijt.Tightening.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/IJT/Tightening/" },
+    Wanted { name: "Opc.Ua.IOLink.NodeSet2.xml", path: "nodesets/Opc.Ua.IOLink.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/IOLink/" },
+    Wanted { name: "Opc.Ua.IOLinkIODD.NodeSet2.xml", path: "nodesets/Opc.Ua.IOLinkIODD.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/IOLink/IODD/" },
+    Wanted { name: "Opc.Ua.IRDI.NodeSet2.xml", path: "nodesets/Opc.Ua.IRDI.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/Dictionary/IRDI" },
+    Wanted { name: "opc.ua.isa95-jobcontrol.nodeset2.xml", path: "nodesets/opc.ua.isa95-jobcontrol.nodeset2.xml", model_uri: "http://opcfoundation.org/UA/ISA95-JOBCONTROL_V2/" },
+    Wanted { name: "Opc.Ua.LADS.NodeSet2.xml", path: "nodesets/Opc.Ua.LADS.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/LADS/" },
+    Wanted { name: "Opc.Ua.Machinery.Jobs.Nodeset2.xml", path: "nodesets/Opc.Ua.Machinery.Jobs.Nodeset2.xml", model_uri: "http://opcfoundation.org/UA/Machinery/Jobs/" },
+    Wanted { name: "Opc.Ua.Machinery.ProcessValues.NodeSet2.xml", path: "nodesets/Opc.Ua.Machinery.ProcessValues.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/Machinery/ProcessValues/" },
+    Wanted { name: "Opc.Ua.Machinery_Result.NodeSet2.xml", path: "nodesets/Opc.Ua.Machinery_Result.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/Machinery/Result/" },
+    Wanted { name: "Opc.Ua.MachineTool.NodeSet2.xml", path: "nodesets/Opc.Ua.MachineTool.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/MachineTool/" },
+    Wanted { name: "Opc.Ua.MachineVision.NodeSet2.xml", path: "nodesets/Opc.Ua.MachineVision.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/MachineVision" },
+    Wanted { name: "Opc.Ua.MetalForming.NodeSet2.xml", path: "nodesets/Opc.Ua.MetalForming.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/MetalForming/" },
+    Wanted { name: "Opc.Ua.PackML.NodeSet2.xml", path: "nodesets/Opc.Ua.PackML.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/PackML/" },
+    Wanted { name: "Opc.Ua.PADIM.NodeSet2.xml", path: "nodesets/Opc.Ua.PADIM.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/PADIM/" },
+    Wanted { name: "Opc.Ua.Scales.NodeSet2.xml", path: "nodesets/Opc.Ua.Scales.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/Scales/V2/" },
+    Wanted { name: "Opc.Ua.ST-Mss.NodeSet2.xml", path: "nodesets/Opc.Ua.ST-Mss.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/SurfaceTechnology/OCT-MSS/" },
+    Wanted { name: "Opc.Ua.STGeneralTypes.NodeSet2.xml", path: "nodesets/Opc.Ua.STGeneralTypes.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/SurfaceTechnology/GeneralTypes/" },
+    Wanted { name: "Opc.Ua.Weihenstephan.NodeSet2.xml", path: "nodesets/Opc.Ua.Weihenstephan.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/Weihenstephan/" },
+    Wanted { name: "Opc.Ua.Woodworking.NodeSet2.xml", path: "nodesets/Opc.Ua.Woodworking.NodeSet2.xml", model_uri: "http://opcfoundation.org/UA/Woodworking/" },
+    Wanted { name: "1.02/FTNIR.NodeSet2.xml", path: "nodesets/1.02/FTNIR.NodeSet2.xml", model_uri: "-" },
+    Wanted { name: "1.02/Opc.Ua.Adi.NodeSet2.xml", path: "nodesets/1.02/Opc.Ua.Adi.NodeSet2.xml", model_uri: "-" },
+    Wanted { name: "1.02/Opc.Ua.Di.NodeSet2.xml", path: "nodesets/1.02/Opc.Ua.Di.NodeSet2.xml", model_uri: "-" },
 ];
 
 /// Arguments of `cargo xtask fetch-nodesets`.
@@ -167,7 +185,9 @@ fn fetch_and_verify(lock_path: &Path, vendor_dir: &Path) -> Result<(), String> {
         .map_err(|e| format!("cannot create {}: {e}", display_path(vendor_dir)))?;
     for (file, _) in &stale {
         let bytes = extracted.remove(file.path.as_str()).unwrap_or_default();
-        write_atomically(&vendor_dir.join(&file.name), &bytes)?;
+        let path = vendor_dir.join(&file.name);
+        create_parent(&path)?;
+        write_atomically(&path, &bytes)?;
     }
 
     // Re-read what is now on disk, so success really means the folder matches the lock.
@@ -224,6 +244,7 @@ fn update_lock(lock_path: &Path, vendor_dir: &Path, version: Option<String>) -> 
     for file in &lock.files {
         let path = vendor_dir.join(&file.name);
         if vendor_problem(&path, file).is_some() {
+            create_parent(&path)?;
             write_atomically(&path, &extracted[file.path.as_str()])?;
         }
     }
@@ -240,6 +261,14 @@ fn update_lock(lock_path: &Path, vendor_dir: &Path, version: Option<String>) -> 
         );
     }
     Ok(())
+}
+
+/// Creates the folder a vendored file goes into (`nodesets/vendor/1.02/`).
+fn create_parent(path: &Path) -> Result<(), String> {
+    match path.parent() {
+        Some(dir) => fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", display_path(dir))),
+        None => Ok(()),
+    }
 }
 
 /// Reads and parses the lock file; a missing file is `Ok(None)`.
@@ -311,6 +340,18 @@ fn describe(wanted: &Wanted, bytes: &[u8]) -> Result<LockedFile, String> {
     let models = models::read_models(text)
         .map_err(|e| format!("cannot read the <Models> header of {}: {e}", wanted.path))?;
     let model = match models.as_slice() {
+        [] if wanted.model_uri == NO_MODEL => {
+            return Ok(LockedFile {
+                name: wanted.name.to_string(),
+                path: wanted.path.to_string(),
+                size: bytes.len() as u64,
+                sha256: sha256_hex(bytes),
+                model_uri: NO_MODEL.to_string(),
+                model_version: None,
+                publication_date: None,
+                requires: Vec::new(),
+            })
+        }
         [model] => model,
         _ => {
             return Err(format!(
@@ -347,6 +388,7 @@ fn describe(wanted: &Wanted, bytes: &[u8]) -> Result<LockedFile, String> {
 fn check_required_models(files: &[LockedFile]) -> Result<(), String> {
     let defined: HashMap<&str, &LockedFile> = files
         .iter()
+        .filter(|file| file.model_uri != NO_MODEL)
         .map(|file| (file.model_uri.as_str(), file))
         .collect();
     for file in files {
@@ -562,11 +604,10 @@ mod tests {
         names.dedup();
         assert_eq!(names.len(), SELECTION.len(), "duplicate local names");
         for wanted in SELECTION {
-            assert!(
-                !wanted.name.contains('/') && !wanted.name.starts_with('.'),
-                "{}",
-                wanted.name
-            );
+            // A plain file name, or one of the package's `1.02/` folder.
+            let file = wanted.name.strip_prefix("1.02/").unwrap_or(wanted.name);
+            assert!(!file.contains('/') && !file.starts_with('.'), "{}", wanted.name);
+            assert!(wanted.path.ends_with(wanted.name), "{} is not the end of {}", wanted.name, wanted.path);
             assert!(
                 !wanted.path.starts_with('/') && !wanted.path.contains(".."),
                 "{}",

@@ -16,6 +16,8 @@ mod fetch;
 mod fuzz;
 mod generate;
 mod load;
+mod one_at_a_time;
+mod registry;
 mod soak;
 mod test;
 mod util;
@@ -42,6 +44,10 @@ enum Command {
     Bench(bench::Args),
     /// Generate Rust for every resolvable ua-nodeset file into one crate and `cargo check` it.
     Corpus(corpus::Args),
+    /// Every NodeSet2 file of a tree generated on its own (its dependencies with it), all compiled.
+    OneAtATime(one_at_a_time::Args),
+    /// Every NodeSet2 file of the pinned registry package through check, Rust (compiled) and Modelica (rumoca).
+    Registry(registry::Args),
     /// Run one cargo-fuzz target of fuzz/ for a number of seconds (installs cargo-fuzz, builds the seeds).
     Fuzz(fuzz::Args),
     /// Regenerate generated/ from the pinned companion specifications (`--check`: fail if stale).
@@ -62,6 +68,8 @@ fn main() -> ExitCode {
         Command::FetchNodesets(args) => fetch::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Corpus(args) => corpus::run(args),
+        Command::OneAtATime(args) => one_at_a_time::run(args),
+        Command::Registry(args) => registry::run(args),
         Command::Fuzz(args) => fuzz::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Load(args) => load::run(args),

@@ -1,2 +1,3 @@
 pub mod modelica;
+pub mod plan;
 pub mod rust;

@@ -12,3 +12,8 @@ pub mod skills_reference {
 pub mod recovered {
     include!(concat!(env!("OUT_DIR"), "/recovered.rs"));
 }
+
+/// The name collision fixture's subtype generated without its dependency (inherited members inlined).
+pub mod name_collision_alone {
+    include!(concat!(env!("OUT_DIR"), "/name_collision_alone.rs"));
+}

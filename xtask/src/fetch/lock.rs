@@ -24,11 +24,11 @@ pub const HEADER: &str = "\
 #   version <exact package version>
 #   integrity <npm integrity string of the tarball, `sha512-` + base64>
 # followed by one block per file, opened by its `file` line:
-#   file <local file name in nodesets/vendor/>
+#   file <local path in nodesets/vendor/>
 #     path <path of the file inside the package, without the `package/` prefix>
 #     size <size in bytes>
 #     sha256 <SHA-256 of the file, lowercase hex>
-#     model-uri <ModelUri of the <Model> element the file defines>
+#     model-uri <ModelUri of the <Model> element the file defines, or `-` when it has none>
 #     model-version <Version attribute of that <Model>, or `-` when absent>
 #     publication-date <PublicationDate attribute of that <Model>, or `-`>
 #     requires <ModelUri> <Version or `-`>   (once per <RequiredModel>, in file order)
@@ -276,12 +276,18 @@ fn or_dash(value: &Option<String>) -> &str {
     value.as_deref().unwrap_or("-")
 }
 
-/// Accepts only plain file names, because the lock decides where files are written.
+/// Accepts only plain file names, or one folder and a plain file name (`1.02/FTNIR.NodeSet2.xml`), because
+/// the lock decides where files are written.
 fn validate_file_name(name: &str) -> Result<(), String> {
     let allowed = |c: char| c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-');
-    if name.starts_with('.') || !name.chars().all(allowed) {
+    let plain = |part: &str| !part.is_empty() && !part.starts_with('.') && part.chars().all(allowed);
+    let ok = match name.split_once('/') {
+        Some((folder, file)) => plain(folder) && plain(file),
+        None => plain(name),
+    };
+    if !ok {
         return Err(format!(
-            "file name `{name}` must use only letters, digits, `.`, `_` and `-`, and not start with `.`"
+            "file name `{name}` must use only letters, digits, `.`, `_` and `-`, and not start with `.` (one `folder/` before it is allowed)"
         ));
     }
     Ok(())

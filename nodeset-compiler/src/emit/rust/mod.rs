@@ -30,6 +30,7 @@
 mod async_opcua_ns0;
 mod objects;
 mod programs;
+mod recursion;
 mod table;
 
 pub use objects::marker_name;
@@ -504,7 +505,13 @@ impl<'m> Gen<'m> {
         self.ns0_types.contains(name.as_str()).then_some(name)
     }
 
-    fn field_type(&self, f: &crate::model::Field) -> TokenStream {
+    /// The Rust type of field `f` of structure `owner` (boxed where the field's type contains the owner again,
+    /// see [`recursion`]).
+    fn field_type(&self, owner: NodeIx, f: &crate::model::Field) -> TokenStream {
+        if recursion::is_boxed(self.model, owner, f) {
+            let scalar = self.rust_type(f.data_type);
+            return quote! { Box<#scalar> };
+        }
         let info = &self.model.data_types[&f.data_type];
         let scalar = match &info.kind {
             DataTypeKind::Structure { .. } if info.is_abstract || f.allow_sub_types => {
@@ -669,7 +676,7 @@ impl<'m> Gen<'m> {
                             .enumerate()
                             .map(|(i, f)| {
                                 let vn = ident(&fnames[&i]);
-                                let ty = self.field_type(f);
+                                let ty = self.field_type(t, f);
                                 let d = doc(&field_doc(f));
                                 quote! { #d #vn(#ty) }
                             })
@@ -693,7 +700,7 @@ impl<'m> Gen<'m> {
                             .enumerate()
                             .map(|(i, f)| {
                                 let fname = ident(&fnames[&i]);
-                                let ty = self.field_type(f);
+                                let ty = self.field_type(t, f);
                                 let d = doc(&field_doc(f));
                                 let original = lit(&f.name);
                                 if f.is_optional {
@@ -712,6 +719,9 @@ impl<'m> Gen<'m> {
                     };
                     items.push(body);
                     items.push(quote! { #runtime::typed::ua_struct!(#name_id); });
+                    if recursion::is_on_cycle(model, t) {
+                        items.push(boxed_encoding(&name_id));
+                    }
                     // Encoding ids and the type loader.
                     let enc = |which: &str| info.encodings.iter().find(|(n, _)| n == which).map(|(_, ix)| *ix);
                     let binary = enc("Default Binary");
@@ -802,6 +812,26 @@ impl<'m> Gen<'m> {
         let m = self.model.model_of_namespace(self.ns)?;
         let ctx = self.model.files.get(&m.file)?;
         self.model.map_node_id(ctx, text).ok()
+    }
+}
+
+/// The binary encoding of `Box<T>` for a structure `T` on a cycle of fields (async-opcua implements JSON and
+/// XML for boxes, not binary): the encoding of the value itself.
+fn boxed_encoding(name: &Ident) -> TokenStream {
+    quote! {
+        impl opcua::types::BinaryEncodable for Box<#name> {
+            fn byte_len(&self, ctx: &opcua::types::Context<'_>) -> usize {
+                opcua::types::BinaryEncodable::byte_len(&**self, ctx)
+            }
+            fn encode<S: std::io::Write + ?Sized>(&self, stream: &mut S, ctx: &opcua::types::Context<'_>) -> opcua::types::EncodingResult<()> {
+                opcua::types::BinaryEncodable::encode(&**self, stream, ctx)
+            }
+        }
+        impl opcua::types::BinaryDecodable for Box<#name> {
+            fn decode<S: std::io::Read + ?Sized>(stream: &mut S, ctx: &opcua::types::Context<'_>) -> opcua::types::EncodingResult<Self> {
+                <#name as opcua::types::BinaryDecodable>::decode(stream, ctx).map(Box::new)
+            }
+        }
     }
 }
 

@@ -371,6 +371,9 @@ impl Gen<'_> {
             scope.add(&model.node(m).browse_name.name, m);
         }
         let (fnames, _) = scope.finish();
+        // Nested struct names of this struct: two members may share a BrowseName text in different
+        // namespaces (a subtype's `1:Identification` beside its supertype's `3:Identification`).
+        let mut nested_names: BTreeSet<String> = BTreeSet::new();
         let mut out = Vec::new();
         for &(m, _) in members {
             let n = model.node(m);
@@ -390,7 +393,9 @@ impl Gen<'_> {
                         && self.adds_children(m)
                         && !self.repeats_its_type(m, names) =>
                 {
-                    let sname = format!("{prefix}{}", crate::names::sanitize(&n.browse_name.name, Case::UpperCamel, Target::Rust).trim_start_matches("r#"));
+                    let base = format!("{prefix}{}", crate::names::sanitize(&n.browse_name.name, Case::UpperCamel, Target::Rust).trim_start_matches("r#"));
+                    let sname = (1..).map(|k| if k == 1 { base.clone() } else { format!("{base}_{k}") }).find(|c| !nested_names.contains(c)).unwrap_or(base);
+                    nested_names.insert(sname.clone());
                     let sub = self.decl_members(m);
                     let text = format!("`{}`, a member of `{}` with children of its own.", n.browse_name.name, prefix.trim_end_matches('_'));
                     nested.push(self.handle_struct(&sname, &text, None, None, &sub, names, uris, nested_prefix(&sname), depth + 1));
