@@ -115,6 +115,17 @@ codes! {
     NameCollision = "NS0301", Warning, "two names map to one identifier in generated code", Some("the names are told apart by a suffix");
     UnsupportedFeature = "NS0302", Warning, "a model feature has no faithful representation in generated code",
         Some("the feature is left out of the generated code");
+    // Verifying a live server against its nodesets (`nodeset-compiler verify`).
+    MissingMember = "NS0401", Error, "a mandatory member is missing on the server", NO;
+    WrongNodeClass = "NS0402", Error, "a member has another NodeClass than its declaration", NO;
+    WrongTypeDefinition = "NS0403", Error, "a TypeDefinition is neither the declared type nor a subtype of it", NO;
+    WrongDataType = "NS0404", Error, "a DataType is neither the declared DataType nor a subtype of it", NO;
+    WrongValueRank = "NS0405", Error, "a ValueRank is not compatible with the declared ValueRank", NO;
+    WrongValueType = "NS0406", Error, "a value's built-in type or shape does not match its DataType and ValueRank", NO;
+    WrongPlaceholderType = "NS0407", Error, "a member in a placeholder's place is not of the placeholder's type", NO;
+    InstanceModellingRule = "NS0408", Error, "an instance has a ModellingRule", NO;
+    UnknownRemoteType = "NS0409", Warning, "a server node names a type or DataType the loaded nodesets do not define",
+        Some("the node's type is not checked");
 }
 
 impl Code {
