@@ -8,10 +8,11 @@
 //! first time the walk (in the server's browse order) reaches it.
 
 use super::{RemoteNode, RemoteValue, Snapshot};
-use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::diag::{Code, Diagnostic, Diagnostics, Severities};
 use crate::model::{ids, Member, Model, ModellingRule, NodeIx};
 use crate::nodeid::{Identifier, NodeId, QualifiedName};
 use crate::raw::NodeClass;
+use crate::source::SourceMap;
 use crate::value::BuiltinType;
 use std::collections::BTreeSet;
 
@@ -30,7 +31,7 @@ pub struct Finding {
 /// What [`check`] found.
 #[derive(Clone, Debug, Default)]
 pub struct Report {
-    /// Violations and warnings, in the order of the walk (deterministic for one snapshot).
+    /// Violations and warnings, in the order of the walk until [`Report::apply`] sorts them.
     pub findings: Vec<Finding>,
     /// Server nodes checked against a declaration or a type.
     pub checked: usize,
@@ -51,6 +52,40 @@ impl Report {
     /// Findings of error severity.
     pub fn violations(&self) -> usize {
         self.findings.iter().filter(|f| f.diagnostic.is_error()).count()
+    }
+
+    /// Findings of warning severity.
+    pub fn warnings(&self) -> usize {
+        self.findings.len() - self.violations()
+    }
+
+    /// Gives every finding the severity `severities` sets for its code (`--allow NS0408` drops them,
+    /// `--warn NS0401` makes them warnings, `--deny warnings` makes every warning a violation), then sorts
+    /// the findings by browse path, code and declaration, so that the report does not depend on the order
+    /// the server listed its nodes in.
+    pub fn apply(&mut self, severities: &Severities, sources: &SourceMap) {
+        self.findings.retain_mut(|f| match severities.severity(f.diagnostic.code, f.diagnostic.severity) {
+            Some(s) => {
+                f.diagnostic.severity = s;
+                true
+            }
+            None => false,
+        });
+        self.sort(sources);
+    }
+
+    /// Sorts the findings by browse path, code, server node, declaration (file and offset) and message.
+    pub fn sort(&mut self, sources: &SourceMap) {
+        let place = |f: &Finding| f.diagnostic.span.map(|s| (sources.get(s.file).display.clone(), s.start));
+        self.findings.sort_by(|a, b| {
+            (&a.path, a.diagnostic.code, &a.node, place(a), &a.diagnostic.message).cmp(&(
+                &b.path,
+                b.diagnostic.code,
+                &b.node,
+                place(b),
+                &b.diagnostic.message,
+            ))
+        });
     }
 }
 

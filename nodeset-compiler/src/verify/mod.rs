@@ -22,8 +22,8 @@
 //!
 //! Limits: only nodes outside namespace 0 are checked (namespace 0 is the server stack's own), and only
 //! those reached by forward hierarchical references from the Objects folder. A node whose type is in a
-//! namespace no loaded nodeset defines is reported once (`NS0409`, a warning) and its children are checked
-//! against their own types.
+//! namespace no loaded nodeset defines is reported (`NS0409`, an error that `--warn NS0409` demotes) and
+//! its children are checked against their own types.
 
 pub mod check;
 #[cfg(feature = "verify")]

@@ -21,7 +21,7 @@ pub fn render_text(report: &Report, sources: &SourceMap, url: &str, millis: u128
 
 /// One line: what was checked, how many violations, how many round trips and how long.
 pub fn summary(report: &Report, url: &str, millis: u128) -> String {
-    let warnings = report.findings.len() - report.violations();
+    let warnings = report.warnings();
     let mut s = format!(
         "{url}: {} node(s) checked ({} instance(s) against their types), {} violation(s), {} warning(s), {} round trip(s), {} ms\n",
         report.checked,
@@ -49,7 +49,7 @@ pub fn render_json(report: &Report, sources: &SourceMap, url: &str, millis: u128
         report.checked,
         report.instances,
         report.violations(),
-        report.findings.len() - report.violations(),
+        report.warnings(),
         report.round_trips,
         millis
     );
