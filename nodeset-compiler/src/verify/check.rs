@@ -415,7 +415,16 @@ impl<'a> Checker<'a> {
                     )
                     .at(member.span)
                     .with_span_label(format!("declared Mandatory in {}", model.qualified(m.declared_in)));
-                    if let Some(same) = children.iter().filter_map(|c| snap.nodes.get(c)).find(|c| c.browse_name.name == m.browse_name.name) {
+                    // A child of that name in another namespace is what the server meant: it is reported here
+                    // once and checked against the declaration, not taken for a placeholder's filler.
+                    let same = (0..children.len())
+                        .filter(|&i| !filled[i])
+                        .find(|&i| snap.nodes.get(&children[i]).is_some_and(|c| c.browse_name.name == m.browse_name.name));
+                    let same = same.and_then(|i| {
+                        filled[i] = true;
+                        snap.nodes.get(&children[i])
+                    });
+                    if let Some(same) = same {
                         d = d.note(format!(
                             "a child named `{}` exists, in namespace {} rather than {}",
                             same.browse_name.name,
@@ -424,6 +433,10 @@ impl<'a> Checker<'a> {
                         ));
                     }
                     self.push(d, path, &node.id);
+                    if let Some(same) = same {
+                        let child_path = join(path, &same.browse_name);
+                        self.visit(same, &child_path, Some(m.node));
+                    }
                 }
                 None => {}
             }

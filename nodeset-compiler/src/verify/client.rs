@@ -9,12 +9,12 @@ use super::{RemoteNode, RemoteReference, RemoteValue, Snapshot};
 use crate::nodeid::{Identifier, NodeId, QualifiedName};
 use crate::raw::NodeClass;
 use crate::value::BuiltinType;
-use async_opcua::client::transport::{ConnectorBuilder, StreamConnection, StreamConnector};
-use async_opcua::client::{ClientBuilder, ConnectionSource, IdentityToken, Password, Session};
-use async_opcua::core::comms::tcp_codec::TcpCodec;
-use async_opcua::core::comms::url::hostname_port_from_url;
-use async_opcua::crypto::SecurityPolicy;
-use async_opcua::types::{
+use opcua::client::transport::{ConnectorBuilder, StreamConnection, StreamConnector};
+use opcua::client::{ClientBuilder, ConnectionSource, IdentityToken, Password, Session};
+use opcua::core::comms::tcp_codec::TcpCodec;
+use opcua::core::comms::url::hostname_port_from_url;
+use opcua::crypto::SecurityPolicy;
+use opcua::types::{
     AttributeId, BrowseDescription, BrowseDirection, BrowseResultMask, ByteString, DecodingOptions, EndpointDescription,
     MessageSecurityMode, ReadValueId, StatusCode, TimestampsToReturn, Variant,
 };
@@ -61,6 +61,11 @@ fn fail(what: &str, e: impl std::fmt::Display) -> ClientError {
 
 /// Connects, reads a [`Snapshot`] and disconnects.
 pub async fn snapshot(connect: &Connect) -> Result<Snapshot, ClientError> {
+    let url_ok = connect.url.starts_with("opc.tcp://")
+        && hostname_port_from_url(&connect.url, opcua::core::constants::DEFAULT_OPC_UA_SERVER_PORT).is_ok_and(|(h, _)| !h.is_empty());
+    if !url_ok {
+        return Err(ClientError(format!("`{}` is not an OPC UA endpoint URL (opc.tcp://HOST:PORT[/PATH])", connect.url)));
+    }
     let policy: SecurityPolicy = connect
         .security_policy
         .parse()
@@ -89,11 +94,31 @@ pub async fn snapshot(connect: &Connect) -> Result<Snapshot, ClientError> {
         Some((user, password)) => IdentityToken::UserName(user.clone(), Password(password.clone())),
         None => IdentityToken::Anonymous,
     };
+    // The endpoint of that policy and mode, reached at the URL the user gave: servers often advertise their
+    // host name (node-opcua does), which the machine running verify may not resolve.
+    let mut endpoint = endpoints
+        .iter()
+        .find(|e| e.security_policy_uri.as_ref() == policy.to_uri() && e.security_mode == mode)
+        .cloned()
+        .ok_or_else(|| {
+            let offered: Vec<String> = endpoints
+                .iter()
+                .map(|e| format!("{} {:?}", e.security_policy_uri.as_ref().rsplit('#').next().unwrap_or_default(), e.security_mode))
+                .collect();
+            ClientError(format!(
+                "{} offers no endpoint with {} and {} (it offers: {})",
+                connect.url,
+                connect.security_policy,
+                connect.security_mode,
+                offered.join(", ")
+            ))
+        })?;
+    endpoint.endpoint_url = connect.url.as_str().into();
     let (session, event_loop) = client
         .session_builder()
         .with_endpoints(endpoints)
-        .connect_to_matching_endpoint((connect.url.as_str(), policy.to_str(), mode))
-        .map_err(|e| fail(&format!("{} offers no endpoint with {} and {}", connect.url, connect.security_policy, connect.security_mode), e))?
+        .connect_to_endpoint_directly(endpoint)
+        .map_err(|e| fail(&format!("cannot use the endpoint {}", connect.url), e))?
         .user_identity_token(identity)
         .with_connector(NoDelay)
         .build(client.certificate_store().clone())
@@ -116,7 +141,7 @@ pub async fn read_all(session: &Arc<Session>) -> Result<Snapshot, ClientError> {
     // NamespaceArray, MaxNodesPerRead, MaxNodesPerBrowse.
     let first: Vec<ReadValueId> = [2255u32, 11705, 11710]
         .iter()
-        .map(|&i| ReadValueId { node_id: async_opcua::types::NodeId::new(0, i), attribute_id: AttributeId::Value as u32, ..Default::default() })
+        .map(|&i| ReadValueId { node_id: opcua::types::NodeId::new(0, i), attribute_id: AttributeId::Value as u32, ..Default::default() })
         .collect();
     let values = session.read(&first, TimestampsToReturn::Neither, 0.0).await.map_err(|e| fail("cannot read the NamespaceArray", e))?;
     snap.round_trips += 1;
@@ -126,7 +151,7 @@ pub async fn read_all(session: &Arc<Session>) -> Result<Snapshot, ClientError> {
         }
         _ => return Err(ClientError("the server's NamespaceArray is not an array of strings".into())),
     }
-    let limit = |v: Option<&async_opcua::types::DataValue>| match v.and_then(|v| v.value.as_ref()) {
+    let limit = |v: Option<&opcua::types::DataValue>| match v.and_then(|v| v.value.as_ref()) {
         Some(Variant::UInt32(n)) if *n > 0 => (*n as usize).min(1000),
         _ => 1000,
     };
@@ -155,7 +180,7 @@ pub async fn read_all(session: &Arc<Session>) -> Result<Snapshot, ClientError> {
                 .map(|id| BrowseDescription {
                     node_id: to_opcua(id),
                     browse_direction: BrowseDirection::Forward,
-                    reference_type_id: async_opcua::types::NodeId::new(0, 31u32),
+                    reference_type_id: opcua::types::NodeId::new(0, 31u32),
                     include_subtypes: true,
                     node_class_mask: 0,
                     result_mask: BrowseResultMask::All as u32,
@@ -252,23 +277,23 @@ fn node_class(mask: u32) -> Option<NodeClass> {
     NodeClass::ALL.into_iter().find(|c| c.mask() == mask)
 }
 
-fn from_opcua(id: &async_opcua::types::NodeId) -> NodeId {
-    use async_opcua::types::Identifier as I;
+fn from_opcua(id: &opcua::types::NodeId) -> NodeId {
+    use opcua::types::Identifier as I;
     let ident = match &id.identifier {
         I::Numeric(n) => Identifier::Numeric(*n),
         I::String(s) => Identifier::String(s.as_ref().into()),
-        I::Guid(g) => Identifier::Guid(*g.as_bytes()),
+        I::Guid(g) => Identifier::Guid(g.to_bytes()),
         I::ByteString(b) => Identifier::Opaque(b.as_ref().to_vec().into_boxed_slice()),
     };
     NodeId { ns: id.namespace, id: ident }
 }
 
-fn to_opcua(id: &NodeId) -> async_opcua::types::NodeId {
+fn to_opcua(id: &NodeId) -> opcua::types::NodeId {
     match &id.id {
-        Identifier::Numeric(n) => async_opcua::types::NodeId::new(id.ns, *n),
-        Identifier::String(s) => async_opcua::types::NodeId::new(id.ns, async_opcua::types::UAString::from(s.as_ref())),
-        Identifier::Guid(g) => async_opcua::types::NodeId::new(id.ns, async_opcua::types::Guid::from_bytes(*g)),
-        Identifier::Opaque(b) => async_opcua::types::NodeId::new(id.ns, ByteString::from(b.to_vec())),
+        Identifier::Numeric(n) => opcua::types::NodeId::new(id.ns, *n),
+        Identifier::String(s) => opcua::types::NodeId::new(id.ns, opcua::types::UAString::from(s.as_ref())),
+        Identifier::Guid(g) => opcua::types::NodeId::new(id.ns, opcua::types::Guid::from_bytes(*g)),
+        Identifier::Opaque(b) => opcua::types::NodeId::new(id.ns, ByteString::from(b.to_vec())),
     }
 }
 
@@ -280,12 +305,12 @@ struct NoDelay;
 struct NoDelayUrl(String);
 
 type Halves = StreamConnection<ReadHalf<TcpStream>, WriteHalf<TcpStream>>;
-type Connecting = Pin<Box<dyn Future<Output = Result<Halves, async_opcua::types::Error>> + Send + Sync>>;
+type Connecting = Pin<Box<dyn Future<Output = Result<Halves, opcua::types::Error>> + Send + Sync>>;
 
 impl ConnectionSource for NoDelay {
     type Builder = NoDelayUrl;
 
-    fn get_connector(&self, endpoint: &EndpointDescription) -> Result<NoDelayUrl, async_opcua::types::Error> {
+    fn get_connector(&self, endpoint: &EndpointDescription) -> Result<NoDelayUrl, opcua::types::Error> {
         Ok(NoDelayUrl(endpoint.endpoint_url.as_ref().to_owned()))
     }
 }
@@ -293,15 +318,15 @@ impl ConnectionSource for NoDelay {
 impl ConnectorBuilder for NoDelayUrl {
     type ConnectorType = StreamConnector<ReadHalf<TcpStream>, WriteHalf<TcpStream>, fn(String, DecodingOptions) -> Connecting, Connecting>;
 
-    fn build(self) -> Result<Self::ConnectorType, async_opcua::types::Error> {
+    fn build(self) -> Result<Self::ConnectorType, opcua::types::Error> {
         Ok(StreamConnector::new(connect_no_delay as fn(String, DecodingOptions) -> Connecting, self.0))
     }
 }
 
 fn connect_no_delay(url: String, options: DecodingOptions) -> Connecting {
     Box::pin(async move {
-        let error = |status: StatusCode, what: String| async_opcua::types::Error::new(status, what);
-        let (host, port) = hostname_port_from_url(&url, async_opcua::core::constants::DEFAULT_OPC_UA_SERVER_PORT)
+        let error = |status: StatusCode, what: String| opcua::types::Error::new(status, what);
+        let (host, port) = hostname_port_from_url(&url, opcua::core::constants::DEFAULT_OPC_UA_SERVER_PORT)
             .map_err(|s| error(s, format!("cannot read host and port from {url}")))?;
         let stream = TcpStream::connect((host.as_str(), port))
             .await
