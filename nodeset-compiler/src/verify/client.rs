@@ -197,7 +197,9 @@ pub async fn read_all(session: &Arc<Session>) -> Result<Snapshot, ClientError> {
                         let reference_type = from_opcua(&r.reference_type_id);
                         if !snap.nodes.contains_key(&target) && target.ns != 0 && r.node_id.server_index == 0 && r.node_id.namespace_uri.is_null() {
                             // Instances only: HasTypeDefinition and other references into types are not followed.
-                            let Some(class) = node_class(r.node_class as u32).filter(|c| !c.is_type()) else { continue };
+                            // (A `continue` here would drop the reference too: HasTypeDefinition into a
+                            // companion namespace was lost that way.)
+                            if let Some(class) = node_class(r.node_class as u32).filter(|c| !c.is_type()) {
                             snap.nodes.insert(
                                 target.clone(),
                                 RemoteNode {
@@ -211,6 +213,7 @@ pub async fn read_all(session: &Arc<Session>) -> Result<Snapshot, ClientError> {
                                 },
                             );
                             next.push(target.clone());
+                            }
                         }
                         if let Some(n) = snap.nodes.get_mut(owner) {
                             n.references.push(RemoteReference { reference_type, target });
