@@ -26,6 +26,8 @@ function placeholders(space, ns) {
         powerTrain: space.findObjectType("PowerTrainType", ns.robotics),
         motor: space.findObjectType("MotorType", ns.robotics),
         axis: space.findObjectType("AxisType", ns.robotics),
+        software: space.findObjectType("SoftwareType", ns.di),
+        taskControl: space.findObjectType("TaskControlType", ns.robotics),
     };
 }
 
@@ -44,9 +46,18 @@ function system(space, ns, own, name, deviceSet) {
     const powerTrain = t.powerTrain.instantiate({ browseName: { namespaceIndex: own, name: "PowerTrain1" }, componentOf: child(device, "PowerTrains") });
     t.motor.instantiate({ browseName: { namespaceIndex: own, name: "Motor1" }, componentOf: powerTrain });
     t.axis.instantiate({ browseName: { namespaceIndex: own, name: "Axis1" }, componentOf: child(device, "Axes") });
-    t.controller.instantiate({ browseName: { namespaceIndex: own, name: "Controller" }, componentOf: child(sys, "Controllers") });
+    controller(space, ns, own, "Controller", child(sys, "Controllers"));
     t.safetyState.instantiate({ browseName: { namespaceIndex: own, name: "SafetyState" }, componentOf: child(sys, "SafetyStates") });
     return { sys, device };
+}
+
+/// A controller with its mandatory placeholders filled: one software and one task control.
+function controller(space, ns, own, name, parent) {
+    const t = placeholders(space, ns);
+    const c = t.controller.instantiate({ browseName: { namespaceIndex: own, name }, componentOf: parent });
+    t.software.instantiate({ browseName: { namespaceIndex: own, name: "Software1" }, componentOf: child(c, "Software") });
+    t.taskControl.instantiate({ browseName: { namespaceIndex: own, name: "TaskControl1" }, componentOf: child(c, "TaskControls") });
+    return c;
 }
 
 async function main() {
@@ -66,7 +77,7 @@ async function main() {
     const model = child(bad.device, "Model");
     model.bindVariable({ get: () => new Variant({ dataType: DataType.Double, value: 42.5 }) }, true);
     // 3. An object of the wrong type in a placeholder's place.
-    placeholders(space, ns).controller.instantiate({ browseName: { namespaceIndex: own, name: "NotAMotionDevice" }, componentOf: child(bad.sys, "MotionDevices") });
+    controller(space, ns, own, "NotAMotionDevice", child(bad.sys, "MotionDevices"));
     await server.start();
     console.log(`listening on opc.tcp://127.0.0.1:${port}/UA/NodeOPCUA`);
     const stop = async () => {

@@ -267,9 +267,9 @@ fn a_node_opcua_server_with_planted_defects() {
     eprintln!("{json}\n{stderr}");
     // The server numbers its own namespace 1, DI 2, IA 3 and Robotics 4. The findings come sorted by path.
     let want = [
+        ("NS0407", "2:DeviceSet/1:BadSystem/4:MotionDevices/1:NotAMotionDevice"),
         ("NS0401", "2:DeviceSet/1:BadSystem/4:MotionDevices/1:Robot"),
         ("NS0406", "2:DeviceSet/1:BadSystem/4:MotionDevices/1:Robot/2:Model"),
-        ("NS0407", "2:DeviceSet/1:BadSystem/4:MotionDevices/1:NotAMotionDevice"),
     ];
     assert_eq!(findings(&json), want.map(|(c, p)| (c.to_owned(), p.to_owned())).to_vec(), "{json}");
     assert_eq!(output.status.code(), Some(1), "violations give exit status 1");
