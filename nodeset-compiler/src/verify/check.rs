@@ -470,6 +470,10 @@ impl<'a> Checker<'a> {
                     used.insert(m.node);
                     self.visit(child, &child_path, Some(m.node))
                 }
+                // Part 3 lets an instance have components its type does not declare, so outside a folder a
+                // child of another type is an addition, checked against its own type. A folder that declares
+                // placeholders (MotionDevices, Controllers) holds only what fills them.
+                None if !actual_type.is_some_and(|t| model.is_subtype_of_ns0(t, ids::FOLDER_TYPE)) => self.root(id, path),
                 None => {
                     let m = places[0];
                     let want = model.node(m.node).type_definition.map(|t| model.qualified(t)).unwrap_or_default();

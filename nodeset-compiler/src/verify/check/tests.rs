@@ -1,4 +1,5 @@
-//! The rules on an in-memory snapshot: a small model (ns0 from `nodesets/vendor` and a box type) and two
+//! The rules on an in-memory snapshot: a small model (ns0 from `nodesets/vendor` and a box type, a folder so
+//! that its placeholder admits nothing else) and two
 //! server instances of it, one correct and one with planted defects.
 
 use super::*;
@@ -16,7 +17,7 @@ const BOX_MODEL: &str = r#"<?xml version="1.0" encoding="utf-8"?>
   <Aliases><Alias Alias="Double">i=11</Alias><Alias Alias="HasProperty">i=46</Alias><Alias Alias="HasComponent">i=47</Alias>
     <Alias Alias="HasSubtype">i=45</Alias><Alias Alias="HasTypeDefinition">i=40</Alias><Alias Alias="HasModellingRule">i=37</Alias></Aliases>
   <UAObjectType NodeId="ns=1;i=1000" BrowseName="1:BoxType">
-    <References><Reference ReferenceType="HasSubtype" IsForward="false">i=58</Reference>
+    <References><Reference ReferenceType="HasSubtype" IsForward="false">i=61</Reference>
       <Reference ReferenceType="HasProperty">ns=1;i=1001</Reference>
       <Reference ReferenceType="HasComponent">ns=1;i=1002</Reference>
       <Reference ReferenceType="HasComponent">ns=1;i=1003</Reference></References>
