@@ -48,6 +48,8 @@ macro_rules! codes {
 }
 
 const NO: Option<&str> = None;
+/// What demoting a finding of `verify` does: verification goes on either way, so only the exit status changes.
+const VERIFY_RECOVERY: Option<&str> = Some("the finding is reported as a warning (or, allowed, not at all) and does not fail verify");
 
 codes! {
     // Reading and parsing one file.
@@ -117,6 +119,17 @@ codes! {
         Some("the feature is left out of the generated code");
     Ns0Named = "NS0303", Error, "the base namespace is named for Rust, which async-opcua provides",
         Some("the base namespace is not generated: generated code uses async-opcua's, as when its file is only in --models");
+    // Verifying a live server against its nodesets (`nodeset-compiler verify`).
+    MissingMember = "NS0401", Error, "a mandatory member is missing on the server", VERIFY_RECOVERY;
+    WrongNodeClass = "NS0402", Error, "a member has another NodeClass than its declaration", VERIFY_RECOVERY;
+    WrongTypeDefinition = "NS0403", Error, "a TypeDefinition is neither the declared type nor a subtype of it", VERIFY_RECOVERY;
+    WrongDataType = "NS0404", Error, "a DataType is neither the declared DataType nor a subtype of it", VERIFY_RECOVERY;
+    WrongValueRank = "NS0405", Error, "a ValueRank is not compatible with the declared ValueRank", VERIFY_RECOVERY;
+    WrongValueType = "NS0406", Error, "a value's built-in type or shape does not match its DataType and ValueRank", VERIFY_RECOVERY;
+    WrongPlaceholderType = "NS0407", Error, "a member in a placeholder's place is not of the placeholder's type", VERIFY_RECOVERY;
+    InstanceModellingRule = "NS0408", Error, "an instance has a ModellingRule", VERIFY_RECOVERY;
+    UnknownRemoteType = "NS0409", Error, "a server node names a type or DataType the loaded nodesets do not define",
+        Some("the node is not checked against that type (its children are checked against their own types)");
 }
 
 impl Code {
@@ -251,6 +264,18 @@ impl Severities {
     /// The level set for `code`, if any.
     pub fn level(&self, code: Code) -> Option<Level> {
         self.levels.get(&code).copied()
+    }
+
+    /// The severity a diagnostic of `code` reported as `severity` has under these settings, or `None` when
+    /// `--allow` drops it. A setting for the code outranks `--deny warnings`.
+    pub fn severity(&self, code: Code, severity: Severity) -> Option<Severity> {
+        match self.level(code) {
+            Some(Level::Allow) => None,
+            Some(Level::Warn) => Some(Severity::Warning),
+            Some(Level::Deny) => Some(Severity::Error),
+            None if self.deny_warnings && severity == Severity::Warning => Some(Severity::Error),
+            None => Some(severity),
+        }
     }
 }
 
@@ -413,22 +438,12 @@ impl Diagnostics {
     /// makes it a warning, `--deny CODE` an error, and `--deny warnings` turns every other warning into an
     /// error. A setting for a code outranks `--deny warnings`. Applying the same settings twice changes nothing.
     pub fn apply(&mut self, severities: &Severities) {
-        self.items.retain_mut(|d| match severities.level(d.code) {
-            Some(Level::Allow) => false,
-            Some(Level::Warn) => {
-                d.severity = Severity::Warning;
+        self.items.retain_mut(|d| match severities.severity(d.code, d.severity) {
+            Some(s) => {
+                d.severity = s;
                 true
             }
-            Some(Level::Deny) => {
-                d.severity = Severity::Error;
-                true
-            }
-            None => {
-                if severities.deny_warnings && d.severity == Severity::Warning {
-                    d.severity = Severity::Error;
-                }
-                true
-            }
+            None => false,
         });
     }
 

@@ -35,6 +35,7 @@ pub mod resolve;
 pub mod source;
 pub mod summary;
 pub mod value;
+pub mod verify;
 pub mod write;
 
 use diag::{Diagnostics, Severities, Severity};

@@ -559,6 +559,35 @@ pub fn cmp_version(a: Option<&str>, b: Option<&str>) -> Ordering {
     }
 }
 
+/// For each of `uris`, the NodeSet2 file under `dirs` that defines that model in its newest version (the
+/// choice the loader makes for a required model without a version); URIs no file defines are left out.
+pub fn find_model_files(dirs: &[PathBuf], uris: &[String]) -> BTreeMap<String, PathBuf> {
+    let index = scan_dirs(dirs);
+    let mut out = BTreeMap::new();
+    for uri in uris {
+        let version_of = |c: &Candidate| c.models.iter().find(|m| m.0 == *uri).map(|m| (m.1.clone(), m.2.clone())).unwrap_or_default();
+        let mut options: Vec<&Candidate> = index.iter().filter(|c| c.models.iter().any(|m| m.0 == *uri)).collect();
+        options.sort_by(|a, b| {
+            let (va, da) = version_of(a);
+            let (vb, db) = version_of(b);
+            cmp_version(vb.as_deref(), va.as_deref())
+                .then_with(|| db.cmp(&da))
+                .then_with(|| a.path.as_os_str().len().cmp(&b.path.as_os_str().len()))
+                .then_with(|| a.path.cmp(&b.path))
+        });
+        if let Some(c) = options.first() {
+            out.insert(uri.clone(), c.path.clone());
+        }
+    }
+    out
+}
+
+/// The models the header of a NodeSet2 file declares (URIs), without parsing the rest; `None` if the file
+/// cannot be read or is not a NodeSet2 file.
+pub fn models_of_file(path: &Path) -> Option<Vec<String>> {
+    scan_header(path).map(|m| m.into_iter().map(|(uri, _, _)| uri).collect())
+}
+
 /// Lists every NodeSet2 file under the folders with the models its header declares.
 fn scan_dirs(dirs: &[PathBuf]) -> Vec<Candidate> {
     let mut paths = Vec::new();

@@ -25,6 +25,13 @@ struct Common {
     /// Folders searched recursively for the models the files require.
     #[arg(long = "models", value_name = "DIR")]
     models: Vec<PathBuf>,
+    #[command(flatten)]
+    levels: Levels,
+}
+
+/// The severity settings, as rustc's lint levels.
+#[derive(Args)]
+struct Levels {
     /// Drop the diagnostics of CODE; an error with a recovery (see `nodeset-compiler codes`) then recovers
     /// silently.
     #[arg(long = "allow", short = 'A', value_name = "CODE")]
@@ -38,16 +45,24 @@ struct Common {
     deny: Vec<String>,
 }
 
-impl Common {
-    /// The compile options these flags say. Levels are applied allow, then warn, then deny: when one code is
-    /// named twice, the stricter level wins.
-    fn options(&self) -> Result<(Vec<Input>, Options), Error> {
+impl Levels {
+    /// The settings these flags say. Levels are applied allow, then warn, then deny: when one code is named
+    /// twice, the stricter level wins.
+    fn severities(&self) -> Result<Severities, Error> {
         let mut severities = Severities::new();
         for (level, list) in [(Level::Allow, &self.allow), (Level::Warn, &self.warn), (Level::Deny, &self.deny)] {
             for what in list {
                 severities.set_named(level, what)?;
             }
         }
+        Ok(severities)
+    }
+}
+
+impl Common {
+    /// The compile options these flags say.
+    fn options(&self) -> Result<(Vec<Input>, Options), Error> {
+        let severities = self.levels.severities()?;
         let inputs = self.files.iter().cloned().map(Input::Path).collect();
         Ok((inputs, Options { model_dirs: self.models.clone(), severities, ..Options::default() }))
     }
@@ -110,6 +125,60 @@ enum Command {
         /// Only these codes.
         codes: Vec<String>,
     },
+    /// Check a live server against its nodesets: every instance below the Objects folder against its type.
+    ///
+    /// Reads the server's NamespaceArray, loads the nodesets of the namespaces it serves (the named FILES,
+    /// and for every other namespace the newest nodeset of that URI in the --models folders), and checks
+    /// every instance outside namespace 0: mandatory members present with the declared BrowseName,
+    /// NodeClass, TypeDefinition (or a subtype), DataType (or a subtype) and ValueRank; values of the
+    /// built-in type their DataType is encoded as; children in a placeholder's place of its type; no
+    /// ModellingRule on instances. Each violation names the declaration it violates and its place in the
+    /// NodeSet2 file. Exit status: 0 without violations, 1 with violations (errors after --allow, --warn
+    /// and --deny), 2 when the server or the nodesets cannot be read.
+    #[cfg(feature = "verify")]
+    #[command(after_help = "Codes: NS0401 missing mandatory member, NS0402 NodeClass, NS0403 TypeDefinition, NS0404 DataType, \
+NS0405 ValueRank, NS0406 value type or shape, NS0407 placeholder type, NS0408 ModellingRule on an instance, \
+NS0409 type of a namespace no nodeset defines; `nodeset-compiler codes NS0401` explains one.\n\n\
+Example: nodeset-compiler verify opc.tcp://localhost:4855/ --models nodesets --security-policy Basic256Sha256 \
+--security-mode SignAndEncrypt --user operator --password-env OPERATOR_PASSWORD")]
+    Verify(VerifyArgs),
+}
+
+/// The arguments of `nodeset-compiler verify`.
+#[cfg(feature = "verify")]
+#[derive(Args)]
+struct VerifyArgs {
+    /// The server's endpoint URL, opc.tcp://HOST:PORT[/PATH].
+    url: String,
+    /// NodeSet2 files of the server's namespaces (others are found in the --models folders).
+    files: Vec<PathBuf>,
+    /// Folders searched recursively for the nodesets of the server's namespaces and the models they require.
+    #[arg(long = "models", value_name = "DIR")]
+    models: Vec<PathBuf>,
+    #[command(flatten)]
+    levels: Levels,
+    /// Print the report as one JSON object on stdout (for CI).
+    #[arg(long)]
+    json: bool,
+    /// SecurityPolicy of the endpoint: None, Basic256Sha256, Aes128Sha256RsaOaep or Aes256Sha256RsaPss.
+    #[arg(long, default_value = "None")]
+    security_policy: String,
+    /// MessageSecurityMode of the endpoint: None, Sign or SignAndEncrypt.
+    #[arg(long, default_value = "None")]
+    security_mode: String,
+    /// The client's PKI folder (its own certificate, created on first use; trusted and rejected server
+    /// certificates). Default: nodeset-compiler-verify-pki in the temporary folder.
+    #[arg(long, value_name = "DIR")]
+    pki: Option<PathBuf>,
+    /// Trust the server's certificate without finding it in the PKI's trusted folder (insecure).
+    #[arg(long)]
+    trust_server_cert: bool,
+    /// Log in as this user (the password is read from the environment variable --password-env names).
+    #[arg(long, value_name = "NAME", requires = "password_env")]
+    user: Option<String>,
+    /// The environment variable that holds the password of --user (never a password on the command line).
+    #[arg(long, value_name = "VAR", requires = "user")]
+    password_env: Option<String>,
 }
 
 fn pairs(items: &[String], what: &str) -> Result<Vec<(String, String)>, Error> {
@@ -216,6 +285,66 @@ fn codes_command(codes: &[String]) -> Result<(), Error> {
     Ok(())
 }
 
+/// The exit status of `verify` when the server or the nodesets cannot be read (1 means violations).
+#[cfg(feature = "verify")]
+const CANNOT_VERIFY: u8 = 2;
+
+#[cfg(feature = "verify")]
+fn verify_command(args: &VerifyArgs) -> ExitCode {
+    use nodeset_compiler::verify::{client::Connect, driver, report};
+    let severities = match args.levels.severities() {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(CANNOT_VERIFY);
+        }
+    };
+    let user = match (&args.user, &args.password_env) {
+        (Some(u), Some(var)) => match std::env::var(var) {
+            Ok(p) => Some((u.clone(), p)),
+            Err(_) => {
+                eprintln!("error: --password-env {var}: the environment variable {var} is not set");
+                return ExitCode::from(CANNOT_VERIFY);
+            }
+        },
+        _ => None,
+    };
+    let connect = Connect {
+        url: args.url.clone(),
+        security_policy: args.security_policy.clone(),
+        security_mode: args.security_mode.clone(),
+        user,
+        pki_dir: args.pki.clone().unwrap_or_else(|| std::env::temp_dir().join("nodeset-compiler-verify-pki")),
+        trust_server_cert: args.trust_server_cert,
+    };
+    let runtime = match tokio::runtime::Builder::new_current_thread().enable_all().build() {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: cannot start the async runtime: {e}");
+            return ExitCode::from(CANNOT_VERIFY);
+        }
+    };
+    let done = match runtime.block_on(driver::verify(&connect, &args.files, &args.models, &severities)) {
+        Ok(done) => done,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(CANNOT_VERIFY);
+        }
+    };
+    eprint!("{}", done.load_warnings);
+    let sources = &done.compiled.model.sources;
+    if args.json {
+        print!("{}", report::render_json(&done.report, sources, &connect.url, done.millis));
+    } else {
+        eprint!("{}", report::render_text(&done.report, sources, &connect.url, done.millis));
+    }
+    if done.report.violations() > 0 {
+        ExitCode::FAILURE
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
@@ -223,6 +352,8 @@ fn main() -> ExitCode {
         Command::Modelica { common, out, externs, check } => modelica_command(common, out, externs, *check),
         Command::Check { common, all_warnings, show, depth } => check_command(common, *all_warnings, show, *depth),
         Command::Codes { codes } => codes_command(codes),
+        #[cfg(feature = "verify")]
+        Command::Verify(args) => return verify_command(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

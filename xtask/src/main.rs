@@ -22,6 +22,7 @@ mod soak;
 mod test;
 mod util;
 mod venv;
+mod node_peer;
 
 /// The top-level command line of `cargo xtask`.
 #[derive(Debug, Parser)]
@@ -60,6 +61,8 @@ enum Command {
     Test(test::Args),
     /// Create or update the Python venv `.venv` with the test peers of `tests/requirements.txt`.
     Venv(venv::Args),
+    /// Install the node-opcua test peer of `tests/node-peer` (npm ci from its pinned package-lock.json).
+    NodePeer(node_peer::Args),
 }
 
 fn main() -> ExitCode {
@@ -76,6 +79,7 @@ fn main() -> ExitCode {
         Command::Soak(args) => soak::run(args),
         Command::Test(args) => test::run(args),
         Command::Venv(args) => venv::run(args),
+        Command::NodePeer(args) => node_peer::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,7 +1,8 @@
 //! `cargo xtask test`: everything a fresh machine needs, then every test.
 //!
 //! 1. The pinned companion specs (`fetch-nodesets`, a no-op when they are present and verified).
-//! 2. The Python venv with the test peers (`.venv`, from `tests/requirements.txt`).
+//! 2. The Python venv with the test peers (`.venv`, from `tests/requirements.txt`) and the node-opcua peer
+//!    (`tests/node-peer`, `cargo xtask node-peer`).
 //! 3. `cargo test --workspace --locked`, whose summary lines CI reads.
 //! 4. `cargo xtask corpus`: Rust for every resolvable ua-nodeset file, compiled.
 //! 5. `cargo xtask load --seconds 20`: the robot example under 50 subscribed client sessions and a writer.
@@ -23,6 +24,7 @@ pub fn run(args: Args) -> Result<(), String> {
     let root = workspace_root();
     crate::fetch::ensure_fetched()?;
     crate::venv::ensure_venv()?;
+    crate::node_peer::ensure_node_peer()?;
     let shared = root.join("../shared/nodesets/ua-nodeset");
     if !shared.is_dir() {
         return Err(format!(

@@ -1,0 +1,68 @@
+//! The `nodeset-compiler` command as a user runs it, where no server or nodeset is needed: `verify` with bad
+//! input ends with a clear message and exit status 2, never a panic, and `codes` lists the verify codes.
+//!
+//! Being an integration test of this package, it also makes `cargo test --workspace` build the command with
+//! the workspace's features, so the live tests in `tests/tests/verify.rs` take it from that build.
+
+use std::process::{Command, Output};
+
+fn run(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_nodeset-compiler")).args(args).output().expect("the command runs")
+}
+
+fn free_port() -> u16 {
+    std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
+}
+
+#[test]
+fn verify_without_a_server_says_so() {
+    let url = format!("opc.tcp://127.0.0.1:{}/", free_port());
+    let output = run(&["verify", &url]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(stderr.starts_with("error: ") && stderr.contains(&url) && !stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn verify_refuses_a_url_that_is_not_opc_tcp() {
+    for url in ["http://localhost:4840/", "opc.tcp://", "localhost:4840"] {
+        let output = run(&["verify", url]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{url}: {stderr}");
+        assert!(stderr.contains("is not an OPC UA endpoint URL (opc.tcp://HOST:PORT[/PATH])"), "{url}: {stderr}");
+    }
+}
+
+#[test]
+fn verify_reads_the_named_nodesets_before_the_server() {
+    let manifest = concat!(env!("CARGO_MANIFEST_DIR"), "/Cargo.toml");
+    let output = run(&["verify", "opc.tcp://127.0.0.1:1/", manifest]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("Cargo.toml is not a readable NodeSet2 file"), "{stderr}");
+}
+
+#[test]
+fn verify_refuses_an_unknown_security_mode_and_a_missing_password() {
+    let output = run(&["verify", "opc.tcp://127.0.0.1:1/", "--security-mode", "Encrypt"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("unknown security mode `Encrypt`"), "{stderr}");
+    let output = Command::new(env!("CARGO_BIN_EXE_nodeset-compiler"))
+        .args(["verify", "opc.tcp://127.0.0.1:1/", "--user", "op", "--password-env", "NODESET_TEST_UNSET_PASSWORD"])
+        .env_remove("NODESET_TEST_UNSET_PASSWORD")
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("the environment variable NODESET_TEST_UNSET_PASSWORD is not set"), "{stderr}");
+}
+
+#[test]
+fn the_codes_table_lists_the_verify_codes() {
+    let output = run(&["codes", "NS0401", "NS0409"]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{stdout}");
+    assert!(stdout.contains("NS0401 error   a mandatory member is missing on the server"), "{stdout}");
+    assert!(stdout.contains("demotable: with --warn NS0409 or --allow NS0409"), "{stdout}");
+}

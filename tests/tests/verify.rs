@@ -1,0 +1,323 @@
+//! `nodeset-compiler verify` against live servers, run as the user runs it (the command, `--json`):
+//!
+//! - the robot example over SignAndEncrypt with a user name (its certificate trusted the way an operator
+//!   trusts it: refused first, then moved from `rejected/` to `trusted/`), and with `--insecure` over None;
+//! - the robot cell's three servers (with `--insecure`): no violation;
+//! - a node-opcua server (`tests/node-peer/server.js`, installed by `cargo xtask node-peer`) with ns0, DI, IA
+//!   and Robotics, one correct MotionDeviceSystem and one with three planted defects: exactly those three;
+//! - a server namespace no nodeset defines: NS0409, and the run fails.
+//!
+//! Bad input without a server (no server, a malformed URL, a file that is not a nodeset) is tested in
+//! `nodeset-compiler/tests/cli.rs`.
+//!
+//! The command and the examples come from `cargo test --workspace --no-run`, as in `interop.rs`. The test
+//! fails, never skips, when node or the node-opcua packages are missing, saying how to install them.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::sync::{mpsc, OnceLock};
+use std::time::Duration;
+
+use nodeset_tests::{root, vendor};
+
+/// The executables `cargo test --workspace --no-run` builds (a no-op after `cargo test --workspace`), as
+/// (kind, name, path); built once per test binary.
+fn artifacts() -> &'static [(String, String, PathBuf)] {
+    static ARTIFACTS: OnceLock<Vec<(String, String, PathBuf)>> = OnceLock::new();
+    ARTIFACTS.get_or_init(|| {
+        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+        let output = Command::new(cargo)
+            .current_dir(root())
+            .args(["test", "--workspace", "--no-run", "--message-format=json-render-diagnostics"])
+            .stderr(Stdio::inherit())
+            .output()
+            .expect("cargo runs");
+        assert!(output.status.success(), "cargo test --workspace --no-run failed");
+        let field = |line: &str, key: &str| -> Option<String> {
+            let start = line.find(key)? + key.len();
+            Some(line[start..start + line[start..].find('"')?].to_owned())
+        };
+        String::from_utf8_lossy(&output.stdout)
+            .lines()
+            .filter(|l| l.contains("\"reason\":\"compiler-artifact\"") && l.contains("\"test\":false"))
+            .filter_map(|l| {
+                let kind = field(l, "\"kind\":[\"")?;
+                let name = field(l, "\"name\":\"")?;
+                let exe = field(l, "\"executable\":\"")?;
+                Some((kind, name, PathBuf::from(exe)))
+            })
+            .collect()
+    })
+}
+
+/// The executable of a `bin` or `example` target.
+fn executable(kind: &str, name: &str) -> PathBuf {
+    artifacts()
+        .iter()
+        .find(|(k, n, _)| k == kind && n == name)
+        .map(|(_, _, p)| p.clone())
+        .unwrap_or_else(|| panic!("cargo test --workspace --no-run built no {kind} `{name}`"))
+}
+
+/// A server process, killed when dropped.
+struct Server {
+    child: Child,
+    lines: mpsc::Receiver<String>,
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+impl Server {
+    fn spawn(mut command: Command) -> Server {
+        let mut child = command.stdout(Stdio::piped()).stderr(Stdio::inherit()).spawn().expect("the server starts");
+        let out = child.stdout.take().unwrap();
+        let (tx, lines) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(out).lines().map_while(Result::ok) {
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        Server { child, lines }
+    }
+
+    /// The URLs of the first `n` lines that contain `listening on <url>`.
+    fn urls(&self, n: usize) -> Vec<String> {
+        let mut urls = Vec::new();
+        while urls.len() < n {
+            let line = self.lines.recv_timeout(Duration::from_secs(90)).expect("the server prints its URL");
+            if let Some((_, url)) = line.split_once("listening on ") {
+                urls.push(url.trim().to_owned());
+            }
+        }
+        urls
+    }
+}
+
+/// A fresh folder in the system's temporary directory.
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("nodeset-verify-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("the temporary folder can be created");
+    dir
+}
+
+/// Runs `nodeset-compiler verify URL ARGS --json`; returns the output and the JSON on stdout.
+fn verify(url: &str, args: &[&str], env: &[(&str, &str)]) -> (Output, String) {
+    let mut command = Command::new(executable("bin", "nodeset-compiler"));
+    command.current_dir(root()).arg("verify").arg(url).args(args).arg("--json");
+    for (k, v) in env {
+        command.env(k, v);
+    }
+    let output = command.output().expect("verify runs");
+    let json = String::from_utf8_lossy(&output.stdout).into_owned();
+    (output, json)
+}
+
+/// The `"key":value` number of the report.
+fn number(json: &str, key: &str) -> u64 {
+    let at = json.find(&format!("\"{key}\":")).unwrap_or_else(|| panic!("no {key} in {json}")) + key.len() + 3;
+    json[at..].chars().take_while(char::is_ascii_digit).collect::<String>().parse().unwrap()
+}
+
+/// (code, path) of every finding, in the report's order.
+fn findings(json: &str) -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    for part in json.split("{\"code\":").skip(1) {
+        let code = part[1..7].to_owned();
+        let path_at = part.find("\"path\":\"").unwrap() + 8;
+        let path = part[path_at..path_at + part[path_at..].find('"').unwrap()].to_owned();
+        out.push((code, path));
+    }
+    out
+}
+
+/// `--models` for the pinned companion specs and this repository's own nodesets.
+fn models() -> Vec<String> {
+    vec!["--models".into(), vendor().display().to_string(), "--models".into(), root().join("nodesets").display().to_string()]
+}
+
+/// Verifies `url` and asserts a clean report; returns the JSON.
+fn assert_clean(url: &str, extra: &[&str], env: &[(&str, &str)]) -> String {
+    let models = models();
+    let args: Vec<&str> = models.iter().map(String::as_str).chain(extra.iter().copied()).collect();
+    let (output, json) = verify(url, &args, env);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(findings(&json), Vec::<(String, String)>::new(), "{url}: {json}\n{stderr}");
+    assert!(output.status.success(), "{url}: exit {}: {json}\n{stderr}", output.status);
+    assert!(number(&json, "checked") > 100, "{url}: too few nodes checked: {json}");
+    // Batched reads: a few dozen round trips, not one per node.
+    assert!(number(&json, "round_trips") < 50, "{url}: too many round trips: {json}");
+    eprintln!("{url}: {json}");
+    json
+}
+
+#[test]
+fn the_robot_example_verifies_clean_over_sign_and_encrypt_with_a_user() {
+    use nodeset_runtime::server::{Role, Users};
+    let dir = temp_dir("robot-secure");
+    let mut users = Users::default();
+    users.set_password("op", vec![Role::Operator], "op-secret-1").unwrap();
+    let users_file = dir.join("users.txt");
+    std::fs::write(&users_file, users.to_text()).unwrap();
+    let (server_pki, client_pki) = (dir.join("server-pki"), dir.join("client-pki"));
+    let mut command = Command::new(executable("example", "robot"));
+    // The server trusts the verifying client's certificate on first use; the client trusts the server's
+    // only once an operator has moved it to `trusted/`.
+    command.args(["--port", "0", "--pki", server_pki.to_str().unwrap(), "--users", users_file.to_str().unwrap(), "--trust-on-first-use"]);
+    let server = Server::spawn(command);
+    let url = server.urls(1).remove(0);
+    let secure = [
+        "--security-policy",
+        "Basic256Sha256",
+        "--security-mode",
+        "SignAndEncrypt",
+        "--user",
+        "op",
+        "--password-env",
+        "VERIFY_TEST_PASSWORD",
+        "--pki",
+        client_pki.to_str().unwrap(),
+    ];
+    let env = [("VERIFY_TEST_PASSWORD", "op-secret-1")];
+    let models = models();
+    let args: Vec<&str> = models.iter().map(String::as_str).chain(secure.iter().copied()).collect();
+    // First contact: the server's certificate is not trusted, so verify refuses to go on (status 2).
+    let (output, _) = verify(&url, &args, &env);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "an untrusted server certificate must stop verify: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    let rejected: Vec<PathBuf> =
+        std::fs::read_dir(client_pki.join("rejected")).expect("the refused certificate is in rejected/").map(|e| e.unwrap().path()).collect();
+    assert_eq!(rejected.len(), 1, "{rejected:?}");
+    let trusted = client_pki.join("trusted");
+    std::fs::create_dir_all(&trusted).unwrap();
+    std::fs::rename(&rejected[0], trusted.join(rejected[0].file_name().unwrap())).unwrap();
+    assert_clean(&url, &secure, &env);
+    // A wrong password is refused with a clear message, not a panic.
+    let (output, _) = verify(&url, &args, &[("VERIFY_TEST_PASSWORD", "wrong")]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    drop(server);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_robot_example_verifies_clean_over_none() {
+    let pki = temp_dir("robot-none");
+    let mut command = Command::new(executable("example", "robot"));
+    command.args(["--port", "0", "--insecure", "--pki", pki.to_str().unwrap()]);
+    let server = Server::spawn(command);
+    let url = server.urls(1).remove(0);
+    assert_clean(&url, &[], &[]);
+    drop(server);
+    let _ = std::fs::remove_dir_all(&pki);
+}
+
+#[test]
+fn the_robot_cell_verifies_clean() {
+    let pki = temp_dir("robot-cell");
+    let mut command = Command::new(executable("example", "robot_cell"));
+    command.args(["--port", "0", "--insecure", "--pki", pki.to_str().unwrap()]);
+    let server = Server::spawn(command);
+    for url in server.urls(3) {
+        assert_clean(&url, &[], &[]);
+    }
+    drop(server);
+    let _ = std::fs::remove_dir_all(&pki);
+}
+
+/// The node-opcua peer's folder, with its packages installed, or a failure that says how to install them.
+fn node_peer() -> PathBuf {
+    let dir = root().join("tests/node-peer");
+    let ok = Command::new("node").arg("--version").output().is_ok_and(|o| o.status.success());
+    assert!(ok, "node is not installed; install Node.js 20 or newer with npm (e.g. `apt-get install nodejs npm`), then run `cargo xtask node-peer`");
+    assert!(
+        dir.join("node_modules/node-opcua/package.json").is_file(),
+        "node-opcua is not installed in {}; run `cargo xtask node-peer`",
+        dir.display()
+    );
+    dir
+}
+
+fn free_port() -> u16 {
+    std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
+}
+
+#[test]
+fn a_node_opcua_server_with_planted_defects() {
+    let dir = node_peer();
+    let port = free_port().to_string();
+    let mut command = Command::new("node");
+    command.current_dir(&dir).arg(Path::new("server.js")).arg(&port);
+    let server = Server::spawn(command);
+    let url = server.urls(1).remove(0);
+    let models = models();
+    let args: Vec<&str> = models.iter().map(String::as_str).collect();
+    let (output, json) = verify(&url, &args, &[]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    eprintln!("{json}\n{stderr}");
+    // The server numbers its own namespace 1, DI 2, IA 3 and Robotics 4. The findings come sorted by path.
+    let want = [
+        ("NS0407", "2:DeviceSet/1:BadSystem/4:MotionDevices/1:NotAMotionDevice"),
+        ("NS0401", "2:DeviceSet/1:BadSystem/4:MotionDevices/1:Robot"),
+        ("NS0406", "2:DeviceSet/1:BadSystem/4:MotionDevices/1:Robot/2:Model"),
+    ];
+    assert_eq!(findings(&json), want.map(|(c, p)| (c.to_owned(), p.to_owned())).to_vec(), "{json}");
+    assert_eq!(output.status.code(), Some(1), "violations give exit status 1");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(number(&json, "checked") > 100, "{json}");
+    // Each finding names the declaration it violates and its place in a NodeSet2 file.
+    assert_eq!(json.matches("\"declaration\":{\"file\":").count(), 3, "{json}");
+    // The same run in text: rustc-style, with the browse path and the summary.
+    let (output, _) = {
+        let mut command = Command::new(executable("bin", "nodeset-compiler"));
+        command.current_dir(root()).arg("verify").arg(&url).args(&args);
+        let output = command.output().expect("verify runs");
+        (output, ())
+    };
+    let text = String::from_utf8_lossy(&output.stderr);
+    assert!(text.contains("error[NS0401]: `2:DeviceSet/1:BadSystem/4:MotionDevices/1:Robot` has no mandatory Variable `2:SerialNumber`"), "{text}");
+    // SerialNumber is declared (again) by Robotics' MotionDeviceType.
+    assert!(text.contains("Opc.Ua.Robotics.NodeSet2.xml:6163:3"), "{text}");
+    assert!(text.contains("3 violation(s), 0 warning(s)"), "{text}");
+    // --warn demotes a finding: it stays in the report, and only the others fail the run.
+    let demoted: Vec<&str> = args.iter().copied().chain(["--warn", "NS0401", "--allow", "NS0406", "--warn", "NS0407"]).collect();
+    let (output, json) = verify(&url, &demoted, &[]);
+    assert_eq!(output.status.code(), Some(0), "{json}");
+    assert_eq!(number(&json, "violations"), 0, "{json}");
+    assert_eq!(number(&json, "warnings"), 2, "{json}");
+    drop(server);
+}
+
+#[test]
+fn a_server_namespace_without_a_nodeset_is_reported() {
+    let dir = temp_dir("robot-no-robotics");
+    let pki = dir.join("pki");
+    let mut command = Command::new(executable("example", "robot"));
+    command.args(["--port", "0", "--insecure", "--pki", pki.to_str().unwrap()]);
+    let server = Server::spawn(command);
+    let url = server.urls(1).remove(0);
+    // A models folder with ns0 and DI only: the IA and Robotics types the robot is made of are unknown.
+    let models = dir.join("models");
+    std::fs::create_dir_all(&models).unwrap();
+    for file in ["Opc.Ua.NodeSet2.xml", "Opc.Ua.Di.NodeSet2.xml"] {
+        std::fs::copy(vendor().join(file), models.join(file)).unwrap();
+    }
+    let (output, json) = verify(&url, &["--models", models.to_str().unwrap()], &[]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "an incomplete check must fail: {json}\n{stderr}");
+    assert!(json.contains("\"unknown_namespaces\":[") && json.contains("http://opcfoundation.org/UA/Robotics/"), "{json}");
+    let found = findings(&json);
+    assert!(!found.is_empty() && found.iter().all(|(code, _)| code == "NS0409"), "{json}");
+    drop(server);
+    let _ = std::fs::remove_dir_all(&dir);
+}
