@@ -1619,12 +1619,22 @@ pub(crate) mod tests {
 
     #[test]
     fn the_vendored_files_read_the_same_on_both_paths() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../nodesets/vendor");
-        let Ok(entries) = std::fs::read_dir(&dir) else { return };
-        for e in entries.flatten() {
-            let text = std::fs::read_to_string(e.path()).unwrap();
-            assert_fast_paths_agree(&text, &Limits::default());
+        // Every NodeSet2 file of the pinned package, those of its `1.02/` folder too.
+        let mut dirs = vec![std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../nodesets/vendor")];
+        let mut read = 0;
+        while let Some(dir) = dirs.pop() {
+            let entries = std::fs::read_dir(&dir)
+                .unwrap_or_else(|e| panic!("{}: {e}; run `cargo xtask fetch-nodesets`", dir.display()));
+            for path in entries.flatten().map(|e| e.path()) {
+                if path.is_dir() {
+                    dirs.push(path);
+                } else if path.extension().is_some_and(|x| x == "xml") {
+                    assert_fast_paths_agree(&std::fs::read_to_string(&path).unwrap(), &Limits::default());
+                    read += 1;
+                }
+            }
         }
+        assert!(read >= 38, "only {read} vendored files; run `cargo xtask fetch-nodesets`");
     }
 
     fn parse_str(text: &str) -> (Option<RawNodeSet>, Diagnostics) {

@@ -1,13 +1,15 @@
 //! RolePermissions and AccessRestrictions travel from the nodesets into the generated tables, node by node
 //! (`Access` lines, which the runtime's access policy reads): a node's own, or else its model's defaults.
+//! The model-defaults file lives in `tests/access/`, outside `tests/fixtures/`, whose every folder is one
+//! fixture with Rust and Modelica snapshots; it is about the tables only.
 
 use nodeset_compiler::build::Builder;
 use nodeset_tests::{root, vendor};
 
-/// The `Access` lines of the table generated for one fixture of `tests/fixtures/roles`.
+/// The `Access` lines of the table generated for one file (under `tests/`).
 fn access_lines(file: &str) -> Vec<String> {
-    let out = std::env::temp_dir().join(format!("nodeset-access-{}-{file}", std::process::id()));
-    let fixture = root().join("tests/fixtures/roles").join(file);
+    let out = std::env::temp_dir().join(format!("nodeset-access-{}-{}", std::process::id(), file.replace('/', "-")));
+    let fixture = root().join("tests").join(file);
     let generated = Builder::new().cargo_output(false).models_dir(vendor()).out_dir(&out).file(fixture).generate();
     let text = std::fs::read_to_string(generated.unwrap_or_else(|e| panic!("{file}: {e}"))).expect("the generated file");
     let _ = std::fs::remove_dir_all(&out);
@@ -19,7 +21,7 @@ fn access_lines(file: &str) -> Vec<String> {
 #[test]
 fn model_defaults_fill_what_nodes_leave_out() {
     assert_eq!(
-        access_lines("Example.RoleDefaults.NodeSet2.xml"),
+        access_lines("access/Example.RoleDefaults.NodeSet2.xml"),
         [
             // Line: both defaults (Operator 33, Engineer 97; EncryptionRequired).
             "Access 1:5001 2 0:15680=33 0:16036=97",
@@ -34,7 +36,7 @@ fn model_defaults_fill_what_nodes_leave_out() {
 /// Without model defaults, only the nodes that give RolePermissions or AccessRestrictions have a line.
 #[test]
 fn nodes_without_their_own_have_no_line() {
-    let lines = access_lines("Example.Roles.NodeSet2.xml");
+    let lines = access_lines("fixtures/roles/Example.Roles.NodeSet2.xml");
     let ids: Vec<&str> = lines.iter().filter_map(|l| l.split(' ').nth(1)).collect();
     assert_eq!(ids, ["1:6001", "1:6002", "1:7001", "1:7002"], "{lines:#?}");
 }
