@@ -139,8 +139,10 @@ enum Command {
     #[command(after_help = "Codes: NS0401 missing mandatory member, NS0402 NodeClass, NS0403 TypeDefinition, NS0404 DataType, \
 NS0405 ValueRank, NS0406 value type or shape, NS0407 placeholder type, NS0408 ModellingRule on an instance, \
 NS0409 type of a namespace no nodeset defines; `nodeset-compiler codes NS0401` explains one.\n\n\
-Example: nodeset-compiler verify opc.tcp://localhost:4855/ --models nodesets --security-policy Basic256Sha256 \
---security-mode SignAndEncrypt --user operator --password-env OPERATOR_PASSWORD")]
+It connects over Basic256Sha256 SignAndEncrypt unless told otherwise; a server certificate it does not trust \
+yet is put in PKI/rejected/ and the run stops: check it, move it to PKI/trusted/ and run again.\n\n\
+Example: nodeset-compiler verify opc.tcp://localhost:4855/ --models nodesets --pki verify-pki \
+--user operator --password-env OPERATOR_PASSWORD")]
     Verify(VerifyArgs),
 }
 
@@ -160,12 +162,17 @@ struct VerifyArgs {
     /// Print the report as one JSON object on stdout (for CI).
     #[arg(long)]
     json: bool,
-    /// SecurityPolicy of the endpoint: None, Basic256Sha256, Aes128Sha256RsaOaep or Aes256Sha256RsaPss.
-    #[arg(long, default_value = "None")]
+    /// SecurityPolicy of the endpoint: Basic256Sha256, Aes128Sha256RsaOaep or Aes256Sha256RsaPss (None
+    /// only through --insecure).
+    #[arg(long, default_value = "Basic256Sha256")]
     security_policy: String,
-    /// MessageSecurityMode of the endpoint: None, Sign or SignAndEncrypt.
-    #[arg(long, default_value = "None")]
+    /// MessageSecurityMode of the endpoint: Sign or SignAndEncrypt (None only through --insecure).
+    #[arg(long, default_value = "SignAndEncrypt")]
     security_mode: String,
+    /// Connect without signing or encryption (SecurityPolicy None, MessageSecurityMode None): for a server
+    /// on loopback that offers nothing else. Everything read and the password cross the network in clear.
+    #[arg(long, conflicts_with_all = ["security_policy", "security_mode"])]
+    insecure: bool,
     /// The client's PKI folder (its own certificate, created on first use; trusted and rejected server
     /// certificates). Default: nodeset-compiler-verify-pki in the temporary folder.
     #[arg(long, value_name = "DIR")]
@@ -309,10 +316,23 @@ fn verify_command(args: &VerifyArgs) -> ExitCode {
         },
         _ => None,
     };
+    let (security_policy, security_mode) = if args.insecure {
+        eprintln!("warning: --insecure: verify connects without signing or encryption");
+        ("None".to_owned(), "None".to_owned())
+    } else if args.security_policy == "None" || args.security_mode == "None" {
+        eprintln!(
+            "error: --security-policy {} with --security-mode {}: an unsecured connection is asked for with --insecure, \
+             nothing else turns security off",
+            args.security_policy, args.security_mode
+        );
+        return ExitCode::from(CANNOT_VERIFY);
+    } else {
+        (args.security_policy.clone(), args.security_mode.clone())
+    };
     let connect = Connect {
         url: args.url.clone(),
-        security_policy: args.security_policy.clone(),
-        security_mode: args.security_mode.clone(),
+        security_policy,
+        security_mode,
         user,
         pki_dir: args.pki.clone().unwrap_or_else(|| std::env::temp_dir().join("nodeset-compiler-verify-pki")),
         trust_server_cert: args.trust_server_cert,

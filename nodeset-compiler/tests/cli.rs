@@ -59,6 +59,24 @@ fn verify_refuses_an_unknown_security_mode_and_a_missing_password() {
 }
 
 #[test]
+fn verify_turns_security_off_only_through_insecure() {
+    // Secure by default: None is refused in either option and only `--insecure` asks for it.
+    for args in [["--security-policy", "None"], ["--security-mode", "None"]] {
+        let output = run(&[&["verify", "opc.tcp://127.0.0.1:1/"][..], &args[..]].concat());
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains("an unsecured connection is asked for with --insecure"), "{args:?}: {stderr}");
+    }
+    let output = run(&["verify", "opc.tcp://127.0.0.1:1/", "--insecure", "--security-mode", "Sign"]);
+    assert_eq!(output.status.code(), Some(2), "{}", String::from_utf8_lossy(&output.stderr));
+    let url = format!("opc.tcp://127.0.0.1:{}/", free_port());
+    let output = run(&["verify", &url, "--insecure"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(stderr.starts_with("warning: --insecure: verify connects without signing or encryption\n"), "{stderr}");
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+}
+
+#[test]
 fn the_codes_table_lists_the_verify_codes() {
     let output = run(&["codes", "NS0401", "NS0409"]);
     let stdout = String::from_utf8_lossy(&output.stdout);

@@ -174,11 +174,8 @@ fn the_robot_example_verifies_clean_over_sign_and_encrypt_with_a_user() {
     command.args(["--port", "0", "--pki", server_pki.to_str().unwrap(), "--users", users_file.to_str().unwrap(), "--trust-on-first-use"]);
     let server = Server::spawn(command);
     let url = server.urls(1).remove(0);
+    // No security options: verify connects over Basic256Sha256 SignAndEncrypt by default.
     let secure = [
-        "--security-policy",
-        "Basic256Sha256",
-        "--security-mode",
-        "SignAndEncrypt",
         "--user",
         "op",
         "--password-env",
@@ -197,6 +194,9 @@ fn the_robot_example_verifies_clean_over_sign_and_encrypt_with_a_user() {
     let rejected: Vec<PathBuf> =
         std::fs::read_dir(client_pki.join("rejected")).expect("the refused certificate is in rejected/").map(|e| e.unwrap().path()).collect();
     assert_eq!(rejected.len(), 1, "{rejected:?}");
+    // The message says where the certificate is and what to do with it.
+    assert!(stderr.contains(&format!("the server's certificate is not trusted; it was put in {}", rejected[0].display())), "{stderr}");
+    assert!(stderr.contains(&format!("move it to {}", client_pki.join("trusted").display())), "{stderr}");
     let trusted = client_pki.join("trusted");
     std::fs::create_dir_all(&trusted).unwrap();
     std::fs::rename(&rejected[0], trusted.join(rejected[0].file_name().unwrap())).unwrap();
@@ -217,7 +217,7 @@ fn the_robot_example_verifies_clean_over_none() {
     command.args(["--port", "0", "--insecure", "--pki", pki.to_str().unwrap()]);
     let server = Server::spawn(command);
     let url = server.urls(1).remove(0);
-    assert_clean(&url, &[], &[]);
+    assert_clean(&url, &["--insecure"], &[]);
     drop(server);
     let _ = std::fs::remove_dir_all(&pki);
 }
@@ -229,7 +229,7 @@ fn the_robot_cell_verifies_clean() {
     command.args(["--port", "0", "--insecure", "--pki", pki.to_str().unwrap()]);
     let server = Server::spawn(command);
     for url in server.urls(3) {
-        assert_clean(&url, &[], &[]);
+        assert_clean(&url, &["--insecure"], &[]);
     }
     drop(server);
     let _ = std::fs::remove_dir_all(&pki);
@@ -261,7 +261,7 @@ fn a_node_opcua_server_with_planted_defects() {
     let server = Server::spawn(command);
     let url = server.urls(1).remove(0);
     let models = models();
-    let args: Vec<&str> = models.iter().map(String::as_str).collect();
+    let args: Vec<&str> = models.iter().map(String::as_str).chain(["--insecure"]).collect();
     let (output, json) = verify(&url, &args, &[]);
     let stderr = String::from_utf8_lossy(&output.stderr);
     eprintln!("{json}\n{stderr}");
@@ -312,7 +312,7 @@ fn a_server_namespace_without_a_nodeset_is_reported() {
     for file in ["Opc.Ua.NodeSet2.xml", "Opc.Ua.Di.NodeSet2.xml"] {
         std::fs::copy(vendor().join(file), models.join(file)).unwrap();
     }
-    let (output, json) = verify(&url, &["--models", models.to_str().unwrap()], &[]);
+    let (output, json) = verify(&url, &["--models", models.to_str().unwrap(), "--insecure"], &[]);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert_eq!(output.status.code(), Some(1), "an incomplete check must fail: {json}\n{stderr}");
     assert!(json.contains("\"unknown_namespaces\":[") && json.contains("http://opcfoundation.org/UA/Robotics/"), "{json}");

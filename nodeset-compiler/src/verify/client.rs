@@ -27,8 +27,6 @@ use tokio::io::{ReadHalf, WriteHalf};
 use tokio::net::TcpStream;
 use tokio_util::codec::FramedRead;
 
-
-
 /// How to reach the server.
 #[derive(Clone, Debug)]
 pub struct Connect {
@@ -114,6 +112,7 @@ pub async fn snapshot(connect: &Connect) -> Result<Snapshot, ClientError> {
             ))
         })?;
     endpoint.endpoint_url = connect.url.as_str().into();
+    let server_certificate = endpoint.server_certificate.as_ref().to_vec();
     let (session, event_loop) = client
         .session_builder()
         .with_endpoints(endpoints)
@@ -127,12 +126,31 @@ pub async fn snapshot(connect: &Connect) -> Result<Snapshot, ClientError> {
     let connected = tokio::time::timeout(Duration::from_secs(10), session.wait_for_connection()).await;
     if connected != Ok(true) {
         event_loop.abort();
-        return Err(ClientError(format!("cannot connect to {} (no session within 10 s)", connect.url)));
+        let mut message = format!("cannot connect to {} (no session within 10 s)", connect.url);
+        if let Some(path) = rejected_copy(&connect.pki_dir, &server_certificate) {
+            message.push_str(&format!(
+                "\n  = note: the server's certificate is not trusted; it was put in {}\n  = help: check it (its thumbprint, \
+                 with the server's operator) and move it to {}, then run again",
+                path.display(),
+                connect.pki_dir.join("trusted").display()
+            ));
+        }
+        return Err(ClientError(message));
     }
     let result = read_all(&session).await;
     let _ = session.disconnect().await;
     let _ = tokio::time::timeout(Duration::from_secs(5), event_loop).await;
     result
+}
+
+/// The file in the PKI's `rejected/` folder that holds `certificate` (DER), if the client refused it.
+fn rejected_copy(pki_dir: &std::path::Path, certificate: &[u8]) -> Option<PathBuf> {
+    if certificate.is_empty() {
+        return None;
+    }
+    let mut files: Vec<PathBuf> = std::fs::read_dir(pki_dir.join("rejected")).ok()?.filter_map(|e| e.ok().map(|e| e.path())).collect();
+    files.sort();
+    files.into_iter().find(|f| std::fs::read(f).is_ok_and(|bytes| bytes == certificate))
 }
 
 /// Reads the snapshot over an open session.
