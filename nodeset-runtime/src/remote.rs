@@ -60,6 +60,7 @@ use opcua::types::{
 use tokio::sync::{mpsc, Mutex};
 use tokio::task::JoinHandle;
 
+use crate::client::ClientConfig;
 use crate::typed::{Control, Parameters, ProgramState};
 
 /// How long a request to another server may take before its server counts as unreachable.
@@ -152,10 +153,16 @@ pub struct RemoteServer {
 impl RemoteServer {
     /// Opens a session (SecurityPolicy None, anonymous) to the server at `url` and reads its namespaces.
     pub async fn connect(url: &str) -> Result<RemoteServer, RemoteError> {
+        ClientConfig::new(url).application("nodeset-models composite skill", "urn:nodeset-models:composite-skill").connect().await
+    }
+
+    /// Opens the session `config` describes (what [`ClientConfig::connect`] does).
+    pub(crate) async fn open(config: &ClientConfig) -> Result<RemoteServer, RemoteError> {
+        let url = config.url.as_str();
         let connect_error = |s: StatusCode| RemoteError::Connect(url.to_owned(), s);
         let client = ClientBuilder::new()
-            .application_name("nodeset-models composite skill")
-            .application_uri("urn:nodeset-models:composite-skill")
+            .application_name(config.application_name.as_str())
+            .application_uri(config.application_uri.as_str())
             .pki_dir(std::env::temp_dir().join("nodeset-models-pki-remote"))
             .create_sample_keypair(false)
             .trust_server_certs(true)
@@ -166,14 +173,14 @@ impl RemoteServer {
         let (session, event_loop) = client
             .session_builder()
             .with_endpoints(endpoints)
-            .connect_to_matching_endpoint((url, SecurityPolicy::None.to_str(), MessageSecurityMode::None))
+            .connect_to_matching_endpoint((url, config.security_policy.to_str(), config.security_mode))
             .map_err(|e| connect_error(e.status()))?
-            .user_identity_token(IdentityToken::Anonymous)
+            .user_identity_token(config.identity.clone())
             .with_connector(NoDelay)
             .build(client.certificate_store().clone())
             .map_err(|e| connect_error(e.status()))?;
         let event_loop = event_loop.spawn();
-        let connected = tokio::time::timeout(Duration::from_secs(10), session.wait_for_connection()).await;
+        let connected = tokio::time::timeout(config.connect_timeout, session.wait_for_connection()).await;
         if connected != Ok(true) {
             event_loop.abort();
             return Err(connect_error(StatusCode::BadTimeout));
@@ -213,7 +220,7 @@ impl RemoteServer {
 }
 
 /// The forward hierarchical children of a node: (BrowseName, NodeId).
-async fn children(session: &Session, node: &NodeId) -> Result<Vec<(QualifiedName, NodeId)>, RemoteError> {
+pub(crate) async fn children(session: &Session, node: &NodeId) -> Result<Vec<(QualifiedName, NodeId)>, RemoteError> {
     let description = BrowseDescription {
         node_id: node.clone(),
         browse_direction: BrowseDirection::Forward,
@@ -238,6 +245,11 @@ async fn children(session: &Session, node: &NodeId) -> Result<Vec<(QualifiedName
         point = r.continuation_point;
     }
     Ok(out)
+}
+
+/// The node at `path` (see [`RemoteServer::find`]) below `start`.
+pub(crate) async fn find_below(session: &Session, start: &NodeId, path: &str) -> Result<NodeId, RemoteError> {
+    find_path(session, start, path).await
 }
 
 async fn find_path(session: &Session, start: &NodeId, path: &str) -> Result<NodeId, RemoteError> {
@@ -268,7 +280,7 @@ async fn find_path(session: &Session, start: &NodeId, path: &str) -> Result<Node
 }
 
 /// The segments of a browse path: split at `/`, except inside `{uri}`.
-fn segments(path: &str) -> Vec<&str> {
+pub(crate) fn segments(path: &str) -> Vec<&str> {
     let mut out = Vec::new();
     let (mut start, mut depth) = (0, 0usize);
     for (i, c) in path.char_indices() {
