@@ -52,7 +52,7 @@ use nodeset_models::models::robotics::objects::{AxisType, MotionDeviceSystemType
 use nodeset_models::models;
 use nodeset_examples::describe::{describe, nameplate};
 use nodeset_examples::secure::{SecureArgs, USAGE};
-use nodeset_models::runtime::remote::{ClientSecurity, RemoteServer};
+use nodeset_models::runtime::client::ClientConfig;
 use nodeset_models::runtime::server::users::random_password;
 use nodeset_models::runtime::server::{security, ModelServer as Server, Role, ServerConfig};
 use nodeset_models::runtime::typed::{Control, Program};
@@ -259,10 +259,10 @@ fn frame(x: f64, y: f64, z: f64) -> ThreeDFrame {
 }
 
 /// The cell: DrillHole and ReferenceDrillBush, composed of the skills of the robot and the drilling unit.
-async fn cell(server: &Server, robot_url: &str, unit_url: &str, client: &ClientSecurity) -> Result<Vec<Program>, String> {
+async fn cell(server: &Server, robot_url: &str, unit_url: &str, client: &ClientConfig) -> Result<Vec<Program>, String> {
     let e = |e: nodeset_models::runtime::remote::RemoteError| e.to_string();
-    let robot = RemoteServer::connect_secure(robot_url, client).await.map_err(e)?;
-    let unit = RemoteServer::connect_secure(unit_url, client).await.map_err(e)?;
+    let robot = client.connect(robot_url).await.map_err(e)?;
+    let unit = client.connect(unit_url).await.map_err(e)?;
     let skills = format!("{SYSTEM}/{CONTROLLER_SKILLS}");
     let relative = Arc::new(robot.skill(&format!("{skills}/RelativeCartesianLinearMove")).await.map_err(e)?);
     let absolute = Arc::new(robot.skill(&format!("{skills}/AbsoluteCartesianLinearMove")).await.map_err(e)?);
@@ -329,8 +329,10 @@ async fn run(o: Options) -> Result<(), String> {
     // cell provisions the trust both ways, as an administrator would by moving certificates into trusted/.
     let password = random_password();
     let client_pki = pki(&o.secure, "cell-client");
-    let client = ClientSecurity::new(&client_pki).user("cell", password.clone());
-    let client_cert = security::prepare_pki(&client_pki, "nodeset-models composite skill", &client.application_uri, &[])
+    let client = ClientConfig::new(&client_pki)
+        .application("nodeset-models composite skill", "urn:nodeset-models:composite-skill")
+        .user("cell", password.clone());
+    let client_cert = security::prepare_pki(&client_pki, &client.application_name, &client.application_uri, &[])
         .map_err(|e| e.to_string())?
         .cert;
     let device = |name: &str, port: u16, sub: &str| -> Result<Server, String> {

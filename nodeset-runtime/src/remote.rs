@@ -53,13 +53,14 @@ use opcua::client::{ClientBuilder, IdentityToken, MonitoredItem, Session, Subscr
 use opcua::crypto::SecurityPolicy;
 use opcua::types::{
     AttributeId, BrowseDescription, BrowseDirection, BrowseResultMask, ContentFilter, DataValue, EventFilter,
-    ExtensionObject, MessageSecurityMode, MonitoredItemCreateRequest, MonitoringMode,
+    ExtensionObject, MonitoredItemCreateRequest, MonitoringMode,
     MonitoringParameters, NodeClassMask, NodeId, ObjectId, ObjectTypeId, QualifiedName, ReadValueId,
     ReferenceTypeId, SimpleAttributeOperand, StatusCode, TimestampsToReturn, Variant, WriteValue,
 };
 use tokio::sync::{mpsc, Mutex};
 use tokio::task::JoinHandle;
 
+use crate::client::ClientConfig;
 use crate::typed::{Control, Parameters, ProgramState};
 
 /// How long a request to another server may take before its server counts as unreachable.
@@ -145,63 +146,6 @@ fn connect_no_delay(url: String, options: DecodingOptions) -> Connecting {
     })
 }
 
-/// How a composite skill's client connects: security policy and mode, user, PKI folder.
-#[derive(Clone, Debug)]
-pub struct ClientSecurity {
-    /// The security policy (Basic256Sha256 by default).
-    pub policy: SecurityPolicy,
-    /// The message security mode (SignAndEncrypt by default).
-    pub mode: MessageSecurityMode,
-    /// User name and password; `None` connects anonymously.
-    pub user: Option<(String, String)>,
-    /// The client's PKI folder: its certificate (`own/cert.der`, created on first use) and the server
-    /// certificates it trusts (`trusted/`). Defaults to a folder in the temporary directory.
-    pub pki_dir: Option<std::path::PathBuf>,
-    /// The ApplicationUri of the client, which its certificate carries.
-    pub application_uri: String,
-    /// Trusts an unknown server certificate on first use (development only).
-    pub trust_server_on_first_use: bool,
-}
-
-impl ClientSecurity {
-    /// Basic256Sha256, SignAndEncrypt, anonymous, with its PKI folder at `pki_dir`.
-    pub fn new(pki_dir: impl Into<std::path::PathBuf>) -> ClientSecurity {
-        ClientSecurity {
-            policy: SecurityPolicy::Basic256Sha256,
-            mode: MessageSecurityMode::SignAndEncrypt,
-            user: None,
-            pki_dir: Some(pki_dir.into()),
-            application_uri: "urn:nodeset-models:composite-skill".to_owned(),
-            trust_server_on_first_use: false,
-        }
-    }
-
-    /// SecurityPolicy None, anonymous: for servers started with `insecure`.
-    pub fn none() -> ClientSecurity {
-        ClientSecurity {
-            policy: SecurityPolicy::None,
-            mode: MessageSecurityMode::None,
-            user: None,
-            pki_dir: None,
-            application_uri: "urn:nodeset-models:composite-skill".to_owned(),
-            trust_server_on_first_use: false,
-        }
-    }
-
-    /// Sets the user name and password.
-    pub fn user(mut self, name: impl Into<String>, password: impl Into<String>) -> ClientSecurity {
-        self.user = Some((name.into(), password.into()));
-        self
-    }
-
-    /// Sets the policy and mode.
-    pub fn policy(mut self, policy: SecurityPolicy, mode: MessageSecurityMode) -> ClientSecurity {
-        self.policy = policy;
-        self.mode = mode;
-        self
-    }
-}
-
 /// A session to another server.
 pub struct RemoteServer {
     session: Arc<Session>,
@@ -211,35 +155,31 @@ pub struct RemoteServer {
 
 impl RemoteServer {
     /// Opens a session with SecurityPolicy None and no user (anonymous) to the server at `url` and reads its
-    /// namespaces: only for servers started with `insecure`, on loopback. Use [`RemoteServer::connect_secure`]
-    /// otherwise.
+    /// namespaces: only for servers started with `insecure`, on loopback. Connect with
+    /// [`ClientConfig::connect`] otherwise (Basic256Sha256 SignAndEncrypt, a user, a PKI folder).
     pub async fn connect(url: &str) -> Result<RemoteServer, RemoteError> {
-        RemoteServer::open(url, &ClientSecurity::none()).await
+        ClientConfig::insecure().connect(url).await
     }
 
-    /// Opens a session as `security` says (policy, mode, user, PKI folder), verifying the server's
-    /// certificate against the `trusted/` folder of the client's PKI folder, and reads the namespaces.
-    pub async fn connect_secure(url: &str, security: &ClientSecurity) -> Result<RemoteServer, RemoteError> {
-        RemoteServer::open(url, security).await
-    }
-
-    async fn open(url: &str, security: &ClientSecurity) -> Result<RemoteServer, RemoteError> {
+    /// Opens the session `config` describes to the server at `url` (what [`ClientConfig::connect`] does):
+    /// on a secure policy the client's certificate is created in its PKI folder on first use, and the
+    /// server's certificate must be in `trusted/` (an unknown one is refused and written to `rejected/`).
+    pub(crate) async fn open(url: &str, config: &ClientConfig) -> Result<RemoteServer, RemoteError> {
         let connect_error = |s: StatusCode| RemoteError::Connect(url.to_owned(), s);
-        let secure = security.policy != SecurityPolicy::None;
-        let pki = security.pki_dir.clone().unwrap_or_else(|| std::env::temp_dir().join("nodeset-models-pki-remote"));
+        let secure = config.policy != SecurityPolicy::None;
         if secure {
-            crate::server::security::prepare_pki(&pki, "nodeset-models composite skill", &security.application_uri, &[])
+            crate::server::security::prepare_pki(&config.pki_dir, &config.application_name, &config.application_uri, &[])
                 .map_err(|e| RemoteError::Pki(e.to_string()))?;
         }
         let client = ClientBuilder::new()
-            .application_name("nodeset-models composite skill")
-            .application_uri(&security.application_uri)
-            .product_uri(&security.application_uri)
-            .pki_dir(pki)
+            .application_name(config.application_name.as_str())
+            .application_uri(config.application_uri.as_str())
+            .product_uri(config.application_uri.as_str())
+            .pki_dir(config.pki_dir.clone())
             .create_sample_keypair(false)
             .certificate_path("own/cert.der")
             .private_key_path("private/private.pem")
-            .trust_server_certs(!secure || security.trust_server_on_first_use)
+            .trust_server_certs(!secure || config.trust_server_on_first_use)
             .verify_server_certs(secure)
             .session_retry_limit(3)
             .client()
@@ -248,9 +188,9 @@ impl RemoteServer {
         let (session, event_loop) = client
             .session_builder()
             .with_endpoints(endpoints)
-            .connect_to_matching_endpoint((url, security.policy.to_str(), security.mode))
+            .connect_to_matching_endpoint((url, config.policy.to_str(), config.mode))
             .map_err(|e| connect_error(e.status()))?
-            .user_identity_token(match &security.user {
+            .user_identity_token(match &config.user {
                 Some((user, password)) => IdentityToken::new_user_name(user.clone(), opcua::client::Password::new(password.clone())),
                 None => IdentityToken::Anonymous,
             })
@@ -258,7 +198,7 @@ impl RemoteServer {
             .build(client.certificate_store().clone())
             .map_err(|e| connect_error(e.status()))?;
         let event_loop = event_loop.spawn();
-        let connected = tokio::time::timeout(Duration::from_secs(10), session.wait_for_connection()).await;
+        let connected = tokio::time::timeout(config.connect_timeout, session.wait_for_connection()).await;
         if connected != Ok(true) {
             event_loop.abort();
             return Err(connect_error(StatusCode::BadTimeout));
@@ -298,7 +238,7 @@ impl RemoteServer {
 }
 
 /// The forward hierarchical children of a node: (BrowseName, NodeId).
-async fn children(session: &Session, node: &NodeId) -> Result<Vec<(QualifiedName, NodeId)>, RemoteError> {
+pub(crate) async fn children(session: &Session, node: &NodeId) -> Result<Vec<(QualifiedName, NodeId)>, RemoteError> {
     let description = BrowseDescription {
         node_id: node.clone(),
         browse_direction: BrowseDirection::Forward,
@@ -323,6 +263,11 @@ async fn children(session: &Session, node: &NodeId) -> Result<Vec<(QualifiedName
         point = r.continuation_point;
     }
     Ok(out)
+}
+
+/// The node at `path` (see [`RemoteServer::find`]) below `start`.
+pub(crate) async fn find_below(session: &Session, start: &NodeId, path: &str) -> Result<NodeId, RemoteError> {
+    find_path(session, start, path).await
 }
 
 async fn find_path(session: &Session, start: &NodeId, path: &str) -> Result<NodeId, RemoteError> {
@@ -353,7 +298,7 @@ async fn find_path(session: &Session, start: &NodeId, path: &str) -> Result<Node
 }
 
 /// The segments of a browse path: split at `/`, except inside `{uri}`.
-fn segments(path: &str) -> Vec<&str> {
+pub(crate) fn segments(path: &str) -> Vec<&str> {
     let mut out = Vec::new();
     let (mut start, mut depth) = (0, 0usize);
     for (i, c) in path.char_indices() {
