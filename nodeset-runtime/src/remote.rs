@@ -49,7 +49,7 @@ use tokio::io::{ReadHalf, WriteHalf};
 use tokio::net::TcpStream;
 use tokio_util::codec::FramedRead;
 
-use opcua::client::{ClientBuilder, IdentityToken, MonitoredItem, Session, SubscriptionCallbacks};
+use opcua::client::{ClientBuilder, IdentityToken, MonitoredItem, Session, SessionPollResult, SubscriptionCallbacks};
 use opcua::crypto::SecurityPolicy;
 use opcua::types::{
     AttributeId, BrowseDescription, BrowseDirection, BrowseResultMask, ContentFilter, DataValue, EventFilter,
@@ -197,11 +197,23 @@ impl RemoteServer {
             .with_connector(NoDelay)
             .build(client.certificate_store().clone())
             .map_err(|e| connect_error(e.status()))?;
-        let event_loop = event_loop.spawn();
-        let connected = tokio::time::timeout(config.connect_timeout, session.wait_for_connection()).await;
-        if connected != Ok(true) {
+        // The event loop, driven here so that a failed attempt is seen: a wrong password or a refused
+        // certificate is answered with its own status at once, not with BadTimeout after the retries.
+        let (failed_tx, mut failed) = tokio::sync::watch::channel(None::<StatusCode>);
+        let event_loop = tokio::spawn(drive(event_loop.enter(), failed_tx));
+        let outcome = tokio::time::timeout(config.connect_timeout, async {
+            tokio::select! {
+                connected = session.wait_for_connection() => if connected { Ok(()) } else { Err(StatusCode::BadNotConnected) },
+                refused = failed.wait_for(|f| f.is_some_and(refused_for_good)) => {
+                    Err(refused.ok().and_then(|f| *f).unwrap_or(StatusCode::BadNotConnected))
+                }
+            }
+        })
+        .await;
+        let outcome = outcome.unwrap_or_else(|_| Err(failed.borrow().unwrap_or(StatusCode::BadTimeout)));
+        if let Err(status) = outcome {
             event_loop.abort();
-            return Err(connect_error(StatusCode::BadTimeout));
+            return Err(connect_error(status));
         }
         session.read_namespace_array().await.map_err(|e| connect_error(e.status()))?;
         Ok(RemoteServer { session, event_loop, url: url.to_owned() })
@@ -235,6 +247,45 @@ impl RemoteServer {
         let _ = self.session.disconnect().await;
         let _ = tokio::time::timeout(Duration::from_secs(5), self.event_loop).await;
     }
+}
+
+/// Polls a session's event loop until it ends (its status), telling `failed` the status of each attempt to
+/// (re)connect that failed.
+async fn drive<S>(events: S, failed: tokio::sync::watch::Sender<Option<StatusCode>>) -> StatusCode
+where
+    S: futures_core::Stream<Item = Result<SessionPollResult, StatusCode>> + Send + 'static,
+{
+    let mut events = Box::pin(events);
+    loop {
+        match std::future::poll_fn(|cx| events.as_mut().poll_next(cx)).await {
+            Some(Ok(SessionPollResult::ReconnectFailed(status))) => {
+                failed.send_replace(Some(status));
+            }
+            Some(Ok(_)) => {}
+            Some(Err(status)) => break status,
+            None => break StatusCode::Good,
+        }
+    }
+}
+
+/// Whether a failed attempt to open a session will fail again however often it is retried: the server
+/// refused the user or a certificate, or the security checks failed (a network error may pass).
+fn refused_for_good(status: StatusCode) -> bool {
+    [
+        StatusCode::BadUserAccessDenied,
+        StatusCode::BadIdentityTokenInvalid,
+        StatusCode::BadIdentityTokenRejected,
+        StatusCode::BadSecurityChecksFailed,
+        StatusCode::BadSecurityPolicyRejected,
+        StatusCode::BadCertificateInvalid,
+        StatusCode::BadCertificateUntrusted,
+        StatusCode::BadCertificateUriInvalid,
+        StatusCode::BadCertificateTimeInvalid,
+        StatusCode::BadCertificateRevoked,
+        StatusCode::BadCertificateUseNotAllowed,
+        StatusCode::BadCertificateHostNameInvalid,
+    ]
+    .contains(&status)
 }
 
 /// The forward hierarchical children of a node: (BrowseName, NodeId).

@@ -150,7 +150,10 @@ impl ClientConfig {
         self
     }
 
-    /// Opens a session to the server at `url` (`opc.tcp://host:port/`) and reads its namespaces.
+    /// Opens a session to the server at `url` (`opc.tcp://host:port/`) and reads its namespaces. A refusal
+    /// that retrying cannot change (the user, or a certificate: `BadIdentityTokenRejected`,
+    /// `BadCertificateUntrusted`, ...) fails at once with its status; a server that does not answer fails
+    /// after `connect_timeout` with the status of the last attempt.
     pub async fn connect(&self, url: &str) -> Result<RemoteServer, RemoteError> {
         RemoteServer::open(url, self).await
     }
@@ -664,4 +667,21 @@ async fn is_subtype(session: &Session, ty: &NodeId, ancestor: &NodeId) -> Result
         }
     }
     Ok(false)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_client_config_is_secure_by_default_and_does_not_show_the_password() {
+        let config = ClientConfig::new("pki/client").user("op", "s3cret-pass");
+        assert_eq!((config.policy, config.mode), (SecurityPolicy::Basic256Sha256, MessageSecurityMode::SignAndEncrypt));
+        assert!(!config.trust_server_on_first_use);
+        assert_eq!(config.pki_dir, PathBuf::from("pki/client"));
+        let shown = format!("{config:?}");
+        assert!(shown.contains("\"op\"") && !shown.contains("s3cret-pass"), "{shown}");
+        let none = ClientConfig::insecure();
+        assert_eq!((none.policy, none.mode, none.user), (SecurityPolicy::None, MessageSecurityMode::None, None));
+    }
 }
