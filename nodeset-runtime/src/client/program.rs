@@ -3,10 +3,10 @@
 //! program type (every skill) a run with its typed inputs awaited to its typed outputs.
 
 use std::collections::BTreeMap;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use opcua::client::{DataChangeCallback, MonitoredItem};
+use opcua::client::{DataChangeCallback, MonitoredItem, Session};
 use opcua::types::{
     AttributeId, DataValue, MonitoredItemCreateRequest, MonitoringMode, MonitoringParameters, NodeId, ReadValueId,
     StatusCode, TimestampsToReturn, Variant, WriteValue,
@@ -14,8 +14,8 @@ use opcua::types::{
 use tokio::sync::watch;
 
 use super::{call, read_values, service, translate, ClientError, Remote};
-use crate::remote::RemoteServer;
-use crate::typed::{Parameters, ProgramType, StateMachine, StateRow};
+use crate::remote::{RemoteError, RemoteServer};
+use crate::typed::{Control, Parameters, ProgramState, ProgramType, StateMachine, StateRow};
 
 /// The ns0 namespace URI (CurrentState, the program methods).
 const UA: &str = "http://opcfoundation.org/UA/";
@@ -119,17 +119,20 @@ impl<M: StateMachine> RemoteMachine<M> {
             what: format!("{} has no method `{name}` that causes a transition", M::BROWSE_NAME),
             status: StatusCode::BadMethodInvalid,
         })?;
-        let known = self.methods.lock().unwrap_or_else(|e| e.into_inner()).get(method).cloned();
-        let node = match known {
-            Some(n) => n,
-            None => {
-                let found = translate(&self.remote.session, &self.remote.node, &[vec![(uri, method.to_owned())]]).await?.remove(0);
-                let n = found.map_err(|status| ClientError::Status { what: format!("method {method} of {}", self.remote.node), status })?;
-                self.methods.lock().unwrap_or_else(|e| e.into_inner()).insert(method, n.clone());
-                n
-            }
-        };
+        let node = self.method_node(uri, method).await?;
         call::<(), ()>(&self.remote.session, &self.remote.node, &node, method, ()).await
+    }
+
+    /// The NodeId of a method of the instance (translated once, then kept).
+    async fn method_node(&self, uri: &'static str, method: &'static str) -> Result<NodeId, ClientError> {
+        let known = self.methods.lock().unwrap_or_else(|e| e.into_inner()).get(method).cloned();
+        if let Some(n) = known {
+            return Ok(n);
+        }
+        let found = translate(&self.remote.session, &self.remote.node, &[vec![(uri, method.to_owned())]]).await?.remove(0);
+        let n = found.map_err(|status| ClientError::Status { what: format!("method {method} of {}", self.remote.node), status })?;
+        self.methods.lock().unwrap_or_else(|e| e.into_inner()).insert(method, n.clone());
+        Ok(n)
     }
 }
 
@@ -180,7 +183,12 @@ impl<P: ProgramType> RemoteProgram<P> {
 
     /// Writes the inputs to `InputParameterSet` (one translation, one Write) and calls Start.
     pub async fn start(&self, inputs: P::Inputs) -> Result<(), ClientError> {
-        let values = inputs.into_values();
+        self.write_inputs(inputs.into_values()).await?;
+        self.cause("Start").await
+    }
+
+    /// Writes the values of the inputs (`None`: left as they are) to `InputParameterSet`.
+    async fn write_inputs(&self, values: Vec<Option<Variant>>) -> Result<(), ClientError> {
         if let Some(set) = <P::Inputs as Parameters>::SET {
             let mut paths = Vec::new();
             let mut chosen = Vec::new();
@@ -208,7 +216,7 @@ impl<P: ProgramType> RemoteProgram<P> {
                 }
             }
         }
-        self.cause("Start").await
+        Ok(())
     }
 
     /// Starts the program with `inputs` and waits until the run ends: its outputs when it ends in Ready,
@@ -280,5 +288,173 @@ impl<P: ProgramType> RemoteProgram<P> {
     /// Calls Reset.
     pub async fn reset(&self) -> Result<(), ClientError> {
         self.cause("Reset").await
+    }
+}
+
+/// How long a request to another server may take before its server counts as unreachable.
+const REQUEST_TIMEOUT: Duration = Duration::from_secs(3);
+/// How long a step waits for a change of CurrentState before it reads the state itself.
+const LIVENESS: Duration = Duration::from_secs(1);
+
+/// The program state of a row of a program's state table.
+fn program_state(row: Option<&'static StateRow>) -> Option<ProgramState> {
+    let name = row?.name;
+    [ProgramState::Ready, ProgramState::Running, ProgramState::Suspended, ProgramState::Halted].into_iter().find(|s| s.name() == name)
+}
+
+/// The status a composite halts with when a step cannot start: `None` when the server is unreachable
+/// (the composite suspends and tries again), the refusal otherwise.
+fn refusal(e: &ClientError) -> Option<StatusCode> {
+    match e {
+        ClientError::Status { status, .. } | ClientError::Arguments { status, .. } => Some(*status),
+        ClientError::Halted { cause, .. } => Some(*cause),
+        ClientError::Type { .. } | ClientError::WrongType { .. } => Some(StatusCode::BadTypeMismatch),
+        ClientError::UnknownNamespace(_) => Some(StatusCode::BadNoMatch),
+        ClientError::Remote(RemoteError::Path { .. } | RemoteError::Missing { .. } | RemoteError::Pki(_)) => Some(StatusCode::BadNoMatch),
+        ClientError::Remote(RemoteError::Service(..) | RemoteError::Connect(..)) | ClientError::Timeout(_) => None,
+    }
+}
+
+impl<P: ProgramType> RemoteProgram<P> {
+    /// Runs the program as a step of the composite skill whose body got `ctl` (see [`crate::remote`]):
+    /// writes the inputs, calls Start and follows the program until it ends. `Ok` when it ends in Ready; the
+    /// status the composite should halt with otherwise (its `Result` output if it halted, `BadInvalidState`
+    /// if it has none, `BadCommunicationError` if its server went away during the run, the refusal if
+    /// Start or an input was refused).
+    pub async fn run_step(&self, inputs: P::Inputs, ctl: &Control) -> Result<(), StatusCode> {
+        let values = inputs.into_values();
+        let name = P::BROWSE_NAME;
+        let halt = match P::TABLE.causes().into_iter().find(|(_, m)| *m == "Halt") {
+            Some((uri, method)) => match self.method_node(uri, method).await {
+                Ok(node) => Some(node),
+                Err(e) => match refusal(&e) {
+                    Some(status) => return Err(status),
+                    // Unreachable now: the Start below suspends the composite, and Halt is found later.
+                    None => None,
+                },
+            },
+            None => None,
+        };
+        let mut seen = self.machine.seen.clone();
+        // Start; a server that cannot be reached suspends the composite until a client resumes it.
+        let before = loop {
+            ctl.checkpoint().await;
+            let before = seen.borrow_and_update().0;
+            let started = async {
+                self.write_inputs(values.clone()).await?;
+                self.cause("Start").await
+            };
+            let error = match tokio::time::timeout(REQUEST_TIMEOUT, started).await {
+                Ok(Ok(())) => break before,
+                Ok(Err(e)) => e,
+                Err(_) => ClientError::Timeout(format!("Start of {name}")),
+            };
+            if let Some(status) = refusal(&error) {
+                return Err(status);
+            }
+            tracing::warn!("skill {name} is unavailable ({error}); the composite suspends");
+            let _ = ctl.suspend();
+        };
+        // From here on, dropping this future (a Halt or Reset of the composite) halts the program.
+        let halt = match halt {
+            Some(h) => Some(h),
+            None => self.method_node(UA, "Halt").await.ok(),
+        };
+        let guard = HaltOnDrop { call: halt.map(|h| (self.remote.session.clone(), self.remote.node.clone(), h)) };
+        let mut composite = ctl.watch();
+        let mut basic = ProgramState::Running;
+        // Without a change of CurrentState for a while, it is read: that finds a server that went away (the
+        // composite halts: what the program did is unknown) and a change whose notification was lost.
+        let mut quiet = tokio::time::interval_at(tokio::time::Instant::now() + LIVENESS, LIVENESS);
+        let outcome = loop {
+            tokio::select! {
+                changed = seen.changed() => {
+                    quiet.reset();
+                    if changed.is_err() {
+                        break Err(StatusCode::BadCommunicationError);
+                    }
+                    let (count, row) = *seen.borrow_and_update();
+                    // Notifications of the state before this run's Start are not its outcome.
+                    if count <= before {
+                        continue;
+                    }
+                    let Some(state) = program_state(row.map(|i| &P::TABLE.states[i])) else { continue };
+                    let was = std::mem::replace(&mut basic, state);
+                    match state {
+                        ProgramState::Ready => break Ok(()),
+                        ProgramState::Halted => break Err(self.halt_cause().await),
+                        // The program has just been suspended: the composite follows (once; a client may
+                        // resume the composite while the program stays suspended).
+                        ProgramState::Suspended if was != ProgramState::Suspended && ctl.state() == ProgramState::Running => {
+                            let _ = ctl.suspend();
+                        }
+                        _ => {}
+                    }
+                }
+                _ = quiet.tick() => {
+                    match tokio::time::timeout(REQUEST_TIMEOUT, self.state()).await {
+                        Ok(Ok(row)) => match program_state(row) {
+                            Some(ProgramState::Ready) => {
+                                tracing::warn!("skill {name} is Ready, but the change of its CurrentState did not arrive");
+                                break Ok(());
+                            }
+                            Some(ProgramState::Halted) => break Err(self.halt_cause().await),
+                            _ => {}
+                        },
+                        Ok(Err(e)) => {
+                            tracing::warn!("skill {name} cannot be read ({e}); the composite halts");
+                            break Err(StatusCode::BadCommunicationError);
+                        }
+                        Err(_) => {
+                            tracing::warn!("skill {name} does not answer; the composite halts");
+                            break Err(StatusCode::BadCommunicationError);
+                        }
+                    }
+                }
+                changed = composite.changed() => {
+                    if changed.is_err() {
+                        break Err(StatusCode::BadShutdown);
+                    }
+                    let now = *composite.borrow_and_update();
+                    // Where the program has no Suspend (an Optional method), it runs on; the composite
+                    // waits at its next checkpoint.
+                    match (now, basic) {
+                        (ProgramState::Suspended, ProgramState::Running) => {
+                            let _ = self.cause("Suspend").await;
+                        }
+                        (ProgramState::Running, ProgramState::Suspended) => {
+                            let _ = self.cause("Resume").await;
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        };
+        guard.disarm();
+        outcome
+    }
+}
+
+/// Halts a remote program if the step that started it is dropped before it ended.
+struct HaltOnDrop {
+    call: Option<(Arc<Session>, NodeId, NodeId)>,
+}
+
+impl HaltOnDrop {
+    fn disarm(mut self) {
+        self.call = None;
+    }
+}
+
+impl Drop for HaltOnDrop {
+    fn drop(&mut self) {
+        if let Some((session, node, halt)) = self.call.take() {
+            // Drop cannot wait; the call runs on its own (there is a runtime: the body was running on it).
+            if let Ok(rt) = tokio::runtime::Handle::try_current() {
+                rt.spawn(async move {
+                    let _ = session.call_one((node, halt, None::<Vec<Variant>>)).await;
+                });
+            }
+        }
     }
 }
