@@ -172,7 +172,17 @@ fn given(o: &Options) -> Result<ClientConfig, String> {
 async fn control(url: &str, config: &ClientConfig) -> Result<bool, String> {
     let e = |e: nodeset_models::runtime::client::ClientError| e.to_string();
     let robot = config.connect(url).await.map_err(|e| {
-        format!("{e} (a server certificate the client does not trust yet is in {}: move it to trusted/)", config.pki_dir.join("rejected").display())
+        let refused: Vec<_> = std::fs::read_dir(config.pki_dir.join("rejected"))
+            .map(|dir| dir.filter_map(Result::ok).map(|f| f.path()).collect())
+            .unwrap_or_default();
+        match refused.first() {
+            Some(cert) => format!(
+                "{e} (this client does not trust the server's certificate yet: to trust it, move {} to {})",
+                cert.display(),
+                config.pki_dir.join("trusted").display()
+            ),
+            None => format!("{e} (if the server does not trust this client yet, its certificate is in the server's rejected/ folder, to be moved to the server's trusted/)"),
+        }
     })?;
     let manipulator: Remote<MotionDeviceType> = robot.bind_path(&format!("{SYSTEM}/{MANIPULATOR}")).await.map_err(e)?;
     let serial = manipulator.read::<String, _>(&members::MotionDeviceType::SerialNumber).await.map_err(e)?;
