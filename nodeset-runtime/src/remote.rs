@@ -276,6 +276,12 @@ fn refused_for_good(status: StatusCode) -> bool {
 
 /// The forward hierarchical children of a node: (BrowseName, NodeId).
 pub(crate) async fn children(session: &Session, node: &NodeId) -> Result<Vec<(QualifiedName, NodeId)>, RemoteError> {
+    Ok(typed_children(session, node).await?.into_iter().map(|(name, id, _)| (name, id)).collect())
+}
+
+/// The forward hierarchical children of a node with their TypeDefinitions (null for a child without
+/// one), from one Browse (and BrowseNext while the server has more): (BrowseName, NodeId, TypeDefinition).
+pub(crate) async fn typed_children(session: &Session, node: &NodeId) -> Result<Vec<(QualifiedName, NodeId, NodeId)>, RemoteError> {
     let description = BrowseDescription {
         node_id: node.clone(),
         browse_direction: BrowseDirection::Forward,
@@ -289,14 +295,14 @@ pub(crate) async fn children(session: &Session, node: &NodeId) -> Result<Vec<(Qu
     if result.status_code.is_bad() {
         return Err(RemoteError::Service("Browse", result.status_code));
     }
-    let mut out: Vec<_> =
-        result.references.unwrap_or_default().into_iter().map(|r| (r.browse_name, r.node_id.node_id)).collect();
+    let row = |r: opcua::types::ReferenceDescription| (r.browse_name, r.node_id.node_id, r.type_definition.node_id);
+    let mut out: Vec<_> = result.references.unwrap_or_default().into_iter().map(row).collect();
     let mut point = result.continuation_point;
     while !point.is_null() {
         let mut next =
             session.browse_next(false, &[point.clone()]).await.map_err(|e| RemoteError::Service("BrowseNext", e.status()))?;
         let Some(r) = next.pop() else { break };
-        out.extend(r.references.unwrap_or_default().into_iter().map(|r| (r.browse_name, r.node_id.node_id)));
+        out.extend(r.references.unwrap_or_default().into_iter().map(row));
         point = r.continuation_point;
     }
     Ok(out)

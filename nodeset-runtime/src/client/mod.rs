@@ -419,14 +419,27 @@ impl<H: ObjectType> Remote<H> {
     }
 
     /// The instances of a placeholder below the member at `below` (`""`: the instance itself), bound as
-    /// `C` (children whose TypeDefinition is `C`'s type or a subtype), in BrowseName order.
+    /// `C` (children whose TypeDefinition is `C`'s type or a subtype), in BrowseName order: one Browse for
+    /// the children, and the supertypes of each distinct TypeDefinition (one Browse a level).
     pub async fn placeholders<C: ObjectType>(&self, below: &str) -> Result<Vec<(String, Remote<C>)>, ClientError> {
         let parent = if below.is_empty() { self.node.clone() } else { crate::remote::find_below(&self.session, &self.node, below).await? };
         let expected = resolve_id(&self.session, C::TYPE_ID)?;
         let mut out = Vec::new();
-        for (name, child) in crate::remote::children(&self.session, &parent).await? {
-            let Some(t) = type_definition(&self.session, &child).await? else { continue };
-            if is_subtype(&self.session, &t, &expected).await? {
+        // One Browse gives the children with their TypeDefinitions; each distinct type is checked once.
+        let mut verdicts: Vec<(NodeId, bool)> = Vec::new();
+        for (name, child, t) in crate::remote::typed_children(&self.session, &parent).await? {
+            if t.is_null() {
+                continue;
+            }
+            let fits = match verdicts.iter().find(|(known, _)| *known == t) {
+                Some((_, fits)) => *fits,
+                None => {
+                    let fits = is_subtype(&self.session, &t, &expected).await?;
+                    verdicts.push((t, fits));
+                    fits
+                }
+            };
+            if fits {
                 out.push((name.name.as_ref().to_owned(), Remote { session: self.session.clone(), node: child, resolved: Default::default(), _type: PhantomData }));
             }
         }
