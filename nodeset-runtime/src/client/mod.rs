@@ -13,7 +13,9 @@
 //!
 //! - [`ClientConfig`] is the one place where a connection is configured (security, identity, PKI folder);
 //! - [`RemoteServer::bind`] and [`RemoteServer::bind_path`] bind a [`Remote<H>`] to an instance by NodeId
-//!   or browse path, checking that its TypeDefinition is `H`'s type or a subtype of it;
+//!   or browse path, checking that its TypeDefinition is `H`'s type or a subtype of it (a path's segments
+//!   may leave out their namespace, so it is followed with one Browse a segment; member paths, whose
+//!   namespaces the markers carry, are translated in batches);
 //! - a member marker (`members::<Type>::<Path>`) names a variable: [`Remote::read`], [`Remote::write`],
 //!   [`Remote::subscribe`]; [`Remote::read_optional`] answers `None` for an Optional member the instance
 //!   lacks; [`Remote::read_selection`] reads any number of members with one TranslateBrowsePathsToNodeIds
@@ -21,7 +23,9 @@
 //! - [`Remote::call`] calls a method with typed arguments and outputs; a Bad status of the server is the
 //!   error, with the status of each argument when the server gives them;
 //! - [`Remote::placeholders`] enumerates the instances of a placeholder by browsing;
-//! - [`RemoteMachine`] and [`RemoteProgram`] follow state machines and run programs (every skill type).
+//! - [`RemoteMachine`] and [`RemoteProgram`] follow state machines and run programs (every skill type);
+//!   [`RemoteProgram::run_step`] runs one as a step of a composite skill (the rules are in
+//!   [`crate::remote`]).
 
 mod program;
 
