@@ -11,9 +11,10 @@
 //! - the **cell** (port P+2): `DrillingCell/SkillSet` with the composite skills `DrillHole` (move in by
 //!   `InsertionDistance`, drill, move out) and `ReferenceDrillBush` (approach the bush `ApproachDistance`
 //!   above `HolePosition`, move onto it, report the measured pose in `ReferencedHolePosition`). The cell
-//!   finds the basic skills on the other two servers by browse path and runs them through async-opcua's
-//!   client (`runtime::remote`): a basic skill that halts halts the composite, one that is suspended
-//!   suspends it, and a Halt of the composite halts the basic skill that runs.
+//!   finds the basic skills on the other two servers by browse path and runs them as typed clients
+//!   (`runtime::client::RemoteProgram::run_step`, with the composite semantics of `runtime::remote`): a
+//!   basic skill that halts halts the composite, one that is suspended suspends it, and a Halt of the
+//!   composite halts the basic skill that runs.
 //!
 //! Every server loads the same models (CommonSkills, RobotCell, DrillingProcess and what they require), so
 //! each shows the whole cell; it runs only its own device's skills. The skills of the other devices stay
@@ -52,7 +53,7 @@ use nodeset_models::models::robotics::objects::{AxisType, MotionDeviceSystemType
 use nodeset_models::models;
 use nodeset_examples::describe::{describe, nameplate};
 use nodeset_examples::secure::{SecureArgs, USAGE};
-use nodeset_models::runtime::remote::{ClientSecurity, RemoteServer};
+use nodeset_models::runtime::client::ClientConfig;
 use nodeset_models::runtime::server::users::random_password;
 use nodeset_models::runtime::server::{security, ModelServer as Server, Role, ServerConfig};
 use nodeset_models::runtime::typed::{Control, Program};
@@ -259,14 +260,16 @@ fn frame(x: f64, y: f64, z: f64) -> ThreeDFrame {
 }
 
 /// The cell: DrillHole and ReferenceDrillBush, composed of the skills of the robot and the drilling unit.
-async fn cell(server: &Server, robot_url: &str, unit_url: &str, client: &ClientSecurity) -> Result<Vec<Program>, String> {
-    let e = |e: nodeset_models::runtime::remote::RemoteError| e.to_string();
-    let robot = RemoteServer::connect_secure(robot_url, client).await.map_err(e)?;
-    let unit = RemoteServer::connect_secure(unit_url, client).await.map_err(e)?;
+async fn cell(server: &Server, robot_url: &str, unit_url: &str, client: &ClientConfig) -> Result<Vec<Program>, String> {
+    let e = |e: nodeset_models::runtime::client::ClientError| e.to_string();
+    let robot = client.connect(robot_url).await.map_err(|e| e.to_string())?;
+    let unit = client.connect(unit_url).await.map_err(|e| e.to_string())?;
     let skills = format!("{SYSTEM}/{CONTROLLER_SKILLS}");
-    let relative = Arc::new(robot.skill(&format!("{skills}/RelativeCartesianLinearMove")).await.map_err(e)?);
-    let absolute = Arc::new(robot.skill(&format!("{skills}/AbsoluteCartesianLinearMove")).await.map_err(e)?);
-    let drill = Arc::new(unit.skill(&format!("{SYSTEM}/{DRILL}")).await.map_err(e)?);
+    // The basic skills, bound by browse path as typed clients of their generated types.
+    let (relative, absolute) = (format!("{skills}/RelativeCartesianLinearMove"), format!("{skills}/AbsoluteCartesianLinearMove"));
+    let relative = Arc::new(robot.program::<RelativeCartesianLinearMoveSkillType>(&relative).await.map_err(e)?);
+    let absolute = Arc::new(robot.program::<AbsoluteCartesianLinearMoveSkillType>(&absolute).await.map_err(e)?);
+    let drill = Arc::new(unit.program::<TemplateDrillingSkillType>(&format!("{SYSTEM}/{DRILL}")).await.map_err(e)?);
     // The skills keep their sessions open; the servers' handles are not needed any more.
     drop((robot, unit));
 
@@ -282,7 +285,7 @@ async fn cell(server: &Server, robot_url: &str, unit_url: &str, client: &ClientS
                     acceleration: 200.0,
                     pose_offset: frame(0.0, 0.0, z),
                 };
-                relative.run(offset(i.insertion_distance), &ctl).await?;
+                relative.run_step(offset(i.insertion_distance), &ctl).await?;
                 let drilling = TemplateDrillingSkillTypeInputs {
                     hole_diameter: i.hole_diameter,
                     depth: i.depth,
@@ -290,8 +293,8 @@ async fn cell(server: &Server, robot_url: &str, unit_url: &str, client: &ClientS
                     spindle_speed: i.spindle_speed,
                     clamp_force: i.clamp_force,
                 };
-                drill.run(drilling, &ctl).await?;
-                relative.run(offset(-i.insertion_distance), &ctl).await?;
+                drill.run_step(drilling, &ctl).await?;
+                relative.run_step(offset(-i.insertion_distance), &ctl).await?;
                 Ok(Done {})
             }
         })
@@ -307,13 +310,13 @@ async fn cell(server: &Server, robot_url: &str, unit_url: &str, client: &ClientS
                 approach.cartesian_coordinates.z += i.approach_distance;
                 let to_approach =
                     AbsoluteCartesianLinearMoveSkillTypeInputs { speed: 100.0, acceleration: 400.0, target_pose: approach };
-                absolute.run(to_approach, &ctl).await?;
+                absolute.run_step(to_approach, &ctl).await?;
                 let onto = RelativeCartesianLinearMoveSkillTypeInputs {
                     speed: 20.0,
                     acceleration: 100.0,
                     pose_offset: frame(0.0, 0.0, -i.approach_distance),
                 };
-                relative.run(onto, &ctl).await?;
+                relative.run_step(onto, &ctl).await?;
                 // The simulated hole referencing unit measures the bush where it was expected.
                 Ok(ReferenceDrillBushSkillTypeOutputs { referenced_hole_position: i.hole_position })
             }
@@ -329,8 +332,10 @@ async fn run(o: Options) -> Result<(), String> {
     // cell provisions the trust both ways, as an administrator would by moving certificates into trusted/.
     let password = random_password();
     let client_pki = pki(&o.secure, "cell-client");
-    let client = ClientSecurity::new(&client_pki).user("cell", password.clone());
-    let client_cert = security::prepare_pki(&client_pki, "nodeset-models composite skill", &client.application_uri, &[])
+    let client = ClientConfig::new(&client_pki)
+        .application("nodeset-models composite skill", "urn:nodeset-models:composite-skill")
+        .user("cell", password.clone());
+    let client_cert = security::prepare_pki(&client_pki, &client.application_name, &client.application_uri, &[])
         .map_err(|e| e.to_string())?
         .cert;
     let device = |name: &str, port: u16, sub: &str| -> Result<Server, String> {

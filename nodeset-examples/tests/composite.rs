@@ -1,7 +1,7 @@
 //! A composite skill running basic skills of other servers (Commands2's DrillHole), three servers on
 //! loopback: the robot serves RelativeCartesianLinearMove, the drilling unit TemplateDrilling, the cell
-//! DrillHole, whose body finds both by browse path through `runtime::remote` and runs move in, drill, move
-//! out. A client drives DrillHole; the composite follows its basic skills into Halted and Suspended, and
+//! DrillHole, whose body binds both by browse path as typed clients (`runtime::client::RemoteProgram`) and
+//! runs move in, drill, move out (`run_step`, the composite semantics of `runtime::remote`). A client drives DrillHole; the composite follows its basic skills into Halted and Suspended, and
 //! takes them along when it is suspended, resumed or halted itself.
 
 mod common;
@@ -18,6 +18,7 @@ use nodeset_models::models::common_skills::objects::{
 use nodeset_models::models::drilling_process::objects::{DrillHoleSkillType, DrillHoleSkillTypeInputs};
 use nodeset_models::models::robot_cell::objects::{TemplateDrillingSkillType, TemplateDrillingSkillTypeInputs};
 use nodeset_models::models::{self, drilling_process};
+use nodeset_models::runtime::client::ClientError;
 use nodeset_models::runtime::remote::{RemoteError, RemoteServer};
 use nodeset_models::runtime::server::{ModelManager, ServerConfig};
 use nodeset_models::runtime::typed::{Program, ProgramState};
@@ -124,15 +125,15 @@ async fn cell() -> Cell {
     let cell = serve(config("cell")).await;
     let robot_server = RemoteServer::connect(&robot.url).await.expect("connects to the robot");
     let unit_server = RemoteServer::connect(&unit.url).await.expect("connects to the drilling unit");
-    let remote_move = Arc::new(robot_server.skill(MOVE).await.expect("finds the move skill"));
-    let remote_drill = Arc::new(unit_server.skill(DRILL).await.expect("finds the drilling skill"));
-    assert_eq!(remote_move.state().await, Ok(Some(ProgramState::Ready)));
+    let remote_move = Arc::new(robot_server.program::<RelativeCartesianLinearMoveSkillType>(MOVE).await.expect("finds the move skill"));
+    let remote_drill = Arc::new(unit_server.program::<TemplateDrillingSkillType>(DRILL).await.expect("finds the drilling skill"));
+    assert_eq!(remote_move.state().await.unwrap().map(|s| s.name), Some("Ready"));
     let drill_hole_handle: DrillHoleSkillType = local(&cell.manager, DRILL_HOLE);
     let drill_hole = drill_hole_handle
         .serve(move |i: DrillHoleSkillTypeInputs, ctl| {
             let (mv, drill) = (remote_move.clone(), remote_drill.clone());
             async move {
-                mv.run(offset(i.insertion_distance), &ctl).await?;
+                mv.run_step(offset(i.insertion_distance), &ctl).await?;
                 let drilling = TemplateDrillingSkillTypeInputs {
                     hole_diameter: i.hole_diameter,
                     depth: i.depth,
@@ -140,8 +141,8 @@ async fn cell() -> Cell {
                     spindle_speed: i.spindle_speed,
                     clamp_force: i.clamp_force,
                 };
-                drill.run(drilling, &ctl).await?;
-                mv.run(offset(-i.insertion_distance), &ctl).await?;
+                drill.run_step(drilling, &ctl).await?;
+                mv.run_step(offset(-i.insertion_distance), &ctl).await?;
                 Ok(Done {})
             }
         })
@@ -302,14 +303,14 @@ async fn a_lost_server_halts_the_composite_and_an_unreachable_one_suspends_it() 
 async fn a_wrong_path_names_where_it_stops() {
     let robot = serve(config("robot paths")).await;
     let server = RemoteServer::connect(&robot.url).await.unwrap();
-    let err = server.skill("DeviceSet/TemplateDrillingLwrSystem/NoSuchDevice/SkillSet/Move").await.err();
+    let err = server.program::<RelativeCartesianLinearMoveSkillType>("DeviceSet/TemplateDrillingLwrSystem/NoSuchDevice/SkillSet/Move").await.err();
     assert_eq!(
         err,
-        Some(RemoteError::Path {
+        Some(ClientError::Remote(RemoteError::Path {
             below: "DeviceSet/TemplateDrillingLwrSystem".into(),
             segment: "NoSuchDevice".into(),
             matches: 0
-        })
+        }))
     );
     let ns = server.session().get_namespace_index_from_cache(drilling_process::NAMESPACE_URI).unwrap();
     let qualified = format!("{{{}}}DrillingCell/SkillSet/DrillHole", drilling_process::NAMESPACE_URI);

@@ -1,0 +1,390 @@
+//! The typed client (`runtime::client`) against the example servers, started as a user starts them (their
+//! binaries, `--port 0`, secure by default) and reached over Basic256Sha256 SignAndEncrypt as an Operator:
+//!
+//! - the robot example (`examples/robot.rs`): its certificate refused on first contact and written to the
+//!   client's `rejected/`, then trusted; binding by browse path and by NodeId (a handle of another type
+//!   refused); placeholders by browsing; one member of six axes in one Read, a selection, Optional members
+//!   present and absent; writes refused and accepted; a subscription stream of the moving joints; typed
+//!   method calls (`Lock/InitLock`: a wrong argument refused with the server's status); the controller's
+//!   SystemOperationStateMachine through its generated state table;
+//! - the robot cell (`examples/robot_cell.rs`): the robot's AbsoluteJointPTPMove run with typed inputs and
+//!   awaited to Ready while the joints are subscribed, a run with refused inputs ending in Halted with its
+//!   cause, a Halt while it runs observed by the run and by `wait_for_state`; the cell's composite DrillHole
+//!   (which runs the robot's and the drilling unit's skills) suspended, resumed and awaited to Ready.
+//!
+//! The example binaries are built by the test (`cargo build -p nodeset-examples --example ...`, a no-op
+//! when they are up to date), as `tests/tests/verify.rs` builds the ones it runs.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::{mpsc, OnceLock};
+use std::time::Duration;
+
+use nodeset_models::models::common_skills::objects::{
+    AbsoluteJointPtpMoveSkillType, AbsoluteJointPtpMoveSkillTypeInputs, ProgramSkillStateMachineTypeOutputs as Done,
+};
+use nodeset_models::models::drilling_process::objects::{DrillHoleSkillType, DrillHoleSkillTypeInputs};
+use nodeset_models::models::robotics::objects::{
+    members, AxisType, ControllerType, MotionDeviceSystemType, MotionDeviceType, SystemOperationStateMachineType,
+};
+use nodeset_models::runtime::client::{ClientConfig, ClientError, Remote, RemoteMachine};
+use nodeset_models::runtime::remote::RemoteError;
+use nodeset_models::runtime::server::{security, Role, Users};
+use nodeset_models::runtime::typed::ObjectType;
+use opcua::types::StatusCode;
+
+const PASSWORD: &str = "op-secret-1";
+
+/// The example executables, built once per test binary: (name, path).
+fn examples() -> &'static [(String, PathBuf)] {
+    static EXAMPLES: OnceLock<Vec<(String, PathBuf)>> = OnceLock::new();
+    EXAMPLES.get_or_init(|| {
+        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+        let output = Command::new(cargo)
+            .current_dir(env!("CARGO_MANIFEST_DIR"))
+            .args(["build", "-p", "nodeset-examples", "--example", "robot", "--example", "robot_cell"])
+            .arg("--message-format=json-render-diagnostics")
+            .stderr(Stdio::inherit())
+            .output()
+            .expect("cargo runs");
+        assert!(output.status.success(), "cargo build -p nodeset-examples --example robot --example robot_cell failed");
+        let field = |line: &str, key: &str| -> Option<String> {
+            let start = line.find(key)? + key.len();
+            Some(line[start..start + line[start..].find('"')?].to_owned())
+        };
+        String::from_utf8_lossy(&output.stdout)
+            .lines()
+            .filter(|l| l.contains("\"reason\":\"compiler-artifact\"") && l.contains("\"kind\":[\"example\"]"))
+            .filter_map(|l| Some((field(l, "\"name\":\"")?, PathBuf::from(field(l, "\"executable\":\"")?))))
+            .collect()
+    })
+}
+
+/// An example server process, killed when dropped, its stdout read line by line.
+struct Example {
+    child: Child,
+    lines: mpsc::Receiver<String>,
+}
+
+impl Drop for Example {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+impl Example {
+    fn start(name: &str, args: &[&str]) -> Example {
+        let exe = examples().iter().find(|(n, _)| n == name).map(|(_, p)| p.clone());
+        let exe = exe.unwrap_or_else(|| panic!("cargo built no example `{name}`"));
+        let mut child = Command::new(exe).args(args).stdout(Stdio::piped()).stderr(Stdio::inherit()).spawn().expect("the example starts");
+        let out = child.stdout.take().expect("stdout");
+        let (tx, lines) = mpsc::channel();
+        std::thread::spawn(move || {
+            for line in BufReader::new(out).lines().map_while(Result::ok) {
+                if tx.send(line).is_err() {
+                    break;
+                }
+            }
+        });
+        Example { child, lines }
+    }
+
+    /// Waits for a line that starts with `prefix`; the rest of it.
+    fn line(&self, prefix: &str) -> String {
+        loop {
+            let line = self.lines.recv_timeout(Duration::from_secs(90)).unwrap_or_else(|_| panic!("the example prints `{prefix}...`"));
+            if let Some(rest) = line.strip_prefix(prefix) {
+                return rest.trim().to_owned();
+            }
+        }
+    }
+}
+
+/// A fresh folder in the system's temporary directory, with a user file that makes `op` an Operator.
+fn temp_dir(name: &str) -> (PathBuf, PathBuf) {
+    let dir = std::env::temp_dir().join(format!("nodeset-client-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("the temporary folder can be created");
+    let mut users = Users::default();
+    users.set_password("op", vec![Role::Operator], PASSWORD).expect("a user");
+    let file = dir.join("users.txt");
+    std::fs::write(&file, users.to_text()).expect("the user file is written");
+    (dir, file)
+}
+
+fn path(p: &Path) -> &str {
+    p.to_str().expect("a UTF-8 path")
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_robot_example_is_read_written_subscribed_and_called_through_typed_handles() {
+    let (dir, users) = temp_dir("robot");
+    let (server_pki, client_pki) = (dir.join("server-pki"), dir.join("client-pki"));
+    // The server trusts the client's certificate on first use; the client trusts the server's only once it
+    // has been moved from rejected/ to trusted/, as an administrator does (the first attempt fails at once
+    // with BadCertificateUntrusted).
+    let robot = tokio::task::spawn_blocking(move || {
+        let robot = Example::start("robot", &["--port", "0", "--pki", path(&server_pki), "--users", path(&users), "--trust-on-first-use"]);
+        let url = robot.line("listening on ");
+        (robot, url)
+    });
+    let (robot, url) = robot.await.unwrap();
+    let config = ClientConfig::new(&client_pki).user("op", PASSWORD);
+    match config.connect(&url).await {
+        Err(RemoteError::Connect(_, status)) => assert_eq!(status, StatusCode::BadCertificateUntrusted),
+        Err(other) => panic!("an untrusted server certificate was refused with {other}"),
+        Ok(_) => panic!("a session to a server whose certificate is not trusted"),
+    }
+    let rejected: Vec<PathBuf> =
+        std::fs::read_dir(client_pki.join("rejected")).expect("rejected/").map(|e| e.unwrap().path()).collect();
+    assert_eq!(rejected.len(), 1, "the server's certificate lands in rejected/: {rejected:?}");
+    std::fs::rename(&rejected[0], client_pki.join("trusted").join(rejected[0].file_name().unwrap())).unwrap();
+    let client = config.connect(&url).await.expect("a session once the server's certificate is trusted");
+    // A wrong password is refused, with the server's status (not a timeout).
+    match ClientConfig::new(&client_pki).user("op", "not-the-password").connect(&url).await {
+        Err(RemoteError::Connect(_, status)) => assert_eq!(status, StatusCode::BadIdentityTokenRejected),
+        Err(other) => panic!("a wrong password was refused with {other}"),
+        Ok(_) => panic!("a session with a wrong password"),
+    }
+
+    // By browse path and by NodeId; a handle of another type is refused.
+    let system: Remote<MotionDeviceSystemType> = client.bind_path("Robot").await.unwrap();
+    let by_id: Remote<MotionDeviceSystemType> = client.bind(system.node()).await.unwrap();
+    assert_eq!(system.node(), by_id.node());
+    match client.bind_path::<AxisType>("Robot").await {
+        Err(ClientError::WrongType { expected, .. }) => assert_eq!(expected, AxisType::BROWSE_NAME),
+        other => panic!("a MotionDeviceSystem bound as an AxisType: {other:?}"),
+    }
+
+    // Placeholders, by browsing.
+    let devices = system.placeholders::<MotionDeviceType>("MotionDevices").await.unwrap();
+    assert_eq!(devices.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>(), ["Arm"]);
+    let arm = &devices[0].1;
+    let axes = arm.placeholders::<AxisType>("Axes").await.unwrap();
+    assert_eq!(axes.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>(), ["A1", "A2", "A3", "A4", "A5", "A6"]);
+    assert!(system.placeholders::<AxisType>("MotionDevices").await.unwrap().is_empty(), "an arm is not an axis");
+    let axes: Vec<Remote<AxisType>> = axes.into_iter().map(|(_, a)| a).collect();
+
+    // Typed reads: one member, the same member of every axis in one Read, a selection.
+    let serial = arm.read::<String, _>(&members::MotionDeviceType::SerialNumber).await.unwrap();
+    assert_eq!(serial.value.as_deref(), Some("0001"));
+    assert!(serial.status.is_good());
+    let position = &members::AxisType::ParameterSet__ActualPosition;
+    let all = Remote::read_each::<f64, _>(&axes, position).await.unwrap();
+    assert_eq!(all.len(), 6);
+    assert!(all.iter().all(|s| s.value.is_some() && s.status.is_good() && s.source_timestamp.is_some()), "{all:?}");
+    let selection = arm
+        .read_selection(&[
+            members::MotionDeviceType::SerialNumber.browse_path(),
+            members::MotionDeviceType::Lock__Locked.browse_path(),
+            members::MotionDeviceType::FlangeLoad__Mass.browse_path(),
+        ])
+        .await
+        .unwrap();
+    assert!(selection[0].is_ok() && selection[1].is_ok(), "{selection:?}");
+    assert!(selection[2].is_err(), "the arm has no FlangeLoad: {:?}", selection[2]);
+
+    // Optional members: present (AssetId) and absent (FlangeLoad/Mass).
+    let asset = arm.read_optional::<String, _>(&members::MotionDeviceType::AssetId).await.unwrap();
+    assert_eq!(asset.and_then(|s| s.value).as_deref(), Some("cell-1/robot"));
+    assert_eq!(arm.read_optional::<f64, _>(&members::MotionDeviceType::FlangeLoad__Mass).await.unwrap(), None);
+
+    // Writes: a read-only variable is refused with the server's status; a writable one lands in the
+    // server's struct (which prints it).
+    match arm.write(&members::MotionDeviceType::ParameterSet__SpeedOverride, 0.5).await {
+        Err(ClientError::Status { status, .. }) => assert_eq!(status, StatusCode::BadNotWritable),
+        other => panic!("a read-only variable was written: {other:?}"),
+    }
+    arm.write(&members::MotionDeviceType::AssetId, "cell-2/robot".to_owned()).await.unwrap();
+    let controllers = system.placeholders::<ControllerType>("Controllers").await.unwrap();
+    let controller = &controllers[0].1;
+    let stop_mode = &members::ControllerType::SystemOperation__SystemOperationStateMachine__ConfiguredDefaultStopMode;
+    controller.write(stop_mode, 2i16).await.unwrap();
+    assert_eq!(controller.read::<i16, _>(stop_mode).await.unwrap().value, Some(2));
+    let robot = tokio::task::spawn_blocking(move || {
+        assert_eq!(robot.line("AssetId written by a client: "), "\"cell-2/robot\"");
+        assert_eq!(robot.line("ConfiguredDefaultStopMode written by a client: "), "2");
+        robot
+    })
+    .await
+    .unwrap();
+
+    // A subscription: the joint moves (a sine at 100 Hz), and its values arrive typed, each with its status
+    // and a later source timestamp than the one before.
+    let mut samples = axes[0].subscribe::<f64, _>(position, 20).await.unwrap();
+    let mut seen = Vec::new();
+    while seen.len() < 6 {
+        let s = tokio::time::timeout(Duration::from_secs(5), samples.next()).await.expect("a sample in time").expect("a sample");
+        assert!(s.status.is_good(), "{s:?}");
+        seen.push((s.value.expect("an f64"), s.source_timestamp.expect("a source timestamp")));
+    }
+    assert!(seen.windows(2).all(|w| w[0].1 < w[1].1), "source timestamps go forward: {seen:?}");
+    assert!(seen.windows(2).all(|w| w[0].0 != w[1].0), "every sample is a changed value: {seen:?}");
+    drop(samples);
+
+    // Typed method calls: a wrong argument is refused with the server's status, the right one runs.
+    match arm.call::<(String,), (i32,)>("Lock/InitLock", (String::new(),)).await {
+        Err(ClientError::Status { status, .. }) => assert_eq!(status, StatusCode::BadInvalidArgument),
+        other => panic!("an empty context was accepted: {other:?}"),
+    }
+    match arm.call::<(i32,), (i32,)>("Lock/InitLock", (7,)).await {
+        Err(ClientError::Arguments { status, arguments, .. }) => {
+            assert_eq!(status, StatusCode::BadInvalidArgument);
+            assert_eq!(arguments, [StatusCode::BadTypeMismatch]);
+        }
+        other => panic!("an Int32 context was accepted: {other:?}"),
+    }
+    assert_eq!(arm.call::<(String,), (i32,)>("Lock/InitLock", ("cell".to_owned(),)).await.unwrap(), (0,));
+    assert_eq!(arm.call::<(String,), (i32,)>("Lock/InitLock", ("other".to_owned(),)).await.unwrap(), (-1,));
+    assert_eq!(arm.read::<bool, _>(&members::MotionDeviceType::Lock__Locked).await.unwrap().value, Some(true));
+
+    // A state machine through its generated table: the controller's SystemOperationStateMachine is Ready.
+    let machine: Remote<SystemOperationStateMachineType> =
+        client.bind_path("Robot/Controllers/Controller/SystemOperation/SystemOperationStateMachine").await.unwrap();
+    let machine = RemoteMachine::of(machine).await.unwrap();
+    assert_eq!(machine.current().map(|s| s.name), Some("Ready"));
+    assert_eq!(machine.state().await.unwrap().map(|s| s.name), Some("Ready"));
+    machine.wait_for_state("Ready", Duration::from_secs(1)).await.unwrap();
+    match machine.wait_for_state("Idle", Duration::from_millis(300)).await {
+        Err(ClientError::Timeout(_)) => {}
+        other => panic!("the machine is Ready, not Idle: {other:?}"),
+    }
+    drop(machine);
+
+    client.disconnect().await;
+    drop(robot);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+const SYSTEM: &str = "DeviceSet/TemplateDrillingLwrSystem/MotionDeviceSystem";
+const PTP: &str = "Controllers/URController/SkillSet/AbsoluteJointPTPMove";
+const JOINTS: [&str; 6] = ["Base", "Shoulder", "Elbow", "Wrist1", "Wrist2", "Wrist3"];
+
+fn ptp(target: [f64; 6], speed: f64) -> AbsoluteJointPtpMoveSkillTypeInputs {
+    AbsoluteJointPtpMoveSkillTypeInputs { speed, acceleration: 180.0, target_joint_positions: target.to_vec() }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn skills_of_the_robot_cell_run_to_ready_and_are_halted() {
+    let (dir, users) = temp_dir("robot-cell");
+    let (server_pki, client_pki) = (dir.join("server-pki"), dir.join("client-pki"));
+    let pki = server_pki.clone();
+    let cell = tokio::task::spawn_blocking(move || {
+        let cell = Example::start(
+            "robot_cell",
+            &["--port", "0", "--pki", path(&pki), "--users", path(&users), "--trust-on-first-use", "--motion-ms", "1000"],
+        );
+        let robot_url = cell.line("robot listening on ");
+        let cell_url = cell.line("cell listening on ");
+        cell.line("cell ready");
+        (cell, robot_url, cell_url)
+    });
+    let (cell, robot_url, cell_url) = cell.await.unwrap();
+    // The client trusts the robot's and the cell's certificates, as an administrator would.
+    let config = ClientConfig::new(&client_pki).user("op", PASSWORD);
+    security::prepare_pki(&client_pki, &config.application_name, &config.application_uri, &[]).unwrap();
+    for server in ["robot", "cell"] {
+        let own = security::own_certificate(&server_pki.join(server)).unwrap();
+        security::trust_certificate(&client_pki, &own).unwrap();
+    }
+    let robot = config.connect(&robot_url).await.expect("a session to the robot");
+
+    let skill = robot.program::<AbsoluteJointPtpMoveSkillType>(&format!("{SYSTEM}/{PTP}")).await.unwrap();
+    assert_eq!(skill.current().map(|s| s.name), Some("Ready"));
+    let manipulator: Remote<MotionDeviceType> = robot.bind_path(&format!("{SYSTEM}/MotionDevices/Manipulator")).await.unwrap();
+    // Placeholders come in BrowseName order; the skill's TargetJointPositions go from the base to the flange.
+    let found = manipulator.placeholders::<AxisType>("Axes").await.unwrap();
+    assert_eq!(found.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>(), ["Base", "Elbow", "Shoulder", "Wrist1", "Wrist2", "Wrist3"]);
+    let axes: Vec<Remote<AxisType>> =
+        JOINTS.iter().map(|j| found.iter().find(|(n, _)| n == j).expect("the joint").1.clone()).collect();
+    let position = &members::AxisType::ParameterSet__ActualPosition;
+
+    // A run with typed inputs, awaited to Ready, while a subscription sees the first joint move.
+    let target = [10.0, -45.0, 60.0, -15.0, 90.0, 0.0];
+    let mut samples = axes[0].subscribe::<f64, _>(position, 0).await.unwrap();
+    let _: Done = tokio::time::timeout(Duration::from_secs(20), skill.run(ptp(target, 90.0))).await.expect("the run ends").unwrap();
+    assert_eq!(skill.state().await.unwrap().map(|s| s.name), Some("Ready"));
+    let reached = Remote::read_each::<f64, _>(&axes, position).await.unwrap();
+    assert_eq!(reached.iter().map(|s| s.value).collect::<Vec<_>>(), target.map(Some));
+    let mut moved = Vec::new();
+    while moved.last() != Some(&target[0]) {
+        let s = tokio::time::timeout(Duration::from_secs(5), samples.next()).await.expect("the joint's last value").unwrap();
+        moved.push(s.value.expect("an f64"));
+    }
+    assert!(moved.len() > 2, "the joint's way to its target, sampled: {moved:?}");
+    drop(samples);
+
+    // A run whose inputs the skill refuses ends in Halted with the skill's status as the cause.
+    match tokio::time::timeout(Duration::from_secs(20), skill.run(ptp(target, 0.0))).await.expect("the run ends") {
+        Err(ClientError::Halted { cause, .. }) => assert_eq!(cause, StatusCode::BadInvalidArgument),
+        other => panic!("a refused run did not halt: {other:?}"),
+    }
+    skill.reset().await.unwrap();
+    skill.wait_for_state("Ready", Duration::from_secs(5)).await.unwrap();
+
+    // The robot's skills have no Suspend (an Optional method of their type that the instances leave out):
+    // the client says so before any call.
+    match skill.suspend().await {
+        Err(ClientError::Status { status, .. }) => assert_eq!(status, StatusCode::BadNoMatch),
+        other => panic!("Suspend of a skill without a Suspend method: {other:?}"),
+    }
+    // A Halt while it runs, observed by the run (Halted, with the cause the skill gives) and by
+    // wait_for_state.
+    let control = async {
+        skill.wait_for_state("Running", Duration::from_secs(5)).await.unwrap();
+        skill.halt().await.unwrap();
+        skill.wait_for_state("Halted", Duration::from_secs(5)).await.unwrap();
+    };
+    let home = [0.0; 6];
+    let (run, ()) = tokio::time::timeout(Duration::from_secs(20), async { tokio::join!(skill.run(ptp(home, 90.0)), control) })
+        .await
+        .expect("the halted run ends");
+    match run {
+        Err(ClientError::Halted { cause, .. }) => assert_eq!(cause, StatusCode::BadRequestCancelledByClient),
+        other => panic!("a halted run: {other:?}"),
+    }
+    assert_eq!(skill.state().await.unwrap().map(|s| s.name), Some("Halted"));
+    let stopped = Remote::read_each::<f64, _>(&axes, position).await.unwrap();
+    // The joint stopped where the Halt found it, on its way from 10 towards 0 (a move takes a second).
+    assert!(stopped[0].value.is_some_and(|v| v > 0.0 && v <= target[0]), "halted on the way home: {stopped:?}");
+    skill.reset().await.unwrap();
+    skill.wait_for_state("Ready", Duration::from_secs(5)).await.unwrap();
+    drop(skill);
+
+    // The cell's composite skill, which runs the robot's and the drilling unit's skills: suspended and
+    // resumed while it runs (a second Suspend is refused by the table's rules), then awaited to Ready.
+    let cell_client = config.connect(&cell_url).await.expect("a session to the cell");
+    let drill_hole = cell_client.program::<DrillHoleSkillType>("DrillingCell/SkillSet/DrillHole").await.unwrap();
+    let inputs = DrillHoleSkillTypeInputs {
+        insertion_distance: 12.0,
+        hole_diameter: 4.8,
+        depth: 6.0,
+        feed_rate: 200.0,
+        spindle_speed: 6000.0,
+        clamp_force: 300.0,
+    };
+    let control = async {
+        drill_hole.wait_for_state("Running", Duration::from_secs(5)).await.unwrap();
+        drill_hole.suspend().await.unwrap();
+        drill_hole.wait_for_state("Suspended", Duration::from_secs(5)).await.unwrap();
+        match drill_hole.suspend().await {
+            Err(ClientError::Status { status, .. }) => assert_eq!(status, StatusCode::BadInvalidState),
+            other => panic!("Suspend in Suspended was accepted: {other:?}"),
+        }
+        drill_hole.resume().await.unwrap();
+        drill_hole.wait_for_state("Running", Duration::from_secs(5)).await.unwrap();
+    };
+    let (run, ()) = tokio::time::timeout(Duration::from_secs(30), async { tokio::join!(drill_hole.run(inputs), control) })
+        .await
+        .expect("DrillHole ends");
+    let _: Done = run.unwrap();
+    assert_eq!(drill_hole.state().await.unwrap().map(|s| s.name), Some("Ready"));
+    drop(drill_hole);
+
+    cell_client.disconnect().await;
+    robot.disconnect().await;
+    drop(cell);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,0 +1,704 @@
+//! Typed clients of remote instances: any generated ObjectType handle, bound to an instance on another
+//! server, with typed reads, writes, subscriptions and method calls, driven by the tables and member markers
+//! the generated code already has (no per-type client code is generated, so the generated crate does not
+//! grow).
+//!
+//! ```text
+//! let robot = ClientConfig::new("pki/cell-controller").user("operator", password).connect("opc.tcp://127.0.0.1:4861/").await?;
+//! let axis: Remote<AxisType> = robot.bind_path("DeviceSet/.../Axes/Base").await?;
+//! let position = axis.read(&members::AxisType::ParameterSet__ActualPosition).await?;  // Sample<f64>
+//! let mut joints = axis.subscribe(&members::AxisType::ParameterSet__ActualPosition, 50).await?;
+//! while let Some(sample) = joints.next().await { println!("{:?} at {:?}", sample.value, sample.source_timestamp) }
+//! ```
+//!
+//! - [`ClientConfig`] is the one place where a connection is configured (security, identity, PKI folder);
+//! - [`RemoteServer::bind`] and [`RemoteServer::bind_path`] bind a [`Remote<H>`] to an instance by NodeId
+//!   or browse path, checking that its TypeDefinition is `H`'s type or a subtype of it (a path's segments
+//!   may leave out their namespace, so it is followed with one Browse a segment; member paths, whose
+//!   namespaces the markers carry, are translated in batches);
+//! - a member marker (`members::<Type>::<Path>`) names a variable: [`Remote::read`], [`Remote::write`],
+//!   [`Remote::subscribe`]; [`Remote::read_optional`] answers `None` for an Optional member the instance
+//!   lacks; [`Remote::read_selection`] reads any number of members with one TranslateBrowsePathsToNodeIds
+//!   and one Read; resolved paths are kept, so later reads are one round trip;
+//! - [`Remote::call`] calls a method with typed arguments and outputs; a Bad status of the server is the
+//!   error, with the status of each argument when the server gives them;
+//! - [`Remote::placeholders`] enumerates the instances of a placeholder by browsing;
+//! - [`RemoteMachine`] and [`RemoteProgram`] follow state machines and run programs (every skill type);
+//!   [`RemoteProgram::run_step`] runs one as a step of a composite skill (the rules are in
+//!   [`crate::remote`]).
+
+mod program;
+
+use std::collections::BTreeMap;
+use std::marker::PhantomData;
+use std::path::PathBuf;
+use std::pin::Pin;
+use std::sync::{Arc, Mutex};
+use std::task::{Context, Poll};
+use std::time::Duration;
+
+use opcua::client::{DataChangeCallback, MonitoredItem, Session};
+use opcua::crypto::SecurityPolicy;
+use opcua::types::{
+    AttributeId, BrowseDescription, BrowseDirection, BrowsePath, BrowseResultMask, CallMethodRequest, DataValue,
+    DateTime, MessageSecurityMode, MonitoredItemCreateRequest, MonitoringMode, MonitoringParameters, NodeClassMask,
+    NodeId, QualifiedName, ReadValueId, ReferenceTypeId, RelativePath, RelativePathElement, StatusCode,
+    TimestampsToReturn, Variant, WriteValue,
+};
+use tokio::sync::mpsc;
+
+pub use program::{RemoteMachine, RemoteProgram};
+
+use crate::remote::{RemoteError, RemoteServer};
+use crate::typed::{Arguments, Holds, MemberPath, ObjectType, UaValue, VariableMember};
+use crate::NsNodeId;
+
+/// How a client connects: the security policy and mode, the user, the client's PKI folder and its
+/// application name and URI. Every client of the runtime (typed handles and composite skills) connects
+/// through it ([`ClientConfig::connect`]); one configuration serves any number of servers.
+///
+/// Secure by default: [`ClientConfig::new`] is Basic256Sha256 with SignAndEncrypt, and the server's
+/// certificate must be in the PKI folder's `trusted/` (an unknown one is refused and written to
+/// `rejected/`, for an administrator to move). [`ClientConfig::insecure`] (SecurityPolicy None, anonymous)
+/// is for servers started with `--insecure` on loopback.
+#[derive(Clone)]
+pub struct ClientConfig {
+    /// The application name the session shows (and the client's certificate carries).
+    pub application_name: String,
+    /// The application URI of the client, which its certificate carries.
+    pub application_uri: String,
+    /// The security policy of the endpoint to use.
+    pub policy: SecurityPolicy,
+    /// The message security mode of the endpoint to use.
+    pub mode: MessageSecurityMode,
+    /// User name and password; `None` connects anonymously.
+    pub user: Option<(String, String)>,
+    /// The client's PKI folder: its certificate (`own/cert.der`, `private/private.pem`, created on first
+    /// use) and the server certificates it trusts (`trusted/`) or refused (`rejected/`).
+    pub pki_dir: PathBuf,
+    /// Trusts an unknown server certificate (development only).
+    pub trust_server_on_first_use: bool,
+    /// How long the session may take to open.
+    pub connect_timeout: Duration,
+}
+
+impl std::fmt::Debug for ClientConfig {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ClientConfig")
+            .field("application_name", &self.application_name)
+            .field("application_uri", &self.application_uri)
+            .field("policy", &self.policy)
+            .field("mode", &self.mode)
+            .field("user", &self.user.as_ref().map(|(name, _)| (name, "<password>")))
+            .field("pki_dir", &self.pki_dir)
+            .field("trust_server_on_first_use", &self.trust_server_on_first_use)
+            .field("connect_timeout", &self.connect_timeout)
+            .finish()
+    }
+}
+
+impl ClientConfig {
+    /// Basic256Sha256, SignAndEncrypt, anonymous, with the client's PKI folder at `pki_dir`.
+    pub fn new(pki_dir: impl Into<PathBuf>) -> ClientConfig {
+        ClientConfig {
+            application_name: "nodeset-models client".into(),
+            application_uri: "urn:nodeset-models:client".into(),
+            policy: SecurityPolicy::Basic256Sha256,
+            mode: MessageSecurityMode::SignAndEncrypt,
+            user: None,
+            pki_dir: pki_dir.into(),
+            trust_server_on_first_use: false,
+            connect_timeout: Duration::from_secs(10),
+        }
+    }
+
+    /// SecurityPolicy None, anonymous: only for servers started with `insecure`, on loopback. No
+    /// certificate is made or checked.
+    pub fn insecure() -> ClientConfig {
+        ClientConfig {
+            policy: SecurityPolicy::None,
+            mode: MessageSecurityMode::None,
+            ..ClientConfig::new(std::env::temp_dir().join("nodeset-models-pki-remote"))
+        }
+    }
+
+    /// Sets the user name and password.
+    pub fn user(mut self, name: impl Into<String>, password: impl Into<String>) -> ClientConfig {
+        self.user = Some((name.into(), password.into()));
+        self
+    }
+
+    /// Sets the security policy and mode.
+    pub fn policy(mut self, policy: SecurityPolicy, mode: MessageSecurityMode) -> ClientConfig {
+        self.policy = policy;
+        self.mode = mode;
+        self
+    }
+
+    /// Sets the application name and URI (a PKI folder holds the certificate of one application URI).
+    pub fn application(mut self, name: &str, uri: &str) -> ClientConfig {
+        self.application_name = name.to_owned();
+        self.application_uri = uri.to_owned();
+        self
+    }
+
+    /// Trusts unknown server certificates: development only.
+    pub fn trust_server_on_first_use(mut self) -> ClientConfig {
+        self.trust_server_on_first_use = true;
+        self
+    }
+
+    /// Sets how long the session may take to open.
+    pub fn connect_timeout(mut self, timeout: Duration) -> ClientConfig {
+        self.connect_timeout = timeout;
+        self
+    }
+
+    /// Opens a session to the server at `url` (`opc.tcp://host:port/`) and reads its namespaces. A refusal
+    /// that retrying cannot change (the user, or a certificate: `BadIdentityTokenRejected`,
+    /// `BadCertificateUntrusted`, ...) fails at once with its status; a server that does not answer fails
+    /// after `connect_timeout` with the status of the last attempt.
+    pub async fn connect(&self, url: &str) -> Result<RemoteServer, RemoteError> {
+        RemoteServer::open(url, self).await
+    }
+}
+
+/// Why a typed client operation failed.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ClientError {
+    /// No session, a failed service or a path that does not lead anywhere.
+    Remote(RemoteError),
+    /// The server answered an operation with a Bad status (what was asked, the status).
+    Status { what: String, status: StatusCode },
+    /// The server refused a method call's arguments: the call's status and one status per argument.
+    Arguments { method: String, status: StatusCode, arguments: Vec<StatusCode> },
+    /// A value is not of the Rust type asked for (what was read, the value).
+    Type { what: String, value: Variant },
+    /// The node is not an instance of the handle's type (the node, its TypeDefinition if it has one).
+    WrongType { node: NodeId, type_definition: Option<NodeId>, expected: &'static str },
+    /// The server's namespace table lacks a namespace a handle names.
+    UnknownNamespace(String),
+    /// Nothing happened in time (what was awaited).
+    Timeout(String),
+    /// A program ended in Halted (the program, the cause it gave: its `Result` output, or
+    /// `BadInvalidState`).
+    Halted { program: String, cause: StatusCode },
+}
+
+impl std::fmt::Display for ClientError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ClientError::Remote(e) => e.fmt(f),
+            ClientError::Status { what, status } => write!(f, "{what}: the server answered {status}"),
+            ClientError::Arguments { method, status, arguments } => {
+                write!(f, "{method}: the server refused the arguments ({status}; per argument: {arguments:?})")
+            }
+            ClientError::Type { what, value } => write!(f, "{what}: the value {value:?} is not of the expected type"),
+            ClientError::WrongType { node, type_definition, expected } => match type_definition {
+                Some(t) => write!(f, "node {node} is of type {t}, not {expected} or a subtype"),
+                None => write!(f, "node {node} has no TypeDefinition; {expected} was expected"),
+            },
+            ClientError::UnknownNamespace(uri) => write!(f, "the server has no namespace `{uri}`"),
+            ClientError::Timeout(what) => write!(f, "timed out waiting for {what}"),
+            ClientError::Halted { program, cause } => write!(f, "program `{program}` halted: {cause}"),
+        }
+    }
+}
+
+impl std::error::Error for ClientError {}
+
+impl From<RemoteError> for ClientError {
+    fn from(e: RemoteError) -> Self {
+        ClientError::Remote(e)
+    }
+}
+
+fn service(what: &'static str) -> impl Fn(opcua::types::Error) -> ClientError {
+    move |e| ClientError::Remote(RemoteError::Service(what, e.status()))
+}
+
+/// A value as the server reported it: typed (`None` if the variable has no value or one of another type),
+/// with its status and timestamps.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sample<T> {
+    /// The value, `None` if there is none or it is not a `T`.
+    pub value: Option<T>,
+    /// The value's status (Good if the server gave none).
+    pub status: StatusCode,
+    /// When the source produced it.
+    pub source_timestamp: Option<DateTime>,
+    /// When the server saw it.
+    pub server_timestamp: Option<DateTime>,
+}
+
+impl<T: UaValue> Sample<T> {
+    /// The sample of a DataValue.
+    pub fn of(value: &DataValue) -> Sample<T> {
+        Sample {
+            value: value.value.as_ref().and_then(T::from_variant),
+            status: value.status.unwrap_or(StatusCode::Good),
+            source_timestamp: value.source_timestamp,
+            server_timestamp: value.server_timestamp,
+        }
+    }
+}
+
+/// A typed instance on a remote server, bound as the generated handle `H` (its ObjectType).
+pub struct Remote<H> {
+    session: Arc<Session>,
+    node: NodeId,
+    /// Member paths resolved so far (path text -> NodeId, or the status that says it is absent).
+    resolved: Arc<Mutex<BTreeMap<String, Result<NodeId, StatusCode>>>>,
+    _type: PhantomData<fn() -> H>,
+}
+
+impl<H> Clone for Remote<H> {
+    fn clone(&self) -> Self {
+        Remote { session: self.session.clone(), node: self.node.clone(), resolved: self.resolved.clone(), _type: PhantomData }
+    }
+}
+
+impl<H: ObjectType> std::fmt::Debug for Remote<H> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Remote<{}>({})", H::BROWSE_NAME, self.node)
+    }
+}
+
+impl RemoteServer {
+    /// Binds the instance `node` as `H`, after checking that its TypeDefinition is `H`'s type or a subtype.
+    pub async fn bind<H: ObjectType>(&self, node: &NodeId) -> Result<Remote<H>, ClientError> {
+        Remote::bind(self.session().clone(), node).await
+    }
+
+    /// Binds the instance at `path` below the Objects folder (see [`RemoteServer::find`]) as `H`.
+    pub async fn bind_path<H: ObjectType>(&self, path: &str) -> Result<Remote<H>, ClientError> {
+        let node = self.find(path).await?;
+        self.bind(&node).await
+    }
+}
+
+impl<H: ObjectType> Remote<H> {
+    async fn bind(session: Arc<Session>, node: &NodeId) -> Result<Remote<H>, ClientError> {
+        let expected = resolve_id(&session, H::TYPE_ID)?;
+        let type_definition = type_definition(&session, node).await?;
+        let fits = match &type_definition {
+            Some(t) => is_subtype(&session, t, &expected).await?,
+            None => false,
+        };
+        if !fits {
+            return Err(ClientError::WrongType { node: node.clone(), type_definition, expected: H::BROWSE_NAME });
+        }
+        Ok(Remote { session, node: node.clone(), resolved: Default::default(), _type: PhantomData })
+    }
+
+    /// The instance's NodeId.
+    pub fn node(&self) -> &NodeId {
+        &self.node
+    }
+
+    /// The session.
+    pub fn session(&self) -> &Arc<Session> {
+        &self.session
+    }
+
+    /// The NodeIds of members, each `Err(status)` if the instance lacks it: one TranslateBrowsePathsToNodeIds
+    /// for the paths not resolved before.
+    pub async fn resolve(&self, paths: &[MemberPath]) -> Result<Vec<Result<NodeId, StatusCode>>, ClientError> {
+        let missing: Vec<MemberPath> = {
+            let known = self.resolved.lock().unwrap_or_else(|e| e.into_inner());
+            let mut m: Vec<MemberPath> = paths.iter().filter(|p| !known.contains_key(p.text)).copied().collect();
+            m.dedup_by_key(|p| p.text);
+            m
+        };
+        if !missing.is_empty() {
+            let segments = missing
+                .iter()
+                .map(|p| p.segments().map_err(|e| ClientError::Type { what: e.to_string(), value: Variant::Empty }))
+                .collect::<Result<Vec<_>, _>>()?;
+            let found = translate(&self.session, &self.node, &segments).await?;
+            let mut known = self.resolved.lock().unwrap_or_else(|e| e.into_inner());
+            for (p, r) in missing.iter().zip(found) {
+                known.insert(p.text.to_owned(), r);
+            }
+        }
+        let known = self.resolved.lock().unwrap_or_else(|e| e.into_inner());
+        Ok(paths.iter().map(|p| known.get(p.text).cloned().unwrap_or(Err(StatusCode::BadNoMatch))).collect())
+    }
+
+    async fn member(&self, path: MemberPath) -> Result<NodeId, ClientError> {
+        self.resolve(&[path]).await?.remove(0).map_err(|status| ClientError::Status { what: self.what(path), status })
+    }
+
+    fn what(&self, path: MemberPath) -> String {
+        format!("{} {}/{}", H::BROWSE_NAME, self.node, path.text)
+    }
+
+    /// Reads a variable member as `T` (`S` for a scalar, `Vec<S>` for an array, per the marker's ValueRank).
+    pub async fn read<T: UaValue + Holds<S>, S>(&self, member: &VariableMember<S>) -> Result<Sample<T>, ClientError> {
+        let node = self.member(member.browse_path()).await?;
+        let mut values = read_values(&self.session, &[node]).await?;
+        sample(values.remove(0), &self.what(member.browse_path()))
+    }
+
+    /// Reads an Optional member: `None` if the instance lacks it.
+    pub async fn read_optional<T: UaValue + Holds<S>, S>(
+        &self,
+        member: &VariableMember<S>,
+    ) -> Result<Option<Sample<T>>, ClientError> {
+        match self.resolve(&[member.browse_path()]).await?.remove(0) {
+            Ok(_) => self.read(member).await.map(Some),
+            Err(_) => Ok(None),
+        }
+    }
+
+    /// Reads any number of members (absent ones are `Err(status)`): one translation for the paths not
+    /// resolved before, and one Read.
+    pub async fn read_selection(&self, paths: &[MemberPath]) -> Result<Vec<Result<DataValue, StatusCode>>, ClientError> {
+        let nodes = self.resolve(paths).await?;
+        let present: Vec<NodeId> = nodes.iter().filter_map(|n| n.as_ref().ok().cloned()).collect();
+        let mut values = read_values(&self.session, &present).await?.into_iter();
+        Ok(nodes.into_iter().map(|n| n.map(|_| values.next().unwrap_or_default())).collect())
+    }
+
+    /// Reads one member of each of several instances of this type: one translation and one Read.
+    pub async fn read_each<T: UaValue + Holds<S>, S>(
+        handles: &[Remote<H>],
+        member: &VariableMember<S>,
+    ) -> Result<Vec<Sample<T>>, ClientError> {
+        let Some(first) = handles.first() else { return Ok(Vec::new()) };
+        let path = member.browse_path();
+        let segments = path.segments().map_err(|e| ClientError::Type { what: e.to_string(), value: Variant::Empty })?;
+        let mut nodes = Vec::with_capacity(handles.len());
+        let starts: Vec<&NodeId> = handles.iter().map(|h| &h.node).collect();
+        let found = translate_from(&first.session, &starts, &segments).await?;
+        for (h, r) in handles.iter().zip(found) {
+            nodes.push(r.map_err(|status| ClientError::Status { what: h.what(path), status })?);
+        }
+        let values = read_values(&first.session, &nodes).await?;
+        values.into_iter().zip(handles).map(|(v, h)| sample(v, &h.what(path))).collect()
+    }
+
+    /// Writes a variable member.
+    pub async fn write<T: UaValue + Holds<S>, S>(&self, member: &VariableMember<S>, value: T) -> Result<(), ClientError> {
+        let node = self.member(member.browse_path()).await?;
+        let write = WriteValue {
+            node_id: node,
+            attribute_id: AttributeId::Value as u32,
+            value: DataValue::value_only(value.to_variant()),
+            ..Default::default()
+        };
+        let status = self.session.write(&[write]).await.map_err(service("Write"))?.pop().unwrap_or(StatusCode::BadUnexpectedError);
+        if status.is_bad() {
+            return Err(ClientError::Status { what: format!("write {}", self.what(member.browse_path())), status });
+        }
+        Ok(())
+    }
+
+    /// Subscribes to a variable member: a stream of its values, sampled every `interval_ms` (0: every
+    /// change).
+    pub async fn subscribe<T: UaValue + Holds<S>, S>(
+        &self,
+        member: &VariableMember<S>,
+        interval_ms: u64,
+    ) -> Result<Samples<T>, ClientError> {
+        let node = self.member(member.browse_path()).await?;
+        Samples::open(self.session.clone(), node, interval_ms).await
+    }
+
+    /// Calls the method at `path` (BrowseNames below the instance, `Lock/InitLock`; `{uri}name` names the
+    /// namespace too) on the object that holds it, with typed arguments; its typed outputs. A Bad status of
+    /// the call is the error ([`ClientError::Arguments`] when the server names the arguments it refused).
+    pub async fn call<I: Arguments, O: Arguments>(&self, path: &str, arguments: I) -> Result<O, ClientError> {
+        let mut segments = crate::remote::segments(path);
+        let Some(name) = segments.pop() else {
+            return Err(ClientError::Remote(RemoteError::Path { below: self.node.to_string(), segment: String::new(), matches: 0 }));
+        };
+        let object = if segments.is_empty() {
+            self.node.clone()
+        } else {
+            crate::remote::find_below(&self.session, &self.node, &segments.join("/")).await?
+        };
+        let method = crate::remote::find_below(&self.session, &object, name).await?;
+        call(&self.session, &object, &method, path, arguments).await
+    }
+
+    /// The instances of a placeholder below the member at `below` (`""`: the instance itself), bound as
+    /// `C` (children whose TypeDefinition is `C`'s type or a subtype), in BrowseName order: one Browse for
+    /// the children, and the supertypes of each distinct TypeDefinition (one Browse a level).
+    pub async fn placeholders<C: ObjectType>(&self, below: &str) -> Result<Vec<(String, Remote<C>)>, ClientError> {
+        let parent = if below.is_empty() { self.node.clone() } else { crate::remote::find_below(&self.session, &self.node, below).await? };
+        let expected = resolve_id(&self.session, C::TYPE_ID)?;
+        let mut out = Vec::new();
+        // One Browse gives the children with their TypeDefinitions; each distinct type is checked once.
+        let mut verdicts: Vec<(NodeId, bool)> = Vec::new();
+        for (name, child, t) in crate::remote::typed_children(&self.session, &parent).await? {
+            if t.is_null() {
+                continue;
+            }
+            let fits = match verdicts.iter().find(|(known, _)| *known == t) {
+                Some((_, fits)) => *fits,
+                None => {
+                    let fits = is_subtype(&self.session, &t, &expected).await?;
+                    verdicts.push((t, fits));
+                    fits
+                }
+            };
+            if fits {
+                out.push((name.name.as_ref().to_owned(), Remote { session: self.session.clone(), node: child, resolved: Default::default(), _type: PhantomData }));
+            }
+        }
+        out.sort_by(|a, b| a.0.cmp(&b.0));
+        Ok(out)
+    }
+}
+
+/// A subscription's values as a [`Stream`](futures_core::Stream) (or with [`Samples::next`]); the
+/// subscription is deleted when it is dropped.
+pub struct Samples<T> {
+    rx: mpsc::UnboundedReceiver<DataValue>,
+    session: Arc<Session>,
+    subscription: u32,
+    _value: PhantomData<fn() -> T>,
+}
+
+impl<T: UaValue> Samples<T> {
+    async fn open(session: Arc<Session>, node: NodeId, interval_ms: u64) -> Result<Samples<T>, ClientError> {
+        let (tx, rx) = mpsc::unbounded_channel();
+        let callback = DataChangeCallback::new(move |value: DataValue, _: &MonitoredItem| {
+            let _ = tx.send(value);
+        });
+        let publishing = Duration::from_millis(interval_ms.max(10));
+        let subscription = session
+            .create_subscription(publishing, 600, 20, 0, 0, true, callback)
+            .await
+            .map_err(service("CreateSubscription"))?;
+        let item = MonitoredItemCreateRequest {
+            item_to_monitor: ReadValueId { node_id: node.clone(), attribute_id: AttributeId::Value as u32, ..Default::default() },
+            monitoring_mode: MonitoringMode::Reporting,
+            requested_parameters: MonitoringParameters {
+                client_handle: 1,
+                sampling_interval: interval_ms as f64,
+                queue_size: 100,
+                discard_oldest: true,
+                ..Default::default()
+            },
+        };
+        let created = session
+            .create_monitored_items(subscription, TimestampsToReturn::Both, vec![item])
+            .await
+            .map_err(service("CreateMonitoredItems"))?;
+        if let Some(bad) = created.iter().map(|c| c.result.status_code).find(|s| s.is_bad()) {
+            let _ = session.delete_subscription(subscription).await;
+            return Err(ClientError::Status { what: format!("subscribe to {node}"), status: bad });
+        }
+        Ok(Samples { rx, session, subscription, _value: PhantomData })
+    }
+
+    /// The next value; `None` once the session is gone.
+    pub async fn next(&mut self) -> Option<Sample<T>> {
+        self.rx.recv().await.map(|v| Sample::of(&v))
+    }
+}
+
+impl<T: UaValue> futures_core::Stream for Samples<T> {
+    type Item = Sample<T>;
+    fn poll_next(mut self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<Option<Sample<T>>> {
+        self.rx.poll_recv(cx).map(|v| v.map(|v| Sample::of(&v)))
+    }
+}
+
+impl<T> Drop for Samples<T> {
+    fn drop(&mut self) {
+        let (session, id) = (self.session.clone(), self.subscription);
+        if let Ok(rt) = tokio::runtime::Handle::try_current() {
+            rt.spawn(async move {
+                let _ = session.delete_subscription(id).await;
+            });
+        }
+    }
+}
+
+fn sample<T: UaValue>(value: DataValue, what: &str) -> Result<Sample<T>, ClientError> {
+    let s = Sample::of(&value);
+    match (&s.value, value.value) {
+        (None, Some(v)) if !matches!(v, Variant::Empty) => Err(ClientError::Type { what: what.to_owned(), value: v }),
+        _ => Ok(s),
+    }
+}
+
+/// The NodeId of a generated NsNodeId on the session's server.
+pub(crate) fn resolve_id(session: &Session, id: NsNodeId) -> Result<NodeId, ClientError> {
+    let ns = session.get_namespace_index_from_cache(id.namespace_uri).ok_or(ClientError::UnknownNamespace(id.namespace_uri.to_owned()))?;
+    Ok(crate::make_node_id(ns, id.id))
+}
+
+/// One Read of the Value attribute of `nodes`.
+pub(crate) async fn read_values(session: &Session, nodes: &[NodeId]) -> Result<Vec<DataValue>, ClientError> {
+    if nodes.is_empty() {
+        return Ok(Vec::new());
+    }
+    let ids: Vec<ReadValueId> = nodes
+        .iter()
+        .map(|n| ReadValueId { node_id: n.clone(), attribute_id: AttributeId::Value as u32, ..Default::default() })
+        .collect();
+    let values = session.read(&ids, TimestampsToReturn::Both, 0.0).await.map_err(service("Read"))?;
+    if values.len() != nodes.len() {
+        return Err(ClientError::Remote(RemoteError::Service("Read", StatusCode::BadUnexpectedError)));
+    }
+    Ok(values)
+}
+
+/// Calls `method` on `object`; a Bad status is the error.
+pub(crate) async fn call<I: Arguments, O: Arguments>(
+    session: &Session,
+    object: &NodeId,
+    method: &NodeId,
+    name: &str,
+    arguments: I,
+) -> Result<O, ClientError> {
+    let request = CallMethodRequest {
+        object_id: object.clone(),
+        method_id: method.clone(),
+        input_arguments: Some(arguments.into_variants()),
+    };
+    let result = session.call(vec![request]).await.map_err(service("Call"))?.pop();
+    let result = result.ok_or(ClientError::Remote(RemoteError::Service("Call", StatusCode::BadUnexpectedError)))?;
+    let per_argument = result.input_argument_results.unwrap_or_default();
+    if result.status_code.is_bad() {
+        if per_argument.iter().any(|s| s.is_bad()) {
+            return Err(ClientError::Arguments { method: name.to_owned(), status: result.status_code, arguments: per_argument });
+        }
+        return Err(ClientError::Status { what: format!("call {name}"), status: result.status_code });
+    }
+    let outputs = result.output_arguments.unwrap_or_default();
+    O::from_variants(&outputs).map_err(|_| ClientError::Type { what: format!("outputs of {name}"), value: Variant::from(outputs) })
+}
+
+/// One TranslateBrowsePathsToNodeIds of `paths` (BrowseNames with namespace URIs) from `start`.
+pub(crate) async fn translate(
+    session: &Session,
+    start: &NodeId,
+    paths: &[Vec<(&'static str, String)>],
+) -> Result<Vec<Result<NodeId, StatusCode>>, ClientError> {
+    let mut out = Vec::with_capacity(paths.len());
+    let mut asked = Vec::new();
+    let mut requests = Vec::new();
+    for (i, path) in paths.iter().enumerate() {
+        out.push(Err(StatusCode::BadNoMatch));
+        if let Some(request) = browse_path(session, start, path) {
+            asked.push(i);
+            requests.push(request);
+        }
+    }
+    resolve_paths(session, requests, asked, out).await
+}
+
+/// One TranslateBrowsePathsToNodeIds of the same path from each of `starts`.
+async fn translate_from(
+    session: &Session,
+    starts: &[&NodeId],
+    path: &[(&'static str, String)],
+) -> Result<Vec<Result<NodeId, StatusCode>>, ClientError> {
+    let mut out = Vec::with_capacity(starts.len());
+    let mut asked = Vec::new();
+    let mut requests = Vec::new();
+    for (i, start) in starts.iter().enumerate() {
+        out.push(Err(StatusCode::BadNoMatch));
+        if let Some(request) = browse_path(session, start, path) {
+            asked.push(i);
+            requests.push(request);
+        }
+    }
+    resolve_paths(session, requests, asked, out).await
+}
+
+async fn resolve_paths(
+    session: &Session,
+    requests: Vec<BrowsePath>,
+    asked: Vec<usize>,
+    mut out: Vec<Result<NodeId, StatusCode>>,
+) -> Result<Vec<Result<NodeId, StatusCode>>, ClientError> {
+    if requests.is_empty() {
+        return Ok(out);
+    }
+    let results = session.translate_browse_paths_to_node_ids(&requests).await.map_err(service("TranslateBrowsePathsToNodeIds"))?;
+    for (i, r) in asked.into_iter().zip(results) {
+        let target = r.targets.unwrap_or_default().into_iter().find(|t| t.remaining_path_index == u32::MAX);
+        out[i] = match target {
+            Some(t) if r.status_code.is_good() => Ok(t.target_id.node_id),
+            _ if r.status_code.is_bad() => Err(r.status_code),
+            _ => Err(StatusCode::BadNoMatch),
+        };
+    }
+    Ok(out)
+}
+
+/// The BrowsePath of `path` from `start`; `None` if a namespace is not on the server (nothing can match).
+fn browse_path(session: &Session, start: &NodeId, path: &[(&'static str, String)]) -> Option<BrowsePath> {
+    let mut elements = Vec::with_capacity(path.len());
+    for (uri, name) in path {
+        let ns = session.get_namespace_index_from_cache(uri)?;
+        elements.push(RelativePathElement {
+            reference_type_id: ReferenceTypeId::HierarchicalReferences.into(),
+            is_inverse: false,
+            include_subtypes: true,
+            target_name: QualifiedName::new(ns, name.as_str()),
+        });
+    }
+    Some(BrowsePath { starting_node: start.clone(), relative_path: RelativePath { elements: Some(elements) } })
+}
+
+/// The targets of one reference type from `node` (forward or inverse).
+async fn references(session: &Session, node: &NodeId, reference: ReferenceTypeId, direction: BrowseDirection) -> Result<Vec<NodeId>, ClientError> {
+    let description = BrowseDescription {
+        node_id: node.clone(),
+        browse_direction: direction,
+        reference_type_id: reference.into(),
+        include_subtypes: false,
+        node_class_mask: NodeClassMask::all().bits(),
+        result_mask: BrowseResultMask::None as u32,
+    };
+    let result = session.browse(&[description], 0, None).await.map_err(service("Browse"))?.pop();
+    let result = result.ok_or(ClientError::Remote(RemoteError::Service("Browse", StatusCode::BadUnexpectedError)))?;
+    if result.status_code.is_bad() {
+        return Err(ClientError::Status { what: format!("browse {node}"), status: result.status_code });
+    }
+    Ok(result.references.unwrap_or_default().into_iter().map(|r| r.node_id.node_id).collect())
+}
+
+/// The TypeDefinition of an instance.
+async fn type_definition(session: &Session, node: &NodeId) -> Result<Option<NodeId>, ClientError> {
+    Ok(references(session, node, ReferenceTypeId::HasTypeDefinition, BrowseDirection::Forward).await?.into_iter().next())
+}
+
+/// Whether `ty` is `ancestor` or one of its subtypes (following HasSubtype up, one Browse per level).
+async fn is_subtype(session: &Session, ty: &NodeId, ancestor: &NodeId) -> Result<bool, ClientError> {
+    let mut current = ty.clone();
+    for _ in 0..64 {
+        if current == *ancestor {
+            return Ok(true);
+        }
+        match references(session, &current, ReferenceTypeId::HasSubtype, BrowseDirection::Inverse).await?.into_iter().next() {
+            Some(parent) => current = parent,
+            None => return Ok(false),
+        }
+    }
+    Ok(false)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_client_config_is_secure_by_default_and_does_not_show_the_password() {
+        let config = ClientConfig::new("pki/client").user("op", "s3cret-pass");
+        assert_eq!((config.policy, config.mode), (SecurityPolicy::Basic256Sha256, MessageSecurityMode::SignAndEncrypt));
+        assert!(!config.trust_server_on_first_use);
+        assert_eq!(config.pki_dir, PathBuf::from("pki/client"));
+        let shown = format!("{config:?}");
+        assert!(shown.contains("\"op\"") && !shown.contains("s3cret-pass"), "{shown}");
+        let none = ClientConfig::insecure();
+        assert_eq!((none.policy, none.mode, none.user), (SecurityPolicy::None, MessageSecurityMode::None, None));
+    }
+}
