@@ -267,6 +267,76 @@ fn value(vars: &[(String, f64, f64)], name: &str) -> (f64, f64) {
         .unwrap_or_else(|| panic!("no variable {name} in {vars:?}"))
 }
 
+/// Simulates `model` below `root` with `tests/modelica/simulate.py --strings-as-parameters` (rumoca 0.10.2
+/// cannot simulate String variables, see `RumocaBehaviour.StringDemo`); (name, value at each of `times`).
+fn simulate_at(root_dir: &Path, model: &str, times: &[f64]) -> Vec<(String, Vec<f64>)> {
+    let out = Command::new(python())
+        .arg(root().join("tests/modelica/simulate.py"))
+        .arg("--strings-as-parameters")
+        .arg(root_dir)
+        .arg(model)
+        .args(times.iter().map(|t| t.to_string()))
+        .output()
+        .expect("cannot run tests/modelica/simulate.py");
+    let text = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(text.contains(&format!("simulated {model}")), "{text}");
+    text.lines()
+        .filter_map(|l| {
+            let mut parts = l.split_whitespace();
+            let name = parts.next()?.to_string();
+            let values: Option<Vec<f64>> =
+                parts.take(times.len()).map(|p| p.split('@').next()?.parse().ok()).collect();
+            Some((name, values?))
+        })
+        .collect()
+}
+
+/// The skill state machine, generated afresh from our skill models: `tests/modelica/SkillExample.DrillHoleRun`
+/// drives the DrillHole skill of the generated DrillingCell instance with pulses on its trigger inputs.
+/// The skill starts in Ready (the instance's CurrentState and Program rule, see `statemachine.rs`), so Start
+/// runs it at once; Halt stops it; a Start in Halted does nothing; Reset brings it back to Ready, and Start
+/// runs it again. The model passes rumoca's check as it is; the simulation has the String variables as
+/// parameters, so the state text (a `final` binding to the text the machine's equation sets) is checked by
+/// the generator's unit test `state_text_follows_the_number_and_instances_set_the_initial_state`.
+#[test]
+fn a_skill_instance_runs_through_start_halt_and_reset() {
+    let dir = vendor();
+    let files: Vec<PathBuf> = ["CommonSkills", "RobotCell", "DrillingProcess"]
+        .iter()
+        .map(|n| root().join("nodesets").join(format!("{n}.NodeSet2.xml")))
+        .collect();
+    let out = compile_files(&files, vec![dir]);
+    let mut cfg = ModelicaConfig::new();
+    for m in &out.model.models {
+        if m.uri != NS0_URI {
+            cfg = cfg.namespace(m.uri.clone());
+        }
+    }
+    let generated = generate(&out.model, &cfg).unwrap_or_else(|d| panic!("{}", d.render(&out.model.sources)));
+    let target = tmp("skills-run");
+    write(&target, &generated);
+    copy_dir(&root().join("tests/modelica/SkillExample"), &target.join("SkillExample"));
+    // The library and the example as they are (with their String variables) pass rumoca's check.
+    let (passed, failed, text) = check(&target, true);
+    assert_eq!(failed, 0, "{text}");
+    assert!(passed > 100, "{text}");
+    // (time, state number): before anything, after Start, after Halt, after the ignored Start, after Reset,
+    // after the second Start.
+    let expected = [(0.5, 12.0), (1.5, 13.0), (2.3, 11.0), (2.8, 11.0), (3.5, 12.0), (4.5, 13.0)];
+    let times: Vec<f64> = expected.iter().map(|e| e.0).collect();
+    let vars = simulate_at(&target, "SkillExample.DrillHoleRun", &times);
+    let get = |name: &str| {
+        vars.iter()
+            .find(|v| v.0 == name)
+            .map(|v| v.1.clone())
+            .unwrap_or_else(|| panic!("no variable {name} in {:?}", vars.iter().map(|v| &v.0).collect::<Vec<_>>()))
+    };
+    let states = get("state");
+    let want: Vec<f64> = expected.iter().map(|e| e.1).collect();
+    assert_eq!(states, want, "state numbers at {times:?} (Halted 11, Ready 12, Running 13)");
+}
+
 /// What rumoca 0.10.2 does with redeclarations, reproduced with small hand-written models
 /// (`tests/modelica/RumocaBehaviour`, which documents each case). The generator works around the first one
 /// (`Mod::Pin`); if a rumoca release fixes it, this test fails and the workaround can be reconsidered.
@@ -287,6 +357,18 @@ fn rumoca_behaviour_is_as_reproduced() {
     let dropped = simulate(&dir, "RumocaBehaviour.DroppedDemo", "1");
     assert!(names(&dropped).contains(&"a.y".to_string()), "{:?}", names(&dropped));
     assert!(!names(&dropped).contains(&"a.ps.pos".to_string()), "rumoca keeps the component now: {:?}", names(&dropped));
+    // A String variable: the model cannot be simulated (simulate.py --strings-as-parameters works around it).
+    let out = Command::new(python())
+        .arg(root().join("tests/modelica/simulate.py"))
+        .arg(&dir)
+        .arg("RumocaBehaviour.StringDemo")
+        .output()
+        .expect("cannot run tests/modelica/simulate.py");
+    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(
+        !out.status.success() && text.contains("String values are not numeric"),
+        "rumoca simulates String variables now; drop --strings-as-parameters: {text}"
+    );
 }
 
 /// Generates the models of each file (with everything it requires, ns0 as a subset) and checks each output

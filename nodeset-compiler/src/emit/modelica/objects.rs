@@ -171,6 +171,8 @@ pub struct Body {
     pub local_replaceable: bool,
     /// The body declares or redeclares something, so it needs a class of its own (modifiers alone do not).
     pub adds: bool,
+    /// The state the inherited state machine starts in here, when a child CurrentState names another one.
+    pub initial: Option<usize>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -256,7 +258,7 @@ impl Ctx<'_> {
             .unwrap_or_default();
         let owner = Owner::Type(t);
         let mut body = self.plan_body(owner, "", base.as_ref(), &own, Mode::Type, true);
-        let mut state_machine = base.as_ref().and_then(|b| b.state_machine.clone());
+        let mut state_machine = starting_in(base.as_ref().and_then(|b| b.state_machine.clone()), body.initial);
         if let Some(sm) = self.plan_state_machine(t, base.as_ref(), &mut body) {
             state_machine = Some(Rc::new(sm));
         }
@@ -608,6 +610,14 @@ impl Ctx<'_> {
             match by_bn.get(&bn) {
                 Some(&ei) if !matches!(elements[ei].kind, ElemKind::Skipped) => {
                     let e = elements[ei].clone();
+                    let machine = base.and_then(|b| b.state_machine.clone());
+                    if let Some(sm) = machine.filter(|sm| sm.text.as_ref().is_some_and(|(cur, _)| *cur == e.ident)) {
+                        // The text of the state follows the number: the state a CurrentState names is where the
+                        // machine starts, never a value of the text.
+                        self.start_state(&sm, o.node, &mut body);
+                        elements[ei].node = o.node;
+                        continue;
+                    }
                     if let Some(updated) = self.plan_override(owner, path, &e, *o, mode, &mut body) {
                         elements[ei] = updated;
                     }
@@ -982,7 +992,7 @@ impl Ctx<'_> {
             elements: sub.elements,
             taken: sub.taken,
             local_replaceable: sub.local_replaceable,
-            state_machine: base.state_machine.clone(),
+            state_machine: starting_in(base.state_machine.clone(), sub.initial),
         };
         self.class_infos.insert(key.clone(), Rc::new(info));
         key
@@ -1162,6 +1172,17 @@ impl Ctx<'_> {
             Some(info) => format!("Method {name}({}): call it through an OPC UA client.", args(&info.inputs)),
             None => format!("Method {name}: call it through an OPC UA client."),
         }
+    }
+}
+
+/// A state machine that starts in state `initial` instead of its own initial state.
+fn starting_in(
+    sm: Option<Rc<super::statemachine::SmInfo>>,
+    initial: Option<usize>,
+) -> Option<Rc<super::statemachine::SmInfo>> {
+    match (sm, initial) {
+        (Some(sm), Some(i)) => Some(Rc::new(super::statemachine::SmInfo { initial: i, ..(*sm).clone() })),
+        (sm, _) => sm,
     }
 }
 

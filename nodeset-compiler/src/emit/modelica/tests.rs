@@ -231,3 +231,56 @@ fn a_subtype_makes_an_optional_member_mandatory_and_redeclares_its_class() {
         axis.contents
     );
 }
+
+fn contents<'a>(files: &'a [crate::write::OutFile], path: &str) -> &'a str {
+    &files.iter().find(|f| f.path.ends_with(path)).unwrap_or_else(|| panic!("no {path}")).contents
+}
+
+/// The skill models, with the CurrentState of the DrillingCell's ReferenceDrillBush instance changed from
+/// Ready to `state` (Id, Number and text).
+fn skills_with_reference_drill_bush_in(state: Option<(&str, &str, &str)>) -> Vec<crate::write::OutFile> {
+    let dir = workspace().join("nodesets");
+    let mut inputs = Vec::new();
+    for name in ["CommonSkills", "RobotCell", "DrillingProcess"] {
+        let path = dir.join(format!("{name}.NodeSet2.xml"));
+        let mut text = std::fs::read_to_string(&path).unwrap();
+        if let (Some((id, number, shown)), "DrillingProcess") = (state, name) {
+            let from = text.find("NodeId=\"ns=1;i=4003\"").unwrap();
+            let to = text.find("NodeId=\"ns=1;i=4006\"").unwrap();
+            let part = text[from..to]
+                .replace("<uax:Text>Ready</uax:Text>", &format!("<uax:Text>{shown}</uax:Text>"))
+                .replace("<uax:Identifier>i=2400</uax:Identifier>", &format!("<uax:Identifier>{id}</uax:Identifier>"))
+                .replace("<uax:UInt32>12</uax:UInt32>", &format!("<uax:UInt32>{number}</uax:UInt32>"));
+            text.replace_range(from..to, &part);
+        }
+        inputs.push(Input::Text { name: path.display().to_string(), text });
+    }
+    let out = compile(inputs, &Options { model_dirs: vec![dir.join("vendor")], ..Options::default() });
+    assert!(out.ok(), "{}", out.render_diagnostics());
+    let mut cfg = ModelicaConfig::new();
+    for m in &out.model.models {
+        if m.uri != crate::load::NS0_URI {
+            cfg = cfg.namespace(m.uri.clone());
+        }
+    }
+    generate(&out.model, &cfg).unwrap()
+}
+
+#[test]
+fn state_text_follows_the_number_and_instances_set_the_initial_state() {
+    let files = skills_with_reference_drill_bush_in(None);
+    let program = contents(&files, "OpcUa/ObjectTypes/ProgramStateMachineType.mo");
+    assert!(program.contains("final currentState=currentStateText"), "{program}");
+    assert!(program.contains("discrete Integer currentStateNumber(start=Ready, fixed=true)"), "{program}");
+    assert!(program.contains("currentStateText = if currentStateNumber == Halted then \"Halted\""), "{program}");
+    // The instances are in Ready, where the skills start anyway: no modifier, and never the text.
+    let cell = contents(&files, "NodesetCompilerDrillingProcess/Instances/DrillingCell.mo");
+    assert!(!cell.contains("currentState"), "{cell}");
+    // An instance in another state starts there; Id, Number and text each name it.
+    for (id, number, shown) in [("i=2406", "11", "Halted"), ("i=2402", "13", "Running")] {
+        let files = skills_with_reference_drill_bush_in(Some((id, number, shown)));
+        let cell = contents(&files, "NodesetCompilerDrillingProcess/Instances/DrillingCell.mo");
+        assert!(cell.contains(&format!("referenceDrillBush(currentStateNumber(start={number})")), "{cell}");
+        assert!(!cell.contains("currentState="), "{cell}");
+    }
+}
