@@ -492,6 +492,139 @@ fn generated_tree_passes_rumoca() {
     assert_eq!(passed, classes, "every class of generated/modelica is checked\n{text}");
 }
 
+/// Removes comments and the contents of string literals from Modelica text.
+fn code_only(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut chars = text.chars().peekable();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' => {
+                while let Some(d) = chars.next() {
+                    match d {
+                        '\\' => {
+                            chars.next();
+                        }
+                        '"' => break,
+                        _ => {}
+                    }
+                }
+                out.push_str("\"\"");
+            }
+            '/' if chars.peek() == Some(&'/') => {
+                for d in chars.by_ref() {
+                    if d == '\n' {
+                        out.push('\n');
+                        break;
+                    }
+                }
+            }
+            '/' if chars.peek() == Some(&'*') => {
+                chars.next();
+                let mut last = ' ';
+                for d in chars.by_ref() {
+                    if last == '*' && d == '/' {
+                        break;
+                    }
+                    last = d;
+                }
+            }
+            _ => out.push(c),
+        }
+    }
+    out
+}
+
+/// The class graph of a Modelica library below `dir` (one class per file): for each class, the classes its
+/// text names by their full names, which is how the generator writes every `extends`, component class,
+/// replaceable alias and redeclaration. Package files are not classes of the graph.
+fn class_graph(dir: &Path) -> std::collections::BTreeMap<String, std::collections::BTreeSet<String>> {
+    let mut texts = std::collections::BTreeMap::new();
+    let mut dirs = vec![dir.to_path_buf()];
+    while let Some(d) = dirs.pop() {
+        for entry in std::fs::read_dir(&d).unwrap().flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                dirs.push(path);
+            } else if path.extension().is_some_and(|x| x == "mo") && !path.ends_with("package.mo") {
+                let rel = path.strip_prefix(dir).unwrap().with_extension("");
+                let name: Vec<String> =
+                    rel.components().map(|c| c.as_os_str().to_string_lossy().into_owned()).collect();
+                texts.insert(name.join("."), code_only(&std::fs::read_to_string(&path).unwrap()));
+            }
+        }
+    }
+    let mut graph = std::collections::BTreeMap::new();
+    for (class, text) in &texts {
+        let mut edges = std::collections::BTreeSet::new();
+        let is_ident = |c: char| c.is_ascii_alphanumeric() || c == '_' || c == '.';
+        for word in text.split(|c: char| !is_ident(c)) {
+            if word.contains('.') && texts.contains_key(word) {
+                edges.insert(word.to_string());
+            }
+        }
+        graph.insert(class.clone(), edges);
+    }
+    graph
+}
+
+/// A cycle of the class graph, as `A -> B -> A`, if there is one.
+fn class_cycle(graph: &std::collections::BTreeMap<String, std::collections::BTreeSet<String>>) -> Option<String> {
+    #[derive(PartialEq)]
+    enum Mark {
+        Open,
+        Done,
+    }
+    let mut marks: std::collections::BTreeMap<&str, Mark> = std::collections::BTreeMap::new();
+    for root in graph.keys() {
+        if marks.contains_key(root.as_str()) {
+            continue;
+        }
+        let mut path: Vec<(&str, Vec<&str>)> = vec![(root, graph[root].iter().map(String::as_str).collect())];
+        marks.insert(root, Mark::Open);
+        while let Some((node, next)) = path.last_mut() {
+            let node: &str = node;
+            let Some(to) = next.pop() else {
+                marks.insert(node, Mark::Done);
+                path.pop();
+                continue;
+            };
+            match marks.get(to) {
+                Some(Mark::Done) => {}
+                Some(Mark::Open) => {
+                    let start = path.iter().position(|p| p.0 == to).unwrap();
+                    let mut names: Vec<&str> = path[start..].iter().map(|p| p.0).collect();
+                    names.push(to);
+                    return Some(names.join(" -> "));
+                }
+                None => {
+                    marks.insert(to, Mark::Open);
+                    path.push((to, graph[to].iter().map(String::as_str).collect()));
+                }
+            }
+        }
+    }
+    None
+}
+
+/// No generated class contains itself, directly or through the classes it extends or contains: the
+/// checked-in tree of DI, IA, Robotics and our skill models. (Modelica tools reject recursive classes;
+/// rumoca does not notice them.) The walk itself is checked on a small cycle.
+#[test]
+fn no_generated_class_contains_itself() {
+    let mut toy = std::collections::BTreeMap::new();
+    toy.insert("P.A".to_string(), ["P.B".to_string()].into_iter().collect());
+    toy.insert("P.B".to_string(), ["P.A".to_string()].into_iter().collect());
+    assert_eq!(class_cycle(&toy).as_deref(), Some("P.A -> P.B -> P.A"));
+    let tree = root().join("generated/modelica");
+    let graph = class_graph(&tree);
+    assert!(graph.len() > 200, "expected the classes of generated/modelica, found {}", graph.len());
+    let edges: usize = graph.values().map(|e| e.len()).sum();
+    if let Some(cycle) = class_cycle(&graph) {
+        panic!("a class contains itself: {cycle}");
+    }
+    println!("generated/modelica: {} classes, {edges} edges, no cycle", graph.len());
+}
+
 #[test]
 fn skill_reference_models_pass_rumoca() {
     let tree = root().join("../shared/nodesets/skills-reference");

@@ -63,6 +63,12 @@ pub enum ElemKind {
         class: ClassKey,
     },
     Method,
+    /// A child held by a reference that is not containment (Requires, Moves, ...), or whose containment would
+    /// make the class contain itself: a `String` parameter with the NodeId of the target (an array of them for
+    /// a placeholder).
+    Reference {
+        array: bool,
+    },
     /// Declared nowhere (no Modelica type); the name stays taken.
     Skipped,
 }
@@ -587,7 +593,7 @@ impl Ctx<'_> {
             }
             if !by_bn.contains_key(bn) {
                 scope.add(&component_original(&bn.name), (i, false));
-                if self.gets_alias(o.node, mode, allow_replaceable) {
+                if self.gets_alias(*o, mode, allow_replaceable) {
                     scope.add(&bn.name, (i, true));
                 }
             }
@@ -651,11 +657,73 @@ impl Ctx<'_> {
     }
 
     /// Whether a new child becomes a replaceable object (with a class alias).
-    fn gets_alias(&self, node: NodeIx, mode: Mode, allow_replaceable: bool) -> bool {
+    fn gets_alias(&self, o: Own, mode: Mode, allow_replaceable: bool) -> bool {
         allow_replaceable
             && mode == Mode::Type
-            && self.m.node(node).class == NodeClass::Object
-            && !self.is_event_type(self.object_td(node))
+            && self.m.node(o.node).class == NodeClass::Object
+            && !self.is_event_type(self.object_td(o.node))
+            && !self.is_reference(o)
+    }
+
+    /// Whether a child becomes a reference parameter rather than a component (see `recursion.rs`).
+    fn is_reference(&self, o: Own) -> bool {
+        matches!(self.m.node(o.node).class, NodeClass::Object | NodeClass::Variable)
+            && (!super::recursion::is_containment(self.m, o.rt) || self.cuts.contains(&o.node))
+    }
+
+    /// A child held by reference: a `String` parameter with the NodeId of its target (in an instance) or `""`
+    /// (in a type, where the target is only declared), an array of them for a placeholder.
+    fn plan_reference(
+        &mut self,
+        ident: String,
+        o: Own,
+        rule: Option<ModellingRule>,
+        body: &mut Body,
+        mut element: Element,
+    ) -> Element {
+        let m = self.m;
+        let n = m.node(o.node);
+        let bn = n.browse_name.clone();
+        body.adds = true;
+        let rt = m.node(o.rt).browse_name.name.clone();
+        let why = if super::recursion::is_containment(m, o.rt) {
+            format!("held by {rt}, but containing it would make the class contain itself")
+        } else {
+            format!("{rt} reference")
+        };
+        let td = n.type_definition.map(|t| format!(", an instance of {}", m.node(t).browse_name.name)).unwrap_or_default();
+        let doc = match n.doc() {
+            Some(d) => format!("{d} [{why}: the NodeId of the target{td}; \"\" for none]"),
+            None => format!("{why}: the NodeId of the target{td}; \"\" for none"),
+        };
+        let desc = text::description(&bn.name, Some(&doc));
+        let mut annotation = self.opcua_annotation(o.node);
+        annotation.insert_str(annotation.len() - 1, &format!(", referenceType={}", string_literal(&rt)));
+        let (dims, value) = if rule.is_some_and(ModellingRule::is_placeholder) {
+            let count = self.derived_name(body, count_name(&ident), o.node);
+            body.items.push(count_decl(&count, &bn.name, rule));
+            let v = format!("fill(\"\", {count})");
+            element.count = Some(count.clone());
+            (format!("[{count}]"), v)
+        } else if rule.is_none() {
+            // An instance: the target is the node itself.
+            (String::new(), string_literal(&node_id_text(m, &n.id)))
+        } else {
+            (String::new(), "\"\"".to_string())
+        };
+        element.kind = ElemKind::Reference { array: element.count.is_some() };
+        body.items.push(Item::Decl {
+            prefix: "parameter".into(),
+            ty: TypeRef::Path("String".into()),
+            ident,
+            dims,
+            mods: Vec::new(),
+            value: Some(value),
+            cond: None,
+            desc,
+            annotation,
+        });
+        element
     }
 
     /// A name derived from an element's (`use_x`, `nX`), unique in the class.
@@ -711,6 +779,9 @@ impl Ctx<'_> {
             count: None,
             alias: None,
         };
+        if self.is_reference(o) {
+            return self.plan_reference(ident, o, rule, body, element);
+        }
         let desc = text::description(&bn.name, n.doc());
         let annotation = self.opcua_annotation(o.node);
         match n.class {
@@ -1029,6 +1100,18 @@ impl Ctx<'_> {
         }
         match &e.kind {
             ElemKind::Method | ElemKind::Skipped => None,
+            ElemKind::Reference { array } => {
+                // An instance names the target; a type has only a declaration of it.
+                if mode == Mode::Instance && !array {
+                    body.mods.push(Mod::Value {
+                        ident: e.ident.clone(),
+                        is_final: false,
+                        attrs: Vec::new(),
+                        value: Some(string_literal(&node_id_text(m, &n.id))),
+                    });
+                }
+                Some(updated)
+            }
             ElemKind::Parameter { ty, dims } | ElemKind::Signal { ty, dims, .. } => {
                 if e.count.is_some() {
                     return Some(updated);
