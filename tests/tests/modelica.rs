@@ -7,6 +7,9 @@
 //! * every resolvable file of the ua-nodeset corpus and the skill reference models, checked by rumoca one
 //!   aggregate model per nodeset;
 //! * the checked-in `generated/modelica` (with our skill models), checked class by class by rumoca;
+//! * no recursive class: the class graph (extends, components, aliases, redeclarations) of
+//!   `generated/modelica`, of every corpus output and of the skill reference models has no cycle;
+//! * a skill instance of our drilling cell simulated through Start, Halt and Reset (`tests/modelica/SkillExample`);
 //! * determinism: same input, byte-identical output, whatever the input order.
 //!
 //! rumoca runs in the venv that `cargo xtask venv` creates; a missing venv fails the tests with that command.
@@ -371,8 +374,8 @@ fn rumoca_behaviour_is_as_reproduced() {
     );
 }
 
-/// Generates the models of each file (with everything it requires, ns0 as a subset) and checks each output
-/// with one aggregate rumoca model, two nodesets at a time.
+/// Generates the models of each file (with everything it requires, ns0 as a subset), checks that no class of
+/// an output contains itself, and checks each output with one aggregate rumoca model, two nodesets at a time.
 fn check_tree(label: &str, tree: &Path, files: &[PathBuf], absent_ok: bool) {
     let t0 = Instant::now();
     let mut jobs: Vec<(PathBuf, PathBuf, usize)> = Vec::new();
@@ -411,6 +414,12 @@ fn check_tree(label: &str, tree: &Path, files: &[PathBuf], absent_ok: bool) {
     if !absent_ok {
         assert!(unresolvable.is_empty(), "{unresolvable:?} do not resolve");
     }
+    // No class contains itself (see `no_generated_class_contains_itself`).
+    let cycles: Vec<String> = jobs
+        .iter()
+        .filter_map(|(f, dir, _)| class_cycle(&class_graph(dir)).map(|c| format!("{}: {c}", f.display())))
+        .collect();
+    assert!(cycles.is_empty(), "classes that contain themselves:\n{}", cycles.join("\n"));
     let gen_elapsed = t0.elapsed().as_secs_f64();
     // Two workers: the CI machine has two cores.
     let t1 = Instant::now();
