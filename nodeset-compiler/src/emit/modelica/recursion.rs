@@ -104,7 +104,7 @@ fn first_cycle(graph: &BTreeMap<NodeIx, Vec<Edge>>, cuts: &BTreeSet<NodeIx>) -> 
                     // A cycle: from e.to along the path back to node, then e. Cut its last containment edge.
                     let start = path.iter().position(|p| p.0 == e.to).expect("an open node is on the path");
                     let cycle = path[start + 1..].iter().filter_map(|p| p.2).chain(std::iter::once(e));
-                    if let Some(via) = cycle.filter_map(|x| x.via).last() {
+                    if let Some(via) = cycle.filter_map(|x| x.via).next_back() {
                         return Some(via);
                     }
                     // Only `extends` edges: a supertype cycle, which the resolver reports; nothing to cut.
