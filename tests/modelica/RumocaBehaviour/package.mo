@@ -1,5 +1,5 @@
 within;
-package RumocaBehaviour "Minimal reproductions of how rumoca 0.10.2 reads redeclarations, which the generator works around"
+package RumocaBehaviour "Minimal reproductions of how rumoca 0.10.2 reads redeclarations and String variables, which the generator and the tests work around"
   annotation (Documentation(info="<html>
 <p>Hand-written, not generated. Each <code>*Demo</code> model is simulated by the test
 <code>rumoca_behaviour_is_as_reproduced</code> in <code>tests/tests/modelica.rs</code>, which asserts what rumoca
@@ -18,6 +18,10 @@ This is what the generator does (<code>Mod::Pin</code> in <code>nodeset-compiler
 (<code>replaceable Empty ps</code> in <code>CBase</code>) redeclared two <code>extends</code> levels below its
 declaration (<code>CAxis extends CMid(redeclare InnerPS ps)</code>): rumoca drops the component and the
 <code>connect</code> to it, again without a diagnostic.</li>
+<li><code>StringDemo</code>: a String variable (not a parameter). rumoca checks the model but refuses to
+simulate it (<code>String values are not numeric Solve coordinates</code>). Every OPC UA state machine has
+one (CurrentState), so <code>tests/modelica/simulate.py --strings-as-parameters</code> simulates a copy of the
+library in which String variables are parameters and their equations are left out.</li>
 </ul>
 </html>"));
 end RumocaBehaviour;

@@ -3,7 +3,7 @@
 within NodesetCompilerDrillingProcess.Instances;
 model DrillingCell "DrillingCell: The template drilling cell for the vertical tail plane: its process skills in SkillSet."
   extends NodesetCompilerDrillingProcess.ObjectTypes.DrillingCellType(
-    skillSet(referenceDrillBush(currentState="Ready", deletable=false, autoDelete=false, recycleCount=0), drillHole(currentState="Ready", deletable=false, autoDelete=false, recycleCount=0)));
+    skillSet(referenceDrillBush(deletable=false, autoDelete=false, recycleCount=0), drillHole(deletable=false, autoDelete=false, recycleCount=0)));
   annotation (
     Documentation(info="<html><p>The template drilling cell for the vertical tail plane: its process skills in SkillSet.</p><p>The instance DrillingCell of DrillingProcess:DrillingCellType (nsu=http://nodeset-compiler.dev/DrillingProcess/;i=4000).</p></html>"),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=4000", browseName="DrillingCell", browsePath="DrillingCell"));

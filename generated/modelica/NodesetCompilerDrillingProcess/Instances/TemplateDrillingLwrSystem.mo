@@ -4,7 +4,7 @@ within NodesetCompilerDrillingProcess.Instances;
 model TemplateDrillingLwrSystem "TemplateDrillingLwrSystem: The mobile lightweight robot system of the cell: a UR10e carrying the drilling end effector."
   extends NodesetCompilerRobotCell.ObjectTypes.TemplateDrillingLwrSystemType(
     redeclare model MotionDeviceSystem = NodesetCompilerDrillingProcess.Declarations.TemplateDrillingLwrSystem_MotionDeviceSystem,
-    drillingEndEffector(skillSet(templateDrilling(currentState="Ready", deletable=false, autoDelete=false, recycleCount=0))));
+    drillingEndEffector(skillSet(templateDrilling(deletable=false, autoDelete=false, recycleCount=0))));
   annotation (
     Documentation(info="<html><p>The mobile lightweight robot system of the cell: a UR10e carrying the drilling end effector.</p><p>The instance DeviceSet/TemplateDrillingLwrSystem of RobotCell:TemplateDrillingLwrSystemType (nsu=http://nodeset-compiler.dev/DrillingProcess/;i=5000).</p></html>"),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=5000", browseName="TemplateDrillingLwrSystem", browsePath="DeviceSet/TemplateDrillingLwrSystem"));

@@ -6,11 +6,9 @@ model FileDirectoryType "FileDirectoryType"
   parameter Integer nFileDirectoryName(min=0) = 0
     "Number of <FileDirectoryName> (OptionalPlaceholder)"
     annotation (Evaluate=true);
-  replaceable model FileDirectoryName = OpcUa.Declarations.FileDirectoryType_FileDirectoryName
-    "Class of <FileDirectoryName>; redeclare it to use a model of your own";
-  FileDirectoryName fileDirectoryName[nFileDirectoryName]
-    "<FileDirectoryName>"
-    annotation (__OPCUA(browsePath="<FileDirectoryName>", nodeId="i=13354", typeDefinition="i=13353"));
+  parameter String fileDirectoryName[nFileDirectoryName] = fill("", nFileDirectoryName)
+    "<FileDirectoryName>: held by Organizes, but containing it would make the class contain itself: the NodeId of the target, an instance of FileDirectoryType; \"\" for none"
+    annotation (__OPCUA(browsePath="<FileDirectoryName>", nodeId="i=13354", typeDefinition="i=13353", referenceType="Organizes"));
   parameter Integer nFileName(min=0) = 0
     "Number of <FileName> (OptionalPlaceholder)"
     annotation (Evaluate=true);

@@ -2,8 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within OpcUa.ObjectTypes;
 model FileTransferStateMachineType "FileTransferStateMachineType"
-  extends OpcUa.ObjectTypes.FiniteStateMachineType(
-    currentState=if currentStateNumber == Idle then "Idle" elseif currentStateNumber == ReadPrepare then "ReadPrepare" elseif currentStateNumber == ReadTransfer then "ReadTransfer" elseif currentStateNumber == ApplyWrite then "ApplyWrite" elseif currentStateNumber == Error then "Error" else "");
+  extends OpcUa.ObjectTypes.FiniteStateMachineType(final currentState=currentStateText);
   // Method Reset(): call it through an OPC UA client.
   // State machine of FileTransferStateMachineType: its states, and transitions driven by the trigger inputs.
   parameter Integer stateMachineLevel = 1
@@ -24,6 +23,8 @@ model FileTransferStateMachineType "FileTransferStateMachineType"
   constant Integer Error = 5
     "Error (StateNumber 5)"
     annotation (__OPCUA(browsePath="Error", nodeId="i=15823", typeDefinition="i=2307"));
+  String currentStateText
+    "The DisplayName of the current state, which currentState shows: set from currentStateNumber by the equation of the class that drives the state machine";
   discrete Integer currentStateNumber(start=Idle, fixed=true)
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput idleToReadPrepare = false
@@ -74,6 +75,7 @@ equation
     elsewhen errorToIdle then
       currentStateNumber = if pre(currentStateNumber) == Error then Idle else pre(currentStateNumber);
     end when;
+    currentStateText = if currentStateNumber == Idle then "Idle" elseif currentStateNumber == ReadPrepare then "ReadPrepare" elseif currentStateNumber == ReadTransfer then "ReadTransfer" elseif currentStateNumber == ApplyWrite then "ApplyWrite" elseif currentStateNumber == Error then "Error" else "";
   end if;
   annotation (
     __OPCUA(nodeId="i=15803", browseName="FileTransferStateMachineType"));

@@ -2,9 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within OpcUa.ObjectTypes;
 model ProgramStateMachineType "ProgramStateMachineType"
-  extends OpcUa.ObjectTypes.FiniteStateMachineType(
-    final use_lastTransition=true,
-    currentState=if currentStateNumber == Halted then "Halted" elseif currentStateNumber == Ready then "Ready" elseif currentStateNumber == Running then "Running" elseif currentStateNumber == Suspended then "Suspended" else "");
+  extends OpcUa.ObjectTypes.FiniteStateMachineType(final use_lastTransition=true, final currentState=currentStateText);
   parameter Boolean deletable = false
     "Deletable"
     annotation (__OPCUA(browsePath="Deletable", nodeId="i=2393", dataType="i=1"));
@@ -49,8 +47,10 @@ model ProgramStateMachineType "ProgramStateMachineType"
   constant Integer Suspended = 14
     "Suspended (StateNumber 14)"
     annotation (__OPCUA(browsePath="Suspended", nodeId="i=2404", typeDefinition="i=2307"));
-  discrete Integer currentStateNumber(start=Halted, fixed=true)
-    "Number of the current state (CurrentState/Number); the nodeset marks no initial state, so it starts in Halted";
+  String currentStateText
+    "The DisplayName of the current state, which currentState shows: set from currentStateNumber by the equation of the class that drives the state machine";
+  discrete Integer currentStateNumber(start=Ready, fixed=true)
+    "Number of the current state (CurrentState/Number); the nodeset marks no initial state, and a Program ready upon creation starts in Ready (OPC 10000-10, 5.2.3.2)";
   OpcUaSupport.BooleanInput reset = false
     "Reset: a rising edge stands for a call of the method Reset"
     annotation (__OPCUA(browsePath="Reset", nodeId="i=2430"));
@@ -85,6 +85,7 @@ equation
     elsewhen resume then
       currentStateNumber = if pre(currentStateNumber) == Suspended then Running else pre(currentStateNumber);
     end when;
+    currentStateText = if currentStateNumber == Halted then "Halted" elseif currentStateNumber == Ready then "Ready" elseif currentStateNumber == Running then "Running" elseif currentStateNumber == Suspended then "Suspended" else "";
   end if;
   annotation (
     __OPCUA(nodeId="i=2391", browseName="ProgramStateMachineType"));

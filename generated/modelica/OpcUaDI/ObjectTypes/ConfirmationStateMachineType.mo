@@ -2,8 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within OpcUaDI.ObjectTypes;
 model ConfirmationStateMachineType "ConfirmationStateMachineType"
-  extends OpcUa.ObjectTypes.FiniteStateMachineType(
-    currentState=if currentStateNumber == NotWaitingForConfirm then "NotWaitingForConfirm" elseif currentStateNumber == WaitingForConfirm then "WaitingForConfirm" else "");
+  extends OpcUa.ObjectTypes.FiniteStateMachineType(final currentState=currentStateText);
   // Method Confirm(): call it through an OPC UA client.
   OpcUaSupport.RealOutput confirmationTimeout = 0
     "ConfirmationTimeout"
@@ -18,6 +17,8 @@ model ConfirmationStateMachineType "ConfirmationStateMachineType"
   constant Integer WaitingForConfirm = 2
     "WaitingForConfirm (StateNumber 2)"
     annotation (__OPCUA(browsePath="WaitingForConfirm", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=325", typeDefinition="i=2307"));
+  String currentStateText
+    "The DisplayName of the current state, which currentState shows: set from currentStateNumber by the equation of the class that drives the state machine";
   discrete Integer currentStateNumber(start=NotWaitingForConfirm, fixed=true)
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput notWaitingForConfirmToWaitingForConfirm = false
@@ -33,6 +34,7 @@ equation
     elsewhen confirm then
       currentStateNumber = if pre(currentStateNumber) == WaitingForConfirm then NotWaitingForConfirm else pre(currentStateNumber);
     end when;
+    currentStateText = if currentStateNumber == NotWaitingForConfirm then "NotWaitingForConfirm" elseif currentStateNumber == WaitingForConfirm then "WaitingForConfirm" else "";
   end if;
   annotation (
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=307", browseName="ConfirmationStateMachineType"));

@@ -6,11 +6,9 @@ model FunctionalGroupType "FunctionalGroupType"
   parameter Integer nGroupIdentifier(min=0) = 0
     "Number of <GroupIdentifier> (OptionalPlaceholder)"
     annotation (Evaluate=true);
-  replaceable model GroupIdentifier = OpcUaDI.Declarations.FunctionalGroupType_GroupIdentifier
-    "Class of <GroupIdentifier>; redeclare it to use a model of your own";
-  GroupIdentifier groupIdentifier[nGroupIdentifier]
-    "<GroupIdentifier>"
-    annotation (__OPCUA(browsePath="<GroupIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6027", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=1005"));
+  parameter String groupIdentifier[nGroupIdentifier] = fill("", nGroupIdentifier)
+    "<GroupIdentifier>: held by HasComponent, but containing it would make the class contain itself: the NodeId of the target, an instance of FunctionalGroupType; \"\" for none"
+    annotation (__OPCUA(browsePath="<GroupIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6027", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=1005", referenceType="HasComponent"));
   // UIElement is left out: BaseDataType stands for any type (a Variant), which has no Modelica type.
   annotation (
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=1005", browseName="FunctionalGroupType"));

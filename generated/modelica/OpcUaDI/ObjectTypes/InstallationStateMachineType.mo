@@ -2,8 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within OpcUaDI.ObjectTypes;
 model InstallationStateMachineType "InstallationStateMachineType"
-  extends OpcUa.ObjectTypes.FiniteStateMachineType(
-    currentState=if currentStateNumber == Idle then "Idle" elseif currentStateNumber == Installing then "Installing" elseif currentStateNumber == Error then "Error" else "");
+  extends OpcUa.ObjectTypes.FiniteStateMachineType(final currentState=currentStateText);
   parameter Boolean use_percentComplete = false
     "Whether the optional PercentComplete exists"
     annotation (Evaluate=true);
@@ -33,6 +32,8 @@ model InstallationStateMachineType "InstallationStateMachineType"
   constant Integer Error = 3
     "Error (StateNumber 3)"
     annotation (__OPCUA(browsePath="Error", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=275", typeDefinition="i=2307"));
+  String currentStateText
+    "The DisplayName of the current state, which currentState shows: set from currentStateNumber by the equation of the class that drives the state machine";
   discrete Integer currentStateNumber(start=Idle, fixed=true)
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput installSoftwarePackage = false
@@ -68,6 +69,7 @@ equation
     elsewhen resume then
       currentStateNumber = if pre(currentStateNumber) == Error then Idle else pre(currentStateNumber);
     end when;
+    currentStateText = if currentStateNumber == Idle then "Idle" elseif currentStateNumber == Installing then "Installing" elseif currentStateNumber == Error then "Error" else "";
   end if;
   annotation (
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=249", browseName="InstallationStateMachineType"));

@@ -2,8 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within OpcUaDI.ObjectTypes;
 model PowerCycleStateMachineType "PowerCycleStateMachineType"
-  extends OpcUa.ObjectTypes.FiniteStateMachineType(
-    currentState=if currentStateNumber == NotWaitingForPowerCycle then "NotWaitingForPowerCycle" elseif currentStateNumber == WaitingForPowerCycle then "WaitingForPowerCycle" else "");
+  extends OpcUa.ObjectTypes.FiniteStateMachineType(final currentState=currentStateText);
   // State machine of PowerCycleStateMachineType: its states, and transitions driven by the trigger inputs.
   parameter Integer stateMachineLevel = 1
     "Which class drives the state machine: a subclass that adds states sets its own level"
@@ -14,6 +13,8 @@ model PowerCycleStateMachineType "PowerCycleStateMachineType"
   constant Integer WaitingForPowerCycle = 2
     "WaitingForPowerCycle (StateNumber 2)"
     annotation (__OPCUA(browsePath="WaitingForPowerCycle", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=301", typeDefinition="i=2307"));
+  String currentStateText
+    "The DisplayName of the current state, which currentState shows: set from currentStateNumber by the equation of the class that drives the state machine";
   discrete Integer currentStateNumber(start=NotWaitingForPowerCycle, fixed=true)
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput notWaitingForPowerCycleToWaitingForPowerCycle = false
@@ -29,6 +30,7 @@ equation
     elsewhen waitingForPowerCycleToNotWaitingForPowerCycle then
       currentStateNumber = if pre(currentStateNumber) == WaitingForPowerCycle then NotWaitingForPowerCycle else pre(currentStateNumber);
     end when;
+    currentStateText = if currentStateNumber == NotWaitingForPowerCycle then "NotWaitingForPowerCycle" elseif currentStateNumber == WaitingForPowerCycle then "WaitingForPowerCycle" else "";
   end if;
   annotation (
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=285", browseName="PowerCycleStateMachineType"));

@@ -2,8 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within OpcUaDI.ObjectTypes;
 model PrepareForUpdateStateMachineType "PrepareForUpdateStateMachineType"
-  extends OpcUa.ObjectTypes.FiniteStateMachineType(
-    currentState=if currentStateNumber == Idle then "Idle" elseif currentStateNumber == Preparing then "Preparing" elseif currentStateNumber == PreparedForUpdate then "PreparedForUpdate" elseif currentStateNumber == Resuming then "Resuming" else "");
+  extends OpcUa.ObjectTypes.FiniteStateMachineType(final currentState=currentStateText);
   parameter Boolean use_percentComplete = false
     "Whether the optional PercentComplete exists"
     annotation (Evaluate=true);
@@ -29,6 +28,8 @@ model PrepareForUpdateStateMachineType "PrepareForUpdateStateMachineType"
   constant Integer Resuming = 4
     "Resuming (StateNumber 4)"
     annotation (__OPCUA(browsePath="Resuming", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=237", typeDefinition="i=2307"));
+  String currentStateText
+    "The DisplayName of the current state, which currentState shows: set from currentStateNumber by the equation of the class that drives the state machine";
   discrete Integer currentStateNumber(start=Idle, fixed=true)
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput prepare = false
@@ -54,6 +55,7 @@ equation
     elsewhen resume then
       currentStateNumber = if pre(currentStateNumber) == PreparedForUpdate then Resuming else pre(currentStateNumber);
     end when;
+    currentStateText = if currentStateNumber == Idle then "Idle" elseif currentStateNumber == Preparing then "Preparing" elseif currentStateNumber == PreparedForUpdate then "PreparedForUpdate" elseif currentStateNumber == Resuming then "Resuming" else "";
   end if;
   annotation (
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=213", browseName="PrepareForUpdateStateMachineType"));

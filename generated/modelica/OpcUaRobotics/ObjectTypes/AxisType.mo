@@ -8,11 +8,9 @@ model AxisType "AxisType: The AxisType describes an axis of a motion device."
   parameter Integer nPowerTrainIdentifier(min=0) = 0
     "Number of <PowerTrainIdentifier> (OptionalPlaceholder)"
     annotation (Evaluate=true);
-  replaceable model PowerTrainIdentifier = OpcUaRobotics.ObjectTypes.PowerTrainType
-    "Class of <PowerTrainIdentifier>; redeclare it to use a model of your own";
-  PowerTrainIdentifier powerTrainIdentifier[nPowerTrainIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
-    "<PowerTrainIdentifier>: The Requires reference provides the relationship of axes to powertrains. For complex kinematics this does not need to be a one to one relationship, because more than one power train might influence the motion of one axis. This reference connects all power trains to an axis that must be actively driven when only this axis should move and all other axes should stand still. Virtual axes that are not actively driven by a power train do not have this reference."
-    annotation (__OPCUA(browsePath="<PowerTrainIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18344", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16794"));
+  parameter String powerTrainIdentifier[nPowerTrainIdentifier] = fill("", nPowerTrainIdentifier)
+    "<PowerTrainIdentifier>: The Requires reference provides the relationship of axes to powertrains. For complex kinematics this does not need to be a one to one relationship, because more than one power train might influence the motion of one axis. This reference connects all power trains to an axis that must be actively driven when only this axis should move and all other axes should stand still. Virtual axes that are not actively driven by a power train do not have this reference. [Requires reference: the NodeId of the target, an instance of PowerTrainType; \"\" for none]"
+    annotation (__OPCUA(browsePath="<PowerTrainIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18344", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16794", referenceType="Requires"));
   parameter Boolean use_additionalLoad = false
     "Whether the optional AdditionalLoad exists"
     annotation (Evaluate=true);

@@ -11,22 +11,15 @@ model ControllerType "ControllerType: The ControllerType describes the control u
   parameter Integer nMotionDeviceIdentifier(min=0) = 0
     "Number of <MotionDeviceIdentifier> (OptionalPlaceholder)"
     annotation (Evaluate=true);
-  replaceable model MotionDeviceIdentifier = OpcUaRobotics.ObjectTypes.MotionDeviceType
-    "Class of <MotionDeviceIdentifier>; redeclare it to use a model of your own";
-  MotionDeviceIdentifier motionDeviceIdentifier[nMotionDeviceIdentifier](
-      redeclare model ParameterSet = OpcUaRobotics.Declarations.MotionDeviceType_ParameterSet,
-      redeclare model Axes = OpcUaRobotics.Declarations.MotionDeviceType_Axes,
-      redeclare model PowerTrains = OpcUaRobotics.Declarations.MotionDeviceType_PowerTrains)
-    "<MotionDeviceIdentifier>: The relationship of a motion device and controller."
-    annotation (__OPCUA(browsePath="<MotionDeviceIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18964", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1004"));
+  parameter String motionDeviceIdentifier[nMotionDeviceIdentifier] = fill("", nMotionDeviceIdentifier)
+    "<MotionDeviceIdentifier>: The relationship of a motion device and controller. [Controls reference: the NodeId of the target, an instance of MotionDeviceType; \"\" for none]"
+    annotation (__OPCUA(browsePath="<MotionDeviceIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18964", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1004", referenceType="Controls"));
   parameter Integer nSafetyStatesIdentifier(min=0) = 0
     "Number of <SafetyStatesIdentifier> (OptionalPlaceholder)"
     annotation (Evaluate=true);
-  replaceable model SafetyStatesIdentifier = OpcUaRobotics.ObjectTypes.SafetyStateType
-    "Class of <SafetyStatesIdentifier>; redeclare it to use a model of your own";
-  SafetyStatesIdentifier safetyStatesIdentifier[nSafetyStatesIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.SafetyStateType_ParameterSet)
-    "<SafetyStatesIdentifier>: The relationship of safety states to a controller."
-    annotation (__OPCUA(browsePath="<SafetyStatesIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18918", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1013"));
+  parameter String safetyStatesIdentifier[nSafetyStatesIdentifier] = fill("", nSafetyStatesIdentifier)
+    "<SafetyStatesIdentifier>: The relationship of safety states to a controller. [HasSafetyStates reference: the NodeId of the target, an instance of SafetyStateType; \"\" for none]"
+    annotation (__OPCUA(browsePath="<SafetyStatesIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18918", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1013", referenceType="HasSafetyStates"));
   parameter Boolean use_components = false
     "Whether the optional Components exists"
     annotation (Evaluate=true);

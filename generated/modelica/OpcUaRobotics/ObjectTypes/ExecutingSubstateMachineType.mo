@@ -2,9 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within OpcUaRobotics.ObjectTypes;
 model ExecutingSubstateMachineType "ExecutingSubstateMachineType"
-  extends OpcUa.ObjectTypes.FiniteStateMachineType(
-    final use_lastTransition=true,
-    currentState=if currentStateNumber == Running then "Running" elseif currentStateNumber == Stopping then "Stopping" else "");
+  extends OpcUa.ObjectTypes.FiniteStateMachineType(final use_lastTransition=true, final currentState=currentStateText);
   OpcUaSupport.IntegerInput lastTransitionReason(min=-32768, max=32767) = 0
     "LastTransitionReason"
     annotation (__OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6038", dataType="i=4"));
@@ -18,6 +16,8 @@ model ExecutingSubstateMachineType "ExecutingSubstateMachineType"
   constant Integer Stopping = 2
     "Stopping (StateNumber 2)"
     annotation (__OPCUA(browsePath="Stopping", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5021", typeDefinition="i=2307"));
+  String currentStateText
+    "The DisplayName of the current state, which currentState shows: set from currentStateNumber by the equation of the class that drives the state machine";
   discrete Integer currentStateNumber(start=Running, fixed=true)
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput runningToStopping = false
@@ -28,6 +28,7 @@ equation
     when runningToStopping then
       currentStateNumber = if pre(currentStateNumber) == Running then Stopping else pre(currentStateNumber);
     end when;
+    currentStateText = if currentStateNumber == Running then "Running" elseif currentStateNumber == Stopping then "Stopping" else "";
   end if;
   annotation (
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1007", browseName="ExecutingSubstateMachineType"));

@@ -2,9 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within OpcUaRobotics.ObjectTypes;
 model IdleSubstateMachineType "IdleSubstateMachineType"
-  extends OpcUa.ObjectTypes.FiniteStateMachineType(
-    final use_lastTransition=true,
-    currentState=if currentStateNumber == GettingReady then "GettingReady" elseif currentStateNumber == StandBy then "StandBy" else "");
+  extends OpcUa.ObjectTypes.FiniteStateMachineType(final use_lastTransition=true, final currentState=currentStateText);
   OpcUaSupport.IntegerInput lastTransitionReason(min=-32768, max=32767) = 0
     "LastTransitionReason"
     annotation (__OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6029", dataType="i=4"));
@@ -18,6 +16,8 @@ model IdleSubstateMachineType "IdleSubstateMachineType"
   constant Integer StandBy = 1
     "StandBy (StateNumber 1), the initial state"
     annotation (__OPCUA(browsePath="StandBy", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5015", typeDefinition="i=2309"));
+  String currentStateText
+    "The DisplayName of the current state, which currentState shows: set from currentStateNumber by the equation of the class that drives the state machine";
   discrete Integer currentStateNumber(start=StandBy, fixed=true)
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput gettingReadyToStandBy = false
@@ -33,6 +33,7 @@ equation
     elsewhen standByToGettingReady then
       currentStateNumber = if pre(currentStateNumber) == StandBy then GettingReady else pre(currentStateNumber);
     end when;
+    currentStateText = if currentStateNumber == GettingReady then "GettingReady" elseif currentStateNumber == StandBy then "StandBy" else "";
   end if;
   annotation (
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1009", browseName="IdleSubstateMachineType"));

@@ -12,11 +12,9 @@ model MotorType "MotorType: The MotorType is for representing instances of elect
   parameter Integer nDriveIdentifier(min=0) = 0
     "Number of <DriveIdentifier> (OptionalPlaceholder)"
     annotation (Evaluate=true);
-  replaceable model DriveIdentifier = OpcUa.ObjectTypes.BaseObjectType
-    "Class of <DriveIdentifier>; redeclare it to use a model of your own";
-  DriveIdentifier driveIdentifier[nDriveIdentifier]
-    "<DriveIdentifier>"
-    annotation (__OPCUA(browsePath="<DriveIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5060", typeDefinition="i=58"));
+  parameter String driveIdentifier[nDriveIdentifier] = fill("", nDriveIdentifier)
+    "<DriveIdentifier>: IsDrivenBy reference: the NodeId of the target, an instance of BaseObjectType; \"\" for none"
+    annotation (__OPCUA(browsePath="<DriveIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5060", typeDefinition="i=58", referenceType="IsDrivenBy"));
   annotation (
     Documentation(info="<html><p>The MotorType is for representing instances of electric motors.</p></html>"),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1019", browseName="MotorType"));

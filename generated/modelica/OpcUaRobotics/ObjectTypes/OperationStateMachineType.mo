@@ -2,9 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within OpcUaRobotics.ObjectTypes;
 partial model OperationStateMachineType "OperationStateMachineType"
-  extends OpcUa.ObjectTypes.FiniteStateMachineType(
-    final use_lastTransition=true,
-    currentState=if currentStateNumber == Executing then "Executing" elseif currentStateNumber == Idle then "Idle" elseif currentStateNumber == Ready then "Ready" else "");
+  extends OpcUa.ObjectTypes.FiniteStateMachineType(final use_lastTransition=true, final currentState=currentStateText);
   parameter Boolean use_configuredDefaultStopMode = false
     "Whether the optional ConfiguredDefaultStopMode exists"
     annotation (Evaluate=true);
@@ -35,8 +33,10 @@ partial model OperationStateMachineType "OperationStateMachineType"
   constant Integer Ready = 2
     "Ready (StateNumber 2)"
     annotation (__OPCUA(browsePath="Ready", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5006", typeDefinition="i=2307"));
+  String currentStateText
+    "The DisplayName of the current state, which currentState shows: set from currentStateNumber by the equation of the class that drives the state machine";
   discrete Integer currentStateNumber(start=Executing, fixed=true)
-    "Number of the current state (CurrentState/Number); the nodeset marks no initial state, so it starts in Executing";
+    "Number of the current state (CurrentState/Number); the nodeset marks no initial state, so it starts in Executing, the first state";
   OpcUaSupport.BooleanInput executingToIdle = false
     "ExecutingToIdle: a rising edge takes this transition, for which the nodeset gives no cause"
     annotation (__OPCUA(browsePath="ExecutingToIdle", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5013", typeDefinition="i=2310"));
@@ -70,6 +70,7 @@ equation
     elsewhen readyToIdle then
       currentStateNumber = if pre(currentStateNumber) == Ready then Idle else pre(currentStateNumber);
     end when;
+    currentStateText = if currentStateNumber == Executing then "Executing" elseif currentStateNumber == Idle then "Idle" elseif currentStateNumber == Ready then "Ready" else "";
   end if;
   annotation (
     Documentation(info="<html><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),

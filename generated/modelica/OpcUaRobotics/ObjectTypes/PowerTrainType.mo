@@ -6,11 +6,9 @@ model PowerTrainType "PowerTrainType: The PowerTrainType represents instances of
   parameter Integer nAxisIdentifier(min=0) = 0
     "Number of <AxisIdentifier> (OptionalPlaceholder)"
     annotation (Evaluate=true);
-  replaceable model AxisIdentifier = OpcUaRobotics.Declarations.PowerTrainType_AxisIdentifier
-    "Class of <AxisIdentifier>; redeclare it to use a model of your own";
-  AxisIdentifier axisIdentifier[nAxisIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet)
-    "<AxisIdentifier>: Moves is a reference to provide the relationship of powertrains to axes. For complex kinematics this does not need to be a one to one relationship, because a powertrain might influence the motion of more than one axis. This reference connects all axis to a powertrain that that move when only this powertrain moves and all other powertrains stand still."
-    annotation (__OPCUA(browsePath="<AxisIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18536", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
+  parameter String axisIdentifier[nAxisIdentifier] = fill("", nAxisIdentifier)
+    "<AxisIdentifier>: Moves is a reference to provide the relationship of powertrains to axes. For complex kinematics this does not need to be a one to one relationship, because a powertrain might influence the motion of more than one axis. This reference connects all axis to a powertrain that that move when only this powertrain moves and all other powertrains stand still. [Moves reference: the NodeId of the target, an instance of AxisType; \"\" for none]"
+    annotation (__OPCUA(browsePath="<AxisIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18536", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601", referenceType="Moves"));
   parameter Integer nGearIdentifier(min=0) = 0
     "Number of <GearIdentifier> (OptionalPlaceholder)"
     annotation (Evaluate=true);
@@ -30,11 +28,9 @@ model PowerTrainType "PowerTrainType: The PowerTrainType represents instances of
   parameter Integer nPowerTrainIdentifier(min=0) = 0
     "Number of <PowerTrainIdentifier> (OptionalPlaceholder)"
     annotation (Evaluate=true);
-  replaceable model PowerTrainIdentifier = OpcUaRobotics.Declarations.PowerTrainType_PowerTrainIdentifier
-    "Class of <PowerTrainIdentifier>; redeclare it to use a model of your own";
-  PowerTrainIdentifier powerTrainIdentifier[nPowerTrainIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
-    "<PowerTrainIdentifier>: HasSlave is a reference to provide the master-slave relationship of powertrains which provide torque for a common axis. The InverseName is IsSlaveOf."
-    annotation (__OPCUA(browsePath="<PowerTrainIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18613", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16794"));
+  parameter String powerTrainIdentifier[nPowerTrainIdentifier] = fill("", nPowerTrainIdentifier)
+    "<PowerTrainIdentifier>: HasSlave is a reference to provide the master-slave relationship of powertrains which provide torque for a common axis. The InverseName is IsSlaveOf. [HasSlave reference: the NodeId of the target, an instance of PowerTrainType; \"\" for none]"
+    annotation (__OPCUA(browsePath="<PowerTrainIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18613", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16794", referenceType="HasSlave"));
   annotation (
     Documentation(info="<html><p>The PowerTrainType represents instances of powertrains of a motion device.</p></html>"),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16794", browseName="PowerTrainType"));

@@ -2,9 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within OpcUaRobotics.ObjectTypes;
 model ReadySubstateMachineType "ReadySubstateMachineType"
-  extends OpcUa.ObjectTypes.FiniteStateMachineType(
-    final use_lastTransition=true,
-    currentState=if currentStateNumber == AtProgramStart then "AtProgramStart" elseif currentStateNumber == Suspended then "Suspended" else "");
+  extends OpcUa.ObjectTypes.FiniteStateMachineType(final use_lastTransition=true, final currentState=currentStateText);
   OpcUaSupport.IntegerInput lastTransitionReason(min=-32768, max=32767) = 0
     "LastTransitionReason"
     annotation (__OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6046", dataType="i=4"));
@@ -19,8 +17,10 @@ model ReadySubstateMachineType "ReadySubstateMachineType"
   constant Integer Suspended = 2
     "Suspended (StateNumber 2)"
     annotation (__OPCUA(browsePath="Suspended", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5024", typeDefinition="i=2307"));
+  String currentStateText
+    "The DisplayName of the current state, which currentState shows: set from currentStateNumber by the equation of the class that drives the state machine";
   discrete Integer currentStateNumber(start=AtProgramStart, fixed=true)
-    "Number of the current state (CurrentState/Number); the nodeset marks no initial state, so it starts in AtProgramStart";
+    "Number of the current state (CurrentState/Number); the nodeset marks no initial state, so it starts in AtProgramStart, the first state";
   OpcUaSupport.BooleanInput programStartToSuspended = false
     "ProgramStartToSuspended: a rising edge takes this transition, for which the nodeset gives no cause"
     annotation (__OPCUA(browsePath="ProgramStartToSuspended", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5025", typeDefinition="i=2310"));
@@ -34,6 +34,7 @@ equation
     elsewhen resetToProgramStart then
       currentStateNumber = if pre(currentStateNumber) == Suspended then AtProgramStart else pre(currentStateNumber);
     end when;
+    currentStateText = if currentStateNumber == AtProgramStart then "AtProgramStart" elseif currentStateNumber == Suspended then "Suspended" else "";
   end if;
   annotation (
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1012", browseName="ReadySubstateMachineType"));

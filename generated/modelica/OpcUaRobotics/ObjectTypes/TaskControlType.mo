@@ -9,14 +9,9 @@ model TaskControlType "TaskControlType: Represents a specific task control activ
   parameter Integer nMotionDeviceIdentifier(min=0) = 0
     "Number of <MotionDeviceIdentifier> (OptionalPlaceholder)"
     annotation (Evaluate=true);
-  replaceable model MotionDeviceIdentifier = OpcUaRobotics.ObjectTypes.MotionDeviceType
-    "Class of <MotionDeviceIdentifier>; redeclare it to use a model of your own";
-  MotionDeviceIdentifier motionDeviceIdentifier[nMotionDeviceIdentifier](
-      redeclare model ParameterSet = OpcUaRobotics.Declarations.MotionDeviceType_ParameterSet,
-      redeclare model Axes = OpcUaRobotics.Declarations.MotionDeviceType_Axes,
-      redeclare model PowerTrains = OpcUaRobotics.Declarations.MotionDeviceType_PowerTrains)
-    "<MotionDeviceIdentifier>: Controls is a reference to provide the relationship between a task control and a motion device."
-    annotation (__OPCUA(browsePath="<MotionDeviceIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=19254", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1004"));
+  parameter String motionDeviceIdentifier[nMotionDeviceIdentifier] = fill("", nMotionDeviceIdentifier)
+    "<MotionDeviceIdentifier>: Controls is a reference to provide the relationship between a task control and a motion device. [Controls reference: the NodeId of the target, an instance of MotionDeviceType; \"\" for none]"
+    annotation (__OPCUA(browsePath="<MotionDeviceIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=19254", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1004", referenceType="Controls"));
   parameter Boolean use_taskControlOperation = false
     "Whether the optional TaskControlOperation exists"
     annotation (Evaluate=true);

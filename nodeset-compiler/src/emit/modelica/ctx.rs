@@ -92,6 +92,9 @@ pub struct Ctx<'a> {
     /// The replaceable class aliases that some planned class redeclares (filled once planning is done). A
     /// component repeats its class's choice for each of them ([`Mod::Pin`](super::objects::Mod::Pin)).
     pub redeclared: BTreeSet<String>,
+    /// The instance declarations that would make a class contain itself; they become reference parameters
+    /// (see `recursion.rs`).
+    pub cuts: BTreeSet<NodeIx>,
 }
 
 impl<'a> Ctx<'a> {
@@ -117,6 +120,7 @@ impl<'a> Ctx<'a> {
             nesting: 0,
             deferred: Vec::new(),
             redeclared: BTreeSet::new(),
+            cuts: super::recursion::containment_cuts(m),
         }
     }
 

@@ -91,6 +91,13 @@
 //! * Optional: `parameter Boolean use_x = false` and `X x if use_x`; a subtype that makes it Mandatory writes
 //!   `final use_x = true`. Placeholder `<X>`: `parameter Integer nX(min=0) = 0`, `replaceable model X = ...`
 //!   and `X x[nX]`.
+//! * Only containment makes a component: a child held by HasChild (HasComponent, HasProperty,
+//!   HasOrderedComponent, ...) or Organizes. A child held by any other reference (Requires, Moves, HasSlave,
+//!   Controls, IsDrivenBy, ...) lives elsewhere and becomes `parameter String x = ""` (an array sized by its
+//!   count for a placeholder) with the NodeId of the target, filled in by instances and users, and
+//!   `referenceType` in its `__OPCUA` annotation. No class contains itself: where containment closes a cycle
+//!   (FileDirectoryType organizes `<FileDirectoryName>` directories, DI's FunctionalGroupType holds
+//!   `<GroupIdentifier>` groups), that member is cut to such a reference parameter too (see `recursion.rs`).
 //! * Methods appear as comments (call them through an OPC UA client), except as the triggers of a state
 //!   machine (see `statemachine.rs`).
 //! * Every component carries `annotation(__OPCUA(browsePath="...", nodeId="...", dataType="..."))`; the
@@ -129,6 +136,7 @@
 mod ctx;
 mod instances;
 mod objects;
+mod recursion;
 mod statemachine;
 pub mod support;
 mod text;

@@ -63,6 +63,12 @@ pub enum ElemKind {
         class: ClassKey,
     },
     Method,
+    /// A child held by a reference that is not containment (Requires, Moves, ...), or whose containment would
+    /// make the class contain itself: a `String` parameter with the NodeId of the target (an array of them for
+    /// a placeholder).
+    Reference {
+        array: bool,
+    },
     /// Declared nowhere (no Modelica type); the name stays taken.
     Skipped,
 }
@@ -171,6 +177,8 @@ pub struct Body {
     pub local_replaceable: bool,
     /// The body declares or redeclares something, so it needs a class of its own (modifiers alone do not).
     pub adds: bool,
+    /// The state the inherited state machine starts in here, when a child CurrentState names another one.
+    pub initial: Option<usize>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -256,7 +264,7 @@ impl Ctx<'_> {
             .unwrap_or_default();
         let owner = Owner::Type(t);
         let mut body = self.plan_body(owner, "", base.as_ref(), &own, Mode::Type, true);
-        let mut state_machine = base.as_ref().and_then(|b| b.state_machine.clone());
+        let mut state_machine = starting_in(base.as_ref().and_then(|b| b.state_machine.clone()), body.initial);
         if let Some(sm) = self.plan_state_machine(t, base.as_ref(), &mut body) {
             state_machine = Some(Rc::new(sm));
         }
@@ -585,7 +593,7 @@ impl Ctx<'_> {
             }
             if !by_bn.contains_key(bn) {
                 scope.add(&component_original(&bn.name), (i, false));
-                if self.gets_alias(o.node, mode, allow_replaceable) {
+                if self.gets_alias(*o, mode, allow_replaceable) {
                     scope.add(&bn.name, (i, true));
                 }
             }
@@ -608,6 +616,14 @@ impl Ctx<'_> {
             match by_bn.get(&bn) {
                 Some(&ei) if !matches!(elements[ei].kind, ElemKind::Skipped) => {
                     let e = elements[ei].clone();
+                    let machine = base.and_then(|b| b.state_machine.clone());
+                    if let Some(sm) = machine.filter(|sm| sm.text.as_ref().is_some_and(|(cur, _)| *cur == e.ident)) {
+                        // The text of the state follows the number: the state a CurrentState names is where the
+                        // machine starts, never a value of the text.
+                        self.start_state(&sm, o.node, &mut body);
+                        elements[ei].node = o.node;
+                        continue;
+                    }
                     if let Some(updated) = self.plan_override(owner, path, &e, *o, mode, &mut body) {
                         elements[ei] = updated;
                     }
@@ -641,11 +657,73 @@ impl Ctx<'_> {
     }
 
     /// Whether a new child becomes a replaceable object (with a class alias).
-    fn gets_alias(&self, node: NodeIx, mode: Mode, allow_replaceable: bool) -> bool {
+    fn gets_alias(&self, o: Own, mode: Mode, allow_replaceable: bool) -> bool {
         allow_replaceable
             && mode == Mode::Type
-            && self.m.node(node).class == NodeClass::Object
-            && !self.is_event_type(self.object_td(node))
+            && self.m.node(o.node).class == NodeClass::Object
+            && !self.is_event_type(self.object_td(o.node))
+            && !self.is_reference(o)
+    }
+
+    /// Whether a child becomes a reference parameter rather than a component (see `recursion.rs`).
+    fn is_reference(&self, o: Own) -> bool {
+        matches!(self.m.node(o.node).class, NodeClass::Object | NodeClass::Variable)
+            && (!super::recursion::is_containment(self.m, o.rt) || self.cuts.contains(&o.node))
+    }
+
+    /// A child held by reference: a `String` parameter with the NodeId of its target (in an instance) or `""`
+    /// (in a type, where the target is only declared), an array of them for a placeholder.
+    fn plan_reference(
+        &mut self,
+        ident: String,
+        o: Own,
+        rule: Option<ModellingRule>,
+        body: &mut Body,
+        mut element: Element,
+    ) -> Element {
+        let m = self.m;
+        let n = m.node(o.node);
+        let bn = n.browse_name.clone();
+        body.adds = true;
+        let rt = m.node(o.rt).browse_name.name.clone();
+        let why = if super::recursion::is_containment(m, o.rt) {
+            format!("held by {rt}, but containing it would make the class contain itself")
+        } else {
+            format!("{rt} reference")
+        };
+        let td = n.type_definition.map(|t| format!(", an instance of {}", m.node(t).browse_name.name)).unwrap_or_default();
+        let doc = match n.doc() {
+            Some(d) => format!("{d} [{why}: the NodeId of the target{td}; \"\" for none]"),
+            None => format!("{why}: the NodeId of the target{td}; \"\" for none"),
+        };
+        let desc = text::description(&bn.name, Some(&doc));
+        let mut annotation = self.opcua_annotation(o.node);
+        annotation.insert_str(annotation.len() - 1, &format!(", referenceType={}", string_literal(&rt)));
+        let (dims, value) = if rule.is_some_and(ModellingRule::is_placeholder) {
+            let count = self.derived_name(body, count_name(&ident), o.node);
+            body.items.push(count_decl(&count, &bn.name, rule));
+            let v = format!("fill(\"\", {count})");
+            element.count = Some(count.clone());
+            (format!("[{count}]"), v)
+        } else if rule.is_none() {
+            // An instance: the target is the node itself.
+            (String::new(), string_literal(&node_id_text(m, &n.id)))
+        } else {
+            (String::new(), "\"\"".to_string())
+        };
+        element.kind = ElemKind::Reference { array: element.count.is_some() };
+        body.items.push(Item::Decl {
+            prefix: "parameter".into(),
+            ty: TypeRef::Path("String".into()),
+            ident,
+            dims,
+            mods: Vec::new(),
+            value: Some(value),
+            cond: None,
+            desc,
+            annotation,
+        });
+        element
     }
 
     /// A name derived from an element's (`use_x`, `nX`), unique in the class.
@@ -701,6 +779,9 @@ impl Ctx<'_> {
             count: None,
             alias: None,
         };
+        if self.is_reference(o) {
+            return self.plan_reference(ident, o, rule, body, element);
+        }
         let desc = text::description(&bn.name, n.doc());
         let annotation = self.opcua_annotation(o.node);
         match n.class {
@@ -982,7 +1063,7 @@ impl Ctx<'_> {
             elements: sub.elements,
             taken: sub.taken,
             local_replaceable: sub.local_replaceable,
-            state_machine: base.state_machine.clone(),
+            state_machine: starting_in(base.state_machine.clone(), sub.initial),
         };
         self.class_infos.insert(key.clone(), Rc::new(info));
         key
@@ -1019,6 +1100,18 @@ impl Ctx<'_> {
         }
         match &e.kind {
             ElemKind::Method | ElemKind::Skipped => None,
+            ElemKind::Reference { array } => {
+                // An instance names the target; a type has only a declaration of it.
+                if mode == Mode::Instance && !array {
+                    body.mods.push(Mod::Value {
+                        ident: e.ident.clone(),
+                        is_final: false,
+                        attrs: Vec::new(),
+                        value: Some(string_literal(&node_id_text(m, &n.id))),
+                    });
+                }
+                Some(updated)
+            }
             ElemKind::Parameter { ty, dims } | ElemKind::Signal { ty, dims, .. } => {
                 if e.count.is_some() {
                     return Some(updated);
@@ -1162,6 +1255,17 @@ impl Ctx<'_> {
             Some(info) => format!("Method {name}({}): call it through an OPC UA client.", args(&info.inputs)),
             None => format!("Method {name}: call it through an OPC UA client."),
         }
+    }
+}
+
+/// A state machine that starts in state `initial` instead of its own initial state.
+fn starting_in(
+    sm: Option<Rc<super::statemachine::SmInfo>>,
+    initial: Option<usize>,
+) -> Option<Rc<super::statemachine::SmInfo>> {
+    match (sm, initial) {
+        (Some(sm), Some(i)) => Some(Rc::new(super::statemachine::SmInfo { initial: i, ..(*sm).clone() })),
+        (sm, _) => sm,
     }
 }
 

@@ -3,8 +3,10 @@
 //! and one `when` equation that moves between the states along the transitions of the nodeset.
 //!
 //! ```modelica
+//!   extends OpcUa.ObjectTypes.FiniteStateMachineType(final currentState=currentStateText);
 //!   parameter Integer stateMachineLevel = 1 "Which class drives the state machine";
 //!   constant Integer Ready = 2 "Ready (StateNumber 2)";
+//!   String currentStateText "The DisplayName of the current state, which currentState shows";
 //!   discrete Integer currentStateNumber(start=Ready, fixed=true) "Number of the current state";
 //!   OpcUaSupport.BooleanInput start = false "Start: a rising edge stands for a call of the method Start";
 //! equation
@@ -13,6 +15,7 @@
 //!       currentStateNumber = if pre(currentStateNumber) == Ready then Running else pre(currentStateNumber);
 //!     elsewhen ...
 //!     end when;
+//!     currentStateText = if currentStateNumber == Ready then "Ready" elseif ... else "";
 //!   end if;
 //! ```
 //!
@@ -20,13 +23,28 @@
 //! ones, sets `stateMachineLevel` to its own level and writes the `when` equation of the whole machine under
 //! `if stateMachineLevel == <its level>`, which switches the inherited equation off. Triggers are checked in
 //! the order of the `elsewhen` branches, so of two triggers that rise at the same instant the first wins.
+//!
+//! The text follows the number. `CurrentState` (bound to `""` in StateMachineType) gets a `final` binding
+//! to `currentStateText`, which the equation of the driving level sets; so no subclass, instance or user
+//! modifier can give the text a value of its own. A CurrentState value in the nodeset (an instance's
+//! `Ready`, its `Id` or `Number` property) names the state the machine starts in instead: it becomes
+//! `currentStateNumber(start=12)` (a literal, as the modifier may sit where the constants are not visible),
+//! or nothing when that is the initial state already.
+//!
+//! The initial state is, in this order: the state whose TypeDefinition is InitialStateType; the state the
+//! type's own CurrentState declaration names; the initial state of the machine a subtype extends; Ready for
+//! ProgramStateMachineType and its subtypes, which mark none (OPC 10000-10, 5.2.3.2: Halted is the idle
+//! state of a Program that cannot begin yet, and a Program ready upon its creation moves on to Ready at once;
+//! a simulated Program waits for nothing, and the skill instances of our nodesets say Ready); else the first
+//! state in the nodeset's order. The description of `currentStateNumber` says which rule applied.
 
 use super::ctx::{component_original, Ctx};
 use super::objects::{Body, ClassInfo, ElemKind, Item, Mod, TypeRef};
 use super::text::string_literal;
 use super::types::{Base, MType};
-use crate::model::NodeIx;
+use crate::model::{ids, Model, NodeIx};
 use crate::nodeid::QualifiedName;
+use crate::value::Variant;
 use std::collections::BTreeSet;
 use std::rc::Rc;
 
@@ -38,6 +56,14 @@ pub struct SmInfo {
     pub var: String,
     /// State node -> constant.
     pub states: Vec<(NodeIx, String)>,
+    /// The StateNumber of each state (the nodeset's, or the one given here), in the order of `states`.
+    pub numbers: Vec<u32>,
+    /// The index in `states` of the state the machine starts in.
+    pub initial: usize,
+    /// The `CurrentState` component, and the variable its final binding reads (the DisplayName of the current
+    /// state, set by an equation of the level that drives the machine); `None` when the class has no String
+    /// CurrentState.
+    pub text: Option<(String, String)>,
     /// Cause (method or transition) node -> trigger input.
     pub triggers: Vec<(NodeIx, String)>,
     /// The BrowseNames of the states and transitions covered.
@@ -49,7 +75,58 @@ enum Key {
     State(usize),
     Var,
     Level,
+    Text,
     Trigger(usize),
+}
+
+/// Where the initial state of a machine comes from, in this order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum InitialFrom {
+    /// A state whose TypeDefinition is InitialStateType.
+    Marked,
+    /// The value the type gives its CurrentState (its Id, Number or text).
+    Declared,
+    /// The initial state of the machine this one extends.
+    Inherited,
+    /// ProgramStateMachineType marks no initial state; Part 10 (5.2.3.2) lets a Program that is ready upon
+    /// creation start in Ready, and a simulated Program has nothing to wait for.
+    ProgramReady,
+    /// Nothing says: the first state in the nodeset.
+    First,
+}
+
+/// The state of `states` that the value of a CurrentState variable names: its Id property (a state node, or
+/// one with the same BrowseName), else its Number property, else its text (DisplayName or BrowseName).
+pub fn state_in_value(m: &Model, current: NodeIx, states: &[(NodeIx, String)], numbers: &[u32]) -> Option<usize> {
+    let child = |name: &str| {
+        m.children(current).map(|(_, c)| c).find(|&c| m.node(c).browse_name.ns == 0 && m.node(c).browse_name.name == name)
+    };
+    let value = |c: NodeIx| m.value(c).and_then(Result::ok);
+    if let Some(Variant::NodeId(id) | Variant::ExpandedNodeId(id)) = child("Id").and_then(value) {
+        if let Some(ix) = m.lookup(&id) {
+            let found = states.iter().position(|(s, _)| *s == ix).or_else(|| {
+                states.iter().position(|(s, _)| m.node(*s).browse_name == m.node(ix).browse_name)
+            });
+            if found.is_some() {
+                return found;
+            }
+        }
+    }
+    if let Some(n) = child("Number").and_then(value).and_then(|v| v.as_i64()) {
+        if let Some(i) = numbers.iter().position(|&x| i64::from(x) == n) {
+            return Some(i);
+        }
+    }
+    let text = match value(current)? {
+        Variant::LocalizedText(t) => t.text,
+        Variant::String(t) => t,
+        _ => return None,
+    };
+    let text = text.trim();
+    states
+        .iter()
+        .position(|(s, _)| m.node(*s).display() == text)
+        .or_else(|| states.iter().position(|(s, _)| m.node(*s).browse_name.name == text))
 }
 
 impl Ctx<'_> {
@@ -125,6 +202,15 @@ impl Ctx<'_> {
                 .find(|e| matches!(e.kind, ElemKind::Method) && (e.node == n || e.bn == m.node(n).browse_name))
                 .map(|e| e.ident.clone())
         };
+        // CurrentState shows the DisplayName of the current state.
+        let current = body
+            .elements
+            .iter()
+            .find(|e| e.bn.ns == 0 && e.bn.name == "CurrentState" && e.use_flag.is_none())
+            .filter(|e| {
+                matches!(&e.kind, ElemKind::Signal { ty: MType::Scalar { base: Base::String, .. }, dims: None, .. })
+            })
+            .map(|e| (e.ident.clone(), e.node));
         let mut scope = self.scope::<Key>();
         for n in &body.taken {
             scope.reserve(n);
@@ -137,6 +223,9 @@ impl Ctx<'_> {
         if inherited.is_none() {
             scope.add(&component_original("CurrentStateNumber"), Key::Var);
             scope.add(&component_original("StateMachineLevel"), Key::Level);
+            if current.is_some() {
+                scope.add(&component_original("CurrentStateText"), Key::Text);
+            }
         }
         let mut fixed_trig: Vec<Option<String>> = Vec::new();
         for (i, &n) in trig_nodes.iter().enumerate() {
@@ -164,6 +253,12 @@ impl Ctx<'_> {
             Some(b) => (b.var.clone(), b.level_param.clone()),
             None => (names[&Key::Var].clone(), names[&Key::Level].clone()),
         };
+        let text = match &inherited {
+            Some(b) => b.text.clone(),
+            None => current.as_ref().map(|(cur, _)| (cur.clone(), names[&Key::Text].clone())),
+        };
+        let pairs: Vec<(NodeIx, String)> = info.states.iter().map(|s| s.node).zip(states.iter().cloned()).collect();
+        let (initial, from) = self.initial_state(t, &info.states, &pairs, &numbers, current.map(|c| c.1), inherited.as_deref());
         let declared_triggers: BTreeSet<String> =
             inherited.iter().flat_map(|b| b.triggers.iter().map(|(_, i)| i.clone())).collect();
         let declared_states: BTreeSet<String> =
@@ -226,14 +321,55 @@ impl Ctx<'_> {
                 annotation: self.opcua_annotation(s.node),
             });
         }
+        let start_in = &info.states[initial].name;
+        let desc = match from {
+            InitialFrom::Marked => "Number of the current state (CurrentState/Number)".to_string(),
+            InitialFrom::Declared => format!(
+                "Number of the current state (CurrentState/Number); it starts in {start_in}, the state the nodeset gives CurrentState"
+            ),
+            InitialFrom::Inherited => format!("Number of the current state (CurrentState/Number); it starts in {start_in}"),
+            InitialFrom::ProgramReady => format!(
+                "Number of the current state (CurrentState/Number); the nodeset marks no initial state, and a Program ready upon creation starts in {start_in} (OPC 10000-10, 5.2.3.2)"
+            ),
+            InitialFrom::First => format!(
+                "Number of the current state (CurrentState/Number); the nodeset marks no initial state, so it starts in {start_in}, the first state"
+            ),
+        };
+        // The state a CurrentState of this type names was already applied by the planner; write it once.
+        body.mods.retain(|x| !matches!(x, Mod::Value { ident, .. } if *ident == var));
+        if inherited.as_ref().is_some_and(|b| b.states[b.initial].1 != states[initial]) {
+            body.mods.push(Mod::Value {
+                ident: var.clone(),
+                is_final: false,
+                attrs: vec![format!("start={}", states[initial])],
+                value: None,
+            });
+        }
+        if let (None, Some((cur, text_var))) = (&inherited, &text) {
+            // The text follows the number: a final binding to a variable that the equation of the driving level
+            // sets, so neither an instance nor a user can give the text a value of its own.
+            body.mods.retain(|x| !matches!(x, Mod::Value { ident, .. } if ident == cur));
+            body.mods.push(Mod::Value {
+                ident: cur.clone(),
+                is_final: true,
+                attrs: Vec::new(),
+                value: Some(text_var.clone()),
+            });
+            body.items.push(Item::Decl {
+                prefix: String::new(),
+                ty: TypeRef::Path("String".into()),
+                ident: text_var.clone(),
+                dims: String::new(),
+                mods: Vec::new(),
+                value: None,
+                cond: None,
+                desc: string_literal(&format!(
+                    "The DisplayName of the current state, which {cur} shows: set from {var} by the equation of the class that drives the state machine"
+                )),
+                annotation: String::new(),
+            });
+        }
         if inherited.is_none() {
-            let marked = info.states.iter().position(|s| s.initial);
-            let initial = marked.unwrap_or(0);
-            let desc = if marked.is_some() {
-                "Number of the current state (CurrentState/Number)".to_string()
-            } else {
-                format!("Number of the current state (CurrentState/Number); the nodeset marks no initial state, so it starts in {}", info.states[0].name)
-            };
             body.items.push(Item::Decl {
                 prefix: "discrete".into(),
                 ty: TypeRef::Path("Integer".into()),
@@ -330,18 +466,7 @@ impl Ctx<'_> {
             }
             eq.push_str("  end when;\n");
         }
-        eq.push_str("end if;");
-        body.equations.push(eq);
-        // CurrentState shows the DisplayName of the current state.
-        let current = body
-            .elements
-            .iter()
-            .find(|e| e.bn.ns == 0 && e.bn.name == "CurrentState" && e.use_flag.is_none())
-            .filter(|e| {
-                matches!(&e.kind, ElemKind::Signal { ty: MType::Scalar { base: Base::String, .. }, dims: None, .. })
-            })
-            .map(|e| e.ident.clone());
-        if let Some(cur) = current {
+        if let Some((_, text_var)) = &text {
             let mut expr = String::new();
             for (i, s) in info.states.iter().enumerate() {
                 let kw = if i == 0 { "if" } else { " elseif" };
@@ -352,15 +477,69 @@ impl Ctx<'_> {
                 ));
             }
             expr.push_str(" else \"\"");
-            body.mods.push(Mod::Value { ident: cur, is_final: false, attrs: Vec::new(), value: Some(expr) });
+            eq.push_str(&format!("  {text_var} = {expr};\n"));
         }
+        eq.push_str("end if;");
+        body.equations.push(eq);
         Some(SmInfo {
             level,
             level_param,
             var,
-            states: info.states.iter().enumerate().map(|(i, s)| (s.node, states[i].clone())).collect(),
+            states: pairs,
+            numbers,
+            initial,
+            text,
             triggers: trig_nodes.iter().enumerate().map(|(i, &n)| (n, triggers[i].clone())).collect(),
             nodes,
         })
+    }
+
+    /// Applies the state that CurrentState child `current` names (an instance's value, or a type's) to the
+    /// inherited machine `sm`: a `start` modifier on the state number when it is not the state the machine
+    /// starts in already. The number is written as a literal, because the modifier may sit in an enclosing
+    /// class where the state constants are not visible.
+    pub fn start_state(&self, sm: &SmInfo, current: NodeIx, body: &mut Body) {
+        let Some(i) = state_in_value(self.m, current, &sm.states, &sm.numbers) else { return };
+        if i != sm.initial {
+            body.mods.push(Mod::Value {
+                ident: sm.var.clone(),
+                is_final: false,
+                attrs: vec![format!("start={}", sm.numbers[i])],
+                value: None,
+            });
+            body.initial = Some(i);
+        }
+    }
+
+    /// The state a machine starts in, and where that comes from (see [`InitialFrom`]).
+    fn initial_state(
+        &self,
+        t: NodeIx,
+        states: &[crate::model::State],
+        pairs: &[(NodeIx, String)],
+        numbers: &[u32],
+        current: Option<NodeIx>,
+        inherited: Option<&SmInfo>,
+    ) -> (usize, InitialFrom) {
+        let m = self.m;
+        if let Some(i) = states.iter().position(|s| s.initial) {
+            return (i, InitialFrom::Marked);
+        }
+        if let Some(i) = current.and_then(|c| state_in_value(m, c, pairs, numbers)) {
+            return (i, InitialFrom::Declared);
+        }
+        let same = |a: NodeIx| states.iter().position(|s| m.node(s.node).browse_name == m.node(a).browse_name);
+        if let Some(i) = inherited.and_then(|b| same(b.states[b.initial].0)) {
+            return (i, InitialFrom::Inherited);
+        }
+        let program = m.ns0(ids::PROGRAM_STATE_MACHINE_TYPE).is_some_and(|p| m.is_subtype_of(t, p));
+        let ready = states.iter().position(|s| {
+            let bn = &m.node(s.node).browse_name;
+            bn.ns == 0 && bn.name == "Ready"
+        });
+        match ready.filter(|_| program) {
+            Some(i) => (i, InitialFrom::ProgramReady),
+            None => (0, InitialFrom::First),
+        }
     }
 }

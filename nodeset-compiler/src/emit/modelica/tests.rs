@@ -231,3 +231,133 @@ fn a_subtype_makes_an_optional_member_mandatory_and_redeclares_its_class() {
         axis.contents
     );
 }
+
+fn robotics_files() -> Vec<crate::write::OutFile> {
+    generate(
+        &robotics().model,
+        &ModelicaConfig::new()
+            .namespace("http://opcfoundation.org/UA/Robotics/")
+            .namespace("http://opcfoundation.org/UA/DI/")
+            .namespace("http://opcfoundation.org/UA/IA/"),
+    )
+    .unwrap()
+}
+
+fn contents<'a>(files: &'a [crate::write::OutFile], path: &str) -> &'a str {
+    &files.iter().find(|f| f.path.ends_with(path)).unwrap_or_else(|| panic!("no {path}")).contents
+}
+
+#[test]
+fn references_that_are_not_containment_name_their_target() {
+    let files = robotics_files();
+    // AxisType Requires <PowerTrainIdentifier>; PowerTrainType Moves <AxisIdentifier> and HasSlave
+    // <PowerTrainIdentifier>: parameters with the NodeIds of the targets, not contained copies.
+    let axis = contents(&files, "OpcUaRobotics/ObjectTypes/AxisType.mo");
+    assert!(axis.contains("parameter String powerTrainIdentifier[nPowerTrainIdentifier] = fill(\"\", nPowerTrainIdentifier)"), "{axis}");
+    assert!(axis.contains("referenceType=\"Requires\""), "{axis}");
+    assert!(!axis.contains("model PowerTrainIdentifier"), "{axis}");
+    let power_train = contents(&files, "OpcUaRobotics/ObjectTypes/PowerTrainType.mo");
+    for (name, rt) in [("axisIdentifier", "Moves"), ("powerTrainIdentifier", "HasSlave")] {
+        assert!(power_train.contains(&format!("parameter String {name}[")), "{power_train}");
+        assert!(power_train.contains(&format!("referenceType=\"{rt}\"")), "{power_train}");
+    }
+    assert!(!power_train.contains("model AxisIdentifier"), "{power_train}");
+}
+
+#[test]
+fn containment_that_would_make_a_class_contain_itself_is_cut() {
+    let out = robotics();
+    let m = &out.model;
+    let cuts = recursion::containment_cuts(m);
+    let named: BTreeSet<String> = cuts
+        .iter()
+        .map(|&c| format!("{}/{}", m.node(m.node(c).parent.unwrap()).browse_name.name, m.node(c).browse_name.name))
+        .collect();
+    for want in ["FunctionalGroupType/<GroupIdentifier>", "FileDirectoryType/<FileDirectoryName>"] {
+        assert!(named.contains(want), "{want} is not cut: {named:?}");
+    }
+    let files = robotics_files();
+    let group = contents(&files, "OpcUaDI/ObjectTypes/FunctionalGroupType.mo");
+    assert!(group.contains("parameter String groupIdentifier["), "{group}");
+    assert!(group.contains("containing it would make the class contain itself"), "{group}");
+}
+
+/// The skill models, with the CurrentState of the DrillingCell's ReferenceDrillBush instance changed from
+/// Ready to `state` (Id, Number and text).
+fn skills_with_reference_drill_bush_in(state: Option<(&str, &str, &str)>) -> Vec<crate::write::OutFile> {
+    skills_with(|text| match state {
+        None => text.to_string(),
+        Some((id, number, shown)) => {
+            let mut text = text.to_string();
+            let from = text.find("NodeId=\"ns=1;i=4003\"").unwrap();
+            let to = text.find("NodeId=\"ns=1;i=4006\"").unwrap();
+            let part = text[from..to]
+                .replace("<uax:Text>Ready</uax:Text>", &format!("<uax:Text>{shown}</uax:Text>"))
+                .replace("<uax:Identifier>i=2400</uax:Identifier>", &format!("<uax:Identifier>{id}</uax:Identifier>"))
+                .replace("<uax:UInt32>12</uax:UInt32>", &format!("<uax:UInt32>{number}</uax:UInt32>"));
+            text.replace_range(from..to, &part);
+            text
+        }
+    })
+}
+
+/// The Modelica packages of our skill models, with the text of DrillingProcess changed by `patch`.
+fn skills_with(patch: impl Fn(&str) -> String) -> Vec<crate::write::OutFile> {
+    let dir = workspace().join("nodesets");
+    let mut inputs = Vec::new();
+    for name in ["CommonSkills", "RobotCell", "DrillingProcess"] {
+        let path = dir.join(format!("{name}.NodeSet2.xml"));
+        let mut text = std::fs::read_to_string(&path).unwrap();
+        if name == "DrillingProcess" {
+            text = patch(&text);
+        }
+        inputs.push(Input::Text { name: path.display().to_string(), text });
+    }
+    let out = compile(inputs, &Options { model_dirs: vec![dir.join("vendor")], ..Options::default() });
+    assert!(out.ok(), "{}", out.render_diagnostics());
+    let mut cfg = ModelicaConfig::new();
+    for m in &out.model.models {
+        if m.uri != crate::load::NS0_URI {
+            cfg = cfg.namespace(m.uri.clone());
+        }
+    }
+    generate(&out.model, &cfg).unwrap()
+}
+
+#[test]
+fn state_text_follows_the_number_and_instances_set_the_initial_state() {
+    let files = skills_with_reference_drill_bush_in(None);
+    let program = contents(&files, "OpcUa/ObjectTypes/ProgramStateMachineType.mo");
+    assert!(program.contains("final currentState=currentStateText"), "{program}");
+    assert!(program.contains("discrete Integer currentStateNumber(start=Ready, fixed=true)"), "{program}");
+    assert!(program.contains("currentStateText = if currentStateNumber == Halted then \"Halted\""), "{program}");
+    // The instances are in Ready, where the skills start anyway: no modifier, and never the text.
+    let cell = contents(&files, "NodesetCompilerDrillingProcess/Instances/DrillingCell.mo");
+    assert!(!cell.contains("currentState"), "{cell}");
+    // An instance in another state starts there; Id, Number and text each name it.
+    for (id, number, shown) in [("i=2406", "11", "Halted"), ("i=2402", "13", "Running")] {
+        let files = skills_with_reference_drill_bush_in(Some((id, number, shown)));
+        let cell = contents(&files, "NodesetCompilerDrillingProcess/Instances/DrillingCell.mo");
+        assert!(cell.contains(&format!("referenceDrillBush(currentStateNumber(start={number})")), "{cell}");
+        assert!(!cell.contains("currentState="), "{cell}");
+    }
+}
+
+#[test]
+fn an_instance_names_the_target_of_its_reference() {
+    // DrillingCell Requires the robot system TemplateDrillingLwrSystem (Requires, i=25256, is hierarchical but
+    // not containment): a parameter with the target's NodeId, not a copy of the robot system.
+    let files = skills_with(|text| {
+        let at = text.find("<Reference ReferenceType=\"HasComponent\">ns=1;i=4001</Reference>").expect("DrillingCell's SkillSet");
+        let mut text = text.to_string();
+        text.insert_str(at, "<Reference ReferenceType=\"i=25256\">ns=1;i=5000</Reference>\n      ");
+        text
+    });
+    let cell = contents(&files, "NodesetCompilerDrillingProcess/Instances/DrillingCell.mo");
+    assert!(
+        cell.contains("parameter String templateDrillingLwrSystem = \"nsu=http://nodeset-compiler.dev/DrillingProcess/;i=5000\""),
+        "{cell}"
+    );
+    assert!(cell.contains("referenceType=\"Requires\""), "{cell}");
+    assert!(!cell.contains("NodesetCompilerRobotCell."), "no component of the robot system's class: {cell}");
+}
