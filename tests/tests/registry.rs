@@ -28,12 +28,15 @@ fn every_registry_file_resolves() {
     for unit in &units {
         let compiled = compile(unit.iter().cloned().map(Input::Path).collect(), &opts);
         nodes += compiled.model.nodes.len();
+        if compiled.model.nodes.is_empty() {
+            failed.push(format!("{unit:?}: no node resolved"));
+        }
         if compiled.diagnostics.error_count() > 0 {
             failed.push(format!("{unit:?}:\n{}", compiled.render_diagnostics()));
         }
     }
     assert!(failed.is_empty(), "{} of {} runs do not resolve:\n{}", failed.len(), units.len(), failed.join("\n"));
-    // Each run holds ns0 (more than 20,000 nodes) and what its files require.
-    assert!(nodes > units.len() * 20_000, "too few nodes resolved: {nodes} in {} runs", units.len());
+    // 236,287 nodes when written (the part of ns0 each run uses, its files and the models they require).
+    assert!(nodes > 200_000, "too few nodes resolved: {nodes} in {} runs", units.len());
     eprintln!("{} runs, {nodes} nodes resolved", units.len());
 }
