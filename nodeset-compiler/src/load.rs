@@ -8,7 +8,7 @@
 
 use crate::fxhash::FxHashMap;
 use crate::diag::{Code, Diagnostic, Diagnostics};
-use crate::nodeid::{parse_node_id, looks_like_node_id, NodeId, NsRef};
+use crate::nodeid::{parse_node_id, looks_like_node_id, NodeId, NsRef, RawNodeId};
 use crate::parse::{self, Limits};
 use crate::raw::{RawModel, RawNodeSet};
 use crate::source::{FileId, SourceFile, SourceMap, Span, Spanned};
@@ -396,7 +396,7 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
         }
     }
 
-    let mut models = Vec::new();
+    let mut models: Vec<ModelInfo> = Vec::new();
     let mut files = Vec::new();
     for set in files_sorted {
         let mut ns_map = vec![0u16];
@@ -405,6 +405,13 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
         }
         for m in &set.models {
             models.push(model_info(m, set.file, intern(&m.uri, &mut namespaces)));
+        }
+        if set.models.is_empty() && sources.get(set.file).named {
+            for uri in defined_namespaces(&set, sources.get(set.file).text.as_str()) {
+                if uri != NS0_URI && !provided.contains_key(uri) && !models.iter().any(|m| m.uri == uri) {
+                    models.push(implied_model(uri, set.file, set.root_span, intern(uri, &mut namespaces)));
+                }
+            }
         }
         let mut aliases: FxHashMap<String, Spanned<String>> = FxHashMap::with_capacity_and_hasher(set.aliases.len(), Default::default());
         for a in &set.aliases {
@@ -424,6 +431,43 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
         files.push(LoadedFile { raw: set, ns_map, aliases });
     }
     Loaded { sources, files, namespaces, models }
+}
+
+/// The namespaces of `NamespaceUris` in which `set` defines nodes (a numeric or string `ns=N` NodeId), in
+/// the order of that list.
+fn defined_namespaces<'a>(set: &'a RawNodeSet, text: &str) -> Vec<&'a str> {
+    let mut used = vec![false; set.namespace_uris.len() + 1];
+    for node in &set.nodes {
+        let ns = match node.node_id.numeric_node_id() {
+            Some((ns, _)) => Some(ns),
+            None => match parse_node_id(node.node_id.get(text)) {
+                Ok(RawNodeId { ns: NsRef::Index(i), .. }) => Some(i),
+                _ => None,
+            },
+        };
+        if let Some(slot) = ns.and_then(|i| used.get_mut(usize::from(i))) {
+            *slot = true;
+        }
+    }
+    set.namespace_uris.iter().enumerate().filter(|(i, _)| used[i + 1]).map(|(_, u)| u.value.as_str()).collect()
+}
+
+/// The model a named file without `<Models>` implies for a namespace it defines nodes in: no version, no
+/// requirement but the base model (which every file needs), so that the file's nodes are generated like a
+/// declared model's (NS0109 says the file declares none).
+fn implied_model(uri: &str, file: FileId, span: Span, ns: u16) -> ModelInfo {
+    ModelInfo {
+        uri: uri.to_string(),
+        version: None,
+        publication_date: None,
+        model_version: None,
+        file,
+        ns,
+        required: Vec::new(),
+        default_role_permissions: Vec::new(),
+        default_access_restrictions: None,
+        span,
+    }
 }
 
 fn model_info(m: &RawModel, file: FileId, ns: u16) -> ModelInfo {
