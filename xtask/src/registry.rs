@@ -6,8 +6,8 @@
 //!
 //! Each file is compiled on its own with `nodesets/vendor/` as the model folder, as
 //! `nodeset-compiler check FILE --models nodesets/vendor` does. The Rust is `cargo xtask corpus` over the
-//! vendor folder (one module per file, its dependencies the modules of the files they resolve to, one
-//! `cargo check`; ns0 is async-opcua's own). The Modelica of each file is the `modelica` command's run
+//! vendor folder (one module per file, the three of `1.02/` generated together, its dependencies the modules
+//! of the files they resolve to, one `cargo check`; ns0 is async-opcua's own). The Modelica of each file is the `modelica` command's run
 //! (every model it requires generated with it, the used part of ns0 as `OpcUa`), checked by
 //! `tests/modelica/check.py --aggregate` in the project's venv, two files at a time.
 
@@ -69,7 +69,8 @@ pub fn run(args: Args) -> Result<(), String> {
     }
 
     // 2. Rust, compiled.
-    crate::corpus::run(crate::corpus::Args { tree: Some(vendor.clone()), out: Some(out.join("rust")) })?;
+    let groups: Vec<Vec<PathBuf>> = units.iter().filter(|u| u.len() > 1).cloned().collect();
+    crate::corpus::run_with_groups(crate::corpus::Args { tree: Some(vendor.clone()), out: Some(out.join("rust")) }, &groups)?;
 
     // 3. Modelica, checked by rumoca.
     let t = Instant::now();
@@ -155,5 +156,26 @@ fn rumoca(python: &Path, checker: &Path, dir: &Path) -> Result<(usize, usize, St
     match nums.as_slice() {
         [p, f] => Ok((*p, *f, text)),
         _ => Err(format!("unexpected summary `{last}` from check.py for {}", dir.display())),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rumoca stage fails on a class rumoca rejects: a package of two classes, one of which reads a
+    /// variable that does not exist, gives `1 passed, 1 failed`, and `run` turns any failure into an error.
+    #[test]
+    fn the_rumoca_stage_counts_a_rejected_class() {
+        let python = crate::venv::ensure_venv().expect("the project's venv (cargo xtask venv)");
+        let dir = std::env::temp_dir().join(format!("xtask-registry-{}", std::process::id()));
+        let pkg = dir.join("Planted");
+        std::fs::create_dir_all(&pkg).unwrap();
+        std::fs::write(pkg.join("package.mo"), "package Planted\nend Planted;\n").unwrap();
+        std::fs::write(pkg.join("Good.mo"), "within Planted;\nmodel Good\n  Real x = 1;\nend Good;\n").unwrap();
+        std::fs::write(pkg.join("Bad.mo"), "within Planted;\nmodel Bad\n  Real x = notDeclared;\nend Bad;\n").unwrap();
+        let (passed, failed, text) = rumoca(&python, &workspace_root().join("tests/modelica/check.py"), &dir).expect("check.py runs");
+        let _ = std::fs::remove_dir_all(&dir);
+        assert_eq!((passed, failed), (1, 1), "{text}");
     }
 }
