@@ -39,6 +39,8 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
+use bench_support::{median, min, ms, proc_status_kib, thread_cpu_ms, Line};
+
 /// The four files of the `robotics` scenario, in `nodesets/vendor/`.
 const ROBOTICS_FILES: &[&str] = &[
     "Opc.Ua.NodeSet2.xml",
@@ -280,63 +282,9 @@ fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// A line of `/proc/self/status`, in KiB (0 where there is no procfs).
-fn proc_status_kib(key: &str) -> u64 {
-    let Ok(s) = std::fs::read_to_string("/proc/self/status") else {
-        return 0;
-    };
-    s.lines()
-        .find_map(|l| l.strip_prefix(key)?.strip_prefix(':'))
-        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
-        .unwrap_or(0)
-}
-
-/// CPU time this thread has run, ms (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`; NaN where unavailable).
-/// Unlike wall time, it does not grow when other processes compete for the CPU.
-#[cfg(all(target_os = "linux", target_pointer_width = "64"))]
-fn thread_cpu_ms() -> f64 {
-    #[repr(C)]
-    struct Timespec {
-        tv_sec: i64,
-        tv_nsec: i64,
-    }
-    extern "C" {
-        fn clock_gettime(clock: i32, tp: *mut Timespec) -> i32;
-    }
-    const CLOCK_THREAD_CPUTIME_ID: i32 = 3;
-    let mut ts = Timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `ts` is a valid, writable timespec of the 64-bit Linux layout.
-    if unsafe { clock_gettime(CLOCK_THREAD_CPUTIME_ID, &mut ts) } == 0 {
-        ts.tv_sec as f64 * 1e3 + ts.tv_nsec as f64 / 1e6
-    } else {
-        f64::NAN
-    }
-}
-
-#[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
-fn thread_cpu_ms() -> f64 {
-    f64::NAN
-}
-
-fn ms(d: Duration) -> f64 {
-    d.as_secs_f64() * 1e3
-}
-
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    match s.len() {
-        0 => 0.0,
-        n if n % 2 == 1 => s[n / 2],
-        n => (s[n / 2 - 1] + s[n / 2]) / 2.0,
-    }
-}
-
-fn min(v: &[f64]) -> f64 {
-    v.iter().copied().fold(f64::INFINITY, f64::min)
+/// The peak resident memory of this process so far, KiB (0 where there is no procfs).
+fn vm_hwm_kib() -> u64 {
+    proc_status_kib("VmHWM").unwrap_or(0)
 }
 
 /// What one compile of a job produced (from the first run).
@@ -390,7 +338,7 @@ fn file_cost(path: &Path, reps: usize) -> FileCost {
 
 fn run() -> Result<(), String> {
     let cli = parse_cli()?;
-    let hwm_start = proc_status_kib("VmHWM");
+    let hwm_start = vm_hwm_kib();
     let jobs = jobs(&cli)?;
     eprintln!(
         "load_bench: scenario `{}`, {} compile(s) per run, {} run(s)",
@@ -439,10 +387,10 @@ fn run() -> Result<(), String> {
         cpu.push(cpu_ms);
         drops.push(drop_ms);
         if run == 0 {
-            hwm_first = proc_status_kib("VmHWM");
+            hwm_first = vm_hwm_kib();
         }
     }
-    let hwm_runs = proc_status_kib("VmHWM");
+    let hwm_runs = vm_hwm_kib();
 
     // Stage split: load, then resolve, timed separately (separate runs, so the headline is untouched).
     let (mut loads, mut resolves) = (Vec::new(), Vec::new());
@@ -534,50 +482,33 @@ fn run() -> Result<(), String> {
     }
 
     let load_med = median(&loads);
-    let kv: Vec<(&str, String)> = vec![
-        ("scenario", cli.scenario.clone()),
-        ("runs", cli.runs.to_string()),
-        ("compiles", jobs.len().to_string()),
-        ("total_median_ms", format!("{:.3}", median(&totals))),
-        ("total_min_ms", format!("{:.3}", min(&totals))),
-        (
-            "total_max_ms",
-            format!("{:.3}", totals.iter().copied().fold(0.0, f64::max)),
-        ),
-        ("cpu_median_ms", format!("{:.3}", median(&cpu))),
-        ("cpu_min_ms", format!("{:.3}", min(&cpu))),
-        ("drop_median_ms", format!("{:.3}", median(&drops))),
-        ("load_median_ms", format!("{:.3}", load_med)),
-        ("resolve_median_ms", format!("{:.3}", median(&resolves))),
-        ("read_ms", format!("{read:.3}")),
-        ("decode_ms", format!("{decode:.3}")),
-        ("parse_ms", format!("{parse_ms:.3}")),
-        (
-            "load_other_ms",
-            format!(
-                "{:.3}",
-                if cli.split {
-                    load_med - read - decode - parse_ms
-                } else {
-                    0.0
-                }
-            ),
-        ),
-        ("unique_files", costs.len().to_string()),
-        ("unique_parse_ms", format!("{unique_parse:.3}")),
-        ("unique_nodes", unique_nodes.to_string()),
-        ("hwm_start_kib", hwm_start.to_string()),
-        ("hwm_kib", hwm_first.to_string()),
-        ("hwm_all_runs_kib", hwm_runs.to_string()),
-        ("nodes", nodes.to_string()),
-        ("max_nodes", max_nodes.to_string()),
-        ("files_loaded", files_loaded.to_string()),
-        ("failed_compiles", failed.len().to_string()),
-        ("errors", errors.to_string()),
-        ("warnings", warnings.to_string()),
-    ];
-    let line: Vec<String> = kv.iter().map(|(k, v)| format!("{k}={v}")).collect();
-    println!("BENCH {}", line.join(" "));
+    Line::new()
+        .kv("scenario", &cli.scenario)
+        .kv("runs", cli.runs)
+        .kv("compiles", jobs.len())
+        .stats("total", &totals, 3)
+        .num("cpu_median_ms", median(&cpu), 3)
+        .num("cpu_min_ms", min(&cpu), 3)
+        .num("drop_median_ms", median(&drops), 3)
+        .num("load_median_ms", load_med, 3)
+        .num("resolve_median_ms", median(&resolves), 3)
+        .num("read_ms", read, 3)
+        .num("decode_ms", decode, 3)
+        .num("parse_ms", parse_ms, 3)
+        .num("load_other_ms", if cli.split { load_med - read - decode - parse_ms } else { 0.0 }, 3)
+        .kv("unique_files", costs.len())
+        .num("unique_parse_ms", unique_parse, 3)
+        .kv("unique_nodes", unique_nodes)
+        .kv("hwm_start_kib", hwm_start)
+        .kv("hwm_kib", hwm_first)
+        .kv("hwm_all_runs_kib", hwm_runs)
+        .kv("nodes", nodes)
+        .kv("max_nodes", max_nodes)
+        .kv("files_loaded", files_loaded)
+        .kv("failed_compiles", failed.len())
+        .kv("errors", errors)
+        .kv("warnings", warnings)
+        .print();
     Ok(())
 }
 

@@ -33,6 +33,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, ExitCode, Stdio};
 use std::time::Instant;
 
+use bench_support::{children_usage, median, ms_since, process_cpu_ms, proc_status_kib, Line};
+
 /// The generated namespaces: (file in nodesets/vendor, module name), as in `xtask/src/generate.rs`.
 const NAMESPACES: &[(&str, &str)] = &[
     ("Opc.Ua.Di.NodeSet2.xml", "di"),
@@ -52,129 +54,9 @@ fn usage() -> String {
         .to_string()
 }
 
-/// A line of `/proc/self/status`, in KiB (0 where there is no procfs).
-fn proc_status_kib(key: &str) -> u64 {
-    let Ok(s) = std::fs::read_to_string("/proc/self/status") else {
-        return 0;
-    };
-    s.lines()
-        .find_map(|l| l.strip_prefix(key)?.strip_prefix(':'))
-        .and_then(|v| v.trim().trim_end_matches("kB").trim().parse().ok())
-        .unwrap_or(0)
-}
-
-#[cfg(all(target_os = "linux", target_pointer_width = "64"))]
-mod sys {
-    #[repr(C)]
-    struct Timespec {
-        tv_sec: i64,
-        tv_nsec: i64,
-    }
-
-    #[repr(C)]
-    struct Timeval {
-        tv_sec: i64,
-        tv_usec: i64,
-    }
-
-    /// `struct rusage` of 64-bit Linux: two timevals, then 14 longs starting with `ru_maxrss` (KiB).
-    #[repr(C)]
-    struct Rusage {
-        utime: Timeval,
-        stime: Timeval,
-        maxrss: i64,
-        rest: [i64; 13],
-    }
-
-    extern "C" {
-        fn clock_gettime(clock: i32, tp: *mut Timespec) -> i32;
-        fn getrusage(who: i32, usage: *mut Rusage) -> i32;
-    }
-
-    /// CPU time this process has run on all its threads, ms (NaN where unavailable). Unlike wall time, it
-    /// does not grow when other processes compete for the CPU; both stages use several threads, so the
-    /// calling thread's time alone would undercount them.
-    pub fn process_cpu_ms() -> f64 {
-        const CLOCK_PROCESS_CPUTIME_ID: i32 = 2;
-        let mut ts = Timespec {
-            tv_sec: 0,
-            tv_nsec: 0,
-        };
-        // SAFETY: `ts` is a valid, writable timespec of the 64-bit Linux layout.
-        if unsafe { clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &mut ts) } == 0 {
-            ts.tv_sec as f64 * 1e3 + ts.tv_nsec as f64 / 1e6
-        } else {
-            f64::NAN
-        }
-    }
-
-    /// Peak RSS (KiB) of the largest terminated child, and the CPU time (user + system, ms) of all of them.
-    pub fn children_usage() -> (u64, f64) {
-        const RUSAGE_CHILDREN: i32 = -1;
-        let mut ru = Rusage {
-            utime: Timeval {
-                tv_sec: 0,
-                tv_usec: 0,
-            },
-            stime: Timeval {
-                tv_sec: 0,
-                tv_usec: 0,
-            },
-            maxrss: 0,
-            rest: [0; 13],
-        };
-        // SAFETY: `ru` is a valid, writable rusage of the 64-bit Linux layout.
-        if unsafe { getrusage(RUSAGE_CHILDREN, &mut ru) } != 0 {
-            return (0, f64::NAN);
-        }
-        let ms = |t: &Timeval| t.tv_sec as f64 * 1e3 + t.tv_usec as f64 / 1e3;
-        (ru.maxrss.max(0) as u64, ms(&ru.utime) + ms(&ru.stime))
-    }
-}
-
-#[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
-mod sys {
-    pub fn process_cpu_ms() -> f64 {
-        f64::NAN
-    }
-
-    pub fn children_usage() -> (u64, f64) {
-        (0, f64::NAN)
-    }
-}
-
-fn ms_since(t: Instant) -> f64 {
-    t.elapsed().as_secs_f64() * 1e3
-}
-
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    match s.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => s[n / 2],
-        n => (s[n / 2 - 1] + s[n / 2]) / 2.0,
-    }
-}
-
-fn min(v: &[f64]) -> f64 {
-    v.iter().copied().fold(f64::INFINITY, f64::min)
-}
-
-fn max(v: &[f64]) -> f64 {
-    v.iter().copied().fold(f64::NEG_INFINITY, f64::max)
-}
-
-/// Adds `<prefix>_median_ms`, `_min_ms` and `_max_ms` of `v` to the report.
-fn stats(kv: &mut Vec<(String, String)>, prefix: &str, v: &[f64]) {
-    kv.push((format!("{prefix}_median_ms"), format!("{:.3}", median(v))));
-    kv.push((format!("{prefix}_min_ms"), format!("{:.3}", min(v))));
-    kv.push((format!("{prefix}_max_ms"), format!("{:.3}", max(v))));
-}
-
-fn print_bench(kv: &[(String, String)]) {
-    let line: Vec<String> = kv.iter().map(|(k, v)| format!("{k}={v}")).collect();
-    println!("BENCH {}", line.join(" "));
+/// The peak resident memory of this process so far, KiB (0 where there is no procfs).
+fn vm_hwm_kib() -> u64 {
+    proc_status_kib("VmHWM").unwrap_or(0)
 }
 
 /// One generation, as `xtask/src/generate.rs` `plan()` does it: returns the files, or why it failed.
@@ -221,17 +103,17 @@ fn generate_cmd(mut args: impl Iterator<Item = String>) -> Result<(), String> {
     };
     eprintln!("rust_bench: generate DI + IA + Robotics (ns0 as dependency), {runs} run(s)");
 
-    let hwm_start = proc_status_kib("VmHWM");
+    let hwm_start = vm_hwm_kib();
     let (mut compile_ms, mut emit_ms, mut total_ms) = (Vec::new(), Vec::new(), Vec::new());
     let (mut compile_cpu, mut emit_cpu) = (Vec::new(), Vec::new());
     let mut first: Option<Generated> = None;
     let mut hwm_first = 0;
     for run in 0..runs {
-        let c0 = sys::process_cpu_ms();
+        let c0 = process_cpu_ms();
         let t0 = Instant::now();
         let out = compile(inputs.iter().cloned().map(Input::Path).collect(), &opts);
         let t_compile = ms_since(t0);
-        let c1 = sys::process_cpu_ms();
+        let c1 = process_cpu_ms();
         if !out.ok() {
             eprint!("{}", out.render_diagnostics());
             return Err("the pinned nodesets do not compile".into());
@@ -271,14 +153,14 @@ fn generate_cmd(mut args: impl Iterator<Item = String>) -> Result<(), String> {
         rust.files.push(rust_emit::models_mod(&modules, &cfg.runtime_path, COMMAND));
         rust.files.push(rust_emit::rustfmt_toml());
         let t_emit = ms_since(t1);
-        let c2 = sys::process_cpu_ms();
+        let c2 = process_cpu_ms();
         compile_ms.push(t_compile);
         emit_ms.push(t_emit);
         total_ms.push(t_compile + t_emit);
         compile_cpu.push(c1 - c0);
         emit_cpu.push(c2 - c1);
         if run == 0 {
-            hwm_first = proc_status_kib("VmHWM");
+            hwm_first = vm_hwm_kib();
             if rust.diagnostics.has_errors() {
                 eprint!("{}", rust.diagnostics.render(&model.sources));
                 return Err("Rust generation reported errors".into());
@@ -296,7 +178,7 @@ fn generate_cmd(mut args: impl Iterator<Item = String>) -> Result<(), String> {
         }
         drop(black_box(out));
     }
-    let hwm_runs = proc_status_kib("VmHWM");
+    let hwm_runs = vm_hwm_kib();
     let g = first.expect("at least one run");
 
     // Lines and bytes per module folder (`di/...`), and for the files at the top (`mod.rs`, `rustfmt.toml`).
@@ -317,36 +199,29 @@ fn generate_cmd(mut args: impl Iterator<Item = String>) -> Result<(), String> {
         e.2 += f.contents.len();
     }
 
-    let mut kv: Vec<(String, String)> = vec![
-        ("scenario".into(), "rust-generate".into()),
-        ("runs".into(), runs.to_string()),
-    ];
-    stats(&mut kv, "compile", &compile_ms);
-    stats(&mut kv, "emit", &emit_ms);
-    stats(&mut kv, "total", &total_ms);
-    kv.push((
-        "compile_cpu_median_ms".into(),
-        format!("{:.3}", median(&compile_cpu)),
-    ));
-    kv.push((
-        "emit_cpu_median_ms".into(),
-        format!("{:.3}", median(&emit_cpu)),
-    ));
-    kv.push(("hwm_start_kib".into(), hwm_start.to_string()));
-    kv.push(("hwm_kib".into(), hwm_first.to_string()));
-    kv.push(("hwm_all_runs_kib".into(), hwm_runs.to_string()));
-    kv.push(("nodes".into(), g.nodes.to_string()));
-    kv.push(("compile_errors".into(), g.compile_errors.to_string()));
-    kv.push(("compile_warnings".into(), g.compile_warnings.to_string()));
-    kv.push(("emit_errors".into(), g.emit_errors.to_string()));
-    kv.push(("emit_warnings".into(), g.emit_warnings.to_string()));
-    kv.push(("files".into(), g.files.len().to_string()));
+    let mut line = Line::new();
+    line.kv("scenario", "rust-generate")
+        .kv("runs", runs)
+        .stats("compile", &compile_ms, 3)
+        .stats("emit", &emit_ms, 3)
+        .stats("total", &total_ms, 3)
+        .num("compile_cpu_median_ms", median(&compile_cpu), 3)
+        .num("emit_cpu_median_ms", median(&emit_cpu), 3)
+        .kv("hwm_start_kib", hwm_start)
+        .kv("hwm_kib", hwm_first)
+        .kv("hwm_all_runs_kib", hwm_runs)
+        .kv("nodes", g.nodes)
+        .kv("compile_errors", g.compile_errors)
+        .kv("compile_warnings", g.compile_warnings)
+        .kv("emit_errors", g.emit_errors)
+        .kv("emit_warnings", g.emit_warnings)
+        .kv("files", g.files.len());
     for (module, (files, lines, bytes)) in &per {
-        kv.push((format!("files_{module}"), files.to_string()));
-        kv.push((format!("lines_{module}"), lines.to_string()));
-        kv.push((format!("bytes_{module}"), bytes.to_string()));
+        line.kv(format!("files_{module}"), files)
+            .kv(format!("lines_{module}"), lines)
+            .kv(format!("bytes_{module}"), bytes);
     }
-    print_bench(&kv);
+    line.print();
     Ok(())
 }
 
@@ -407,19 +282,15 @@ fn exec_cmd(mut args: impl Iterator<Item = String>) -> Result<(), String> {
             break;
         }
     }
-    let (maxrss, cpu) = sys::children_usage();
-    let mut kv: Vec<(String, String)> = vec![
-        ("scenario".into(), "exec".into()),
-        ("ok".into(), u8::from(failure.is_none()).to_string()),
-        ("runs".into(), wall.len().to_string()),
-    ];
-    stats(&mut kv, "wall", &wall);
-    kv.push((
-        "cpu_per_run_ms".into(),
-        format!("{:.3}", cpu / wall.len().max(1) as f64),
-    ));
-    kv.push(("maxrss_kib".into(), maxrss.to_string()));
-    print_bench(&kv);
+    let (maxrss, cpu) = children_usage();
+    Line::new()
+        .kv("scenario", "exec")
+        .kv("ok", u8::from(failure.is_none()))
+        .kv("runs", wall.len())
+        .stats("wall", &wall, 3)
+        .num("cpu_per_run_ms", cpu / wall.len().max(1) as f64, 3)
+        .kv("maxrss_kib", maxrss)
+        .print();
     match failure {
         Some(f) => Err(f),
         None => Ok(()),

@@ -27,6 +27,8 @@ use std::hint::black_box;
 use std::process::ExitCode;
 use std::time::Instant;
 
+use bench_support::{median, ms_since, thread_cpu_ms, Line};
+
 use nodeset_models::models::{di, ia, robotics};
 use nodeset_models::runtime::import::TableImport;
 use nodeset_models::runtime::table::NodeSetTable;
@@ -35,64 +37,6 @@ use opcua::server::address_space::{AddressSpace, CoreNamespace};
 
 /// The tables, in the order a server registers them (dependencies first).
 const TABLES: [&NodeSetTable; 3] = [&di::TABLE, &ia::TABLE, &robotics::TABLE];
-
-/// CPU time this thread has run, ms (NaN where unavailable). Unlike wall time, it does not grow when
-/// other processes compete for the CPU.
-#[cfg(all(target_os = "linux", target_pointer_width = "64"))]
-fn thread_cpu_ms() -> f64 {
-    #[repr(C)]
-    struct Timespec {
-        tv_sec: i64,
-        tv_nsec: i64,
-    }
-    extern "C" {
-        fn clock_gettime(clock: i32, tp: *mut Timespec) -> i32;
-    }
-    const CLOCK_THREAD_CPUTIME_ID: i32 = 3;
-    let mut ts = Timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `ts` is a valid, writable timespec of the 64-bit Linux layout.
-    if unsafe { clock_gettime(CLOCK_THREAD_CPUTIME_ID, &mut ts) } == 0 {
-        ts.tv_sec as f64 * 1e3 + ts.tv_nsec as f64 / 1e6
-    } else {
-        f64::NAN
-    }
-}
-
-#[cfg(not(all(target_os = "linux", target_pointer_width = "64")))]
-fn thread_cpu_ms() -> f64 {
-    f64::NAN
-}
-
-fn ms_since(t: Instant) -> f64 {
-    t.elapsed().as_secs_f64() * 1e3
-}
-
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    match s.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => s[n / 2],
-        n => (s[n / 2 - 1] + s[n / 2]) / 2.0,
-    }
-}
-
-fn min(v: &[f64]) -> f64 {
-    v.iter().copied().fold(f64::INFINITY, f64::min)
-}
-
-fn max(v: &[f64]) -> f64 {
-    v.iter().copied().fold(f64::NEG_INFINITY, f64::max)
-}
-
-fn stats(kv: &mut Vec<(String, String)>, prefix: &str, v: &[f64]) {
-    kv.push((format!("{prefix}_median_ms"), format!("{:.4}", median(v))));
-    kv.push((format!("{prefix}_min_ms"), format!("{:.4}", min(v))));
-    kv.push((format!("{prefix}_max_ms"), format!("{:.4}", max(v))));
-}
 
 fn run() -> Result<(), String> {
     let mut runs = 50usize;
@@ -187,30 +131,22 @@ fn run() -> Result<(), String> {
         drop_ms.push(ms_since(t));
     }
 
-    let mut kv: Vec<(String, String)> = vec![
-        ("scenario".into(), "import".into()),
-        ("runs".into(), runs.to_string()),
-        ("rows".into(), rows.to_string()),
-        ("imported".into(), imported.to_string()),
-    ];
-    stats(&mut kv, "import", &import_ms);
-    kv.push(("decode_ms".into(), format!("{decode_ms:.4}")));
-    // What a server pays the first time it imports the tables in a process: the decode, then the import.
-    kv.push((
-        "first_import_ms".into(),
-        format!("{:.4}", decode_ms + import_ms[0]),
-    ));
-    kv.push((
-        "import_cpu_median_ms".into(),
-        format!("{:.4}", median(&import_cpu)),
-    ));
-    stats(&mut kv, "type_tree", &tree_ms);
-    kv.push(("drop_median_ms".into(), format!("{:.4}", median(&drop_ms))));
-    kv.push(("ns0_nodes".into(), ns0_nodes.to_string()));
-    kv.push(("ns0_import_ms".into(), format!("{ns0_import:.3}")));
-    kv.push(("ns0_type_tree_ms".into(), format!("{ns0_tree_ms:.3}")));
-    let line: Vec<String> = kv.iter().map(|(k, v)| format!("{k}={v}")).collect();
-    println!("BENCH {}", line.join(" "));
+    let mut line = Line::new();
+    line.kv("scenario", "import")
+        .kv("runs", runs)
+        .kv("rows", rows)
+        .kv("imported", imported)
+        .stats("import", &import_ms, 4)
+        .num("decode_ms", decode_ms, 4)
+        // What a server pays the first time it imports the tables in a process: the decode, then the import.
+        .num("first_import_ms", decode_ms + import_ms[0], 4)
+        .num("import_cpu_median_ms", median(&import_cpu), 4)
+        .stats("type_tree", &tree_ms, 4)
+        .num("drop_median_ms", median(&drop_ms), 4)
+        .kv("ns0_nodes", ns0_nodes)
+        .num("ns0_import_ms", ns0_import, 3)
+        .num("ns0_type_tree_ms", ns0_tree_ms, 3)
+        .print();
     Ok(())
 }
 

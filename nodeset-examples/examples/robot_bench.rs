@@ -21,6 +21,8 @@
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
+use bench_support::{proc_status_kib, Line};
+
 use nodeset_models::models::robotics::objects::MotionDeviceSystemType;
 use nodeset_models::models::{di, ia, robotics};
 use nodeset_models::runtime::server::{ModelManager, ServerConfig};
@@ -70,13 +72,9 @@ fn robot_options() -> Instantiate {
     o
 }
 
-/// A field of `/proc/self/status` in KiB (`VmRSS`, `VmHWM`).
+/// A field of `/proc/self/status` in KiB (`VmRSS`, `VmHWM`); an error where it cannot be read.
 fn status_kib(field: &str) -> Result<u64, String> {
-    let status = std::fs::read_to_string("/proc/self/status").map_err(|e| format!("cannot read /proc/self/status: {e}"))?;
-    status
-        .lines()
-        .find_map(|l| l.strip_prefix(field)?.strip_prefix(':')?.trim().strip_suffix("kB")?.trim().parse().ok())
-        .ok_or_else(|| format!("/proc/self/status has no {field}"))
+    proc_status_kib(field).ok_or_else(|| format!("/proc/self/status cannot be read or has no {field}"))
 }
 
 /// The nodes reachable from `root` through forward hierarchical references, `root` included.
@@ -167,28 +165,27 @@ async fn run(o: Options) -> Result<(), String> {
     let n = cycles.len();
     cycles.sort();
     let us = |d: Duration| d.as_secs_f64() * 1e6;
-    println!(
-        "BENCH scenario=robots robots={} joints={} hz={} seconds={} nodes_per_robot={} instantiate_ms={:.1} \
-         instantiate_per_robot_ms={:.2} rss_base_kib={} rss_robots_kib={} kib_per_robot={:.1} cycles={} late_cycles={} \
-         achieved_hz={:.1} cycle_median_us={:.1} cycle_p99_us={:.1} cycle_max_us={:.1} vmhwm_kib={}",
-        o.robots,
-        joints.len(),
-        o.hz,
-        o.seconds,
-        nodes_per_robot,
-        instantiate.as_secs_f64() * 1e3,
-        instantiate.as_secs_f64() * 1e3 / o.robots as f64,
-        rss_base,
-        rss_robots,
-        rss_robots.saturating_sub(rss_base) as f64 / o.robots as f64,
-        n,
-        late,
-        n as f64 / ran.as_secs_f64(),
-        us(percentile(&cycles, 0.5)),
-        us(percentile(&cycles, 0.99)),
-        us(cycles[n - 1]),
-        status_kib("VmHWM")?,
-    );
+    let instantiate_ms = instantiate.as_secs_f64() * 1e3;
+    Line::new()
+        .kv("scenario", "robots")
+        .kv("robots", o.robots)
+        .kv("joints", joints.len())
+        .kv("hz", o.hz)
+        .kv("seconds", o.seconds)
+        .kv("nodes_per_robot", nodes_per_robot)
+        .num("instantiate_ms", instantiate_ms, 1)
+        .num("instantiate_per_robot_ms", instantiate_ms / o.robots as f64, 2)
+        .kv("rss_base_kib", rss_base)
+        .kv("rss_robots_kib", rss_robots)
+        .num("kib_per_robot", rss_robots.saturating_sub(rss_base) as f64 / o.robots as f64, 1)
+        .kv("cycles", n)
+        .kv("late_cycles", late)
+        .num("achieved_hz", n as f64 / ran.as_secs_f64(), 1)
+        .num("cycle_median_us", us(percentile(&cycles, 0.5)), 1)
+        .num("cycle_p99_us", us(percentile(&cycles, 0.99)), 1)
+        .num("cycle_max_us", us(cycles[n - 1]), 1)
+        .kv("vmhwm_kib", status_kib("VmHWM")?)
+        .print();
     Ok(())
 }
 

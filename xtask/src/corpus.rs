@@ -13,7 +13,6 @@ use nodeset_compiler::names::{sanitize, Case, Target};
 use nodeset_compiler::{compile, Options};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
 #[derive(Debug, Default, clap::Args)]
 pub struct Args {
@@ -30,7 +29,7 @@ pub(crate) fn module_for(tree: &Path, file: &Path) -> String {
     format!("m_{}", sanitize(&rel, Case::Snake, Target::Rust).trim_start_matches("r#"))
 }
 
-pub(crate) fn nodeset_files(dir: &Path, out: &mut Vec<PathBuf>) {
+fn nodeset_files(dir: &Path, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     for e in entries.flatten() {
         let p = e.path();
@@ -58,6 +57,21 @@ pub fn package_name(out: &Path) -> String {
     format!("nodeset-corpus-check-{h:016x}")
 }
 
+/// The start of `corpus` and `one-at-a-time`: the tree (default: ../shared/nodesets/ua-nodeset, made
+/// canonical), the crate's `src/` folder in `out`, emptied, and the tree's NodeSet2 files in order.
+pub(crate) fn prepare(tree: Option<PathBuf>, out: &Path) -> Result<(PathBuf, PathBuf, Vec<PathBuf>), String> {
+    let tree = tree.unwrap_or_else(|| workspace_root().join("../shared/nodesets/ua-nodeset"));
+    let tree = tree.canonicalize().map_err(|e| format!("{}: {e}", tree.display()))?;
+    let src = out.join("src");
+    let _ = std::fs::remove_dir_all(&src);
+    std::fs::create_dir_all(&src).map_err(|e| format!("cannot create {}: {e}", src.display()))?;
+    let mut files = Vec::new();
+    nodeset_files(&tree, &mut files);
+    files.sort();
+    Ok((tree, src, files))
+}
+
+/// Generates every resolvable file of the tree into one crate, prints the counts, and `cargo check`s it.
 pub fn run(args: Args) -> Result<(), String> {
     run_with_groups(args, &[])
 }
@@ -67,15 +81,8 @@ pub fn run(args: Args) -> Result<(), String> {
 /// every other file is generated on its own.
 pub fn run_with_groups(args: Args, groups: &[Vec<PathBuf>]) -> Result<(), String> {
     let root = workspace_root();
-    let tree = args.tree.unwrap_or_else(|| root.join("../shared/nodesets/ua-nodeset"));
-    let tree = tree.canonicalize().map_err(|e| format!("{}: {e}", tree.display()))?;
     let out = args.out.unwrap_or_else(|| root.join("target/corpus-crate"));
-    let src = out.join("src");
-    let _ = std::fs::remove_dir_all(&src);
-    std::fs::create_dir_all(&src).map_err(|e| format!("cannot create {}: {e}", src.display()))?;
-    let mut files = Vec::new();
-    nodeset_files(&tree, &mut files);
-    files.sort();
+    let (tree, src, files) = prepare(args.tree, &out)?;
     let grouped: Vec<PathBuf> = groups.iter().flatten().map(|f| f.canonicalize().unwrap_or_else(|_| f.clone())).collect();
     let mut units: Vec<Vec<PathBuf>> = files.iter().filter(|f| !grouped.contains(f)).map(|f| vec![f.clone()]).collect();
     units.extend(groups.iter().cloned());
@@ -153,8 +160,7 @@ pub fn run_with_groups(args: Args, groups: &[Vec<PathBuf>]) -> Result<(), String
 /// `cargo check` of a generated corpus crate in the workspace's target folder (its dependencies are
 /// shared with the workspace's build; the crate's own name is unique to `out`, see [`package_name`]).
 pub fn cargo_check(root: &Path, out: &Path) -> Result<(), String> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
+    let status = crate::util::cargo()
         .current_dir(out)
         .env("CARGO_TARGET_DIR", root.join("target"))
         .args(["check", "--quiet", "--message-format", "short"])

@@ -8,13 +8,17 @@
 
 mod integrity;
 mod lock;
-mod models;
 
 use std::collections::{BTreeMap, HashMap};
 use std::fs;
 use std::io::{ErrorKind, Read};
 use std::path::{Path, PathBuf};
 use std::process::Command;
+
+use nodeset_compiler::diag::Diagnostics;
+use nodeset_compiler::parse::{self, Limits};
+use nodeset_compiler::raw::RawModel;
+use nodeset_compiler::source::{SourceFile, SourceMap};
 
 use crate::util::{display_path, workspace_root, write_atomically};
 use integrity::{sha256_hex, verify_sri_sha512};
@@ -337,8 +341,7 @@ fn vendor_problem(path: &Path, file: &LockedFile) -> Option<String> {
 fn describe(wanted: &Wanted, bytes: &[u8]) -> Result<LockedFile, String> {
     let text = std::str::from_utf8(bytes)
         .map_err(|e| format!("{} is not valid UTF-8: {e}", wanted.path))?;
-    let models = models::read_models(text)
-        .map_err(|e| format!("cannot read the <Models> header of {}: {e}", wanted.path))?;
+    let models = read_models(wanted.path, text)?;
     let model = match models.as_slice() {
         [] if wanted.model_uri == NO_MODEL => {
             return Ok(LockedFile {
@@ -381,6 +384,17 @@ fn describe(wanted: &Wanted, bytes: &[u8]) -> Result<LockedFile, String> {
             .map(|required| (required.uri.clone(), required.version.clone()))
             .collect(),
     })
+}
+
+/// The `<Model>` elements of a NodeSet2 file (at `path` in the package), read by the compiler's parser.
+fn read_models(path: &str, text: &str) -> Result<Vec<RawModel>, String> {
+    let mut sources = SourceMap::new();
+    let file = sources.add(SourceFile::new(PathBuf::from(path), path.to_string(), text.to_string(), true));
+    let mut diags = Diagnostics::new();
+    match parse::parse(file, &sources.get(file).text, &Limits::default(), &mut diags) {
+        Some(set) => Ok(set.models),
+        None => Err(format!("cannot parse {path}:\n{}", diags.render(&sources))),
+    }
 }
 
 /// Fails unless every `<RequiredModel>` is defined by a selected file, and warns
@@ -587,6 +601,21 @@ impl Drop for TempDir {
 mod tests {
     use super::*;
     use std::cmp::Ordering;
+
+    /// `--update-lock` describes each file with the compiler's parser; for the vendored files, that must
+    /// give the entries the lock holds (model, version, date, required models, size and digest).
+    #[test]
+    fn describe_reproduces_the_lock_for_the_vendored_files() {
+        let root = workspace_root();
+        let lock = read_lock(&root.join(LOCK_PATH)).expect("the lock parses").expect("the lock exists");
+        for (wanted, locked) in SELECTION.iter().zip(&lock.files) {
+            let path = root.join(VENDOR_DIR).join(wanted.name);
+            let bytes = fs::read(&path)
+                .unwrap_or_else(|e| panic!("{}: {e} (run `cargo xtask fetch-nodesets`)", path.display()));
+            assert_eq!(&describe(wanted, &bytes).expect("describes"), locked, "{}", wanted.name);
+        }
+        assert_eq!(lock.files.len(), SELECTION.len());
+    }
 
     #[test]
     fn versions_compare_numerically() {

@@ -18,7 +18,7 @@
 //! 1,454 on the name target, measured side by side) and 500 MB of quarantine per process. Panics, overflow
 //! checks and debug assertions are on either way; they are what finds bugs in this code.
 
-use crate::util::{display_path, workspace_root};
+use crate::util::{cargo, display_path, target_dir, workspace_root};
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -62,18 +62,6 @@ pub struct Args {
     pub libfuzzer_args: Vec<String>,
 }
 
-/// The cargo target folder (`CARGO_TARGET_DIR` when set), where the tools and fuzz builds go.
-fn target_dir() -> PathBuf {
-    match std::env::var_os("CARGO_TARGET_DIR") {
-        Some(d) => PathBuf::from(d),
-        None => workspace_root().join("target"),
-    }
-}
-
-fn cargo() -> String {
-    std::env::var("CARGO").unwrap_or_else(|_| "cargo".into())
-}
-
 /// Installs the pinned cargo-fuzz into `target/tools` unless it is there; returns its `bin` folder.
 pub fn ensure_cargo_fuzz() -> Result<PathBuf, String> {
     let tools = target_dir().join("tools");
@@ -88,7 +76,7 @@ pub fn ensure_cargo_fuzz() -> Result<PathBuf, String> {
         return Ok(bin);
     }
     eprintln!("installing {want} into {}", display_path(&tools));
-    let status = Command::new(cargo())
+    let status = cargo()
         .args(["install", "cargo-fuzz", "--locked", "--version", &format!("={CARGO_FUZZ_VERSION}"), "--root"])
         .arg(&tools)
         .status()
@@ -271,7 +259,7 @@ pub fn run(args: Args) -> Result<(), String> {
     let bin = ensure_cargo_fuzz()?;
     let fuzz_dir = root.join("fuzz");
     // The fuzz workspace's lock file is committed; refuse to run with one that needs changes.
-    let status = Command::new(cargo())
+    let status = cargo()
         .args(["fetch", "--locked", "--manifest-path"])
         .arg(fuzz_dir.join("Cargo.toml"))
         .status()
@@ -297,7 +285,7 @@ pub fn run(args: Args) -> Result<(), String> {
     let fuzz_target_dir = target_dir().join("fuzz");
     let path = std::env::join_paths(std::iter::once(bin.clone()).chain(std::env::split_paths(&std::env::var_os("PATH").unwrap_or_default())))
         .map_err(|e| format!("cannot extend PATH: {e}"))?;
-    let mut cmd = Command::new(cargo());
+    let mut cmd = cargo();
     cmd.current_dir(&root)
         .env("PATH", path)
         .env("RUSTC_BOOTSTRAP", "1")

@@ -59,8 +59,7 @@ fn add_user(bins: &Path, file: &Path, name: &str, roles: &str, password: &str) -
 
 /// Builds examples of nodeset-examples and returns the folder of their executables.
 pub(crate) fn build(root: &Path, release: bool, examples: &[&str]) -> Result<PathBuf, String> {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let mut cmd = Command::new(cargo);
+    let mut cmd = crate::util::cargo();
     cmd.current_dir(root);
     if release {
         cmd.args(["build", "--quiet", "--release", "-p", "nodeset-examples", "-p", "nodeset-runtime", "--bins"]);
@@ -77,9 +76,7 @@ pub(crate) fn build(root: &Path, release: bool, examples: &[&str]) -> Result<Pat
     if !status.success() {
         return Err(format!("building the examples {} failed ({status})", examples.join(", ")));
     }
-    let target = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| root.join("target"));
-    let target = if target.is_absolute() { target } else { root.join(target) };
-    Ok(target.join(if release { "release" } else { "debug" }).join("examples"))
+    Ok(crate::util::target_dir().join(if release { "release" } else { "debug" }).join("examples"))
 }
 
 /// An example server running as a child process, its stdout read line by line; killed if dropped.

@@ -4,7 +4,7 @@
 //! output is one module of one crate (so the dependencies of the crate are built once), and one
 //! `cargo check` compiles them all. ns0 files are answered with NS0303 and counted as such.
 
-use crate::corpus::{cargo_check, module_for, nodeset_files, package_name};
+use crate::corpus::{cargo_check, module_for, package_name, prepare};
 use crate::util::workspace_root;
 use nodeset_compiler::load::Input;
 use nodeset_compiler::{compile, Error, Options, RustOptions};
@@ -24,15 +24,8 @@ pub struct Args {
 /// Generates every file of the tree on its own into one crate, prints the counts, and `cargo check`s it.
 pub fn run(args: Args) -> Result<(), String> {
     let root = workspace_root();
-    let tree = args.tree.unwrap_or_else(|| root.join("../shared/nodesets/ua-nodeset"));
-    let tree = tree.canonicalize().map_err(|e| format!("{}: {e}", tree.display()))?;
     let out = args.out.unwrap_or_else(|| root.join("target/one-at-a-time-crate"));
-    let src = out.join("src");
-    let _ = std::fs::remove_dir_all(&src);
-    std::fs::create_dir_all(&src).map_err(|e| format!("cannot create {}: {e}", src.display()))?;
-    let mut files = Vec::new();
-    nodeset_files(&tree, &mut files);
-    files.sort();
+    let (tree, src, files) = prepare(args.tree, &out)?;
     let start = std::time::Instant::now();
     let opts = Options { model_dirs: vec![tree.clone()], ..Options::default() };
     let (mut modules, mut ns0, mut unresolved, mut lines) = (Vec::new(), 0usize, Vec::new(), 0usize);

@@ -12,7 +12,6 @@
 //!    and replays the corpus they grew on this machine before; a crash fails the run.
 
 use crate::util::workspace_root;
-use std::process::Command;
 
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -33,8 +32,7 @@ pub fn run(args: Args) -> Result<(), String> {
             shared.display()
         ));
     }
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
-    let status = Command::new(cargo)
+    let status = crate::util::cargo()
         .current_dir(&root)
         .args(["test", "--workspace", "--locked"])
         .args(&args.cargo_args)

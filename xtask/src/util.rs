@@ -3,6 +3,7 @@
 use std::fs;
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 /// Returns the root of the workspace, which is the parent of this crate's directory.
 ///
@@ -13,6 +14,21 @@ pub fn workspace_root() -> PathBuf {
     match manifest_dir.parent() {
         Some(parent) => parent.to_path_buf(),
         None => manifest_dir,
+    }
+}
+
+/// A command for the cargo that runs this task (`$CARGO`, else `cargo` from the `PATH`).
+pub fn cargo() -> Command {
+    Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()))
+}
+
+/// The developer's cargo target folder: `CARGO_TARGET_DIR` (relative to the workspace root unless
+/// absolute), else `target/` in the workspace root.
+pub fn target_dir() -> PathBuf {
+    let root = workspace_root();
+    match std::env::var_os("CARGO_TARGET_DIR") {
+        Some(dir) => root.join(dir),
+        None => root.join("target"),
     }
 }
 

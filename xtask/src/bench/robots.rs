@@ -2,35 +2,24 @@
 //! instantiates N six-axis Robotics robots in one running server and updates every joint position at a fixed
 //! rate through typed handles; this task builds it in release mode, runs it once and shows its figures.
 
-use std::env;
 use std::path::Path;
-use std::process::{Command, Stdio};
+use std::process::Command;
 
-use super::{parse_report, release_dir};
+use super::{build, run_report};
 
 /// Builds and runs the robot bench with `robots` robots for `seconds` seconds at `hz`, and prints its report.
 pub(super) fn run(root: &Path, robots: usize, hz: u32, seconds: u64) -> Result<(), String> {
-    eprintln!("robots: building the robot_bench example (release) ...");
-    let cargo = env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-    let status = Command::new(cargo)
-        .current_dir(root)
-        .args(["build", "--quiet", "--release", "-p", "nodeset-examples", "--example", "robot_bench"])
-        .status()
-        .map_err(|e| format!("cannot run cargo: {e}"))?;
-    if !status.success() {
-        return Err(format!("building the robot_bench example failed ({status})"));
-    }
-    let exe = release_dir(root).join("examples").join(format!("robot_bench{}", env::consts::EXE_SUFFIX));
+    let exe = build(root, "nodeset-examples", "robot_bench", &[])?;
     eprintln!("robots: {robots} robots, every joint set at {hz} Hz for {seconds} s ...");
-    let out = Command::new(&exe)
-        .args(["--robots", &robots.to_string(), "--hz", &hz.to_string(), "--seconds", &seconds.to_string()])
-        .stderr(Stdio::inherit())
-        .output()
-        .map_err(|e| format!("cannot run {}: {e}", exe.display()))?;
-    if !out.status.success() {
-        return Err(format!("the robot bench failed ({})", out.status));
-    }
-    let r = parse_report(&String::from_utf8_lossy(&out.stdout)).ok_or("the robot bench printed no BENCH line")?;
+    let r = run_report(Command::new(&exe).args([
+        "--robots",
+        &robots.to_string(),
+        "--hz",
+        &hz.to_string(),
+        "--seconds",
+        &seconds.to_string(),
+    ]))
+    .map_err(|e| format!("the robot bench: {e}"))?;
     let period_us = 1e6 / f64::from(hz);
     println!();
     println!("Typed API at scale: {} robots x 6 axes ({} joints) in one server, release build.", r.s("robots"), r.s("joints"));

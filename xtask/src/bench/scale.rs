@@ -12,6 +12,7 @@
 //! The times are medians of `--runs` runs, in the xtask build (the compiler at the dev profile's opt-level
 //! 2, debug assertions on), so they are for ratios, not for comparison with the release figures above.
 
+use bench_support::{median, ms_since};
 use nodeset_compiler::emit::modelica::{generate_with_diagnostics, ModelicaConfig};
 use nodeset_compiler::emit::rust::{self as rust_emit, RustConfig, RustNamespace};
 use nodeset_compiler::load::Input;
@@ -28,22 +29,19 @@ struct Times {
     modelica: f64,
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
+/// One compile of a synthetic model, with ns0 from `vendor`.
 fn compile_text(vendor: &Path, text: &str) -> Compiled {
     let opts = Options { model_dirs: vec![vendor.to_path_buf()], ..Options::default() };
     compile(vec![Input::Text { name: "synth.xml".into(), text: text.to_string() }], &opts)
 }
 
+/// The median times of `runs` runs of each stage on one model.
 fn time(vendor: &Path, text: &str, runs: usize) -> Result<Times, String> {
     let (mut front, mut rust, mut modelica) = (Vec::new(), Vec::new(), Vec::new());
     for _ in 0..runs {
         let t = Instant::now();
         let out = compile_text(vendor, text);
-        front.push(t.elapsed().as_secs_f64() * 1e3);
+        front.push(ms_since(t));
         if !out.ok() {
             return Err(format!("a synthetic model does not compile:\n{}", out.render_diagnostics()));
         }
@@ -55,25 +53,26 @@ fn time(vendor: &Path, text: &str, runs: usize) -> Result<Times, String> {
         };
         let t = Instant::now();
         let r = rust_emit::generate(&out.model, &cfg);
-        rust.push(t.elapsed().as_secs_f64() * 1e3);
+        rust.push(ms_since(t));
         std::hint::black_box(&r);
         let t = Instant::now();
         let m = generate_with_diagnostics(&out.model, &ModelicaConfig::new().namespace(synth::URI));
-        modelica.push(t.elapsed().as_secs_f64() * 1e3);
+        modelica.push(ms_since(t));
         std::hint::black_box(&m);
     }
-    Ok(Times { front: median(front), rust: median(rust), modelica: median(modelica) })
+    Ok(Times { front: median(&front), rust: median(&rust), modelica: median(&modelica) })
 }
 
+/// Runs the scenario and prints its table.
 pub(super) fn run(vendor: &Path, n: usize, runs: usize) -> Result<(), String> {
     eprintln!("running scenario `scale` (n = {n}, {runs} run(s) each) ...");
     let runs = runs.max(1);
     let empty = synth::nodeset(Shape::Siblings, 0);
-    let base = median((0..runs).map(|_| {
+    let base = median(&(0..runs).map(|_| {
         let t = Instant::now();
         std::hint::black_box(compile_text(vendor, &empty));
-        t.elapsed().as_secs_f64() * 1e3
-    }).collect());
+        ms_since(t)
+    }).collect::<Vec<_>>());
     println!();
     println!("Scale: time for n and 4n nodes (medians of {runs} runs; xtask build, for ratios only).");
     println!("front = compile (parse + load + resolve, ns0 included); net = front minus a compile of an empty model ({base:.1} ms).");
@@ -115,13 +114,13 @@ pub(super) fn run(vendor: &Path, n: usize, runs: usize) -> Result<(), String> {
     // for a suggestion); an invalid model, so the front end only.
     let misspelt = |n: usize| synth::nodeset(Shape::ManyAliases, n).replace("\">Folder", "\">Foldr");
     let front = |text: &str| {
-        median((0..runs).map(|_| {
+        median(&(0..runs).map(|_| {
             let t = Instant::now();
             let out = compile_text(vendor, text);
-            let ms = t.elapsed().as_secs_f64() * 1e3;
+            let ms = ms_since(t);
             std::hint::black_box(out.render_diagnostics());
             ms
-        }).collect())
+        }).collect::<Vec<_>>())
     };
     let (small, large) = (front(&misspelt(n)), front(&misspelt(4 * n)));
     let net = (large - base) / (small - base);
