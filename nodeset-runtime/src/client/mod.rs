@@ -456,42 +456,18 @@ impl<H: ObjectType> Remote<H> {
 /// subscription is deleted when it is dropped.
 pub struct Samples<T> {
     rx: mpsc::UnboundedReceiver<DataValue>,
-    session: Arc<Session>,
-    subscription: u32,
+    _subscription: Subscription,
     _value: PhantomData<fn() -> T>,
 }
 
 impl<T: UaValue> Samples<T> {
     async fn open(session: Arc<Session>, node: NodeId, interval_ms: u64) -> Result<Samples<T>, ClientError> {
         let (tx, rx) = mpsc::unbounded_channel();
-        let callback = DataChangeCallback::new(move |value: DataValue, _: &MonitoredItem| {
+        let notify = move |value: DataValue| {
             let _ = tx.send(value);
-        });
-        let publishing = Duration::from_millis(interval_ms.max(10));
-        let subscription = session
-            .create_subscription(publishing, 600, 20, 0, 0, true, callback)
-            .await
-            .map_err(service("CreateSubscription"))?;
-        let item = MonitoredItemCreateRequest {
-            item_to_monitor: ReadValueId { node_id: node.clone(), attribute_id: AttributeId::Value as u32, ..Default::default() },
-            monitoring_mode: MonitoringMode::Reporting,
-            requested_parameters: MonitoringParameters {
-                client_handle: 1,
-                sampling_interval: interval_ms as f64,
-                queue_size: 100,
-                discard_oldest: true,
-                ..Default::default()
-            },
         };
-        let created = session
-            .create_monitored_items(subscription, TimestampsToReturn::Both, vec![item])
-            .await
-            .map_err(service("CreateMonitoredItems"))?;
-        if let Some(bad) = created.iter().map(|c| c.result.status_code).find(|s| s.is_bad()) {
-            let _ = session.delete_subscription(subscription).await;
-            return Err(ClientError::Status { what: format!("subscribe to {node}"), status: bad });
-        }
-        Ok(Samples { rx, session, subscription, _value: PhantomData })
+        let subscription = Subscription::watch(session, &node, interval_ms, true, notify).await?;
+        Ok(Samples { rx, _subscription: subscription, _value: PhantomData })
     }
 
     /// The next value; `None` once the session is gone.
@@ -507,9 +483,58 @@ impl<T: UaValue> futures_core::Stream for Samples<T> {
     }
 }
 
-impl<T> Drop for Samples<T> {
+/// A subscription with one monitored item, the Value of one variable; deleted when dropped. [`Samples`]
+/// and [`RemoteMachine`] (CurrentState) both follow a variable through it.
+pub(crate) struct Subscription {
+    session: Arc<Session>,
+    id: u32,
+}
+
+impl Subscription {
+    /// Subscribes to the Value of `node`, sampled every `interval_ms` (0: every change) and published as
+    /// often (but not more often than every 10 ms), each notification given to `notify`. `discard_oldest`:
+    /// whether a full queue (100 values) drops its oldest value or its newest.
+    pub(crate) async fn watch(
+        session: Arc<Session>,
+        node: &NodeId,
+        interval_ms: u64,
+        discard_oldest: bool,
+        notify: impl Fn(DataValue) + Send + Sync + 'static,
+    ) -> Result<Subscription, ClientError> {
+        let callback = DataChangeCallback::new(move |value: DataValue, _: &MonitoredItem| notify(value));
+        let publishing = Duration::from_millis(interval_ms.max(10));
+        let id = session
+            .create_subscription(publishing, 600, 20, 0, 0, true, callback)
+            .await
+            .map_err(service("CreateSubscription"))?;
+        // From here on, dropping the guard deletes the subscription (also on the error below).
+        let subscription = Subscription { session, id };
+        let item = MonitoredItemCreateRequest {
+            item_to_monitor: ReadValueId { node_id: node.clone(), attribute_id: AttributeId::Value as u32, ..Default::default() },
+            monitoring_mode: MonitoringMode::Reporting,
+            requested_parameters: MonitoringParameters {
+                client_handle: 1,
+                sampling_interval: interval_ms as f64,
+                queue_size: 100,
+                discard_oldest,
+                ..Default::default()
+            },
+        };
+        let created = subscription
+            .session
+            .create_monitored_items(id, TimestampsToReturn::Both, vec![item])
+            .await
+            .map_err(service("CreateMonitoredItems"))?;
+        if let Some(bad) = created.iter().map(|c| c.result.status_code).find(|s| s.is_bad()) {
+            return Err(ClientError::Status { what: format!("subscribe to {node}"), status: bad });
+        }
+        Ok(subscription)
+    }
+}
+
+impl Drop for Subscription {
     fn drop(&mut self) {
-        let (session, id) = (self.session.clone(), self.subscription);
+        let (session, id) = (self.session.clone(), self.id);
         if let Ok(rt) = tokio::runtime::Handle::try_current() {
             rt.spawn(async move {
                 let _ = session.delete_subscription(id).await;
