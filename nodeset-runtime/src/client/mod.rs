@@ -20,7 +20,8 @@
 //!   [`Remote::subscribe`]; [`Remote::read_optional`] answers `None` for an Optional member the instance
 //!   lacks; [`Remote::read_selection`] reads any number of members with one TranslateBrowsePathsToNodeIds
 //!   and one Read; resolved paths are kept, so later reads are one round trip;
-//! - [`Remote::call`] calls a method with typed arguments and outputs; a Bad status of the server is the
+//! - a method marker (`members::<Type>::<Path>`, a [`MethodMember<I, O>`]) names a method and its argument
+//!   types: [`Remote::call`] calls it with typed arguments and outputs; a Bad status of the server is the
 //!   error, with the status of each argument when the server gives them;
 //! - [`Remote::placeholders`] enumerates the instances of a placeholder by browsing;
 //! - [`RemoteMachine`] and [`RemoteProgram`] follow state machines and run programs (every skill type);
@@ -40,17 +41,17 @@ use std::time::Duration;
 use opcua::client::{DataChangeCallback, MonitoredItem, Session};
 use opcua::crypto::SecurityPolicy;
 use opcua::types::{
-    AttributeId, BrowseDescription, BrowseDirection, BrowsePath, BrowseResultMask, CallMethodRequest, DataValue,
+    Array, AttributeId, BrowseDescription, BrowseDirection, BrowsePath, BrowseResultMask, CallMethodRequest, DataValue,
     DateTime, MessageSecurityMode, MonitoredItemCreateRequest, MonitoringMode, MonitoringParameters, NodeClassMask,
     NodeId, QualifiedName, ReadValueId, ReferenceTypeId, RelativePath, RelativePathElement, StatusCode,
-    TimestampsToReturn, Variant, WriteValue,
+    TimestampsToReturn, Variant, VariantScalarTypeId, WriteValue,
 };
 use tokio::sync::mpsc;
 
 pub use program::{RemoteMachine, RemoteProgram};
 
 use crate::remote::{RemoteError, RemoteServer};
-use crate::typed::{Arguments, Holds, MemberPath, ObjectType, UaValue, VariableMember};
+use crate::typed::{Arguments, Holds, MemberPath, MethodMember, ObjectType, UaValue, VariableMember};
 use crate::NsNodeId;
 
 /// How a client connects: the security policy and mode, the user, the client's PKI folder and its
@@ -405,21 +406,26 @@ impl<H: ObjectType> Remote<H> {
         Samples::open(self.session.clone(), node, interval_ms).await
     }
 
-    /// Calls the method at `path` (BrowseNames below the instance, `Lock/InitLock`; `{uri}name` names the
-    /// namespace too) on the object that holds it, with typed arguments; its typed outputs. A Bad status of
-    /// the call is the error ([`ClientError::Arguments`] when the server names the arguments it refused).
-    pub async fn call<I: Arguments, O: Arguments>(&self, path: &str, arguments: I) -> Result<O, ClientError> {
-        let mut segments = crate::remote::segments(path);
-        let Some(name) = segments.pop() else {
-            return Err(ClientError::Remote(RemoteError::Path { below: self.node.to_string(), segment: String::new(), matches: 0 }));
+    /// Calls a method member (`&members::<Type>::<Path>`, whose type gives the input and output tuples) on
+    /// the object that holds it, with typed arguments; its typed outputs. The method's and the object's
+    /// NodeIds come from one TranslateBrowsePathsToNodeIds the first time (kept for later calls, which are
+    /// then one Call). A Bad status of the call is the error: [`ClientError::Arguments`] with the status of
+    /// each argument when the server gives them, [`ClientError::Status`] otherwise (and for a method the
+    /// instance lacks: `BadNoMatch`).
+    pub async fn call<I: Arguments, O: Arguments>(&self, method: &MethodMember<I, O>, arguments: I) -> Result<O, ClientError> {
+        let path = method.browse_path();
+        let (object, method_node) = match path.parent() {
+            None => (Ok(self.node.clone()), self.resolve(&[path]).await?.remove(0)),
+            Some(parent) => {
+                let mut found = self.resolve(&[parent, path]).await?;
+                let method_node = found.remove(1);
+                (found.remove(0), method_node)
+            }
         };
-        let object = if segments.is_empty() {
-            self.node.clone()
-        } else {
-            crate::remote::find_below(&self.session, &self.node, &segments.join("/")).await?
-        };
-        let method = crate::remote::find_below(&self.session, &object, name).await?;
-        call(&self.session, &object, &method, path, arguments).await
+        let what = self.what(path);
+        let object = object.map_err(|status| ClientError::Status { what: what.clone(), status })?;
+        let method_node = method_node.map_err(|status| ClientError::Status { what: what.clone(), status })?;
+        call(&self.session, &object, &method_node, &what, arguments).await
     }
 
     /// The instances of a placeholder below the member at `below` (`""`: the instance itself), bound as
@@ -596,7 +602,12 @@ pub(crate) async fn call<I: Arguments, O: Arguments>(
         return Err(ClientError::Status { what: format!("call {name}"), status: result.status_code });
     }
     let outputs = result.output_arguments.unwrap_or_default();
-    O::from_variants(&outputs).map_err(|_| ClientError::Type { what: format!("outputs of {name}"), value: Variant::from(outputs) })
+    O::from_variants(&outputs).map_err(|_| {
+        // The outputs as one array of Variants (each element boxed, as an array of BaseDataType holds them).
+        let boxed: Vec<Variant> = outputs.iter().cloned().map(|v| Variant::Variant(Box::new(v))).collect();
+        let value = Array::new(VariantScalarTypeId::Variant, boxed).map(Variant::from).unwrap_or(Variant::Empty);
+        ClientError::Type { what: format!("outputs of {name}"), value }
+    })
 }
 
 /// One TranslateBrowsePathsToNodeIds of `paths` (BrowseNames with namespace URIs) from `start`.
