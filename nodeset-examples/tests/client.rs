@@ -160,6 +160,24 @@ async fn the_robot_example_is_read_written_subscribed_and_called_through_typed_h
         other => panic!("a MotionDeviceSystem bound as an AxisType: {other:?}"),
     }
 
+    // Paths in a bounded number of requests. The robot serves 6 namespaces; a segment without its namespace
+    // is tried in each, with every prefix, so a request of at most 100 browse paths takes two segments
+    // (6 + 36 = 42; three would be 42 + 216): five segments are three TranslateBrowsePathsToNodeIds, where
+    // a Browse a segment was five round trips. The same path with its segments qualified is one request.
+    let namespaces = client.session().encoding_context().read().namespaces().known_namespaces().len();
+    assert_eq!(namespaces, 6, "the robot's NamespaceArray");
+    let machine_path = "Robot/Controllers/Controller/SystemOperation/SystemOperationStateMachine";
+    let found = client.find_counted(machine_path).await.unwrap();
+    assert_eq!(found.requests, 3, "{found:?}");
+    let qualified = client.find_counted(&found.path).await.unwrap();
+    assert_eq!((&qualified.node, qualified.requests), (&found.node, 1), "{qualified:?}");
+    assert!(found.path.starts_with('{') && found.path.matches('{').count() == 5, "{}", found.path);
+    // A path that stops says where.
+    match client.find_counted("Robot/Controllers/NoSuchController/SystemOperation").await {
+        Err(RemoteError::Path { below, segment, matches: 0 }) => assert_eq!((below.as_str(), segment.as_str()), ("Robot/Controllers", "NoSuchController")),
+        other => panic!("a path through a controller the robot lacks: {other:?}"),
+    }
+
     // Placeholders, by browsing.
     let devices = system.placeholders::<MotionDeviceType>("MotionDevices").await.unwrap();
     assert_eq!(devices.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>(), ["Arm"]);

@@ -14,8 +14,9 @@
 //! - [`ClientConfig`] is the one place where a connection is configured (security, identity, PKI folder);
 //! - [`RemoteServer::bind`] and [`RemoteServer::bind_path`] bind a [`Remote<H>`] to an instance by NodeId
 //!   or browse path, checking that its TypeDefinition is `H`'s type or a subtype of it (a path's segments
-//!   may leave out their namespace, so it is followed with one Browse a segment; member paths, whose
-//!   namespaces the markers carry, are translated in batches);
+//!   may leave out their namespace: they are tried in every namespace of the server, several segments to
+//!   one TranslateBrowsePathsToNodeIds, see [`RemoteServer::find_counted`]; member paths, whose namespaces
+//!   the markers carry, are translated in batches);
 //! - a member marker (`members::<Type>::<Path>`) names a variable: [`Remote::read`], [`Remote::write`],
 //!   [`Remote::subscribe`]; [`Remote::read_optional`] answers `None` for an Optional member the instance
 //!   lacks; [`Remote::read_selection`] reads any number of members with one TranslateBrowsePathsToNodeIds

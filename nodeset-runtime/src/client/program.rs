@@ -275,7 +275,9 @@ fn refusal(e: &ClientError) -> Option<StatusCode> {
         ClientError::Halted { cause, .. } => Some(*cause),
         ClientError::Type { .. } | ClientError::WrongType { .. } => Some(StatusCode::BadTypeMismatch),
         ClientError::UnknownNamespace(_) => Some(StatusCode::BadNoMatch),
-        ClientError::Remote(RemoteError::Path { .. } | RemoteError::Missing { .. } | RemoteError::Pki(_)) => Some(StatusCode::BadNoMatch),
+        ClientError::Remote(RemoteError::Path { .. } | RemoteError::Ambiguous { .. } | RemoteError::Missing { .. } | RemoteError::Pki(_)) => {
+            Some(StatusCode::BadNoMatch)
+        }
         ClientError::Remote(RemoteError::Service(..) | RemoteError::Connect(..)) | ClientError::Timeout(_) => None,
     }
 }
