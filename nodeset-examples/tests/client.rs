@@ -5,7 +5,8 @@
 //!   client's `rejected/`, then trusted; binding by browse path and by NodeId (a handle of another type
 //!   refused); placeholders by browsing; one member of six axes in one Read, a selection, Optional members
 //!   present and absent; writes refused and accepted; a subscription stream of the moving joints; typed
-//!   method calls (`Lock/InitLock`: a wrong argument refused with the server's status); the controller's
+//!   method calls through the generated marker `Lock__InitLock` (a wrong argument refused with the server's
+//!   status; per-argument statuses through a hand-written marker of the wrong type); the controller's
 //!   SystemOperationStateMachine through its generated state table;
 //! - the robot cell (`examples/robot_cell.rs`): the robot's AbsoluteJointPTPMove run with typed inputs and
 //!   awaited to Ready while the joints are subscribed, a run with refused inputs ending in Halted with its
@@ -17,6 +18,7 @@
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
+use std::marker::PhantomData;
 use std::process::{Child, Command, Stdio};
 use std::sync::{mpsc, OnceLock};
 use std::time::Duration;
@@ -31,7 +33,7 @@ use nodeset_models::models::robotics::objects::{
 use nodeset_models::runtime::client::{ClientConfig, ClientError, Remote, RemoteMachine};
 use nodeset_models::runtime::remote::RemoteError;
 use nodeset_models::runtime::server::{security, Role, Users};
-use nodeset_models::runtime::typed::ObjectType;
+use nodeset_models::runtime::typed::{MethodMember, ObjectType};
 use opcua::types::StatusCode;
 
 const PASSWORD: &str = "op-secret-1";
@@ -158,6 +160,24 @@ async fn the_robot_example_is_read_written_subscribed_and_called_through_typed_h
         other => panic!("a MotionDeviceSystem bound as an AxisType: {other:?}"),
     }
 
+    // Paths in a bounded number of requests. The robot serves 6 namespaces; a segment without its namespace
+    // is tried in each, with every prefix, so a request of at most 100 browse paths takes two segments
+    // (6 + 36 = 42; three would be 42 + 216): five segments are three TranslateBrowsePathsToNodeIds, where
+    // a Browse a segment was five round trips. The same path with its segments qualified is one request.
+    let namespaces = client.session().encoding_context().read().namespaces().known_namespaces().len();
+    assert_eq!(namespaces, 6, "the robot's NamespaceArray");
+    let machine_path = "Robot/Controllers/Controller/SystemOperation/SystemOperationStateMachine";
+    let found = client.find_counted(machine_path).await.unwrap();
+    assert_eq!(found.requests, 3, "{found:?}");
+    let qualified = client.find_counted(&found.path).await.unwrap();
+    assert_eq!((&qualified.node, qualified.requests), (&found.node, 1), "{qualified:?}");
+    assert!(found.path.starts_with('{') && found.path.matches('{').count() == 5, "{}", found.path);
+    // A path that stops says where.
+    match client.find_counted("Robot/Controllers/NoSuchController/SystemOperation").await {
+        Err(RemoteError::Path { below, segment, matches: 0 }) => assert_eq!((below.as_str(), segment.as_str()), ("Robot/Controllers", "NoSuchController")),
+        other => panic!("a path through a controller the robot lacks: {other:?}"),
+    }
+
     // Placeholders, by browsing.
     let devices = system.placeholders::<MotionDeviceType>("MotionDevices").await.unwrap();
     assert_eq!(devices.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>(), ["Arm"]);
@@ -224,21 +244,42 @@ async fn the_robot_example_is_read_written_subscribed_and_called_through_typed_h
     assert!(seen.windows(2).all(|w| w[0].0 != w[1].0), "every sample is a changed value: {seen:?}");
     drop(samples);
 
-    // Typed method calls: a wrong argument is refused with the server's status, the right one runs.
-    match arm.call::<(String,), (i32,)>("Lock/InitLock", (String::new(),)).await {
+    // Typed method calls through the generated marker, whose type gives the arguments' and outputs' types: a
+    // wrong argument is refused with the server's status, the right one runs.
+    let init_lock = &members::MotionDeviceType::Lock__InitLock;
+    match arm.call(init_lock, (String::new(),)).await {
         Err(ClientError::Status { status, .. }) => assert_eq!(status, StatusCode::BadInvalidArgument),
         other => panic!("an empty context was accepted: {other:?}"),
     }
-    match arm.call::<(i32,), (i32,)>("Lock/InitLock", (7,)).await {
+    let (first,): (i32,) = arm.call(init_lock, ("cell".to_owned(),)).await.unwrap();
+    assert_eq!(first, 0, "InitLock's InitLockStatus: 0 is the lock taken");
+    assert_eq!(arm.call(init_lock, ("other".to_owned(),)).await.unwrap(), (-1,), "a second lock is refused in its output");
+    assert_eq!(arm.read::<bool, _>(&members::MotionDeviceType::Lock__Locked).await.unwrap().value, Some(true));
+    // A hand-written marker that gets the input type wrong (an Int32 context; the generated one does not
+    // compile with it): the server refuses the argument, and its status per argument comes back.
+    let int_context: MethodMember<(i32,), (i32,)> =
+        MethodMember { ns: init_lock.ns, path: init_lock.path, mandatory: false, signature: PhantomData };
+    match arm.call(&int_context, (7,)).await {
         Err(ClientError::Arguments { status, arguments, .. }) => {
             assert_eq!(status, StatusCode::BadInvalidArgument);
             assert_eq!(arguments, [StatusCode::BadTypeMismatch]);
         }
         other => panic!("an Int32 context was accepted: {other:?}"),
     }
-    assert_eq!(arm.call::<(String,), (i32,)>("Lock/InitLock", ("cell".to_owned(),)).await.unwrap(), (0,));
-    assert_eq!(arm.call::<(String,), (i32,)>("Lock/InitLock", ("other".to_owned(),)).await.unwrap(), (-1,));
-    assert_eq!(arm.read::<bool, _>(&members::MotionDeviceType::Lock__Locked).await.unwrap().value, Some(true));
+    // Outputs of another type than the marker says (a hand-written marker of ExitLock without its Int32
+    // output): the call runs (the lock is released), and the outputs are a typed error, not a panic.
+    let exit_lock: MethodMember<(), ()> = MethodMember { ns: init_lock.ns, path: "0:Lock/0:ExitLock", mandatory: false, signature: PhantomData };
+    match arm.call(&exit_lock, ()).await {
+        Err(ClientError::Type { what, .. }) => assert!(what.contains("ExitLock"), "{what}"),
+        other => panic!("ExitLock's Int32 output read as no outputs: {other:?}"),
+    }
+    assert_eq!(arm.read::<bool, _>(&members::MotionDeviceType::Lock__Locked).await.unwrap().value, Some(false));
+    // A method the instance lacks: the translation finds nothing, and no Call is made.
+    let absent: MethodMember<(), ()> = MethodMember { ns: init_lock.ns, path: "0:NoSuchMethod", mandatory: false, signature: PhantomData };
+    match arm.call(&absent, ()).await {
+        Err(ClientError::Status { status, .. }) => assert_eq!(status, StatusCode::BadNoMatch),
+        other => panic!("a method the arm lacks was called: {other:?}"),
+    }
 
     // A state machine through its generated table: the controller's SystemOperationStateMachine is Ready.
     let machine: Remote<SystemOperationStateMachineType> =

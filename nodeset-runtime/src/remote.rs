@@ -54,8 +54,8 @@ use tokio_util::codec::FramedRead;
 use opcua::client::{ClientBuilder, IdentityToken, Session, SessionPollResult};
 use opcua::crypto::SecurityPolicy;
 use opcua::types::{
-    BrowseDescription, BrowseDirection, BrowseResultMask, NodeClassMask, NodeId, ObjectId, QualifiedName, ReferenceTypeId,
-    StatusCode,
+    BrowseDescription, BrowseDirection, BrowsePath, BrowseResultMask, NodeClassMask, NodeId, ObjectId, QualifiedName,
+    ReferenceTypeId, RelativePath, RelativePathElement, StatusCode,
 };
 use tokio::task::JoinHandle;
 
@@ -70,6 +70,9 @@ pub enum RemoteError {
     Service(&'static str, StatusCode),
     /// A segment of a browse path matches no child, or several (the path so far, the segment).
     Path { below: String, segment: String, matches: usize },
+    /// A browse path whose segments leave out their namespace leads to several nodes (the path, and each
+    /// match with every segment qualified, `{uri}name/...`, in order).
+    Ambiguous { path: String, matches: Vec<String> },
     /// The skill lacks a node a run needs (`CurrentState`, `Start`, ...).
     Missing { skill: String, what: String },
     /// The client's PKI folder cannot be used (why).
@@ -84,6 +87,9 @@ impl std::fmt::Display for RemoteError {
             RemoteError::Path { below, segment, matches: 0 } => write!(f, "`{below}` has no child `{segment}`"),
             RemoteError::Path { below, segment, matches } => {
                 write!(f, "`{below}` has {matches} children named `{segment}`; name one by its namespace URI: `{{uri}}{segment}`")
+            }
+            RemoteError::Ambiguous { path, matches } => {
+                write!(f, "`{path}` leads to {} nodes; name the one meant by namespace URIs: {}", matches.len(), matches.join(", "))
             }
             RemoteError::Missing { skill, what } => write!(f, "skill `{skill}` has no {what}"),
             RemoteError::Pki(e) => write!(f, "the client's PKI folder: {e}"),
@@ -223,8 +229,23 @@ impl RemoteServer {
     }
 
     /// The node at `path` below the Objects folder: BrowseNames separated by `/`, each matched by its
-    /// name, or by namespace URI and name when written `{uri}name`.
+    /// name, or by namespace URI and name when written `{uri}name`. A path of qualified segments is one
+    /// TranslateBrowsePathsToNodeIds; a segment without its namespace is tried in each namespace of the
+    /// server, several segments in one request (see [`RemoteServer::find_counted`]).
     pub async fn find(&self, path: &str) -> Result<NodeId, RemoteError> {
+        Ok(self.find_counted(path).await?.node)
+    }
+
+    /// [`RemoteServer::find`], and how many requests (round trips) it took.
+    ///
+    /// The path is translated in steps. Each step is one TranslateBrowsePathsToNodeIds of at most
+    /// [`PATHS_PER_REQUEST`] browse paths, which takes as many of the next segments as fit: from each node
+    /// the previous step reached, every choice of namespace for those segments (one for a qualified segment,
+    /// each of the server's namespaces for another), each prefix of them too, so that a path that stops
+    /// names the segment where it stops. A path of qualified segments is one request; with N namespaces on
+    /// the server, about log_N(100) unqualified segments go in one. Several matches are followed on; the
+    /// path is [`RemoteError::Ambiguous`] only if more than one node matches it all.
+    pub async fn find_counted(&self, path: &str) -> Result<Found, RemoteError> {
         find_path(&self.session, &ObjectId::ObjectsFolder.into(), path).await
     }
 
@@ -274,11 +295,6 @@ fn refused_for_good(status: StatusCode) -> bool {
     .contains(&status)
 }
 
-/// The forward hierarchical children of a node: (BrowseName, NodeId).
-pub(crate) async fn children(session: &Session, node: &NodeId) -> Result<Vec<(QualifiedName, NodeId)>, RemoteError> {
-    Ok(typed_children(session, node).await?.into_iter().map(|(name, id, _)| (name, id)).collect())
-}
-
 /// The forward hierarchical children of a node with their TypeDefinitions (null for a child without
 /// one), from one Browse (and BrowseNext while the server has more): (BrowseName, NodeId, TypeDefinition).
 pub(crate) async fn typed_children(session: &Session, node: &NodeId) -> Result<Vec<(QualifiedName, NodeId, NodeId)>, RemoteError> {
@@ -310,34 +326,142 @@ pub(crate) async fn typed_children(session: &Session, node: &NodeId) -> Result<V
 
 /// The node at `path` (see [`RemoteServer::find`]) below `start`.
 pub(crate) async fn find_below(session: &Session, start: &NodeId, path: &str) -> Result<NodeId, RemoteError> {
-    find_path(session, start, path).await
+    Ok(find_path(session, start, path).await?.node)
 }
 
-async fn find_path(session: &Session, start: &NodeId, path: &str) -> Result<NodeId, RemoteError> {
-    let mut node = start.clone();
-    let mut walked = String::new();
-    for segment in segments(path) {
-        let (ns, name) = match segment.strip_prefix('{').and_then(|s| s.split_once('}')) {
-            Some((uri, name)) => (Some(session.get_namespace_index_from_cache(uri).unwrap_or(u16::MAX)), name),
-            None => (None, segment),
-        };
-        let kids = children(session, &node).await?;
-        let hits: Vec<&NodeId> = kids
-            .iter()
-            .filter(|(b, _)| b.name.as_ref() == name && ns.is_none_or(|ns| b.namespace_index == ns))
-            .map(|(_, id)| id)
-            .collect();
-        let below = if walked.is_empty() { "Objects".to_owned() } else { walked.clone() };
-        match hits.as_slice() {
-            [one] => node = (*one).clone(),
-            _ => return Err(RemoteError::Path { below, segment: segment.to_owned(), matches: hits.len() }),
+/// What [`RemoteServer::find_counted`] found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Found {
+    /// The node.
+    pub node: NodeId,
+    /// The path with every segment qualified (`{uri}name/...`): finding it again is one request.
+    pub path: String,
+    /// How many TranslateBrowsePathsToNodeIds requests it took (each one round trip).
+    pub requests: u32,
+}
+
+/// How many browse paths one TranslateBrowsePathsToNodeIds of [`RemoteServer::find`] holds at most: the
+/// default MaxNodesPerTranslateBrowsePathsToNodeIds of async-opcua servers (a larger step is sent as more
+/// than one request).
+pub const PATHS_PER_REQUEST: usize = 100;
+
+/// How many nodes a path may lead to part way before it is called ambiguous.
+const MAX_PARTIAL_MATCHES: usize = 100;
+
+/// A node reached part way along a path: its NodeId and the qualified path to it (`{uri}name/...`).
+type Reached = (NodeId, String);
+
+/// [`RemoteServer::find_counted`] below `start`.
+async fn find_path(session: &Session, start: &NodeId, path: &str) -> Result<Found, RemoteError> {
+    let written = segments(path);
+    let (uris, all): (Vec<(u16, String)>, Vec<u16>) = {
+        let context = session.encoding_context().read();
+        let mut uris: Vec<(u16, String)> = context.namespaces().known_namespaces().iter().map(|(u, i)| (*i, u.clone())).collect();
+        uris.sort();
+        let all = uris.iter().map(|(i, _)| *i).collect();
+        (uris, all)
+    };
+    // Each segment: its name and the namespaces it may be in (none if it names a URI the server lacks).
+    let wanted: Vec<(&str, Vec<u16>)> = written
+        .iter()
+        .map(|segment| match segment.strip_prefix('{').and_then(|s| s.split_once('}')) {
+            Some((uri, name)) => (name, session.get_namespace_index_from_cache(uri).into_iter().collect()),
+            None => (*segment, all.clone()),
+        })
+        .collect();
+    let uri_of = |ns: u16| uris.iter().find(|(i, _)| *i == ns).map_or("", |(_, u)| u.as_str());
+    let mut reached: Vec<Reached> = vec![(start.clone(), String::new())];
+    let mut requests = 0u32;
+    let mut done = 0;
+    while done < wanted.len() {
+        // As many segments as fit in one request (at least one).
+        let (mut depth, mut total, mut product) = (0, 0usize, reached.len());
+        while done + depth < wanted.len() {
+            let next = product.saturating_mul(wanted[done + depth].1.len());
+            if depth > 0 && total.saturating_add(next) > PATHS_PER_REQUEST {
+                break;
+            }
+            product = next;
+            total = total.saturating_add(next);
+            depth += 1;
         }
-        if !walked.is_empty() {
-            walked.push('/');
+        // Every (start, namespaces) combination, for each prefix length: (length, qualified path, BrowsePath).
+        let mut asked: Vec<(usize, String, BrowsePath)> = Vec::new();
+        for (node, qualified) in &reached {
+            let mut partial: Vec<(String, Vec<RelativePathElement>)> = vec![(qualified.clone(), Vec::new())];
+            for (length, (name, namespaces)) in wanted[done..done + depth].iter().enumerate() {
+                let mut longer = Vec::with_capacity(partial.len() * namespaces.len());
+                for (text, elements) in &partial {
+                    for &ns in namespaces {
+                        let mut elements = elements.clone();
+                        elements.push(RelativePathElement {
+                            reference_type_id: ReferenceTypeId::HierarchicalReferences.into(),
+                            is_inverse: false,
+                            include_subtypes: true,
+                            target_name: QualifiedName::new(ns, *name),
+                        });
+                        let separator = if text.is_empty() { "" } else { "/" };
+                        let text = format!("{text}{separator}{{{}}}{name}", uri_of(ns));
+                        let request = BrowsePath {
+                            starting_node: node.clone(),
+                            relative_path: RelativePath { elements: Some(elements.clone()) },
+                        };
+                        asked.push((length + 1, text.clone(), request));
+                        longer.push((text, elements));
+                    }
+                }
+                partial = longer;
+            }
         }
-        walked.push_str(segment);
+        // One request per PATHS_PER_REQUEST paths; each fully matched target is reached at its length.
+        let mut levels: Vec<Vec<Reached>> = vec![Vec::new(); depth + 1];
+        for chunk in asked.chunks(PATHS_PER_REQUEST) {
+            let paths: Vec<BrowsePath> = chunk.iter().map(|(_, _, p)| p.clone()).collect();
+            requests += 1;
+            let results = session
+                .translate_browse_paths_to_node_ids(&paths)
+                .await
+                .map_err(|e| RemoteError::Service("TranslateBrowsePathsToNodeIds", e.status()))?;
+            for ((length, text, _), result) in chunk.iter().zip(results) {
+                if !result.status_code.is_good() {
+                    continue;
+                }
+                for target in result.targets.unwrap_or_default() {
+                    if target.remaining_path_index == u32::MAX && target.target_id.server_index == 0 {
+                        levels[*length].push((target.target_id.node_id, text.clone()));
+                    }
+                }
+            }
+        }
+        for (length, level) in levels.iter_mut().enumerate().skip(1) {
+            // In order of the qualified paths, each node once (reached along two paths, the first is kept).
+            level.sort_by(|a, b| a.1.cmp(&b.1));
+            let mut seen: Vec<NodeId> = Vec::with_capacity(level.len());
+            level.retain(|(node, _)| !seen.contains(node) && {
+                seen.push(node.clone());
+                true
+            });
+            if level.is_empty() {
+                let below = if done + length == 1 { "Objects".to_owned() } else { written[..done + length - 1].join("/") };
+                return Err(RemoteError::Path { below, segment: written[done + length - 1].to_owned(), matches: 0 });
+            }
+        }
+        reached = levels.pop().unwrap_or_default();
+        done += depth;
+        if reached.len() > MAX_PARTIAL_MATCHES && done < wanted.len() {
+            return Err(RemoteError::Ambiguous {
+                path: written[..done].join("/"),
+                matches: reached.into_iter().map(|(_, text)| text).collect(),
+            });
+        }
     }
-    Ok(node)
+    match reached.len() {
+        1 => {
+            let (node, path) = reached.remove(0);
+            Ok(Found { node, path, requests })
+        }
+        _ => Err(RemoteError::Ambiguous { path: path.to_owned(), matches: reached.into_iter().map(|(_, text)| text).collect() }),
+    }
 }
 
 /// The segments of a browse path: split at `/`, except inside `{uri}`.

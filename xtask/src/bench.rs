@@ -22,6 +22,9 @@
 //! * `robots`: the typed API at scale ([`robots`]): N six-axis robots instantiated in one server, every joint
 //!   position updated at 100 Hz; time per update cycle and memory per robot. Not part of `all` (it runs for
 //!   `--robots-seconds` and builds the server stack in release mode).
+//! * `verify`: `nodeset-compiler verify` against the robot cell's robot server, several runs, next to a
+//!   naive client's walk of the same nodes in the same run (module [`verify`]). Not part of `all` (it
+//!   starts the robot cell).
 //! * `scale`: synthetic models of n and 4n nodes in several shapes, timed in this process, with the ratio
 //!   per stage (module [`scale`]); looks for quadratic behaviour.
 //!
@@ -54,6 +57,7 @@ mod peer;
 mod robots;
 mod rust;
 mod scale;
+mod verify;
 
 /// The files of the `robotics` scenario, in `nodesets/vendor/`.
 const VENDOR_FILES: &[&str] = &[
@@ -70,7 +74,7 @@ const DEFAULT_TREE: &str = "../shared/nodesets/ua-nodeset";
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Which scenario(s) to run.
-    #[arg(long, value_parser = ["all", "robotics", "tree", "sets", "rust", "scale", "robots"], default_value = "all")]
+    #[arg(long, value_parser = ["all", "robotics", "tree", "sets", "rust", "scale", "robots", "verify"], default_value = "all")]
     scenario: String,
 
     /// Runs of the robotics scenario (ns0 + DI + IA + Robotics).
@@ -112,7 +116,8 @@ pub struct Args {
     #[arg(long)]
     no_peer: bool,
 
-    /// Rust scenario: skip the release builds (the import bench is still built in release).
+    /// Rust scenario: skip the release builds (the import bench is still built in release). Verify
+    /// scenario: measure dev-profile builds (those `cargo test` makes) instead of release ones.
     #[arg(long)]
     no_release: bool,
 
@@ -134,6 +139,10 @@ pub struct Args {
     /// Runs of each model in the scale scenario (the median is shown).
     #[arg(long, value_name = "N", default_value_t = 3)]
     runs_scale: usize,
+
+    /// Runs of `nodeset-compiler verify` (and of each baseline walk) in the verify scenario.
+    #[arg(long, value_name = "N", default_value_t = 5)]
+    runs_verify: usize,
 
     /// Skip the stage-split runs (halves the run time; the table then shows totals only).
     #[arg(long)]
@@ -176,6 +185,10 @@ pub fn run(args: Args) -> Result<(), String> {
     }
     if args.scenario == "robots" {
         robots::run(&root, args.robots, args.robots_hz, args.robots_seconds)?;
+    }
+    if args.scenario == "verify" {
+        ensure_vendor(&root.join("nodesets/vendor"))?;
+        verify::run(&root, args.runs_verify, !args.no_release)?;
     }
     Ok(())
 }

@@ -59,6 +59,13 @@ fn fail(what: &str, e: impl std::fmt::Display) -> ClientError {
 
 /// Connects, reads a [`Snapshot`] and disconnects.
 pub async fn snapshot(connect: &Connect) -> Result<Snapshot, ClientError> {
+    snapshot_batched(connect, None).await
+}
+
+/// [`snapshot`] with at most `max_batch` nodes a Browse and attributes a Read (besides the server's own
+/// limits): `Some(1)` is the same walk one node at a time, the baseline of `cargo xtask bench --scenario
+/// verify`.
+pub async fn snapshot_batched(connect: &Connect, max_batch: Option<usize>) -> Result<Snapshot, ClientError> {
     let url_ok = connect.url.starts_with("opc.tcp://")
         && hostname_port_from_url(&connect.url, opcua::core::constants::DEFAULT_OPC_UA_SERVER_PORT).is_ok_and(|(h, _)| !h.is_empty());
     if !url_ok {
@@ -137,7 +144,7 @@ pub async fn snapshot(connect: &Connect) -> Result<Snapshot, ClientError> {
         }
         return Err(ClientError(message));
     }
-    let result = read_all(&session).await;
+    let result = read_all_batched(&session, max_batch).await;
     let _ = session.disconnect().await;
     let _ = tokio::time::timeout(Duration::from_secs(5), event_loop).await;
     result
@@ -155,6 +162,11 @@ fn rejected_copy(pki_dir: &std::path::Path, certificate: &[u8]) -> Option<PathBu
 
 /// Reads the snapshot over an open session.
 pub async fn read_all(session: &Arc<Session>) -> Result<Snapshot, ClientError> {
+    read_all_batched(session, None).await
+}
+
+/// [`read_all`] with at most `max_batch` nodes a Browse and attributes a Read.
+pub async fn read_all_batched(session: &Arc<Session>, max_batch: Option<usize>) -> Result<Snapshot, ClientError> {
     let mut snap = Snapshot::default();
     // NamespaceArray, MaxNodesPerRead, MaxNodesPerBrowse.
     let first: Vec<ReadValueId> = [2255u32, 11705, 11710]
@@ -173,7 +185,8 @@ pub async fn read_all(session: &Arc<Session>) -> Result<Snapshot, ClientError> {
         Some(Variant::UInt32(n)) if *n > 0 => (*n as usize).min(1000),
         _ => 1000,
     };
-    let (per_read, per_browse) = (limit(values.get(1)), limit(values.get(2)));
+    let cap = max_batch.unwrap_or(usize::MAX).max(1);
+    let (per_read, per_browse) = (limit(values.get(1)).min(cap), limit(values.get(2)).min(cap));
 
     // Breadth first from the Objects folder, one level per batch of Browse requests.
     let objects = Snapshot::objects_folder();

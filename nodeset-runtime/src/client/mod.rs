@@ -14,13 +14,15 @@
 //! - [`ClientConfig`] is the one place where a connection is configured (security, identity, PKI folder);
 //! - [`RemoteServer::bind`] and [`RemoteServer::bind_path`] bind a [`Remote<H>`] to an instance by NodeId
 //!   or browse path, checking that its TypeDefinition is `H`'s type or a subtype of it (a path's segments
-//!   may leave out their namespace, so it is followed with one Browse a segment; member paths, whose
-//!   namespaces the markers carry, are translated in batches);
+//!   may leave out their namespace: they are tried in every namespace of the server, several segments to
+//!   one TranslateBrowsePathsToNodeIds, see [`RemoteServer::find_counted`]; member paths, whose namespaces
+//!   the markers carry, are translated in batches);
 //! - a member marker (`members::<Type>::<Path>`) names a variable: [`Remote::read`], [`Remote::write`],
 //!   [`Remote::subscribe`]; [`Remote::read_optional`] answers `None` for an Optional member the instance
 //!   lacks; [`Remote::read_selection`] reads any number of members with one TranslateBrowsePathsToNodeIds
 //!   and one Read; resolved paths are kept, so later reads are one round trip;
-//! - [`Remote::call`] calls a method with typed arguments and outputs; a Bad status of the server is the
+//! - a method marker (`members::<Type>::<Path>`, a [`MethodMember<I, O>`]) names a method and its argument
+//!   types: [`Remote::call`] calls it with typed arguments and outputs; a Bad status of the server is the
 //!   error, with the status of each argument when the server gives them;
 //! - [`Remote::placeholders`] enumerates the instances of a placeholder by browsing;
 //! - [`RemoteMachine`] and [`RemoteProgram`] follow state machines and run programs (every skill type);
@@ -40,17 +42,17 @@ use std::time::Duration;
 use opcua::client::{DataChangeCallback, MonitoredItem, Session};
 use opcua::crypto::SecurityPolicy;
 use opcua::types::{
-    AttributeId, BrowseDescription, BrowseDirection, BrowsePath, BrowseResultMask, CallMethodRequest, DataValue,
+    Array, AttributeId, BrowseDescription, BrowseDirection, BrowsePath, BrowseResultMask, CallMethodRequest, DataValue,
     DateTime, MessageSecurityMode, MonitoredItemCreateRequest, MonitoringMode, MonitoringParameters, NodeClassMask,
     NodeId, QualifiedName, ReadValueId, ReferenceTypeId, RelativePath, RelativePathElement, StatusCode,
-    TimestampsToReturn, Variant, WriteValue,
+    TimestampsToReturn, Variant, VariantScalarTypeId, WriteValue,
 };
 use tokio::sync::mpsc;
 
 pub use program::{RemoteMachine, RemoteProgram};
 
 use crate::remote::{RemoteError, RemoteServer};
-use crate::typed::{Arguments, Holds, MemberPath, ObjectType, UaValue, VariableMember};
+use crate::typed::{Arguments, Holds, MemberPath, MethodMember, ObjectType, UaValue, VariableMember};
 use crate::NsNodeId;
 
 /// How a client connects: the security policy and mode, the user, the client's PKI folder and its
@@ -405,21 +407,26 @@ impl<H: ObjectType> Remote<H> {
         Samples::open(self.session.clone(), node, interval_ms).await
     }
 
-    /// Calls the method at `path` (BrowseNames below the instance, `Lock/InitLock`; `{uri}name` names the
-    /// namespace too) on the object that holds it, with typed arguments; its typed outputs. A Bad status of
-    /// the call is the error ([`ClientError::Arguments`] when the server names the arguments it refused).
-    pub async fn call<I: Arguments, O: Arguments>(&self, path: &str, arguments: I) -> Result<O, ClientError> {
-        let mut segments = crate::remote::segments(path);
-        let Some(name) = segments.pop() else {
-            return Err(ClientError::Remote(RemoteError::Path { below: self.node.to_string(), segment: String::new(), matches: 0 }));
+    /// Calls a method member (`&members::<Type>::<Path>`, whose type gives the input and output tuples) on
+    /// the object that holds it, with typed arguments; its typed outputs. The method's and the object's
+    /// NodeIds come from one TranslateBrowsePathsToNodeIds the first time (kept for later calls, which are
+    /// then one Call). A Bad status of the call is the error: [`ClientError::Arguments`] with the status of
+    /// each argument when the server gives them, [`ClientError::Status`] otherwise (and for a method the
+    /// instance lacks: `BadNoMatch`).
+    pub async fn call<I: Arguments, O: Arguments>(&self, method: &MethodMember<I, O>, arguments: I) -> Result<O, ClientError> {
+        let path = method.browse_path();
+        let (object, method_node) = match path.parent() {
+            None => (Ok(self.node.clone()), self.resolve(&[path]).await?.remove(0)),
+            Some(parent) => {
+                let mut found = self.resolve(&[parent, path]).await?;
+                let method_node = found.remove(1);
+                (found.remove(0), method_node)
+            }
         };
-        let object = if segments.is_empty() {
-            self.node.clone()
-        } else {
-            crate::remote::find_below(&self.session, &self.node, &segments.join("/")).await?
-        };
-        let method = crate::remote::find_below(&self.session, &object, name).await?;
-        call(&self.session, &object, &method, path, arguments).await
+        let what = self.what(path);
+        let object = object.map_err(|status| ClientError::Status { what: what.clone(), status })?;
+        let method_node = method_node.map_err(|status| ClientError::Status { what: what.clone(), status })?;
+        call(&self.session, &object, &method_node, &what, arguments).await
     }
 
     /// The instances of a placeholder below the member at `below` (`""`: the instance itself), bound as
@@ -456,42 +463,18 @@ impl<H: ObjectType> Remote<H> {
 /// subscription is deleted when it is dropped.
 pub struct Samples<T> {
     rx: mpsc::UnboundedReceiver<DataValue>,
-    session: Arc<Session>,
-    subscription: u32,
+    _subscription: Subscription,
     _value: PhantomData<fn() -> T>,
 }
 
 impl<T: UaValue> Samples<T> {
     async fn open(session: Arc<Session>, node: NodeId, interval_ms: u64) -> Result<Samples<T>, ClientError> {
         let (tx, rx) = mpsc::unbounded_channel();
-        let callback = DataChangeCallback::new(move |value: DataValue, _: &MonitoredItem| {
+        let notify = move |value: DataValue| {
             let _ = tx.send(value);
-        });
-        let publishing = Duration::from_millis(interval_ms.max(10));
-        let subscription = session
-            .create_subscription(publishing, 600, 20, 0, 0, true, callback)
-            .await
-            .map_err(service("CreateSubscription"))?;
-        let item = MonitoredItemCreateRequest {
-            item_to_monitor: ReadValueId { node_id: node.clone(), attribute_id: AttributeId::Value as u32, ..Default::default() },
-            monitoring_mode: MonitoringMode::Reporting,
-            requested_parameters: MonitoringParameters {
-                client_handle: 1,
-                sampling_interval: interval_ms as f64,
-                queue_size: 100,
-                discard_oldest: true,
-                ..Default::default()
-            },
         };
-        let created = session
-            .create_monitored_items(subscription, TimestampsToReturn::Both, vec![item])
-            .await
-            .map_err(service("CreateMonitoredItems"))?;
-        if let Some(bad) = created.iter().map(|c| c.result.status_code).find(|s| s.is_bad()) {
-            let _ = session.delete_subscription(subscription).await;
-            return Err(ClientError::Status { what: format!("subscribe to {node}"), status: bad });
-        }
-        Ok(Samples { rx, session, subscription, _value: PhantomData })
+        let subscription = Subscription::watch(session, &node, interval_ms, true, notify).await?;
+        Ok(Samples { rx, _subscription: subscription, _value: PhantomData })
     }
 
     /// The next value; `None` once the session is gone.
@@ -507,9 +490,58 @@ impl<T: UaValue> futures_core::Stream for Samples<T> {
     }
 }
 
-impl<T> Drop for Samples<T> {
+/// A subscription with one monitored item, the Value of one variable; deleted when dropped. [`Samples`]
+/// and [`RemoteMachine`] (CurrentState) both follow a variable through it.
+pub(crate) struct Subscription {
+    session: Arc<Session>,
+    id: u32,
+}
+
+impl Subscription {
+    /// Subscribes to the Value of `node`, sampled every `interval_ms` (0: every change) and published as
+    /// often (but not more often than every 10 ms), each notification given to `notify`. `discard_oldest`:
+    /// whether a full queue (100 values) drops its oldest value or its newest.
+    pub(crate) async fn watch(
+        session: Arc<Session>,
+        node: &NodeId,
+        interval_ms: u64,
+        discard_oldest: bool,
+        notify: impl Fn(DataValue) + Send + Sync + 'static,
+    ) -> Result<Subscription, ClientError> {
+        let callback = DataChangeCallback::new(move |value: DataValue, _: &MonitoredItem| notify(value));
+        let publishing = Duration::from_millis(interval_ms.max(10));
+        let id = session
+            .create_subscription(publishing, 600, 20, 0, 0, true, callback)
+            .await
+            .map_err(service("CreateSubscription"))?;
+        // From here on, dropping the guard deletes the subscription (also on the error below).
+        let subscription = Subscription { session, id };
+        let item = MonitoredItemCreateRequest {
+            item_to_monitor: ReadValueId { node_id: node.clone(), attribute_id: AttributeId::Value as u32, ..Default::default() },
+            monitoring_mode: MonitoringMode::Reporting,
+            requested_parameters: MonitoringParameters {
+                client_handle: 1,
+                sampling_interval: interval_ms as f64,
+                queue_size: 100,
+                discard_oldest,
+                ..Default::default()
+            },
+        };
+        let created = subscription
+            .session
+            .create_monitored_items(id, TimestampsToReturn::Both, vec![item])
+            .await
+            .map_err(service("CreateMonitoredItems"))?;
+        if let Some(bad) = created.iter().map(|c| c.result.status_code).find(|s| s.is_bad()) {
+            return Err(ClientError::Status { what: format!("subscribe to {node}"), status: bad });
+        }
+        Ok(subscription)
+    }
+}
+
+impl Drop for Subscription {
     fn drop(&mut self) {
-        let (session, id) = (self.session.clone(), self.subscription);
+        let (session, id) = (self.session.clone(), self.id);
         if let Ok(rt) = tokio::runtime::Handle::try_current() {
             rt.spawn(async move {
                 let _ = session.delete_subscription(id).await;
@@ -571,7 +603,12 @@ pub(crate) async fn call<I: Arguments, O: Arguments>(
         return Err(ClientError::Status { what: format!("call {name}"), status: result.status_code });
     }
     let outputs = result.output_arguments.unwrap_or_default();
-    O::from_variants(&outputs).map_err(|_| ClientError::Type { what: format!("outputs of {name}"), value: Variant::from(outputs) })
+    O::from_variants(&outputs).map_err(|_| {
+        // The outputs as one array of Variants (each element boxed, as an array of BaseDataType holds them).
+        let boxed: Vec<Variant> = outputs.iter().cloned().map(|v| Variant::Variant(Box::new(v))).collect();
+        let value = Array::new(VariantScalarTypeId::Variant, boxed).map(Variant::from).unwrap_or(Variant::Empty);
+        ClientError::Type { what: format!("outputs of {name}"), value }
+    })
 }
 
 /// One TranslateBrowsePathsToNodeIds of `paths` (BrowseNames with namespace URIs) from `start`.

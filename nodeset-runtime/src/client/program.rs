@@ -6,14 +6,11 @@ use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use opcua::client::{DataChangeCallback, MonitoredItem, Session};
-use opcua::types::{
-    AttributeId, DataValue, MonitoredItemCreateRequest, MonitoringMode, MonitoringParameters, NodeId, ReadValueId,
-    StatusCode, TimestampsToReturn, Variant, WriteValue,
-};
+use opcua::client::Session;
+use opcua::types::{AttributeId, DataValue, NodeId, StatusCode, Variant, WriteValue};
 use tokio::sync::watch;
 
-use super::{call, read_values, service, translate, ClientError, Remote};
+use super::{call, read_values, service, translate, ClientError, Remote, Subscription};
 use crate::remote::{RemoteError, RemoteServer};
 use crate::typed::{Control, Parameters, ProgramState, ProgramType, StateMachine, StateRow};
 
@@ -30,7 +27,7 @@ pub struct RemoteMachine<M> {
     remote: Remote<M>,
     current_state: NodeId,
     seen: watch::Receiver<Seen>,
-    subscription: u32,
+    _subscription: Subscription,
     methods: Mutex<BTreeMap<&'static str, NodeId>>,
 }
 
@@ -41,34 +38,13 @@ impl<M: StateMachine> RemoteMachine<M> {
         let found = translate(&session, &remote.node, &[vec![(UA, "CurrentState".to_owned())]]).await?.remove(0);
         let current_state = found.map_err(|status| ClientError::Status { what: format!("{}/CurrentState", remote.node), status })?;
         let (tx, seen) = watch::channel((0, None));
-        let callback = DataChangeCallback::new(move |value: DataValue, _: &MonitoredItem| {
+        let notify = move |value: DataValue| {
             let state = value.value.as_ref().and_then(state_of::<M>);
             tx.send_modify(|s| *s = (s.0 + 1, state));
-        });
-        let subscription = session
-            .create_subscription(Duration::from_millis(10), 600, 20, 0, 0, true, callback)
-            .await
-            .map_err(service("CreateSubscription"))?;
-        let item = MonitoredItemCreateRequest {
-            item_to_monitor: ReadValueId { node_id: current_state.clone(), attribute_id: AttributeId::Value as u32, ..Default::default() },
-            monitoring_mode: MonitoringMode::Reporting,
-            requested_parameters: MonitoringParameters {
-                client_handle: 1,
-                sampling_interval: 0.0,
-                queue_size: 100,
-                discard_oldest: false,
-                ..Default::default()
-            },
         };
-        let created = session
-            .create_monitored_items(subscription, TimestampsToReturn::Both, vec![item])
-            .await
-            .map_err(service("CreateMonitoredItems"))?;
-        if let Some(bad) = created.iter().map(|c| c.result.status_code).find(|s| s.is_bad()) {
-            let _ = session.delete_subscription(subscription).await;
-            return Err(ClientError::Status { what: format!("subscribe to {current_state}"), status: bad });
-        }
-        let mut machine = RemoteMachine { remote, current_state, seen, subscription, methods: Default::default() };
+        // Every change, none dropped: a run must see each state it passes through.
+        let subscription = Subscription::watch(session, &current_state, 0, false, notify).await?;
+        let mut machine = RemoteMachine { remote, current_state, seen, _subscription: subscription, methods: Default::default() };
         // The first notification is the state now.
         let first = matches!(tokio::time::timeout(Duration::from_secs(5), machine.seen.wait_for(|s| s.0 > 0)).await, Ok(Ok(_)));
         if !first {
@@ -133,17 +109,6 @@ impl<M: StateMachine> RemoteMachine<M> {
         let n = found.map_err(|status| ClientError::Status { what: format!("method {method} of {}", self.remote.node), status })?;
         self.methods.lock().unwrap_or_else(|e| e.into_inner()).insert(method, n.clone());
         Ok(n)
-    }
-}
-
-impl<M> Drop for RemoteMachine<M> {
-    fn drop(&mut self) {
-        let (session, id) = (self.remote.session.clone(), self.subscription);
-        if let Ok(rt) = tokio::runtime::Handle::try_current() {
-            rt.spawn(async move {
-                let _ = session.delete_subscription(id).await;
-            });
-        }
     }
 }
 
@@ -310,7 +275,9 @@ fn refusal(e: &ClientError) -> Option<StatusCode> {
         ClientError::Halted { cause, .. } => Some(*cause),
         ClientError::Type { .. } | ClientError::WrongType { .. } => Some(StatusCode::BadTypeMismatch),
         ClientError::UnknownNamespace(_) => Some(StatusCode::BadNoMatch),
-        ClientError::Remote(RemoteError::Path { .. } | RemoteError::Missing { .. } | RemoteError::Pki(_)) => Some(StatusCode::BadNoMatch),
+        ClientError::Remote(RemoteError::Path { .. } | RemoteError::Ambiguous { .. } | RemoteError::Missing { .. } | RemoteError::Pki(_)) => {
+            Some(StatusCode::BadNoMatch)
+        }
         ClientError::Remote(RemoteError::Service(..) | RemoteError::Connect(..)) | ClientError::Timeout(_) => None,
     }
 }

@@ -88,6 +88,41 @@ pub struct VariableMember<S> {
     pub scalar: PhantomData<fn() -> S>,
 }
 
+/// A method reachable from an instance of an ObjectType (without crossing a placeholder), as generated code
+/// declares it beside the [`VariableMember`]s: one `const` per browse path in `<type module>::members::<Owner>`
+/// (`Lock__InitLock`), whose type carries the method's input and output tuples (`I`, `O`, from its
+/// InputArguments and OutputArguments, as [`Method<I, O>`] has them on the server). A typed client calls it:
+/// `remote.call(&members::MotionDeviceType::Lock__InitLock, ("cell".to_owned(),))` is an `(i32,)`.
+pub struct MethodMember<I, O> {
+    /// The namespace URIs that `path`'s indices refer to (the generated module's `NS`).
+    pub ns: &'static [&'static str],
+    /// The BrowseNames from the instance down to the method, in [`MemberPath`]'s text form; the method is
+    /// called on the object the path leads to before its last segment (the instance if there is none).
+    pub path: &'static str,
+    /// Whether every instance has it (Mandatory, all the way down).
+    pub mandatory: bool,
+    /// The signature. (Public so that a marker is a struct literal.)
+    pub signature: PhantomData<fn(I) -> O>,
+}
+
+impl<I, O> MethodMember<I, O> {
+    /// The marker's browse path.
+    pub const fn browse_path(&self) -> MemberPath {
+        MemberPath { ns: self.ns, text: self.path }
+    }
+}
+
+impl<I, O> std::fmt::Debug for MethodMember<I, O> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("MethodMember")
+            .field("path", &self.path)
+            .field("inputs", &std::any::type_name::<I>())
+            .field("outputs", &std::any::type_name::<O>())
+            .field("mandatory", &self.mandatory)
+            .finish()
+    }
+}
+
 /// A browse path as generated code writes it: each BrowseName as `index:name`, where `index` is a position
 /// in `ns` (the namespace URIs of the generated module), joined by `/`; a `/` or `\` in a name is escaped
 /// with `\`. With `ns = ["…/Robotics/", "…/DI/"]`, `1:ParameterSet/0:ActualPosition` is DI's
@@ -118,6 +153,22 @@ impl std::fmt::Display for BadMemberPath {
 impl std::error::Error for BadMemberPath {}
 
 impl MemberPath {
+    /// The path without its last segment (`None` for a path of one segment): the object that holds a
+    /// method. An escaped `/` does not end a segment.
+    pub fn parent(&self) -> Option<MemberPath> {
+        let mut last = None;
+        let mut escaped = false;
+        for (i, c) in self.text.char_indices() {
+            match c {
+                _ if escaped => escaped = false,
+                '\\' => escaped = true,
+                '/' => last = Some(i),
+                _ => {}
+            }
+        }
+        last.map(|i| MemberPath { ns: self.ns, text: &self.text[..i] })
+    }
+
     /// The BrowseNames along the path, each with its namespace URI.
     pub fn segments(&self) -> Result<Vec<(&'static str, String)>, BadMemberPath> {
         let bad = |reason: String| BadMemberPath { text: self.text, reason };
@@ -246,15 +297,21 @@ pub use crate::__nodeset_ua_struct as ua_struct;
 
 /// Declares the member markers of an ObjectType (generated `members` modules use it): a module named
 /// after the handle that re-exports the markers of its supertype's module when one is given (`Owner: path;`;
-/// a marker declared here shadows the supertype's of that name), with, for each variable member declared
-/// here, a [`VariableMember`] constant given the marker name, the Rust scalar type, the ValueRank, the
-/// browse path (a [`MemberPath`] text over the `NS` of the module two levels up), and whether it is
-/// mandatory, has a default value, and is writable; and `REQUIRED`, the mandatory variables without a
+/// a marker declared here shadows the supertype's of that name), with, for each method member declared here
+/// (`methods: [Name: (Inputs) => (Outputs), "path", mandatory;]`), a [`MethodMember`]; for each variable
+/// member declared here, a [`VariableMember`] constant given the marker name, the Rust scalar type, the
+/// ValueRank, the browse path (a [`MemberPath`] text over the `NS` of the module two levels up), and whether
+/// it is mandatory, has a default value, and is writable; and `REQUIRED`, the mandatory variables without a
 /// default, with the message for a derive that leaves one unbound.
 #[doc(hidden)]
 #[macro_export]
 macro_rules! __nodeset_object_members {
-    ($owner:ident $(: $base:path)?; required: [$(($rp:literal, $rm:literal)),* $(,)?]; $($m:ident: $scalar:ty, $rank:literal, $path:literal, $mandatory:literal $default:literal $writable:literal;)*) => {
+    (
+        $owner:ident $(: $base:path)?;
+        $(methods: [$($fm:ident: $fi:ty => $fo:ty, $fpath:literal, $fmandatory:literal;)*];)?
+        required: [$(($rp:literal, $rm:literal)),* $(,)?];
+        $($m:ident: $scalar:ty, $rank:literal, $path:literal, $mandatory:literal $default:literal $writable:literal;)*
+    ) => {
         #[doc = concat!(" Member markers of [`", stringify!($owner), "`](super::", stringify!($owner), ") for `nodeset-derive`.")]
         #[allow(non_upper_case_globals)]
         pub mod $owner {
@@ -264,6 +321,15 @@ macro_rules! __nodeset_object_members {
                 #[doc(no_inline)]
                 pub use $base::*;
             )?
+            $($(
+                #[doc = concat!(" The method `", $fpath, "`.")]
+                pub const $fm: $crate::typed::MethodMember<$fi, $fo> = $crate::typed::MethodMember {
+                    ns: super::super::NS,
+                    path: $fpath,
+                    mandatory: $fmandatory,
+                    signature: ::core::marker::PhantomData,
+                };
+            )*)?
             $(
                 #[doc = concat!(" The variable `", $path, "`.")]
                 pub const $m: $crate::typed::VariableMember<$scalar> = $crate::typed::VariableMember {
@@ -388,6 +454,17 @@ mod tests {
             [("urn:a", r"a:b/c\d".to_string()), ("urn:b", "<Axis>".to_string())]
         );
         assert_eq!(segments("1:").unwrap(), [("urn:b", String::new())]);
+    }
+
+    #[test]
+    fn the_parent_of_a_member_path_ends_before_its_last_unescaped_slash() {
+        let parent = |text: &'static str| MemberPath { ns: NS, text }.parent().map(|p| p.text);
+        assert_eq!(parent("1:Lock/1:InitLock"), Some("1:Lock"));
+        assert_eq!(parent("0:A/0:B/1:C"), Some("0:A/0:B"));
+        assert_eq!(parent(r"0:A\/B/1:C\/D"), Some(r"0:A\/B"));
+        assert_eq!(parent(r"0:A\\/1:C"), Some(r"0:A\\"));
+        assert_eq!(parent(r"0:A\/B"), None);
+        assert_eq!(parent("0:Start"), None);
     }
 
     #[test]

@@ -816,6 +816,10 @@ pub mod members {
     }
     t::object_members! {
         CompositeSkillType: super::ProgramSkillStateMachineType;
+        methods: [
+            Suspend: () => (), "1:Suspend", true;
+            Resume: () => (), "1:Resume", true;
+        ];
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of CompositeSkillType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
@@ -861,6 +865,13 @@ pub mod members {
     }
     t::object_members! {
         ProgramSkillStateMachineType;
+        methods: [
+            Start: () => (), "1:Start", true;
+            Suspend: () => (), "1:Suspend", false;
+            Resume: () => (), "1:Resume", false;
+            Halt: () => (), "1:Halt", true;
+            Reset: () => (), "1:Reset", true;
+        ];
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of ProgramSkillStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),

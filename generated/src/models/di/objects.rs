@@ -2262,6 +2262,11 @@ pub mod members {
     }
     t::object_members! {
         CachedLoadingType: super::PackageLoadingType;
+        methods: [
+            PendingVersion__Clear: () => (), "0:PendingVersion/0:Clear", false;
+            FallbackVersion__Clear: () => (), "0:FallbackVersion/0:Clear", false;
+            GetUpdateBehavior: (String, String, Vec<String>) => (super::super::super::types::UpdateBehavior,), "0:GetUpdateBehavior", true;
+        ];
         required: [
             ("CurrentVersion/Manufacturer", "the mandatory variable `CurrentVersion/Manufacturer` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/Manufacturer\")]"),
             ("CurrentVersion/ManufacturerUri", "the mandatory variable `CurrentVersion/ManufacturerUri` of CachedLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/ManufacturerUri\")]"),
@@ -2339,6 +2344,9 @@ pub mod members {
     }
     t::object_members! {
         ConfirmationStateMachineType;
+        methods: [
+            Confirm: () => (), "0:Confirm", true;
+        ];
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of ConfirmationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("ConfirmationTimeout", "the mandatory variable `ConfirmationTimeout` of ConfirmationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ConfirmationTimeout\")]"),
@@ -2356,6 +2364,31 @@ pub mod members {
     }
     t::object_members! {
         DeviceHealthDiagnosticAlarmType;
+        methods: [
+            Disable: () => (), "1:Disable", true;
+            Enable: () => (), "1:Enable", true;
+            AddComment: (ua::ByteString, ua::LocalizedText) => (), "1:AddComment", true;
+            Acknowledge: (ua::ByteString, ua::LocalizedText) => (), "1:Acknowledge", true;
+            Confirm: (ua::ByteString, ua::LocalizedText) => (), "1:Confirm", false;
+            ShelvingState__TimedShelve: (f64,) => (), "1:ShelvingState/1:TimedShelve", false;
+            ShelvingState__TimedShelve2: (f64, ua::LocalizedText) => (), "1:ShelvingState/1:TimedShelve2", false;
+            ShelvingState__Unshelve: () => (), "1:ShelvingState/1:Unshelve", false;
+            ShelvingState__Unshelve2: (ua::LocalizedText,) => (), "1:ShelvingState/1:Unshelve2", false;
+            ShelvingState__OneShotShelve: () => (), "1:ShelvingState/1:OneShotShelve", false;
+            ShelvingState__OneShotShelve2: (ua::LocalizedText,) => (), "1:ShelvingState/1:OneShotShelve2", false;
+            Silence: () => (), "1:Silence", false;
+            Suppress: () => (), "1:Suppress", false;
+            Suppress2: (ua::LocalizedText,) => (), "1:Suppress2", false;
+            Unsuppress: () => (), "1:Unsuppress", false;
+            Unsuppress2: (ua::LocalizedText,) => (), "1:Unsuppress2", false;
+            RemoveFromService: () => (), "1:RemoveFromService", false;
+            RemoveFromService2: (ua::LocalizedText,) => (), "1:RemoveFromService2", false;
+            PlaceInService: () => (), "1:PlaceInService", false;
+            PlaceInService2: (ua::LocalizedText,) => (), "1:PlaceInService2", false;
+            Reset: () => (), "1:Reset", false;
+            Reset2: (ua::LocalizedText,) => (), "1:Reset2", false;
+            GetGroupMemberships: () => (Vec<ua::NodeId>,), "1:GetGroupMemberships", false;
+        ];
         required: [
             ("EventId", "the mandatory variable `EventId` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
             ("EventType", "the mandatory variable `EventType` of DeviceHealthDiagnosticAlarmType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
@@ -2495,6 +2528,14 @@ pub mod members {
     }
     t::object_members! {
         FileSystemLoadingType: super::SoftwareLoadingType;
+        methods: [
+            FileSystem__CreateDirectory: (String,) => (ua::NodeId,), "1:FileSystem/1:CreateDirectory", true;
+            FileSystem__CreateFile: (String, bool) => (ua::NodeId, u32), "1:FileSystem/1:CreateFile", true;
+            FileSystem__Delete: (ua::NodeId,) => (), "1:FileSystem/1:Delete", true;
+            FileSystem__MoveOrCopy: (ua::NodeId, ua::NodeId, bool, String) => (ua::NodeId,), "1:FileSystem/1:MoveOrCopy", true;
+            GetUpdateBehavior: (Vec<ua::NodeId>,) => (super::super::super::types::UpdateBehavior,), "0:GetUpdateBehavior", true;
+            ValidateFiles: (Vec<ua::NodeId>,) => (i32, ua::LocalizedText), "0:ValidateFiles", false;
+        ];
         required: [];
     }
     t::object_members! {
@@ -2504,6 +2545,10 @@ pub mod members {
     }
     t::object_members! {
         IAssetLocationIndicationType;
+        methods: [
+            StartLocationIndication: (f64,) => (), "0:StartLocationIndication", true;
+            StopLocationIndication: () => (), "0:StopLocationIndication", true;
+        ];
         required: [
             ("IsIndicating", "the mandatory variable `IsIndicating` of IAssetLocationIndicationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"IsIndicating\")]"),
         ];
@@ -2553,6 +2598,12 @@ pub mod members {
     }
     t::object_members! {
         InstallationStateMachineType;
+        methods: [
+            InstallSoftwarePackage: (String, String, Vec<String>, ua::ByteString) => (), "0:InstallSoftwarePackage", false;
+            InstallFiles: (Vec<ua::NodeId>,) => (), "0:InstallFiles", false;
+            Uninstall: () => (), "0:Uninstall", false;
+            Resume: () => (), "0:Resume", true;
+        ];
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of InstallationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
         ];
@@ -2569,6 +2620,12 @@ pub mod members {
     }
     t::object_members! {
         LockingServicesType;
+        methods: [
+            InitLock: (String,) => (i32,), "0:InitLock", true;
+            RenewLock: () => (i32,), "0:RenewLock", true;
+            ExitLock: () => (i32,), "0:ExitLock", true;
+            BreakLock: () => (i32,), "0:BreakLock", true;
+        ];
         required: [
             ("Locked", "the mandatory variable `Locked` of LockingServicesType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Locked\")]"),
             ("LockingClient", "the mandatory variable `LockingClient` of LockingServicesType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LockingClient\")]"),
@@ -2610,6 +2667,12 @@ pub mod members {
     }
     t::object_members! {
         NetworkType;
+        methods: [
+            Lock__InitLock: (String,) => (i32,), "0:Lock/0:InitLock", false;
+            Lock__RenewLock: () => (i32,), "0:Lock/0:RenewLock", false;
+            Lock__ExitLock: () => (i32,), "0:Lock/0:ExitLock", false;
+            Lock__BreakLock: () => (i32,), "0:Lock/0:BreakLock", false;
+        ];
         required: [];
         Lock__Locked: bool, -1, "0:Lock/0:Locked", false false false;
         Lock__LockingClient: String, -1, "0:Lock/0:LockingClient", false false false;
@@ -2654,6 +2717,12 @@ pub mod members {
     }
     t::object_members! {
         PackageLoadingType: super::SoftwareLoadingType;
+        methods: [
+            CurrentVersion__Clear: () => (), "0:CurrentVersion/0:Clear", false;
+            FileTransfer__GenerateFileForRead: (ua::Variant,) => (ua::NodeId, u32, ua::NodeId), "0:FileTransfer/1:GenerateFileForRead", true;
+            FileTransfer__GenerateFileForWrite: (ua::Variant,) => (ua::NodeId, u32), "0:FileTransfer/1:GenerateFileForWrite", true;
+            FileTransfer__CloseAndCommit: (u32,) => (ua::NodeId,), "0:FileTransfer/1:CloseAndCommit", true;
+        ];
         required: [
             ("CurrentVersion/Manufacturer", "the mandatory variable `CurrentVersion/Manufacturer` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/Manufacturer\")]"),
             ("CurrentVersion/ManufacturerUri", "the mandatory variable `CurrentVersion/ManufacturerUri` of PackageLoadingType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentVersion/ManufacturerUri\")]"),
@@ -2684,6 +2753,11 @@ pub mod members {
     }
     t::object_members! {
         PrepareForUpdateStateMachineType;
+        methods: [
+            Prepare: () => (), "0:Prepare", true;
+            Abort: () => (), "0:Abort", true;
+            Resume: () => (), "0:Resume", false;
+        ];
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of PrepareForUpdateStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
         ];
@@ -2699,6 +2773,10 @@ pub mod members {
     }
     t::object_members! {
         SoftwareFolderType;
+        methods: [
+            Add: (String, String) => (), "0:Add", true;
+            Delete: (ua::NodeId,) => (), "0:Delete", true;
+        ];
         required: [
             ("SoftwareClass", "the mandatory variable `SoftwareClass` of SoftwareFolderType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SoftwareClass\")]"),
         ];
@@ -2722,6 +2800,19 @@ pub mod members {
     }
     t::object_members! {
         SoftwareUpdateType;
+        methods: [
+            PrepareForUpdate__Prepare: () => (), "0:PrepareForUpdate/0:Prepare", false;
+            PrepareForUpdate__Abort: () => (), "0:PrepareForUpdate/0:Abort", false;
+            PrepareForUpdate__Resume: () => (), "0:PrepareForUpdate/0:Resume", false;
+            Installation__InstallSoftwarePackage: (String, String, Vec<String>, ua::ByteString) => (), "0:Installation/0:InstallSoftwarePackage", false;
+            Installation__InstallFiles: (Vec<ua::NodeId>,) => (), "0:Installation/0:InstallFiles", false;
+            Installation__Uninstall: () => (), "0:Installation/0:Uninstall", false;
+            Installation__Resume: () => (), "0:Installation/0:Resume", false;
+            Confirmation__Confirm: () => (), "0:Confirmation/0:Confirm", false;
+            Parameters__GenerateFileForRead: (ua::Variant,) => (ua::NodeId, u32, ua::NodeId), "0:Parameters/1:GenerateFileForRead", false;
+            Parameters__GenerateFileForWrite: (ua::Variant,) => (ua::NodeId, u32), "0:Parameters/1:GenerateFileForWrite", false;
+            Parameters__CloseAndCommit: (u32,) => (ua::NodeId,), "0:Parameters/1:CloseAndCommit", false;
+        ];
         required: [];
         Loading__UpdateKey: String, -1, "0:Loading/0:UpdateKey", false false false;
         PrepareForUpdate__CurrentState: ua::LocalizedText, -1, "0:PrepareForUpdate/1:CurrentState", false false false;
@@ -2754,6 +2845,9 @@ pub mod members {
     }
     t::object_members! {
         SoftwareVersionType;
+        methods: [
+            Clear: () => (), "0:Clear", false;
+        ];
         required: [
             ("Manufacturer", "the mandatory variable `Manufacturer` of SoftwareVersionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
             ("ManufacturerUri", "the mandatory variable `ManufacturerUri` of SoftwareVersionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ManufacturerUri\")]"),
@@ -2777,6 +2871,12 @@ pub mod members {
     }
     t::object_members! {
         TopologyElementType;
+        methods: [
+            Lock__InitLock: (String,) => (i32,), "0:Lock/0:InitLock", false;
+            Lock__RenewLock: () => (i32,), "0:Lock/0:RenewLock", false;
+            Lock__ExitLock: () => (i32,), "0:Lock/0:ExitLock", false;
+            Lock__BreakLock: () => (i32,), "0:Lock/0:BreakLock", false;
+        ];
         required: [];
         Identification__UIElement: ua::Variant, -1, "0:Identification/0:UIElement", false false false;
         Lock__Locked: bool, -1, "0:Lock/0:Locked", false false false;
@@ -2786,6 +2886,11 @@ pub mod members {
     }
     t::object_members! {
         TransferServicesType;
+        methods: [
+            TransferToDevice: () => (i32, i32), "0:TransferToDevice", true;
+            TransferFromDevice: () => (i32, i32), "0:TransferFromDevice", true;
+            FetchTransferResultData: (i32, i32, i32, bool) => (ua::ExtensionObject,), "0:FetchTransferResultData", true;
+        ];
         required: [];
     }
 }

@@ -307,6 +307,18 @@ pub mod members {
     }
     t::object_members! {
         DrillingCellType;
+        methods: [
+            SkillSet__ReferenceDrillBush__Start: () => (), "1:SkillSet/0:ReferenceDrillBush/2:Start", true;
+            SkillSet__ReferenceDrillBush__Suspend: () => (), "1:SkillSet/0:ReferenceDrillBush/2:Suspend", true;
+            SkillSet__ReferenceDrillBush__Resume: () => (), "1:SkillSet/0:ReferenceDrillBush/2:Resume", true;
+            SkillSet__ReferenceDrillBush__Halt: () => (), "1:SkillSet/0:ReferenceDrillBush/2:Halt", true;
+            SkillSet__ReferenceDrillBush__Reset: () => (), "1:SkillSet/0:ReferenceDrillBush/2:Reset", true;
+            SkillSet__DrillHole__Start: () => (), "1:SkillSet/0:DrillHole/2:Start", true;
+            SkillSet__DrillHole__Suspend: () => (), "1:SkillSet/0:DrillHole/2:Suspend", true;
+            SkillSet__DrillHole__Resume: () => (), "1:SkillSet/0:DrillHole/2:Resume", true;
+            SkillSet__DrillHole__Halt: () => (), "1:SkillSet/0:DrillHole/2:Halt", true;
+            SkillSet__DrillHole__Reset: () => (), "1:SkillSet/0:DrillHole/2:Reset", true;
+        ];
         required: [
             ("SkillSet/ReferenceDrillBush/CurrentState", "the mandatory variable `SkillSet/ReferenceDrillBush/CurrentState` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/CurrentState\")]"),
             ("SkillSet/ReferenceDrillBush/LastTransition", "the mandatory variable `SkillSet/ReferenceDrillBush/LastTransition` of DrillingCellType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SkillSet/ReferenceDrillBush/LastTransition\")]"),

@@ -812,6 +812,9 @@ pub mod members {
     }
     t::object_members! {
         IStatisticsType;
+        methods: [
+            ResetStatistics: () => (), "0:ResetStatistics", false;
+        ];
         required: [];
         StartTime: ua::DateTime, -1, "0:StartTime", false false true;
     }

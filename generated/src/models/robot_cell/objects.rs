@@ -639,6 +639,13 @@ pub mod members {
     use super::t;
     t::object_members! {
         DrillingEndEffectorType: super::super::super::super::di::objects::members::ComponentType;
+        methods: [
+            SkillSet__TemplateDrilling__Start: () => (), "2:SkillSet/0:TemplateDrilling/3:Start", true;
+            SkillSet__TemplateDrilling__Suspend: () => (), "2:SkillSet/0:TemplateDrilling/3:Suspend", false;
+            SkillSet__TemplateDrilling__Resume: () => (), "2:SkillSet/0:TemplateDrilling/3:Resume", false;
+            SkillSet__TemplateDrilling__Halt: () => (), "2:SkillSet/0:TemplateDrilling/3:Halt", true;
+            SkillSet__TemplateDrilling__Reset: () => (), "2:SkillSet/0:TemplateDrilling/3:Reset", true;
+        ];
         required: [
             ("Manufacturer", "the mandatory variable `Manufacturer` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
             ("Model", "the mandatory variable `Model` of DrillingEndEffectorType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
@@ -675,6 +682,12 @@ pub mod members {
     }
     t::object_members! {
         LwrSystemType: super::super::super::super::di::objects::members::ComponentType;
+        methods: [
+            MotionDeviceSystem__Lock__InitLock: (String,) => (i32,), "0:MotionDeviceSystem/1:Lock/1:InitLock", false;
+            MotionDeviceSystem__Lock__RenewLock: () => (i32,), "0:MotionDeviceSystem/1:Lock/1:RenewLock", false;
+            MotionDeviceSystem__Lock__ExitLock: () => (i32,), "0:MotionDeviceSystem/1:Lock/1:ExitLock", false;
+            MotionDeviceSystem__Lock__BreakLock: () => (i32,), "0:MotionDeviceSystem/1:Lock/1:BreakLock", false;
+        ];
         required: [];
         MotionDeviceSystem__Identification__UIElement: ua::Variant, -1, "0:MotionDeviceSystem/1:Identification/1:UIElement", false false false;
         MotionDeviceSystem__Lock__Locked: bool, -1, "0:MotionDeviceSystem/1:Lock/1:Locked", false false false;
@@ -698,6 +711,17 @@ pub mod members {
     }
     t::object_members! {
         TemplateDrillingLwrSystemType: super::LwrSystemType;
+        methods: [
+            DrillingEndEffector__Lock__InitLock: (String,) => (i32,), "0:DrillingEndEffector/1:Lock/1:InitLock", false;
+            DrillingEndEffector__Lock__RenewLock: () => (i32,), "0:DrillingEndEffector/1:Lock/1:RenewLock", false;
+            DrillingEndEffector__Lock__ExitLock: () => (i32,), "0:DrillingEndEffector/1:Lock/1:ExitLock", false;
+            DrillingEndEffector__Lock__BreakLock: () => (i32,), "0:DrillingEndEffector/1:Lock/1:BreakLock", false;
+            DrillingEndEffector__SkillSet__TemplateDrilling__Start: () => (), "0:DrillingEndEffector/2:SkillSet/0:TemplateDrilling/3:Start", true;
+            DrillingEndEffector__SkillSet__TemplateDrilling__Suspend: () => (), "0:DrillingEndEffector/2:SkillSet/0:TemplateDrilling/3:Suspend", false;
+            DrillingEndEffector__SkillSet__TemplateDrilling__Resume: () => (), "0:DrillingEndEffector/2:SkillSet/0:TemplateDrilling/3:Resume", false;
+            DrillingEndEffector__SkillSet__TemplateDrilling__Halt: () => (), "0:DrillingEndEffector/2:SkillSet/0:TemplateDrilling/3:Halt", true;
+            DrillingEndEffector__SkillSet__TemplateDrilling__Reset: () => (), "0:DrillingEndEffector/2:SkillSet/0:TemplateDrilling/3:Reset", true;
+        ];
         required: [
             ("DrillingEndEffector/Manufacturer", "the mandatory variable `DrillingEndEffector/Manufacturer` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/Manufacturer\")]"),
             ("DrillingEndEffector/Model", "the mandatory variable `DrillingEndEffector/Model` of TemplateDrillingLwrSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"DrillingEndEffector/Model\")]"),
@@ -771,6 +795,99 @@ pub mod members {
     }
     t::object_members! {
         Ur10eSystemType: super::super::super::super::robotics::objects::members::MotionDeviceSystemType;
+        methods: [
+            Controllers__URController__Lock__InitLock: (String,) => (i32,), "4:Controllers/0:URController/1:Lock/1:InitLock", false;
+            Controllers__URController__Lock__RenewLock: () => (i32,), "4:Controllers/0:URController/1:Lock/1:RenewLock", false;
+            Controllers__URController__Lock__ExitLock: () => (i32,), "4:Controllers/0:URController/1:Lock/1:ExitLock", false;
+            Controllers__URController__Lock__BreakLock: () => (i32,), "4:Controllers/0:URController/1:Lock/1:BreakLock", false;
+            Controllers__URController__Programs__CreateDirectory: (String,) => (ua::NodeId,), "4:Controllers/0:URController/4:Programs/3:CreateDirectory", false;
+            Controllers__URController__Programs__CreateFile: (String, bool) => (ua::NodeId, u32), "4:Controllers/0:URController/4:Programs/3:CreateFile", false;
+            Controllers__URController__Programs__Delete: (ua::NodeId,) => (), "4:Controllers/0:URController/4:Programs/3:Delete", false;
+            Controllers__URController__Programs__MoveOrCopy: (ua::NodeId, ua::NodeId, bool, String) => (ua::NodeId,), "4:Controllers/0:URController/4:Programs/3:MoveOrCopy", false;
+            Controllers__URController__Software__PolyScope__Lock__InitLock: (String,) => (i32,), "4:Controllers/0:URController/4:Software/0:PolyScope/1:Lock/1:InitLock", false;
+            Controllers__URController__Software__PolyScope__Lock__RenewLock: () => (i32,), "4:Controllers/0:URController/4:Software/0:PolyScope/1:Lock/1:RenewLock", false;
+            Controllers__URController__Software__PolyScope__Lock__ExitLock: () => (i32,), "4:Controllers/0:URController/4:Software/0:PolyScope/1:Lock/1:ExitLock", false;
+            Controllers__URController__Software__PolyScope__Lock__BreakLock: () => (i32,), "4:Controllers/0:URController/4:Software/0:PolyScope/1:Lock/1:BreakLock", false;
+            Controllers__URController__SystemOperation__SystemOperationStateMachine__Start: () => (i32,), "4:Controllers/0:URController/4:SystemOperation/4:SystemOperationStateMachine/4:Start", false;
+            Controllers__URController__SystemOperation__SystemOperationStateMachine__Stop: (i64,) => (i32,), "4:Controllers/0:URController/4:SystemOperation/4:SystemOperationStateMachine/4:Stop", false;
+            Controllers__URController__SystemOperation__SystemOperationStateMachine__GetReady: () => (i32,), "4:Controllers/0:URController/4:SystemOperation/4:SystemOperationStateMachine/4:GetReady", false;
+            Controllers__URController__SystemOperation__SystemOperationStateMachine__StandDown: () => (i32,), "4:Controllers/0:URController/4:SystemOperation/4:SystemOperationStateMachine/4:StandDown", false;
+            Controllers__URController__TaskControls__ProgramTask__Lock__InitLock: (String,) => (i32,), "4:Controllers/0:URController/4:TaskControls/0:ProgramTask/1:Lock/1:InitLock", false;
+            Controllers__URController__TaskControls__ProgramTask__Lock__RenewLock: () => (i32,), "4:Controllers/0:URController/4:TaskControls/0:ProgramTask/1:Lock/1:RenewLock", false;
+            Controllers__URController__TaskControls__ProgramTask__Lock__ExitLock: () => (i32,), "4:Controllers/0:URController/4:TaskControls/0:ProgramTask/1:Lock/1:ExitLock", false;
+            Controllers__URController__TaskControls__ProgramTask__Lock__BreakLock: () => (i32,), "4:Controllers/0:URController/4:TaskControls/0:ProgramTask/1:Lock/1:BreakLock", false;
+            Controllers__URController__SkillSet__AbsoluteJointPTPMove__Start: () => (), "4:Controllers/0:URController/2:SkillSet/0:AbsoluteJointPTPMove/3:Start", true;
+            Controllers__URController__SkillSet__AbsoluteJointPTPMove__Suspend: () => (), "4:Controllers/0:URController/2:SkillSet/0:AbsoluteJointPTPMove/3:Suspend", false;
+            Controllers__URController__SkillSet__AbsoluteJointPTPMove__Resume: () => (), "4:Controllers/0:URController/2:SkillSet/0:AbsoluteJointPTPMove/3:Resume", false;
+            Controllers__URController__SkillSet__AbsoluteJointPTPMove__Halt: () => (), "4:Controllers/0:URController/2:SkillSet/0:AbsoluteJointPTPMove/3:Halt", true;
+            Controllers__URController__SkillSet__AbsoluteJointPTPMove__Reset: () => (), "4:Controllers/0:URController/2:SkillSet/0:AbsoluteJointPTPMove/3:Reset", true;
+            Controllers__URController__SkillSet__RelativeCartesianLinearMove__Start: () => (), "4:Controllers/0:URController/2:SkillSet/0:RelativeCartesianLinearMove/3:Start", true;
+            Controllers__URController__SkillSet__RelativeCartesianLinearMove__Suspend: () => (), "4:Controllers/0:URController/2:SkillSet/0:RelativeCartesianLinearMove/3:Suspend", false;
+            Controllers__URController__SkillSet__RelativeCartesianLinearMove__Resume: () => (), "4:Controllers/0:URController/2:SkillSet/0:RelativeCartesianLinearMove/3:Resume", false;
+            Controllers__URController__SkillSet__RelativeCartesianLinearMove__Halt: () => (), "4:Controllers/0:URController/2:SkillSet/0:RelativeCartesianLinearMove/3:Halt", true;
+            Controllers__URController__SkillSet__RelativeCartesianLinearMove__Reset: () => (), "4:Controllers/0:URController/2:SkillSet/0:RelativeCartesianLinearMove/3:Reset", true;
+            Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__Start: () => (), "4:Controllers/0:URController/2:SkillSet/0:AbsoluteCartesianLinearMove/3:Start", true;
+            Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__Suspend: () => (), "4:Controllers/0:URController/2:SkillSet/0:AbsoluteCartesianLinearMove/3:Suspend", false;
+            Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__Resume: () => (), "4:Controllers/0:URController/2:SkillSet/0:AbsoluteCartesianLinearMove/3:Resume", false;
+            Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__Halt: () => (), "4:Controllers/0:URController/2:SkillSet/0:AbsoluteCartesianLinearMove/3:Halt", true;
+            Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__Reset: () => (), "4:Controllers/0:URController/2:SkillSet/0:AbsoluteCartesianLinearMove/3:Reset", true;
+            MotionDevices__Manipulator__Lock__InitLock: (String,) => (i32,), "4:MotionDevices/0:Manipulator/1:Lock/1:InitLock", false;
+            MotionDevices__Manipulator__Lock__RenewLock: () => (i32,), "4:MotionDevices/0:Manipulator/1:Lock/1:RenewLock", false;
+            MotionDevices__Manipulator__Lock__ExitLock: () => (i32,), "4:MotionDevices/0:Manipulator/1:Lock/1:ExitLock", false;
+            MotionDevices__Manipulator__Lock__BreakLock: () => (i32,), "4:MotionDevices/0:Manipulator/1:Lock/1:BreakLock", false;
+            MotionDevices__Manipulator__Axes__Base__Lock__InitLock: (String,) => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Base/1:Lock/1:InitLock", false;
+            MotionDevices__Manipulator__Axes__Base__Lock__RenewLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Base/1:Lock/1:RenewLock", false;
+            MotionDevices__Manipulator__Axes__Base__Lock__ExitLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Base/1:Lock/1:ExitLock", false;
+            MotionDevices__Manipulator__Axes__Base__Lock__BreakLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Base/1:Lock/1:BreakLock", false;
+            MotionDevices__Manipulator__Axes__Shoulder__Lock__InitLock: (String,) => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Shoulder/1:Lock/1:InitLock", false;
+            MotionDevices__Manipulator__Axes__Shoulder__Lock__RenewLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Shoulder/1:Lock/1:RenewLock", false;
+            MotionDevices__Manipulator__Axes__Shoulder__Lock__ExitLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Shoulder/1:Lock/1:ExitLock", false;
+            MotionDevices__Manipulator__Axes__Shoulder__Lock__BreakLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Shoulder/1:Lock/1:BreakLock", false;
+            MotionDevices__Manipulator__Axes__Elbow__Lock__InitLock: (String,) => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Elbow/1:Lock/1:InitLock", false;
+            MotionDevices__Manipulator__Axes__Elbow__Lock__RenewLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Elbow/1:Lock/1:RenewLock", false;
+            MotionDevices__Manipulator__Axes__Elbow__Lock__ExitLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Elbow/1:Lock/1:ExitLock", false;
+            MotionDevices__Manipulator__Axes__Elbow__Lock__BreakLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Elbow/1:Lock/1:BreakLock", false;
+            MotionDevices__Manipulator__Axes__Wrist1__Lock__InitLock: (String,) => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist1/1:Lock/1:InitLock", false;
+            MotionDevices__Manipulator__Axes__Wrist1__Lock__RenewLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist1/1:Lock/1:RenewLock", false;
+            MotionDevices__Manipulator__Axes__Wrist1__Lock__ExitLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist1/1:Lock/1:ExitLock", false;
+            MotionDevices__Manipulator__Axes__Wrist1__Lock__BreakLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist1/1:Lock/1:BreakLock", false;
+            MotionDevices__Manipulator__Axes__Wrist2__Lock__InitLock: (String,) => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist2/1:Lock/1:InitLock", false;
+            MotionDevices__Manipulator__Axes__Wrist2__Lock__RenewLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist2/1:Lock/1:RenewLock", false;
+            MotionDevices__Manipulator__Axes__Wrist2__Lock__ExitLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist2/1:Lock/1:ExitLock", false;
+            MotionDevices__Manipulator__Axes__Wrist2__Lock__BreakLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist2/1:Lock/1:BreakLock", false;
+            MotionDevices__Manipulator__Axes__Wrist3__Lock__InitLock: (String,) => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist3/1:Lock/1:InitLock", false;
+            MotionDevices__Manipulator__Axes__Wrist3__Lock__RenewLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist3/1:Lock/1:RenewLock", false;
+            MotionDevices__Manipulator__Axes__Wrist3__Lock__ExitLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist3/1:Lock/1:ExitLock", false;
+            MotionDevices__Manipulator__Axes__Wrist3__Lock__BreakLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist3/1:Lock/1:BreakLock", false;
+            MotionDevices__Manipulator__PowerTrains__BaseDrive__Lock__InitLock: (String,) => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:BaseDrive/1:Lock/1:InitLock", false;
+            MotionDevices__Manipulator__PowerTrains__BaseDrive__Lock__RenewLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:BaseDrive/1:Lock/1:RenewLock", false;
+            MotionDevices__Manipulator__PowerTrains__BaseDrive__Lock__ExitLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:BaseDrive/1:Lock/1:ExitLock", false;
+            MotionDevices__Manipulator__PowerTrains__BaseDrive__Lock__BreakLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:BaseDrive/1:Lock/1:BreakLock", false;
+            MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Lock__InitLock: (String,) => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:ShoulderDrive/1:Lock/1:InitLock", false;
+            MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Lock__RenewLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:ShoulderDrive/1:Lock/1:RenewLock", false;
+            MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Lock__ExitLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:ShoulderDrive/1:Lock/1:ExitLock", false;
+            MotionDevices__Manipulator__PowerTrains__ShoulderDrive__Lock__BreakLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:ShoulderDrive/1:Lock/1:BreakLock", false;
+            MotionDevices__Manipulator__PowerTrains__ElbowDrive__Lock__InitLock: (String,) => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:ElbowDrive/1:Lock/1:InitLock", false;
+            MotionDevices__Manipulator__PowerTrains__ElbowDrive__Lock__RenewLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:ElbowDrive/1:Lock/1:RenewLock", false;
+            MotionDevices__Manipulator__PowerTrains__ElbowDrive__Lock__ExitLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:ElbowDrive/1:Lock/1:ExitLock", false;
+            MotionDevices__Manipulator__PowerTrains__ElbowDrive__Lock__BreakLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:ElbowDrive/1:Lock/1:BreakLock", false;
+            MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Lock__InitLock: (String,) => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:Wrist1Drive/1:Lock/1:InitLock", false;
+            MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Lock__RenewLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:Wrist1Drive/1:Lock/1:RenewLock", false;
+            MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Lock__ExitLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:Wrist1Drive/1:Lock/1:ExitLock", false;
+            MotionDevices__Manipulator__PowerTrains__Wrist1Drive__Lock__BreakLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:Wrist1Drive/1:Lock/1:BreakLock", false;
+            MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Lock__InitLock: (String,) => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:Wrist2Drive/1:Lock/1:InitLock", false;
+            MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Lock__RenewLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:Wrist2Drive/1:Lock/1:RenewLock", false;
+            MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Lock__ExitLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:Wrist2Drive/1:Lock/1:ExitLock", false;
+            MotionDevices__Manipulator__PowerTrains__Wrist2Drive__Lock__BreakLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:Wrist2Drive/1:Lock/1:BreakLock", false;
+            MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Lock__InitLock: (String,) => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:Wrist3Drive/1:Lock/1:InitLock", false;
+            MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Lock__RenewLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:Wrist3Drive/1:Lock/1:RenewLock", false;
+            MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Lock__ExitLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:Wrist3Drive/1:Lock/1:ExitLock", false;
+            MotionDevices__Manipulator__PowerTrains__Wrist3Drive__Lock__BreakLock: () => (i32,), "4:MotionDevices/0:Manipulator/4:PowerTrains/0:Wrist3Drive/1:Lock/1:BreakLock", false;
+            SafetyStates__SafetyState__Lock__InitLock: (String,) => (i32,), "4:SafetyStates/0:SafetyState/1:Lock/1:InitLock", false;
+            SafetyStates__SafetyState__Lock__RenewLock: () => (i32,), "4:SafetyStates/0:SafetyState/1:Lock/1:RenewLock", false;
+            SafetyStates__SafetyState__Lock__ExitLock: () => (i32,), "4:SafetyStates/0:SafetyState/1:Lock/1:ExitLock", false;
+            SafetyStates__SafetyState__Lock__BreakLock: () => (i32,), "4:SafetyStates/0:SafetyState/1:Lock/1:BreakLock", false;
+        ];
         required: [
             ("Controllers/URController/ProductCode", "the mandatory variable `Controllers/URController/ProductCode` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/ProductCode\")]"),
             ("Controllers/URController/SerialNumber", "the mandatory variable `Controllers/URController/SerialNumber` of Ur10eSystemType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Controllers/URController/SerialNumber\")]"),

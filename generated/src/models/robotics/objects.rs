@@ -1956,6 +1956,16 @@ pub mod members {
     }
     t::object_members! {
         ControllerType: super::super::super::super::di::objects::members::ComponentType;
+        methods: [
+            Programs__CreateDirectory: (String,) => (ua::NodeId,), "0:Programs/2:CreateDirectory", false;
+            Programs__CreateFile: (String, bool) => (ua::NodeId, u32), "0:Programs/2:CreateFile", false;
+            Programs__Delete: (ua::NodeId,) => (), "0:Programs/2:Delete", false;
+            Programs__MoveOrCopy: (ua::NodeId, ua::NodeId, bool, String) => (ua::NodeId,), "0:Programs/2:MoveOrCopy", false;
+            SystemOperation__SystemOperationStateMachine__Start: () => (i32,), "0:SystemOperation/0:SystemOperationStateMachine/0:Start", false;
+            SystemOperation__SystemOperationStateMachine__Stop: (i64,) => (i32,), "0:SystemOperation/0:SystemOperationStateMachine/0:Stop", false;
+            SystemOperation__SystemOperationStateMachine__GetReady: () => (i32,), "0:SystemOperation/0:SystemOperationStateMachine/0:GetReady", false;
+            SystemOperation__SystemOperationStateMachine__StandDown: () => (i32,), "0:SystemOperation/0:SystemOperationStateMachine/0:StandDown", false;
+        ];
         required: [
             ("Manufacturer", "the mandatory variable `Manufacturer` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Manufacturer\")]"),
             ("Model", "the mandatory variable `Model` of ControllerType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Model\")]"),
@@ -2108,6 +2118,13 @@ pub mod members {
     }
     t::object_members! {
         MultiAcknowledgeableConditionType;
+        methods: [
+            Disable: () => (), "2:Disable", true;
+            Enable: () => (), "2:Enable", true;
+            AddComment: (ua::ByteString, ua::LocalizedText) => (), "2:AddComment", true;
+            Acknowledge: (ua::ByteString, ua::LocalizedText) => (), "2:Acknowledge", true;
+            Confirm: (ua::ByteString, ua::LocalizedText) => (), "2:Confirm", false;
+        ];
         required: [
             ("EventId", "the mandatory variable `EventId` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventId\")]"),
             ("EventType", "the mandatory variable `EventType` of MultiAcknowledgeableConditionType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EventType\")]"),
@@ -2157,6 +2174,10 @@ pub mod members {
     }
     t::object_members! {
         OperationStateMachineType;
+        methods: [
+            Start: () => (i32,), "0:Start", false;
+            Stop: (i64,) => (i32,), "0:Stop", false;
+        ];
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of OperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of OperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
@@ -2187,6 +2208,9 @@ pub mod members {
     }
     t::object_members! {
         ReadySubstateMachineType;
+        methods: [
+            ResetToProgramStart: () => (i32,), "0:ResetToProgramStart", false;
+        ];
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of ReadySubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of ReadySubstateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
@@ -2211,6 +2235,10 @@ pub mod members {
     }
     t::object_members! {
         SystemOperationStateMachineType: super::OperationStateMachineType;
+        methods: [
+            GetReady: () => (i32,), "0:GetReady", false;
+            StandDown: () => (i32,), "0:StandDown", false;
+        ];
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of SystemOperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of SystemOperationStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
@@ -2229,6 +2257,12 @@ pub mod members {
     }
     t::object_members! {
         SystemOperationType;
+        methods: [
+            SystemOperationStateMachine__Start: () => (i32,), "0:SystemOperationStateMachine/0:Start", false;
+            SystemOperationStateMachine__Stop: (i64,) => (i32,), "0:SystemOperationStateMachine/0:Stop", false;
+            SystemOperationStateMachine__GetReady: () => (i32,), "0:SystemOperationStateMachine/0:GetReady", false;
+            SystemOperationStateMachine__StandDown: () => (i32,), "0:SystemOperationStateMachine/0:StandDown", false;
+        ];
         required: [
             ("SystemOperationStateMachine/CurrentState", "the mandatory variable `SystemOperationStateMachine/CurrentState` of SystemOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SystemOperationStateMachine/CurrentState\")]"),
             ("SystemOperationStateMachine/LastTransition", "the mandatory variable `SystemOperationStateMachine/LastTransition` of SystemOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"SystemOperationStateMachine/LastTransition\")]"),
@@ -2254,6 +2288,16 @@ pub mod members {
     }
     t::object_members! {
         TaskControlOperationType;
+        methods: [
+            TaskControlStateMachine__Start: () => (i32,), "0:TaskControlStateMachine/0:Start", false;
+            TaskControlStateMachine__Stop: (i64,) => (i32,), "0:TaskControlStateMachine/0:Stop", false;
+            TaskControlStateMachine__LoadByName: (String,) => (i32,), "0:TaskControlStateMachine/0:LoadByName", false;
+            TaskControlStateMachine__LoadByNodeId: (ua::ExpandedNodeId,) => (i32,), "0:TaskControlStateMachine/0:LoadByNodeId", false;
+            TaskControlStateMachine__ReadySubstateMachine__ResetToProgramStart: () => (i32,), "0:TaskControlStateMachine/0:ReadySubstateMachine/0:ResetToProgramStart", false;
+            TaskControlStateMachine__UnloadByName: (String,) => (i32,), "0:TaskControlStateMachine/0:UnloadByName", false;
+            TaskControlStateMachine__UnloadByNodeId: (ua::ExpandedNodeId,) => (i32,), "0:TaskControlStateMachine/0:UnloadByNodeId", false;
+            TaskControlStateMachine__UnloadProgram: () => (i32,), "0:TaskControlStateMachine/0:UnloadProgram", false;
+        ];
         required: [
             ("TaskControlStateMachine/CurrentState", "the mandatory variable `TaskControlStateMachine/CurrentState` of TaskControlOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"TaskControlStateMachine/CurrentState\")]"),
             ("TaskControlStateMachine/LastTransition", "the mandatory variable `TaskControlStateMachine/LastTransition` of TaskControlOperationType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"TaskControlStateMachine/LastTransition\")]"),
@@ -2275,6 +2319,14 @@ pub mod members {
     }
     t::object_members! {
         TaskControlStateMachineType: super::OperationStateMachineType;
+        methods: [
+            LoadByName: (String,) => (i32,), "0:LoadByName", false;
+            LoadByNodeId: (ua::ExpandedNodeId,) => (i32,), "0:LoadByNodeId", false;
+            ReadySubstateMachine__ResetToProgramStart: () => (i32,), "0:ReadySubstateMachine/0:ResetToProgramStart", false;
+            UnloadByName: (String,) => (i32,), "0:UnloadByName", false;
+            UnloadByNodeId: (ua::ExpandedNodeId,) => (i32,), "0:UnloadByNodeId", false;
+            UnloadProgram: () => (i32,), "0:UnloadProgram", false;
+        ];
         required: [
             ("CurrentState", "the mandatory variable `CurrentState` of TaskControlStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"CurrentState\")]"),
             ("LastTransition", "the mandatory variable `LastTransition` of TaskControlStateMachineType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LastTransition\")]"),
@@ -2288,6 +2340,16 @@ pub mod members {
     }
     t::object_members! {
         TaskControlType: super::super::super::super::di::objects::members::ComponentType;
+        methods: [
+            TaskControlOperation__TaskControlStateMachine__Start: () => (i32,), "0:TaskControlOperation/0:TaskControlStateMachine/0:Start", false;
+            TaskControlOperation__TaskControlStateMachine__Stop: (i64,) => (i32,), "0:TaskControlOperation/0:TaskControlStateMachine/0:Stop", false;
+            TaskControlOperation__TaskControlStateMachine__LoadByName: (String,) => (i32,), "0:TaskControlOperation/0:TaskControlStateMachine/0:LoadByName", false;
+            TaskControlOperation__TaskControlStateMachine__LoadByNodeId: (ua::ExpandedNodeId,) => (i32,), "0:TaskControlOperation/0:TaskControlStateMachine/0:LoadByNodeId", false;
+            TaskControlOperation__TaskControlStateMachine__ReadySubstateMachine__ResetToProgramStart: () => (i32,), "0:TaskControlOperation/0:TaskControlStateMachine/0:ReadySubstateMachine/0:ResetToProgramStart", false;
+            TaskControlOperation__TaskControlStateMachine__UnloadByName: (String,) => (i32,), "0:TaskControlOperation/0:TaskControlStateMachine/0:UnloadByName", false;
+            TaskControlOperation__TaskControlStateMachine__UnloadByNodeId: (ua::ExpandedNodeId,) => (i32,), "0:TaskControlOperation/0:TaskControlStateMachine/0:UnloadByNodeId", false;
+            TaskControlOperation__TaskControlStateMachine__UnloadProgram: () => (i32,), "0:TaskControlOperation/0:TaskControlStateMachine/0:UnloadProgram", false;
+        ];
         required: [
             ("ParameterSet/TaskProgramLoaded", "the mandatory variable `ParameterSet/TaskProgramLoaded` of TaskControlType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/TaskProgramLoaded\")]"),
             ("ParameterSet/TaskProgramName", "the mandatory variable `ParameterSet/TaskProgramName` of TaskControlType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"ParameterSet/TaskProgramName\")]"),

@@ -17,8 +17,11 @@
 //! reachable from an instance without crossing a placeholder, named from the browse path
 //! (`ParameterSet__ActualPosition`), with the DataType's Rust scalar type, ValueRank, whether it is mandatory,
 //! has a default, is writable; plus `REQUIRED`, the mandatory variables without a default value.
-//! `nodeset-derive` checks bindings against these at compile time (it never reads XML). A path whose marker
-//! name would be `REQUIRED` gets no marker, like a name that two paths map to.
+//! `nodeset-derive` checks bindings against these at compile time (it never reads XML). Methods reachable
+//! the same way get a `runtime::typed::MethodMember<Inputs, Outputs>` each (`Lock__InitLock`), with the
+//! tuples of their Argument definitions, which typed clients call (`Remote::call`). Variables and methods
+//! share one name scope: a path whose marker name would be `REQUIRED` gets no marker, like a name that two
+//! paths map to.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
@@ -74,7 +77,7 @@ struct Field {
     doc: String,
 }
 
-/// One member marker of a type: a variable reachable from an instance, not crossing placeholders.
+/// One member marker of a type: a variable or method reachable from an instance, not crossing placeholders.
 struct Marker {
     /// The marker's name (`ParameterSet__ActualPosition`).
     name: String,
@@ -84,6 +87,8 @@ struct Marker {
     qpath: Vec<(u16, String)>,
     node: NodeIx,
     mandatory: bool,
+    /// A method's input and output tuples, as text seen from `members::<Owner>`; `None` for a variable.
+    method: Option<(String, String)>,
 }
 
 impl Marker {
@@ -98,6 +103,7 @@ impl Marker {
             self.mandatory,
             n.value.is_some(),
             n.attrs.access_level.unwrap_or(1) & 2 != 0,
+            self.method.clone(),
         )
     }
 }
@@ -335,6 +341,23 @@ impl Gen<'_> {
         quote! { t::Method<#i, #o> }
     }
 
+    /// A method's input and output tuples as text, seen from `members::<Owner>` (two modules below
+    /// objects.rs): `(String,)`, `()`, `Vec<ua::Variant>` beyond twelve arguments.
+    fn method_io_text(&self, decl: NodeIx) -> (String, String) {
+        let info = self.model.methods.get(&decl).cloned().unwrap_or_default();
+        let tuple = |args: &[crate::model::Argument]| -> String {
+            let items: Vec<String> =
+                args.iter().map(|a| from_members_module(&type_text(&self.value_type(a.data_type, a.value_rank)))).collect();
+            match items.len() {
+                0 => "()".to_owned(),
+                1 => format!("({},)", items[0]),
+                n if n > 12 => "Vec<ua::Variant>".to_owned(),
+                _ => format!("({})", items.join(", ")),
+            }
+        };
+        (tuple(&info.inputs), tuple(&info.outputs))
+    }
+
     /// Index of a namespace URI in the file's `NS` table.
     pub(super) fn ns_index(&self, uris: &mut BTreeMap<String, usize>, ns: u16) -> usize {
         let uri = self.model.namespace_uri(ns).to_owned();
@@ -490,7 +513,7 @@ impl Gen<'_> {
         }
     }
 
-    /// Variables reachable from an instance of `members`' owner, not crossing placeholders.
+    /// Variables and methods reachable from an instance of `members`' owner, not crossing placeholders.
     fn reach(&self, members: &[(NodeIx, NodeIx)], path: &mut Vec<(NodeIx, bool)>, out: &mut Vec<(Vec<NodeIx>, NodeIx, bool)>) {
         if path.len() >= MAX_DEPTH {
             return;
@@ -503,7 +526,7 @@ impl Gen<'_> {
             }
             let mandatory = rule == ModellingRule::Mandatory && path.iter().all(|(_, mand)| *mand);
             match n.class {
-                NodeClass::Variable => {
+                NodeClass::Variable | NodeClass::Method => {
                     let p: Vec<NodeIx> = path.iter().map(|(p, _)| *p).chain([m]).collect();
                     out.push((p, m, mandatory));
                 }
@@ -535,6 +558,7 @@ impl Gen<'_> {
                     path,
                     node,
                     mandatory,
+                    method: (model.node(node).class == NodeClass::Method).then(|| self.method_io_text(node)),
                 }
             })
             .collect();
@@ -585,10 +609,20 @@ impl Gen<'_> {
             }
         }
         let mut items = String::new();
+        let mut methods = String::new();
         let mut required = String::new();
         for r in &list {
             let n = model.node(r.node);
             let has_default = n.value.is_some();
+            if let Some((inputs, outputs)) = &r.method {
+                if !inherited.as_ref().is_some_and(|(_, same)| same.contains(&r.name)) {
+                    let path: Vec<String> =
+                        r.qpath.iter().map(|(ns, s)| format!("{}:{}", self.ns_index(uris, *ns), escape_segment(s))).collect();
+                    let path = Literal::string(&path.join("/"));
+                    let _ = writeln!(methods, "            {}: {inputs} => {outputs}, {path}, {};", r.name, r.mandatory);
+                }
+                continue;
+            }
             if r.mandatory && !has_default {
                 let p = r.path.join("/");
                 let msg = format!(
@@ -624,7 +658,8 @@ impl Gen<'_> {
             Some((module, _)) => format!("{type_name}: {module}"),
             None => type_name.to_string(),
         };
-        format!("    t::object_members! {{\n        {head};\n        required: {required};\n{items}    }}\n")
+        let methods = if methods.is_empty() { String::new() } else { format!("        methods: [\n{methods}        ];\n") };
+        format!("    t::object_members! {{\n        {head};\n{methods}        required: {required};\n{items}    }}\n")
     }
 
     pub(super) fn objects_file(&mut self) -> OutFile {
@@ -751,7 +786,40 @@ fn type_text(tokens: &TokenStream) -> String {
     tokens.to_string().replace(" :: ", "::").replace(":: ", "::").replace(" < ", "<").replace(" >", ">").replace("opcua::types::", "ua::")
 }
 
+/// A type's text as objects.rs names it, seen from `members::<Owner>`, two modules down: each path that
+/// starts with `super::` gets two more.
+fn from_members_module(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    let mut rest = text;
+    while let Some(i) = rest.find("super::") {
+        out.push_str(&rest[..i]);
+        if !out.ends_with("::") {
+            out.push_str("super::super::");
+        }
+        out.push_str("super::");
+        rest = &rest[i + "super::".len()..];
+    }
+    out.push_str(rest);
+    out
+}
+
 /// The prefix of nested handle struct names of a type (`AxisType` -> `AxisType_`).
 fn nested_prefix(name: &str) -> String {
     format!("{name}_")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::from_members_module;
+
+    #[test]
+    fn types_named_from_objects_rs_are_renamed_for_the_members_modules() {
+        assert_eq!(from_members_module("String"), "String");
+        assert_eq!(from_members_module("ua::NodeId"), "ua::NodeId");
+        assert_eq!(from_members_module("super::types::Mode"), "super::super::super::types::Mode");
+        assert_eq!(
+            from_members_module("Vec<super::super::di::types::A>"),
+            "Vec<super::super::super::super::di::types::A>"
+        );
+    }
 }

@@ -1,0 +1,192 @@
+//! The `verify` scenario: `nodeset-compiler verify` against a live server (issue 23, "Typed clients, and
+//! verifying any live server against its nodesets", whose target is the robot cell verified in under one
+//! second).
+//!
+//! It builds, in release mode (with `--no-release`, in the dev profile, as `cargo test` builds them), the
+//! `nodeset-compiler` command, the `walk_bench` example of nodeset-compiler
+//! and the `robot_cell` example of nodeset-examples; starts the robot cell (`--insecure`, on loopback,
+//! free ports) and, against its robot server (the MotionDeviceSystem with its skills):
+//!
+//! - runs `nodeset-compiler verify URL --models nodesets/vendor --models nodesets --insecure --json` the
+//!   given number of times, each a fresh process timed from spawn to exit (loading the nodesets, the
+//!   session, the walk, the checks), and reads the nodes checked and the round trips from its report;
+//! - the baseline, in the same run: `walk_bench --batch 1`, the same walk verify makes of the server (the
+//!   same nodes, browsed and read) by a naive client that sends one request per node browsed and per
+//!   attribute read, timed per session (connect, walk, disconnect) without loading nodesets or checking;
+//! - `walk_bench` with verify's own batches, to show how much of verify's time is the walk.
+//!
+//! The ratio is verify's median over the naive walk's median: below 1, verify (nodesets and checks
+//! included) takes less time than the naive client needs only to read the same nodes. The target is
+//! printed as a verdict, never asserted: the host is shared and its speed varies.
+
+use std::env;
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use super::{parse_report, release_dir, verdict};
+
+/// The issue's target for the robot cell, in milliseconds.
+const TARGET_MS: f64 = 1000.0;
+
+/// The robot cell example, killed when dropped.
+struct Cell(Child);
+
+impl Drop for Cell {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn cargo_build(root: &Path, release: bool, args: &[&str]) -> Result<(), String> {
+    let cargo = env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let status = Command::new(cargo)
+        .current_dir(root)
+        .args(["build", "--quiet"])
+        .args(release.then_some("--release"))
+        .args(args)
+        .status()
+        .map_err(|e| format!("cannot run cargo: {e}"))?;
+    if status.success() {
+        Ok(())
+    } else {
+        Err(format!("cargo build {} failed ({status})", args.join(" ")))
+    }
+}
+
+/// (median, min, max) of some times.
+fn spread(mut times: Vec<f64>) -> (f64, f64, f64) {
+    times.sort_by(f64::total_cmp);
+    (times[times.len() / 2], times[0], times[times.len() - 1])
+}
+
+/// The number after `"key":` in verify's JSON report.
+fn json_number(json: &str, key: &str) -> Option<u64> {
+    let at = json.find(&format!("\"{key}\":"))? + key.len() + 3;
+    json[at..].chars().take_while(char::is_ascii_digit).collect::<String>().parse().ok()
+}
+
+/// Builds what it needs, starts the robot cell, measures, and prints the table.
+pub(super) fn run(root: &Path, runs: usize, release: bool) -> Result<(), String> {
+    let runs = runs.max(1);
+    let profile = if release { "release" } else { "dev profile" };
+    eprintln!("verify: building nodeset-compiler, walk_bench and robot_cell ({profile}) ...");
+    cargo_build(root, release, &["-p", "nodeset-compiler", "--bin", "nodeset-compiler", "--example", "walk_bench"])?;
+    cargo_build(root, release, &["-p", "nodeset-examples", "--example", "robot_cell"])?;
+    let release_dir = release_dir(root);
+    let dir = if release { release_dir } else { release_dir.with_file_name("debug") };
+    let exe = |sub: &str, name: &str| dir.join(sub).join(format!("{name}{}", env::consts::EXE_SUFFIX));
+    let (compiler, walk, cell_exe) = (exe("", "nodeset-compiler"), exe("examples", "walk_bench"), exe("examples", "robot_cell"));
+
+    let pki = env::temp_dir().join(format!("nodeset-bench-verify-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&pki);
+    let mut child = Command::new(&cell_exe)
+        .args(["--port", "0", "--insecure", "--pki"])
+        .arg(&pki)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .map_err(|e| format!("cannot start {}: {e}", cell_exe.display()))?;
+    let out = child.stdout.take().ok_or("the robot cell has no stdout")?;
+    let cell = Cell(child);
+    let (tx, lines) = mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(out).lines().map_while(Result::ok) {
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let mut url = None;
+    loop {
+        let line = lines.recv_timeout(Duration::from_secs(120)).map_err(|_| "the robot cell did not get ready in 120 s")?;
+        if let Some(u) = line.strip_prefix("robot listening on ") {
+            url = Some(u.trim().to_owned());
+        }
+        if line.trim() == "cell ready" {
+            break;
+        }
+    }
+    let url = url.ok_or("the robot cell printed no `robot listening on <url>`")?;
+
+    let vendor = root.join("nodesets/vendor");
+    let nodesets = root.join("nodesets");
+    eprintln!("verify: {runs} run(s) of `nodeset-compiler verify {url}` ...");
+    let mut times = Vec::with_capacity(runs);
+    let (mut checked, mut round_trips, mut violations, mut inside_ms) = (0, 0, 0, Vec::new());
+    for run in 1..=runs {
+        let start = Instant::now();
+        let output = Command::new(&compiler)
+            .current_dir(root)
+            .arg("verify")
+            .arg(&url)
+            .arg("--models")
+            .arg(&vendor)
+            .arg("--models")
+            .arg(&nodesets)
+            .args(["--insecure", "--json"])
+            .stderr(Stdio::null())
+            .output()
+            .map_err(|e| format!("cannot run {}: {e}", compiler.display()))?;
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        let json = String::from_utf8_lossy(&output.stdout);
+        let number = |key: &str| json_number(&json, key).ok_or_else(|| format!("verify printed no `{key}`: {json}"));
+        (checked, round_trips, violations) = (number("checked")?, number("round_trips")?, number("violations")?);
+        inside_ms.push(number("millis")? as f64);
+        eprintln!("verify: run {run}: {ms:.1} ms, {checked} nodes checked, {round_trips} round trips, {violations} violation(s)");
+        times.push(ms);
+    }
+    let walk_report = |batch: &str| -> Result<super::Report, String> {
+        eprintln!("verify: walk_bench --batch {batch} --runs {runs} ...");
+        let out = Command::new(&walk)
+            .args([url.as_str(), "--batch", batch, "--runs", &runs.to_string()])
+            .stderr(Stdio::inherit())
+            .output()
+            .map_err(|e| format!("cannot run {}: {e}", walk.display()))?;
+        if !out.status.success() {
+            return Err(format!("walk_bench --batch {batch} failed ({})", out.status));
+        }
+        parse_report(&String::from_utf8_lossy(&out.stdout)).ok_or_else(|| "walk_bench printed no BENCH line".to_owned())
+    };
+    let naive = walk_report("1")?;
+    let batched = walk_report("1000")?;
+    drop(cell);
+    let _ = std::fs::remove_dir_all(&pki);
+
+    let (median, min, max) = spread(times);
+    let (inside, _, _) = spread(inside_ms);
+    println!();
+    println!("Verify: `nodeset-compiler verify` against the robot cell's robot server ({url}), {profile} build, {runs} run(s).");
+    println!("  nodes checked                       {checked:>8}   ({violations} violation(s))");
+    println!("  round trips (verify's report)       {round_trips:>8}");
+    println!("  verify, process spawn to exit       median {median:>7.1} ms   min {min:.1}   max {max:.1}");
+    println!("  verify's own `millis` (its report)  median {inside:>7.1} ms");
+    println!(
+        "  verify's walk alone (walk_bench)    median {:>7.1} ms   min {}   max {}   ({} nodes, {} round trips)",
+        batched.f("median_ms"),
+        batched.s("min_ms"),
+        batched.s("max_ms"),
+        batched.s("nodes"),
+        batched.s("round_trips")
+    );
+    println!(
+        "  baseline: naive walk, batch 1       median {:>7.1} ms   min {}   max {}   ({} nodes, {} round trips)",
+        naive.f("median_ms"),
+        naive.s("min_ms"),
+        naive.s("max_ms"),
+        naive.s("nodes"),
+        naive.s("round_trips")
+    );
+    println!(
+        "  ratio verify / naive walk           {:>8.2}   (verify with nodesets and checks, against one request per node)",
+        median / naive.f("median_ms")
+    );
+    println!(
+        "  target: robot cell verified in under {TARGET_MS:.0} ms: {} (median {median:.1} ms, spawn to exit)",
+        verdict(median, TARGET_MS)
+    );
+    Ok(())
+}
