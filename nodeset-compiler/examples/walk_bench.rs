@@ -51,12 +51,6 @@ fn main() -> ExitCode {
         eprintln!("walk_bench: run {run}: {nodes} nodes, {round_trips} round trips, {ms:.1} ms (batch {batch})");
         times.push(ms);
     }
-    times.sort_by(f64::total_cmp);
-    let median = times[times.len() / 2];
-    println!(
-        "BENCH nodes={nodes} round_trips={round_trips} median_ms={median:.1} min_ms={:.1} max_ms={:.1}",
-        times[0],
-        times[times.len() - 1]
-    );
+    bench_support::Line::new().kv("nodes", nodes).kv("round_trips", round_trips).stats("walk", &times, 1).print();
     ExitCode::SUCCESS
 }

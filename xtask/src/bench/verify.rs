@@ -26,7 +26,9 @@ use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
-use super::{parse_report, release_dir, verdict};
+use super::verdict;
+use bench_support::Report;
+use crate::util::target_dir;
 
 /// The target for the robot cell, in milliseconds.
 const TARGET_MS: f64 = 1000.0;
@@ -42,8 +44,7 @@ impl Drop for Cell {
 }
 
 fn cargo_build(root: &Path, release: bool, args: &[&str]) -> Result<(), String> {
-    let cargo = env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-    let status = Command::new(cargo)
+    let status = crate::util::cargo()
         .current_dir(root)
         .args(["build", "--quiet"])
         .args(release.then_some("--release"))
@@ -55,12 +56,6 @@ fn cargo_build(root: &Path, release: bool, args: &[&str]) -> Result<(), String> 
     } else {
         Err(format!("cargo build {} failed ({status})", args.join(" ")))
     }
-}
-
-/// (median, min, max) of some times.
-fn spread(mut times: Vec<f64>) -> (f64, f64, f64) {
-    times.sort_by(f64::total_cmp);
-    (times[times.len() / 2], times[0], times[times.len() - 1])
 }
 
 /// The number after `"key":` in verify's JSON report.
@@ -76,8 +71,7 @@ pub(super) fn run(root: &Path, runs: usize, release: bool) -> Result<(), String>
     eprintln!("verify: building nodeset-compiler, walk_bench and robot_cell ({profile}) ...");
     cargo_build(root, release, &["-p", "nodeset-compiler", "--bin", "nodeset-compiler", "--example", "walk_bench"])?;
     cargo_build(root, release, &["-p", "nodeset-examples", "--example", "robot_cell"])?;
-    let release_dir = release_dir(root);
-    let dir = if release { release_dir } else { release_dir.with_file_name("debug") };
+    let dir = target_dir().join(if release { "release" } else { "debug" });
     let exe = |sub: &str, name: &str| dir.join(sub).join(format!("{name}{}", env::consts::EXE_SUFFIX));
     let (compiler, walk, cell_exe) = (exe("", "nodeset-compiler"), exe("examples", "walk_bench"), exe("examples", "robot_cell"));
 
@@ -149,15 +143,15 @@ pub(super) fn run(root: &Path, runs: usize, release: bool) -> Result<(), String>
         if !out.status.success() {
             return Err(format!("walk_bench --batch {batch} failed ({})", out.status));
         }
-        parse_report(&String::from_utf8_lossy(&out.stdout)).ok_or_else(|| "walk_bench printed no BENCH line".to_owned())
+        Report::parse(&String::from_utf8_lossy(&out.stdout)).ok_or_else(|| "walk_bench printed no BENCH line".to_owned())
     };
     let naive = walk_report("1")?;
     let batched = walk_report("1000")?;
     drop(cell);
     let _ = std::fs::remove_dir_all(&pki);
 
-    let (median, min, max) = spread(times);
-    let (inside, _, _) = spread(inside_ms);
+    let (median, min, max) = (bench_support::median(&times), bench_support::min(&times), bench_support::max(&times));
+    let inside = bench_support::median(&inside_ms);
     println!();
     println!("Verify: `nodeset-compiler verify` against the robot cell's robot server ({url}), {profile} build, {runs} run(s).");
     println!("  nodes checked                       {checked:>8}   ({violations} violation(s))");
@@ -166,23 +160,23 @@ pub(super) fn run(root: &Path, runs: usize, release: bool) -> Result<(), String>
     println!("  verify's own `millis` (its report)  median {inside:>7.1} ms");
     println!(
         "  verify's walk alone (walk_bench)    median {:>7.1} ms   min {}   max {}   ({} nodes, {} round trips)",
-        batched.f("median_ms"),
-        batched.s("min_ms"),
-        batched.s("max_ms"),
+        batched.f("walk_median_ms"),
+        batched.s("walk_min_ms"),
+        batched.s("walk_max_ms"),
         batched.s("nodes"),
         batched.s("round_trips")
     );
     println!(
         "  baseline: naive walk, batch 1       median {:>7.1} ms   min {}   max {}   ({} nodes, {} round trips)",
-        naive.f("median_ms"),
-        naive.s("min_ms"),
-        naive.s("max_ms"),
+        naive.f("walk_median_ms"),
+        naive.s("walk_min_ms"),
+        naive.s("walk_max_ms"),
         naive.s("nodes"),
         naive.s("round_trips")
     );
     println!(
         "  ratio verify / naive walk           {:>8.2}   (verify with nodesets and checks, against one request per node)",
-        median / naive.f("median_ms")
+        median / naive.f("walk_median_ms")
     );
     println!(
         "  target: robot cell verified in under {TARGET_MS:.0} ms: {} (median {median:.1} ms, spawn to exit)",
