@@ -617,17 +617,7 @@ pub(crate) async fn translate(
     start: &NodeId,
     paths: &[Vec<(&'static str, String)>],
 ) -> Result<Vec<Result<NodeId, StatusCode>>, ClientError> {
-    let mut out = Vec::with_capacity(paths.len());
-    let mut asked = Vec::new();
-    let mut requests = Vec::new();
-    for (i, path) in paths.iter().enumerate() {
-        out.push(Err(StatusCode::BadNoMatch));
-        if let Some(request) = browse_path(session, start, path) {
-            asked.push(i);
-            requests.push(request);
-        }
-    }
-    resolve_paths(session, requests, asked, out).await
+    translate_pairs(session, paths.iter().map(|p| (start, p.as_slice()))).await
 }
 
 /// One TranslateBrowsePathsToNodeIds of the same path from each of `starts`.
@@ -636,10 +626,17 @@ async fn translate_from(
     starts: &[&NodeId],
     path: &[(&'static str, String)],
 ) -> Result<Vec<Result<NodeId, StatusCode>>, ClientError> {
-    let mut out = Vec::with_capacity(starts.len());
-    let mut asked = Vec::new();
-    let mut requests = Vec::new();
-    for (i, start) in starts.iter().enumerate() {
+    translate_pairs(session, starts.iter().map(|s| (*s, path))).await
+}
+
+/// One TranslateBrowsePathsToNodeIds of each (start, path) pair, in order; a path with a namespace the
+/// server does not serve is `BadNoMatch` without being asked.
+async fn translate_pairs<'a>(
+    session: &Session,
+    pairs: impl Iterator<Item = (&'a NodeId, &'a [(&'static str, String)])>,
+) -> Result<Vec<Result<NodeId, StatusCode>>, ClientError> {
+    let (mut out, mut asked, mut requests) = (Vec::new(), Vec::new(), Vec::new());
+    for (i, (start, path)) in pairs.enumerate() {
         out.push(Err(StatusCode::BadNoMatch));
         if let Some(request) = browse_path(session, start, path) {
             asked.push(i);
