@@ -77,7 +77,7 @@ codes! {
     UnknownNamespaceIndex = "NS0106", Error, "a namespace index is not declared in NamespaceUris", NO;
     MalformedNodeId = "NS0107", Error, "a NodeId is malformed", NO;
     UnknownAlias = "NS0108", Error, "an alias is not declared", NO;
-    NoModel = "NS0109", Warning, "the file declares no model", Some("the file's nodes join the models it names by URI");
+    NoModel = "NS0109", Warning, "the file declares no model", Some("each namespace it defines nodes in becomes a model without version; the namespaces it only refers to are looked for in the named files and the model folders");
     DuplicateAlias = "NS0110", Error, "an alias is declared twice with different targets", Some("the first declaration is kept");
     MalformedQualifiedName = "NS0111", Error, "a QualifiedName is malformed", NO;
     UnknownNamespaceUri = "NS0112", Error, "a namespace URI names no loaded model", NO;

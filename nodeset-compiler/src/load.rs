@@ -246,6 +246,26 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
         }
     }
 
+    // A named file without <Models> implies one model per namespace it defines nodes in (unless a declared
+    // model or an earlier file provides it), and requires the namespaces of its NamespaceUris it only refers
+    // to: they are found like RequiredModels, any version (see `implied_model`).
+    let mut implied: BTreeMap<String, FileId> = BTreeMap::new();
+    let mut implied_requires: BTreeMap<FileId, Vec<String>> = BTreeMap::new();
+    for set in &parsed {
+        if !set.models.is_empty() || !sources.get(set.file).named {
+            continue;
+        }
+        let defined = defined_namespaces(set, sources.get(set.file).text.as_str());
+        for uri in &defined {
+            if *uri != NS0_URI && !provided.contains_key(*uri) {
+                provided.insert(uri.to_string(), set.file);
+                implied.insert(uri.to_string(), set.file);
+            }
+        }
+        let referred = set.namespace_uris.iter().map(|u| u.value.as_str()).filter(|u| *u != NS0_URI && !defined.contains(u));
+        implied_requires.insert(set.file, referred.map(str::to_string).collect());
+    }
+
     // Resolve requirements transitively, from the named files and from the models folders.
     let mut index: Option<Vec<Candidate>> = None;
     let mut queue: Vec<usize> = (0..parsed.len()).collect();
@@ -261,6 +281,9 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
                 ));
             }
         }
+        for uri in implied_requires.get(&set_file).into_iter().flatten() {
+            reqs.push((RequiredInfo { uri: uri.clone(), version: None, publication_date: None, span: parsed[i].root_span }, false));
+        }
         // Every file needs the OPC UA namespace, whether or not it says so.
         let is_ns0 = parsed[i].models.iter().any(|m| m.uri == NS0_URI);
         if !is_ns0 && !reqs.iter().any(|(r, _)| r.uri == NS0_URI) {
@@ -271,9 +294,10 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
                 continue;
             }
             if let Some(&fid) = provided.get(&req.uri) {
-                let set = parsed.iter().find(|s| s.file == fid).expect("provided file is parsed");
-                let m = set.models.iter().find(|m| m.uri == req.uri).expect("provided model exists");
-                check_version(&req, m.version.as_deref(), m.publication_date.as_deref(), &sources.get(fid).display, diags);
+                // An implied model has no version to check.
+                if let Some(m) = parsed.iter().find(|s| s.file == fid).and_then(|set| set.models.iter().find(|m| m.uri == req.uri)) {
+                    check_version(&req, m.version.as_deref(), m.publication_date.as_deref(), &sources.get(fid).display, diags);
+                }
                 continue;
             }
             let idx = index.get_or_insert_with(|| scan_dirs(&opts.model_dirs));
@@ -337,7 +361,9 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
                     );
                 }
                 None => {
-                    if provided.get(&req.uri) == Some(&FileId(u32::MAX)) {
+                    if provided.get(&req.uri) == Some(&FileId(u32::MAX)) || (!explicit && req.uri != NS0_URI) {
+                        // An implied requirement not found: the file's references into that namespace are
+                        // reported where they are written.
                         continue;
                     }
                     let looked = if opts.model_dirs.is_empty() {
@@ -367,7 +393,7 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
     }
 
     // Order files by requirement, ties by model URI then file name, never by input order.
-    let order = topo_order(&parsed, &sources, diags);
+    let order = topo_order(&parsed, &sources, &implied, &implied_requires, diags);
     let mut files_sorted: Vec<RawNodeSet> = Vec::with_capacity(parsed.len());
     let mut slots: Vec<Option<RawNodeSet>> = parsed.into_iter().map(Some).collect();
     for i in order {
@@ -406,12 +432,8 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
         for m in &set.models {
             models.push(model_info(m, set.file, intern(&m.uri, &mut namespaces)));
         }
-        if set.models.is_empty() && sources.get(set.file).named {
-            for uri in defined_namespaces(&set, sources.get(set.file).text.as_str()) {
-                if uri != NS0_URI && !provided.contains_key(uri) && !models.iter().any(|m| m.uri == uri) {
-                    models.push(implied_model(uri, set.file, set.root_span, intern(uri, &mut namespaces)));
-                }
-            }
+        for (uri, _) in implied.iter().filter(|(_, &f)| f == set.file) {
+            models.push(implied_model(uri, set.file, set.root_span, intern(uri, &mut namespaces)));
         }
         let mut aliases: FxHashMap<String, Spanned<String>> = FxHashMap::with_capacity_and_hasher(set.aliases.len(), Default::default());
         for a in &set.aliases {
@@ -452,9 +474,11 @@ fn defined_namespaces<'a>(set: &'a RawNodeSet, text: &str) -> Vec<&'a str> {
     set.namespace_uris.iter().enumerate().filter(|(i, _)| used[i + 1]).map(|(_, u)| u.value.as_str()).collect()
 }
 
-/// The model a named file without `<Models>` implies for a namespace it defines nodes in: no version, no
-/// requirement but the base model (which every file needs), so that the file's nodes are generated like a
-/// declared model's (NS0109 says the file declares none).
+/// The model a named file without `<Models>` implies for a namespace it defines nodes in: no version, so
+/// that the file's nodes are generated like a declared model's (NS0109 says the file declares none). The
+/// namespaces of its NamespaceUris it only refers to are looked for as requirements of any version, in the
+/// named files and then the model folders; one not found is not reported as such (the references into it
+/// are, where they are written).
 fn implied_model(uri: &str, file: FileId, span: Span, ns: u16) -> ModelInfo {
     ModelInfo {
         uri: uri.to_string(),
@@ -725,12 +749,23 @@ fn header_complete(text: &str) -> bool {
     text.contains("UANodeSet") && text.find("<Models>").is_some_and(|start| text[start..].contains("</Models>"))
 }
 
-fn topo_order(parsed: &[RawNodeSet], sources: &SourceMap, diags: &mut Diagnostics) -> Vec<usize> {
+fn topo_order(
+    parsed: &[RawNodeSet],
+    sources: &SourceMap,
+    implied: &BTreeMap<String, FileId>,
+    implied_requires: &BTreeMap<FileId, Vec<String>>,
+    diags: &mut Diagnostics,
+) -> Vec<usize> {
     let provider: HashMap<&str, usize> = {
         let mut m = HashMap::new();
         for (i, s) in parsed.iter().enumerate() {
             for model in &s.models {
                 m.entry(model.uri.as_str()).or_insert(i);
+            }
+        }
+        for (uri, file) in implied {
+            if let Some(i) = parsed.iter().position(|s| s.file == *file) {
+                m.entry(uri.as_str()).or_insert(i);
             }
         }
         m
@@ -743,8 +778,9 @@ fn topo_order(parsed: &[RawNodeSet], sources: &SourceMap, diags: &mut Diagnostic
             let mut d: BTreeSet<usize> = s
                 .models
                 .iter()
-                .flat_map(|m| m.required.iter())
-                .filter_map(|r| provider.get(r.uri.as_str()).copied())
+                .flat_map(|m| m.required.iter().map(|r| r.uri.as_str()))
+                .chain(implied_requires.get(&s.file).into_iter().flatten().map(String::as_str))
+                .filter_map(|uri| provider.get(uri).copied())
                 .filter(|&j| j != i)
                 .collect();
             if let Some(n) = ns0 {
@@ -917,6 +953,30 @@ mod tests {
             }
         }
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A named file without `<Models>` implies one model per namespace it defines nodes in (numeric and
+    /// string NodeIds), in the order of its NamespaceUris; a namespace it only refers to implies none.
+    #[test]
+    fn a_file_without_models_implies_one_per_namespace_it_defines_nodes_in() {
+        let text = r#"<UANodeSet xmlns="http://opcfoundation.org/UA/2011/03/UANodeSet.xsd">
+  <NamespaceUris><Uri>http://a/</Uri><Uri>http://only-referenced/</Uri><Uri>http://b/</Uri></NamespaceUris>
+  <UAObject NodeId="ns=3;s=Pump" BrowseName="3:Pump">
+    <References><Reference ReferenceType="HasTypeDefinition">i=58</Reference>
+      <Reference ReferenceType="Organizes">ns=2;i=7</Reference></References>
+  </UAObject>
+  <UAObjectType NodeId="ns=1;i=1" BrowseName="1:ValveType">
+    <References><Reference ReferenceType="HasSubtype" IsForward="false">i=58</Reference></References>
+  </UAObjectType>
+</UANodeSet>"#;
+        let mut diags = Diagnostics::new();
+        let input = Input::Text { name: "implied.xml".into(), text: text.into() };
+        let loaded = load(vec![input], &LoadOptions::default(), &mut diags);
+        let implied: Vec<(&str, bool, bool)> =
+            loaded.models.iter().map(|m| (m.uri.as_str(), m.version.is_none(), m.required.is_empty())).collect();
+        assert_eq!(implied, vec![("http://a/", true, true), ("http://b/", true, true)]);
+        let said = format!("{diags:?}");
+        assert!(!said.contains("only-referenced"), "a namespace only referred to is looked for, not required: {said}");
     }
 
     #[test]
