@@ -16,7 +16,9 @@
 //! handles. The arm's `Lock` object (DI LockingServicesType) has typed methods: `InitLock(Context)` locks
 //! for a client (Locked, LockingClient and LockingUser show who holds it), `ExitLock` unlocks. The
 //! controller's SystemOperationStateMachine is served as a state machine: it comes up Idle and takes
-//! IdleToReady. Every other variable a client may browse has a value too (`describe`): nameplates of motors,
+//! IdleToReady. Each gear has a `Lifetime` variable (DI LifetimeVariableType, an AnalogUnitType): its
+//! remaining life in hours, counting down while the robot runs, from StartValue 20000 h to LimitValue 0 h.
+//! Every other variable a client may browse has a value too (`describe`): nameplates of motors,
 //! gears and software, gear ratios, engineering units, motion profiles, the safety state and the task.
 //!
 //! The first line on stdout is `listening on <url>`; the server stops on SIGINT, SIGTERM or after
@@ -30,14 +32,14 @@ use std::time::{Duration, Instant};
 use nodeset_models::models::robotics::objects::MotionDeviceSystemType;
 use nodeset_models::models::robotics::types::MotionDeviceCategoryEnumeration;
 use nodeset_models::models::{di, ia, robotics};
-use nodeset_examples::describe::describe;
+use nodeset_examples::describe::{describe, units, HOUR};
 use nodeset_examples::secure::{SecureArgs, USAGE};
-use nodeset_models::runtime::server::{MethodError, ServerConfig};
-use nodeset_models::runtime::typed::{Bound, Instantiate, Machine, ObjectType, Variable};
+use nodeset_models::runtime::server::{MethodError, ModelManager, ServerConfig};
+use nodeset_models::runtime::typed::{Bound, Instantiate, Machine, ObjectType, Variable, VariableType};
 use nodeset_models::ObjectModel;
 use opcua::nodes::NodeType;
 use opcua::server::address_space::AccessLevel;
-use opcua::types::{LocalizedText, NodeId, ObjectId, StatusCode};
+use opcua::types::{Identifier, LocalizedText, NodeId, ObjectId, QualifiedName, StatusCode, Variant};
 
 /// The arm's identification, bound to the Robotics MotionDeviceType (and the DI members it inherits).
 #[derive(Clone, Debug, ObjectModel)]
@@ -203,6 +205,7 @@ async fn run(port: u16, seconds: Option<u64>, secure: SecureArgs) -> Result<(), 
         LockShown::of(lock).show(None).map_err(|s| s.to_string())?;
     }
 
+    let lifetimes = gear_lifetimes(&manager, &robot)?;
     let axes: Vec<_> = arm.axes.axis_identifier.values().map(|a| a.parameter_set.actual_position.clone()).collect();
     let handle = server.handle().clone();
     println!("listening on {}", server.endpoint_url());
@@ -231,6 +234,9 @@ async fn run(port: u16, seconds: Option<u64>, secure: SecureArgs) -> Result<(), 
                     let amplitude = 90.0 - 10.0 * i as f64;
                     let _ = position.set(amplitude * (t * (0.2 + 0.05 * i as f64)).sin());
                 }
+                for (i, lifetime) in lifetimes.iter().enumerate() {
+                    let _ = lifetime.set(Variant::Double(remaining_hours(i, t)));
+                }
                 let asset = identity.read(|i| i.asset_id.clone());
                 if asset != last_asset {
                     identity.update(|i| i.writes_seen += 1);
@@ -251,6 +257,39 @@ async fn run(port: u16, seconds: Option<u64>, secure: SecureArgs) -> Result<(), 
     task.await.map_err(|e| e.to_string())??;
     println!("server stopped cleanly");
     Ok(())
+}
+
+/// The gears' lifetime in hours (DI LifetimeVariableType's StartValue; its LimitValue is 0).
+const GEAR_LIFETIME_HOURS: f64 = 20_000.0;
+
+/// The remaining lifetime of gear `i` after `seconds` of running: each gear has seen some use before.
+fn remaining_hours(i: usize, seconds: f64) -> f64 {
+    GEAR_LIFETIME_HOURS - 1_000.0 * (i + 1) as f64 - seconds / 3_600.0
+}
+
+/// Gives each gear a `Lifetime` variable of DI's LifetimeVariableType (NodeId `<gear>/Lifetime`), with its
+/// StartValue, LimitValue and EngineeringUnits (hours); the values of the variables, in gear order.
+fn gear_lifetimes(manager: &ModelManager, robot: &MotionDeviceSystemType) -> Result<Vec<Variable<Variant>>, String> {
+    let type_id = manager.resolve(di::objects::LifetimeVariableType::TYPE_ID).ok_or("the server has no DI namespace")?;
+    let mut out = Vec::new();
+    for device in robot.motion_devices.motion_device_identifier.values() {
+        for pt in device.power_trains.power_train_identifier.values() {
+            for gear in pt.gear_identifier.values() {
+                let gear_id = gear.node.id();
+                let Identifier::String(path) = &gear_id.identifier else { return Err(format!("gear {gear_id} has no path NodeId")) };
+                let options = Instantiate::new().node_id(NodeId::new(gear_id.namespace, format!("{path}/Lifetime")));
+                let name = QualifiedName::new(manager.instance_namespace(), "Lifetime");
+                let id = manager.instantiate(&type_id, gear_id, name, &options).map_err(|e| e.to_string())?;
+                let lifetime: di::objects::LifetimeVariableType = manager.bind(&id).map_err(|e| e.to_string())?;
+                lifetime.start_value.set(Variant::Double(GEAR_LIFETIME_HOURS)).map_err(|s| s.to_string())?;
+                lifetime.limit_value.set(Variant::Double(0.0)).map_err(|s| s.to_string())?;
+                units(manager, &id, HOUR)?;
+                lifetime.node.set(Variant::Double(remaining_hours(out.len(), 0.0))).map_err(|s| s.to_string())?;
+                out.push(lifetime.node);
+            }
+        }
+    }
+    Ok(out)
 }
 
 /// Robotics' LastTransitionReason 3: "System", the system took the transition by itself.

@@ -20,6 +20,7 @@ const UNECE: &str = "http://www.opcfoundation.org/UA/units/un/cefact";
 pub type Unit = (&'static str, &'static str, &'static str);
 pub const DEGREE: Unit = ("DD", "°", "degree");
 pub const DEGREE_CELSIUS: Unit = ("CEL", "°C", "degree Celsius");
+pub const HOUR: Unit = ("HUR", "h", "hour");
 
 /// The manufacturer the examples' simulated parts name.
 const MAKER: &str = "nodeset-compiler robotics";

@@ -1,7 +1,7 @@
-//! Typed clients of remote instances: any generated ObjectType handle, bound to an instance on another
-//! server, with typed reads, writes, subscriptions and method calls, driven by the tables and member markers
-//! the generated code already has (no per-type client code is generated, so the generated crate does not
-//! grow).
+//! Typed clients of remote instances: any generated ObjectType or VariableType handle, bound to an instance
+//! on another server, with typed reads, writes, subscriptions and method calls, driven by the tables and
+//! member markers the generated code already has (no per-type client code is generated, so the generated
+//! crate does not grow).
 //!
 //! ```text
 //! let robot = ClientConfig::new("pki/cell-controller").user("operator", password).connect("opc.tcp://127.0.0.1:4861/").await?;
@@ -9,11 +9,15 @@
 //! let position = axis.read(&members::AxisType::ParameterSet__ActualPosition).await?;  // Sample<f64>
 //! let mut joints = axis.subscribe(&members::AxisType::ParameterSet__ActualPosition, 50).await?;
 //! while let Some(sample) = joints.next().await { println!("{:?} at {:?}", sample.value, sample.source_timestamp) }
+//! let lifetime: Remote<LifetimeVariableType> = robot.bind_path(".../Gear/Lifetime").await?;   // a Variable
+//! let left = lifetime.read_value().await?;                                                  // Sample<Variant>
+//! let unit = lifetime.read(&members::LifetimeVariableType::EngineeringUnits).await?;       // Sample<EUInformation>
 //! ```
 //!
 //! - [`ClientConfig`] is the one place where a connection is configured (security, identity, PKI folder);
-//! - [`RemoteServer::bind`] and [`RemoteServer::bind_path`] bind a [`Remote<H>`] to an instance by NodeId
-//!   or browse path, checking that its TypeDefinition is `H`'s type or a subtype of it (a path's segments
+//! - [`RemoteServer::bind`] and [`RemoteServer::bind_path`] bind a [`Remote<H>`] to an instance (an Object
+//!   for an ObjectType handle, a Variable for a VariableType handle: any [`TypeHandle`]) by NodeId or browse
+//!   path, checking that its TypeDefinition is `H`'s type or a subtype of it (a path's segments
 //!   may leave out their namespace: they are tried in every namespace of the server, several segments to
 //!   one TranslateBrowsePathsToNodeIds, see [`RemoteServer::find_counted`]; member paths, whose namespaces
 //!   the markers carry, are translated in batches);
@@ -21,6 +25,9 @@
 //!   [`Remote::subscribe`]; [`Remote::read_optional`] answers `None` for an Optional member the instance
 //!   lacks; [`Remote::read_selection`] reads any number of members with one TranslateBrowsePathsToNodeIds
 //!   and one Read; resolved paths are kept, so later reads are one round trip;
+//! - a Variable bound with its VariableType handle has a value of its own, typed by the VariableType's
+//!   DataType ([`VariableType::Value`]): [`Remote::read_value`], [`Remote::write_value`],
+//!   [`Remote::subscribe_value`]; its child variables have markers like an object's members;
 //! - a method marker (`members::<Type>::<Path>`, a [`MethodMember<I, O>`]) names a method and its argument
 //!   types: [`Remote::call`] calls it with typed arguments and outputs; a Bad status of the server is the
 //!   error, with the status of each argument when the server gives them;
@@ -52,7 +59,7 @@ use tokio::sync::mpsc;
 pub use program::{RemoteMachine, RemoteProgram};
 
 use crate::remote::{RemoteError, RemoteServer};
-use crate::typed::{Arguments, Holds, MemberPath, MethodMember, ObjectType, UaValue, VariableMember};
+use crate::typed::{Arguments, Holds, MemberPath, MethodMember, TypeHandle, UaValue, VariableMember, VariableType};
 use crate::NsNodeId;
 
 /// How a client connects: the security policy and mode, the user, the client's PKI folder and its
@@ -245,7 +252,7 @@ impl<T: UaValue> Sample<T> {
     }
 }
 
-/// A typed instance on a remote server, bound as the generated handle `H` (its ObjectType).
+/// A typed instance on a remote server, bound as the generated handle `H` (its ObjectType or VariableType).
 pub struct Remote<H> {
     session: Arc<Session>,
     node: NodeId,
@@ -260,35 +267,35 @@ impl<H> Clone for Remote<H> {
     }
 }
 
-impl<H: ObjectType> std::fmt::Debug for Remote<H> {
+impl<H: TypeHandle> std::fmt::Debug for Remote<H> {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "Remote<{}>({})", H::BROWSE_NAME, self.node)
+        write!(f, "Remote<{}>({})", H::TYPE_NAME, self.node)
     }
 }
 
 impl RemoteServer {
     /// Binds the instance `node` as `H`, after checking that its TypeDefinition is `H`'s type or a subtype.
-    pub async fn bind<H: ObjectType>(&self, node: &NodeId) -> Result<Remote<H>, ClientError> {
+    pub async fn bind<H: TypeHandle>(&self, node: &NodeId) -> Result<Remote<H>, ClientError> {
         Remote::bind(self.session().clone(), node).await
     }
 
     /// Binds the instance at `path` below the Objects folder (see [`RemoteServer::find`]) as `H`.
-    pub async fn bind_path<H: ObjectType>(&self, path: &str) -> Result<Remote<H>, ClientError> {
+    pub async fn bind_path<H: TypeHandle>(&self, path: &str) -> Result<Remote<H>, ClientError> {
         let node = self.find(path).await?;
         self.bind(&node).await
     }
 }
 
-impl<H: ObjectType> Remote<H> {
+impl<H: TypeHandle> Remote<H> {
     async fn bind(session: Arc<Session>, node: &NodeId) -> Result<Remote<H>, ClientError> {
-        let expected = resolve_id(&session, H::TYPE_ID)?;
+        let expected = resolve_id(&session, H::TYPE_NODE_ID)?;
         let type_definition = type_definition(&session, node).await?;
         let fits = match &type_definition {
             Some(t) => is_subtype(&session, t, &expected).await?,
             None => false,
         };
         if !fits {
-            return Err(ClientError::WrongType { node: node.clone(), type_definition, expected: H::BROWSE_NAME });
+            return Err(ClientError::WrongType { node: node.clone(), type_definition, expected: H::TYPE_NAME });
         }
         Ok(Remote { session, node: node.clone(), resolved: Default::default(), _type: PhantomData })
     }
@@ -332,14 +339,13 @@ impl<H: ObjectType> Remote<H> {
     }
 
     fn what(&self, path: MemberPath) -> String {
-        format!("{} {}/{}", H::BROWSE_NAME, self.node, path.text)
+        format!("{} {}/{}", H::TYPE_NAME, self.node, path.text)
     }
 
     /// Reads a variable member as `T` (`S` for a scalar, `Vec<S>` for an array, per the marker's ValueRank).
     pub async fn read<T: UaValue + Holds<S>, S>(&self, member: &VariableMember<S>) -> Result<Sample<T>, ClientError> {
         let node = self.member(member.browse_path()).await?;
-        let mut values = read_values(&self.session, &[node]).await?;
-        sample(values.remove(0), &self.what(member.browse_path()))
+        read_one(&self.session, node, &self.what(member.browse_path())).await
     }
 
     /// Reads an Optional member: `None` if the instance lacks it.
@@ -383,17 +389,7 @@ impl<H: ObjectType> Remote<H> {
     /// Writes a variable member.
     pub async fn write<T: UaValue + Holds<S>, S>(&self, member: &VariableMember<S>, value: T) -> Result<(), ClientError> {
         let node = self.member(member.browse_path()).await?;
-        let write = WriteValue {
-            node_id: node,
-            attribute_id: AttributeId::Value as u32,
-            value: DataValue::value_only(value.to_variant()),
-            ..Default::default()
-        };
-        let status = self.session.write(&[write]).await.map_err(service("Write"))?.pop().unwrap_or(StatusCode::BadUnexpectedError);
-        if status.is_bad() {
-            return Err(ClientError::Status { what: format!("write {}", self.what(member.browse_path())), status });
-        }
-        Ok(())
+        write_one(&self.session, node, value.to_variant(), &self.what(member.browse_path())).await
     }
 
     /// Subscribes to a variable member: a stream of its values, sampled every `interval_ms` (0: every
@@ -432,9 +428,9 @@ impl<H: ObjectType> Remote<H> {
     /// The instances of a placeholder below the member at `below` (`""`: the instance itself), bound as
     /// `C` (children whose TypeDefinition is `C`'s type or a subtype), in BrowseName order: one Browse for
     /// the children, and the supertypes of each distinct TypeDefinition (one Browse a level).
-    pub async fn placeholders<C: ObjectType>(&self, below: &str) -> Result<Vec<(String, Remote<C>)>, ClientError> {
+    pub async fn placeholders<C: TypeHandle>(&self, below: &str) -> Result<Vec<(String, Remote<C>)>, ClientError> {
         let parent = if below.is_empty() { self.node.clone() } else { crate::remote::find_below(&self.session, &self.node, below).await? };
-        let expected = resolve_id(&self.session, C::TYPE_ID)?;
+        let expected = resolve_id(&self.session, C::TYPE_NODE_ID)?;
         let mut out = Vec::new();
         // One Browse gives the children with their TypeDefinitions; each distinct type is checked once.
         let mut verdicts: Vec<(NodeId, bool)> = Vec::new();
@@ -456,6 +452,31 @@ impl<H: ObjectType> Remote<H> {
         }
         out.sort_by(|a, b| a.0.cmp(&b.0));
         Ok(out)
+    }
+}
+
+/// The value of a Variable bound with its VariableType handle, typed by the VariableType's DataType
+/// ([`VariableType::Value`]). Its child variables are read, written and subscribed with their markers,
+/// like an object's members.
+impl<H: VariableType> Remote<H> {
+    fn what_value(&self) -> String {
+        format!("{} {}", H::TYPE_NAME, self.node)
+    }
+
+    /// Reads the variable's own value: one Read.
+    pub async fn read_value(&self) -> Result<Sample<H::Value>, ClientError> {
+        read_one(&self.session, self.node.clone(), &self.what_value()).await
+    }
+
+    /// Writes the variable's own value: one Write.
+    pub async fn write_value(&self, value: H::Value) -> Result<(), ClientError> {
+        write_one(&self.session, self.node.clone(), value.to_variant(), &self.what_value()).await
+    }
+
+    /// Subscribes to the variable's own value: a stream of its values, sampled every `interval_ms` (0: every
+    /// change).
+    pub async fn subscribe_value(&self, interval_ms: u64) -> Result<Samples<H::Value>, ClientError> {
+        Samples::open(self.session.clone(), self.node.clone(), interval_ms).await
     }
 }
 
@@ -548,6 +569,22 @@ impl Drop for Subscription {
             });
         }
     }
+}
+
+/// One Read of the Value of `node`, as a `T` (a value of another type is an error).
+async fn read_one<T: UaValue>(session: &Session, node: NodeId, what: &str) -> Result<Sample<T>, ClientError> {
+    let mut values = read_values(session, &[node]).await?;
+    sample(values.remove(0), what)
+}
+
+/// One Write of the Value of `node`; a Bad status is the error.
+async fn write_one(session: &Session, node: NodeId, value: Variant, what: &str) -> Result<(), ClientError> {
+    let write = WriteValue { node_id: node, attribute_id: AttributeId::Value as u32, value: DataValue::value_only(value), ..Default::default() };
+    let status = session.write(&[write]).await.map_err(service("Write"))?.pop().unwrap_or(StatusCode::BadUnexpectedError);
+    if status.is_bad() {
+        return Err(ClientError::Status { what: format!("write {what}"), status });
+    }
+    Ok(())
 }
 
 fn sample<T: UaValue>(value: DataValue, what: &str) -> Result<Sample<T>, ClientError> {

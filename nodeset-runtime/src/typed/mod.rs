@@ -1,8 +1,9 @@
 //! The typed API generated handles are built on: Rust value types for OPC UA DataTypes ([`UaValue`]),
 //! handles to the nodes of an instance ([`Variable<T>`], [`Method<I, O>`], [`ObjectNode`],
 //! [`Placeholders<H>`]), instantiation of types as they prescribe ([`Instantiate`]), and the traits that
-//! generated code implements for every ObjectType ([`ObjectType`]), and the member markers that
-//! `nodeset-derive` checks bindings against ([`VariableMember`]).
+//! generated code implements for every ObjectType ([`ObjectType`]) and VariableType ([`VariableType`]), both
+//! [`TypeHandle`]s, and the member markers that `nodeset-derive` checks bindings against and typed clients
+//! read ([`VariableMember`], [`MethodMember`]).
 
 pub mod handle;
 pub mod instance;
@@ -28,6 +29,26 @@ use opcua::types::{NodeId, QualifiedName};
 use crate::server::ModelManager;
 use crate::NsNodeId;
 
+/// What the handles of ObjectTypes and VariableTypes have in common: the type whose instances they stand
+/// for. A typed client binds a remote instance as `H` (`client::Remote<H>`) when its TypeDefinition is
+/// this type or a subtype of it.
+///
+/// Its constants repeat [`ObjectType`]'s or [`VariableType`]'s under other names, so that a bound on both
+/// traits (every [`ObjectType`] is a `TypeHandle`) does not make `H::TYPE_ID` ambiguous, and code that names
+/// `AxisType::TYPE_ID` with `ObjectType` in scope keeps working. The generated `object_type!` and
+/// `variable_type!` invocations implement it.
+#[diagnostic::on_unimplemented(
+    message = "`{Self}` is not the handle of an ObjectType or VariableType",
+    label = "name a struct of a generated `objects` module",
+    note = "generated ObjectType and VariableType handles are in `models::<namespace>::objects`; data types cannot be bound"
+)]
+pub trait TypeHandle: Handle {
+    /// The type's NodeId.
+    const TYPE_NODE_ID: NsNodeId;
+    /// The type's BrowseName (its name; the namespace is `TYPE_NODE_ID`'s).
+    const TYPE_NAME: &'static str;
+}
+
 /// A generated handle of an ObjectType: its instances can be created ([`ObjectType::instantiate`]) and bound
 /// ([`ModelManager::bind`]).
 #[diagnostic::on_unimplemented(
@@ -35,7 +56,7 @@ use crate::NsNodeId;
     label = "name a struct of a generated `objects` module that stands for an ObjectType",
     note = "generated ObjectType handles are in `models::<namespace>::objects`; VariableTypes and data types cannot be bound"
 )]
-pub trait ObjectType: Handle {
+pub trait ObjectType: TypeHandle {
     /// The ObjectType's NodeId.
     const TYPE_ID: NsNodeId;
     /// The ObjectType's BrowseName (its name; the namespace is `TYPE_ID`'s).
@@ -53,12 +74,18 @@ pub trait ObjectType: Handle {
     }
 }
 
-/// A generated handle of a VariableType.
-pub trait VariableType: Handle {
+/// A generated handle of a VariableType. Its instance's own value is a [`Variable<Self::Value>`] (the
+/// handle's `node`), and its child variables have markers in `members::<Type>` like an ObjectType's.
+pub trait VariableType: TypeHandle {
     /// The VariableType's NodeId.
     const TYPE_ID: NsNodeId;
     /// The VariableType's BrowseName.
     const BROWSE_NAME: &'static str;
+    /// The Rust type of the variable's value, from the VariableType's DataType and ValueRank: the scalar
+    /// type for ValueRank -1 (the default), `Vec` of it for 0 and 1, and [`opcua::types::Variant`] for
+    /// other ranks and for a DataType without a Rust type of its own (abstract ones such as `Number` or
+    /// `BaseDataType`). An instance of a subtype may narrow the DataType; its value is still read as this.
+    type Value: UaValue;
 }
 
 /// A variable reachable from an instance of an ObjectType (without crossing a placeholder), as generated
@@ -348,6 +375,9 @@ macro_rules! __nodeset_object_members {
     };
 }
 pub use crate::__nodeset_object_members as object_members;
+/// The member markers of a VariableType (its child variables, such as AnalogItemType's `EURange`): the
+/// same declaration as [`object_members!`].
+pub use crate::__nodeset_object_members as variable_members;
 
 /// `Debug` of a generated handle: its name and node, not the whole tree of members (which a derive would
 /// print, and compile a `Debug` of every member type for).
@@ -385,11 +415,15 @@ macro_rules! __nodeset_deref_base {
 }
 pub use crate::__nodeset_deref_base as deref_base;
 
-/// The [`ObjectType`] impl of a generated handle.
+/// The [`ObjectType`] and [`TypeHandle`] impls of a generated handle.
 #[doc(hidden)]
 #[macro_export]
 macro_rules! __nodeset_object_type {
     ($t:ident, $id:expr, $name:literal) => {
+        impl $crate::typed::TypeHandle for $t {
+            const TYPE_NODE_ID: $crate::NsNodeId = $id;
+            const TYPE_NAME: &'static str = $name;
+        }
         impl $crate::typed::ObjectType for $t {
             const TYPE_ID: $crate::NsNodeId = $id;
             const BROWSE_NAME: &'static str = $name;
@@ -398,14 +432,19 @@ macro_rules! __nodeset_object_type {
 }
 pub use crate::__nodeset_object_type as object_type;
 
-/// The [`VariableType`] impl of a generated handle.
+/// The [`VariableType`] and [`TypeHandle`] impls of a generated handle, with the Rust type of its value.
 #[doc(hidden)]
 #[macro_export]
 macro_rules! __nodeset_variable_type {
-    ($t:ident, $id:expr, $name:literal) => {
+    ($t:ident, $id:expr, $name:literal, $value:ty) => {
+        impl $crate::typed::TypeHandle for $t {
+            const TYPE_NODE_ID: $crate::NsNodeId = $id;
+            const TYPE_NAME: &'static str = $name;
+        }
         impl $crate::typed::VariableType for $t {
             const TYPE_ID: $crate::NsNodeId = $id;
             const BROWSE_NAME: &'static str = $name;
+            type Value = $value;
         }
     };
 }

@@ -779,7 +779,7 @@ t::object_type!(
     SkillTransitionEventType, rt::NsNodeId::numeric(NS[0], 1100),
     "SkillTransitionEventType"
 );
-/// Member markers of each ObjectType, named from browse paths (`ParameterSet__ActualPosition`).
+/// Member markers of each ObjectType and VariableType, named from browse paths (`ParameterSet__ActualPosition`).
 #[allow(non_snake_case, non_camel_case_types)]
 pub mod members {
     #[allow(unused_imports)]

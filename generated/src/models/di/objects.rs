@@ -1421,7 +1421,8 @@ impl t::Handle for LifetimeVariableType {
     }
 }
 t::variable_type!(
-    LifetimeVariableType, rt::NsNodeId::numeric(NS[0], 468), "LifetimeVariableType"
+    LifetimeVariableType, rt::NsNodeId::numeric(NS[0], 468), "LifetimeVariableType",
+    ua::Variant
 );
 /// Handle of an instance of `LockingServicesType` (nsu=http://opcfoundation.org/UA/DI/;i=6388).
 #[derive(Clone)]
@@ -2241,8 +2242,10 @@ impl t::Handle for UIElementType {
         Self { node: b.build_this(id) }
     }
 }
-t::variable_type!(UIElementType, rt::NsNodeId::numeric(NS[0], 6246), "UIElementType");
-/// Member markers of each ObjectType, named from browse paths (`ParameterSet__ActualPosition`).
+t::variable_type!(
+    UIElementType, rt::NsNodeId::numeric(NS[0], 6246), "UIElementType", ua::Variant
+);
+/// Member markers of each ObjectType and VariableType, named from browse paths (`ParameterSet__ActualPosition`).
 #[allow(non_snake_case, non_camel_case_types)]
 pub mod members {
     #[allow(unused_imports)]
@@ -2618,6 +2621,25 @@ pub mod members {
         LengthIndicationType: super::BaseLifetimeIndicationType;
         required: [];
     }
+    t::variable_members! {
+        LifetimeVariableType;
+        required: [
+            ("EngineeringUnits", "the mandatory variable `EngineeringUnits` of LifetimeVariableType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EngineeringUnits\")]"),
+            ("StartValue", "the mandatory variable `StartValue` of LifetimeVariableType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"StartValue\")]"),
+            ("LimitValue", "the mandatory variable `LimitValue` of LifetimeVariableType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"LimitValue\")]"),
+        ];
+        Definition: String, -1, "1:Definition", false false false;
+        ValuePrecision: f64, -1, "1:ValuePrecision", false false false;
+        InstrumentRange: ua::Range, -1, "1:InstrumentRange", false false false;
+        InstrumentNumberRange: ua::ExtensionObject, -1, "1:InstrumentNumberRange", false false false;
+        EURange: ua::Range, -1, "1:EURange", false false false;
+        EUNumberRange: ua::ExtensionObject, -1, "1:EUNumberRange", false false false;
+        EngineeringUnits: ua::EUInformation, -1, "1:EngineeringUnits", true false false;
+        StartValue: ua::Variant, -1, "0:StartValue", true false false;
+        LimitValue: ua::Variant, -1, "0:LimitValue", true false false;
+        Indication: ua::NodeId, -1, "0:Indication", false false false;
+        WarningValues: ua::Variant, -3, "0:WarningValues", false false false;
+    }
     t::object_members! {
         LockingServicesType;
         methods: [
@@ -2891,6 +2913,10 @@ pub mod members {
             TransferFromDevice: () => (i32, i32), "0:TransferFromDevice", true;
             FetchTransferResultData: (i32, i32, i32, bool) => (ua::ExtensionObject,), "0:FetchTransferResultData", true;
         ];
+        required: [];
+    }
+    t::variable_members! {
+        UIElementType;
         required: [];
     }
 }

@@ -277,7 +277,7 @@ t::parameters!(
     ReferenceDrillBushSkillTypeOutputs; set : 1 "OutputParameterSet"; outcome : 1
     "Result"; fields : [referenced_hole_position : 0 "ReferencedHolePosition"]
 );
-/// Member markers of each ObjectType, named from browse paths (`ParameterSet__ActualPosition`).
+/// Member markers of each ObjectType and VariableType, named from browse paths (`ParameterSet__ActualPosition`).
 #[allow(non_snake_case, non_camel_case_types)]
 pub mod members {
     #[allow(unused_imports)]

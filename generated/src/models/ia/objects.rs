@@ -265,7 +265,8 @@ impl t::Handle for CalibrationValueType {
     }
 }
 t::variable_type!(
-    CalibrationValueType, rt::NsNodeId::numeric(NS[0], 2002), "CalibrationValueType"
+    CalibrationValueType, rt::NsNodeId::numeric(NS[0], 2002), "CalibrationValueType",
+    ua::Variant
 );
 /// Handle of an instance of `CapacityRangeType` (nsu=http://opcfoundation.org/UA/IA/;i=2003).
 ///
@@ -274,7 +275,7 @@ t::variable_type!(
 #[allow(non_snake_case)]
 pub struct CapacityRangeType {
     /// The instance.
-    pub node: t::Variable<ua::Variant>,
+    pub node: t::Variable<ua::Range>,
     /// `Definition` (Optional).
     pub definition: Option<t::Variable<String>>,
     /// `ValuePrecision` (Optional).
@@ -298,7 +299,7 @@ impl t::Handle for CapacityRangeType {
     }
 }
 t::variable_type!(
-    CapacityRangeType, rt::NsNodeId::numeric(NS[0], 2003), "CapacityRangeType"
+    CapacityRangeType, rt::NsNodeId::numeric(NS[0], 2003), "CapacityRangeType", ua::Range
 );
 /// Handle of an instance of `ControlChannelType` (nsu=http://opcfoundation.org/UA/IA/;i=1008).
 ///
@@ -733,7 +734,7 @@ impl t::Handle for StacklightType {
 }
 t::deref_base!(StacklightType => BasicStacklightType);
 t::object_type!(StacklightType, rt::NsNodeId::numeric(NS[0], 1010), "StacklightType");
-/// Member markers of each ObjectType, named from browse paths (`ParameterSet__ActualPosition`).
+/// Member markers of each ObjectType and VariableType, named from browse paths (`ParameterSet__ActualPosition`).
 #[allow(non_snake_case, non_camel_case_types)]
 pub mod members {
     #[allow(unused_imports)]
@@ -782,6 +783,26 @@ pub mod members {
         LastValidationDate: ua::DateTime, -1, "0:LastValidationDate", false false true;
         NextValidationDate: ua::DateTime, -1, "0:NextValidationDate", false false true;
         Quality: u8, -1, "0:Quality", false false true;
+    }
+    t::variable_members! {
+        CalibrationValueType;
+        required: [
+            ("EngineeringUnits", "the mandatory variable `EngineeringUnits` of CalibrationValueType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EngineeringUnits\")]"),
+        ];
+        Definition: String, -1, "1:Definition", false false false;
+        ValuePrecision: f64, -1, "1:ValuePrecision", false false false;
+        EngineeringUnits: ua::EUInformation, -1, "1:EngineeringUnits", true false true;
+    }
+    t::variable_members! {
+        CapacityRangeType;
+        required: [
+            ("EngineeringUnits", "the mandatory variable `EngineeringUnits` of CapacityRangeType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"EngineeringUnits\")]"),
+            ("Resolution", "the mandatory variable `Resolution` of CapacityRangeType has no default value in the nodeset, and no field binds it: add a field with #[opcua(path = \"Resolution\")]"),
+        ];
+        Definition: String, -1, "1:Definition", false false false;
+        ValuePrecision: f64, -1, "1:ValuePrecision", false false false;
+        EngineeringUnits: ua::EUInformation, -1, "1:EngineeringUnits", true false true;
+        Resolution: f64, -1, "0:Resolution", true false true;
     }
     t::object_members! {
         ControlChannelType;

@@ -632,7 +632,7 @@ impl t::Handle for Ur10eSystemType_SafetyStates {
     }
 }
 t::object_type!(Ur10eSystemType, rt::NsNodeId::numeric(NS[0], 4000), "UR10eSystemType");
-/// Member markers of each ObjectType, named from browse paths (`ParameterSet__ActualPosition`).
+/// Member markers of each ObjectType and VariableType, named from browse paths (`ParameterSet__ActualPosition`).
 #[allow(non_snake_case, non_camel_case_types)]
 pub mod members {
     #[allow(unused_imports)]

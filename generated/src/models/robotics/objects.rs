@@ -1928,7 +1928,7 @@ impl t::Handle for UserType {
     }
 }
 t::object_type!(UserType, rt::NsNodeId::numeric(NS[0], 18175), "UserType");
-/// Member markers of each ObjectType, named from browse paths (`ParameterSet__ActualPosition`).
+/// Member markers of each ObjectType and VariableType, named from browse paths (`ParameterSet__ActualPosition`).
 #[allow(non_snake_case, non_camel_case_types)]
 pub mod members {
     #[allow(unused_imports)]

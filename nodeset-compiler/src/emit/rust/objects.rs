@@ -13,8 +13,14 @@
 //! that declares them. A server binding two ObjectTypes of Robotics compiles their builders, not the other
 //! 150; the generated crate's own build is about a tenth shorter.
 //!
-//! `members::<Type>` holds one marker constant (`runtime::typed::VariableMember<Scalar>`) per variable
-//! reachable from an instance without crossing a placeholder, named from the browse path
+//! A VariableType's handle has the variable itself in `node`, a `Variable<T>` with `T` from the type's
+//! DataType and ValueRank (-1 when the nodeset leaves it out, as the NodeSet schema and the node tables
+//! have it; `Variant` for an abstract DataType such as `Number`), and its child variables as fields; the
+//! same `T` is its `VariableType::Value`, which typed clients read (`Remote::read_value`).
+//!
+//! `members::<Type>` (for ObjectTypes and VariableTypes alike) holds one marker constant
+//! (`runtime::typed::VariableMember<Scalar>`) per variable reachable from an instance without crossing a
+//! placeholder, named from the browse path
 //! (`ParameterSet__ActualPosition`), with the DataType's Rust scalar type, ValueRank, whether it is mandatory,
 //! has a default, is writable; plus `REQUIRED`, the mandatory variables without a default value.
 //! `nodeset-derive` checks bindings against these at compile time (it never reads XML). Methods reachable
@@ -570,8 +576,9 @@ impl Gen<'_> {
         all.into_iter().zip(keep).filter_map(|(m, k)| k.then_some(m)).collect()
     }
 
-    /// The `object_members!` invocation of a type, as text: one marker per line (a table, like the node
-    /// rows of nodes.rs, which prettyplease would fold into a paragraph).
+    /// The `object_members!` invocation of a type (`variable_members!` for a VariableType: the same macro), as
+    /// text: one marker per line (a table, like the node rows of nodes.rs, which prettyplease would fold into
+    /// a paragraph).
     ///
     /// `base` is the nearest supertype with a handle, and the path of that handle. When the type has every
     /// marker of that supertype, its module re-exports the supertype's (`pub use`, which costs the compiler
@@ -580,6 +587,7 @@ impl Gen<'_> {
     /// it declares them all.
     fn markers(
         &self,
+        macro_name: &str,
         type_name: &str,
         members: &[(NodeIx, NodeIx)],
         base: Option<(NodeIx, &TokenStream)>,
@@ -659,7 +667,7 @@ impl Gen<'_> {
             None => type_name.to_string(),
         };
         let methods = if methods.is_empty() { String::new() } else { format!("        methods: [\n{methods}        ];\n") };
-        format!("    t::object_members! {{\n        {head};\n{methods}        required: {required};\n{items}    }}\n")
+        format!("    t::{macro_name}! {{\n        {head};\n{methods}        required: {required};\n{items}    }}\n")
     }
 
     pub(super) fn objects_file(&mut self) -> OutFile {
@@ -701,14 +709,18 @@ impl Gen<'_> {
                     t::object_type!(#sname, #tid, #bname);
                     #machine
                 });
-                markers.push(self.markers(name, &all, base_for_markers.as_ref().map(|(s, p)| (*s, p)), &mut uris));
+                markers.push(self.markers("object_members", name, &all, base_for_markers.as_ref().map(|(s, p)| (*s, p)), &mut uris));
             } else {
-                let vt = self.value_type(n.attrs.data_type, n.attrs.value_rank.unwrap_or(-2));
+                // The value itself: ValueRank -1 when the nodeset leaves it out (the schema's default, and
+                // what the node table gives the server).
+                let vt = self.value_type(n.attrs.data_type, n.attrs.value_rank.unwrap_or(-1));
                 let body = self.handle_struct(name, &text, Some(quote! { t::Variable<#vt> }), None, &all, &names, &mut uris, nested_prefix(name), 0);
                 items.push(quote! {
                     #body
-                    t::variable_type!(#sname, #tid, #bname);
+                    t::variable_type!(#sname, #tid, #bname, #vt);
                 });
+                let base = model.supertypes(t).find_map(|s| Some((s, self.handle_path(s, &names)?)));
+                markers.push(self.markers("variable_members", name, &all, base.as_ref().map(|(s, p)| (*s, p)), &mut uris));
             }
         }
         let runtime = path(&self.cfg.runtime_path);
@@ -732,7 +744,7 @@ impl Gen<'_> {
         };
         let mut file = self.file("objects.rs", "Typed handles", tokens);
         file.contents.push_str(
-            "/// Member markers of each ObjectType, named from browse paths (`ParameterSet__ActualPosition`).\n\
+            "/// Member markers of each ObjectType and VariableType, named from browse paths (`ParameterSet__ActualPosition`).\n\
              #[allow(non_snake_case, non_camel_case_types)]\n\
              pub mod members {\n    #[allow(unused_imports)]\n    use super::t;\n",
         );
