@@ -22,7 +22,7 @@
 //! * `robots`: the typed API at scale ([`robots`]): N six-axis robots instantiated in one server, every joint
 //!   position updated at 100 Hz; time per update cycle and memory per robot. Not part of `all` (it runs for
 //!   `--robots-seconds` and builds the server stack in release mode).
-//! * `verify`: `nodeset-compiler verify` against the robot cell's robot server, several runs, next to a
+//! * `verify`: `nodeset-compiler verify` against the robot cell (its three servers), several runs, next to a
 //!   naive client's walk of the same nodes in the same run (module [`verify`]). Not part of `all` (it
 //!   starts the robot cell).
 //! * `scale`: synthetic models of n and 4n nodes in several shapes, timed in this process, with the ratio

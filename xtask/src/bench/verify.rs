@@ -5,14 +5,18 @@
 //! It builds, in release mode (with `--no-release`, in the dev profile, as `cargo test` builds them), the
 //! `nodeset-compiler` command, the `walk_bench` example of nodeset-compiler
 //! and the `robot_cell` example of nodeset-examples; starts the robot cell (`--insecure`, on loopback,
-//! free ports) and, against its robot server (the MotionDeviceSystem with its skills):
+//! free ports), whose three servers (the robot, the drilling unit and the cell) each show the whole cell,
+//! and verifies the cell, that is all three servers, one after the other:
 //!
-//! - runs `nodeset-compiler verify URL --models nodesets/vendor --models nodesets --insecure --json` the
-//!   given number of times, each a fresh process timed from spawn to exit (loading the nodesets, the
-//!   session, the walk, the checks), and reads the nodes checked and the round trips from its report;
-//! - the baseline, in the same run: `walk_bench --batch 1`, the same walk verify makes of the server (the
-//!   same nodes, browsed and read) by a naive client that sends one request per node browsed and per
-//!   attribute read, timed per session (connect, walk, disconnect) without loading nodesets or checking;
+//! - runs `nodeset-compiler verify URL --models nodesets/vendor --models nodesets --insecure --json` for
+//!   each server, each a fresh process timed from spawn to exit (loading the nodesets, the session, the
+//!   walk, the checks); a run is the three in a row, timed as a whole. Nodes checked and round trips are
+//!   read from the reports and summed, and shown per server too: each server's round trips grow with the
+//!   depth of its address space, not with the nodes of the cell;
+//! - the baseline, in the same run: `walk_bench --batch 1` over the three servers, the same walk verify
+//!   makes of them (the same nodes, browsed and read) by a naive client that sends one request per node
+//!   browsed and per attribute read, timed per run (three sessions: connect, walk, disconnect) without
+//!   loading nodesets or checking;
 //! - `walk_bench` with verify's own batches, to show how much of verify's time is the walk.
 //!
 //! The ratio is verify's median over the naive walk's median: below 1, verify (nodesets and checks
@@ -64,6 +68,46 @@ fn json_number(json: &str, key: &str) -> Option<u64> {
     json[at..].chars().take_while(char::is_ascii_digit).collect::<String>().parse().ok()
 }
 
+/// The robot cell's servers, in the order it starts them: the label of their `<label> listening on <url>`
+/// line.
+const SERVERS: [&str; 3] = ["robot", "drilling unit", "cell"];
+
+/// One server's figures from verify's JSON report.
+#[derive(Clone, Copy, Default)]
+struct Figures {
+    checked: u64,
+    round_trips: u64,
+    violations: u64,
+    millis: u64,
+}
+
+/// Runs `nodeset-compiler verify URL ... --json` once: the time from spawn to exit, and its figures.
+fn verify_once(compiler: &Path, root: &Path, url: &str) -> Result<(f64, Figures), String> {
+    let start = Instant::now();
+    let output = Command::new(compiler)
+        .current_dir(root)
+        .arg("verify")
+        .arg(url)
+        .arg("--models")
+        .arg(root.join("nodesets/vendor"))
+        .arg("--models")
+        .arg(root.join("nodesets"))
+        .args(["--insecure", "--json"])
+        .stderr(Stdio::null())
+        .output()
+        .map_err(|e| format!("cannot run {}: {e}", compiler.display()))?;
+    let ms = start.elapsed().as_secs_f64() * 1e3;
+    let json = String::from_utf8_lossy(&output.stdout);
+    let number = |key: &str| json_number(&json, key).ok_or_else(|| format!("verify {url} printed no `{key}`: {json}"));
+    let figures = Figures {
+        checked: number("checked")?,
+        round_trips: number("round_trips")?,
+        violations: number("violations")?,
+        millis: number("millis")?,
+    };
+    Ok((ms, figures))
+}
+
 /// Builds what it needs, starts the robot cell, measures, and prints the table.
 pub(super) fn run(root: &Path, runs: usize, release: bool) -> Result<(), String> {
     let runs = runs.max(1);
@@ -94,49 +138,46 @@ pub(super) fn run(root: &Path, runs: usize, release: bool) -> Result<(), String>
             }
         }
     });
-    let mut url = None;
+    let mut urls: Vec<Option<String>> = vec![None; SERVERS.len()];
     loop {
         let line = lines.recv_timeout(Duration::from_secs(120)).map_err(|_| "the robot cell did not get ready in 120 s")?;
-        if let Some(u) = line.strip_prefix("robot listening on ") {
-            url = Some(u.trim().to_owned());
+        for (label, url) in SERVERS.iter().zip(urls.iter_mut()) {
+            if let Some(u) = line.strip_prefix(&format!("{label} listening on ")) {
+                *url = Some(u.trim().to_owned());
+            }
         }
         if line.trim() == "cell ready" {
             break;
         }
     }
-    let url = url.ok_or("the robot cell printed no `robot listening on <url>`")?;
+    let urls: Vec<String> = SERVERS
+        .iter()
+        .zip(urls)
+        .map(|(label, url)| url.ok_or_else(|| format!("the robot cell printed no `{label} listening on <url>`")))
+        .collect::<Result<_, _>>()?;
 
-    let vendor = root.join("nodesets/vendor");
-    let nodesets = root.join("nodesets");
-    eprintln!("verify: {runs} run(s) of `nodeset-compiler verify {url}` ...");
+    eprintln!("verify: {runs} run(s) of `nodeset-compiler verify` against each of {} ...", urls.join(", "));
     let mut times = Vec::with_capacity(runs);
-    let (mut checked, mut round_trips, mut violations, mut inside_ms) = (0, 0, 0, Vec::new());
+    let mut inside_ms = Vec::with_capacity(runs);
+    let mut per_server = vec![Figures::default(); urls.len()];
     for run in 1..=runs {
-        let start = Instant::now();
-        let output = Command::new(&compiler)
-            .current_dir(root)
-            .arg("verify")
-            .arg(&url)
-            .arg("--models")
-            .arg(&vendor)
-            .arg("--models")
-            .arg(&nodesets)
-            .args(["--insecure", "--json"])
-            .stderr(Stdio::null())
-            .output()
-            .map_err(|e| format!("cannot run {}: {e}", compiler.display()))?;
-        let ms = start.elapsed().as_secs_f64() * 1e3;
-        let json = String::from_utf8_lossy(&output.stdout);
-        let number = |key: &str| json_number(&json, key).ok_or_else(|| format!("verify printed no `{key}`: {json}"));
-        (checked, round_trips, violations) = (number("checked")?, number("round_trips")?, number("violations")?);
-        inside_ms.push(number("millis")? as f64);
+        let mut ms = 0.0;
+        for (url, figures) in urls.iter().zip(per_server.iter_mut()) {
+            let (one, f) = verify_once(&compiler, root, url)?;
+            ms += one;
+            *figures = f;
+        }
+        let sum = |f: fn(&Figures) -> u64| per_server.iter().map(f).sum::<u64>();
+        let (checked, round_trips, violations) = (sum(|f| f.checked), sum(|f| f.round_trips), sum(|f| f.violations));
+        inside_ms.push(sum(|f| f.millis) as f64);
         eprintln!("verify: run {run}: {ms:.1} ms, {checked} nodes checked, {round_trips} round trips, {violations} violation(s)");
         times.push(ms);
     }
     let walk_report = |batch: &str| -> Result<super::Report, String> {
         eprintln!("verify: walk_bench --batch {batch} --runs {runs} ...");
         let out = Command::new(&walk)
-            .args([url.as_str(), "--batch", batch, "--runs", &runs.to_string()])
+            .args(&urls)
+            .args(["--batch", batch, "--runs", &runs.to_string()])
             .stderr(Stdio::inherit())
             .output()
             .map_err(|e| format!("cannot run {}: {e}", walk.display()))?;
@@ -150,16 +191,27 @@ pub(super) fn run(root: &Path, runs: usize, release: bool) -> Result<(), String>
     drop(cell);
     let _ = std::fs::remove_dir_all(&pki);
 
+    let sum = |f: fn(&Figures) -> u64| per_server.iter().map(f).sum::<u64>();
+    let (checked, round_trips, violations) = (sum(|f| f.checked), sum(|f| f.round_trips), sum(|f| f.violations));
     let (median, min, max) = (bench_support::median(&times), bench_support::min(&times), bench_support::max(&times));
     let inside = bench_support::median(&inside_ms);
     println!();
-    println!("Verify: `nodeset-compiler verify` against the robot cell's robot server ({url}), {profile} build, {runs} run(s).");
-    println!("  nodes checked                       {checked:>8}   ({violations} violation(s))");
-    println!("  round trips (verify's report)       {round_trips:>8}");
-    println!("  verify, process spawn to exit       median {median:>7.1} ms   min {min:.1}   max {max:.1}");
-    println!("  verify's own `millis` (its report)  median {inside:>7.1} ms");
+    println!("Verify: `nodeset-compiler verify` against the robot cell, its {} servers one after the other, {profile} build, {runs} run(s).", urls.len());
+    for ((label, url), f) in SERVERS.iter().zip(&urls).zip(&per_server) {
+        println!(
+            "  {:<35} {:>8} nodes checked, {:>3} round trips, {} violation(s)",
+            format!("{label} ({url})"),
+            f.checked,
+            f.round_trips,
+            f.violations
+        );
+    }
+    println!("  nodes checked, the cell              {checked:>8}   ({violations} violation(s))");
+    println!("  round trips, the cell                {round_trips:>8}");
+    println!("  verify, process spawn to exit        median {median:>7.1} ms   min {min:.1}   max {max:.1}   (the servers' runs summed)");
+    println!("  verify's own `millis` (its reports)  median {inside:>7.1} ms");
     println!(
-        "  verify's walk alone (walk_bench)    median {:>7.1} ms   min {}   max {}   ({} nodes, {} round trips)",
+        "  verify's walk alone (walk_bench)     median {:>7.1} ms   min {}   max {}   ({} nodes, {} round trips)",
         batched.f("walk_median_ms"),
         batched.s("walk_min_ms"),
         batched.s("walk_max_ms"),
@@ -167,7 +219,7 @@ pub(super) fn run(root: &Path, runs: usize, release: bool) -> Result<(), String>
         batched.s("round_trips")
     );
     println!(
-        "  baseline: naive walk, batch 1       median {:>7.1} ms   min {}   max {}   ({} nodes, {} round trips)",
+        "  baseline: naive walk, batch 1        median {:>7.1} ms   min {}   max {}   ({} nodes, {} round trips)",
         naive.f("walk_median_ms"),
         naive.s("walk_min_ms"),
         naive.s("walk_max_ms"),
@@ -175,7 +227,7 @@ pub(super) fn run(root: &Path, runs: usize, release: bool) -> Result<(), String>
         naive.s("round_trips")
     );
     println!(
-        "  ratio verify / naive walk           {:>8.2}   (verify with nodesets and checks, against one request per node)",
+        "  ratio verify / naive walk            {:>8.2}   (verify with nodesets and checks, against one request per node)",
         median / naive.f("walk_median_ms")
     );
     println!(
