@@ -4,6 +4,7 @@ within NodesetCompilerDrillingProcess.Instances;
 model TemplateDrillingLwrSystem "TemplateDrillingLwrSystem: The mobile lightweight robot system of the cell: a UR10e carrying the drilling end effector."
   extends NodesetCompilerRobotCell.ObjectTypes.TemplateDrillingLwrSystemType(
     redeclare model MotionDeviceSystem = NodesetCompilerDrillingProcess.Declarations.TemplateDrillingLwrSystem_MotionDeviceSystem,
+    motionDeviceSystem(redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType, redeclare model Controllers = NodesetCompilerRobotCell.Declarations.UR10eSystemType_Controllers, redeclare model MotionDevices = NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevices, redeclare model SafetyStates = NodesetCompilerRobotCell.Declarations.UR10eSystemType_SafetyStates),
     drillingEndEffector(skillSet(templateDrilling(deletable=false, autoDelete=false, recycleCount=0))));
   annotation (
     Documentation(info="<html><p>The mobile lightweight robot system of the cell: a UR10e carrying the drilling end effector.</p><p>The instance DeviceSet/TemplateDrillingLwrSystem of RobotCell:TemplateDrillingLwrSystemType (nsu=http://nodeset-compiler.dev/DrillingProcess/;i=5000).</p></html>"),

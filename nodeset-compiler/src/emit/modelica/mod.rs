@@ -655,12 +655,28 @@ fn render_mod(ctx: &mut Ctx, m: &Mod) -> String {
             s
         }
         Mod::Nested { ident, mods } => {
-            let inner: Vec<String> = mods.iter().map(|x| render_mod(ctx, x)).collect();
-            format!("{ident}({})", inner.join(", "))
+            let inner = render_parts(ctx, mods);
+            if inner.is_empty() {
+                // Only pins, and the class has no choice to repeat: no modifier at all.
+                String::new()
+            } else {
+                format!("{ident}({})", inner.join(", "))
+            }
         }
         Mod::Redeclare { ident, class } => format!("redeclare model {ident} = {}", type_ref(ctx, class)),
         Mod::Pin { class } => pinned(ctx, class).join(", "),
     }
+}
+
+/// The modifiers of a modification list, a [`Mod::Pin`] expanded, empty ones left out.
+fn render_parts(ctx: &mut Ctx, mods: &[Mod]) -> Vec<String> {
+    mods.iter()
+        .flat_map(|x| match x {
+            Mod::Pin { class } => pinned(ctx, class),
+            _ => vec![render_mod(ctx, x)],
+        })
+        .filter(|s| !s.is_empty())
+        .collect()
 }
 
 /// The redeclarations a [`Mod::Pin`] on a component of `class` stands for, one per alias.
@@ -711,13 +727,7 @@ fn render_mods(ctx: &mut Ctx, mods: &[Mod], indent: usize) -> String {
     if mods.is_empty() {
         return String::new();
     }
-    let parts: Vec<String> = mods
-        .iter()
-        .flat_map(|x| match x {
-            Mod::Pin { class } => pinned(ctx, class),
-            _ => vec![render_mod(ctx, x)],
-        })
-        .collect();
+    let parts = render_parts(ctx, mods);
     if parts.is_empty() {
         return String::new();
     }

@@ -1223,6 +1223,12 @@ impl Ctx<'_> {
                 };
                 let key = self.add_decl(owner, &child_path, o.node, &base_info, sub);
                 body.mods.push(Mod::Redeclare { ident: alias, class: TypeRef::Class(key.clone()) });
+                // The component's declaration repeats the choices of the class it was declared with
+                // (`Mod::Pin`). That is an outer modification of the class plugged in here, so it would win
+                // over this class's own choices (Modelica 7.2.4) and hide the members they add: repeat this
+                // class's choices on the component, which is more outer still. (pymoca rejects the modifiers
+                // of the added members otherwise; `tests/modelica/planted`, `PinnedOverride`.)
+                body.mods.push(Mod::Nested { ident: e.ident.clone(), mods: vec![Mod::Pin { class: key.clone() }] });
                 body.adds = true;
                 updated.kind = ElemKind::Object { class: key };
                 Some(updated)
