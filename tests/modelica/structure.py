@@ -49,11 +49,19 @@ class Library:
         self.root = root
         tree = parser.modelicapath_to_tree([root])
         self.classes = {}
+        # Classes whose file does not parse: {full name: message}.
+        self.errors = {}
         stack = list(tree.classes.values())
         while stack:
             c = stack.pop()
-            self.classes[c.full_name] = c
-            stack.extend(c.classes.values())  # parses a lazily loaded class
+            name = c.full_name
+            try:
+                children = list(c.classes.values())  # parses a lazily loaded class
+            except Exception as e:  # ModelicaSyntaxError: not Modelica (rumoca may still accept it)
+                self.errors[name] = " ".join(f"{type(e).__name__}: {e}".split())[:300]
+                continue
+            self.classes[name] = c
+            stack.extend(children)
         self._members = {}
 
     def resolve(self, name, scope):
@@ -383,6 +391,11 @@ def main(argv):
         names = [n for n in names if any(n == p or n.startswith(p + ".") for p in only)]
     passed = 0
     failed = {}
+    for cname, msg in sorted(lib.errors.items()):
+        if cname in files and (not only or any(cname == p or cname.startswith(p + ".") for p in only)):
+            failed[cname] = f"pymoca cannot parse it: {msg}"
+            if not quiet:
+                print(f"FAIL {cname}: {failed[cname]}", flush=True)
     for cname in names:
         problems = []
         # Modifier targets, in the class and in the classes it declares (replaceable aliases, ...).
@@ -416,7 +429,7 @@ def main(argv):
     if quiet:
         for name, m in sorted(failed.items()):
             print(f"FAIL {name}: {m}")
-    print(f"structure (pymoca {pymoca.__version__} parser): checked {len(names)} classes below {root} in {time.time() - t0:.1f} s")
+    print(f"structure (pymoca {pymoca.__version__} parser): checked {len(names) + sum(n in lib.errors for n in failed)} classes below {root} in {time.time() - t0:.1f} s")
     print(f"{passed} passed, {len(failed)} failed")
     return 0 if not failed else 1
 
