@@ -148,7 +148,9 @@ impl Ctx<'_> {
             entries.push(self.variable_node(v, &uris));
         }
         let sup = super::support::PACKAGE;
-        s.push_str(&format!("  parameter {sup}.Nodes nodes = {sup}.Nodes(\n    nsUri={{{}}}", ns_list.join(", ")));
+        // `{}` is no Modelica (an array constructor needs an element; rumoca accepts it, pymoca does not).
+        let ns = if ns_list.is_empty() { "fill(\"\", 0)".to_string() } else { format!("{{{}}}", ns_list.join(", ")) };
+        s.push_str(&format!("  parameter {sup}.Nodes nodes = {sup}.Nodes(\n    nsUri={ns}"));
         if !entries.is_empty() {
             s.push_str(&format!(
                 ",\n    nVars={},\n    vars={{\n      {}}})",
