@@ -149,8 +149,8 @@ impl Ctx<'_> {
         }
         let sup = super::support::PACKAGE;
         // `{}` is no Modelica (an array constructor needs an element; rumoca accepts it, pymoca does not).
-        let ns = if ns_list.is_empty() { "fill(\"\", 0)".to_string() } else { format!("{{{}}}", ns_list.join(", ")) };
-        s.push_str(&format!("  parameter {sup}.Nodes nodes = {sup}.Nodes(\n    nsUri={ns}"));
+        let ns_uris = if ns_list.is_empty() { "fill(\"\", 0)".to_string() } else { format!("{{{}}}", ns_list.join(", ")) };
+        s.push_str(&format!("  parameter {sup}.Nodes nodes = {sup}.Nodes(\n    nsUri={ns_uris}"));
         if !entries.is_empty() {
             s.push_str(&format!(
                 ",\n    nVars={},\n    vars={{\n      {}}})",
