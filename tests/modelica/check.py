@@ -121,15 +121,16 @@ def decode(line):
     return name, kind, partial == "1", consts
 
 
-def run_checks(root, items, jobs, quiet):
-    """Checks `items` in `jobs` worker processes; returns {name: (ok, message)}."""
+def run_checks(root, items, jobs, quiet, script=None):
+    """Checks `items` in `jobs` worker processes (`script --worker ROOT`, this file by default); returns
+    {name: (ok, message)}."""
     results = {}
     chunks = [items[i::jobs] for i in range(jobs)]
     procs = []
 
     def start(chunk):
         p = subprocess.Popen(
-            [sys.executable, os.path.abspath(__file__), "--worker", root],
+            [sys.executable, script or os.path.abspath(__file__), "--worker", root],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             text=True,
@@ -158,7 +159,7 @@ def run_checks(root, items, jobs, quiet):
             rc = p.wait()
             if current is not None or rc != 0:
                 if current is not None:
-                    results[current] = (False, f"rumoca crashed (exit status {rc}) while compiling this class")
+                    results[current] = (False, f"the checker crashed (exit status {rc}) while compiling this class")
                     if not quiet:
                         print(f"FAIL {current}: {results[current][1]}", flush=True)
                 rest = [it for it in chunk if it[0] not in results]

@@ -86,8 +86,10 @@ def simulate(rm, root, model, times):
         parts = []
         for want in times:
             i = min(range(len(t)), key=lambda k: abs(t[k] - want))
-            parts.append(f"{values[i]!r}@{want}")
-        parts.append(f"{values[-1]!r}@end")
+            # float(): with numpy 2 (pymoca brings it into the venv) the values are numpy scalars, whose
+            # repr is `np.float64(...)`.
+            parts.append(f"{float(values[i])!r}@{want}")
+        parts.append(f"{float(values[-1])!r}@end")
         print(name, " ".join(parts))
     print(f"simulated {model} to {stop}")
     return 0

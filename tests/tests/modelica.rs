@@ -6,13 +6,19 @@
 //!   class by rumoca (`tests/modelica/check.py`), and the example simulated;
 //! * every resolvable file of the ua-nodeset corpus and the skill reference models, checked by rumoca one
 //!   aggregate model per nodeset;
-//! * the checked-in `generated/modelica` (with our skill models), checked class by class by rumoca;
+//! * the checked-in `generated/modelica` (with our skill models), checked class by class by rumoca, and by a
+//!   second front end, pymoca (`tests/modelica/check2.py`), which catches what rumoca 0.10.2 lets through
+//!   (misspelt nested modifiers, a redeclaration hidden by an outer one);
+//! * structural checks (`tests/modelica/structure.py`) of every output above: every modifier names a member,
+//!   at any depth, and only connections and modifiers reach a conditional component;
 //! * no recursive class: the class graph (extends, components, aliases, redeclarations) of
 //!   `generated/modelica`, of every corpus output and of the skill reference models has no cycle;
+//! * each of these checks fails on its planted mistake (`tests/modelica/planted`);
 //! * a skill instance of our drilling cell simulated through Start, Halt and Reset (`tests/modelica/SkillExample`);
 //! * determinism: same input, byte-identical output, whatever the input order.
 //!
-//! rumoca runs in the venv that `cargo xtask venv` creates; a missing venv fails the tests with that command.
+//! rumoca and pymoca run in the venv that `cargo xtask venv` creates; a missing venv fails the tests with that
+//! command.
 
 use nodeset_compiler::emit::modelica::{generate, generate_with_diagnostics, ModelicaConfig};
 use nodeset_compiler::load::{Input, NS0_URI};
@@ -49,7 +55,7 @@ fn python() -> PathBuf {
     let py = root().join(".venv/bin/python");
     assert!(
         py.is_file(),
-        "{} is missing: run `cargo xtask venv` (it installs rumoca from tests/requirements.txt)",
+        "{} is missing: run `cargo xtask venv` (it installs rumoca and pymoca from tests/requirements.txt)",
         py.display()
     );
     py
@@ -166,21 +172,64 @@ fn copy_dir(from: &Path, to: &Path) {
 
 /// Runs the checker; returns (passed, failed) and the output.
 fn check(dir: &Path, aggregate: bool) -> (usize, usize, String) {
-    let mut cmd = Command::new(python());
-    cmd.arg(root().join("tests/modelica/check.py")).arg(dir).arg("--quiet");
-    if aggregate {
-        cmd.arg("--aggregate").args(["--jobs", "1"]);
-    }
-    let out = cmd.output().expect("cannot run tests/modelica/check.py");
+    let args: &[&str] = if aggregate { &["--aggregate", "--jobs", "1"] } else { &[] };
+    run_checker("check.py", dir, args)
+}
+
+/// The checkers of `tests/modelica`: `check.py` (rumoca), `check2.py` (pymoca, the second front end) and
+/// `structure.py` (the structural checks, with pymoca's parser).
+fn run_checker(script: &str, dir: &Path, args: &[&str]) -> (usize, usize, String) {
+    let out = Command::new(python())
+        .arg(root().join("tests/modelica").join(script))
+        .arg(dir)
+        .arg("--quiet")
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run tests/modelica/{script}: {e}"));
     let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     let last = text
         .lines()
         .rev()
         .find(|l| l.ends_with(" failed"))
-        .unwrap_or_else(|| panic!("no summary line from check.py:\n{text}"));
+        .unwrap_or_else(|| panic!("no summary line from {script}:\n{text}"));
     let nums: Vec<usize> = last.split_whitespace().filter_map(|w| w.parse().ok()).collect();
-    assert_eq!(nums.len(), 2, "unexpected summary `{last}`");
+    assert_eq!(nums.len(), 2, "unexpected summary `{last}` from {script}");
     (nums[0], nums[1], text)
+}
+
+/// The classes a checker's `--quiet` output names as failed, sorted.
+fn failed_classes(text: &str) -> Vec<String> {
+    let mut v: Vec<String> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix("FAIL "))
+        .map(|l| l.split(':').next().unwrap_or(l).to_string())
+        .collect();
+    v.sort();
+    v
+}
+
+/// pymoca (`check2.py`) and the structural checks (`structure.py`) over a library; with `only`, pymoca checks
+/// only the classes of those packages (the rest is checked elsewhere). Returns a line for the test's output.
+fn second_checks(label: &str, dir: &Path, only: &[&str], classes: usize) -> String {
+    let mut args = vec![];
+    for o in only {
+        args.extend(["--only", *o]);
+    }
+    let t = Instant::now();
+    let (p2, f2, text2) = run_checker("check2.py", dir, &args);
+    let pymoca_s = t.elapsed().as_secs_f64();
+    assert_eq!(f2, 0, "{label}: pymoca rejects classes\n{text2}");
+    if only.is_empty() {
+        assert_eq!(p2, classes, "{label}: pymoca checks every class\n{text2}");
+    } else {
+        assert!(p2 > 0, "{label}: pymoca checked nothing\n{text2}");
+    }
+    let t = Instant::now();
+    let (ps, fs, texts) = run_checker("structure.py", dir, &[]);
+    let structure_s = t.elapsed().as_secs_f64();
+    assert_eq!(fs, 0, "{label}: the structural checks fail\n{texts}");
+    assert_eq!(ps, classes, "{label}: the structural checks cover every class\n{texts}");
+    format!("{label}: pymoca {p2} passed, 0 failed in {pymoca_s:.1} s; structure {ps} passed, 0 failed in {structure_s:.1} s")
 }
 
 fn tmp(name: &str) -> PathBuf {
@@ -218,6 +267,9 @@ fn companion_specs_and_the_example_pass_rumoca_and_the_example_simulates() {
     );
     assert_eq!(failed, 0, "{text}");
     assert_eq!(passed, classes + example_classes, "every generated class and the example are checked\n{text}");
+    // The second checker flattens the example (and with it the Robotics classes it uses); the generated classes
+    // one by one are `generated_tree_passes_pymoca_and_the_structural_checks`'s.
+    println!("{}", second_checks("RoboticsExample", &target, &["RoboticsExample"], classes + example_classes));
 
     // The example: the axis follows its target with a first-order lag, and the generated OPC UA variable
     // ParameterSet/ActualPosition carries the position.
@@ -324,6 +376,7 @@ fn a_skill_instance_runs_through_start_halt_and_reset() {
     let (passed, failed, text) = check(&target, true);
     assert_eq!(failed, 0, "{text}");
     assert!(passed > 100, "{text}");
+    println!("{}", second_checks("SkillExample", &target, &["SkillExample"], passed));
     // (time, state number): before anything, after Start, after Halt, after the ignored Start, after Reset,
     // after the second Start.
     let expected = [(0.5, 12.0), (1.5, 13.0), (2.3, 11.0), (2.8, 11.0), (3.5, 12.0), (4.5, 13.0)];
@@ -375,7 +428,8 @@ fn rumoca_behaviour_is_as_reproduced() {
 }
 
 /// Generates the models of each file (with everything it requires, ns0 as a subset), checks that no class of
-/// an output contains itself, and checks each output with one aggregate rumoca model, two nodesets at a time.
+/// an output contains itself, and checks each output with one aggregate rumoca model and the structural checks
+/// (`structure.py`), two nodesets at a time.
 fn check_tree(label: &str, tree: &Path, files: &[PathBuf], absent_ok: bool) {
     let t0 = Instant::now();
     let mut jobs: Vec<(PathBuf, PathBuf, usize)> = Vec::new();
@@ -423,7 +477,7 @@ fn check_tree(label: &str, tree: &Path, files: &[PathBuf], absent_ok: bool) {
     let gen_elapsed = t0.elapsed().as_secs_f64();
     // Two workers: the CI machine has two cores.
     let t1 = Instant::now();
-    let results: Vec<(PathBuf, usize, usize, String)> = std::thread::scope(|s| {
+    let results: Vec<(PathBuf, usize, usize, String, f64)> = std::thread::scope(|s| {
         let chunks: Vec<Vec<&(PathBuf, PathBuf, usize)>> =
             (0..2).map(|w| jobs.iter().skip(w).step_by(2).collect()).collect();
         let handles: Vec<_> = chunks
@@ -432,9 +486,15 @@ fn check_tree(label: &str, tree: &Path, files: &[PathBuf], absent_ok: bool) {
                 s.spawn(move || {
                     chunk
                         .into_iter()
-                        .map(|(f, dir, _)| {
-                            let (p, fl, text) = check(dir, true);
-                            (f.clone(), p, fl, text)
+                        .map(|(f, dir, classes)| {
+                            let (p, fl, mut text) = check(dir, true);
+                            // The structural checks (modifier targets, conditional reads) too.
+                            let t = Instant::now();
+                            let (ps, fs, texts) = run_checker("structure.py", dir, &[]);
+                            if fs > 0 || ps != *classes {
+                                text.push_str(&format!("structure: {ps} of {classes} passed\n{texts}"));
+                            }
+                            (f.clone(), p, fl + fs + classes.saturating_sub(ps), text, t.elapsed().as_secs_f64())
                         })
                         .collect::<Vec<_>>()
                 })
@@ -444,16 +504,18 @@ fn check_tree(label: &str, tree: &Path, files: &[PathBuf], absent_ok: bool) {
     });
     let mut passed = 0;
     let mut failed = 0;
+    let mut structure_s = 0.0;
     let mut failures = String::new();
-    for (f, p, fl, text) in &results {
+    for (f, p, fl, text, secs) in &results {
         passed += p;
         failed += fl;
+        structure_s += secs;
         if *fl > 0 {
             failures.push_str(&format!("{}:\n{text}\n", f.display()));
         }
     }
     println!(
-        "{label}: {} files, {} generated ({generated_classes} classes, generation {gen_time:.2} s, {gen_elapsed:.1} s with loading), {} unresolvable (missing models); rumoca: {passed} passed, {failed} failed in {:.1} s",
+        "{label}: {} files, {} generated ({generated_classes} classes, generation {gen_time:.2} s, {gen_elapsed:.1} s with loading), {} unresolvable (missing models); rumoca: {passed} passed, {failed} failed (with the structural checks, {structure_s:.1} s of them) in {:.1} s",
         files.len(),
         jobs.len(),
         unresolvable.len(),
@@ -499,6 +561,57 @@ fn generated_tree_passes_rumoca() {
     println!("generated/modelica: {passed} passed, {failed} failed in {:.1} s", t.elapsed().as_secs_f64());
     assert_eq!(failed, 0, "{text}");
     assert_eq!(passed, classes, "every class of generated/modelica is checked\n{text}");
+}
+
+/// The checked-in tree passes the second checker, pymoca (`tests/modelica/check2.py`), class by class, and the
+/// structural checks (`tests/modelica/structure.py`): no modifier names a member that does not exist, at any
+/// depth, and nothing but a connection or a modifier reaches a conditional component.
+#[test]
+fn generated_tree_passes_pymoca_and_the_structural_checks() {
+    let tree = root().join("generated/modelica");
+    let classes = class_graph(&tree).len();
+    assert!(classes > 200, "expected the classes of generated/modelica, found {classes}");
+    println!("{}", second_checks("generated/modelica", &tree, &[], classes));
+}
+
+/// Each check fails on its planted mistake (`tests/modelica/planted`, whose package documents each case) and
+/// on nothing else there: pymoca on misspelt modifiers at any depth, on a recursive class and on a component's
+/// repeated choice that hides the members of the class an instance plugs in; the structural checks on the
+/// misspelt modifiers and on reads of a conditional component; the class graph on the recursive pair.
+#[test]
+fn the_checks_catch_the_planted_mistakes() {
+    let dir = root().join("tests/modelica/planted");
+    let (passed, _, text) = run_checker("check2.py", &dir, &["--jobs", "1"]);
+    assert_eq!(
+        failed_classes(&text),
+        [
+            "Planted.ExtendsModifierTypo",
+            "Planted.ModifierTypo",
+            "Planted.NestedModifierTypo",
+            "Planted.PinnedOverride",
+            "Planted.RecursiveA",
+            "Planted.RecursiveB"
+        ],
+        "{text}"
+    );
+    assert_eq!(passed, 12, "{text}");
+    let (passed, _, text) = run_checker("structure.py", &dir, &[]);
+    assert_eq!(
+        failed_classes(&text),
+        [
+            "Planted.ConditionalBinding",
+            "Planted.ConditionalEquation",
+            "Planted.ExtendsModifierTypo",
+            "Planted.ModifierTypo",
+            "Planted.NestedModifierTypo"
+        ],
+        "{text}"
+    );
+    assert_eq!(passed, 13, "{text}");
+    assert_eq!(
+        class_cycle(&class_graph(&dir)).as_deref(),
+        Some("Planted.RecursiveA -> Planted.RecursiveB -> Planted.RecursiveA")
+    );
 }
 
 /// Removes comments and the contents of string literals from Modelica text.

@@ -47,7 +47,8 @@ enum Command {
     Corpus(corpus::Args),
     /// Every NodeSet2 file of a tree generated on its own (its dependencies with it), all compiled.
     OneAtATime(one_at_a_time::Args),
-    /// Every NodeSet2 file of the pinned registry package through check, Rust (compiled) and Modelica (rumoca).
+    /// Every NodeSet2 file of the pinned registry package through check, Rust (compiled) and Modelica (rumoca and
+    /// the structural checks; `--pymoca` adds pymoca).
     Registry(registry::Args),
     /// Run one cargo-fuzz target of fuzz/ for a number of seconds (installs cargo-fuzz, builds the seeds).
     Fuzz(fuzz::Args),

@@ -1,15 +1,16 @@
 //! `cargo xtask registry`: every NodeSet2 file of the pinned registry package (`node-opcua-nodesets`, all
 //! of [`crate::fetch::SELECTION`]: the current specifications and the older files of its `1.02/` folder)
 //! through the three things a user does with one: `check`, Rust that compiles, and Modelica that rumoca
-//! accepts. Each step prints its counts; the step fails when a file does not resolve, when the Rust crate
-//! does not compile, or when rumoca rejects a class.
+//! accepts and that passes the structural checks (and, with `--pymoca`, that pymoca flattens). Each step prints its counts; the step fails when a
+//! file does not resolve, when the Rust crate does not compile, or when a Modelica check rejects a class.
 //!
 //! Each file is compiled on its own with `nodesets/vendor/` as the model folder, as
 //! `nodeset-compiler check FILE --models nodesets/vendor` does. The Rust is `cargo xtask corpus` over the
 //! vendor folder (one module per file, the three of `1.02/` generated together, its dependencies the modules
 //! of the files they resolve to, one `cargo check`; ns0 is async-opcua's own). The Modelica of each file is the `modelica` command's run
 //! (every model it requires generated with it, the used part of ns0 as `OpcUa`), checked by
-//! `tests/modelica/check.py --aggregate` in the project's venv, two files at a time.
+//! `tests/modelica/check.py --aggregate` (rumoca) and `structure.py` in the project's venv, two files at a
+//! time; `--pymoca` adds `check2.py` (pymoca, class by class: over an hour, so not in `cargo xtask test`).
 
 use crate::util::workspace_root;
 use nodeset_compiler::diag::Severities;
@@ -24,6 +25,11 @@ pub struct Args {
     /// Where to put the generated Rust crate and Modelica folders (default: target/registry).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Also flatten every class with pymoca, one at a time (`tests/modelica/check2.py`). About 1.2 s of CPU
+    /// per class, over an hour for the package's ~6,500 classes, so it is not part of `cargo xtask test`;
+    /// pymoca checks `generated/modelica` and the examples there.
+    #[arg(long)]
+    pymoca: bool,
 }
 
 pub fn run(args: Args) -> Result<(), String> {
@@ -94,43 +100,61 @@ pub fn run(args: Args) -> Result<(), String> {
         jobs.push((unit_name(u), dir, classes));
     }
     let generation = t.elapsed().as_secs_f64();
-    let t = Instant::now();
-    let checker = root.join("tests/modelica/check.py");
-    // Two workers: the CI machine has two cores.
-    let results: Vec<Result<(String, usize, usize, usize, String), String>> = std::thread::scope(|s| {
+    // The checkers per file: rumoca (one aggregate model), the structural checks (tests/modelica/structure.py)
+    // and, with --pymoca, pymoca (class by class: the second front end). Two workers: the CI machine has two cores.
+    let mut checkers: Vec<(&str, &str, &[&str])> =
+        vec![("rumoca", "check.py", &["--aggregate", "--jobs", "1"]), ("structure", "structure.py", &[])];
+    if args.pymoca {
+        checkers.push(("pymoca", "check2.py", &["--jobs", "1"]));
+    }
+    type Outcome = Result<(String, usize, Vec<(usize, usize, f64, String)>), String>;
+    let results: Vec<Outcome> = std::thread::scope(|s| {
         let handles: Vec<_> = (0..2)
             .map(|w| {
-                let (jobs, python, checker) = (&jobs, &python, &checker);
+                let (jobs, python, root, checkers) = (&jobs, &python, &root, &checkers);
                 s.spawn(move || {
                     jobs.iter()
                         .skip(w)
                         .step_by(2)
                         .map(|(name, dir, classes)| {
-                            rumoca(python, checker, dir).map(|(p, fl, text)| (name.clone(), *classes, p, fl, text))
+                            let mut per = Vec::new();
+                            for (_, script, args) in checkers {
+                                let t = Instant::now();
+                                let (p, fl, text) = checker(python, &root.join("tests/modelica").join(script), dir, args)?;
+                                per.push((p, fl, t.elapsed().as_secs_f64(), text));
+                            }
+                            Ok((name.clone(), *classes, per))
                         })
                         .collect::<Vec<_>>()
                 })
             })
             .collect();
-        handles.into_iter().flat_map(|h| h.join().expect("a rumoca worker panicked")).collect()
+        handles.into_iter().flat_map(|h| h.join().expect("a checker worker panicked")).collect()
     });
-    let (mut classes, mut passed, mut failed, mut problems) = (0, 0, 0, Vec::new());
+    let mut classes = 0;
+    let mut totals = vec![(0usize, 0usize, 0f64); checkers.len()];
+    let mut problems = Vec::new();
     for r in results {
-        let (name, c, p, fl, text) = r?;
+        let (name, c, per) = r?;
         classes += c;
-        passed += p;
-        failed += fl;
-        if fl > 0 || p != c {
-            problems.push(format!("{name}: {c} classes, rumoca: {p} passed, {fl} failed\n{text}"));
+        for (i, (p, fl, secs, text)) in per.into_iter().enumerate() {
+            totals[i].0 += p;
+            totals[i].1 += fl;
+            totals[i].2 += secs;
+            if fl > 0 || p != c {
+                problems.push(format!("{name}: {c} classes, {}: {p} passed, {fl} failed\n{text}", checkers[i].0));
+            }
         }
     }
+    let counts: Vec<String> =
+        checkers.iter().zip(totals).map(|((n, ..), (p, f, secs))| format!("{n}: {p} passed, {f} failed in {secs:.1} s")).collect();
     println!(
-        "registry modelica: {} files, {classes} classes generated in {generation:.1} s; rumoca: {passed} passed, {failed} failed in {:.1} s",
+        "registry modelica: {} files, {classes} classes generated in {generation:.1} s; {} (seconds summed over two workers)",
         jobs.len(),
-        t.elapsed().as_secs_f64()
+        counts.join("; ")
     );
     if !problems.is_empty() {
-        return Err(format!("rumoca rejects the Modelica of {} registry file(s):\n{}", problems.len(), problems.join("\n")));
+        return Err(format!("the Modelica checks reject {} registry file(s):\n{}", problems.len(), problems.join("\n")));
     }
     println!("registry: {} files through check, Rust and Modelica in {:.1} s", files.len(), start.elapsed().as_secs_f64());
     Ok(())
@@ -141,21 +165,27 @@ fn rel(vendor: &Path, file: &Path) -> String {
     file.strip_prefix(vendor).unwrap_or(file).display().to_string()
 }
 
-/// Runs `check.py --aggregate` over `dir`: (passed, failed, output).
-fn rumoca(python: &Path, checker: &Path, dir: &Path) -> Result<(usize, usize, String), String> {
+/// Runs a checker of `tests/modelica` (`check.py`, `check2.py` or `structure.py`) over `dir`: (passed, failed,
+/// output).
+fn checker(python: &Path, script: &Path, dir: &Path, args: &[&str]) -> Result<(usize, usize, String), String> {
     let out = Command::new(python)
-        .arg(checker)
+        .arg(script)
         .arg(dir)
-        .args(["--quiet", "--aggregate", "--jobs", "1"])
+        .arg("--quiet")
+        .args(args)
         .output()
-        .map_err(|e| format!("cannot run {}: {e}", checker.display()))?;
+        .map_err(|e| format!("cannot run {}: {e}", script.display()))?;
     let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
-    // The last line of check.py's output is always `N passed, N failed`.
-    let last = text.lines().rev().find(|l| l.ends_with(" failed")).ok_or_else(|| format!("no summary line from check.py for {}:\n{text}", dir.display()))?;
+    // The last line of each checker's output is always `N passed, N failed`.
+    let last = text
+        .lines()
+        .rev()
+        .find(|l| l.ends_with(" failed"))
+        .ok_or_else(|| format!("no summary line from {} for {}:\n{text}", script.display(), dir.display()))?;
     let nums: Vec<usize> = last.split_whitespace().filter_map(|w| w.trim_end_matches(',').parse().ok()).collect();
     match nums.as_slice() {
         [p, f] => Ok((*p, *f, text)),
-        _ => Err(format!("unexpected summary `{last}` from check.py for {}", dir.display())),
+        _ => Err(format!("unexpected summary `{last}` from {} for {}", script.display(), dir.display())),
     }
 }
 

@@ -5,7 +5,7 @@
 //!    (`tests/node-peer`, `cargo xtask node-peer`).
 //! 3. `cargo test --workspace --locked`, whose summary lines CI reads.
 //! 4. `cargo xtask corpus`: Rust for every resolvable ua-nodeset file, compiled; `cargo xtask registry`: every
-//!    file of the pinned registry package through check, Rust (compiled) and Modelica (rumoca).
+//!    file of the pinned registry package through check, Rust (compiled) and Modelica (rumoca and the structural checks).
 //! 5. `cargo xtask load --seconds 20`: the robot example under 50 subscribed client sessions and a writer.
 //! 6. `cargo xtask soak`: the robot cell runs DrillHole 1,000 times, every skill state watched.
 //! 7. Each fuzz target of `fuzz/` for [`FUZZ_SECS`] seconds (`cargo xtask fuzz`): CI exercises the targets
@@ -44,7 +44,7 @@ pub fn run(args: Args) -> Result<(), String> {
     // The whole corpus as Rust, compiled: too long for a #[test] among others, so it runs after them.
     crate::corpus::run(crate::corpus::Args::default())?;
     // The registry package's 38 files, each as a user names it: resolved, as Rust compiled, as Modelica
-    // checked by rumoca (about six minutes on two cores).
+    // checked by rumoca and the structural checks (about six minutes on two cores).
     crate::registry::run(crate::registry::Args::default())?;
     // The robot server under 50 client sessions, briefly (`cargo xtask load` runs five minutes).
     crate::load::run(crate::load::Args { sessions: 50, seconds: 20, publishing_ms: 100, release: false })?;

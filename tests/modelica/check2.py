@@ -1,0 +1,131 @@
+#!/usr/bin/env python3
+"""Checks generated Modelica packages with pymoca, a second Modelica front end (pymoca==0.12.0 from PyPI).
+
+Usage:
+    check2.py ROOT [--only PREFIX]... [--jobs N] [--quiet]
+
+The same classes and the same wrapper models as check.py (rumoca), compiled by an independent front end:
+pymoca loads ROOT as its MODELICAPATH, instantiates the wrapper (`model Check__ extends <Class>; end
+Check__;`, a record component, a zero-length array of a connector or type, a parameter per constant) and
+flattens it. It fails on what rumoca 0.10.2 lets through (tests/modelica/planted holds one case of each):
+
+* a modifier naming a member that does not exist, also nested (`a(b(c=1))`) and in an `extends` clause,
+  judged on the class in effect after every redeclaration, outer modifications winning as Modelica 7.2.4
+  says (rumoca checks only the top level of a component's modifiers);
+* a class that contains itself (pymoca recurses without end: a RecursionError, reported as such).
+
+pymoca does not flatten balanced equation systems the way rumoca does (a check is no simulation), and it
+lets a read of a conditional component through; tests/modelica/structure.py checks that.
+
+--only PREFIX checks only the classes whose name starts with PREFIX (the rest of ROOT is still loaded).
+Each class is checked in a fresh tree; workers are separate processes, and a worker that dies marks its
+class as failed. The last line of the output is always `N passed, N failed`.
+"""
+
+import os
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import check  # noqa: E402  (the class list, the wrappers and the worker pool are rumoca's check's)
+
+# pymoca's instantiation recurses once per nesting level and per extends; generated classes nest up to 64
+# levels, which the default limit of 1000 frames does not always hold. A class that contains itself still
+# ends in a RecursionError.
+RECURSION_LIMIT = 20000
+
+
+def check_one(root, name, kind, partial, consts):
+    from pymoca import ast, parser, tree
+
+    src = check.wrapper(name, kind, partial, consts)
+    if src is None:
+        return False, f"cannot check a {kind} (no wrapper for this kind)"
+    try:
+        lib = parser.modelicapath_to_tree([root])
+        lib.extend(parser.parse(src, bypass_cache=True))
+        tree.flatten(lib, ast.ComponentRef(name="Check__"))
+        return True, ""
+    except RecursionError:
+        return False, "pymoca recursed without end: a class that contains itself?"
+    except Exception as e:  # ModelicaSemanticError, NameLookupError, ModelicaSyntaxError, ...
+        return False, " ".join(f"{type(e).__name__}: {e}".split())[:600]
+
+
+def worker(root):
+    """Runs in a child process: checks classes read from stdin, prints START/RESULT lines."""
+    import threading
+
+    sys.setrecursionlimit(RECURSION_LIMIT)
+    threading.stack_size(512 * 1024 * 1024)
+
+    def run():
+        for line in sys.stdin:
+            name, kind, partial, consts = check.decode(line.rstrip("\n"))
+            print(f"START\t{name}", flush=True)
+            ok, msg = check_one(root, name, kind, partial, consts)
+            print(f"RESULT\t{name}\t{'OK' if ok else 'FAIL'}\t{msg}", flush=True)
+
+    # A big recursion limit needs a big stack: run in a thread that has one.
+    t = threading.Thread(target=run)
+    t.start()
+    t.join()
+
+
+def main(argv):
+    if len(argv) >= 2 and argv[0] == "--worker":
+        worker(argv[1])
+        return 0
+    try:
+        import pymoca
+    except ImportError:
+        print("pymoca is missing: run `cargo xtask venv` (it installs tests/requirements.txt)", file=sys.stderr)
+        print("0 passed, 1 failed")
+        return 2
+    quiet = "--quiet" in argv
+    jobs = 2
+    only = []
+    args = []
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        if a == "--jobs" and i + 1 < len(argv):
+            jobs = max(1, int(argv[i + 1]))
+            i += 1
+        elif a == "--only" and i + 1 < len(argv):
+            only.append(argv[i + 1])
+            i += 1
+        elif not a.startswith("--"):
+            args.append(a)
+        i += 1
+    if len(args) != 1 or not os.path.isdir(args[0]):
+        print(__doc__, file=sys.stderr)
+        print("0 passed, 1 failed")
+        return 2
+    root = os.path.abspath(args[0])
+    items = check.classes(root)
+    if only:
+        items = [it for it in items if any(it[0] == p or it[0].startswith(p + ".") for p in only)]
+    failed = {}
+    for path, kind, *_ in items:
+        if kind == "unknown":
+            failed[path] = "no `within` clause or class header found"
+    items = [it for it in items if it[1] != "unknown"]
+    t0 = time.time()
+    results = check.run_checks(root, items, jobs, quiet, script=os.path.abspath(__file__)) if items else {}
+    passed = 0
+    for name, (good, m) in results.items():
+        if good:
+            passed += 1
+        else:
+            failed[name] = m
+    if quiet:
+        for name, m in sorted(failed.items()):
+            print(f"FAIL {name}: {m}")
+    print(f"pymoca {pymoca.__version__}: checked {len(items)} classes below {root} in {time.time() - t0:.1f} s")
+    print(f"{passed} passed, {len(failed)} failed")
+    return 0 if not failed else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

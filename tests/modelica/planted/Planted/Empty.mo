@@ -1,0 +1,3 @@
+within Planted;
+model Empty "Nothing"
+end Empty;

@@ -1,0 +1,4 @@
+within Planted;
+connector Part "A connector with one signal"
+  Real v;
+end Part;

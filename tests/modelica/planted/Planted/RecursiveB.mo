@@ -1,0 +1,4 @@
+within Planted;
+model RecursiveB "Contains a RecursiveA"
+  Planted.RecursiveA a;
+end RecursiveB;
