@@ -171,6 +171,17 @@ impl Loaded {
 struct Candidate {
     path: PathBuf,
     models: Vec<(String, Option<String>, Option<String>)>,
+    /// For a file without `<Models>`: the first of its NamespaceUris, the namespace such files (the older
+    /// specifications) define their nodes in.
+    own_namespace: Option<String>,
+}
+
+/// What [`scan_header`] reads of a NodeSet2 file: its declared models (URI, version, publication date)
+/// and, when it declares none, the first of its NamespaceUris.
+#[derive(Debug, PartialEq)]
+struct Header {
+    models: Vec<(String, Option<String>, Option<String>)>,
+    own_namespace: Option<String>,
 }
 
 /// A source of input: a file on disk or text held in memory (tests, fuzzing, build scripts).
@@ -252,18 +263,9 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
     let mut implied: BTreeMap<String, FileId> = BTreeMap::new();
     let mut implied_requires: BTreeMap<FileId, Vec<String>> = BTreeMap::new();
     for set in &parsed {
-        if !set.models.is_empty() || !sources.get(set.file).named {
-            continue;
+        if set.models.is_empty() {
+            imply_models(set, sources.get(set.file).text.as_str(), &mut provided, &mut implied, &mut implied_requires);
         }
-        let defined = defined_namespaces(set, sources.get(set.file).text.as_str());
-        for uri in &defined {
-            if *uri != NS0_URI && !provided.contains_key(*uri) {
-                provided.insert(uri.to_string(), set.file);
-                implied.insert(uri.to_string(), set.file);
-            }
-        }
-        let referred = set.namespace_uris.iter().map(|u| u.value.as_str()).filter(|u| *u != NS0_URI && !defined.contains(u));
-        implied_requires.insert(set.file, referred.map(str::to_string).collect());
     }
 
     // Resolve requirements transitively, from the named files and from the models folders.
@@ -311,9 +313,21 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
                     .then_with(|| a.path.as_os_str().len().cmp(&b.path.as_os_str().len()))
                     .then_with(|| a.path.cmp(&b.path))
             });
-            let satisfying = options.iter().find(|c| {
-                let (v, _) = version_of(c);
-                req.version.is_none() || cmp_version(v.as_deref(), req.version.as_deref()) != Ordering::Less
+            // A file without <Models> (an older specification) that refers to a namespace takes, first, a file
+            // of the same kind whose own namespace that is, from its own folder if there is one there: the
+            // release it was written against, not the newest model of that URI.
+            let requirer_dir = sources.get(set_file).path.parent().map(Path::to_path_buf);
+            let mut same_kind: Vec<&Candidate> = if explicit || !parsed[i].models.is_empty() {
+                Vec::new()
+            } else {
+                idx.iter().filter(|c| c.models.is_empty() && c.own_namespace.as_deref() == Some(req.uri.as_str())).collect()
+            };
+            same_kind.sort_by_key(|c| (c.path.parent() != requirer_dir.as_deref(), c.path.as_os_str().len(), c.path.clone()));
+            let satisfying = same_kind.first().copied().or_else(|| {
+                options.iter().copied().find(|c| {
+                    let (v, _) = version_of(c);
+                    req.version.is_none() || cmp_version(v.as_deref(), req.version.as_deref()) != Ordering::Less
+                })
             });
             let requirer = sources.get(set_file).display.clone();
             match satisfying {
@@ -332,6 +346,9 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
                     if let Some(set) = read_and_parse(&mut sources, path, display, bytes, false, &opts.limits, diags) {
                         for m in &set.models {
                             provided.entry(m.uri.clone()).or_insert(set.file);
+                        }
+                        if set.models.is_empty() {
+                            imply_models(&set, sources.get(set.file).text.as_str(), &mut provided, &mut implied, &mut implied_requires);
                         }
                         parsed.push(set);
                         queue.push(parsed.len() - 1);
@@ -453,6 +470,26 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
         files.push(LoadedFile { raw: set, ns_map, aliases });
     }
     Loaded { sources, files, namespaces, models }
+}
+
+/// A file without `<Models>` implies one model per namespace it defines nodes in (unless a declared model or
+/// an earlier file provides it), and requires the namespaces of its NamespaceUris it only refers to.
+fn imply_models(
+    set: &RawNodeSet,
+    text: &str,
+    provided: &mut BTreeMap<String, FileId>,
+    implied: &mut BTreeMap<String, FileId>,
+    implied_requires: &mut BTreeMap<FileId, Vec<String>>,
+) {
+    let defined = defined_namespaces(set, text);
+    for uri in &defined {
+        if *uri != NS0_URI && !provided.contains_key(*uri) {
+            provided.insert(uri.to_string(), set.file);
+            implied.insert(uri.to_string(), set.file);
+        }
+    }
+    let referred = set.namespace_uris.iter().map(|u| u.value.as_str()).filter(|u| *u != NS0_URI && !defined.contains(u));
+    implied_requires.insert(set.file, referred.map(str::to_string).collect());
 }
 
 /// The namespaces of `NamespaceUris` in which `set` defines nodes (a numeric or string `ns=N` NodeId), in
@@ -653,7 +690,7 @@ pub fn find_model_files(dirs: &[PathBuf], uris: &[String]) -> BTreeMap<String, P
 /// The models the header of a NodeSet2 file declares (URIs), without parsing the rest; `None` if the file
 /// cannot be read or is not a NodeSet2 file.
 pub fn models_of_file(path: &Path) -> Option<Vec<String>> {
-    scan_header(path).map(|m| m.into_iter().map(|(uri, _, _)| uri).collect())
+    scan_header(path).map(|h| h.models.into_iter().map(|(uri, _, _)| uri).collect())
 }
 
 /// Lists every NodeSet2 file under the folders with the models its header declares.
@@ -664,7 +701,10 @@ fn scan_dirs(dirs: &[PathBuf]) -> Vec<Candidate> {
     }
     paths.sort();
     paths.dedup();
-    paths.into_iter().filter_map(|p| scan_header(&p).map(|models| Candidate { path: p, models })).collect()
+    paths
+        .into_iter()
+        .filter_map(|p| scan_header(&p).map(|h| Candidate { path: p, models: h.models, own_namespace: h.own_namespace }))
+        .collect()
 }
 
 fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -684,14 +724,15 @@ fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
 /// first few KiB.
 const HEADER_LIMIT: usize = 256 * 1024;
 
-/// Reads the `<Models>` element of a file without parsing the rest.
+/// Reads the `<Models>` element of a file without parsing the rest (and, for a file that declares no
+/// models within [`HEADER_LIMIT`], its first NamespaceUri).
 ///
 /// A models folder is scanned once per compile and may hold hundreds of files, so the file is read in
 /// growing chunks and reading stops as soon as `</Models>` has been seen. The answer is the one the first
 /// [`HEADER_LIMIT`] bytes give: reading stops early only when the bytes read so far already contain
 /// everything the tests below look for (the first `<Models>` and the `</Models>` after it, and
 /// `UANodeSet`), and reading more cannot change where those are first found.
-fn scan_header(path: &Path) -> Option<Vec<(String, Option<String>, Option<String>)>> {
+fn scan_header(path: &Path) -> Option<Header> {
     use std::io::Read;
     let mut f = std::fs::File::open(path).ok()?;
     let mut buf: Vec<u8> = Vec::new();
@@ -718,7 +759,9 @@ fn scan_header(path: &Path) -> Option<Vec<(String, Option<String>, Option<String
     if !text.contains("UANodeSet") {
         return None;
     }
-    let start = text.find("<Models>")?;
+    let Some(start) = text.find("<Models>") else {
+        return Some(Header { models: Vec::new(), own_namespace: first_namespace_uri(&text) });
+    };
     let end = text[start..].find("</Models>")? + start + "</Models>".len();
     let mut reader = quick_xml::Reader::from_str(&text[start..end]);
     let mut out = Vec::new();
@@ -741,7 +784,17 @@ fn scan_header(path: &Path) -> Option<Vec<(String, Option<String>, Option<String
             _ => {}
         }
     }
-    Some(out)
+    Some(Header { models: out, own_namespace: None })
+}
+
+/// The first `<Uri>` of the `<NamespaceUris>` in a header's text.
+fn first_namespace_uri(text: &str) -> Option<String> {
+    let start = text.find("<NamespaceUris>")?;
+    let end = text[start..].find("</NamespaceUris>")? + start;
+    let from = text[start..end].find("<Uri>")? + start + "<Uri>".len();
+    let to = text[from..end].find("</Uri>")? + from;
+    let uri = quick_xml::escape::unescape(text[from..to].trim()).ok()?.into_owned();
+    (!uri.is_empty()).then_some(uri)
 }
 
 /// Whether a prefix of a file already decides [`scan_header`]'s answer (see there).
@@ -935,22 +988,21 @@ mod tests {
         let model = "<Model ModelUri=\"http://x/\" Version=\"1.0\" PublicationDate=\"2020-01-01\"/>";
         // A header past the first chunk, one that straddles chunks, one past the limit, and no UANodeSet.
         let pad = "<!--".to_string() + &"x".repeat(40_000) + "-->";
+        // A file without <Models> answers with its first NamespaceUri (none when it has none).
+        let uris = "<NamespaceUris><Uri>http://old/</Uri><Uri>http://other/</Uri></NamespaceUris>";
+        let x = || vec![("http://x/".to_string(), Some("1.0".to_string()), Some("2020-01-01".to_string()))];
+        let none = |own: Option<&str>| Some(Header { models: Vec::new(), own_namespace: own.map(str::to_string) });
         let cases = [
-            (format!("<UANodeSet>{pad}<Models>{model}</Models></UANodeSet>"), true),
-            (format!("<UANodeSet><Models>{pad}{model}</Models></UANodeSet>"), true),
-            (format!("<UANodeSet>{}<Models>{model}</Models></UANodeSet>", "x".repeat(HEADER_LIMIT)), false),
-            (format!("<Other><Models>{model}</Models></Other>"), false),
+            (format!("<UANodeSet>{pad}<Models>{model}</Models></UANodeSet>"), Some(Header { models: x(), own_namespace: None })),
+            (format!("<UANodeSet><Models>{pad}{model}</Models></UANodeSet>"), Some(Header { models: x(), own_namespace: None })),
+            (format!("<UANodeSet>{}<Models>{model}</Models></UANodeSet>", "x".repeat(HEADER_LIMIT)), none(None)),
+            (format!("<Other><Models>{model}</Models></Other>"), None),
+            (format!("<UANodeSet>{uris}{pad}<UAObject NodeId=\"ns=1;i=1\"/></UANodeSet>"), none(Some("http://old/"))),
         ];
-        for (i, (text, found)) in cases.iter().enumerate() {
+        for (i, (text, want)) in cases.iter().enumerate() {
             let path = dir.join(format!("{i}.xml"));
             std::fs::write(&path, text).unwrap();
-            let got = scan_header(&path);
-            if *found {
-                let models = got.unwrap_or_else(|| panic!("case {i}"));
-                assert_eq!(models, vec![("http://x/".to_string(), Some("1.0".to_string()), Some("2020-01-01".to_string()))]);
-            } else {
-                assert!(got.is_none(), "case {i}: {got:?}");
-            }
+            assert_eq!(&scan_header(&path), want, "case {i}");
         }
         std::fs::remove_dir_all(&dir).unwrap();
     }
@@ -977,6 +1029,38 @@ mod tests {
         assert_eq!(implied, vec![("http://a/", true, true), ("http://b/", true, true)]);
         let said = format!("{diags:?}");
         assert!(!said.contains("only-referenced"), "a namespace only referred to is looked for, not required: {said}");
+    }
+
+    /// A file without `<Models>` found in a models folder: an older file that refers to its namespace takes
+    /// it (from its own folder), not the newest model of that URI, and the namespace is its implied model.
+    #[test]
+    fn an_older_file_takes_the_older_file_of_its_folder_for_a_namespace_it_refers_to() {
+        let dir = std::env::temp_dir().join(format!("nodeset-older-{}", std::process::id()));
+        let file = |rel: &str, text: &str| {
+            let p = dir.join(rel);
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            std::fs::write(&p, text).unwrap();
+            p
+        };
+        let head = r#"<UANodeSet xmlns="http://opcfoundation.org/UA/2011/03/UANodeSet.xsd">"#;
+        let object = r#"<UAObject NodeId="ns=1;i=1" BrowseName="1:X"><References><Reference ReferenceType="HasTypeDefinition">i=58</Reference></References></UAObject>"#;
+        file(
+            "current/A.xml",
+            &format!(r#"{head}<NamespaceUris><Uri>http://a/</Uri></NamespaceUris><Models><Model ModelUri="http://a/" Version="2.0"/></Models>{object}</UANodeSet>"#),
+        );
+        let old_a = file("old/A.xml", &format!("{head}<NamespaceUris><Uri>http://a/</Uri></NamespaceUris>{object}</UANodeSet>"));
+        let old_b = file(
+            "old/B.xml",
+            &format!("{head}<NamespaceUris><Uri>http://b/</Uri><Uri>http://a/</Uri></NamespaceUris>{object}</UANodeSet>"),
+        );
+        let mut diags = Diagnostics::new();
+        let loaded = load(vec![Input::Path(old_b.clone())], &LoadOptions { model_dirs: vec![dir.clone()], ..Default::default() }, &mut diags);
+        let mut paths: Vec<&Path> = loaded.files.iter().map(|f| loaded.sources.get(f.raw.file).path.as_path()).collect();
+        paths.sort();
+        assert_eq!(paths, vec![old_a.as_path(), old_b.as_path()]);
+        let a = loaded.models.iter().find(|m| m.uri == "http://a/").expect("http://a/ is a model");
+        assert_eq!((a.version.as_deref(), loaded.sources.get(a.file).path.as_path()), (None, old_a.as_path()));
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]
