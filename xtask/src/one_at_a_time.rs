@@ -21,7 +21,8 @@ pub struct Args {
     out: Option<PathBuf>,
 }
 
-/// Generates every file of the tree on its own into one crate, prints the counts, and `cargo check`s it.
+/// Generates every file of the tree on its own into one crate, prints the counts, and `cargo check`s it;
+/// fails when a file does not resolve on its own, or when no file was generated.
 pub fn run(args: Args) -> Result<(), String> {
     let root = workspace_root();
     let out = args.out.unwrap_or_else(|| root.join("target/one-at-a-time-crate"));
@@ -77,8 +78,19 @@ pub fn run(args: Args) -> Result<(), String> {
     for u in &unresolved {
         println!("  not resolvable: {}", u.display());
     }
+    if modules.is_empty() {
+        // A check of nothing is no check (a tree without ns0, say, resolves no file).
+        return Err(format!("one-at-a-time: no file of {} generated, nothing to compile", tree.display()));
+    }
     let start = std::time::Instant::now();
     cargo_check(&root, &out)?;
     println!("one-at-a-time: cargo check of {} outputs passed in {:.1} s", modules.len(), start.elapsed().as_secs_f64());
+    if !unresolved.is_empty() {
+        return Err(format!(
+            "one-at-a-time: {} file(s) do not resolve on their own (listed above; `nodeset-compiler check FILE --models {}` says why)",
+            unresolved.len(),
+            tree.display()
+        ));
+    }
     Ok(())
 }
