@@ -14,14 +14,16 @@
 //!   (which runs the robot's and the drilling unit's skills) suspended, resumed and awaited to Ready.
 //!
 //! The example binaries are built by the test (`cargo build -p nodeset-examples --example ...`, a no-op
-//! when they are up to date), as `tests/tests/verify.rs` builds the ones it runs.
+//! when they are up to date; `tests/common/example.rs`).
 
-use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
+#[path = "common/example.rs"]
+mod example;
+
 use std::marker::PhantomData;
-use std::process::{Child, Command, Stdio};
-use std::sync::{mpsc, OnceLock};
+use std::path::{Path, PathBuf};
 use std::time::Duration;
+
+use example::PASSWORD;
 
 use nodeset_models::models::common_skills::objects::{
     AbsoluteJointPtpMoveSkillType, AbsoluteJointPtpMoveSkillTypeInputs, ProgramSkillStateMachineTypeOutputs as Done,
@@ -32,89 +34,9 @@ use nodeset_models::models::robotics::objects::{
 };
 use nodeset_models::runtime::client::{ClientConfig, ClientError, Remote, RemoteMachine};
 use nodeset_models::runtime::remote::RemoteError;
-use nodeset_models::runtime::server::{security, Role, Users};
+use nodeset_models::runtime::server::security;
 use nodeset_models::runtime::typed::{MethodMember, ObjectType};
 use opcua::types::StatusCode;
-
-const PASSWORD: &str = "op-secret-1";
-
-/// The example executables, built once per test binary: (name, path).
-fn examples() -> &'static [(String, PathBuf)] {
-    static EXAMPLES: OnceLock<Vec<(String, PathBuf)>> = OnceLock::new();
-    EXAMPLES.get_or_init(|| {
-        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-        let output = Command::new(cargo)
-            .current_dir(env!("CARGO_MANIFEST_DIR"))
-            .args(["build", "-p", "nodeset-examples", "--example", "robot", "--example", "robot_cell"])
-            .arg("--message-format=json-render-diagnostics")
-            .stderr(Stdio::inherit())
-            .output()
-            .expect("cargo runs");
-        assert!(output.status.success(), "cargo build -p nodeset-examples --example robot --example robot_cell failed");
-        let field = |line: &str, key: &str| -> Option<String> {
-            let start = line.find(key)? + key.len();
-            Some(line[start..start + line[start..].find('"')?].to_owned())
-        };
-        String::from_utf8_lossy(&output.stdout)
-            .lines()
-            .filter(|l| l.contains("\"reason\":\"compiler-artifact\"") && l.contains("\"kind\":[\"example\"]"))
-            .filter_map(|l| Some((field(l, "\"name\":\"")?, PathBuf::from(field(l, "\"executable\":\"")?))))
-            .collect()
-    })
-}
-
-/// An example server process, killed when dropped, its stdout read line by line.
-struct Example {
-    child: Child,
-    lines: mpsc::Receiver<String>,
-}
-
-impl Drop for Example {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-impl Example {
-    fn start(name: &str, args: &[&str]) -> Example {
-        let exe = examples().iter().find(|(n, _)| n == name).map(|(_, p)| p.clone());
-        let exe = exe.unwrap_or_else(|| panic!("cargo built no example `{name}`"));
-        let mut child = Command::new(exe).args(args).stdout(Stdio::piped()).stderr(Stdio::inherit()).spawn().expect("the example starts");
-        let out = child.stdout.take().expect("stdout");
-        let (tx, lines) = mpsc::channel();
-        std::thread::spawn(move || {
-            for line in BufReader::new(out).lines().map_while(Result::ok) {
-                if tx.send(line).is_err() {
-                    break;
-                }
-            }
-        });
-        Example { child, lines }
-    }
-
-    /// Waits for a line that starts with `prefix`; the rest of it.
-    fn line(&self, prefix: &str) -> String {
-        loop {
-            let line = self.lines.recv_timeout(Duration::from_secs(90)).unwrap_or_else(|_| panic!("the example prints `{prefix}...`"));
-            if let Some(rest) = line.strip_prefix(prefix) {
-                return rest.trim().to_owned();
-            }
-        }
-    }
-}
-
-/// A fresh folder in the system's temporary directory, with a user file that makes `op` an Operator.
-fn temp_dir(name: &str) -> (PathBuf, PathBuf) {
-    let dir = std::env::temp_dir().join(format!("nodeset-client-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("the temporary folder can be created");
-    let mut users = Users::default();
-    users.set_password("op", vec![Role::Operator], PASSWORD).expect("a user");
-    let file = dir.join("users.txt");
-    std::fs::write(&file, users.to_text()).expect("the user file is written");
-    (dir, file)
-}
 
 fn path(p: &Path) -> &str {
     p.to_str().expect("a UTF-8 path")
@@ -122,13 +44,13 @@ fn path(p: &Path) -> &str {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_robot_example_is_read_written_subscribed_and_called_through_typed_handles() {
-    let (dir, users) = temp_dir("robot");
+    let (dir, users) = example::operator_files("client", "robot");
     let (server_pki, client_pki) = (dir.join("server-pki"), dir.join("client-pki"));
     // The server trusts the client's certificate on first use; the client trusts the server's only once it
     // has been moved from rejected/ to trusted/, as an administrator does (the first attempt fails at once
     // with BadCertificateUntrusted).
     let robot = tokio::task::spawn_blocking(move || {
-        let robot = Example::start("robot", &["--port", "0", "--pki", path(&server_pki), "--users", path(&users), "--trust-on-first-use"]);
+        let robot = example::start("robot", &["--port", "0", "--pki", path(&server_pki), "--users", path(&users), "--trust-on-first-use"]);
         let url = robot.line("listening on ");
         (robot, url)
     });
@@ -309,11 +231,11 @@ fn ptp(target: [f64; 6], speed: f64) -> AbsoluteJointPtpMoveSkillTypeInputs {
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn skills_of_the_robot_cell_run_to_ready_and_are_halted() {
-    let (dir, users) = temp_dir("robot-cell");
+    let (dir, users) = example::operator_files("client", "robot-cell");
     let (server_pki, client_pki) = (dir.join("server-pki"), dir.join("client-pki"));
     let pki = server_pki.clone();
     let cell = tokio::task::spawn_blocking(move || {
-        let cell = Example::start(
+        let cell = example::start(
             "robot_cell",
             &["--port", "0", "--pki", path(&pki), "--users", path(&users), "--trust-on-first-use", "--motion-ms", "1000"],
         );

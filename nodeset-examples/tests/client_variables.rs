@@ -16,33 +16,18 @@ mod example;
 use std::path::PathBuf;
 use std::time::Duration;
 
-use example::Example;
+use example::{Process, PASSWORD};
 use nodeset_models::models::di::objects::{members, LifetimeVariableType};
 use nodeset_models::models::ia::objects::CalibrationValueType;
 use nodeset_models::models::robotics::objects::GearType;
 use nodeset_models::runtime::client::{ClientConfig, ClientError, Remote, Sample};
 use nodeset_models::runtime::remote::RemoteServer;
-use nodeset_models::runtime::server::{Role, Users};
 use nodeset_models::runtime::typed::VariableType;
 use opcua::types::{EUInformation, NodeId, StatusCode, Variant};
-
-const PASSWORD: &str = "op-secret-1";
 
 /// The first gear's lifetime, and its gear.
 const GEAR: &str = "Robot/MotionDevices/Arm/PowerTrains/PT1/Gear";
 const LIFETIME: &str = "Robot/MotionDevices/Arm/PowerTrains/PT1/Gear/Lifetime";
-
-/// A fresh folder in the system's temporary directory, with a user file that makes `op` an Operator.
-fn temp_dir(name: &str) -> (PathBuf, PathBuf) {
-    let dir = std::env::temp_dir().join(format!("nodeset-client-variables-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("the temporary folder can be created");
-    let mut users = Users::default();
-    users.set_password("op", vec![Role::Operator], PASSWORD).expect("a user");
-    let file = dir.join("users.txt");
-    std::fs::write(&file, users.to_text()).expect("the user file is written");
-    (dir, file)
-}
 
 fn double(sample: &Sample<Variant>) -> f64 {
     match sample.value {
@@ -53,7 +38,7 @@ fn double(sample: &Sample<Variant>) -> f64 {
 
 /// The robot, started with a fresh PKI folder and user file, and an Operator's session to it.
 struct Robot {
-    _process: Example,
+    _process: Process,
     client: RemoteServer,
     dir: PathBuf,
 }
@@ -65,11 +50,11 @@ impl Drop for Robot {
 }
 
 async fn robot(name: &str) -> Robot {
-    let (dir, users) = temp_dir(name);
+    let (dir, users) = example::operator_files("client-variables", name);
     let (server_pki, client_pki) = (dir.join("server-pki"), dir.join("client-pki"));
     let started = tokio::task::spawn_blocking(move || {
         let (pki, users) = (server_pki.to_str().expect("UTF-8").to_owned(), users.to_str().expect("UTF-8").to_owned());
-        let robot = Example::start("robot", &["--port", "0", "--pki", &pki, "--users", &users, "--trust-on-first-use"]);
+        let robot = example::start("robot", &["--port", "0", "--pki", &pki, "--users", &users, "--trust-on-first-use"]);
         let url = robot.line("listening on ");
         (robot, url)
     });

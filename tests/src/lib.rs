@@ -10,6 +10,19 @@ pub fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("tests/ sits in the workspace").to_path_buf()
 }
 
+/// The executable of a `bin` or `example` target of the workspace, from `cargo test --workspace --no-run`:
+/// the build `cargo test --workspace` has just done, so nothing is compiled again (`cargo build --example`
+/// resolves features differently and rebuilt async-opcua). Asked of cargo once per test binary.
+pub fn executable(kind: &str, name: &str) -> PathBuf {
+    static ARTIFACTS: std::sync::OnceLock<Vec<process_support::Artifact>> = std::sync::OnceLock::new();
+    ARTIFACTS
+        .get_or_init(|| process_support::cargo_artifacts(&root(), &["test", "--workspace", "--no-run"]).unwrap_or_else(|e| panic!("{e}")))
+        .iter()
+        .find(|a| a.kind == kind && a.name == name)
+        .map(|a| a.path.clone())
+        .unwrap_or_else(|| panic!("cargo test --workspace --no-run built no {kind} `{name}`"))
+}
+
 /// The folder `cargo xtask fetch-nodesets` fills with the pinned companion specs.
 pub fn vendor() -> PathBuf {
     let dir = root().join("nodesets/vendor");

@@ -6,13 +6,13 @@
 //! stops the server with SIGTERM, which must end it cleanly. It fails, never skips, when the venv is
 //! missing: run `cargo xtask venv`.
 
-use std::io::{BufRead, BufReader, Read};
-use std::path::PathBuf;
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc;
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
 use std::time::Duration;
 
-use nodeset_tests::root;
+use nodeset_tests::{executable, root};
+use process_support::Process;
 
 /// The suites of `robotics_check.py` to run: the runtime's demo namespace (writes, methods, subscriptions)
 /// and the generated DI, IA and Robotics namespaces against their NodeSet2 files.
@@ -27,90 +27,31 @@ fn python() -> PathBuf {
     python
 }
 
-/// Builds an example of nodeset-examples and returns the path of its executable.
-///
-/// `cargo test --workspace --no-run` is the build `cargo test --workspace` has just done, so nothing is
-/// compiled again; `cargo build --example` resolves features differently and rebuilt async-opcua (9 min).
+/// An example of nodeset-examples, from `cargo test --workspace --no-run` (see [`executable`]).
 fn build_server(example: &str) -> PathBuf {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-    let output = Command::new(cargo)
-        .current_dir(root())
-        .args(["test", "--workspace", "--no-run", "--message-format=json-render-diagnostics"])
-        .stderr(Stdio::inherit())
-        .output()
-        .expect("cargo runs");
-    assert!(output.status.success(), "cargo test --workspace --no-run failed");
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    let line = stdout
-        .lines()
-        .filter(|l| l.contains("\"reason\":\"compiler-artifact\"") && l.contains("\"executable\":\""))
-        .find(|l| l.contains("\"kind\":[\"example\"]") && l.contains(&format!("\"name\":\"{example}\"")))
-        .expect("cargo reports the example's executable");
-    let start = line.find("\"executable\":\"").unwrap() + "\"executable\":\"".len();
-    let end = start + line[start..].find('"').unwrap();
-    PathBuf::from(&line[start..end])
+    executable("example", example)
 }
 
-/// The server process; killed if the test panics before stopping it.
-struct Server {
-    child: Child,
-    stdout: mpsc::Receiver<String>,
+/// Starts a server on a free port; the process and the URL it prints.
+fn start(exe: &Path, args: &[&str]) -> (Process, String) {
+    let server = spawn(exe, args);
+    let url = server.line("listening on ");
+    (server, url)
 }
 
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
+/// Starts a server on a free port.
+fn spawn(exe: &Path, args: &[&str]) -> Process {
+    Process::start(exe, &[&["--port", "0"][..], args].concat())
 }
 
-impl Server {
-    fn start(exe: &PathBuf, args: &[&str]) -> (Server, String) {
-        let server = Server::spawn(exe, args);
-        let first = server.line();
-        let url = first.strip_prefix("listening on ").unwrap_or_else(|| panic!("unexpected first line {first:?}"));
-        (server, url.to_owned())
-    }
+/// The next line the server prints (within a minute).
+fn next(server: &Process) -> String {
+    server.next_line(Duration::from_secs(60)).unwrap_or_else(|e| panic!("{e}"))
+}
 
-    /// The next line the server prints (within a minute).
-    fn line(&self) -> String {
-        self.stdout.recv_timeout(Duration::from_secs(60)).expect("the server prints a line")
-    }
-
-    fn spawn(exe: &PathBuf, args: &[&str]) -> Server {
-        let mut child = Command::new(exe)
-            .args(["--port", "0"])
-            .args(args)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .unwrap_or_else(|e| panic!("cannot start {}: {e}", exe.display()));
-        let out = child.stdout.take().unwrap();
-        let (tx, rx) = mpsc::channel();
-        std::thread::spawn(move || {
-            for line in BufReader::new(out).lines().map_while(Result::ok) {
-                if tx.send(line).is_err() {
-                    break;
-                }
-            }
-        });
-        Server { child, stdout: rx }
-    }
-
-    /// Sends SIGTERM, checks that the server ends cleanly, and returns what it printed after its URL.
-    fn stop(mut self) -> Vec<String> {
-        let pid = self.child.id().to_string();
-        let sent = Command::new("kill").args(["-TERM", &pid]).status().is_ok_and(|s| s.success());
-        assert!(sent, "cannot send SIGTERM to the server");
-        let mut rest = Vec::new();
-        while let Ok(line) = self.stdout.recv_timeout(Duration::from_secs(15)) {
-            rest.push(line);
-        }
-        let status = self.child.wait().expect("the server ends");
-        assert!(status.success(), "the server exited with {status}; its output: {rest:?}");
-        assert!(rest.iter().any(|l| l == "server stopped cleanly"), "the server did not stop cleanly: {rest:?}");
-        rest
-    }
+/// Sends SIGTERM, checks that the server ends cleanly, and returns what it printed after its URL.
+fn stop(server: Process) -> Vec<String> {
+    server.stop().unwrap_or_else(|e| panic!("{e}"))
 }
 
 #[test]
@@ -119,7 +60,7 @@ fn asyncua_client_against_the_example_server() {
     let exe = build_server("server");
     // This test checks the model, not security: the None endpoint, deliberately (`--insecure`).
     let pki = temp_dir("example-server");
-    let (server, url) = Server::start(&exe, &["--demo", "--insecure", "--pki", pki.to_str().unwrap()]);
+    let (server, url) = start(&exe, &["--demo", "--insecure", "--pki", pki.to_str().unwrap()]);
     let script = root().join("tests/interop/robotics_check.py");
     let mut check = Command::new(&python);
     check.arg(&script).args(["--url", &url]).args(["--nodesets"]).arg(root().join("nodesets/vendor"));
@@ -127,7 +68,7 @@ fn asyncua_client_against_the_example_server() {
         check.args(["--suite", suite]);
     }
     run_check(check);
-    server.stop();
+    stop(server);
 }
 
 /// The six-axis robot example (typed handles, instantiation, the derive) against `robot_check.py`: the
@@ -140,11 +81,11 @@ fn asyncua_client_against_the_robot_example() {
     let exe = build_server("robot");
     // The model and typed handles, not security: the None endpoint, deliberately (`--insecure`).
     let pki = temp_dir("robot");
-    let (server, url) = Server::start(&exe, &["--insecure", "--pki", pki.to_str().unwrap()]);
+    let (server, url) = start(&exe, &["--insecure", "--pki", pki.to_str().unwrap()]);
     let mut check = Command::new(&python);
     check.arg(root().join("tests/interop/robot_check.py")).args(["--url", &url]);
     run_check(check);
-    let printed = server.stop();
+    let printed = stop(server);
     assert!(
         printed.iter().any(|l| l == "ConfiguredDefaultStopMode written by a client: 2"),
         "the client's write of ConfiguredDefaultStopMode did not reach the derived struct; the server printed {printed:?}"
@@ -162,19 +103,19 @@ fn asyncua_client_against_the_robot_cell() {
     // The python client uses the None endpoint (`--insecure`); the cell's composite skills still reach the
     // other two servers over SignAndEncrypt with a user name, and verify their certificates.
     let pki = temp_dir("robot-cell");
-    let server = Server::spawn(&exe, &["--motion-ms", "600", "--insecure", "--pki", pki.to_str().unwrap()]);
+    let server = spawn(&exe, &["--motion-ms", "600", "--insecure", "--pki", pki.to_str().unwrap()]);
     let mut urls = Vec::new();
     for label in ["robot", "drilling unit", "cell"] {
-        let line = server.line();
+        let line = next(&server);
         let url = line.strip_prefix(&format!("{label} listening on ")).unwrap_or_else(|| panic!("unexpected line {line:?}"));
         urls.push(url.to_owned());
     }
-    assert_eq!(server.line(), "cell ready");
+    assert_eq!(next(&server), "cell ready");
     let mut check = Command::new(&python);
     check.arg(root().join("tests/interop/skills_check.py"));
     check.args(["--robot", &urls[0], "--unit", &urls[1], "--cell", &urls[2]]);
     run_check(check);
-    server.stop();
+    stop(server);
 }
 
 /// A fresh folder in the system's temporary directory for one test's PKI folders and files.
@@ -203,22 +144,22 @@ fn asyncua_client_against_a_secure_server() {
     std::fs::write(&users_file, users.to_text()).unwrap();
     let pki = dir.join("pki");
     let args = ["--demo", "--pki", pki.to_str().unwrap(), "--users", users_file.to_str().unwrap()];
-    let (server, url) = Server::start(&exe, &args);
+    let (server, url) = start(&exe, &args);
     let mut check = Command::new(&python);
     check.arg(root().join("tests/interop/security_check.py")).args(["--url", &url]).arg("--pki").arg(&pki);
     check.arg("--work").arg(dir.join("client"));
     check.args(["--user", "op", "--password", "op-secret-1", "--observer", "obs", "--observer-password", "obs-secret-2"]);
     run_check(check);
-    server.stop();
+    stop(server);
 
-    let (server, url) = Server::start(&exe, &[&args[..], &["--insecure"]].concat());
+    let (server, url) = start(&exe, &[&args[..], &["--insecure"]].concat());
     let mut check = Command::new(&python);
     check.arg(root().join("tests/interop/security_check.py")).args(["--url", &url]).arg("--pki").arg(&pki);
     check.arg("--work").arg(dir.join("client"));
     check.args(["--user", "op", "--password", "op-secret-1", "--observer", "obs", "--observer-password", "obs-secret-2"]);
     check.arg("--expect-none");
     run_check(check);
-    server.stop();
+    stop(server);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -243,7 +184,7 @@ fn asyncua_finds_the_role_permissions_obeyed() {
     let pki = dir.join("pki");
     // Certificates are not what this test is about: the client's is trusted on first use.
     let args = ["--pki", pki.to_str().unwrap(), "--users", users_file.to_str().unwrap(), "--trust-on-first-use"];
-    let (server, url) = Server::start(&exe, &args);
+    let (server, url) = start(&exe, &args);
     let mut check = Command::new(&python);
     check.arg(root().join("tests/interop/roles_check.py")).args(["--url", &url]);
     check.arg("--nodeset").arg(root().join("tests/fixtures/roles/Example.Roles.NodeSet2.xml"));
@@ -252,7 +193,7 @@ fn asyncua_finds_the_role_permissions_obeyed() {
         check.args(["--user", &format!("{name}={role}:{name}-secret")]);
     }
     run_check(check);
-    let printed = server.stop();
+    let printed = stop(server);
     let calls: Vec<&String> = printed.iter().filter(|l| l.contains(" called by ")).collect();
     assert_eq!(
         calls,
@@ -289,11 +230,11 @@ fn asyncua_finds_the_robot_defects_mended() {
     let exe = build_server("robot");
     // What the third-party clients found, not security: the None endpoint, deliberately (`--insecure`).
     let pki = temp_dir("robot-defects");
-    let (server, url) = Server::start(&exe, &["--insecure", "--pki", pki.to_str().unwrap()]);
+    let (server, url) = start(&exe, &["--insecure", "--pki", pki.to_str().unwrap()]);
     let mut check = Command::new(&python);
     check.arg(root().join("tests/interop/defects_check.py")).args(["--robot", &url]);
     run_check(check);
-    let printed = server.stop();
+    let printed = stop(server);
     for rejected in [1, 3] {
         let line = format!("ConfiguredDefaultStopMode written by a client: {rejected}");
         assert!(!printed.contains(&line), "a rejected IndexRange write reached the derived struct: {printed:?}");
@@ -312,16 +253,16 @@ fn asyncua_finds_the_robot_cell_defects_mended() {
     let python = python();
     let exe = build_server("robot_cell");
     let pki = temp_dir("robot-cell-defects");
-    let server = Server::spawn(&exe, &["--motion-ms", "600", "--insecure", "--pki", pki.to_str().unwrap()]);
+    let server = spawn(&exe, &["--motion-ms", "600", "--insecure", "--pki", pki.to_str().unwrap()]);
     let mut urls = Vec::new();
     for label in ["robot", "drilling unit", "cell"] {
-        let line = server.line();
+        let line = next(&server);
         let url = line.strip_prefix(&format!("{label} listening on ")).unwrap_or_else(|| panic!("unexpected line {line:?}"));
         urls.push(url.to_owned());
     }
-    assert_eq!(server.line(), "cell ready");
+    assert_eq!(next(&server), "cell ready");
     let mut check = Command::new(&python);
     check.arg(root().join("tests/interop/defects_check.py")).args(["--cell", &urls[2]]);
     run_check(check);
-    server.stop();
+    stop(server);
 }

@@ -13,92 +13,15 @@
 //! The command and the examples come from `cargo test --workspace --no-run`, as in `interop.rs`. The test
 //! fails, never skips, when node or the node-opcua packages are missing, saying how to install them.
 
-use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
-use std::sync::{mpsc, OnceLock};
-use std::time::Duration;
+use std::process::{Command, Output};
 
-use nodeset_tests::{root, vendor};
+use nodeset_tests::{executable, root, vendor};
+use process_support::Process;
 
-/// The executables `cargo test --workspace --no-run` builds (a no-op after `cargo test --workspace`), as
-/// (kind, name, path); built once per test binary.
-fn artifacts() -> &'static [(String, String, PathBuf)] {
-    static ARTIFACTS: OnceLock<Vec<(String, String, PathBuf)>> = OnceLock::new();
-    ARTIFACTS.get_or_init(|| {
-        let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-        let output = Command::new(cargo)
-            .current_dir(root())
-            .args(["test", "--workspace", "--no-run", "--message-format=json-render-diagnostics"])
-            .stderr(Stdio::inherit())
-            .output()
-            .expect("cargo runs");
-        assert!(output.status.success(), "cargo test --workspace --no-run failed");
-        let field = |line: &str, key: &str| -> Option<String> {
-            let start = line.find(key)? + key.len();
-            Some(line[start..start + line[start..].find('"')?].to_owned())
-        };
-        String::from_utf8_lossy(&output.stdout)
-            .lines()
-            .filter(|l| l.contains("\"reason\":\"compiler-artifact\"") && l.contains("\"test\":false"))
-            .filter_map(|l| {
-                let kind = field(l, "\"kind\":[\"")?;
-                let name = field(l, "\"name\":\"")?;
-                let exe = field(l, "\"executable\":\"")?;
-                Some((kind, name, PathBuf::from(exe)))
-            })
-            .collect()
-    })
-}
-
-/// The executable of a `bin` or `example` target.
-fn executable(kind: &str, name: &str) -> PathBuf {
-    artifacts()
-        .iter()
-        .find(|(k, n, _)| k == kind && n == name)
-        .map(|(_, _, p)| p.clone())
-        .unwrap_or_else(|| panic!("cargo test --workspace --no-run built no {kind} `{name}`"))
-}
-
-/// A server process, killed when dropped.
-struct Server {
-    child: Child,
-    lines: mpsc::Receiver<String>,
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-impl Server {
-    fn spawn(mut command: Command) -> Server {
-        let mut child = command.stdout(Stdio::piped()).stderr(Stdio::inherit()).spawn().expect("the server starts");
-        let out = child.stdout.take().unwrap();
-        let (tx, lines) = mpsc::channel();
-        std::thread::spawn(move || {
-            for line in BufReader::new(out).lines().map_while(Result::ok) {
-                if tx.send(line).is_err() {
-                    break;
-                }
-            }
-        });
-        Server { child, lines }
-    }
-
-    /// The URLs of the first `n` lines that contain `listening on <url>`.
-    fn urls(&self, n: usize) -> Vec<String> {
-        let mut urls = Vec::new();
-        while urls.len() < n {
-            let line = self.lines.recv_timeout(Duration::from_secs(90)).expect("the server prints its URL");
-            if let Some((_, url)) = line.split_once("listening on ") {
-                urls.push(url.trim().to_owned());
-            }
-        }
-        urls
-    }
+/// The URLs of the next `n` lines that contain `listening on <url>`.
+fn urls(server: &Process, n: usize) -> Vec<String> {
+    (0..n).map(|_| server.line("listening on ")).collect()
 }
 
 /// A fresh folder in the system's temporary directory.
@@ -172,8 +95,8 @@ fn the_robot_example_verifies_clean_over_sign_and_encrypt_with_a_user() {
     // The server trusts the verifying client's certificate on first use; the client trusts the server's
     // only once an operator has moved it to `trusted/`.
     command.args(["--port", "0", "--pki", server_pki.to_str().unwrap(), "--users", users_file.to_str().unwrap(), "--trust-on-first-use"]);
-    let server = Server::spawn(command);
-    let url = server.urls(1).remove(0);
+    let server = Process::spawn(&mut command).unwrap_or_else(|e| panic!("{e}"));
+    let url = urls(&server, 1).remove(0);
     // No security options: verify connects over Basic256Sha256 SignAndEncrypt by default.
     let secure = [
         "--user",
@@ -215,8 +138,8 @@ fn the_robot_example_verifies_clean_over_none() {
     let pki = temp_dir("robot-none");
     let mut command = Command::new(executable("example", "robot"));
     command.args(["--port", "0", "--insecure", "--pki", pki.to_str().unwrap()]);
-    let server = Server::spawn(command);
-    let url = server.urls(1).remove(0);
+    let server = Process::spawn(&mut command).unwrap_or_else(|e| panic!("{e}"));
+    let url = urls(&server, 1).remove(0);
     assert_clean(&url, &["--insecure"], &[]);
     drop(server);
     let _ = std::fs::remove_dir_all(&pki);
@@ -227,8 +150,8 @@ fn the_robot_cell_verifies_clean() {
     let pki = temp_dir("robot-cell");
     let mut command = Command::new(executable("example", "robot_cell"));
     command.args(["--port", "0", "--insecure", "--pki", pki.to_str().unwrap()]);
-    let server = Server::spawn(command);
-    for url in server.urls(3) {
+    let server = Process::spawn(&mut command).unwrap_or_else(|e| panic!("{e}"));
+    for url in urls(&server, 3) {
         assert_clean(&url, &["--insecure"], &[]);
     }
     drop(server);
@@ -258,8 +181,8 @@ fn a_node_opcua_server_with_planted_defects() {
     let port = free_port().to_string();
     let mut command = Command::new("node");
     command.current_dir(&dir).arg(Path::new("server.js")).arg(&port);
-    let server = Server::spawn(command);
-    let url = server.urls(1).remove(0);
+    let server = Process::spawn(&mut command).unwrap_or_else(|e| panic!("{e}"));
+    let url = urls(&server, 1).remove(0);
     let models = models();
     let args: Vec<&str> = models.iter().map(String::as_str).chain(["--insecure"]).collect();
     let (output, json) = verify(&url, &args, &[]);
@@ -304,8 +227,8 @@ fn a_server_namespace_without_a_nodeset_is_reported() {
     let pki = dir.join("pki");
     let mut command = Command::new(executable("example", "robot"));
     command.args(["--port", "0", "--insecure", "--pki", pki.to_str().unwrap()]);
-    let server = Server::spawn(command);
-    let url = server.urls(1).remove(0);
+    let server = Process::spawn(&mut command).unwrap_or_else(|e| panic!("{e}"));
+    let url = urls(&server, 1).remove(0);
     // A models folder with ns0 and DI only: the IA and Robotics types the robot is made of are unknown.
     let models = dir.join("models");
     std::fs::create_dir_all(&models).unwrap();

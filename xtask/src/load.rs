@@ -11,11 +11,11 @@
 //! `--insecure` adds) and over Basic256Sha256 SignAndEncrypt as an Operator user, so that the cost of
 //! encryption (notifications per second, server CPU) is measured in one run.
 
-use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc;
+use std::process::{Command, Stdio};
 use std::time::Duration;
+
+use process_support::Process;
 
 use crate::util::workspace_root;
 
@@ -79,65 +79,6 @@ pub(crate) fn build(root: &Path, release: bool, examples: &[&str]) -> Result<Pat
     Ok(crate::util::target_dir().join(if release { "release" } else { "debug" }).join("examples"))
 }
 
-/// An example server running as a child process, its stdout read line by line; killed if dropped.
-pub(crate) struct Example {
-    child: Child,
-    lines: mpsc::Receiver<String>,
-}
-
-impl Drop for Example {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-impl Example {
-    pub(crate) fn spawn(exe: &Path, args: &[&str]) -> Result<Example, String> {
-        let mut child = Command::new(exe)
-            .args(args)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .map_err(|e| format!("cannot start {}: {e}", exe.display()))?;
-        let out = child.stdout.take().ok_or("no stdout")?;
-        let (tx, lines) = mpsc::channel();
-        std::thread::spawn(move || {
-            for line in BufReader::new(out).lines().map_while(Result::ok) {
-                if tx.send(line).is_err() {
-                    break;
-                }
-            }
-        });
-        Ok(Example { child, lines })
-    }
-
-    /// The next line it prints (within a minute).
-    pub(crate) fn line(&self) -> Result<String, String> {
-        self.lines.recv_timeout(Duration::from_secs(60)).map_err(|_| "the example printed nothing for a minute".into())
-    }
-
-    pub(crate) fn pid(&self) -> u32 {
-        self.child.id()
-    }
-
-    /// Sends SIGTERM; the lines printed until it ended, or why it did not end cleanly (printing
-    /// `server stopped cleanly` and exiting with 0).
-    pub(crate) fn stop(mut self) -> Result<Vec<String>, String> {
-        let killed = Command::new("kill").args(["-TERM", &self.pid().to_string()]).status().is_ok_and(|s| s.success());
-        let mut rest = Vec::new();
-        while let Ok(line) = self.lines.recv_timeout(Duration::from_secs(15)) {
-            rest.push(line);
-        }
-        let exit = self.child.wait().map_err(|e| e.to_string())?;
-        if killed && exit.success() && rest.iter().any(|l| l == "server stopped cleanly") {
-            Ok(rest)
-        } else {
-            Err(format!("the server did not stop cleanly ({exit}); last lines: {:?}", rest.iter().rev().take(5).collect::<Vec<_>>()))
-        }
-    }
-}
-
 pub fn run(args: Args) -> Result<(), String> {
     let root = workspace_root();
     crate::fetch::ensure_fetched()?;
@@ -154,11 +95,11 @@ pub fn run(args: Args) -> Result<(), String> {
     // `--trust-on-first-use` lets the load client's certificate in without an administrator (a test harness).
     let pki = dir.join("pki").to_string_lossy().into_owned();
     let users_arg = users.to_string_lossy().into_owned();
-    let robot = Example::spawn(
-        &examples.join("robot"),
-        &["--port", "0", "--insecure", "--trust-on-first-use", "--pki", &pki, "--users", &users_arg],
+    let robot = Process::spawn(
+        Command::new(examples.join("robot"))
+            .args(["--port", "0", "--insecure", "--trust-on-first-use", "--pki", &pki, "--users", &users_arg]),
     )?;
-    let first = robot.line()?;
+    let first = robot.next_line(Duration::from_secs(60))?;
     let url = first.strip_prefix("listening on ").ok_or_else(|| format!("unexpected first line {first:?}"))?.to_owned();
     let pid = robot.pid();
     eprintln!("load: robot example (pid {pid}) listening on {url}");

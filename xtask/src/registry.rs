@@ -204,7 +204,8 @@ mod tests {
         std::fs::write(pkg.join("package.mo"), "package Planted\nend Planted;\n").unwrap();
         std::fs::write(pkg.join("Good.mo"), "within Planted;\nmodel Good\n  Real x = 1;\nend Good;\n").unwrap();
         std::fs::write(pkg.join("Bad.mo"), "within Planted;\nmodel Bad\n  Real x = notDeclared;\nend Bad;\n").unwrap();
-        let (passed, failed, text) = rumoca(&python, &workspace_root().join("tests/modelica/check.py"), &dir).expect("check.py runs");
+        let script = workspace_root().join("tests/modelica/check.py");
+        let (passed, failed, text) = checker(&python, &script, &dir, &["--aggregate", "--jobs", "1"]).expect("check.py runs");
         let _ = std::fs::remove_dir_all(&dir);
         assert_eq!((passed, failed), (1, 1), "{text}");
     }

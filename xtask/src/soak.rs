@@ -6,7 +6,12 @@
 //! times, each transition event checked in order, the servers' memory sampled. Then it stops the servers,
 //! which must end cleanly. `cargo xtask test` runs it as it is by default: 1,000 runs, about a minute.
 
-use crate::load::{build, Example};
+use std::process::Command;
+use std::time::Duration;
+
+use process_support::Process;
+
+use crate::load::build;
 use crate::util::workspace_root;
 
 #[derive(Debug, clap::Args)]
@@ -33,19 +38,20 @@ pub fn run(args: Args) -> Result<(), String> {
     let pki = std::env::temp_dir().join(format!("nodeset-soak-pki-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&pki);
     let pki_arg = pki.to_string_lossy().into_owned();
-    let cell = Example::spawn(&examples.join("robot_cell"), &["--port", "0", "--motion-ms", &motion, "--insecure", "--pki", &pki_arg])?;
+    let cell =
+        Process::spawn(Command::new(examples.join("robot_cell")).args(["--port", "0", "--motion-ms", &motion, "--insecure", "--pki", &pki_arg]))?;
     let mut urls = Vec::new();
     for label in ["robot", "drilling unit", "cell"] {
-        let line = cell.line()?;
+        let line = cell.next_line(Duration::from_secs(60))?;
         let url = line.strip_prefix(&format!("{label} listening on ")).ok_or_else(|| format!("unexpected line {line:?}"))?;
         urls.push(url.to_owned());
     }
-    let ready = cell.line()?;
+    let ready = cell.next_line(Duration::from_secs(60))?;
     if ready != "cell ready" {
         return Err(format!("unexpected line {ready:?}"));
     }
     eprintln!("soak: robot cell (pid {}) at {}", cell.pid(), urls.join(", "));
-    let status = std::process::Command::new(python)
+    let status = Command::new(python)
         .current_dir(root.join("tests/interop"))
         .arg("skills_soak.py")
         .args(["--robot", &urls[0], "--unit", &urls[1], "--cell", &urls[2]])

@@ -24,28 +24,17 @@
 //! printed as a verdict, never asserted: the host is shared and its speed varies.
 
 use std::env;
-use std::io::{BufRead, BufReader};
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc;
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use super::verdict;
 use bench_support::Report;
+use process_support::Process;
 use crate::util::target_dir;
 
 /// The target for the robot cell, in milliseconds.
 const TARGET_MS: f64 = 1000.0;
-
-/// The robot cell example, killed when dropped.
-struct Cell(Child);
-
-impl Drop for Cell {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 fn cargo_build(root: &Path, release: bool, args: &[&str]) -> Result<(), String> {
     let status = crate::util::cargo()
@@ -121,26 +110,10 @@ pub(super) fn run(root: &Path, runs: usize, release: bool) -> Result<(), String>
 
     let pki = env::temp_dir().join(format!("nodeset-bench-verify-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&pki);
-    let mut child = Command::new(&cell_exe)
-        .args(["--port", "0", "--insecure", "--pki"])
-        .arg(&pki)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::null())
-        .spawn()
-        .map_err(|e| format!("cannot start {}: {e}", cell_exe.display()))?;
-    let out = child.stdout.take().ok_or("the robot cell has no stdout")?;
-    let cell = Cell(child);
-    let (tx, lines) = mpsc::channel();
-    std::thread::spawn(move || {
-        for line in BufReader::new(out).lines().map_while(Result::ok) {
-            if tx.send(line).is_err() {
-                break;
-            }
-        }
-    });
+    let cell = Process::spawn(Command::new(&cell_exe).args(["--port", "0", "--insecure", "--pki"]).arg(&pki).stderr(Stdio::null()))?;
     let mut urls: Vec<Option<String>> = vec![None; SERVERS.len()];
     loop {
-        let line = lines.recv_timeout(Duration::from_secs(120)).map_err(|_| "the robot cell did not get ready in 120 s")?;
+        let line = cell.next_line(Duration::from_secs(120)).map_err(|e| format!("the robot cell did not get ready: {e}"))?;
         for (label, url) in SERVERS.iter().zip(urls.iter_mut()) {
             if let Some(u) = line.strip_prefix(&format!("{label} listening on ")) {
                 *url = Some(u.trim().to_owned());
