@@ -234,25 +234,32 @@ def main(argv):
         else:
             if not quiet:
                 print(f"the aggregate model failed ({' '.join(msg.split())[:300]}); checking class by class")
-            results = run_checks(root, items, jobs, quiet)
-            for name, (good, m) in results.items():
-                if good:
-                    passed += 1
-                else:
-                    failed[name] = m
+            passed += tally(run_checks(root, items, jobs, quiet), failed)
             if not failed:
                 failed["<aggregate model>"] = " ".join(msg.split())
     elif items:
-        results = run_checks(root, items, jobs, quiet)
-        for name, (good, m) in results.items():
-            if good:
-                passed += 1
-            else:
-                failed[name] = m
+        passed += tally(run_checks(root, items, jobs, quiet), failed)
+    return report(f"checked {len(items)} classes below {root} in {time.time() - t0:.1f} s", passed, failed, quiet)
+
+
+def tally(results, failed):
+    """Adds the failures of `results` ({name: (ok, message)}) to `failed`; returns how many passed."""
+    passed = 0
+    for name, (good, m) in results.items():
+        if good:
+            passed += 1
+        else:
+            failed[name] = m
+    return passed
+
+
+def report(what, passed, failed, quiet):
+    """Prints the failures (with --quiet; otherwise they were printed as they came), `what` and the summary
+    line every checker ends with, `N passed, N failed`; returns the exit status."""
     if quiet:
         for name, m in sorted(failed.items()):
             print(f"FAIL {name}: {m}")
-    print(f"checked {len(items)} classes below {root} in {time.time() - t0:.1f} s")
+    print(what)
     print(f"{passed} passed, {len(failed)} failed")
     return 0 if not failed else 1
 

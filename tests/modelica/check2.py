@@ -113,18 +113,9 @@ def main(argv):
     items = [it for it in items if it[1] != "unknown"]
     t0 = time.time()
     results = check.run_checks(root, items, jobs, quiet, script=os.path.abspath(__file__)) if items else {}
-    passed = 0
-    for name, (good, m) in results.items():
-        if good:
-            passed += 1
-        else:
-            failed[name] = m
-    if quiet:
-        for name, m in sorted(failed.items()):
-            print(f"FAIL {name}: {m}")
-    print(f"pymoca {pymoca.__version__}: checked {len(items)} classes below {root} in {time.time() - t0:.1f} s")
-    print(f"{passed} passed, {len(failed)} failed")
-    return 0 if not failed else 1
+    passed = check.tally(results, failed)
+    what = f"pymoca {pymoca.__version__}: checked {len(items)} classes below {root} in {time.time() - t0:.1f} s"
+    return check.report(what, passed, failed, quiet)
 
 
 if __name__ == "__main__":

@@ -426,12 +426,9 @@ def main(argv):
             passed += 1
             if not quiet:
                 print(f"ok   {cname}", flush=True)
-    if quiet:
-        for name, m in sorted(failed.items()):
-            print(f"FAIL {name}: {m}")
-    print(f"structure (pymoca {pymoca.__version__} parser): checked {len(names) + sum(n in lib.errors for n in failed)} classes below {root} in {time.time() - t0:.1f} s")
-    print(f"{passed} passed, {len(failed)} failed")
-    return 0 if not failed else 1
+    checked = len(names) + sum(n in lib.errors for n in failed)
+    what = f"structure (pymoca {pymoca.__version__} parser): checked {checked} classes below {root} in {time.time() - t0:.1f} s"
+    return check.report(what, passed, failed, quiet)
 
 
 if __name__ == "__main__":
