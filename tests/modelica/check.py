@@ -242,6 +242,39 @@ def main(argv):
     return report(f"checked {len(items)} classes below {root} in {time.time() - t0:.1f} s", passed, failed, quiet)
 
 
+def options(argv, doc):
+    """The arguments `ROOT [--only PREFIX]... [--jobs N] [--quiet]` of the checkers: (root, quiet, jobs, only),
+    or None after printing `doc` and a failing summary when ROOT is not one folder."""
+    quiet, jobs, only, args, i = "--quiet" in argv, 2, [], [], 0
+    while i < len(argv):
+        a = argv[i]
+        if a in ("--jobs", "--only") and i + 1 < len(argv):
+            if a == "--jobs":
+                jobs = max(1, int(argv[i + 1]))
+            else:
+                only.append(argv[i + 1])
+            i += 1
+        elif not a.startswith("--"):
+            args.append(a)
+        i += 1
+    if len(args) != 1 or not os.path.isdir(args[0]):
+        print(doc, file=sys.stderr)
+        print("0 passed, 1 failed")
+        return None
+    return os.path.abspath(args[0]), quiet, jobs, only
+
+
+def pymoca_or_none():
+    """The pymoca module, or None after saying how to install it (and a failing summary)."""
+    try:
+        import pymoca
+    except ImportError:
+        print("pymoca is missing: run `cargo xtask venv` (it installs tests/requirements.txt)", file=sys.stderr)
+        print("0 passed, 1 failed")
+        return None
+    return pymoca
+
+
 def tally(results, failed):
     """Adds the failures of `results` ({name: (ok, message)}) to `failed`; returns how many passed."""
     passed = 0

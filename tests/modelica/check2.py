@@ -76,33 +76,11 @@ def main(argv):
     if len(argv) >= 2 and argv[0] == "--worker":
         worker(argv[1])
         return 0
-    try:
-        import pymoca
-    except ImportError:
-        print("pymoca is missing: run `cargo xtask venv` (it installs tests/requirements.txt)", file=sys.stderr)
-        print("0 passed, 1 failed")
+    pymoca = check.pymoca_or_none()
+    opts = check.options(argv, __doc__) if pymoca else None
+    if opts is None:
         return 2
-    quiet = "--quiet" in argv
-    jobs = 2
-    only = []
-    args = []
-    i = 0
-    while i < len(argv):
-        a = argv[i]
-        if a == "--jobs" and i + 1 < len(argv):
-            jobs = max(1, int(argv[i + 1]))
-            i += 1
-        elif a == "--only" and i + 1 < len(argv):
-            only.append(argv[i + 1])
-            i += 1
-        elif not a.startswith("--"):
-            args.append(a)
-        i += 1
-    if len(args) != 1 or not os.path.isdir(args[0]):
-        print(__doc__, file=sys.stderr)
-        print("0 passed, 1 failed")
-        return 2
-    root = os.path.abspath(args[0])
+    root, quiet, jobs, only = opts
     items = check.classes(root)
     if only:
         items = [it for it in items if any(it[0] == p or it[0].startswith(p + ".") for p in only)]

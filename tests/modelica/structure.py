@@ -345,26 +345,11 @@ def modification_values(cm):
 
 
 def main(argv):
-    try:
-        import pymoca
-    except ImportError:
-        print("pymoca is missing: run `cargo xtask venv` (it installs tests/requirements.txt)", file=sys.stderr)
-        print("0 passed, 1 failed")
+    pymoca = check.pymoca_or_none()
+    opts = check.options(argv, __doc__) if pymoca else None
+    if opts is None:
         return 2
-    quiet = "--quiet" in argv
-    only, args, i = [], [], 0
-    while i < len(argv):
-        if argv[i] == "--only" and i + 1 < len(argv):
-            only.append(argv[i + 1])
-            i += 1
-        elif not argv[i].startswith("--"):
-            args.append(argv[i])
-        i += 1
-    if len(args) != 1 or not os.path.isdir(args[0]):
-        print(__doc__, file=sys.stderr)
-        print("0 passed, 1 failed")
-        return 2
-    root = os.path.abspath(args[0])
+    root, quiet, _, only = opts
     t0 = time.time()
     lib = Library(root)
     # Conditional components of each class file, by class name.
