@@ -1,4 +1,4 @@
-// A node-opcua server for tests/tests/verify_node_opcua.rs: ns0, DI, IA and Robotics from
+// A node-opcua server for tests/tests/verify.rs: ns0, DI, IA and Robotics from
 // node-opcua-nodesets, one correct MotionDeviceSystem instance (`GoodSystem`) and one with three planted
 // defects (`BadSystem`):
 //   1. its motion device has no `SerialNumber` (a Mandatory property of DI's ComponentType, NS0401);
