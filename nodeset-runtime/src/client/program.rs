@@ -187,17 +187,25 @@ impl<P: ProgramType> RemoteProgram<P> {
     /// Starts the program with `inputs` and waits until the run ends: its outputs when it ends in Ready,
     /// [`ClientError::Halted`] with the cause when it ends in Halted.
     pub async fn run(&self, inputs: P::Inputs) -> Result<P::Outputs, ClientError> {
-        let ready = self.table_state("Ready")?;
-        let halted = self.table_state("Halted")?;
         let mut seen = self.machine.seen.clone();
         let before = seen.borrow_and_update().0;
         self.start(inputs).await?;
-        let ended = seen.wait_for(|s| s.0 > before && (s.1 == Some(ready) || s.1 == Some(halted))).await.map(|s| s.1);
-        let state = match ended {
-            Ok(s) => s,
-            Err(_) => return Err(ClientError::Remote(crate::remote::RemoteError::Service("Publish", StatusCode::BadCommunicationError))),
+        let mut started = false;
+        let state = loop {
+            if seen.changed().await.is_err() {
+                return Err(ClientError::Remote(crate::remote::RemoteError::Service("Publish", StatusCode::BadCommunicationError)));
+            }
+            let (count, row) = *seen.borrow_and_update();
+            if count <= before {
+                continue;
+            }
+            let Some(state) = program_state(row.map(|i| &P::TABLE.states[i])) else { continue };
+            let state = self.this_run(state, &mut started).await;
+            if matches!(state, ProgramState::Ready | ProgramState::Halted) {
+                break state;
+            }
         };
-        if state == Some(halted) {
+        if state == ProgramState::Halted {
             return Err(ClientError::Halted { program: P::BROWSE_NAME.to_owned(), cause: self.halt_cause().await });
         }
         self.outputs().await
@@ -330,6 +338,7 @@ impl<P: ProgramType> RemoteProgram<P> {
         let guard = HaltOnDrop { call: halt.map(|h| (self.remote.session.clone(), self.remote.node.clone(), h)) };
         let mut composite = ctl.watch();
         let mut basic = ProgramState::Running;
+        let mut started = false;
         // Without a change of CurrentState for a while, it is read: that finds a server that went away (the
         // composite halts: what the program did is unknown) and a change whose notification was lost.
         let mut quiet = tokio::time::interval_at(tokio::time::Instant::now() + LIVENESS, LIVENESS);
@@ -346,6 +355,7 @@ impl<P: ProgramType> RemoteProgram<P> {
                         continue;
                     }
                     let Some(state) = program_state(row.map(|i| &P::TABLE.states[i])) else { continue };
+                    let state = self.this_run(state, &mut started).await;
                     let was = std::mem::replace(&mut basic, state);
                     match state {
                         ProgramState::Ready => break Ok(()),
@@ -399,6 +409,27 @@ impl<P: ProgramType> RemoteProgram<P> {
         };
         guard.disarm();
         outcome
+    }
+}
+
+impl<P: ProgramType> RemoteProgram<P> {
+    /// The state of this run a notification of `state` stands for. Notifications arrive late: the Ready of
+    /// a Reset before this run's Start can come after the Start. So until this run has been seen Running or
+    /// Suspended (`started`), a Ready or Halted is checked by reading CurrentState; the read wins (it is
+    /// the state now). Where the read fails, the notification stands: a server that went away is found by
+    /// the step's own liveness read.
+    async fn this_run(&self, state: ProgramState, started: &mut bool) -> ProgramState {
+        let state = match state {
+            ProgramState::Ready | ProgramState::Halted if !*started => {
+                match tokio::time::timeout(REQUEST_TIMEOUT, self.state()).await {
+                    Ok(Ok(row)) => program_state(row).unwrap_or(state),
+                    _ => state,
+                }
+            }
+            _ => state,
+        };
+        *started |= matches!(state, ProgramState::Running | ProgramState::Suspended);
+        state
     }
 }
 
