@@ -34,6 +34,7 @@ use std::time::Instant;
 const CASES: &[&str] = &[
     "abstract_base",
     "arrays",
+    "engineering_units",
     "enum_gaps",
     "event_type",
     "instances",
@@ -120,6 +121,7 @@ macro_rules! snapshots {
 snapshots!(
     abstract_base,
     arrays,
+    engineering_units,
     enum_gaps,
     event_type,
     instances,

@@ -3,9 +3,9 @@
 within NodesetCompilerCommonSkills.Declarations;
 model AbsoluteJointPTPMoveSkillType_InputParameterSet "InputParameterSet: The inputs of the joint motion: TargetJointPositions, Speed and Acceleration."
   extends NodesetCompilerCommonSkills.Declarations.MoveSkillType_InputParameterSet;
-  OpcUaSupport.RealInput targetJointPositions[:](each unit="deg") = fill(0, 0)
+  OpcUaSupport.RealInput targetJointPositions[:](each unit="rad", each displayUnit="deg", each quantity="Angle") = fill(0, 0)
     "TargetJointPositions: Target angle of every joint, in degrees, in the order of the joints from the base to the flange. The array has one element per joint of the robot."
-    annotation (__OPCUA(browsePath="TargetJointPositions", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1606", dataType="i=11"));
+    annotation (__OPCUA(browsePath="TargetJointPositions", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1606", dataType="i=11", engineeringUnit="DD", siFactor=0.017453292519943295));
   annotation (
     Documentation(info="<html><p>The inputs of the joint motion: TargetJointPositions, Speed and Acceleration.</p><p>The class of <code>InputParameterSet</code> in CommonSkills:AbsoluteJointPTPMoveSkillType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1601", browseName="InputParameterSet"));

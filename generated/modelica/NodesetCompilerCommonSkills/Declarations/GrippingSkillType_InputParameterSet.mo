@@ -6,9 +6,9 @@ model GrippingSkillType_InputParameterSet "InputParameterSet: The inputs of the 
   input NodesetCompilerCommonSkills.Types.GripperActionEnumeration action = NodesetCompilerCommonSkills.Types.GripperActionEnumeration.Open
     "Action: Whether the run opens or closes the gripper."
     annotation (__OPCUA(browsePath="Action", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1902", dataType="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1000"));
-  OpcUaSupport.RealInput gripForce = 0
-    "GripForce: Force the jaws hold the part with when closing, in newtons; ignored when opening. [unit N (UnitId 5129559): no Modelica unit]"
-    annotation (__OPCUA(browsePath="GripForce", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1903", dataType="i=11"));
+  OpcUaSupport.RealInput gripForce(unit="N", quantity="Force") = 0
+    "GripForce: Force the jaws hold the part with when closing, in newtons; ignored when opening."
+    annotation (__OPCUA(browsePath="GripForce", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1903", dataType="i=11", engineeringUnit="NEW"));
   annotation (
     Documentation(info="<html><p>The inputs of the gripping: Action and GripForce.</p><p>The class of <code>InputParameterSet</code> in CommonSkills:GrippingSkillType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1901", browseName="InputParameterSet"));

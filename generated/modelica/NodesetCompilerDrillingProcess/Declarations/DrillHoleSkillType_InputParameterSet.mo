@@ -3,24 +3,24 @@
 within NodesetCompilerDrillingProcess.Declarations;
 model DrillHoleSkillType_InputParameterSet "InputParameterSet: The inputs: InsertionDistance and the drilling parameters passed to TemplateDrilling."
   extends OpcUa.ObjectTypes.BaseObjectType;
-  OpcUaSupport.RealInput insertionDistance(unit="mm") = 0
+  OpcUaSupport.RealInput insertionDistance(unit="m", displayUnit="mm", quantity="Length") = 0
     "InsertionDistance: Distance the nose moves along tool Z into the drill bush before drilling and back out after, in millimetres."
-    annotation (__OPCUA(browsePath="InsertionDistance", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=2002", dataType="i=11"));
-  OpcUaSupport.RealInput holeDiameter(unit="mm") = 0
+    annotation (__OPCUA(browsePath="InsertionDistance", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=2002", dataType="i=11", engineeringUnit="MMT", siFactor=0.001));
+  OpcUaSupport.RealInput holeDiameter(unit="m", displayUnit="mm", quantity="Length") = 0
     "HoleDiameter: Nominal diameter of the hole, in millimetres; selects and checks the drill."
-    annotation (__OPCUA(browsePath="HoleDiameter", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=2004", dataType="i=11"));
-  OpcUaSupport.RealInput depth(unit="mm") = 0
+    annotation (__OPCUA(browsePath="HoleDiameter", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=2004", dataType="i=11", engineeringUnit="MMT", siFactor=0.001));
+  OpcUaSupport.RealInput depth(unit="m", displayUnit="mm", quantity="Length") = 0
     "Depth: Depth to drill, in millimetres, measured from the face of the drill bush."
-    annotation (__OPCUA(browsePath="Depth", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=2006", dataType="i=11"));
+    annotation (__OPCUA(browsePath="Depth", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=2006", dataType="i=11", engineeringUnit="MMT", siFactor=0.001));
   OpcUaSupport.RealInput feedRate = 0
     "FeedRate: Feed of the drill along its axis, in millimetres per minute. [unit mm/min (UnitId 4732977): no Modelica unit]"
     annotation (__OPCUA(browsePath="FeedRate", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=2008", dataType="i=11"));
   OpcUaSupport.RealInput spindleSpeed = 0
     "SpindleSpeed: Rotational speed of the spindle, in revolutions per minute. [unit r/min (UnitId 5394509): no Modelica unit]"
     annotation (__OPCUA(browsePath="SpindleSpeed", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=2010", dataType="i=11"));
-  OpcUaSupport.RealInput clampForce = 0
-    "ClampForce: Force the nose clamps the stack against the template with, in newtons. [unit N (UnitId 5129559): no Modelica unit]"
-    annotation (__OPCUA(browsePath="ClampForce", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=2012", dataType="i=11"));
+  OpcUaSupport.RealInput clampForce(unit="N", quantity="Force") = 0
+    "ClampForce: Force the nose clamps the stack against the template with, in newtons."
+    annotation (__OPCUA(browsePath="ClampForce", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=2012", dataType="i=11", engineeringUnit="NEW"));
   annotation (
     Documentation(info="<html><p>The inputs: InsertionDistance and the drilling parameters passed to TemplateDrilling.</p><p>The class of <code>InputParameterSet</code> in DrillingProcess:DrillHoleSkillType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=2001", browseName="InputParameterSet"));

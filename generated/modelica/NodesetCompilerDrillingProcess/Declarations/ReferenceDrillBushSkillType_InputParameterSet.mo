@@ -6,9 +6,9 @@ model ReferenceDrillBushSkillType_InputParameterSet "InputParameterSet: The inpu
   input OpcUa.Types.N3DFrame holePosition = OpcUa.Types.N3DFrame()
     "HolePosition: Rough pose of the drill bush in the base frame of the robot, from the template referencing camera: position of the bush face centre, Z along the bush axis into the part; millimetres and degrees."
     annotation (__OPCUA(browsePath="HolePosition", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1002", dataType="i=18814"));
-  OpcUaSupport.RealInput approachDistance(unit="mm") = 0
+  OpcUaSupport.RealInput approachDistance(unit="m", displayUnit="mm", quantity="Length") = 0
     "ApproachDistance: Distance in front of the bush face at which the end effector stops, in millimetres."
-    annotation (__OPCUA(browsePath="ApproachDistance", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1013", dataType="i=11"));
+    annotation (__OPCUA(browsePath="ApproachDistance", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1013", dataType="i=11", engineeringUnit="MMT", siFactor=0.001));
   annotation (
     Documentation(info="<html><p>The inputs: HolePosition and ApproachDistance.</p><p>The class of <code>InputParameterSet</code> in DrillingProcess:ReferenceDrillBushSkillType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1001", browseName="InputParameterSet"));

@@ -7,7 +7,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
     "Class of Base; redeclare it to use a model of your own";
   Base base(
       redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
-      parameterSet(actualPosition(unit="deg")),
+      parameterSet(actualPosition(unit="rad", displayUnit="deg", quantity="Angle")),
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Base: Joint 1 of the UR10e (base), rotary, limited to ±360°."
     annotation (__OPCUA(browsePath="Base", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4117", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
@@ -15,7 +15,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
     "Class of Shoulder; redeclare it to use a model of your own";
   Shoulder shoulder(
       redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
-      parameterSet(actualPosition(unit="deg")),
+      parameterSet(actualPosition(unit="rad", displayUnit="deg", quantity="Angle")),
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Shoulder: Joint 2 of the UR10e (shoulder), rotary, limited to ±360°."
     annotation (__OPCUA(browsePath="Shoulder", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4122", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
@@ -23,7 +23,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
     "Class of Elbow; redeclare it to use a model of your own";
   Elbow elbow(
       redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
-      parameterSet(actualPosition(unit="deg")),
+      parameterSet(actualPosition(unit="rad", displayUnit="deg", quantity="Angle")),
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Elbow: Joint 3 of the UR10e (elbow), rotary, limited to ±360°."
     annotation (__OPCUA(browsePath="Elbow", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4127", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
@@ -31,7 +31,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
     "Class of Wrist1; redeclare it to use a model of your own";
   Wrist1 wrist1(
       redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
-      parameterSet(actualPosition(unit="deg")),
+      parameterSet(actualPosition(unit="rad", displayUnit="deg", quantity="Angle")),
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Wrist1: Joint 4 of the UR10e (wrist 1), rotary, limited to ±360°."
     annotation (__OPCUA(browsePath="Wrist1", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4132", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
@@ -39,7 +39,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
     "Class of Wrist2; redeclare it to use a model of your own";
   Wrist2 wrist2(
       redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
-      parameterSet(actualPosition(unit="deg")),
+      parameterSet(actualPosition(unit="rad", displayUnit="deg", quantity="Angle")),
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Wrist2: Joint 5 of the UR10e (wrist 2), rotary, limited to ±360°."
     annotation (__OPCUA(browsePath="Wrist2", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4137", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
@@ -47,7 +47,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
     "Class of Wrist3; redeclare it to use a model of your own";
   Wrist3 wrist3(
       redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
-      parameterSet(actualPosition(unit="deg")),
+      parameterSet(actualPosition(unit="rad", displayUnit="deg", quantity="Angle")),
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Wrist3: Joint 6 of the UR10e (wrist 3), rotary, limited to ±360°."
     annotation (__OPCUA(browsePath="Wrist3", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4142", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));

@@ -7,7 +7,7 @@ model UR10eSystemType_MotionDevicesManipulatorPowerTrainsWrist3Drive "Wrist3Driv
     "Class of Motor; redeclare it to use a model of your own";
   Motor motor(
       redeclare model ParameterSet = OpcUaRobotics.Declarations.MotorType_ParameterSet,
-      parameterSet(motorTemperature(unit="degC")),
+      parameterSet(motorTemperature(unit="K", displayUnit="degC", quantity="ThermodynamicTemperature")),
       manufacturer="Universal Robots A/S")
     "Motor: Motor of the Wrist3 joint."
     annotation (__OPCUA(browsePath="Motor", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4195", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1019"));

@@ -82,7 +82,10 @@
 //! * A property becomes a `parameter`; a data variable becomes an `OpcUaSupport` output connector, or an
 //!   input connector when its AccessLevel has CurrentWrite (0x02); enumerations and records use `output` /
 //!   `input` components. The value in the nodeset is the binding, else zero, false, "" or the record's
-//!   defaults. The unit comes from the EngineeringUnits value (UNECE code, see `units.rs`).
+//!   defaults. A Real with EngineeringUnits holds its SI value, as the Modelica Standard Library does
+//!   (`unit="m", displayUnit="mm", quantity="Length"`; a value from the nodeset is converted), and its
+//!   `__OPCUA` annotation keeps the UNECE code and the conversion from the OPC UA value (`engineeringUnit=
+//!   "MMT", siFactor=0.001`; see `units.rs`).
 //! * An object becomes a component whose class is a replaceable alias (`replaceable model Axes =
 //!   OpcUaRobotics.Declarations.MotionDeviceType_Axes; Axes axes;`). An instance declaration that adds or
 //!   changes children gets a class of its own in `Declarations`; a subtype that overrides an inherited
@@ -129,7 +132,8 @@
 //! # Limits
 //!
 //! VariableTypes have no classes: a variable is a connector of its value, and of the properties of a
-//! variable only EngineeringUnits (as `unit`) is kept; the instance `Nodes` record lists all of them.
+//! variable only EngineeringUnits (as `unit`, `displayUnit` and `quantity`) is kept; the instance `Nodes`
+//! record lists all of them.
 //! Children that an instance declaration adds to an inherited component that is not replaceable are left
 //! out with a warning.
 

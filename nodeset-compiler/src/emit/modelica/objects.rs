@@ -9,11 +9,12 @@
 
 use super::ctx::{component_original, count_name, node_id_text, ClassKey, Ctx, Owner, MAX_NESTING};
 use super::text::{self, string_literal};
-use super::types::{dims_text, Base, MType};
+use super::types::{as_i128, dims_text, Base, MType};
+use super::units::Unit;
 use crate::model::{ids, ModellingRule, NodeIx};
 use crate::nodeid::QualifiedName;
 use crate::raw::NodeClass;
-use crate::value::Variant;
+use crate::value::{BuiltinType, Variant};
 use std::collections::{BTreeSet, HashMap};
 use std::rc::Rc;
 
@@ -469,6 +470,15 @@ impl Ctx<'_> {
                 s.push_str(&format!(", typeDefinition={}", string_literal(&node_id_text(m, &m.node(td).id))));
             }
         }
+        if let Some(Ok(unit)) = self.unit_of(node) {
+            s.push_str(&format!(", engineeringUnit={}", string_literal(unit.code)));
+            if !unit.is_si() {
+                s.push_str(&format!(", siFactor={}", text::real_literal(unit.factor).unwrap_or_default()));
+                if unit.offset != 0.0 {
+                    s.push_str(&format!(", siOffset={}", text::real_literal(unit.offset).unwrap_or_default()));
+                }
+            }
+        }
         s.push(')');
         s
     }
@@ -488,6 +498,15 @@ impl Ctx<'_> {
         if matches!(v, Variant::Null) {
             return None;
         }
+        // A Real in an engineering unit is held in SI (see `units.rs`).
+        let v = match (ty, self.unit_of(node)) {
+            (MType::Scalar { base: Base::Real, builtin, .. }, Some(Ok(unit)))
+                if !unit.is_si() && *builtin != BuiltinType::DateTime =>
+            {
+                to_si(&v, unit)?
+            }
+            _ => v,
+        };
         let file = m.node(node).file;
         match (dims, &v) {
             (Some(d), Variant::Array(_, items)) => {
@@ -512,7 +531,7 @@ impl Ctx<'_> {
 
     /// The Modelica unit of a variable from its EngineeringUnits property (a child, or one its type declares
     /// with a value); `Err` with the unit's display name when the table has no Modelica form for it.
-    pub fn unit_of(&self, node: NodeIx) -> Option<Result<&'static str, String>> {
+    pub fn unit_of(&self, node: NodeIx) -> Option<Result<&'static Unit, String>> {
         let m = self.m;
         let eu = m
             .children(node)
@@ -889,7 +908,7 @@ impl Ctx<'_> {
                 let mut attrs = Vec::new();
                 if let MType::Scalar { base: Base::Real, .. } = ty {
                     match self.unit_of(o.node) {
-                        Some(Ok(u)) => attrs.push(format!("unit={}", string_literal(u))),
+                        Some(Ok(u)) => attrs.extend(u.attrs()),
                         Some(Err(shown)) => {
                             desc = text::description(
                                 &bn.name,
@@ -915,9 +934,10 @@ impl Ctx<'_> {
                     element.kind = ElemKind::Parameter { ty, dims };
                 } else {
                     let (prefix, tyname, mut sattrs) = signal_type(&ty, writable);
-                    if let Some(unit) = attrs.iter().find(|a| a.starts_with("unit=")) {
+                    if !attrs.is_empty() {
+                        // The engineering unit replaces the unit a builtin type would give.
                         sattrs.retain(|a| !a.starts_with("unit="));
-                        sattrs.push(unit.clone());
+                        sattrs.extend(attrs);
                     }
                     let mods = attr_mods(&sattrs, dims.is_some());
                     body.items.push(Item::Decl {
@@ -1120,11 +1140,8 @@ impl Ctx<'_> {
                 if let (MType::Scalar { base: Base::Real, .. }, ElemKind::Signal { .. }) = (ty, &e.kind) {
                     if let Some(Ok(u)) = self.unit_of(o.node) {
                         if self.unit_of(e.node).and_then(|x| x.ok()) != Some(u) {
-                            attrs.push(format!(
-                                "{}unit={}",
-                                if dims.is_some() { "each " } else { "" },
-                                string_literal(u)
-                            ));
+                            let each = if dims.is_some() { "each " } else { "" };
+                            attrs.extend(u.attrs().into_iter().map(|a| format!("{each}{a}")));
                         }
                     }
                 }
@@ -1361,4 +1378,20 @@ fn signal_type(ty: &MType, writable: bool) -> (String, String, Vec<String>) {
         }
         other => ((if writable { "input" } else { "output" }).into(), other.type_name().to_string(), Vec::new()),
     }
+}
+
+/// A numeric value (or an array of them) in the engineering unit as the SI value, a Double; `None` for a value
+/// that is not a number.
+fn to_si(v: &Variant, unit: &Unit) -> Option<Variant> {
+    let x = match v {
+        Variant::Array(ty, items) => {
+            let items: Option<Vec<Variant>> = items.iter().map(|i| to_si(i, unit)).collect();
+            return Some(Variant::Array(*ty, items?));
+        }
+        Variant::Variant(inner) => return to_si(inner, unit),
+        Variant::Float(f) => *f as f64,
+        Variant::Double(f) => *f,
+        other => as_i128(other)? as f64,
+    };
+    Some(Variant::Double(unit.to_si(x)))
 }

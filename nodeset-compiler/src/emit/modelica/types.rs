@@ -910,7 +910,7 @@ pub fn attrs(min: Option<&str>, max: Option<&str>, unit: Option<&str>) -> String
     }
 }
 
-fn as_i128(v: &Variant) -> Option<i128> {
+pub fn as_i128(v: &Variant) -> Option<i128> {
     Some(match v {
         Variant::SByte(x) => *x as i128,
         Variant::Byte(x) => *x as i128,
