@@ -4,5 +4,7 @@ within NodesetCompilerCommonSkills;
 package EnumerationValues "OPC UA values of the enumerations of NodesetCompilerCommonSkills.Types"
   constant Integer GripperActionEnumeration[2] = {0, 1}
     "OPC UA values of the literals of Types.GripperActionEnumeration, in their order";
-  annotation (Documentation(info="<html><p>Modelica numbers the literals of an enumeration from 1; OPC UA gives each a value of its own, which need not start at 0 nor be consecutive. <code>EnumerationValues.E[Integer(x)]</code> is the OPC UA value of literal <code>x</code> of <code>NodesetCompilerCommonSkills.Types.E</code>.</p></html>"));
+  annotation (
+    Documentation(info="<html><p>Modelica numbers the literals of an enumeration from 1; OPC UA gives each a value of its own, which need not start at 0 nor be consecutive. <code>EnumerationValues.E[Integer(x)]</code> is the OPC UA value of literal <code>x</code> of <code>NodesetCompilerCommonSkills.Types.E</code>.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={128,128,128}, fillColor={240,240,240}, fillPattern=FillPattern.Solid, radius=25), Text(extent={{-80,40},{80,-40}}, textString="UA", textColor={128,128,128})}));
 end EnumerationValues;

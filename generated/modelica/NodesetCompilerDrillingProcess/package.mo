@@ -6,5 +6,6 @@ package NodesetCompilerDrillingProcess "OPC UA namespace http://nodeset-compiler
     version="1.0.0",
     uses(OpcUa(version="1.05.07"), OpcUaDI(version="1.05.0"), OpcUaIA(version="1.01.4"), OpcUaRobotics(version="1.02"), NodesetCompilerCommonSkills(version="1.0.0"), NodesetCompilerRobotCell(version="1.0.0"), OpcUaSupport(version="0.1.0")),
     Documentation(info="<html><p>Generated from the OPC UA information model <code>http://nodeset-compiler.dev/DrillingProcess/</code>, version 1.0.0, published 2026-11-21T00:00:00Z.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={128,128,128}, fillColor={240,240,240}, fillPattern=FillPattern.Solid, radius=25), Text(extent={{-80,40},{80,-40}}, textString="UA", textColor={128,128,128})}),
     __OPCUA(namespaceUri="http://nodeset-compiler.dev/DrillingProcess/"));
 end NodesetCompilerDrillingProcess;

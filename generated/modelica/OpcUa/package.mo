@@ -6,5 +6,6 @@ package OpcUa "OPC UA namespace http://opcfoundation.org/UA/ (the part the gener
     version="1.05.07",
     uses(OpcUaSupport(version="0.1.0")),
     Documentation(info="<html><p>Generated from the OPC UA information model <code>http://opcfoundation.org/UA/</code>, version 1.05.07, published 2026-05-01T00:00:00Z.</p><p>This package holds only the part of the namespace that the other generated packages use.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={128,128,128}, fillColor={240,240,240}, fillPattern=FillPattern.Solid, radius=25), Text(extent={{-80,40},{80,-40}}, textString="UA", textColor={128,128,128})}),
     __OPCUA(namespaceUri="http://opcfoundation.org/UA/"));
 end OpcUa;

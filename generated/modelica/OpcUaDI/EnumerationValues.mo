@@ -8,5 +8,7 @@ package EnumerationValues "OPC UA values of the enumerations of OpcUaDI.Types"
     "OPC UA values of the literals of Types.SoftwareClass, in their order";
   constant Integer SoftwareVersionFileType[3] = {0, 1, 2}
     "OPC UA values of the literals of Types.SoftwareVersionFileType, in their order";
-  annotation (Documentation(info="<html><p>Modelica numbers the literals of an enumeration from 1; OPC UA gives each a value of its own, which need not start at 0 nor be consecutive. <code>EnumerationValues.E[Integer(x)]</code> is the OPC UA value of literal <code>x</code> of <code>OpcUaDI.Types.E</code>.</p></html>"));
+  annotation (
+    Documentation(info="<html><p>Modelica numbers the literals of an enumeration from 1; OPC UA gives each a value of its own, which need not start at 0 nor be consecutive. <code>EnumerationValues.E[Integer(x)]</code> is the OPC UA value of literal <code>x</code> of <code>OpcUaDI.Types.E</code>.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={128,128,128}, fillColor={240,240,240}, fillPattern=FillPattern.Solid, radius=25), Text(extent={{-80,40},{80,-40}}, textString="UA", textColor={128,128,128})}));
 end EnumerationValues;

@@ -6,5 +6,6 @@ package OpcUaIA "OPC UA namespace http://opcfoundation.org/UA/IA/"
     version="1.01.4",
     uses(OpcUa(version="1.05.07"), OpcUaDI(version="1.05.0"), OpcUaSupport(version="0.1.0")),
     Documentation(info="<html><p>Generated from the OPC UA information model <code>http://opcfoundation.org/UA/IA/</code>, version 1.01.4, published 2025-05-23T00:00:00Z.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={128,128,128}, fillColor={240,240,240}, fillPattern=FillPattern.Solid, radius=25), Text(extent={{-80,40},{80,-40}}, textString="UA", textColor={128,128,128})}),
     __OPCUA(namespaceUri="http://opcfoundation.org/UA/IA/"));
 end OpcUaIA;

@@ -6,5 +6,6 @@ package OpcUaRobotics "OPC UA namespace http://opcfoundation.org/UA/Robotics/"
     version="1.02",
     uses(OpcUa(version="1.05.07"), OpcUaDI(version="1.05.0"), OpcUaIA(version="1.01.4"), OpcUaSupport(version="0.1.0")),
     Documentation(info="<html><p>Generated from the OPC UA information model <code>http://opcfoundation.org/UA/Robotics/</code>, version 1.02, published 2025-09-08T00:00:00Z.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={128,128,128}, fillColor={240,240,240}, fillPattern=FillPattern.Solid, radius=25), Text(extent={{-80,40},{80,-40}}, textString="UA", textColor={128,128,128})}),
     __OPCUA(namespaceUri="http://opcfoundation.org/UA/Robotics/"));
 end OpcUaRobotics;

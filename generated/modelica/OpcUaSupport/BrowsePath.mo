@@ -4,7 +4,7 @@ within OpcUaSupport;
 record BrowsePath "A node reached by BrowseNames from a start node"
   String startNodeId = "i=85" "NodeId of the start node (default: the ObjectsFolder)";
   String path = "" "BrowseNames separated by '/'; a '/' or '&' inside a name is written '&/' or '&&'";
-  annotation (Documentation(info="<html><p>Generated components carry a <code>browsePath</code> relative to the
+  annotation (Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}), Documentation(info="<html><p>Generated components carry a <code>browsePath</code> relative to the
 object their enclosing class stands for: the path of a nested component is the path of its parent component, a
 '/', and its own path. Like the DLR OPC UA library, a path names BrowseNames without their namespace.</p></html>"));
 end BrowsePath;

@@ -2,7 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within OpcUaSupport;
 type BuiltinType = enumeration(
-    Boolean "Boolean (1)",
+    Boolean_ "Boolean (1)",
     SByte "SByte (2)",
     Byte "Byte (3)",
     Int16 "Int16 (4)",
@@ -13,7 +13,7 @@ type BuiltinType = enumeration(
     UInt64 "UInt64 (9)",
     Float "Float (10)",
     Double "Double (11)",
-    String "String (12)",
+    String_ "String (12)",
     DateTime "DateTime (13)",
     Guid "Guid (14)",
     ByteString "ByteString (15)",
@@ -27,4 +27,8 @@ type BuiltinType = enumeration(
     DataValue "DataValue (23)",
     Variant "Variant (24)",
     DiagnosticInfo "DiagnosticInfo (25)")
-  "The 25 built-in types of OPC UA Part 6; Integer(t) is the built-in type id";
+  "The 25 built-in types of OPC UA Part 6; Integer(t) is the built-in type id"
+  annotation (Documentation(info="<html><p>The built-in types of OPC UA Part 6, 5.1.2, in the order of their ids,
+so that <code>Integer(t)</code> is the id. A variable's value is encoded as one of them; a structure is an
+<code>ExtensionObject</code>. Boolean and String are the literals <code>Boolean_</code> and <code>String_</code>:
+no literal is named like a predefined Modelica type.</p></html>"));

@@ -5,7 +5,7 @@ record NodeId "A NodeId, split as in the DLR OPC UA library"
   Integer nsIndex = 0 "Namespace: 0 is the OPC UA base namespace, i > 0 is Nodes.nsUri[i]";
   NodeIdType nodeIdType = NodeIdType.Numeric "Kind of identifier";
   String id = "" "Identifier as text (the number of a Numeric identifier)";
-  annotation (Documentation(info="<html><p>Generated code writes NodeIds as text in the standard
+  annotation (Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}), Documentation(info="<html><p>Generated code writes NodeIds as text in the standard
 <code>nsu=&lt;namespace URI&gt;;i=&lt;number&gt;</code> form (<code>i=&lt;number&gt;</code> in the base
 namespace); this record is the split form that server and client blocks take as parameters.</p></html>"));
 end NodeId;

@@ -6,4 +6,9 @@ record Nodes "Nodes of an OPC UA server or client configuration, as in the DLR O
     annotation (Dialog(enable=true));
   Integer nVars = 0 "Number of variable nodes";
   VariableNode vars[nVars] "Variable nodes" annotation (Dialog(enable=true));
+  annotation (Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}), Documentation(info="<html><p>The variables of an address space, as the configuration record of
+an OPC UA server or client block of the DLR OPC UA library. The generated <code>Instances.Objects</code> model of
+each namespace fills one with every variable of its instances. <code>vars</code> is sized by
+<code>nVars</code>, because an unsized array of records inside a record is not accepted by every Modelica
+tool.</p></html>"));
 end Nodes;

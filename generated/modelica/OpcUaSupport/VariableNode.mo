@@ -12,4 +12,9 @@ record VariableNode "A variable node of the Nodes configuration record"
   String arrayDimensions = "" "Comma-separated array lengths (0: any length); empty for a scalar";
   String initValue = "" "Initial value as text; empty when the node has none or it is a structure";
   String browsePath = "" "BrowseNames from the ObjectsFolder, separated by '/'";
+  annotation (Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}), Documentation(info="<html><p>One variable of an OPC UA address space as the DLR OPC UA library
+configures it (Sch&ouml;nfeld et al., Modelica Conference 2021): its NodeId (<code>nsIndex</code>,
+<code>nodeIdType</code>, <code>id</code>), names, built-in type and initial value. Values are those of OPC UA,
+in the variable's engineering unit (a generated model holds SI values; its <code>__OPCUA</code> annotation
+gives the conversion). <code>browsePath</code> is ours: it finds the node on a server whose NodeIds differ.</p></html>"));
 end VariableNode;

@@ -2,11 +2,102 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within;
 package OpcUaSupport "Connectors and configuration records shared by the Modelica packages generated from OPC UA information models"
+  package UsersGuide "User's Guide: the Modelica packages nodeset-compiler generates from OPC UA information models"
+    annotation (
+      DocumentationClass=true,
+      Icon(graphics={Ellipse(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Text(extent={{-60,70},{60,-70}}, textString="i", textColor={0,0,127})}),
+      Documentation(info="<html>
+<h4>What is generated</h4>
+<p>nodeset-compiler reads OPC UA NodeSet2 files and writes one Modelica package per namespace, next to this
+support package. Neither depends on the Modelica Standard Library. A namespace package holds:</p>
+<ul>
+<li><code>Types</code>: one class per DataType: an <code>enumeration</code>, a <code>record</code> for a
+structure (it extends the record of its supertype), or a <code>type</code> for a simple DataType.
+<code>EnumerationValues</code> gives the OPC UA value of each literal, since Modelica numbers literals from 1.</li>
+<li><code>ObjectTypes</code>: one model per ObjectType, extending the model of its supertype; a
+<code>partial model</code> where the ObjectType is abstract; a <code>record</code> of its fields for an event
+type.</li>
+<li><code>Declarations</code>: the classes of instance declarations that add children to their type, named
+<code>Owner_BrowsePath</code> (<code>AxisType_ParameterSet</code>).</li>
+<li><code>Instances</code>: one model per instance of the namespace below the ObjectsFolder, and
+<code>Objects</code>, which holds them all and the <code>Nodes</code> record of their variables.</li>
+</ul>
+<p>Every class says what it stands for: its description string starts with the BrowseName, its
+<code>Documentation</code> holds the Description of the nodeset, and its <code>__OPCUA</code> annotation holds
+the NodeId and BrowseName.</p>
+
+<h4>Members</h4>
+<ul>
+<li>A property is a <code>parameter</code>. A data variable is a connector of this package:
+<code>RealOutput</code> where clients may only read it, <code>RealInput</code> where they may write it
+(AccessLevel CurrentWrite). The value in the nodeset is its binding, else zero, false or an empty string.</li>
+<li>An object is a component whose class is a replaceable alias: <code>replaceable model Axes =
+...Declarations.MotionDeviceType_Axes; Axes axes;</code>. Redeclare the alias to use a model of your own.</li>
+<li>An optional member exists when <code>use_x = true</code>: <code>parameter Boolean use_x = false</code>,
+<code>X x if use_x</code>.</li>
+<li>A placeholder <code>&lt;X&gt;</code> is an array: <code>parameter Integer nX</code>, <code>replaceable model
+X</code>, <code>X x[nX]</code>.</li>
+<li>A member held by a non-hierarchical reference (Requires, Moves, HasSlave, ...) lives elsewhere: it is
+<code>parameter String x</code>, the NodeId of its target.</li>
+<li>Methods are comments: call them through an OPC UA client. The methods of a state machine (Start, Suspend,
+Resume, Halt, Reset of a program or skill) are Boolean trigger inputs: a rising edge stands for a call.</li>
+</ul>
+
+<h4>Using a generated model</h4>
+<p>Extend a type and bind what your model computes with modifiers:</p>
+<pre>model FirstOrderAxis
+  extends OpcUaRobotics.ObjectTypes.AxisType(
+    parameterSet(actualPosition=position, use_actualSpeed=true, actualSpeed=der(position)));
+  parameter Real T(unit=\"s\") = 0.2;
+  Real position(unit=\"rad\", start=0, fixed=true);
+equation
+  der(position) = (1 - position)/T;
+end FirstOrderAxis;</pre>
+<p>and fill placeholders by redeclaring their class and setting their count:</p>
+<pre>extends OpcUaRobotics.Declarations.MotionDeviceType_Axes(
+  nAxisIdentifier=2, redeclare model AxisIdentifier = FirstOrderAxis);</pre>
+
+<h4>State machines</h4>
+<p>A state machine has <code>currentStateNumber</code>, an Integer holding the StateNumber of the nodeset, one
+constant per state, and <code>currentStateText</code>, the DisplayName of the current state, which
+<code>currentState</code> shows. It starts in the initial state of the nodeset (Ready for programs and skills)
+and moves along the transitions of the nodeset when a trigger rises.</p>
+
+<h4>Units</h4>
+<p>A variable with EngineeringUnits holds its SI value, as the Modelica Standard Library does:
+<code>unit=\"m\", displayUnit=\"mm\", quantity=\"Length\"</code>, and a value from the nodeset is converted. Its
+<code>__OPCUA</code> annotation keeps the UNECE code and the conversion from the OPC UA value:
+<code>engineeringUnit=\"MMT\", siFactor=0.001</code>, and <code>siOffset=273.15</code> for degree Celsius. So
+SI value = siFactor * OPC UA value + siOffset. A unit nodeset-compiler cannot map (percent, for one) gets no
+<code>unit</code>; the description string says which it was.</p>
+
+<h4>The __OPCUA annotation</h4>
+<p>Each member names its node: <code>browsePath</code> (from the object its class stands for),
+<code>nodeId</code> (in the form <code>nsu=URI;i=5</code>), <code>dataType</code>, <code>typeDefinition</code>
+for objects, <code>referenceType</code> for a non-hierarchical member, and the unit conversion above. In a type,
+the NodeId is the one of the declaration; an instance's own NodeIds are in the <code>Nodes</code> record of
+<code>Instances.Objects</code>.</p>
+
+<h4>Connecting to a server</h4>
+<p><code>Nodes</code> and <code>VariableNode</code> follow the configuration record of the DLR OPC UA library
+(Sch&ouml;nfeld et al., Modelica Conference 2021): each instance variable with its NodeId, built-in type and
+initial value, in OPC UA units, and its browse path, for a server whose NodeIds differ.</p>
+
+<h4>Checked by</h4>
+<p>Every generated class is checked with two independent Modelica front ends, rumoca and pymoca, and by
+structural checks of nodeset-compiler's own (no class contains itself, no conditional component read in an
+equation, no modifier naming a member that does not exist). Hand-written example models built on the
+generated classes are simulated.</p>
+</html>"));
+  end UsersGuide;
   annotation (
     version="0.1.0",
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={128,128,128}, fillColor={240,240,240}, fillPattern=FillPattern.Solid, radius=25), Text(extent={{-80,40},{80,-40}}, textString="UA", textColor={128,128,128})}),
     Documentation(info="<html>
 <p>This package is emitted by nodeset-compiler next to the packages it generates from OPC UA NodeSet2 files. It
 does not depend on the Modelica Standard Library.</p>
+<p>Start with the <code>UsersGuide</code>: how the generated packages stand for an information model, and how
+to use them.</p>
 <ul>
 <li><code>RealInput</code> ... <code>StringOutput</code>: signal connectors shaped like those of
 <code>Modelica.Blocks.Interfaces</code>. Generated models declare read-only OPC UA variables as outputs and

@@ -8,5 +8,6 @@ model AbsoluteCartesianLinearMoveSkillType_InputParameterSet "InputParameterSet:
     annotation (__OPCUA(browsePath="TargetPose", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1806", dataType="i=18814"));
   annotation (
     Documentation(info="<html><p>The inputs of the absolute motion: TargetPose, Speed and Acceleration.</p><p>The class of <code>InputParameterSet</code> in CommonSkills:AbsoluteCartesianLinearMoveSkillType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1801", browseName="InputParameterSet"));
 end AbsoluteCartesianLinearMoveSkillType_InputParameterSet;

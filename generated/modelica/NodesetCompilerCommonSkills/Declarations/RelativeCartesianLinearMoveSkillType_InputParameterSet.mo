@@ -8,5 +8,6 @@ model RelativeCartesianLinearMoveSkillType_InputParameterSet "InputParameterSet:
     annotation (__OPCUA(browsePath="PoseOffset", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1706", dataType="i=18814"));
   annotation (
     Documentation(info="<html><p>The inputs of the relative motion: PoseOffset, Speed and Acceleration.</p><p>The class of <code>InputParameterSet</code> in CommonSkills:RelativeCartesianLinearMoveSkillType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1701", browseName="InputParameterSet"));
 end RelativeCartesianLinearMoveSkillType_InputParameterSet;

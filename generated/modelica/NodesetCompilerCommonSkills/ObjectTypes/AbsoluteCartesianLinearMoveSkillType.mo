@@ -6,5 +6,6 @@ model AbsoluteCartesianLinearMoveSkillType "AbsoluteCartesianLinearMoveSkillType
     redeclare model InputParameterSet = NodesetCompilerCommonSkills.Declarations.AbsoluteCartesianLinearMoveSkillType_InputParameterSet);
   annotation (
     Documentation(info="<html><p>Linear Cartesian motion to an absolute pose: the tool centre point moves on a straight line to TargetPose, expressed in the base frame of the robot.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1800", browseName="AbsoluteCartesianLinearMoveSkillType"));
 end AbsoluteCartesianLinearMoveSkillType;

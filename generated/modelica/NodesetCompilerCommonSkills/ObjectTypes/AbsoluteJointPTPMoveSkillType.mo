@@ -6,5 +6,6 @@ model AbsoluteJointPTPMoveSkillType "AbsoluteJointPTPMoveSkillType: Point-to-poi
     redeclare model InputParameterSet = NodesetCompilerCommonSkills.Declarations.AbsoluteJointPTPMoveSkillType_InputParameterSet);
   annotation (
     Documentation(info="<html><p>Point-to-point motion in joint space: every joint moves to its target angle, all joints start and stop together; the path of the tool between is not a straight line.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1600", browseName="AbsoluteJointPTPMoveSkillType"));
 end AbsoluteJointPTPMoveSkillType;

@@ -5,5 +5,6 @@ partial model CompositeSkillType "CompositeSkillType: A skill that runs other sk
   extends NodesetCompilerCommonSkills.ObjectTypes.ProgramSkillStateMachineType;
   annotation (
     Documentation(info="<html><p>A skill that runs other skills one after another, possibly of other devices and servers (for example move, drill, move). If a skill it uses is unavailable it suspends, if one halts it halts, so the state of the innermost skill reaches the outermost; Suspend and Resume are therefore Mandatory.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1400", browseName="CompositeSkillType"));
 end CompositeSkillType;

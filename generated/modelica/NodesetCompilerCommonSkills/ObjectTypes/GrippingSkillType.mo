@@ -6,5 +6,6 @@ model GrippingSkillType "GrippingSkillType: Opening or closing a gripper. The ru
     redeclare model InputParameterSet = NodesetCompilerCommonSkills.Declarations.GrippingSkillType_InputParameterSet);
   annotation (
     Documentation(info="<html><p>Opening or closing a gripper. The run ends in Ready when the jaws have reached their end position or, when closing, hold the part with GripForce; in Halted when they could not.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1900", browseName="GrippingSkillType"));
 end GrippingSkillType;

@@ -10,5 +10,6 @@ partial model ISkillSetType "ISkillSetType: Interface of everything that offers 
     annotation (__OPCUA(browsePath="SkillSet", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1201", typeDefinition="i=61"));
   annotation (
     Documentation(info="<html><p>Interface of everything that offers skills: devices, device systems, controllers, cells. An object that implements it (HasInterface) has a folder SkillSet, and the SkillSet convention applies: every skill of the object is a component (HasComponent) of SkillSet, is an instance of a concrete subtype of ProgramSkillStateMachineType, and is named after its type without the suffix SkillType (AbsoluteJointPTPMove for AbsoluteJointPTPMoveSkillType). A client finds what an object can do by browsing its SkillSet; composite skills of a cell call the skills in the SkillSets of its devices.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1200", browseName="ISkillSetType"));
 end ISkillSetType;

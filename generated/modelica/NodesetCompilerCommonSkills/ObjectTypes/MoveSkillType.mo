@@ -6,5 +6,6 @@ partial model MoveSkillType "MoveSkillType: A robot motion. Each concrete move s
     redeclare model InputParameterSet = NodesetCompilerCommonSkills.Declarations.MoveSkillType_InputParameterSet);
   annotation (
     Documentation(info="<html><p>A robot motion. Each concrete move skill fixes the target and the units of Speed and Acceleration; the run ends in Ready when the robot stands at the target, in Halted when the motion was stopped (an emergency or protective stop, or Halt).</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1500", browseName="MoveSkillType"));
 end MoveSkillType;

@@ -15,5 +15,6 @@ partial model ProgramSkillStateMachineType "ProgramSkillStateMachineType: A skil
     annotation (__OPCUA(browsePath="OutputParameterSet", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1302", typeDefinition="i=58"));
   annotation (
     Documentation(info="<html><p>A skill: a capability of a device or cell that a client parameterises and runs. It is an OPC UA Program (ProgramStateMachineType) and keeps its states Ready, Running, Suspended and Halted, its transitions and their causes: a client writes the variables of InputParameterSet, calls Start, and the skill runs until it is back in Ready (success, results in OutputParameterSet) or in Halted (failure or Halt, Reset to go on). Start, Halt and Reset are Mandatory; Suspend and Resume are Optional and made Mandatory by subtypes that can pause. Every transition raises a SkillTransitionEventType.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1300", browseName="ProgramSkillStateMachineType"));
 end ProgramSkillStateMachineType;

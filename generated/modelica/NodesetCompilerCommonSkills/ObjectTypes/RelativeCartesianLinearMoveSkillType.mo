@@ -6,5 +6,6 @@ model RelativeCartesianLinearMoveSkillType "RelativeCartesianLinearMoveSkillType
     redeclare model InputParameterSet = NodesetCompilerCommonSkills.Declarations.RelativeCartesianLinearMoveSkillType_InputParameterSet);
   annotation (
     Documentation(info="<html><p>Linear Cartesian motion relative to where the tool is: the tool centre point moves on a straight line by PoseOffset, expressed in the tool frame (the frame of the tool centre point when the motion starts). Used for short approach and retreat motions, such as moving a drill nose into a drill bush along tool Z.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1700", browseName="RelativeCartesianLinearMoveSkillType"));
 end RelativeCartesianLinearMoveSkillType;

@@ -8,5 +8,6 @@ record SkillTransitionEventType "SkillTransitionEventType: Event of a skill stat
     annotation (__OPCUA(browsePath="SkillName", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1101", dataType="i=12"));
   annotation (
     Documentation(info="<html><p>Event of a skill state change. A skill (a ProgramSkillStateMachineType) raises it for every transition of its state machine, as the ProgramTransitionEventType its ns0 transitions name as their effect, with the BrowseName of the skill added, so one subscription serves a dashboard of many skills.</p><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1100", browseName="SkillTransitionEventType"));
 end SkillTransitionEventType;

@@ -19,5 +19,6 @@ model DrillingCellType_SkillSet "SkillSet: The process skills of the cell (ISkil
     annotation (__OPCUA(browsePath="DrillHole", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=3045", typeDefinition="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=2000"));
   annotation (
     Documentation(info="<html><p>The process skills of the cell (ISkillSetType).</p><p>The class of <code>SkillSet</code> in DrillingProcess:DrillingCellType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=3001", browseName="SkillSet"));
 end DrillingCellType_SkillSet;

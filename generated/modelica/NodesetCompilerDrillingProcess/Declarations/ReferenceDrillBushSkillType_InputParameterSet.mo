@@ -8,8 +8,9 @@ model ReferenceDrillBushSkillType_InputParameterSet "InputParameterSet: The inpu
     annotation (__OPCUA(browsePath="HolePosition", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1002", dataType="i=18814"));
   OpcUaSupport.RealInput approachDistance(unit="m", displayUnit="mm", quantity="Length") = 0
     "ApproachDistance: Distance in front of the bush face at which the end effector stops, in millimetres."
-    annotation (__OPCUA(browsePath="ApproachDistance", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1013", dataType="i=11", engineeringUnit="MMT", siFactor=0.001));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="ApproachDistance", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1013", dataType="i=11", engineeringUnit="MMT", siFactor=0.001));
   annotation (
     Documentation(info="<html><p>The inputs: HolePosition and ApproachDistance.</p><p>The class of <code>InputParameterSet</code> in DrillingProcess:ReferenceDrillBushSkillType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1001", browseName="InputParameterSet"));
 end ReferenceDrillBushSkillType_InputParameterSet;

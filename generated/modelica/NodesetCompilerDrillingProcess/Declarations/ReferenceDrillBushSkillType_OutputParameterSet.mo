@@ -8,5 +8,6 @@ model ReferenceDrillBushSkillType_OutputParameterSet "OutputParameterSet: The re
     annotation (__OPCUA(browsePath="ReferencedHolePosition", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1017", dataType="i=18814"));
   annotation (
     Documentation(info="<html><p>The results: Result and ReferencedHolePosition.</p><p>The class of <code>OutputParameterSet</code> in DrillingProcess:ReferenceDrillBushSkillType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1015", browseName="OutputParameterSet"));
 end ReferenceDrillBushSkillType_OutputParameterSet;

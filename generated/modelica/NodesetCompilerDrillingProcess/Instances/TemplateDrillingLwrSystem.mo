@@ -8,5 +8,6 @@ model TemplateDrillingLwrSystem "TemplateDrillingLwrSystem: The mobile lightweig
     drillingEndEffector(skillSet(templateDrilling(deletable=false, autoDelete=false, recycleCount=0))));
   annotation (
     Documentation(info="<html><p>The mobile lightweight robot system of the cell: a UR10e carrying the drilling end effector.</p><p>The instance DeviceSet/TemplateDrillingLwrSystem of RobotCell:TemplateDrillingLwrSystemType (nsu=http://nodeset-compiler.dev/DrillingProcess/;i=5000).</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=5000", browseName="TemplateDrillingLwrSystem", browsePath="DeviceSet/TemplateDrillingLwrSystem"));
 end TemplateDrillingLwrSystem;

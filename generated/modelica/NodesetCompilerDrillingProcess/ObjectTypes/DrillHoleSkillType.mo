@@ -6,5 +6,6 @@ model DrillHoleSkillType "DrillHoleSkillType: Drills one hole through the drill 
     redeclare model InputParameterSet = NodesetCompilerDrillingProcess.Declarations.DrillHoleSkillType_InputParameterSet);
   annotation (
     Documentation(info="<html><p>Drills one hole through the drill bush the end effector is in front of: moves the nose into the bush by InsertionDistance along tool Z (RelativeCartesianLinearMove), runs TemplateDrilling of the end effector with the drilling parameters, and moves back out by the same distance (RelativeCartesianLinearMove).</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=2000", browseName="DrillHoleSkillType"));
 end DrillHoleSkillType;

@@ -10,5 +10,6 @@ model DrillingCellType "DrillingCellType: A template drilling work cell: offers 
     annotation (__OPCUA(browsePath="SkillSet", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=3001", typeDefinition="i=61"));
   annotation (
     Documentation(info="<html><p>A template drilling work cell: offers the process skills ReferenceDrillBush and DrillHole, which a process controller runs once per hole, using the skills of the robot system and its end effector.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=3000", browseName="DrillingCellType"));
 end DrillingCellType;

@@ -7,5 +7,6 @@ model ReferenceDrillBushSkillType "ReferenceDrillBushSkillType: Brings the drill
     redeclare model OutputParameterSet = NodesetCompilerDrillingProcess.Declarations.ReferenceDrillBushSkillType_OutputParameterSet);
   annotation (
     Documentation(info="<html><p>Brings the drilling end effector in front of a drill bush: moves the robot to the rough pose of the bush measured by the template referencing camera (AbsoluteCartesianLinearMove), measures the bush with the hole referencing unit of the end effector, corrects position and perpendicularity and stops ApproachDistance in front of the bush. The corrected pose of the bush is the result.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1000", browseName="ReferenceDrillBushSkillType"));
 end ReferenceDrillBushSkillType;

@@ -12,5 +12,6 @@ model DrillingEndEffectorType_SkillSet "SkillSet: The skills of the end effector
     annotation (__OPCUA(browsePath="TemplateDrilling", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=2005", typeDefinition="nsu=http://nodeset-compiler.dev/RobotCell/;i=1000"));
   annotation (
     Documentation(info="<html><p>The skills of the end effector (ISkillSetType): TemplateDrilling.</p><p>The class of <code>SkillSet</code> in RobotCell:DrillingEndEffectorType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=2004", browseName="SkillSet"));
 end DrillingEndEffectorType_SkillSet;

@@ -14,5 +14,6 @@ model UR10eSystemType_ControllersURController "URController: The UR10e control b
     annotation (__OPCUA(browsePath="SkillSet", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4020", typeDefinition="i=61"));
   annotation (
     Documentation(info="<html><p>The UR10e control box. Besides the Robotics controller data it offers the basic move skills of the robot in SkillSet (ISkillSetType).</p><p>The class of <code>Controllers/URController</code> in RobotCell:UR10eSystemType: Robotics:ControllerType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4002", browseName="URController"));
 end UR10eSystemType_ControllersURController;

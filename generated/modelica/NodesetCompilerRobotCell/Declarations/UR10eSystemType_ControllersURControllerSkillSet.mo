@@ -26,5 +26,6 @@ model UR10eSystemType_ControllersURControllerSkillSet "SkillSet: The basic move 
     annotation (__OPCUA(browsePath="AbsoluteCartesianLinearMove", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4076", typeDefinition="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1800"));
   annotation (
     Documentation(info="<html><p>The basic move skills of the UR10e (ISkillSetType): AbsoluteJointPTPMove, RelativeCartesianLinearMove and AbsoluteCartesianLinearMove.</p><p>The class of <code>Controllers/URController/SkillSet</code> in RobotCell:UR10eSystemType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4020", browseName="SkillSet"));
 end UR10eSystemType_ControllersURControllerSkillSet;

@@ -13,5 +13,6 @@ model UR10eSystemType_ControllersURControllerSoftware "Software: The software ru
     annotation (__OPCUA(browsePath="PolyScope", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4010", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=15106"));
   annotation (
     Documentation(info="<html><p>The software running on the controller.</p><p>The class of <code>Controllers/URController/Software</code> in RobotCell:UR10eSystemType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4009", browseName="Software"));
 end UR10eSystemType_ControllersURControllerSoftware;

@@ -10,5 +10,6 @@ model UR10eSystemType_ControllersURControllerTaskControls "TaskControls: The pro
     annotation (__OPCUA(browsePath="ProgramTask", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4015", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1011"));
   annotation (
     Documentation(info="<html><p>The program task of the controller.</p><p>The class of <code>Controllers/URController/TaskControls</code> in RobotCell:UR10eSystemType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4014", browseName="TaskControls"));
 end UR10eSystemType_ControllersURControllerTaskControls;

@@ -13,5 +13,6 @@ model UR10eSystemType_MotionDevices "MotionDevices: The arm of the UR10e."
     annotation (__OPCUA(browsePath="Manipulator", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4109", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1004"));
   annotation (
     Documentation(info="<html><p>The arm of the UR10e.</p><p>The class of <code>MotionDevices</code> in RobotCell:UR10eSystemType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4108", browseName="MotionDevices"));
 end UR10eSystemType_MotionDevices;

@@ -10,5 +10,6 @@ model UR10eSystemType_MotionDevicesManipulator "Manipulator: The six-joint UR10e
     redeclare model PowerTrains = NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrains);
   annotation (
     Documentation(info="<html><p>The six-joint UR10e arm.</p><p>The class of <code>MotionDevices/Manipulator</code> in RobotCell:UR10eSystemType: Robotics:MotionDeviceType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4109", browseName="Manipulator"));
 end UR10eSystemType_MotionDevicesManipulator;

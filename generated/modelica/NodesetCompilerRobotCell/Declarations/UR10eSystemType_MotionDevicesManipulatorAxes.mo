@@ -53,5 +53,6 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
     annotation (__OPCUA(browsePath="Wrist3", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4142", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
   annotation (
     Documentation(info="<html><p>The six joints of the arm.</p><p>The class of <code>MotionDevices/Manipulator/Axes</code> in RobotCell:UR10eSystemType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4116", browseName="Axes"));
 end UR10eSystemType_MotionDevicesManipulatorAxes;

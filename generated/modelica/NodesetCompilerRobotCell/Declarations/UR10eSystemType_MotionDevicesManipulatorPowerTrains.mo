@@ -35,5 +35,6 @@ model UR10eSystemType_MotionDevicesManipulatorPowerTrains "PowerTrains: The six 
     annotation (__OPCUA(browsePath="Wrist3Drive", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4194", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16794"));
   annotation (
     Documentation(info="<html><p>The six drive trains of the arm, one per joint.</p><p>The class of <code>MotionDevices/Manipulator/PowerTrains</code> in RobotCell:UR10eSystemType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4148", browseName="PowerTrains"));
 end UR10eSystemType_MotionDevicesManipulatorPowerTrains;

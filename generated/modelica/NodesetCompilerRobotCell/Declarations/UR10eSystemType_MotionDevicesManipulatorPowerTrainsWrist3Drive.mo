@@ -13,5 +13,6 @@ model UR10eSystemType_MotionDevicesManipulatorPowerTrainsWrist3Drive "Wrist3Driv
     annotation (__OPCUA(browsePath="Motor", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4195", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1019"));
   annotation (
     Documentation(info="<html><p>Drive train of the Wrist3 joint: its motor and gear.</p><p>The class of <code>MotionDevices/Manipulator/PowerTrains/Wrist3Drive</code> in RobotCell:UR10eSystemType: Robotics:PowerTrainType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4194", browseName="Wrist3Drive"));
 end UR10eSystemType_MotionDevicesManipulatorPowerTrainsWrist3Drive;

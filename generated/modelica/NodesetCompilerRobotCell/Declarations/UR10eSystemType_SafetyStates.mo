@@ -10,5 +10,6 @@ model UR10eSystemType_SafetyStates "SafetyStates: The safety state of the UR10e.
     annotation (__OPCUA(browsePath="SafetyState", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4204", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1013"));
   annotation (
     Documentation(info="<html><p>The safety state of the UR10e.</p><p>The class of <code>SafetyStates</code> in RobotCell:UR10eSystemType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4203", browseName="SafetyStates"));
 end UR10eSystemType_SafetyStates;

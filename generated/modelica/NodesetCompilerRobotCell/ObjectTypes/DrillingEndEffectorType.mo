@@ -10,5 +10,6 @@ model DrillingEndEffectorType "DrillingEndEffectorType: A drilling end effector 
     annotation (__OPCUA(browsePath="SkillSet", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=2004", typeDefinition="i=61"));
   annotation (
     Documentation(info="<html><p>A drilling end effector for template drilling, carried by a robot: a drilling unit with a concentric collet nose and an expanding mandrel that locks into the drill bushes of a drilling template. Its skill TemplateDrilling drills one hole.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=2000", browseName="DrillingEndEffectorType"));
 end DrillingEndEffectorType;

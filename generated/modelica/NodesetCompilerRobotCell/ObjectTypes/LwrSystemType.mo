@@ -19,5 +19,6 @@ model LwrSystemType "LwrSystemType: A lightweight robot system: a collaborative 
     annotation (__OPCUA(browsePath="SkillSet", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=3005", typeDefinition="i=61"));
   annotation (
     Documentation(info="<html><p>A lightweight robot system: a collaborative robot arm with its controller (MotionDeviceSystem, as the Robotics companion specification models it) and the skills of the system as a whole in SkillSet. Subtypes add the end effectors of an application.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=3000", browseName="LwrSystemType"));
 end LwrSystemType;

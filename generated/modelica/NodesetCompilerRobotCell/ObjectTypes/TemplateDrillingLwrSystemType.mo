@@ -10,5 +10,6 @@ model TemplateDrillingLwrSystemType "TemplateDrillingLwrSystemType: A lightweigh
     annotation (__OPCUA(browsePath="DrillingEndEffector", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=5001", typeDefinition="nsu=http://nodeset-compiler.dev/RobotCell/;i=2000"));
   annotation (
     Documentation(info="<html><p>A lightweight robot system for template drilling: the robot of LwrSystemType carrying a drilling end effector. Composite skills such as DrillHole combine the move skills of the robot controller with the TemplateDrilling skill of the end effector.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=5000", browseName="TemplateDrillingLwrSystemType"));
 end TemplateDrillingLwrSystemType;

@@ -6,5 +6,6 @@ model TemplateDrillingSkillType "TemplateDrillingSkillType: Drilling one hole th
     redeclare model InputParameterSet = NodesetCompilerRobotCell.Declarations.TemplateDrillingSkillType_InputParameterSet);
   annotation (
     Documentation(info="<html><p>Drilling one hole through a drilling template: the end effector locks its expanding mandrel in the drill bush it sits in, clamps the stack with ClampForce, drills to Depth and retracts the drill. The run ends in Ready with the mandrel released, so the robot can move the end effector out of the bush.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=1000", browseName="TemplateDrillingSkillType"));
 end TemplateDrillingSkillType;

@@ -8,5 +8,6 @@ model UR10eSystemType "UR10eSystemType: A Universal Robots UR10e as a Robotics m
     redeclare model SafetyStates = NodesetCompilerRobotCell.Declarations.UR10eSystemType_SafetyStates);
   annotation (
     Documentation(info="<html><p>A Universal Robots UR10e as a Robotics motion device system: the six-joint arm (12.5 kg payload, 1300 mm reach) and its controller. The controller offers the three basic move skills of CommonSkills in its SkillSet, so composite skills can drive any robot that offers the same skills.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4000", browseName="UR10eSystemType"));
 end UR10eSystemType;

@@ -8,5 +8,6 @@ model OrderedListType_OrderedObject "<OrderedObject>"
     annotation (__OPCUA(browsePath="NumberInList", nodeId="i=23521", dataType="i=26"));
   annotation (
     Documentation(info="<html><p>The class of <code>&lt;OrderedObject&gt;</code> in OrderedListType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="i=23519", browseName="<OrderedObject>"));
 end OrderedListType_OrderedObject;

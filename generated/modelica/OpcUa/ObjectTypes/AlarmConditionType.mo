@@ -47,6 +47,7 @@ record AlarmConditionType "AlarmConditionType"
     "ReAlarmRepeatCount"
     annotation (__OPCUA(browsePath="ReAlarmRepeatCount", nodeId="i=16401", dataType="i=4"));
   annotation (
-    Documentation(info="<html><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Documentation(info="<html><p>The EventType <code>AlarmConditionType</code> (i=2915), a subtype of <code>AcknowledgeableConditionType</code>. The information model gives it no description.</p><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="i=2915", browseName="AlarmConditionType"));
 end AlarmConditionType;

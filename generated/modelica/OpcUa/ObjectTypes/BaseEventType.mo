@@ -44,6 +44,7 @@ record BaseEventType "BaseEventType"
     "ConditionSubClassName"
     annotation (__OPCUA(browsePath="ConditionSubClassName", nodeId="i=31774", dataType="i=21"));
   annotation (
-    Documentation(info="<html><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Documentation(info="<html><p>The EventType <code>BaseEventType</code> (i=2041), a subtype of <code>BaseObjectType</code>. The information model gives it no description.</p><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="i=2041", browseName="BaseEventType"));
 end BaseEventType;

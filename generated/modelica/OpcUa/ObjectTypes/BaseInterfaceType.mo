@@ -4,6 +4,7 @@ within OpcUa.ObjectTypes;
 partial model BaseInterfaceType "BaseInterfaceType"
   extends OpcUa.ObjectTypes.BaseObjectType;
   annotation (
-    Documentation(info="<html><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Documentation(info="<html><p>The ObjectType <code>BaseInterfaceType</code> (i=17602), a subtype of <code>BaseObjectType</code>. The information model gives it no description.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="i=17602", browseName="BaseInterfaceType"));
 end BaseInterfaceType;

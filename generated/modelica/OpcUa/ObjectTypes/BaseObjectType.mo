@@ -3,5 +3,7 @@
 within OpcUa.ObjectTypes;
 model BaseObjectType "BaseObjectType"
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>BaseObjectType</code> (i=58). The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="i=58", browseName="BaseObjectType"));
 end BaseObjectType;

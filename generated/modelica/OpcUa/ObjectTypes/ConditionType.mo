@@ -28,6 +28,7 @@ record ConditionType "ConditionType"
     "ClientUserId"
     annotation (__OPCUA(browsePath="ClientUserId", nodeId="i=9026", dataType="i=12"));
   annotation (
-    Documentation(info="<html><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Documentation(info="<html><p>The EventType <code>ConditionType</code> (i=2782), a subtype of <code>BaseEventType</code>. The information model gives it no description.</p><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="i=2782", browseName="ConditionType"));
 end ConditionType;

@@ -22,5 +22,7 @@ model FileDirectoryType "FileDirectoryType"
   // Method Delete(NodeId ObjectToDelete): call it through an OPC UA client.
   // Method MoveOrCopy(NodeId ObjectToMoveOrCopy, NodeId TargetDirectory, Boolean CreateCopy, String NewName) returns (NodeId NewNodeId): call it through an OPC UA client.
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>FileDirectoryType</code> (i=13353), a subtype of <code>FolderType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="i=13353", browseName="FileDirectoryType"));
 end FileDirectoryType;

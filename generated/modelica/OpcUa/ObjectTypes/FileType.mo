@@ -40,5 +40,7 @@ model FileType "FileType"
   // Method GetPosition(UInt32 FileHandle) returns (UInt64 Position): call it through an OPC UA client.
   // Method SetPosition(UInt32 FileHandle, UInt64 Position): call it through an OPC UA client.
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>FileType</code> (i=11575), a subtype of <code>BaseObjectType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="i=11575", browseName="FileType"));
 end FileType;

@@ -18,5 +18,7 @@ model OrderedListType "OrderedListType"
     "NodeVersion"
     annotation (__OPCUA(browsePath="NodeVersion", nodeId="i=23525", dataType="i=12"));
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>OrderedListType</code> (i=23518), a subtype of <code>BaseObjectType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="i=23518", browseName="OrderedListType"));
 end OrderedListType;

@@ -5,6 +5,7 @@ record ProgramTransitionEventType "ProgramTransitionEventType"
   extends OpcUa.ObjectTypes.TransitionEventType;
   // Field IntermediateResult is left out: BaseDataType stands for any type (a Variant), which has no Modelica type.
   annotation (
-    Documentation(info="<html><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Documentation(info="<html><p>The EventType <code>ProgramTransitionEventType</code> (i=2378), a subtype of <code>TransitionEventType</code>. The information model gives it no description.</p><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="i=2378", browseName="ProgramTransitionEventType"));
 end ProgramTransitionEventType;

@@ -13,6 +13,7 @@ record TransitionEventType "TransitionEventType"
     "ToState"
     annotation (__OPCUA(browsePath="ToState", nodeId="i=2776", dataType="i=21"));
   annotation (
-    Documentation(info="<html><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Documentation(info="<html><p>The EventType <code>TransitionEventType</code> (i=2311), a subtype of <code>BaseEventType</code>. The information model gives it no description.</p><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="i=2311", browseName="TransitionEventType"));
 end TransitionEventType;

@@ -9,5 +9,7 @@ record Argument "Argument"
   OpcUa.Types.UInt32 arrayDimensions[nArrayDimensions] = fill(0, nArrayDimensions) "ArrayDimensions";
   OpcUa.Types.LocalizedText description = "" "Description";
   annotation (
+    Documentation(info="<html><p>The DataType <code>Argument</code> (i=296), a subtype of <code>Structure</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="i=296", browseName="Argument"));
 end Argument;

@@ -3,4 +3,5 @@
 within OpcUa.Types;
 type Duration = Real "Duration"
   annotation (
+    Documentation(info="<html><p>The DataType <code>Duration</code> (i=290), a subtype of <code>Double</code>. The information model gives it no description.</p></html>"),
     __OPCUA(nodeId="i=290", browseName="Duration"));

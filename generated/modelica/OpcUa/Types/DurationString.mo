@@ -3,4 +3,5 @@
 within OpcUa.Types;
 type DurationString = String "DurationString"
   annotation (
+    Documentation(info="<html><p>The DataType <code>DurationString</code> (i=12879), a subtype of <code>String</code>. The information model gives it no description.</p></html>"),
     __OPCUA(nodeId="i=12879", browseName="DurationString"));

@@ -6,5 +6,7 @@ record EnumValueType "EnumValueType"
   OpcUa.Types.LocalizedText displayName = "" "DisplayName";
   OpcUa.Types.LocalizedText description = "" "Description";
   annotation (
+    Documentation(info="<html><p>The DataType <code>EnumValueType</code> (i=7594), a subtype of <code>Structure</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="i=7594", browseName="EnumValueType"));
 end EnumValueType;

@@ -6,5 +6,7 @@ record N3DCartesianCoordinates "3DCartesianCoordinates"
   Real y = 0 "Y";
   Real z = 0 "Z";
   annotation (
+    Documentation(info="<html><p>The DataType <code>3DCartesianCoordinates</code> (i=18810), a subtype of <code>CartesianCoordinates</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="i=18810", browseName="3DCartesianCoordinates"));
 end N3DCartesianCoordinates;

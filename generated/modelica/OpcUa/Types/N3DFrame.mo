@@ -5,5 +5,7 @@ record N3DFrame "3DFrame"
   OpcUa.Types.N3DCartesianCoordinates cartesianCoordinates = OpcUa.Types.N3DCartesianCoordinates() "CartesianCoordinates";
   OpcUa.Types.N3DOrientation orientation = OpcUa.Types.N3DOrientation() "Orientation";
   annotation (
+    Documentation(info="<html><p>The DataType <code>3DFrame</code> (i=18814), a subtype of <code>Frame</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="i=18814", browseName="3DFrame"));
 end N3DFrame;

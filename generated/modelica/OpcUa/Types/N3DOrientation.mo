@@ -6,5 +6,7 @@ record N3DOrientation "3DOrientation"
   Real b = 0 "B";
   Real c = 0 "C";
   annotation (
+    Documentation(info="<html><p>The DataType <code>3DOrientation</code> (i=18812), a subtype of <code>Orientation</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="i=18812", browseName="3DOrientation"));
 end N3DOrientation;

@@ -6,5 +6,7 @@ record N3DVector "3DVector"
   Real y = 0 "Y";
   Real z = 0 "Z";
   annotation (
+    Documentation(info="<html><p>The DataType <code>3DVector</code> (i=18808), a subtype of <code>Vector</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="i=18808", browseName="3DVector"));
 end N3DVector;

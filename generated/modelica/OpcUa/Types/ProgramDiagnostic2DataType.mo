@@ -17,5 +17,7 @@ record ProgramDiagnostic2DataType "ProgramDiagnostic2DataType"
   OpcUa.Types.UtcTime lastMethodCallTime = 0 "LastMethodCallTime";
   OpcUa.Types.StatusCode lastMethodReturnStatus = 0 "LastMethodReturnStatus";
   annotation (
+    Documentation(info="<html><p>The DataType <code>ProgramDiagnostic2DataType</code> (i=24033), a subtype of <code>Structure</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="i=24033", browseName="ProgramDiagnostic2DataType"));
 end ProgramDiagnostic2DataType;

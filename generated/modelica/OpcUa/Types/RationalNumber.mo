@@ -5,5 +5,7 @@ record RationalNumber "RationalNumber"
   Integer numerator = 0 "Numerator";
   OpcUa.Types.UInt32 denominator = 0 "Denominator";
   annotation (
+    Documentation(info="<html><p>The DataType <code>RationalNumber</code> (i=18806), a subtype of <code>Structure</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="i=18806", browseName="RationalNumber"));
 end RationalNumber;

@@ -3,4 +3,5 @@
 within OpcUa.Types;
 type UtcTime = OpcUa.Types.DateTime "UtcTime"
   annotation (
+    Documentation(info="<html><p>The DataType <code>UtcTime</code> (i=294), a subtype of <code>DateTime</code>. The information model gives it no description.</p></html>"),
     __OPCUA(nodeId="i=294", browseName="UtcTime"));

@@ -13,5 +13,6 @@ model ISupportInfoType_DocumentationFiles "DocumentationFiles"
     annotation (__OPCUA(browsePath="<DocumentFileId>", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=28", typeDefinition="i=11575"));
   annotation (
     Documentation(info="<html><p>The class of <code>DocumentationFiles</code> in DI:ISupportInfoType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=27", browseName="DocumentationFiles"));
 end ISupportInfoType_DocumentationFiles;

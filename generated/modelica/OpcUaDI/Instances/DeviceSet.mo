@@ -8,5 +8,6 @@ model DeviceSet "DeviceSet"
     annotation (__OPCUA(browsePath="DeviceFeatures", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=15034", typeDefinition="i=58"));
   annotation (
     Documentation(info="<html><p>The instance DeviceSet of BaseObjectType (nsu=http://opcfoundation.org/UA/DI/;i=5001).</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=5001", browseName="DeviceSet", browsePath="DeviceSet"));
 end DeviceSet;

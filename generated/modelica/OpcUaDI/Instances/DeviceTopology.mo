@@ -8,5 +8,6 @@ model DeviceTopology "DeviceTopology"
     annotation (__OPCUA(browsePath="OnlineAccess", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6095", dataType="i=1"));
   annotation (
     Documentation(info="<html><p>The instance DeviceTopology of BaseObjectType (nsu=http://opcfoundation.org/UA/DI/;i=6094).</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6094", browseName="DeviceTopology", browsePath="DeviceTopology"));
 end DeviceTopology;

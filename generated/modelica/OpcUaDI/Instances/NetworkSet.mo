@@ -5,5 +5,6 @@ model NetworkSet "NetworkSet"
   extends OpcUa.ObjectTypes.BaseObjectType;
   annotation (
     Documentation(info="<html><p>The instance NetworkSet of BaseObjectType (nsu=http://opcfoundation.org/UA/DI/;i=6078).</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6078", browseName="NetworkSet", browsePath="NetworkSet"));
 end NetworkSet;

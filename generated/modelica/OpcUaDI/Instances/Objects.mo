@@ -6,7 +6,7 @@ model Objects "The instances of http://opcfoundation.org/UA/DI/ below the Object
     nsUri={"http://opcfoundation.org/UA/DI/"},
     nVars=1,
     vars={
-      OpcUaSupport.VariableNode(nsIndex=1, nodeIdType=OpcUaSupport.NodeIdType.Numeric, id="6095", displayName="OnlineAccess", dataType=OpcUaSupport.BuiltinType.Boolean, dataTypeId="i=1", browsePath="DeviceTopology/OnlineAccess")})
+      OpcUaSupport.VariableNode(nsIndex=1, nodeIdType=OpcUaSupport.NodeIdType.Numeric, id="6095", displayName="OnlineAccess", dataType=OpcUaSupport.BuiltinType.Boolean_, dataTypeId="i=1", browsePath="DeviceTopology/OnlineAccess")})
     "Every variable of the instances, as the configuration record of an OPC UA server or client block"
     annotation (Dialog(group="Configuration"));
   OpcUaDI.Instances.DeviceSet deviceSet "DeviceSet"
@@ -15,5 +15,7 @@ model Objects "The instances of http://opcfoundation.org/UA/DI/ below the Object
     annotation (__OPCUA(browsePath="NetworkSet", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6078"));
   OpcUaDI.Instances.DeviceTopology deviceTopology "DeviceTopology"
     annotation (__OPCUA(browsePath="DeviceTopology", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6094"));
-  annotation (Documentation(info="<html><p>The instances of http://opcfoundation.org/UA/DI/ in the address space, one component per instance whose parent belongs to another namespace, and <code>nodes</code>, the variables of all of them with their NodeIds.</p></html>"));
+  annotation (
+    Documentation(info="<html><p>The instances of http://opcfoundation.org/UA/DI/ in the address space, one component per instance whose parent belongs to another namespace, and <code>nodes</code>, the variables of all of them with their NodeIds.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}));
 end Objects;

@@ -18,5 +18,7 @@ model CachedLoadingType "CachedLoadingType"
     annotation (__OPCUA(browsePath="FallbackVersion", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=188", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=212"));
   // Method GetUpdateBehavior(String ManufacturerUri, String SoftwareRevision, String[] PatchIdentifiers) returns (UpdateBehavior UpdateBehavior): call it through an OPC UA client.
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>DI:CachedLoadingType</code> (nsu=http://opcfoundation.org/UA/DI/;i=171), a subtype of <code>DI:PackageLoadingType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=171", browseName="CachedLoadingType"));
 end CachedLoadingType;

@@ -6,7 +6,7 @@ model ConfirmationStateMachineType "ConfirmationStateMachineType"
   // Method Confirm(): call it through an OPC UA client.
   OpcUaSupport.RealOutput confirmationTimeout = 0
     "ConfirmationTimeout"
-    annotation (__OPCUA(browsePath="ConfirmationTimeout", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=322", dataType="i=290"));
+    annotation (Placement(transformation(extent={{100,-10},{120,10}})), __OPCUA(browsePath="ConfirmationTimeout", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=322", dataType="i=290"));
   // State machine of ConfirmationStateMachineType: its states, and transitions driven by the trigger inputs.
   parameter Integer stateMachineLevel = 1
     "Which class drives the state machine: a subclass that adds states sets its own level"
@@ -23,10 +23,10 @@ model ConfirmationStateMachineType "ConfirmationStateMachineType"
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput notWaitingForConfirmToWaitingForConfirm = false
     "NotWaitingForConfirmToWaitingForConfirm: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (__OPCUA(browsePath="NotWaitingForConfirmToWaitingForConfirm", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=327", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="NotWaitingForConfirmToWaitingForConfirm", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=327", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput confirm = false
     "Confirm: a rising edge stands for a call of the method Confirm"
-    annotation (__OPCUA(browsePath="Confirm", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=321"));
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="Confirm", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=321"));
 equation
   if stateMachineLevel == 1 then
     when notWaitingForConfirmToWaitingForConfirm then
@@ -37,5 +37,7 @@ equation
     currentStateText = if currentStateNumber == NotWaitingForConfirm then "NotWaitingForConfirm" elseif currentStateNumber == WaitingForConfirm then "WaitingForConfirm" else "";
   end if;
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>DI:ConfirmationStateMachineType</code> (nsu=http://opcfoundation.org/UA/DI/;i=307), a subtype of <code>FiniteStateMachineType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=307", browseName="ConfirmationStateMachineType"));
 end ConfirmationStateMachineType;

@@ -66,6 +66,7 @@ partial model DeviceType "DeviceType"
     "ImageSet"
     annotation (__OPCUA(browsePath="ImageSet", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6215", typeDefinition="i=61"));
   annotation (
-    Documentation(info="<html><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Documentation(info="<html><p>The ObjectType <code>DI:DeviceType</code> (nsu=http://opcfoundation.org/UA/DI/;i=1002), a subtype of <code>DI:ComponentType</code>. The information model gives it no description.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=1002", browseName="DeviceType"));
 end DeviceType;

@@ -5,5 +5,6 @@ partial model DiameterIndicationType "DiameterIndicationType: Indicates the abra
   extends OpcUaDI.ObjectTypes.BaseLifetimeIndicationType;
   annotation (
     Documentation(info="<html><p>Indicates the abraded diameter, for example of a drill.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=478", browseName="DiameterIndicationType"));
 end DiameterIndicationType;

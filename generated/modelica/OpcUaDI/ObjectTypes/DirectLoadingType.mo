@@ -13,5 +13,7 @@ model DirectLoadingType "DirectLoadingType"
     "WriteTimeout"
     annotation (__OPCUA(browsePath="WriteTimeout", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=170", dataType="i=290"));
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>DI:DirectLoadingType</code> (nsu=http://opcfoundation.org/UA/DI/;i=153), a subtype of <code>DI:PackageLoadingType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=153", browseName="DirectLoadingType"));
 end DirectLoadingType;

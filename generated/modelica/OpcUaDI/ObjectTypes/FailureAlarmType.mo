@@ -4,6 +4,7 @@ within OpcUaDI.ObjectTypes;
 record FailureAlarmType "FailureAlarmType"
   extends OpcUaDI.ObjectTypes.DeviceHealthDiagnosticAlarmType;
   annotation (
-    Documentation(info="<html><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Documentation(info="<html><p>The EventType <code>DI:FailureAlarmType</code> (nsu=http://opcfoundation.org/UA/DI/;i=15292), a subtype of <code>DI:DeviceHealthDiagnosticAlarmType</code>. The information model gives it no description.</p><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=15292", browseName="FailureAlarmType"));
 end FailureAlarmType;

@@ -11,5 +11,7 @@ model FileSystemLoadingType "FileSystemLoadingType"
   // Method GetUpdateBehavior(NodeId[] NodeIds) returns (UpdateBehavior UpdateBehavior): call it through an OPC UA client.
   // Method ValidateFiles(NodeId[] NodeIds) returns (Int32 ErrorCode, LocalizedText ErrorMessage): call it through an OPC UA client.
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>DI:FileSystemLoadingType</code> (nsu=http://opcfoundation.org/UA/DI/;i=192), a subtype of <code>DI:SoftwareLoadingType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=192", browseName="FileSystemLoadingType"));
 end FileSystemLoadingType;

@@ -11,5 +11,7 @@ model FunctionalGroupType "FunctionalGroupType"
     annotation (__OPCUA(browsePath="<GroupIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6027", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=1005", referenceType="HasComponent"));
   // UIElement is left out: BaseDataType stands for any type (a Variant), which has no Modelica type.
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>DI:FunctionalGroupType</code> (nsu=http://opcfoundation.org/UA/DI/;i=1005), a subtype of <code>FolderType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=1005", browseName="FunctionalGroupType"));
 end FunctionalGroupType;

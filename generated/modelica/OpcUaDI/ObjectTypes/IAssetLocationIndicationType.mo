@@ -21,6 +21,7 @@ partial model IAssetLocationIndicationType "IAssetLocationIndicationType"
     "SupportedIndicationTypes"
     annotation (__OPCUA(browsePath="SupportedIndicationTypes", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=156", dataType="nsu=http://opcfoundation.org/UA/DI/;i=410"));
   annotation (
-    Documentation(info="<html><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Documentation(info="<html><p>The ObjectType <code>DI:IAssetLocationIndicationType</code> (nsu=http://opcfoundation.org/UA/DI/;i=118), a subtype of <code>BaseInterfaceType</code>. The information model gives it no description.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=118", browseName="IAssetLocationIndicationType"));
 end IAssetLocationIndicationType;

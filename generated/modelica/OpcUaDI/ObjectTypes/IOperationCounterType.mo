@@ -23,5 +23,6 @@ partial model IOperationCounterType "IOperationCounterType: Interface defining c
     annotation (__OPCUA(browsePath="OperationCycleCounter", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=483", dataType="i=28"));
   annotation (
     Documentation(info="<html><p>Interface defining counters for the duration of operation</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=480", browseName="IOperationCounterType"));
 end IOperationCounterType;

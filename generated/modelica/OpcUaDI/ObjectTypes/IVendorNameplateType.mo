@@ -88,6 +88,7 @@ partial model IVendorNameplateType "IVendorNameplateType"
     "PatchIdentifiers"
     annotation (__OPCUA(browsePath="PatchIdentifiers", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=24", dataType="i=12"));
   annotation (
-    Documentation(info="<html><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Documentation(info="<html><p>The ObjectType <code>DI:IVendorNameplateType</code> (nsu=http://opcfoundation.org/UA/DI/;i=15035), a subtype of <code>BaseInterfaceType</code>. The information model gives it no description.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=15035", browseName="IVendorNameplateType"));
 end IVendorNameplateType;

@@ -8,13 +8,13 @@ model InstallationStateMachineType "InstallationStateMachineType"
     annotation (Evaluate=true);
   OpcUaSupport.IntegerOutput percentComplete(min=0, max=255) = 0 if use_percentComplete
     "PercentComplete"
-    annotation (__OPCUA(browsePath="PercentComplete", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=263", dataType="i=3"));
+    annotation (Placement(transformation(extent={{100,-10},{120,10}})), __OPCUA(browsePath="PercentComplete", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=263", dataType="i=3"));
   parameter Boolean use_installationDelay = false
     "Whether the optional InstallationDelay exists"
     annotation (Evaluate=true);
   OpcUaSupport.RealOutput installationDelay = 0 if use_installationDelay
     "InstallationDelay"
-    annotation (__OPCUA(browsePath="InstallationDelay", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=264", dataType="i=290"));
+    annotation (Placement(transformation(extent={{100,-30},{120,-10}})), __OPCUA(browsePath="InstallationDelay", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=264", dataType="i=290"));
   // Method InstallSoftwarePackage(String ManufacturerUri, String SoftwareRevision, String[] PatchIdentifiers, ByteString Hash): call it through an OPC UA client.
   // Method InstallFiles(NodeId[] NodeIds): call it through an OPC UA client.
   // Method Uninstall(): call it through an OPC UA client.
@@ -38,22 +38,22 @@ model InstallationStateMachineType "InstallationStateMachineType"
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput installSoftwarePackage = false
     "InstallSoftwarePackage: a rising edge stands for a call of the method InstallSoftwarePackage"
-    annotation (__OPCUA(browsePath="InstallSoftwarePackage", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=265"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="InstallSoftwarePackage", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=265"));
   OpcUaSupport.BooleanInput installFiles = false
     "InstallFiles: a rising edge stands for a call of the method InstallFiles"
-    annotation (__OPCUA(browsePath="InstallFiles", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=268"));
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="InstallFiles", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=268"));
   OpcUaSupport.BooleanInput uninstall = false
     "Uninstall: a rising edge stands for a call of the method Uninstall"
-    annotation (__OPCUA(browsePath="Uninstall", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=407"));
+    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="Uninstall", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=407"));
   OpcUaSupport.BooleanInput installingToIdle = false
     "InstallingToIdle: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (__OPCUA(browsePath="InstallingToIdle", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=279", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,10},{-100,30}})), __OPCUA(browsePath="InstallingToIdle", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=279", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput installingToError = false
     "InstallingToError: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (__OPCUA(browsePath="InstallingToError", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=281", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="InstallingToError", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=281", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput resume = false
     "Resume: a rising edge stands for a call of the method Resume"
-    annotation (__OPCUA(browsePath="Resume", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=270"));
+    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="Resume", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=270"));
 equation
   if stateMachineLevel == 1 then
     when installSoftwarePackage then
@@ -72,5 +72,7 @@ equation
     currentStateText = if currentStateNumber == Idle then "Idle" elseif currentStateNumber == Installing then "Installing" elseif currentStateNumber == Error then "Error" else "";
   end if;
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>DI:InstallationStateMachineType</code> (nsu=http://opcfoundation.org/UA/DI/;i=249), a subtype of <code>FiniteStateMachineType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=249", browseName="InstallationStateMachineType"));
 end InstallationStateMachineType;

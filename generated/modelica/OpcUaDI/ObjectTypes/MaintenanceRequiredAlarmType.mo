@@ -4,6 +4,7 @@ within OpcUaDI.ObjectTypes;
 record MaintenanceRequiredAlarmType "MaintenanceRequiredAlarmType"
   extends OpcUaDI.ObjectTypes.DeviceHealthDiagnosticAlarmType;
   annotation (
-    Documentation(info="<html><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Documentation(info="<html><p>The EventType <code>DI:MaintenanceRequiredAlarmType</code> (nsu=http://opcfoundation.org/UA/DI/;i=15739), a subtype of <code>DI:DeviceHealthDiagnosticAlarmType</code>. The information model gives it no description.</p><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=15739", browseName="MaintenanceRequiredAlarmType"));
 end MaintenanceRequiredAlarmType;

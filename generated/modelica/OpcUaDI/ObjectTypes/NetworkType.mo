@@ -20,5 +20,7 @@ model NetworkType "NetworkType"
     "Lock"
     annotation (__OPCUA(browsePath="Lock", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6294", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=6388"));
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>DI:NetworkType</code> (nsu=http://opcfoundation.org/UA/DI/;i=6247), a subtype of <code>BaseObjectType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6247", browseName="NetworkType"));
 end NetworkType;

@@ -15,7 +15,7 @@ partial model PackageLoadingType "PackageLoadingType"
     annotation (__OPCUA(browsePath="FileTransfer", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=140", typeDefinition="i=15744"));
   OpcUaSupport.StringOutput errorMessage = ""
     "ErrorMessage"
-    annotation (__OPCUA(browsePath="ErrorMessage", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=151", dataType="i=21"));
+    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="ErrorMessage", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=151", dataType="i=21"));
   parameter Boolean use_writeBlockSize = false
     "Whether the optional WriteBlockSize exists"
     annotation (Evaluate=true);
@@ -23,6 +23,7 @@ partial model PackageLoadingType "PackageLoadingType"
     "WriteBlockSize"
     annotation (__OPCUA(browsePath="WriteBlockSize", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=152", dataType="i=7"));
   annotation (
-    Documentation(info="<html><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Documentation(info="<html><p>The ObjectType <code>DI:PackageLoadingType</code> (nsu=http://opcfoundation.org/UA/DI/;i=137), a subtype of <code>DI:SoftwareLoadingType</code>. The information model gives it no description.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=137", browseName="PackageLoadingType"));
 end PackageLoadingType;

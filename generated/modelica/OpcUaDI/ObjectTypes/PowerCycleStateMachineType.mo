@@ -19,10 +19,10 @@ model PowerCycleStateMachineType "PowerCycleStateMachineType"
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput notWaitingForPowerCycleToWaitingForPowerCycle = false
     "NotWaitingForPowerCycleToWaitingForPowerCycle: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (__OPCUA(browsePath="NotWaitingForPowerCycleToWaitingForPowerCycle", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=303", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="NotWaitingForPowerCycleToWaitingForPowerCycle", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=303", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput waitingForPowerCycleToNotWaitingForPowerCycle = false
     "WaitingForPowerCycleToNotWaitingForPowerCycle: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (__OPCUA(browsePath="WaitingForPowerCycleToNotWaitingForPowerCycle", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=305", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="WaitingForPowerCycleToNotWaitingForPowerCycle", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=305", typeDefinition="i=2310"));
 equation
   if stateMachineLevel == 1 then
     when notWaitingForPowerCycleToWaitingForPowerCycle then
@@ -33,5 +33,7 @@ equation
     currentStateText = if currentStateNumber == NotWaitingForPowerCycle then "NotWaitingForPowerCycle" elseif currentStateNumber == WaitingForPowerCycle then "WaitingForPowerCycle" else "";
   end if;
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>DI:PowerCycleStateMachineType</code> (nsu=http://opcfoundation.org/UA/DI/;i=285), a subtype of <code>FiniteStateMachineType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=285", browseName="PowerCycleStateMachineType"));
 end PowerCycleStateMachineType;

@@ -8,7 +8,7 @@ model PrepareForUpdateStateMachineType "PrepareForUpdateStateMachineType"
     annotation (Evaluate=true);
   OpcUaSupport.IntegerOutput percentComplete(min=0, max=255) = 0 if use_percentComplete
     "PercentComplete"
-    annotation (__OPCUA(browsePath="PercentComplete", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=227", dataType="i=3"));
+    annotation (Placement(transformation(extent={{100,-10},{120,10}})), __OPCUA(browsePath="PercentComplete", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=227", dataType="i=3"));
   // Method Prepare(): call it through an OPC UA client.
   // Method Abort(): call it through an OPC UA client.
   // Method Resume(): call it through an OPC UA client.
@@ -34,16 +34,16 @@ model PrepareForUpdateStateMachineType "PrepareForUpdateStateMachineType"
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput prepare = false
     "Prepare: a rising edge stands for a call of the method Prepare"
-    annotation (__OPCUA(browsePath="Prepare", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=228"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="Prepare", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=228"));
   OpcUaSupport.BooleanInput abort = false
     "Abort: a rising edge stands for a call of the method Abort"
-    annotation (__OPCUA(browsePath="Abort", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=229"));
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="Abort", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=229"));
   OpcUaSupport.BooleanInput preparingToPreparedForUpdate = false
     "PreparingToPreparedForUpdate: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (__OPCUA(browsePath="PreparingToPreparedForUpdate", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=243", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="PreparingToPreparedForUpdate", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=243", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput resume = false
     "Resume: a rising edge stands for a call of the method Resume"
-    annotation (__OPCUA(browsePath="Resume", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=230"));
+    annotation (Placement(transformation(extent={{-120,10},{-100,30}})), __OPCUA(browsePath="Resume", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=230"));
 equation
   if stateMachineLevel == 1 then
     when prepare then
@@ -58,5 +58,7 @@ equation
     currentStateText = if currentStateNumber == Idle then "Idle" elseif currentStateNumber == Preparing then "Preparing" elseif currentStateNumber == PreparedForUpdate then "PreparedForUpdate" elseif currentStateNumber == Resuming then "Resuming" else "";
   end if;
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>DI:PrepareForUpdateStateMachineType</code> (nsu=http://opcfoundation.org/UA/DI/;i=213), a subtype of <code>FiniteStateMachineType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=213", browseName="PrepareForUpdateStateMachineType"));
 end PrepareForUpdateStateMachineType;

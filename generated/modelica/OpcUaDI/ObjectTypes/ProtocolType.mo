@@ -4,5 +4,7 @@ within OpcUaDI.ObjectTypes;
 model ProtocolType "ProtocolType"
   extends OpcUa.ObjectTypes.BaseObjectType;
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>DI:ProtocolType</code> (nsu=http://opcfoundation.org/UA/DI/;i=1006), a subtype of <code>BaseObjectType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=1006", browseName="ProtocolType"));
 end ProtocolType;

@@ -9,5 +9,7 @@ model SoftwareFolderType "SoftwareFolderType"
   // Method Add(String Subclass, String Name): call it through an OPC UA client.
   // Method Delete(NodeId ObjectToDelete): call it through an OPC UA client.
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>DI:SoftwareFolderType</code> (nsu=http://opcfoundation.org/UA/DI/;i=364), a subtype of <code>FolderType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=364", browseName="SoftwareFolderType"));
 end SoftwareFolderType;

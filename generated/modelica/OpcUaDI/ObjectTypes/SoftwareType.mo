@@ -4,5 +4,7 @@ within OpcUaDI.ObjectTypes;
 model SoftwareType "SoftwareType"
   extends OpcUaDI.ObjectTypes.ComponentType(final use_manufacturer=true, final use_model_=true, final use_softwareRevision=true);
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>DI:SoftwareType</code> (nsu=http://opcfoundation.org/UA/DI/;i=15106), a subtype of <code>DI:ComponentType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=15106", browseName="SoftwareType"));
 end SoftwareType;

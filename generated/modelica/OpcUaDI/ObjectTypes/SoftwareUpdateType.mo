@@ -56,7 +56,7 @@ model SoftwareUpdateType "SoftwareUpdateType"
     annotation (Evaluate=true);
   OpcUaSupport.StringOutput updateStatus = "" if use_updateStatus
     "UpdateStatus"
-    annotation (__OPCUA(browsePath="UpdateStatus", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=133", dataType="i=21"));
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="UpdateStatus", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=133", dataType="i=21"));
   parameter Boolean use_softwareClass = false
     "Whether the optional SoftwareClass exists"
     annotation (Evaluate=true);
@@ -86,7 +86,9 @@ model SoftwareUpdateType "SoftwareUpdateType"
     annotation (Evaluate=true);
   OpcUaSupport.IntegerOutput vendorErrorCode = 0 if use_vendorErrorCode
     "VendorErrorCode"
-    annotation (__OPCUA(browsePath="VendorErrorCode", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=402", dataType="i=6"));
+    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="VendorErrorCode", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=402", dataType="i=6"));
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>DI:SoftwareUpdateType</code> (nsu=http://opcfoundation.org/UA/DI/;i=1), a subtype of <code>BaseObjectType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=1", browseName="SoftwareUpdateType"));
 end SoftwareUpdateType;

@@ -33,5 +33,7 @@ model SoftwareVersionType "SoftwareVersionType"
   // Hash is left out: ByteString has no Modelica type.
   // Method Clear(): call it through an OPC UA client.
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>DI:SoftwareVersionType</code> (nsu=http://opcfoundation.org/UA/DI/;i=212), a subtype of <code>BaseObjectType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=212", browseName="SoftwareVersionType"));
 end SoftwareVersionType;

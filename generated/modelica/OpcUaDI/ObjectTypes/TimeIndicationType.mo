@@ -5,5 +5,6 @@ partial model TimeIndicationType "TimeIndicationType: Indicates the time the ent
   extends OpcUaDI.ObjectTypes.BaseLifetimeIndicationType;
   annotation (
     Documentation(info="<html><p>Indicates the time the entity has been in use or can still be used</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=474", browseName="TimeIndicationType"));
 end TimeIndicationType;

@@ -7,5 +7,7 @@ model TransferServicesType "TransferServicesType"
   // Method TransferFromDevice() returns (Int32 TransferID, Int32 InitTransferStatus): call it through an OPC UA client.
   // Method FetchTransferResultData(Int32 TransferID, Int32 SequenceNumber, Int32 MaxParameterResultsToReturn, Boolean OmitGoodResults) returns (Structure FetchResultData): call it through an OPC UA client.
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>DI:TransferServicesType</code> (nsu=http://opcfoundation.org/UA/DI/;i=6526), a subtype of <code>BaseObjectType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6526", browseName="TransferServicesType"));
 end TransferServicesType;

@@ -9,5 +9,5 @@ type DeviceHealthEnumeration = enumeration(
     MAINTENANCEREQUIRED "MAINTENANCE_REQUIRED = 4: This element is working, but a maintenance operation is required.")
   "DeviceHealthEnumeration"
   annotation (
-    Documentation(info="<html><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaDI.EnumerationValues.DeviceHealthEnumeration[Integer(x)]</code>.</p></html>"),
+    Documentation(info="<html><p>The DataType <code>DI:DeviceHealthEnumeration</code> (nsu=http://opcfoundation.org/UA/DI/;i=6244), a subtype of <code>Enumeration</code>. The information model gives it no description.</p><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaDI.EnumerationValues.DeviceHealthEnumeration[Integer(x)]</code>.</p></html>"),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6244", browseName="DeviceHealthEnumeration", values={0, 1, 2, 3, 4}));

@@ -3,5 +3,7 @@
 within OpcUaDI.Types;
 record FetchResultDataType "FetchResultDataType"
   annotation (
+    Documentation(info="<html><p>The DataType <code>DI:FetchResultDataType</code> (nsu=http://opcfoundation.org/UA/DI/;i=6522), a subtype of <code>Structure</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6522", browseName="FetchResultDataType"));
 end FetchResultDataType;

@@ -5,6 +5,7 @@ record LocationIndicationType "LocationIndicationType"
   Boolean visual = false "Visual (bit 0): Location indication through optical signals, such as blinking LEDs, if supported by the device.";
   Boolean audible = false "Audible (bit 1): Location indication through auditory signals, such as sounds or beeps, if supported by the device.";
   annotation (
-    Documentation(info="<html><p>An OptionSet of UInt16: one Boolean per defined bit, true when the bit is set. A record of Booleans rather than an Integer mask, because a Modelica Integer cannot hold the upper bits of a UInt32 or UInt64 mask and has no bit operators.</p></html>"),
+    Documentation(info="<html><p>The DataType <code>DI:LocationIndicationType</code> (nsu=http://opcfoundation.org/UA/DI/;i=410), a subtype of <code>UInt16</code>. The information model gives it no description.</p><p>An OptionSet of UInt16: one Boolean per defined bit, true when the bit is set. A record of Booleans rather than an Integer mask, because a Modelica Integer cannot hold the upper bits of a UInt32 or UInt64 mask and has no bit operators.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=410", browseName="LocationIndicationType"));
 end LocationIndicationType;

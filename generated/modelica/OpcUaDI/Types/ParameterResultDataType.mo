@@ -7,5 +7,7 @@ record ParameterResultDataType "ParameterResultDataType"
   OpcUa.Types.StatusCode statusCode = 0 "StatusCode";
   // Field Diagnostics is left out: DiagnosticInfo has no Modelica type.
   annotation (
+    Documentation(info="<html><p>The DataType <code>DI:ParameterResultDataType</code> (nsu=http://opcfoundation.org/UA/DI/;i=6525), a subtype of <code>Structure</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6525", browseName="ParameterResultDataType"));
 end ParameterResultDataType;

@@ -8,5 +8,5 @@ type SoftwareClass = enumeration(
     Solution "Solution = 3: The software update is used to install a solution with several software package to several components.")
   "SoftwareClass"
   annotation (
-    Documentation(info="<html><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaDI.EnumerationValues.SoftwareClass[Integer(x)]</code>.</p></html>"),
+    Documentation(info="<html><p>The DataType <code>DI:SoftwareClass</code> (nsu=http://opcfoundation.org/UA/DI/;i=408), a subtype of <code>Enumeration</code>. The information model gives it no description.</p><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaDI.EnumerationValues.SoftwareClass[Integer(x)]</code>.</p></html>"),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=408", browseName="SoftwareClass", values={0, 1, 2, 3}));

@@ -7,5 +7,5 @@ type SoftwareVersionFileType = enumeration(
     Fallback "Fallback = 2: The fallback version of the software identified by the FallbackVersion Object.")
   "SoftwareVersionFileType"
   annotation (
-    Documentation(info="<html><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaDI.EnumerationValues.SoftwareVersionFileType[Integer(x)]</code>.</p></html>"),
+    Documentation(info="<html><p>The DataType <code>DI:SoftwareVersionFileType</code> (nsu=http://opcfoundation.org/UA/DI/;i=331), a subtype of <code>Enumeration</code>. The information model gives it no description.</p><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaDI.EnumerationValues.SoftwareVersionFileType[Integer(x)]</code>.</p></html>"),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=331", browseName="SoftwareVersionFileType", values={0, 1, 2}));

@@ -7,5 +7,7 @@ record TransferResultDataDataType "TransferResultDataDataType"
   parameter Integer nParameterDefs = 0 "Number of elements of ParameterDefs";
   OpcUaDI.Types.ParameterResultDataType parameterDefs[nParameterDefs] = fill(OpcUaDI.Types.ParameterResultDataType(), nParameterDefs) "ParameterDefs";
   annotation (
+    Documentation(info="<html><p>The DataType <code>DI:TransferResultDataDataType</code> (nsu=http://opcfoundation.org/UA/DI/;i=15889), a subtype of <code>DI:FetchResultDataType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/DI/;i=15889", browseName="TransferResultDataDataType"));
 end TransferResultDataDataType;

@@ -17,5 +17,6 @@ model BasicStacklightType_OrderedObject "<OrderedObject>: Represent the stack el
     annotation (__OPCUA(browsePath="SignalOn", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6013", dataType="i=1"));
   annotation (
     Documentation(info="<html><p>Represent the stack elements (lamps and acoustic elements) the stacklight is composed of. The HasOrderedComponent Reference shall represent the ordering from the base of the stacklight.</p><p>The class of <code>&lt;OrderedObject&gt;</code> in IA:BasicStacklightType: IA:StackElementType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=5006", browseName="<OrderedObject>"));
 end BasicStacklightType_OrderedObject;

@@ -5,5 +5,6 @@ model CalibrationTargetType_CalibrationTargetCategory "CalibrationTargetCategory
   extends OpcUaIA.ObjectTypes.BaseCalibrationTargetCategoryType;
   annotation (
     Documentation(info="<html><p>Defines what category the calibration target is of.</p><p>The class of <code>CalibrationTargetCategory</code> in IA:CalibrationTargetType: IA:BaseCalibrationTargetCategoryType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=5011", browseName="CalibrationTargetCategory"));
 end CalibrationTargetType_CalibrationTargetCategory;

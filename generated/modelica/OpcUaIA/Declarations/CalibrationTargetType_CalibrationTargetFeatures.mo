@@ -8,7 +8,7 @@ model CalibrationTargetType_CalibrationTargetFeatures "CalibrationTargetFeatures
     annotation (Evaluate=true);
   OpcUaSupport.RealInput calibrationValue[nCalibrationValue] = fill(0, nCalibrationValue)
     "<CalibrationValue>: A calibration value indicates the value the calibration target provides for calibration and includes its quantity and engineering unit."
-    annotation (__OPCUA(browsePath="<CalibrationValue>", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6064", dataType="i=26"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="<CalibrationValue>", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6064", dataType="i=26"));
   parameter Integer nCapacityRange(min=0) = 0
     "Number of <CapacityRange> (OptionalPlaceholder)"
     annotation (Evaluate=true);
@@ -17,5 +17,6 @@ model CalibrationTargetType_CalibrationTargetFeatures "CalibrationTargetFeatures
     annotation (__OPCUA(browsePath="<CapacityRange>", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6066", dataType="i=884"));
   annotation (
     Documentation(info="<html><p>A folder containing information about the features of a calibration target, that is, what can be calibrated with the calibration target.</p><p>The class of <code>CalibrationTargetFeatures</code> in IA:CalibrationTargetType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=5013", browseName="CalibrationTargetFeatures"));
 end CalibrationTargetType_CalibrationTargetFeatures;

@@ -89,5 +89,6 @@ model CalibrationTargetType_Identification "Identification: Provides identificat
     annotation (__OPCUA(browsePath="SoftwareRevision", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6074", dataType="i=12"));
   annotation (
     Documentation(info="<html><p>Provides identification information.</p><p>The class of <code>Identification</code> in IA:CalibrationTargetType: DI:FunctionalGroupType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=5010", browseName="Identification"));
 end CalibrationTargetType_Identification;

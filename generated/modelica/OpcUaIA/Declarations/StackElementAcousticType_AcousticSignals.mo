@@ -6,5 +6,6 @@ model StackElementAcousticType_AcousticSignals "AcousticSignals: Contains a list
     redeclare model OrderedObject = OpcUaIA.Declarations.StackElementAcousticType_AcousticSignalsOrderedObject);
   annotation (
     Documentation(info="<html><p>Contains a list of audio signals used by this acoustic stacklight element.</p><p>The class of <code>AcousticSignals</code> in IA:StackElementAcousticType: OrderedListType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=5003", browseName="AcousticSignals"));
 end StackElementAcousticType_AcousticSignals;

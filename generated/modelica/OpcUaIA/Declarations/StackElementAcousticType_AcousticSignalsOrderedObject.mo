@@ -5,5 +5,6 @@ model StackElementAcousticType_AcousticSignalsOrderedObject "<OrderedObject>: Re
   extends OpcUa.Declarations.OrderedListType_OrderedObject;
   annotation (
     Documentation(info="<html><p>Represents an acoustic signal.</p><p>The class of <code>AcousticSignals/&lt;OrderedObject&gt;</code> in IA:StackElementAcousticType: IA:AcousticSignalType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=5004", browseName="<OrderedObject>"));
 end StackElementAcousticType_AcousticSignalsOrderedObject;

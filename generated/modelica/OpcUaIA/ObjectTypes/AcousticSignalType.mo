@@ -9,5 +9,6 @@ model AcousticSignalType "AcousticSignalType: Represents an acoustic signal."
     annotation (__OPCUA(browsePath="NumberInList", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6028", dataType="i=28"));
   annotation (
     Documentation(info="<html><p>Represents an acoustic signal.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1009", browseName="AcousticSignalType"));
 end AcousticSignalType;

@@ -5,5 +5,6 @@ partial model BaseCalibrationTargetCategoryType "BaseCalibrationTargetCategoryTy
   extends OpcUa.ObjectTypes.BaseObjectType;
   annotation (
     Documentation(info="<html><p>Abstract base type for categorizing calibration targets. Subtypes define the concrete categories.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1014", browseName="BaseCalibrationTargetCategoryType"));
 end BaseCalibrationTargetCategoryType;

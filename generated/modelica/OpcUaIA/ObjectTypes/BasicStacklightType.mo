@@ -24,5 +24,6 @@ model BasicStacklightType "BasicStacklightType: Entry point to a stacklight cont
     annotation (__OPCUA(browsePath="StackRunning", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=5005", typeDefinition="nsu=http://opcfoundation.org/UA/IA/;i=1004"));
   annotation (
     Documentation(info="<html><p>Entry point to a stacklight containing elements of the stacklight as well as additional information valid for the whole unit.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1002", browseName="BasicStacklightType"));
 end BasicStacklightType;

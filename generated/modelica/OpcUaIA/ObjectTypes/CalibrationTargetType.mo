@@ -52,5 +52,6 @@ model CalibrationTargetType "CalibrationTargetType: Provides information about a
     annotation (__OPCUA(browsePath="Quality", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6062", dataType="i=3"));
   annotation (
     Documentation(info="<html><p>Provides information about a calibration target.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1019", browseName="CalibrationTargetType"));
 end CalibrationTargetType;

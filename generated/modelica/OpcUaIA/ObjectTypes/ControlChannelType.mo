@@ -11,7 +11,7 @@ model ControlChannelType "ControlChannelType: Used for control channels of singl
     annotation (Evaluate=true);
   OpcUaSupport.RealInput intensity = 0 if use_intensity
     "Intensity: Shows the channel’s intensity, thus its brightness. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent."
-    annotation (__OPCUA(browsePath="Intensity", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6026", dataType="i=10"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="Intensity", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6026", dataType="i=10"));
   input OpcUaIA.Types.SignalModeLight signalMode = OpcUaIA.Types.SignalModeLight.Continuous
     "SignalMode: Contains a list of audio signals used by this acoustic stacklight element."
     annotation (__OPCUA(browsePath="SignalMode", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6025", dataType="nsu=http://opcfoundation.org/UA/IA/;i=3005"));
@@ -20,5 +20,6 @@ model ControlChannelType "ControlChannelType: Used for control channels of singl
     annotation (__OPCUA(browsePath="SignalOn", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6023", dataType="i=1"));
   annotation (
     Documentation(info="<html><p>Used for control channels of single colour elements within a stack element (e.g. RGB elements would use three ControlChannels, one for each controllable colour).</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1008", browseName="ControlChannelType"));
 end ControlChannelType;

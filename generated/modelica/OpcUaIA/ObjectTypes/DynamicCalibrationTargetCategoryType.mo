@@ -5,5 +5,6 @@ model DynamicCalibrationTargetCategoryType "DynamicCalibrationTargetCategoryType
   extends OpcUaIA.ObjectTypes.BaseCalibrationTargetCategoryType;
   annotation (
     Documentation(info="<html><p>Characterizes a calibration target to be used together with a measurement instrument, that determines the values to be calibrated. It can be a piece created during the normal production process or an item specifically created for calibration purposes. The calibration target represents an individual piece or item, that is, if a new piece should be used or item is created, a new Object of this ObjectType is created.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1018", browseName="DynamicCalibrationTargetCategoryType"));
 end DynamicCalibrationTargetCategoryType;

@@ -11,5 +11,6 @@ partial model IAggregateStatisticsType "IAggregateStatisticsType: Base interface
     annotation (__OPCUA(browsePath="ResetCondition", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6047", dataType="i=12"));
   annotation (
     Documentation(info="<html><p>Base interface for managing statistical data that is not rolled over. All data from the start of tracking the statistical data are considered, until the tracking gets reset.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1012", browseName="IAggregateStatisticsType"));
 end IAggregateStatisticsType;

@@ -17,5 +17,6 @@ partial model IRollingStatisticsType "IRollingStatisticsType: Base interface for
     annotation (__OPCUA(browsePath="WindowNumberOfValues", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6049", dataType="i=7"));
   annotation (
     Documentation(info="<html><p>Base interface for managing statistical data that is rolled over, i.e. only a certain amount of data is considered for statistical data.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1013", browseName="IRollingStatisticsType"));
 end IRollingStatisticsType;

@@ -12,5 +12,6 @@ partial model IStatisticsType "IStatisticsType: Base interface for managing stat
     annotation (__OPCUA(browsePath="StartTime", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6046", dataType="i=13"));
   annotation (
     Documentation(info="<html><p>Base interface for managing statistical data.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1011", browseName="IStatisticsType"));
 end IStatisticsType;

@@ -5,5 +5,6 @@ model OneTimeCalibrationTargetCategoryType "OneTimeCalibrationTargetCategoryType
   extends OpcUaIA.ObjectTypes.BaseCalibrationTargetCategoryType;
   annotation (
     Documentation(info="<html><p>Categorizes a calibration target to be used only once, for example because the calibration destroys the target. Typically, Objects of this ObjectType do not represent one individual calibration target, but a batch of calibration targets with the same characteristics.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1017", browseName="OneTimeCalibrationTargetCategoryType"));
 end OneTimeCalibrationTargetCategoryType;

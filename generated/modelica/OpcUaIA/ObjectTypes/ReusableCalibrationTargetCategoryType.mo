@@ -5,5 +5,6 @@ model ReusableCalibrationTargetCategoryType "ReusableCalibrationTargetCategoryTy
   extends OpcUaIA.ObjectTypes.BaseCalibrationTargetCategoryType;
   annotation (
     Documentation(info="<html><p>Categorizes a calibration target to be reused several times. For example, a calibration target like a meter, that is bought specifically for calibration and not destroyed by an individual usage is of this category.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1015", browseName="ReusableCalibrationTargetCategoryType"));
 end ReusableCalibrationTargetCategoryType;

@@ -5,5 +5,6 @@ model ReusableDeviceCalibrationTargetCategoryType "ReusableDeviceCalibrationTarg
   extends OpcUaIA.ObjectTypes.ReusableCalibrationTargetCategoryType;
   annotation (
     Documentation(info="<html><p>Categorizes a calibration target to be a reusable device that produces a certain environment like pressure that can be used for calibration.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1016", browseName="ReusableDeviceCalibrationTargetCategoryType"));
 end ReusableDeviceCalibrationTargetCategoryType;

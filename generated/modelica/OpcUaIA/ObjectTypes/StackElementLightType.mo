@@ -16,7 +16,7 @@ model StackElementLightType "StackElementLightType: Represents a lamp element in
     annotation (Evaluate=true);
   OpcUaSupport.RealInput intensity = 0 if use_intensity
     "Intensity: Intensity of the lamp, thus its brightness. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent."
-    annotation (__OPCUA(browsePath="Intensity", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6018", dataType="i=10"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="Intensity", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6018", dataType="i=10"));
   parameter Boolean use_signalColor = false
     "Whether the optional SignalColor exists"
     annotation (Evaluate=true);
@@ -37,5 +37,6 @@ model StackElementLightType "StackElementLightType: Represents a lamp element in
     annotation (__OPCUA(browsePath="SignalRGBWValue", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6052", dataType="nsu=http://opcfoundation.org/UA/IA/;i=3007"));
   annotation (
     Documentation(info="<html><p>Represents a lamp element in a stacklight.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1006", browseName="StackElementLightType"));
 end StackElementLightType;

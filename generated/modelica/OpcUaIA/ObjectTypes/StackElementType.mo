@@ -20,5 +20,6 @@ partial model StackElementType "StackElementType: Base class for elements in a s
     annotation (__OPCUA(browsePath="SignalOn", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6013", dataType="i=1"));
   annotation (
     Documentation(info="<html><p>Base class for elements in a stacklight.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1005", browseName="StackElementType"));
 end StackElementType;

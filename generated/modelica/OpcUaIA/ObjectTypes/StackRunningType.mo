@@ -5,5 +5,6 @@ model StackRunningType "StackRunningType: Contains information relevant to a sta
   extends OpcUa.ObjectTypes.BaseObjectType;
   annotation (
     Documentation(info="<html><p>Contains information relevant to a stacklight operating as a running light. This base type does not define any specific information, but can be extended.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1004", browseName="StackRunningType"));
 end StackRunningType;

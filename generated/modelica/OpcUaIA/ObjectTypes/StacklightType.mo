@@ -19,5 +19,6 @@ model StacklightType "StacklightType: Entry point to a stacklight with the possi
     annotation (__OPCUA(browsePath="DeviceHealthAlarms", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=5007", typeDefinition="i=61"));
   annotation (
     Documentation(info="<html><p>Entry point to a stacklight with the possibility to show the stacklight’s health status.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=1010", browseName="StacklightType"));
 end StacklightType;

@@ -8,6 +8,7 @@ record RGBWDataType "RGBWDataType"
   Boolean has_white = false "Whether the optional field White is set";
   OpcUa.Types.Byte white = 0 "White: Defines the intensity of an additional white component. Shall be not provided when using RGB.";
   annotation (
-    Documentation(info="<html><p>A structure with optional fields: <code>has_&lt;field&gt;</code> says whether a field is set.</p></html>"),
+    Documentation(info="<html><p>The DataType <code>IA:RGBWDataType</code> (nsu=http://opcfoundation.org/UA/IA/;i=3007), a subtype of <code>Structure</code>. The information model gives it no description.</p><p>A structure with optional fields: <code>has_&lt;field&gt;</code> says whether a field is set.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/IA/;i=3007", browseName="RGBWDataType"));
 end RGBWDataType;

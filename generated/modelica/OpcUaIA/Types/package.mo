@@ -2,5 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within OpcUaIA;
 package Types "DataTypes of http://opcfoundation.org/UA/IA/"
-  annotation (Documentation(info="<html><p>DataTypes of the OPC UA namespace http://opcfoundation.org/UA/IA/.</p></html>"));
+  annotation (
+    Documentation(info="<html><p>DataTypes of the OPC UA namespace http://opcfoundation.org/UA/IA/.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={128,128,128}, fillColor={240,240,240}, fillPattern=FillPattern.Solid, radius=25), Text(extent={{-80,40},{80,-40}}, textString="UA", textColor={128,128,128})}));
 end Types;

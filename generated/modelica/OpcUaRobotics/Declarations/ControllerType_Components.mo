@@ -13,5 +13,6 @@ model ControllerType_Components "Components: Components is a container for one o
     annotation (__OPCUA(browsePath="<ComponentIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18813", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=15063"));
   annotation (
     Documentation(info="<html><p>Components is a container for one or more instances of subtypes of ComponentType defined in OPC UA DI. The listed components are installed in the motion device system, e.g. a processing-unit, a power-supply, an IO-board or a drive, and have an electrical interface to the controller.</p><p>The class of <code>Components</code> in Robotics:ControllerType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17252", browseName="Components"));
 end ControllerType_Components;

@@ -13,5 +13,6 @@ model ControllerType_Software "Software: Software is a container for one or more
     annotation (__OPCUA(browsePath="<SoftwareIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18847", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=15106"));
   annotation (
     Documentation(info="<html><p>Software is a container for one or more instances of SoftwareType defined in OPC UA DI.</p><p>The class of <code>Software</code> in Robotics:ControllerType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15800", browseName="Software"));
 end ControllerType_Software;

@@ -13,5 +13,6 @@ model ControllerType_TaskControls "TaskControls: TaskControls is a container for
     annotation (__OPCUA(browsePath="<TaskControlIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18881", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1011"));
   annotation (
     Documentation(info="<html><p>TaskControls is a container for one or more instances of TaskControlType.</p><p>The class of <code>TaskControls</code> in Robotics:ControllerType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15826", browseName="TaskControls"));
 end ControllerType_TaskControls;

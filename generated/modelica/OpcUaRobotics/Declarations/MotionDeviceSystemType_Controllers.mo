@@ -16,5 +16,6 @@ model MotionDeviceSystemType_Controllers "Controllers: Contains the set of contr
     annotation (__OPCUA(browsePath="<ControllerIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15405", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1003"));
   annotation (
     Documentation(info="<html><p>Contains the set of controllers in the motion device system.</p><p>The class of <code>Controllers</code> in Robotics:MotionDeviceSystemType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5001", browseName="Controllers"));
 end MotionDeviceSystemType_Controllers;

@@ -16,5 +16,6 @@ model MotionDeviceSystemType_MotionDevices "MotionDevices: Contains any kinemati
     annotation (__OPCUA(browsePath="<MotionDeviceIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15008", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1004"));
   annotation (
     Documentation(info="<html><p>Contains any kinematic or motion device which is part of the motion device system.</p><p>The class of <code>MotionDevices</code> in Robotics:MotionDeviceSystemType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5002", browseName="MotionDevices"));
 end MotionDeviceSystemType_MotionDevices;

@@ -13,5 +13,6 @@ model MotionDeviceSystemType_SafetyStates "SafetyStates: Contains safety-related
     annotation (__OPCUA(browsePath="<SafetyStateIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15697", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1013"));
   annotation (
     Documentation(info="<html><p>Contains safety-related data from motion device system.</p><p>The class of <code>SafetyStates</code> in Robotics:MotionDeviceSystemType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5010", browseName="SafetyStates"));
 end MotionDeviceSystemType_SafetyStates;

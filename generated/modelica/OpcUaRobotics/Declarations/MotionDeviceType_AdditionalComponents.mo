@@ -13,5 +13,6 @@ model MotionDeviceType_AdditionalComponents "AdditionalComponents: AdditionalCom
     annotation (__OPCUA(browsePath="<AdditionalComponentIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5003", typeDefinition="i=58"));
   annotation (
     Documentation(info="<html><p>AdditionalComponents is a container for one or more instances of subtypes of ComponentType defined in OPC UA DI. The listed components are installed at the motion device, e.g. an IO-board.</p><p>The class of <code>AdditionalComponents</code> in Robotics:MotionDeviceType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16566", browseName="AdditionalComponents"));
 end MotionDeviceType_AdditionalComponents;

@@ -13,5 +13,6 @@ model MotionDeviceType_Axes "Axes: Axes is a container for one or more instances
     annotation (__OPCUA(browsePath="<AxisIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15743", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
   annotation (
     Documentation(info="<html><p>Axes is a container for one or more instances of the AxisType.</p><p>The class of <code>Axes</code> in Robotics:MotionDeviceType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15305", browseName="Axes"));
 end MotionDeviceType_Axes;

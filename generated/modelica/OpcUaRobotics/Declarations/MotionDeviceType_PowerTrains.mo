@@ -13,5 +13,6 @@ model MotionDeviceType_PowerTrains "PowerTrains: PowerTrains is a container for 
     annotation (__OPCUA(browsePath="<PowerTrainIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15905", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16794"));
   annotation (
     Documentation(info="<html><p>PowerTrains is a container for one or more instances of the PowerTrainType.</p><p>The class of <code>PowerTrains</code> in Robotics:MotionDeviceType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16443", browseName="PowerTrains"));
 end MotionDeviceType_PowerTrains;

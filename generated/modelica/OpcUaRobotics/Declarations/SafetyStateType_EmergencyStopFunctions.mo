@@ -13,5 +13,6 @@ model SafetyStateType_EmergencyStopFunctions "EmergencyStopFunctions: EmergencyS
     annotation (__OPCUA(browsePath="<EmergencyStopFunctionIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18806", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=17230"));
   annotation (
     Documentation(info="<html><p>EmergencyStopFunctions is a container for one or more instances of the EmergencyStopFunctionType.</p><p>The class of <code>EmergencyStopFunctions</code> in Robotics:SafetyStateType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17221", browseName="EmergencyStopFunctions"));
 end SafetyStateType_EmergencyStopFunctions;

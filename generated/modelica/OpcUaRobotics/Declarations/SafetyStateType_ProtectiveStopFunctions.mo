@@ -13,5 +13,6 @@ model SafetyStateType_ProtectiveStopFunctions "ProtectiveStopFunctions: Protecti
     annotation (__OPCUA(browsePath="<ProtectiveStopFunctionIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18809", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=17233"));
   annotation (
     Documentation(info="<html><p>ProtectiveStopFunctions is a container for one or more instances of the ProtectiveStopFunctionType.</p><p>The class of <code>ProtectiveStopFunctions</code> in Robotics:SafetyStateType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17225", browseName="ProtectiveStopFunctions"));
 end SafetyStateType_ProtectiveStopFunctions;

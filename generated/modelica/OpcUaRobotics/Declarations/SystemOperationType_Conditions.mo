@@ -12,5 +12,6 @@ model SystemOperationType_Conditions "Conditions"
     annotation (__OPCUA(browsePath="<AcknowledgeableCondition>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5059", typeDefinition="i=2881"));
   annotation (
     Documentation(info="<html><p>The class of <code>Conditions</code> in Robotics:SystemOperationType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5050", browseName="Conditions"));
 end SystemOperationType_Conditions;

@@ -11,11 +11,12 @@ model TaskControlType_ParameterSet "ParameterSet: Flat list of Parameters"
     annotation (__OPCUA(browsePath="ExecutionMode", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17876", dataType="nsu=http://opcfoundation.org/UA/Robotics/;i=18191"));
   OpcUaSupport.BooleanOutput taskProgramLoaded = false
     "TaskProgramLoaded: The TaskProgramLoaded variable is TRUE if a task program is loaded in the task control, FALSE otherwise."
-    annotation (__OPCUA(browsePath="TaskProgramLoaded", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17875", dataType="i=1"));
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="TaskProgramLoaded", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17875", dataType="i=1"));
   OpcUaSupport.StringOutput taskProgramName = ""
     "TaskProgramName: A customer given identifier for the task program."
-    annotation (__OPCUA(browsePath="TaskProgramName", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17874", dataType="i=12"));
+    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="TaskProgramName", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17874", dataType="i=12"));
   annotation (
     Documentation(info="<html><p>Flat list of Parameters</p><p>The class of <code>ParameterSet</code> in Robotics:TaskControlType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15883", browseName="ParameterSet"));
 end TaskControlType_ParameterSet;

@@ -13,5 +13,6 @@ model TaskControlType_TaskModules "TaskModules"
     annotation (__OPCUA(browsePath="<TaskModule>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5058", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1016"));
   annotation (
     Documentation(info="<html><p>The class of <code>TaskModules</code> in Robotics:TaskControlType: FolderType with the children this declaration adds or changes.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5057", browseName="TaskModules"));
 end TaskControlType_TaskModules;

@@ -5,5 +5,6 @@ model AuxiliaryComponentType "AuxiliaryComponentType: Components mounted in a co
   extends OpcUaDI.ObjectTypes.ComponentType(final use_productCode=true);
   annotation (
     Documentation(info="<html><p>Components mounted in a controller cabinet or a motion device e.g. an IO-board or a power supply.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17725", browseName="AuxiliaryComponentType"));
 end AuxiliaryComponentType;

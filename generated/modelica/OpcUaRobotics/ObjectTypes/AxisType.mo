@@ -24,5 +24,6 @@ model AxisType "AxisType: The AxisType describes an axis of a motion device."
     annotation (__OPCUA(browsePath="MotionProfile", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16637", dataType="nsu=http://opcfoundation.org/UA/Robotics/;i=3008"));
   annotation (
     Documentation(info="<html><p>The AxisType describes an axis of a motion device.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16601", browseName="AxisType"));
 end AxisType;

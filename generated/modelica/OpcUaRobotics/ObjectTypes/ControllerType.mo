@@ -61,5 +61,6 @@ model ControllerType "ControllerType: The ControllerType describes the control u
     annotation (__OPCUA(browsePath="TaskControls", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15826", typeDefinition="i=61"));
   annotation (
     Documentation(info="<html><p>The ControllerType describes the control unit of motion devices. One motion device system can have one or more instances of the ControllerType.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1003", browseName="ControllerType"));
 end ControllerType;

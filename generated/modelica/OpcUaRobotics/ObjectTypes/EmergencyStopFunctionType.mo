@@ -5,11 +5,12 @@ model EmergencyStopFunctionType "EmergencyStopFunctionType: According to ISO 102
   extends OpcUa.ObjectTypes.BaseObjectType;
   OpcUaSupport.BooleanOutput active = false
     "Active: The Active variable is TRUE if this particular emergency stop function is active, e.g. that the emergency stop button is pressed, FALSE otherwise."
-    annotation (__OPCUA(browsePath="Active", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17232", dataType="i=1"));
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="Active", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17232", dataType="i=1"));
   parameter String name = ""
     "Name: The Name of the EmergencyStopFunctionType provides a manufacturer-specific emergency stop function identifier within the safety system."
     annotation (__OPCUA(browsePath="Name", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17231", dataType="i=12"));
   annotation (
     Documentation(info="<html><p>According to ISO 10218-1:2011 Ch.5.5.2 Emergency stop the robot shall have one or more emergency stop functions.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17230", browseName="EmergencyStopFunctionType"));
 end EmergencyStopFunctionType;

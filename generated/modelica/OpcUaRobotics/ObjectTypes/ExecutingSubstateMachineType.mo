@@ -5,7 +5,7 @@ model ExecutingSubstateMachineType "ExecutingSubstateMachineType"
   extends OpcUa.ObjectTypes.FiniteStateMachineType(final use_lastTransition=true, final currentState=currentStateText);
   OpcUaSupport.IntegerInput lastTransitionReason(min=-32768, max=32767) = 0
     "LastTransitionReason"
-    annotation (__OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6038", dataType="i=4"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6038", dataType="i=4"));
   // State machine of ExecutingSubstateMachineType: its states, and transitions driven by the trigger inputs.
   parameter Integer stateMachineLevel = 1
     "Which class drives the state machine: a subclass that adds states sets its own level"
@@ -22,7 +22,7 @@ model ExecutingSubstateMachineType "ExecutingSubstateMachineType"
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput runningToStopping = false
     "RunningToStopping: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (__OPCUA(browsePath="RunningToStopping", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5022", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="RunningToStopping", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5022", typeDefinition="i=2310"));
 equation
   if stateMachineLevel == 1 then
     when runningToStopping then
@@ -31,5 +31,7 @@ equation
     currentStateText = if currentStateNumber == Running then "Running" elseif currentStateNumber == Stopping then "Stopping" else "";
   end if;
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>Robotics:ExecutingSubstateMachineType</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=1007), a subtype of <code>FiniteStateMachineType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1007", browseName="ExecutingSubstateMachineType"));
 end ExecutingSubstateMachineType;

@@ -5,7 +5,7 @@ model IdleSubstateMachineType "IdleSubstateMachineType"
   extends OpcUa.ObjectTypes.FiniteStateMachineType(final use_lastTransition=true, final currentState=currentStateText);
   OpcUaSupport.IntegerInput lastTransitionReason(min=-32768, max=32767) = 0
     "LastTransitionReason"
-    annotation (__OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6029", dataType="i=4"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6029", dataType="i=4"));
   // State machine of IdleSubstateMachineType: its states, and transitions driven by the trigger inputs.
   parameter Integer stateMachineLevel = 1
     "Which class drives the state machine: a subclass that adds states sets its own level"
@@ -22,10 +22,10 @@ model IdleSubstateMachineType "IdleSubstateMachineType"
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput gettingReadyToStandBy = false
     "GettingReadyToStandBy: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (__OPCUA(browsePath="GettingReadyToStandBy", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5018", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="GettingReadyToStandBy", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5018", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput standByToGettingReady = false
     "StandByToGettingReady: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (__OPCUA(browsePath="StandByToGettingReady", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5019", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="StandByToGettingReady", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5019", typeDefinition="i=2310"));
 equation
   if stateMachineLevel == 1 then
     when gettingReadyToStandBy then
@@ -36,5 +36,7 @@ equation
     currentStateText = if currentStateNumber == GettingReady then "GettingReady" elseif currentStateNumber == StandBy then "StandBy" else "";
   end if;
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>Robotics:IdleSubstateMachineType</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=1009), a subtype of <code>FiniteStateMachineType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1009", browseName="IdleSubstateMachineType"));
 end IdleSubstateMachineType;

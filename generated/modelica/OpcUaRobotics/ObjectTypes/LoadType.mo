@@ -17,8 +17,9 @@ model LoadType "LoadType: The LoadType is for describing loads mounted on the mo
     annotation (__OPCUA(browsePath="Inertia", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18170", dataType="i=18808"));
   OpcUaSupport.RealOutput mass = 0
     "Mass: The weight of the load mounted on one mounting point."
-    annotation (__OPCUA(browsePath="Mass", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6723", dataType="i=11"));
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="Mass", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6723", dataType="i=11"));
   annotation (
     Documentation(info="<html><p>The LoadType is for describing loads mounted on the motion device typically by an integrator or a customer.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1018", browseName="LoadType"));
 end LoadType;

@@ -20,5 +20,6 @@ model MotionDeviceSystemType "MotionDeviceSystemType: Contains the set of contro
     annotation (__OPCUA(browsePath="SafetyStates", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5010", typeDefinition="i=61"));
   annotation (
     Documentation(info="<html><p>Contains the set of controllers and motion devices in a closely-coupled motion device system.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1002", browseName="MotionDeviceSystemType"));
 end MotionDeviceSystemType;

@@ -43,8 +43,9 @@ model MotionDeviceType "MotionDeviceType: Represents a specific motion device in
     annotation (Evaluate=true);
   OpcUaSupport.StringOutput taskControlReference = "" if use_taskControlReference
     "TaskControlReference"
-    annotation (__OPCUA(browsePath="TaskControlReference", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6001", dataType="i=17"));
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="TaskControlReference", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6001", dataType="i=17"));
   annotation (
     Documentation(info="<html><p>Represents a specific motion device in the motion device system like a robot, a linear unit or a positioner. A MotionDevice should have at least one axis.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1004", browseName="MotionDeviceType"));
 end MotionDeviceType;

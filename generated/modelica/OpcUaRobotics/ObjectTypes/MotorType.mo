@@ -17,5 +17,6 @@ model MotorType "MotorType: The MotorType is for representing instances of elect
     annotation (__OPCUA(browsePath="<DriveIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5060", typeDefinition="i=58", referenceType="IsDrivenBy"));
   annotation (
     Documentation(info="<html><p>The MotorType is for representing instances of electric motors.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1019", browseName="MotorType"));
 end MotorType;

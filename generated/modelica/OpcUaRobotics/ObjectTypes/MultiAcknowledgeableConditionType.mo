@@ -9,6 +9,7 @@ record MultiAcknowledgeableConditionType "MultiAcknowledgeableConditionType"
     "ConditionDescriptions"
     annotation (__OPCUA(browsePath="ConditionDescriptions", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6140", dataType="i=21"));
   annotation (
-    Documentation(info="<html><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Documentation(info="<html><p>The EventType <code>Robotics:MultiAcknowledgeableConditionType</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=1015), a subtype of <code>AcknowledgeableConditionType</code>. The information model gives it no description.</p><p>An event type: the record holds the fields an event of this type carries.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, textString="%name", textColor={0,0,0})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1015", browseName="MultiAcknowledgeableConditionType"));
 end MultiAcknowledgeableConditionType;

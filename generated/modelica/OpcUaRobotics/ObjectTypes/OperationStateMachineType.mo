@@ -8,10 +8,10 @@ partial model OperationStateMachineType "OperationStateMachineType"
     annotation (Evaluate=true);
   OpcUaSupport.IntegerInput configuredDefaultStopMode(min=-32768, max=32767) = 0 if use_configuredDefaultStopMode
     "ConfiguredDefaultStopMode"
-    annotation (__OPCUA(browsePath="ConfiguredDefaultStopMode", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6009", dataType="i=4"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="ConfiguredDefaultStopMode", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6009", dataType="i=4"));
   OpcUaSupport.IntegerInput lastTransitionReason(min=-32768, max=32767) = 0
     "LastTransitionReason"
-    annotation (__OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6007", dataType="i=4"));
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6007", dataType="i=4"));
   parameter Boolean use_possibleStopModes = false
     "Whether the optional PossibleStopModes exists"
     annotation (Evaluate=true);
@@ -39,22 +39,22 @@ partial model OperationStateMachineType "OperationStateMachineType"
     "Number of the current state (CurrentState/Number); the nodeset marks no initial state, so it starts in Executing, the first state";
   OpcUaSupport.BooleanInput executingToIdle = false
     "ExecutingToIdle: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (__OPCUA(browsePath="ExecutingToIdle", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5013", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="ExecutingToIdle", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5013", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput stop = false
     "Stop: a rising edge stands for a call of the method Stop"
-    annotation (__OPCUA(browsePath="Stop", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=7002"));
+    annotation (Placement(transformation(extent={{-120,10},{-100,30}})), __OPCUA(browsePath="Stop", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=7002"));
   OpcUaSupport.BooleanInput idleToIdle = false
     "IdleToIdle: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (__OPCUA(browsePath="IdleToIdle", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5014", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="IdleToIdle", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5014", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput idleToReady = false
     "IdleToReady: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (__OPCUA(browsePath="IdleToReady", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5009", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="IdleToReady", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5009", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput start = false
     "Start: a rising edge stands for a call of the method Start"
-    annotation (__OPCUA(browsePath="Start", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=7001"));
+    annotation (Placement(transformation(extent={{-120,-50},{-100,-30}})), __OPCUA(browsePath="Start", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=7001"));
   OpcUaSupport.BooleanInput readyToIdle = false
     "ReadyToIdle: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (__OPCUA(browsePath="ReadyToIdle", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5008", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-70},{-100,-50}})), __OPCUA(browsePath="ReadyToIdle", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5008", typeDefinition="i=2310"));
 equation
   if stateMachineLevel == 1 then
     when executingToIdle then
@@ -73,6 +73,7 @@ equation
     currentStateText = if currentStateNumber == Executing then "Executing" elseif currentStateNumber == Idle then "Idle" elseif currentStateNumber == Ready then "Ready" else "";
   end if;
   annotation (
-    Documentation(info="<html><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Documentation(info="<html><p>The ObjectType <code>Robotics:OperationStateMachineType</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=1006), a subtype of <code>FiniteStateMachineType</code>. The information model gives it no description.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1006", browseName="OperationStateMachineType"));
 end OperationStateMachineType;

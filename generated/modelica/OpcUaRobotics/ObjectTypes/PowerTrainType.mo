@@ -33,5 +33,6 @@ model PowerTrainType "PowerTrainType: The PowerTrainType represents instances of
     annotation (__OPCUA(browsePath="<PowerTrainIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18613", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16794", referenceType="HasSlave"));
   annotation (
     Documentation(info="<html><p>The PowerTrainType represents instances of powertrains of a motion device.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16794", browseName="PowerTrainType"));
 end PowerTrainType;

@@ -5,7 +5,7 @@ model ReadySubstateMachineType "ReadySubstateMachineType"
   extends OpcUa.ObjectTypes.FiniteStateMachineType(final use_lastTransition=true, final currentState=currentStateText);
   OpcUaSupport.IntegerInput lastTransitionReason(min=-32768, max=32767) = 0
     "LastTransitionReason"
-    annotation (__OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6046", dataType="i=4"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6046", dataType="i=4"));
   // Method ResetToProgramStart() returns (Int32 Status): call it through an OPC UA client.
   // State machine of ReadySubstateMachineType: its states, and transitions driven by the trigger inputs.
   parameter Integer stateMachineLevel = 1
@@ -23,10 +23,10 @@ model ReadySubstateMachineType "ReadySubstateMachineType"
     "Number of the current state (CurrentState/Number); the nodeset marks no initial state, so it starts in AtProgramStart, the first state";
   OpcUaSupport.BooleanInput programStartToSuspended = false
     "ProgramStartToSuspended: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (__OPCUA(browsePath="ProgramStartToSuspended", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5025", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="ProgramStartToSuspended", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5025", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput resetToProgramStart = false
     "ResetToProgramStart: a rising edge stands for a call of the method ResetToProgramStart"
-    annotation (__OPCUA(browsePath="ResetToProgramStart", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=7003"));
+    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="ResetToProgramStart", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=7003"));
 equation
   if stateMachineLevel == 1 then
     when programStartToSuspended then
@@ -37,5 +37,7 @@ equation
     currentStateText = if currentStateNumber == AtProgramStart then "AtProgramStart" elseif currentStateNumber == Suspended then "Suspended" else "";
   end if;
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>Robotics:ReadySubstateMachineType</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=1012), a subtype of <code>FiniteStateMachineType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1012", browseName="ReadySubstateMachineType"));
 end ReadySubstateMachineType;

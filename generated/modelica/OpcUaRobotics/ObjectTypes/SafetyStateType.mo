@@ -23,5 +23,6 @@ model SafetyStateType "SafetyStateType: SafetyStateType describes the safety sta
     annotation (__OPCUA(browsePath="ProtectiveStopFunctions", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17225", typeDefinition="i=61"));
   annotation (
     Documentation(info="<html><p>SafetyStateType describes the safety states of the motion devices and controllers. One motion device system is associated with one or more instances of the SafetyStateType.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1013", browseName="SafetyStateType"));
 end SafetyStateType;

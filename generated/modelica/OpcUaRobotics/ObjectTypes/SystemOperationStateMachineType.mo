@@ -22,5 +22,7 @@ model SystemOperationStateMachineType "SystemOperationStateMachineType"
     annotation (__OPCUA(browsePath="IdleSubstateMachine", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5027", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1009"));
   // Method StandDown() returns (Int32 Status): call it through an OPC UA client.
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>Robotics:SystemOperationStateMachineType</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=1021), a subtype of <code>Robotics:OperationStateMachineType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1021", browseName="SystemOperationStateMachineType"));
 end SystemOperationStateMachineType;

@@ -17,5 +17,7 @@ model SystemOperationType "SystemOperationType"
     "SystemOperationStateMachine"
     annotation (__OPCUA(browsePath="SystemOperationStateMachine", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5049", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1021"));
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>Robotics:SystemOperationType</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=1028), a subtype of <code>BaseObjectType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1028", browseName="SystemOperationType"));
 end SystemOperationType;

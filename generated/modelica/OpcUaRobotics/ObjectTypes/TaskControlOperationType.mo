@@ -15,5 +15,7 @@ model TaskControlOperationType "TaskControlOperationType"
     "TaskControlStateMachine"
     annotation (__OPCUA(browsePath="TaskControlStateMachine", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5051", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1025"));
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>Robotics:TaskControlOperationType</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=1008), a subtype of <code>BaseObjectType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1008", browseName="TaskControlOperationType"));
 end TaskControlOperationType;

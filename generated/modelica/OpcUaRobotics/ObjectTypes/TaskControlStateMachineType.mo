@@ -17,5 +17,7 @@ model TaskControlStateMachineType "TaskControlStateMachineType"
   // Method UnloadByNodeId(ExpandedNodeId Id) returns (Int32 Status): call it through an OPC UA client.
   // Method UnloadProgram() returns (Int32 Status): call it through an OPC UA client.
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>Robotics:TaskControlStateMachineType</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=1025), a subtype of <code>Robotics:OperationStateMachineType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1025", browseName="TaskControlStateMachineType"));
 end TaskControlStateMachineType;

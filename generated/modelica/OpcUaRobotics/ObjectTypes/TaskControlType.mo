@@ -30,5 +30,6 @@ model TaskControlType "TaskControlType: Represents a specific task control activ
     annotation (__OPCUA(browsePath="TaskModules", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5057", typeDefinition="i=61"));
   annotation (
     Documentation(info="<html><p>Represents a specific task control active on the controller.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1011", browseName="TaskControlType"));
 end TaskControlType;

@@ -19,5 +19,7 @@ model TaskModuleType "TaskModuleType"
     "Version"
     annotation (__OPCUA(browsePath="Version", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6055", dataType="i=12"));
   annotation (
+    Documentation(info="<html><p>The ObjectType <code>Robotics:TaskModuleType</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=1016), a subtype of <code>BaseObjectType</code>. The information model gives it no description.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=1016", browseName="TaskModuleType"));
 end TaskModuleType;

@@ -14,5 +14,6 @@ model UserType "UserType: The UserType ObjectType describes information of the r
     annotation (__OPCUA(browsePath="Name", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18177", dataType="i=12"));
   annotation (
     Documentation(info="<html><p>The UserType ObjectType describes information of the registered user groups within the control system.</p></html>"),
+    Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18175", browseName="UserType"));
 end UserType;

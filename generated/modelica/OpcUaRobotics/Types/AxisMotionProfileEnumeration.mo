@@ -9,5 +9,5 @@ type AxisMotionProfileEnumeration = enumeration(
     LINEARENDLESS "LINEAR_ENDLESS = 4: Linear motion is a one dimensional motion along a straight line with no limits. Motion movement is going endless in the same direction. Control unit is mainly mm.")
   "AxisMotionProfileEnumeration"
   annotation (
-    Documentation(info="<html><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaRobotics.EnumerationValues.AxisMotionProfileEnumeration[Integer(x)]</code>.</p></html>"),
+    Documentation(info="<html><p>The DataType <code>Robotics:AxisMotionProfileEnumeration</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=3008), a subtype of <code>Enumeration</code>. The information model gives it no description.</p><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaRobotics.EnumerationValues.AxisMotionProfileEnumeration[Integer(x)]</code>.</p></html>"),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=3008", browseName="AxisMotionProfileEnumeration", values={0, 1, 2, 3, 4}));

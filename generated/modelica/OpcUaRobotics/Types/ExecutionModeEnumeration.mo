@@ -7,5 +7,5 @@ type ExecutionModeEnumeration = enumeration(
     STEP "STEP = 2: Task program is executed in steps.")
   "ExecutionModeEnumeration"
   annotation (
-    Documentation(info="<html><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaRobotics.EnumerationValues.ExecutionModeEnumeration[Integer(x)]</code>.</p></html>"),
+    Documentation(info="<html><p>The DataType <code>Robotics:ExecutionModeEnumeration</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=18191), a subtype of <code>Enumeration</code>. The information model gives it no description.</p><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaRobotics.EnumerationValues.ExecutionModeEnumeration[Integer(x)]</code>.</p></html>"),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18191", browseName="ExecutionModeEnumeration", values={0, 1, 2}));

@@ -11,5 +11,5 @@ type MotionDeviceCategoryEnumeration = enumeration(
     CYLINDRICALROBOT "CYLINDRICAL_ROBOT = 6: The robot has at least one rotary joint at the base and at least one prismatic joint to connect the links. The rotary joint uses a rotational motion along the joint axis, while the prismatic joint moves in a linear motion. Cylindrical robots operate within a cylindrical-shaped work envelope.")
   "MotionDeviceCategoryEnumeration"
   annotation (
-    Documentation(info="<html><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaRobotics.EnumerationValues.MotionDeviceCategoryEnumeration[Integer(x)]</code>.</p></html>"),
+    Documentation(info="<html><p>The DataType <code>Robotics:MotionDeviceCategoryEnumeration</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=18193), a subtype of <code>Enumeration</code>. The information model gives it no description.</p><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaRobotics.EnumerationValues.MotionDeviceCategoryEnumeration[Integer(x)]</code>.</p></html>"),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18193", browseName="MotionDeviceCategoryEnumeration", values={0, 1, 2, 3, 4, 5, 6}));

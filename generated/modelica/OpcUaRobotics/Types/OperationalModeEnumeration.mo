@@ -9,5 +9,5 @@ type OperationalModeEnumeration = enumeration(
     AUTOMATICEXTERNAL "AUTOMATIC_EXTERNAL = 4: \"Automatic external\" - Same as \"Automatic\" but with external control, e.g. by a PLC.")
   "OperationalModeEnumeration"
   annotation (
-    Documentation(info="<html><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaRobotics.EnumerationValues.OperationalModeEnumeration[Integer(x)]</code>.</p></html>"),
+    Documentation(info="<html><p>The DataType <code>Robotics:OperationalModeEnumeration</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=3006), a subtype of <code>Enumeration</code>. The information model gives it no description.</p><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaRobotics.EnumerationValues.OperationalModeEnumeration[Integer(x)]</code>.</p></html>"),
     __OPCUA(nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=3006", browseName="OperationalModeEnumeration", values={0, 1, 2, 3, 4}));

@@ -272,6 +272,21 @@ impl<'a> Ctx<'a> {
     }
 }
 
+/// Documentation for the class of a node the information model gives no Description: what it stands for,
+/// so that no generated class is undocumented.
+pub fn undescribed(m: &Model, node: NodeIx, what: &str) -> String {
+    let n = m.node(node);
+    let sup = n
+        .super_type
+        .map(|s| format!(", a subtype of <code>{}</code>", super::text::html_escape(&m.qualified(s))))
+        .unwrap_or_default();
+    format!(
+        "<p>The {what} <code>{}</code> ({}){sup}. The information model gives it no description.</p>",
+        super::text::html_escape(&m.qualified(node)),
+        super::text::html_escape(&node_id_text(m, &n.id))
+    )
+}
+
 /// A NodeId in its standard text form with the namespace URI (`nsu=...;i=5`), or `i=5` in namespace 0.
 pub fn node_id_text(m: &Model, id: &NodeId) -> String {
     if id.ns == 0 {
@@ -285,7 +300,7 @@ pub fn node_id_text(m: &Model, id: &NodeId) -> String {
 pub fn node_id_type(id: &Identifier) -> &'static str {
     match id {
         Identifier::Numeric(_) => "Numeric",
-        Identifier::String(_) => "String",
+        Identifier::String(_) => "String_",
         Identifier::Guid(_) => "Guid",
         Identifier::Opaque(_) => "Opaque",
     }

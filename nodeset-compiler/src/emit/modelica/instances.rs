@@ -221,12 +221,13 @@ impl Ctx<'_> {
             }
         }
         s.push_str(&format!(
-            "  annotation ({});\nend Objects;\n",
+            "  annotation (\n    {},\n    {});\nend Objects;\n",
             text::documentation(&format!(
                 "<p>The instances of {} in the address space, one component per instance whose parent belongs to \
                  another namespace, and <code>nodes</code>, the variables of all of them with their NodeIds.</p>",
                 text::html_escape(m.namespace_uri(ns))
-            ))
+            )),
+            text::MODEL_ICON
         ));
         s
     }
@@ -328,6 +329,9 @@ fn builtin_literal(b: BuiltinType) -> &'static str {
     match b {
         BuiltinType::ExtensionObject => "ExtensionObject",
         BuiltinType::Variant => "Variant",
+        // Literals are not named like Modelica's predefined types.
+        BuiltinType::Boolean => "Boolean_",
+        BuiltinType::String => "String_",
         other => other.type_name(),
     }
 }

@@ -4,8 +4,10 @@
 //! (paths relative to one output root that holds every package, as Modelica tools expect a library root)
 //! and writes nothing. The output follows the conventions of the Modelica Standard Library and does not
 //! depend on it: one class per file, `package.mo` and `package.order` in every package folder, `within`
-//! clauses, description strings, `Documentation(info=...)` from the nodeset's Descriptions, and `version` and
-//! `uses` annotations from the Model and RequiredModel elements.
+//! clauses, description strings, `Documentation(info=...)` on every class (the nodeset's Description, else
+//! what the class stands for), an `Icon` on every model, record and package (connectors placed down its left
+//! edge for inputs and its right edge for outputs), `version` and `uses` annotations from the Model and
+//! RequiredModel elements, and a `UsersGuide` in `OpcUaSupport`.
 //!
 //! ```no_run
 //! use nodeset_compiler::emit::modelica::{generate, ModelicaConfig};
@@ -455,12 +457,13 @@ impl Output {
                 files.push(OutFile {
                     path: dir.join("package.mo"),
                     contents: format!(
-                        "{header}within {pkg};\npackage {sub} {}\n  annotation ({});\nend {sub};\n",
+                        "{header}within {pkg};\npackage {sub} {}\n  annotation (\n    {},\n    {});\nend {sub};\n",
                         string_literal(&format!("{what} of {}", m.namespace_uri(ns))),
                         text::documentation(&format!(
                             "<p>{what} of the OPC UA namespace {}.</p>",
                             text::html_escape(m.namespace_uri(ns))
-                        ))
+                        )),
+                        text::PACKAGE_ICON
                     ),
                 });
                 files.push(OutFile { path: dir.join("package.order"), contents: lines(&order) });
@@ -534,6 +537,7 @@ fn package_mo(ctx: &Ctx, ns: u16, subset: bool) -> String {
         doc.push_str("<p>This package holds only the part of the namespace that the other generated packages use.</p>");
     }
     ann.push(text::documentation(&doc));
+    ann.push(text::PACKAGE_ICON.to_string());
     ann.push(format!("__OPCUA(namespaceUri={})", string_literal(uri)));
     let desc = if subset {
         format!("OPC UA namespace {uri} (the part the generated packages use)")
@@ -791,6 +795,11 @@ fn render_class(ctx: &mut Ctx, plan: &ClassPlan, ident: &str) -> String {
     let mut ann = Vec::new();
     if !plan.doc_html.is_empty() {
         ann.push(text::documentation(&plan.doc_html));
+    }
+    if plan.keyword.ends_with("model") {
+        ann.push(text::MODEL_ICON.to_string());
+    } else if plan.keyword == "record" {
+        ann.push(text::RECORD_ICON.to_string());
     }
     ann.push(plan.opcua.clone());
     s.push_str(&format!("  annotation (\n    {});\nend {ident};\n", ann.join(",\n    ")));

@@ -7,7 +7,7 @@
 //! element. Every element keeps its origin in an `__OPCUA(browsePath, nodeId, dataType)` annotation; the
 //! browse path is relative to the object the enclosing class stands for.
 
-use super::ctx::{component_original, count_name, node_id_text, ClassKey, Ctx, Owner, MAX_NESTING};
+use super::ctx::{component_original, count_name, node_id_text, undescribed, ClassKey, Ctx, Owner, MAX_NESTING};
 use super::text::{self, string_literal};
 use super::types::{as_i128, dims_text, Base, MType};
 use super::units::Unit;
@@ -31,6 +31,8 @@ pub struct ClassInfo {
     pub local_replaceable: bool,
     /// The state machine this class (or a base class) drives.
     pub state_machine: Option<Rc<super::statemachine::SmInfo>>,
+    /// The connectors on its icon.
+    pub placed: Placed,
 }
 
 #[derive(Debug, Clone)]
@@ -180,6 +182,27 @@ pub struct Body {
     pub adds: bool,
     /// The state the inherited state machine starts in here, when a child CurrentState names another one.
     pub initial: Option<usize>,
+    /// How many input and output connectors the class has placed on its icon (inherited ones included).
+    pub placed: Placed,
+}
+
+/// How many input connectors (left edge of the icon) and output connectors (right edge) a class places.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Placed {
+    pub inputs: usize,
+    pub outputs: usize,
+}
+
+impl Placed {
+    /// The `Placement` of the next input (or output) connector: inputs down the left edge of the icon,
+    /// outputs down the right one, 20 units apart from the top, as in the Modelica Standard Library's blocks.
+    pub fn next(&mut self, input: bool) -> String {
+        let i = if input { &mut self.inputs } else { &mut self.outputs };
+        let y = 80 - 20 * *i as i64;
+        *i += 1;
+        let (x0, x1) = if input { (-120, -100) } else { (100, 120) };
+        format!("Placement(transformation(extent={{{{{x0},{}}},{{{x1},{}}}}}))", y - 10, y + 10)
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -270,7 +293,7 @@ impl Ctx<'_> {
             state_machine = Some(Rc::new(sm));
         }
         let partial = node.is_abstract();
-        let mut doc = node.doc().map(text::html_paragraphs).unwrap_or_default();
+        let mut doc = node.doc().map(text::html_paragraphs).unwrap_or_else(|| undescribed(m, t, "ObjectType"));
         if partial {
             doc.push_str("<p>The ObjectType is abstract, so the class is partial: extend it.</p>");
         }
@@ -294,6 +317,7 @@ impl Ctx<'_> {
             taken: body.taken,
             local_replaceable: body.local_replaceable,
             state_machine,
+            placed: body.placed,
         }
     }
 
@@ -417,7 +441,7 @@ impl Ctx<'_> {
                 alias: None,
             });
         }
-        let mut doc = node.doc().map(text::html_paragraphs).unwrap_or_default();
+        let mut doc = node.doc().map(text::html_paragraphs).unwrap_or_else(|| undescribed(m, t, "EventType"));
         doc.push_str("<p>An event type: the record holds the fields an event of this type carries.</p>");
         let plan = ClassPlan {
             keyword: "record",
@@ -433,7 +457,14 @@ impl Ctx<'_> {
             ),
         };
         self.plans.entry(Owner::Type(t)).or_default().main = Some(plan);
-        ClassInfo { key: ClassKey::Type(t), elements, taken, local_replaceable: false, state_machine: None }
+        ClassInfo {
+            key: ClassKey::Type(t),
+            elements,
+            taken,
+            local_replaceable: false,
+            state_machine: None,
+            placed: Placed::default(),
+        }
     }
 
     /// Gives the declaration classes of an owner their names: one scope over their browse paths.
@@ -593,7 +624,11 @@ impl Ctx<'_> {
         allow_replaceable: bool,
     ) -> Body {
         let m = self.m;
-        let mut body = Body { taken: base.map(|b| b.taken.clone()).unwrap_or_default(), ..Body::default() };
+        let mut body = Body {
+            taken: base.map(|b| b.taken.clone()).unwrap_or_default(),
+            placed: base.map(|b| b.placed).unwrap_or_default(),
+            ..Body::default()
+        };
         let mut elements: Vec<Element> = base.map(|b| b.elements.clone()).unwrap_or_default();
         let by_bn: HashMap<QualifiedName, usize> =
             elements.iter().enumerate().map(|(i, e)| (e.bn.clone(), i)).collect();
@@ -940,6 +975,12 @@ impl Ctx<'_> {
                         sattrs.extend(attrs);
                     }
                     let mods = attr_mods(&sattrs, dims.is_some());
+                    // A connector (no input/output prefix) gets its place on the icon.
+                    let annotation = if prefix.is_empty() {
+                        format!("{}, {annotation}", body.placed.next(writable))
+                    } else {
+                        annotation
+                    };
                     body.items.push(Item::Decl {
                         prefix,
                         ty: TypeRef::Path(tyname),
@@ -1084,6 +1125,7 @@ impl Ctx<'_> {
             taken: sub.taken,
             local_replaceable: sub.local_replaceable,
             state_machine: starting_in(base.state_machine.clone(), sub.initial),
+            placed: sub.placed,
         };
         self.class_infos.insert(key.clone(), Rc::new(info));
         key

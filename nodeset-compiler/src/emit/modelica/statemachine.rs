@@ -414,7 +414,7 @@ impl Ctx<'_> {
                 value: Some("false".into()),
                 cond: None,
                 desc: string_literal(&d),
-                annotation: self.opcua_annotation(n),
+                annotation: format!("{}, {}", body.placed.next(true), self.opcua_annotation(n)),
             });
         }
         // One branch per trigger, in the order triggers first appear.

@@ -361,3 +361,65 @@ fn an_instance_names_the_target_of_its_reference() {
     assert!(cell.contains("referenceType=\"Requires\""), "{cell}");
     assert!(!cell.contains("NodesetCompilerRobotCell."), "no component of the robot system's class: {cell}");
 }
+
+/// What the library conventions ask of a generated tree: documentation on every class, an icon on every model,
+/// record and package, and a place on the icon for every connector, no two in one class at the same place.
+/// Returns the offences, one per line.
+fn convention_offences(files: &[crate::write::OutFile]) -> Vec<String> {
+    let connector = regex_lite_connector();
+    let mut out = Vec::new();
+    for f in files.iter().filter(|f| f.path.extension().is_some_and(|e| e == "mo")) {
+        let path = f.path.display();
+        let text = &f.contents;
+        let class = text.lines().find(|l| !l.starts_with("//") && !l.starts_with("within")).unwrap_or("");
+        if !text.contains("Documentation(info=") {
+            out.push(format!("{path}: no Documentation"));
+        }
+        let kind = class.split_whitespace().take_while(|w| *w != "=").collect::<Vec<_>>();
+        let needs_icon = ["model", "record", "package", "connector"].iter().any(|k| kind.contains(k));
+        if needs_icon && !text.contains("Icon(") {
+            out.push(format!("{path}: no Icon"));
+        }
+        let mut places = BTreeSet::new();
+        for statement in text.split(";\n") {
+            let first = statement.trim_start_matches('\n');
+            if first.starts_with("  ") && !first.starts_with("   ") && connector(first.trim_start()) {
+                match statement.find("Placement(transformation(extent=") {
+                    None => out.push(format!("{path}: connector without Placement: {}", first.lines().next().unwrap_or(""))),
+                    Some(at) => {
+                        let place = statement[at..].split(")").next().unwrap_or("").to_string();
+                        if !places.insert(place.clone()) {
+                            out.push(format!("{path}: two connectors at {place}"));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Whether a declaration starts with a connector of the support package (`OpcUaSupport.RealOutput x`).
+fn regex_lite_connector() -> impl Fn(&str) -> bool {
+    |decl: &str| {
+        let Some(ty) = decl.strip_prefix("OpcUaSupport.") else { return false };
+        let ty = ty.split_whitespace().next().unwrap_or("");
+        ["Real", "Integer", "Boolean", "String"].iter().any(|b| ty == format!("{b}Input") || ty == format!("{b}Output"))
+    }
+}
+
+#[test]
+fn every_class_is_documented_and_has_an_icon_and_every_connector_a_place() {
+    let mut files = robotics_files();
+    files.extend(skills_with(str::to_string));
+    let mut offences = convention_offences(&files);
+    offences.sort();
+    offences.dedup();
+    assert!(offences.is_empty(), "{} offences:\n{}", offences.len(), offences.join("\n"));
+    // The check sees what it looks for.
+    let mut bare = robotics_files();
+    let axis = bare.iter_mut().find(|f| f.path.ends_with("Declarations/AxisType_ParameterSet.mo")).unwrap();
+    axis.contents = axis.contents.replacen("Placement(", "Place(", 1).replace("Documentation(", "Doc(").replace("Icon(", "I(");
+    let offences = convention_offences(&bare);
+    assert_eq!(offences.len(), 3, "{offences:?}");
+}

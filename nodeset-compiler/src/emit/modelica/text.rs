@@ -64,6 +64,28 @@ pub fn html_paragraphs(text: &str) -> String {
     out
 }
 
+/// The icon of a model: a white box with a blue frame, its name above it. Connectors sit on its left (inputs)
+/// and right (outputs) edges.
+pub const MODEL_ICON: &str = "Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, \
+fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, \
+textString=\"%name\", textColor={0,0,255})})";
+
+/// The icon of a record: a box with a grey header that holds its name.
+pub const RECORD_ICON: &str = "Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, \
+fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, \
+lineColor={64,64,64}, fillColor={200,200,200}, fillPattern=FillPattern.Solid), Text(extent={{-100,100},{100,50}}, \
+textString=\"%name\", textColor={0,0,0})})";
+
+/// The icon of a package: a grey rounded box marked UA.
+pub const PACKAGE_ICON: &str = "Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={128,128,128}, \
+fillColor={240,240,240}, fillPattern=FillPattern.Solid, radius=25), Text(extent={{-80,40},{80,-40}}, \
+textString=\"UA\", textColor={128,128,128})})";
+
+/// The icon of a package of documentation (the support package's UsersGuide): an i in a circle.
+pub const INFO_ICON: &str = "Icon(graphics={Ellipse(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, \
+fillColor={255,255,255}, fillPattern=FillPattern.Solid), Text(extent={{-60,70},{60,-70}}, textString=\"i\", \
+textColor={0,0,127})})";
+
 /// A `Documentation(info=...)` annotation item for an HTML body.
 pub fn documentation(html_body: &str) -> String {
     format!("Documentation(info={})", string_literal(&format!("<html>{html_body}</html>")))

@@ -649,7 +649,8 @@ impl Ctx<'_> {
         let names = self.names(ns);
         let ident = names.types.get(&dt)?.clone();
         let kind = m.data_types.get(&dt)?.kind.clone();
-        let doc = node.doc().map(text::html_paragraphs).unwrap_or_default();
+        let described = node.doc().map(text::html_paragraphs);
+        let doc = described.clone().unwrap_or_else(|| super::ctx::undescribed(m, dt, "DataType"));
         let opcua = format!(
             "__OPCUA(nodeId={}, browseName={})",
             string_literal(&node_id_text(m, &node.id)),
@@ -660,7 +661,8 @@ impl Ctx<'_> {
             DataTypeKind::Builtin(b) => {
                 let map = builtin_map(b).ok().filter(|m| m.alias)?;
                 let attrs = attrs(map.min, map.max, map.unit);
-                let doc = format!("<p>{}.</p>{doc}", text::html_escape(map.doc));
+                // The mapping says what the built-in type is; the nodeset may say more.
+                let doc = format!("<p>{}.</p>{}", text::html_escape(map.doc), described.unwrap_or_default());
                 format!(
                     "type {ident} = {}{attrs} {}\n  annotation (\n    {},\n    {opcua});\n",
                     map.base.name(),
@@ -727,8 +729,9 @@ impl Ctx<'_> {
                     base.type_name()
                 );
                 s.push_str(&format!(
-                    "  annotation (\n    {},\n    {opcua});\nend {ident};\n",
-                    text::documentation(&doc)
+                    "  annotation (\n    {},\n    {},\n    {opcua});\nend {ident};\n",
+                    text::documentation(&doc),
+                    text::RECORD_ICON
                 ));
                 s
             }
@@ -839,6 +842,7 @@ impl Ctx<'_> {
                     ),
                     StructureKind::Structure => {}
                 }
+                let opcua = format!("{},\n    {opcua}", text::RECORD_ICON);
                 s.push_str(&format!("{}end {ident};\n", annotation(&doc, &opcua)));
                 s
             }
@@ -864,13 +868,14 @@ impl Ctx<'_> {
             ));
         }
         s.push_str(&format!(
-            "  annotation ({});\nend EnumerationValues;\n",
+            "  annotation (\n    {},\n    {});\nend EnumerationValues;\n",
             text::documentation(&format!(
                 "<p>Modelica numbers the literals of an enumeration from 1; OPC UA gives each a value of its own, which \
                  need not start at 0 nor be consecutive. <code>EnumerationValues.E[Integer(x)]</code> is the OPC UA \
                  value of literal <code>x</code> of <code>{}.Types.E</code>.</p>",
                 text::html_escape(&pkg)
-            ))
+            )),
+            text::PACKAGE_ICON
         ));
         s
     }
