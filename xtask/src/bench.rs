@@ -19,6 +19,8 @@
 //! * `rust`: the Rust back end, end to end (module [`rust`] below says how each figure is taken):
 //!   generation time and memory for DI + IA + Robotics, generated lines, build time of the generated crate
 //!   alone, address-space import time, and the same figures for async-opcua-codegen 0.19 on the same inputs.
+//! * `modelica`: Modelica generation for DI + IA + Robotics (`nodeset-compiler/examples/modelica_bench.rs`,
+//!   loading excluded), between two timings of the peer; module [`modelica`].
 //! * `robots`: the typed API at scale ([`robots`]): N six-axis robots instantiated in one server, every joint
 //!   position updated at 100 Hz; time per update cycle and memory per robot. Not part of `all` (it runs for
 //!   `--robots-seconds` and builds the server stack in release mode).
@@ -53,6 +55,7 @@ use crate::util::{cargo, display_path, target_dir, workspace_root};
 
 mod builds;
 mod foundation;
+mod modelica;
 mod peer;
 mod robots;
 mod rust;
@@ -74,7 +77,7 @@ const DEFAULT_TREE: &str = "../shared/nodesets/ua-nodeset";
 #[derive(Debug, clap::Args)]
 pub struct Args {
     /// Which scenario(s) to run.
-    #[arg(long, value_parser = ["all", "robotics", "tree", "sets", "rust", "scale", "robots", "verify"], default_value = "all")]
+    #[arg(long, value_parser = ["all", "robotics", "tree", "sets", "rust", "modelica", "scale", "robots", "verify"], default_value = "all")]
     scenario: String,
 
     /// Runs of the robotics scenario (ns0 + DI + IA + Robotics).
@@ -155,7 +158,7 @@ pub fn run(args: Args) -> Result<(), String> {
     let want = |s: &str| args.scenario == "all" || args.scenario == s;
     let tree = args.tree.clone().unwrap_or_else(|| root.join(DEFAULT_TREE));
 
-    if want("robotics") || want("rust") || want("scale") {
+    if want("robotics") || want("rust") || want("modelica") || want("scale") {
         ensure_vendor(&root.join("nodesets/vendor"))?;
     }
     let tree_scenarios: Vec<&str> = ["tree", "sets"].into_iter().filter(|s| want(s)).collect();
@@ -179,6 +182,9 @@ pub fn run(args: Args) -> Result<(), String> {
     }
     if want("rust") {
         rust::run(&args, &root, &tree)?;
+    }
+    if want("modelica") {
+        modelica::run(&args, &root, &tree)?;
     }
     if want("scale") {
         scale::run(&root.join("nodesets/vendor"), args.scale_n, args.runs_scale)?;

@@ -1,0 +1,58 @@
+//! The `modelica` scenario: Modelica generation for DI + IA + Robotics, timed by
+//! `nodeset-compiler/examples/modelica_bench.rs` (generation alone, loading excluded) in a fresh process, between
+//! two timings of the peer. The 20 ms target was set on the development machine; the peer's run in the same
+//! bench says how fast the host is now, so the target is judged scaled by it, and as a ratio to the peer.
+
+use std::path::Path;
+use std::process::Command;
+
+use super::peer::{self, Yardsticks};
+use super::{build, run_report, verdict, Args};
+
+/// Target: the median time of one generation of DI + IA + Robotics (with the used part of ns0 and
+/// OpcUaSupport), on the development machine.
+const MODELICA_TIME_MS: f64 = 20.0;
+
+/// Runs of the generation in one process.
+const RUNS: usize = 50;
+
+pub(super) fn run(args: &Args, root: &Path, tree: &Path) -> Result<(), String> {
+    let exe = build(root, "nodeset-compiler", "modelica_bench", &[])?;
+    eprintln!("running scenario `modelica` ({RUNS} runs) ...");
+    let (report, yard) = Yardsticks::new(args, root, tree)
+        .around("ours", || run_report(Command::new(&exe).arg(RUNS.to_string())));
+    let r = report.map_err(|e| format!("scenario `modelica`: {e}"))?;
+    let median = r.f("total_median_ms");
+    println!();
+    println!("Modelica generation of DI + IA + Robotics (emit::modelica::generate, loading excluded), release build.");
+    println!(
+        "   time     median {median:>10.2} ms   min {:>10.2} ms   max {:>10.2} ms   target <= {MODELICA_TIME_MS} ms  {}",
+        r.f("total_min_ms"),
+        r.f("total_max_ms"),
+        verdict(median, MODELICA_TIME_MS)
+    );
+    match yard {
+        Some(Ok(y)) => {
+            println!(
+                "   peer     async-opcua-codegen {}, its whole DI + Robotics run, {} run(s) around ours: median {:.1} ms; \
+                 the host is {:.2}x as slow as when the target was set: {}",
+                peer::PEER_VERSION,
+                y.runs,
+                y.median_ms,
+                y.slowdown(),
+                peer::scaled(median, MODELICA_TIME_MS, y.slowdown(), "ms")
+            );
+            println!(
+                "            (ours / peer = {:.3}; the target's ratio is {MODELICA_TIME_MS} / {} = {:.3})",
+                median / y.median_ms,
+                peer::PEER_RUN_STATED_MS,
+                MODELICA_TIME_MS / peer::PEER_RUN_STATED_MS
+            );
+        }
+        Some(Err(e)) => println!("   peer     not measured: {e}"),
+        None => println!("   peer     not measured (--no-peer): the target is not scaled to the host's speed"),
+    }
+    println!("   output   {} files, {:.1} KiB", r.s("files"), r.f("bytes") / 1024.0);
+    println!();
+    Ok(())
+}
