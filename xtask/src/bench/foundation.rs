@@ -105,31 +105,7 @@ fn print_table(reports: &[Report], split: bool, yard: Option<&Result<Yardstick, 
             r.f("cpu_min_ms")
         );
         if scenario == "robotics" {
-            match yard {
-                Some(Ok(y)) => {
-                    println!(
-                        "   peer     async-opcua-codegen {}, its whole DI + Robotics run, {} run(s) around ours: median {:.1} ms, min {:.1} ms;",
-                        peer::PEER_VERSION,
-                        y.runs,
-                        y.median_ms,
-                        y.min_ms
-                    );
-                    println!(
-                        "            the issue measured {} ms on this machine, so the host is {:.2}x as slow now: {}",
-                        peer::PEER_RUN_STATED_MS,
-                        y.slowdown(),
-                        peer::scaled(total, ROBOTICS_TIME_MS, y.slowdown(), "ms")
-                    );
-                    println!(
-                        "            (ours / peer = {:.3}; the target's ratio is {ROBOTICS_TIME_MS} / {} = {:.3})",
-                        total / y.median_ms,
-                        peer::PEER_RUN_STATED_MS,
-                        ROBOTICS_TIME_MS / peer::PEER_RUN_STATED_MS
-                    );
-                }
-                Some(Err(e)) => println!("   peer     not measured: {e}"),
-                None => println!("   peer     not measured (--no-peer): the target is not scaled to the host's speed"),
-            }
+            peer::print_judged(yard, total, ROBOTICS_TIME_MS);
         }
         let hwm_mib = r.f("hwm_kib") / 1024.0;
         let mem_target = if scenario == "robotics" {

@@ -31,27 +31,7 @@ pub(super) fn run(args: &Args, root: &Path, tree: &Path) -> Result<(), String> {
         r.f("total_max_ms"),
         verdict(median, MODELICA_TIME_MS)
     );
-    match yard {
-        Some(Ok(y)) => {
-            println!(
-                "   peer     async-opcua-codegen {}, its whole DI + Robotics run, {} run(s) around ours: median {:.1} ms; \
-                 the host is {:.2}x as slow as when the target was set: {}",
-                peer::PEER_VERSION,
-                y.runs,
-                y.median_ms,
-                y.slowdown(),
-                peer::scaled(median, MODELICA_TIME_MS, y.slowdown(), "ms")
-            );
-            println!(
-                "            (ours / peer = {:.3}; the target's ratio is {MODELICA_TIME_MS} / {} = {:.3})",
-                median / y.median_ms,
-                peer::PEER_RUN_STATED_MS,
-                MODELICA_TIME_MS / peer::PEER_RUN_STATED_MS
-            );
-        }
-        Some(Err(e)) => println!("   peer     not measured: {e}"),
-        None => println!("   peer     not measured (--no-peer): the target is not scaled to the host's speed"),
-    }
+    peer::print_judged(yard.as_ref(), median, MODELICA_TIME_MS);
     println!("   output   {} files, {:.1} KiB", r.s("files"), r.f("bytes") / 1024.0);
     println!();
     Ok(())

@@ -286,6 +286,31 @@ fn yardstick(before: &Report, after: &Report) -> Yardstick {
 }
 
 /// A target scaled by the host's slowdown, and the verdict against it.
+/// Prints how the peer's runs around ours judge `ours_ms` against `target_ms`: the host's slowdown, the
+/// scaled target, and ours / peer beside the target's own ratio.
+pub(super) fn print_judged(yard: Option<&Result<Yardstick, String>>, ours_ms: f64, target_ms: f64) {
+    match yard {
+        Some(Ok(y)) => {
+            println!(
+                "   peer     {PEER} {PEER_VERSION}, its whole DI + Robotics run, {} run(s) around ours: median {:.1} ms, min {:.1} ms;",
+                y.runs, y.median_ms, y.min_ms
+            );
+            println!(
+                "            the issue measured {PEER_RUN_STATED_MS} ms on this machine, so the host is {:.2}x as slow now: {}",
+                y.slowdown(),
+                scaled(ours_ms, target_ms, y.slowdown(), "ms")
+            );
+            println!(
+                "            (ours / peer = {:.3}; the target's ratio is {target_ms} / {PEER_RUN_STATED_MS} = {:.3})",
+                ours_ms / y.median_ms,
+                target_ms / PEER_RUN_STATED_MS
+            );
+        }
+        Some(Err(e)) => println!("   peer     not measured: {e}"),
+        None => println!("   peer     not measured (--no-peer): the target is not scaled to the host's speed"),
+    }
+}
+
 pub(super) fn scaled(value: f64, target: f64, slowdown: f64, unit: &str) -> String {
     let limit = target * slowdown;
     format!(
