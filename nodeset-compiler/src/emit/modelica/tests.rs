@@ -366,7 +366,7 @@ fn an_instance_names_the_target_of_its_reference() {
 /// record and package, and a place on the icon for every connector, no two in one class at the same place.
 /// Returns the offences, one per line.
 fn convention_offences(files: &[crate::write::OutFile]) -> Vec<String> {
-    let connector = regex_lite_connector();
+    let connector = is_support_connector();
     let mut out = Vec::new();
     for f in files.iter().filter(|f| f.path.extension().is_some_and(|e| e == "mo")) {
         let path = f.path.display();
@@ -400,7 +400,7 @@ fn convention_offences(files: &[crate::write::OutFile]) -> Vec<String> {
 }
 
 /// Whether a declaration starts with a connector of the support package (`OpcUaSupport.RealOutput x`).
-fn regex_lite_connector() -> impl Fn(&str) -> bool {
+fn is_support_connector() -> impl Fn(&str) -> bool {
     |decl: &str| {
         let Some(ty) = decl.strip_prefix("OpcUaSupport.") else { return false };
         let ty = ty.split_whitespace().next().unwrap_or("");
