@@ -14,7 +14,8 @@ rumoca 0.10.2 cannot simulate a model with a String variable (tests/modelica/Rum
 every OPC UA state machine has one (CurrentState). With --strings-as-parameters the script simulates a copy of
 ROOT in which each String variable of the generated packages is a parameter: `OpcUaSupport.StringOutput x` and
 `OpcUaSupport.StringInput x` become `parameter String x`, a `String x` without a value becomes
-`parameter String x = ""`, and the equations `x = ...;` of the latter are left out. Numbers, Booleans and the
+`parameter String x = ""`, and the equations `x = ...;` of the latter are left out; the equation `w.u = ...;`
+that gives a binding model's String write block `w` its input becomes the binding `u=...` of that parameter. Numbers, Booleans and the
 state machines are simulated as generated; the texts are not.
 """
 
@@ -39,8 +40,16 @@ def strings_as_parameters(root):
             new = re.sub(r"(?m)^(\s*)OpcUaSupport\.String(?:Output|Input) ", r"\1parameter String ", text)
             unbound = re.findall(r"(?m)^\s*String (\w+)$", new)
             new = re.sub(r"(?m)^(\s*)String (\w+)$", r'\1parameter String \2 = ""', new)
+            new = re.sub(r"(?m)^(\s*)String (\w+ = )", r"\1parameter String \2", new)
             for var in unbound:
                 new = re.sub(r"(?m)^\s*%s = .*;\n" % re.escape(var), "", new)
+            # A binding model's String write block gets its input through an equation; with the input a
+            # parameter, the equation becomes its binding.
+            for block in re.findall(r"(?m)^\s*WriteString (\w+)\(", new):
+                eq = re.search(r"(?m)^\s*%s\.u = (.*);\n" % re.escape(block), new)
+                if eq:
+                    new = new.replace(eq.group(0), "")
+                    new = re.sub(r"(?m)^(\s*WriteString %s\()" % re.escape(block), r"\g<1>u=%s, " % eq.group(1).replace("\\", "\\\\"), new)
             if new != text:
                 with open(path, "w", encoding="utf-8") as f:
                     f.write(new)

@@ -349,7 +349,9 @@ fn simulate_at(root_dir: &Path, model: &str, times: &[f64]) -> Vec<(String, Vec<
         .collect()
 }
 
-/// The skill state machine, generated afresh from our skill models: `tests/modelica/SkillExample.DrillHoleRun`
+/// The skill state machine and the binding to OPC UA, generated afresh from our skill models.
+///
+/// `tests/modelica/SkillExample.DrillHoleRun`
 /// drives the DrillHole skill of the generated DrillingCell instance with pulses on its trigger inputs.
 /// The skill starts in Ready (the instance's CurrentState and Program rule, see `statemachine.rs`), so Start
 /// runs it at once; Halt stops it; a Start in Halted does nothing; Reset brings it back to Ready, and Start
@@ -374,11 +376,13 @@ fn a_skill_instance_runs_through_start_halt_and_reset() {
     let target = tmp("skills-run");
     write(&target, &generated);
     copy_dir(&root().join("tests/modelica/SkillExample"), &target.join("SkillExample"));
-    // The library and the example as they are (with their String variables) pass rumoca's check.
+    copy_dir(&root().join("tests/modelica/BindingExample"), &target.join("BindingExample"));
+    // The library and the examples as they are (with their String variables) pass rumoca's check.
     let (passed, failed, text) = check(&target, true);
     assert_eq!(failed, 0, "{text}");
     assert!(passed > 100, "{text}");
-    println!("{}", second_checks("SkillExample", &target, &["SkillExample"], passed));
+    let examples = ["SkillExample", "BindingExample", "NodesetCompilerDrillingProcess.Instances.Bindings", "OpcUaSupport"];
+    println!("{}", second_checks("the examples, the binding models and OpcUaSupport", &target, &examples, passed));
     // (time, state number): before anything, after Start, after Halt, after the ignored Start, after Reset,
     // after the second Start.
     let expected = [(0.5, 12.0), (1.5, 13.0), (2.3, 11.0), (2.8, 11.0), (3.5, 12.0), (4.5, 13.0)];
@@ -393,6 +397,30 @@ fn a_skill_instance_runs_through_start_halt_and_reset() {
     let states = get("state");
     let want: Vec<f64> = expected.iter().map(|e| e.1).collect();
     assert_eq!(states, want, "state numbers at {times:?} (Halted 11, Ready 12, Running 13)");
+
+    // The generated binding model of the same instance, its blocks the loopback ones
+    // (`tests/modelica/BindingExample.LoopbackCell`): a read feeds the instance in SI units from a table in
+    // the variable's engineering unit, and a write sends what the instance publishes.
+    let times = [0.0, 0.5, 1.5, 2.5];
+    let vars = simulate_at(&target, "BindingExample.LoopbackCell", &times);
+    let get = |name: &str| {
+        vars.iter()
+            .find(|v| v.0 == name)
+            .map(|v| v.1.clone())
+            .unwrap_or_else(|| panic!("no variable {name} in {:?}", vars.iter().map(|v| &v.0).collect::<Vec<_>>()))
+    };
+    let close = |got: Vec<f64>, want: [f64; 4], what: &str| {
+        assert!(got.iter().zip(want).all(|(g, w)| (g - w).abs() < 1e-9), "{what} at {times:?}: {got:?}, want {want:?}");
+    };
+    // ApproachDistance: 10 mm rising linearly to 30 mm at 1 s, read in millimetres, used in metres.
+    close(get("cell.skillSet.referenceDrillBush.inputParameterSet.approachDistance"), [0.01, 0.02, 0.03, 0.03], "approachDistance (m)");
+    close(get("cell.readSkillSetReferenceDrillBushInputParameterSetApproachDistance.value"), [10.0, 20.0, 30.0, 30.0], "the ApproachDistance read (mm)");
+    // Depth: 5 mm, 8 mm from 2 s on.
+    close(get("cell.skillSet.drillHole.inputParameterSet.depth"), [0.005, 0.005, 0.005, 0.008], "depth (m)");
+    // A read without a table gives the nodeset's value (FeedRate has none: 0).
+    close(get("cell.skillSet.drillHole.inputParameterSet.feedRate"), [0.0; 4], "feedRate");
+    // DrillHole's Result, set by the example, is what its write block sends: Good, then Bad_Timeout.
+    close(get("result"), [0.0, 0.0, -2136276992.0, -2136276992.0], "the Result written");
 }
 
 /// What rumoca 0.10.2 does with redeclarations, reproduced with small hand-written models

@@ -57,6 +57,22 @@ end FirstOrderAxis;</pre>
 <pre>extends OpcUaRobotics.Declarations.MotionDeviceType_Axes(
   nAxisIdentifier=2, redeclare model AxisIdentifier = FirstOrderAxis);</pre>
 
+<h4>Binding to OPC UA</h4>
+<p><code>Instances.Bindings</code> holds each instance again, extended by one block per variable: a variable
+clients may write is read from the server (<code>OpcUaSupport.Interfaces.ReadReal</code>, ...), a variable the
+model publishes is written to it. Each block has the instance's NodeId, browse path and the conversion from the
+engineering unit to SI. The block classes are replaceable and default to <code>OpcUaSupport.Loopback</code>,
+which reads tables and needs no server. Extend the interfaces with an OPC UA library (the DLR OPC UA library,
+or another) and redeclare them, with one <code>inner parameter OpcUaSupport.Interfaces.Connection
+connection</code> at the top of the model:</p>
+<pre>model Cell
+  inner parameter OpcUaSupport.Interfaces.Connection connection(endpointUrl=\"opc.tcp://cell:4840\");
+  NodesetCompilerDrillingProcess.Instances.Bindings.DrillingCell cell(
+    redeclare block ReadReal = MyOpcUa.ReadReal);
+end Cell;</pre>
+<p><code>Instances.Objects.nodes</code> is the <code>Nodes</code> configuration record of the DLR library's
+server and client blocks: every variable of the instances it can create.</p>
+
 <h4>State machines</h4>
 <p>A state machine has <code>currentStateNumber</code>, an Integer holding the StateNumber of the nodeset, one
 constant per state, and <code>currentStateText</code>, the DisplayName of the current state, which

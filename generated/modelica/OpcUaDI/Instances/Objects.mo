@@ -7,7 +7,7 @@ model Objects "The instances of http://opcfoundation.org/UA/DI/ below the Object
     nVars=1,
     vars={
       OpcUaSupport.VariableNode(nsIndex=1, nodeIdType=OpcUaSupport.NodeIdType.Numeric, id="6095", displayName="OnlineAccess", dataType=OpcUaSupport.BuiltinType.Boolean_, dataTypeId="i=1", browsePath="DeviceTopology/OnlineAccess")})
-    "Every variable of the instances, as the configuration record of an OPC UA server or client block"
+    "The variables of the instances that the DLR OPC UA library can create, as the configuration record of its server and client blocks"
     annotation (Dialog(group="Configuration"));
   OpcUaDI.Instances.DeviceSet deviceSet "DeviceSet"
     annotation (__OPCUA(browsePath="DeviceSet", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=5001"));

@@ -95,6 +95,9 @@ pub struct Ctx<'a> {
     /// The instance declarations that would make a class contain itself; they become reference parameters
     /// (see `recursion.rs`).
     pub cuts: BTreeSet<NodeIx>,
+    /// The elements and taken identifiers of each top-level instance's class, for its binding model (see
+    /// `bindings.rs`).
+    pub instance_classes: BTreeMap<NodeIx, (Vec<super::objects::Element>, BTreeSet<String>)>,
 }
 
 impl<'a> Ctx<'a> {
@@ -121,6 +124,7 @@ impl<'a> Ctx<'a> {
             deferred: Vec::new(),
             redeclared: BTreeSet::new(),
             cuts: super::recursion::containment_cuts(m),
+            instance_classes: BTreeMap::new(),
         }
     }
 

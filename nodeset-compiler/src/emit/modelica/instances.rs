@@ -98,6 +98,7 @@ impl Ctx<'_> {
         let base = self.type_class(td);
         let own = self.own_children(ix, Mode::Instance);
         let mut body = self.plan_body(owner, "", base.as_ref(), &own, Mode::Instance, true);
+        self.instance_classes.insert(ix, (body.elements.clone(), body.taken.clone()));
         let doc = format!(
             "{}<p>The instance {} of {} ({}).</p>",
             node.doc().map(text::html_paragraphs).unwrap_or_default(),
@@ -139,6 +140,9 @@ impl Ctx<'_> {
         for &top in &names.top_instances {
             collect_variables(m, top, &mut vars, &mut seen);
         }
+        // The DLR OPC UA library creates Boolean, integer, Float, Double and String variables; the others are
+        // listed in a comment.
+        let (vars, unsupported): (Vec<NodeIx>, Vec<NodeIx>) = vars.into_iter().partition(|&v| dlr_creates(self.builtin_of(v)));
         let mut uris: Vec<u16> = vars.iter().map(|&v| m.node(v).id.ns).filter(|&n| n != 0).collect();
         uris.sort();
         uris.dedup();
@@ -163,9 +167,19 @@ impl Ctx<'_> {
         s.push_str(&format!(
             "\n    {}\n    annotation (Dialog(group=\"Configuration\"));\n",
             string_literal(
-                "Every variable of the instances, as the configuration record of an OPC UA server or client block"
+                "The variables of the instances that the DLR OPC UA library can create, as the configuration record of its server and client blocks"
             )
         ));
+        if !unsupported.is_empty() {
+            s.push_str("  // Not in nodes: the DLR OPC UA library creates Boolean, integer, Float, Double and String variables only.\n");
+            for &v in &unsupported {
+                s.push_str(&format!(
+                    "  //   {} ({})\n",
+                    path_from_objects(m, v),
+                    builtin_literal(self.builtin_of(v)).trim_end_matches('_')
+                ));
+            }
+        }
         let mut scope = self.scope::<NodeIx>();
         scope.reserve("nodes");
         for &top in &names.top_instances {
@@ -232,6 +246,12 @@ impl Ctx<'_> {
         s
     }
 
+    /// The built-in type a variable's value is encoded as.
+    fn builtin_of(&self, v: NodeIx) -> BuiltinType {
+        let m = self.m;
+        m.node(v).attrs.data_type.and_then(|d| m.data_types.get(&d)).map(|i| i.encoding).unwrap_or(BuiltinType::Variant)
+    }
+
     /// One `OpcUaSupport.VariableNode(...)` entry.
     fn variable_node(&mut self, v: NodeIx, uris: &[u16]) -> String {
         let m = self.m;
@@ -240,7 +260,7 @@ impl Ctx<'_> {
             if n.id.ns == 0 { 0 } else { uris.iter().position(|&u| u == n.id.ns).map(|p| p + 1).unwrap_or(0) };
         let sup = super::support::PACKAGE;
         let dt = n.attrs.data_type;
-        let builtin = dt.and_then(|d| m.data_types.get(&d)).map(|i| i.encoding).unwrap_or(BuiltinType::Variant);
+        let builtin = self.builtin_of(v);
         let rank = n.attrs.value_rank.unwrap_or(-1);
         let dims = if rank >= 0 {
             if n.attrs.array_dimensions.is_empty() {
@@ -280,7 +300,7 @@ impl Ctx<'_> {
 
     /// A value as the text of `VariableNode.initValue`: scalars as written, arrays as `{a, b}`; structures have
     /// no text form.
-    fn value_text(&self, v: &Variant) -> Option<String> {
+    pub(super) fn value_text(&self, v: &Variant) -> Option<String> {
         Some(match v {
             Variant::Boolean(b) => b.to_string(),
             Variant::SByte(x) => x.to_string(),
@@ -322,6 +342,13 @@ fn collect_variables(m: &Model, ix: NodeIx, out: &mut Vec<NodeIx>, seen: &mut BT
             collect_variables(m, c, out, seen);
         }
     }
+}
+
+/// Whether the DLR OPC UA library can create a variable of a built-in type (Modelica Boolean, Integer, Real and
+/// String; Schönfeld et al., Modelica Conference 2021).
+fn dlr_creates(b: BuiltinType) -> bool {
+    use BuiltinType::*;
+    matches!(b, Boolean | SByte | Byte | Int16 | UInt16 | Int32 | UInt32 | Int64 | UInt64 | Float | Double | String)
 }
 
 /// The `OpcUaSupport.BuiltinType` literal of a built-in type.

@@ -25,7 +25,8 @@
 //! # Layout
 //!
 //! ```text
-//! OpcUaSupport/              connectors RealInput ... StringOutput, NodeId, BrowsePath, VariableNode, Nodes
+//! OpcUaSupport/              connectors RealInput ... StringOutput, NodeId, BrowsePath, VariableNode, Nodes,
+//!                            Interfaces (read/write blocks for an OPC UA library), Loopback (tables, no server)
 //! OpcUa/                     the part of the base namespace the other packages use (or all of it)
 //! OpcUaRobotics/
 //!   package.mo               version, uses, the namespace URI
@@ -35,6 +36,7 @@
 //!   Declarations/            classes of instance declarations that add children to their type, named
 //!                            <Owner>_<BrowsePath> (AxisType_ParameterSet)
 //!   Instances/               one model per top-level instance and `Objects` with the `Nodes` record
+//!     Bindings/             each instance with a read or write block per variable (see `bindings.rs`)
 //! ```
 //!
 //! Package names derive from the namespace URI (`http://opcfoundation.org/UA/Robotics/` -> `OpcUaRobotics`,
@@ -139,6 +141,7 @@
 //! Children that an instance declaration adds to an inherited component that is not replaceable are left
 //! out with a warning.
 
+mod bindings;
 mod ctx;
 mod instances;
 mod objects;
@@ -445,9 +448,28 @@ impl Output {
                 ("Declarations", "Classes of instance declarations"),
                 ("Instances", "Instances"),
             ] {
-                let order: Vec<String> = subs.get(sub).cloned().unwrap_or_default();
+                let mut order: Vec<String> = subs.get(sub).cloned().unwrap_or_default();
                 if order.is_empty() {
                     continue;
+                }
+                if sub == "Instances" && subs.contains_key("Instances.Bindings") {
+                    // The binding models (`bindings.rs`), a package of their own inside Instances.
+                    order.insert(0, "Bindings".into());
+                    let dir = root.join("Instances/Bindings");
+                    files.push(OutFile {
+                        path: dir.join("package.mo"),
+                        contents: format!(
+                            "{header}within {pkg}.Instances;\npackage Bindings {}\n  annotation (\n    {},\n    {});\nend Bindings;\n",
+                            string_literal(&format!("Instances of {} bound to their OPC UA nodes", m.namespace_uri(ns))),
+                            text::documentation(
+                                "<p>One model per instance: the instance with a read or write block of \
+                                 <code>OpcUaSupport.Interfaces</code> for each of its variables. See \
+                                 <code>OpcUaSupport.UsersGuide</code>.</p>"
+                            ),
+                            text::PACKAGE_ICON
+                        ),
+                    });
+                    files.push(OutFile { path: dir.join("package.order"), contents: lines(&subs["Instances.Bindings"]) });
                 }
                 top_order.push(sub.to_string());
                 if sub == "Types" && self.top_files.get(&ns).is_some_and(|t| t.contains_key("EnumerationValues")) {
@@ -589,6 +611,13 @@ fn emit_namespace(ctx: &mut Ctx, ns: u16, out: &mut Output) {
     if !names.top_instances.is_empty() {
         let body = ctx.objects_model(ns);
         out.add(ns, "Instances", "Objects", body);
+    }
+    for &top in &names.top_instances {
+        if m.node(top).class == NodeClass::Object {
+            if let Some(body) = ctx.binding_model(ns, top) {
+                out.add(ns, "Instances.Bindings", &names.instances[&top], body);
+            }
+        }
     }
     emit_enumeration_values(ctx, ns, out);
 }

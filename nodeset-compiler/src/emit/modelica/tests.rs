@@ -376,7 +376,7 @@ fn convention_offences(files: &[crate::write::OutFile]) -> Vec<String> {
             out.push(format!("{path}: no Documentation"));
         }
         let kind = class.split_whitespace().take_while(|w| *w != "=").collect::<Vec<_>>();
-        let needs_icon = ["model", "record", "package", "connector"].iter().any(|k| kind.contains(k));
+        let needs_icon = ["model", "block", "record", "package", "connector"].iter().any(|k| kind.contains(k));
         if needs_icon && !text.contains("Icon(") {
             out.push(format!("{path}: no Icon"));
         }

@@ -70,6 +70,11 @@ pub const MODEL_ICON: &str = "Icon(graphics={Rectangle(extent={{-100,100},{100,-
 fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, \
 textString=\"%name\", textColor={0,0,255})})";
 
+/// The icon of a block, as the Modelica Standard Library draws `Modelica.Blocks.Icons.Block`.
+pub const BLOCK_ICON: &str = "Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, \
+fillColor={255,255,255}, fillPattern=FillPattern.Solid), Text(extent={{-150,150},{150,110}}, \
+textString=\"%name\", textColor={0,0,255})})";
+
 /// The icon of a record: a box with a grey header that holds its name.
 pub const RECORD_ICON: &str = "Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={64,64,64}, \
 fillColor={255,255,255}, fillPattern=FillPattern.Solid), Rectangle(extent={{-100,100},{100,50}}, \

@@ -1,0 +1,12 @@
+within OpcUaSupport.Interfaces;
+partial block WriteReal "Writes a Real value to a variable of an OPC UA server"
+  outer parameter Connection connection "The connection to the OPC UA server, declared inner at the top of the model";
+  parameter String nodeId = "" "NodeId of the variable: nsu=<namespace URI>;i=<number>, or i=<number> in the base namespace";
+  parameter String browsePath = "" "BrowseNames from the ObjectsFolder, separated by '/', to find the variable on a server whose NodeIds differ";
+  parameter Real siFactor = 1 "u = siFactor*value + siOffset: from the engineering unit of the variable to SI";
+  parameter Real siOffset = 0 "u = siFactor*value + siOffset: from the engineering unit of the variable to SI";
+  OpcUaSupport.RealInput u "The value to write, in SI units"
+    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})));
+  Real value = (u - siOffset)/siFactor "The OPC UA value an implementation writes";
+  annotation ({BLOCK_ICON}, Documentation(info="<html><p>The interface an OPC UA library implements to write a Real variable: extend this block and send <code>value</code> to the variable <code>nodeId</code> on the server of the <code>outer</code> <code>connection</code>, at the connection's sample period or when it changes. <code>value</code> is <code>u</code> converted from SI to the engineering unit of the variable.</p></html>"));
+end WriteReal;
