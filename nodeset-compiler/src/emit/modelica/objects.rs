@@ -560,14 +560,33 @@ impl Ctx<'_> {
         }
     }
 
-    /// The Modelica unit of a variable from its EngineeringUnits property (a child, or one its type declares
-    /// with a value); `Err` with the unit's display name when the table has no Modelica form for it.
+    /// The Modelica unit of a variable from its EngineeringUnits property (a child, or one its VariableType or a
+    /// supertype of it declares with a value); `Err` with the unit's display name when the table has no Modelica
+    /// form for it.
     pub fn unit_of(&self, node: NodeIx) -> Option<Result<&'static Unit, String>> {
         let m = self.m;
-        let eu = m
-            .children(node)
-            .map(|(_, c)| c)
-            .find(|&c| m.node(c).browse_name.ns == 0 && m.node(c).browse_name.name == "EngineeringUnits")?;
+        let eu_of = |n: NodeIx| {
+            m.children(n)
+                .map(|(_, c)| c)
+                .find(|&c| m.node(c).browse_name.ns == 0 && m.node(c).browse_name.name == "EngineeringUnits")
+        };
+        // The variable's own EngineeringUnits, else the one its VariableType (or a supertype of it) gives a value.
+        let eu = match eu_of(node).filter(|&eu| m.value(eu).is_some()) {
+            Some(eu) => eu,
+            None => {
+                let mut t = m.node(node).type_definition;
+                let mut found = None;
+                for _ in 0..64 {
+                    let Some(ty) = t else { break };
+                    if let Some(eu) = eu_of(ty).filter(|&eu| m.value(eu).is_some()) {
+                        found = Some(eu);
+                        break;
+                    }
+                    t = m.node(ty).super_type;
+                }
+                found?
+            }
+        };
         let Ok(Variant::ExtensionObject(eo)) = m.value(eu)? else { return None };
         let body = eo.body.as_ref()?;
         let id: i32 = body.child_text("UnitId")?.trim().parse().ok()?;
