@@ -349,6 +349,14 @@ fn simulate_at(root_dir: &Path, model: &str, times: &[f64]) -> Vec<(String, Vec<
         .collect()
 }
 
+/// The values of variable `name` in a [`simulate_at`] result.
+fn values_at(vars: &[(String, Vec<f64>)], name: &str) -> Vec<f64> {
+    vars.iter()
+        .find(|v| v.0 == name)
+        .map(|v| v.1.clone())
+        .unwrap_or_else(|| panic!("no variable {name} in {:?}", vars.iter().map(|v| &v.0).collect::<Vec<_>>()))
+}
+
 /// The skill state machine and the binding to OPC UA, generated afresh from our skill models.
 ///
 /// `tests/modelica/SkillExample.DrillHoleRun`
@@ -388,12 +396,7 @@ fn a_skill_instance_runs_through_start_halt_and_reset() {
     let expected = [(0.5, 12.0), (1.5, 13.0), (2.3, 11.0), (2.8, 11.0), (3.5, 12.0), (4.5, 13.0)];
     let times: Vec<f64> = expected.iter().map(|e| e.0).collect();
     let vars = simulate_at(&target, "SkillExample.DrillHoleRun", &times);
-    let get = |name: &str| {
-        vars.iter()
-            .find(|v| v.0 == name)
-            .map(|v| v.1.clone())
-            .unwrap_or_else(|| panic!("no variable {name} in {:?}", vars.iter().map(|v| &v.0).collect::<Vec<_>>()))
-    };
+    let get = |name: &str| values_at(&vars, name);
     let states = get("state");
     let want: Vec<f64> = expected.iter().map(|e| e.1).collect();
     assert_eq!(states, want, "state numbers at {times:?} (Halted 11, Ready 12, Running 13)");
@@ -403,12 +406,7 @@ fn a_skill_instance_runs_through_start_halt_and_reset() {
     // the variable's engineering unit, and a write sends what the instance publishes.
     let times = [0.0, 0.5, 1.5, 2.5];
     let vars = simulate_at(&target, "BindingExample.LoopbackCell", &times);
-    let get = |name: &str| {
-        vars.iter()
-            .find(|v| v.0 == name)
-            .map(|v| v.1.clone())
-            .unwrap_or_else(|| panic!("no variable {name} in {:?}", vars.iter().map(|v| &v.0).collect::<Vec<_>>()))
-    };
+    let get = |name: &str| values_at(&vars, name);
     let close = |got: Vec<f64>, want: [f64; 4], what: &str| {
         assert!(got.iter().zip(want).all(|(g, w)| (g - w).abs() < 1e-9), "{what} at {times:?}: {got:?}, want {want:?}");
     };
