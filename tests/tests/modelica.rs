@@ -419,6 +419,14 @@ fn a_skill_instance_runs_through_start_halt_and_reset() {
     close(get("cell.skillSet.drillHole.inputParameterSet.feedRate"), [0.0; 4], "feedRate");
     // DrillHole's Result, set by the example, is what its write block sends: Good, then Bad_Timeout.
     close(get("result"), [0.0, 0.0, -2136276992.0, -2136276992.0], "the Result written");
+
+    // The generated example of the cell simulates as it is (its experiment annotation gives the time): both
+    // skills stay in Ready, the initial state of the nodeset.
+    let vars = simulate_at(&target, "NodesetCompilerDrillingProcess.Examples.DrillingCell", &[0.5]);
+    for skill in ["referenceDrillBush", "drillHole"] {
+        let state = values_at(&vars, &format!("drillingCell.skillSet.{skill}.currentStateNumber"));
+        assert_eq!(state, [12.0], "{skill} in Ready");
+    }
 }
 
 /// What rumoca 0.10.2 does with redeclarations, reproduced with small hand-written models

@@ -275,3 +275,59 @@ fn camel_path(verb: &str, path: &[String]) -> String {
     }
     out
 }
+
+impl Ctx<'_> {
+    /// `<Pkg>.Examples.<Name>`: a top-level instance object as a model that simulates as it is, with an
+    /// `experiment` annotation: its binding model beside the `inner` connection, or the instance when it has no
+    /// variable to bind.
+    pub fn example_model(&mut self, ns: u16, top: NodeIx, bound: bool) -> String {
+        let m = self.m;
+        let names = self.names(ns);
+        let pkg = self.pkg[ns as usize].clone();
+        let class = names.instances[&top].clone();
+        let n = m.node(top);
+        let sup = super::support::PACKAGE;
+        let mut scope = self.scope::<u8>();
+        scope.reserve("connection");
+        scope.add(&super::ctx::component_original(&n.browse_name.name), 0);
+        let (idents, _) = scope.finish();
+        let ident = &idents[&0];
+        let (used, how) = if bound {
+            (
+                format!("{pkg}.Instances.Bindings.{class}"),
+                format!(
+                    "its binding model, whose read and write blocks are <code>{sup}.Loopback</code>: the reads give \
+                     the values of the nodeset until you feed them tables (<code>{ident}(read...(table=[0, v0; t1, v1]))</code>) \
+                     or redeclare them with an OPC UA library"
+                ),
+            )
+        } else {
+            (format!("{pkg}.Instances.{class}"), "the instance (it has no variable to bind)".to_string())
+        };
+        let mut s = format!(
+            "model {class} {}\n",
+            string_literal(&format!("{}, simulated as it is", n.browse_name.name))
+        );
+        if bound {
+            s.push_str(&format!(
+            "  inner parameter {sup}.Interfaces.Connection connection\n    {}\n    annotation (Placement(transformation(extent={{{{-90,70}},{{-70,90}}}})));\n",
+            string_literal("The OPC UA server the read and write blocks talk to (the loopback blocks need none)")
+            ));
+        }
+        s.push_str(&format!(
+            "  {used} {ident} {}\n    annotation (Placement(transformation(extent={{{{-20,-20}},{{20,20}}}})));\n",
+            text::description(&n.browse_name.name, n.doc())
+        ));
+        let doc = format!(
+            "<p>The instance {} of the nodeset, ready to simulate: {how}. Its state machines, if any, stay in their \
+             initial state until a model of yours drives their triggers.</p>",
+            text::html_escape(&super::instances::path_from_objects(m, top))
+        );
+        s.push_str(&format!(
+            "  annotation (\n    experiment(StopTime=1, Interval=0.01),\n    {},\n    {});\nend {class};\n",
+            text::documentation(&doc),
+            text::EXAMPLE_ICON
+        ));
+        s
+    }
+}

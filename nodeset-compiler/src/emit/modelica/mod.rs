@@ -37,6 +37,7 @@
 //!                            <Owner>_<BrowsePath> (AxisType_ParameterSet)
 //!   Instances/               one model per top-level instance and `Objects` with the `Nodes` record
 //!     Bindings/             each instance with a read or write block per variable (see `bindings.rs`)
+//!   Examples/                each instance as a model that simulates as it is, with an `experiment` annotation
 //! ```
 //!
 //! Package names derive from the namespace URI (`http://opcfoundation.org/UA/Robotics/` -> `OpcUaRobotics`,
@@ -447,6 +448,7 @@ impl Output {
                 ("ObjectTypes", "ObjectTypes"),
                 ("Declarations", "Classes of instance declarations"),
                 ("Instances", "Instances"),
+                ("Examples", "Examples"),
             ] {
                 let mut order: Vec<String> = subs.get(sub).cloned().unwrap_or_default();
                 if order.is_empty() {
@@ -614,9 +616,13 @@ fn emit_namespace(ctx: &mut Ctx, ns: u16, out: &mut Output) {
     }
     for &top in &names.top_instances {
         if m.node(top).class == NodeClass::Object {
-            if let Some(body) = ctx.binding_model(ns, top) {
+            let binding = ctx.binding_model(ns, top);
+            let bound = binding.is_some();
+            if let Some(body) = binding {
                 out.add(ns, "Instances.Bindings", &names.instances[&top], body);
             }
+            let example = ctx.example_model(ns, top, bound);
+            out.add(ns, "Examples", &names.instances[&top], example);
         }
     }
     emit_enumeration_values(ctx, ns, out);

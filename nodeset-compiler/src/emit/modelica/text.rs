@@ -70,6 +70,11 @@ pub const MODEL_ICON: &str = "Icon(graphics={Rectangle(extent={{-100,100},{100,-
 fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, \
 textString=\"%name\", textColor={0,0,255})})";
 
+/// The icon of an example, as the Modelica Standard Library draws `Modelica.Icons.Example`: a play button.
+pub const EXAMPLE_ICON: &str = "Icon(graphics={Ellipse(extent={{-100,100},{100,-100}}, lineColor={75,138,73}, \
+fillColor={255,255,255}, fillPattern=FillPattern.Solid), Polygon(points={{-36,60},{64,0},{-36,-60},{-36,60}}, \
+lineColor={0,0,255}, fillColor={75,138,73}, fillPattern=FillPattern.Solid)})";
+
 /// The icon of a block, as the Modelica Standard Library draws `Modelica.Blocks.Icons.Block`.
 pub const BLOCK_ICON: &str = "Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, \
 fillColor={255,255,255}, fillPattern=FillPattern.Solid), Text(extent={{-150,150},{150,110}}, \

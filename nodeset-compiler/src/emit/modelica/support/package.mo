@@ -68,7 +68,9 @@ connection</code> at the top of the model:</p>
   NodesetCompilerDrillingProcess.Instances.Bindings.DrillingCell cell(
     redeclare block ReadReal = MyOpcUa.ReadReal);
 end Cell;</pre>
-<p><code>Instances.Objects.nodes</code> is the <code>Nodes</code> configuration record of the DLR library's
+<p><code>Examples</code> holds each instance ready to simulate (its binding model with the loopback blocks,
+beside the <code>inner</code> connection), with an <code>experiment</code> annotation.
+<code>Instances.Objects.nodes</code> is the <code>Nodes</code> configuration record of the DLR library's
 server and client blocks: every variable of the instances it can create.</p>
 
 <h4>State machines</h4>
