@@ -4,6 +4,7 @@
 //! ([`server`]), the client side of composite skills ([`remote`]) and typed clients of any instance ([`client`]).
 
 #![cfg_attr(test, deny(warnings))]
+#![deny(missing_docs)]
 
 pub mod client;
 pub mod import;

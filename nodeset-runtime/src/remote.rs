@@ -68,13 +68,29 @@ pub enum RemoteError {
     Connect(String, StatusCode),
     /// A service call failed.
     Service(&'static str, StatusCode),
-    /// A segment of a browse path matches no child, or several (the path so far, the segment).
-    Path { below: String, segment: String, matches: usize },
-    /// A browse path whose segments leave out their namespace leads to several nodes (the path, and each
-    /// match with every segment qualified, `{uri}name/...`, in order).
-    Ambiguous { path: String, matches: Vec<String> },
+    /// A segment of a browse path matches no child, or several.
+    Path {
+        /// The path so far.
+        below: String,
+        /// The segment.
+        segment: String,
+        /// How many children it matches (0, or more than one).
+        matches: usize,
+    },
+    /// A browse path whose segments leave out their namespace leads to several nodes.
+    Ambiguous {
+        /// The path.
+        path: String,
+        /// Each match with every segment qualified, `{uri}name/...`, in order.
+        matches: Vec<String>,
+    },
     /// The skill lacks a node a run needs (`CurrentState`, `Start`, ...).
-    Missing { skill: String, what: String },
+    Missing {
+        /// The skill.
+        skill: String,
+        /// The node it lacks.
+        what: String,
+    },
     /// The client's PKI folder cannot be used (why).
     Pki(String),
 }

@@ -58,24 +58,32 @@ use std::sync::OnceLock;
 /// The identifier part of a NodeId in a table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum IdKind {
+    /// A numeric identifier (`i=`).
     Numeric(u32),
+    /// A string identifier (`s=`).
     String(&'static str),
+    /// A GUID identifier (`g=`), as its 16 bytes.
     Guid([u8; 16]),
+    /// An opaque identifier (`b=`), as its bytes.
     Opaque(&'static [u8]),
 }
 
 /// A NodeId with a table-local namespace index (0 is always the OPC UA namespace).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Id {
+    /// The table-local namespace index (see [`NodeSetTable::namespaces`]).
     pub ns: u16,
+    /// The identifier.
     pub id: IdKind,
 }
 
 impl Id {
+    /// A numeric NodeId of the OPC UA namespace.
     pub const fn ns0(n: u32) -> Id {
         Id { ns: 0, id: IdKind::Numeric(n) }
     }
 
+    /// A numeric NodeId of table-local namespace `ns`.
     pub const fn numeric(ns: u16, n: u32) -> Id {
         Id { ns, id: IdKind::Numeric(n) }
     }
@@ -84,8 +92,11 @@ impl Id {
 /// A reference from the row's node.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ref {
+    /// The ReferenceType.
     pub reference_type: Id,
+    /// The node at the other end.
     pub target: Id,
+    /// Whether the reference points from the row's node to the target (false: from the target to it).
     pub forward: bool,
 }
 
@@ -105,73 +116,126 @@ impl Ref {
 /// A field of a structure's DataTypeDefinition.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FieldRow {
+    /// The field's name.
     pub name: &'static str,
+    /// Its description, if the nodeset gives one.
     pub description: Option<&'static str>,
+    /// Its DataType.
     pub data_type: Id,
+    /// Its ValueRank (-1 scalar, n >= 1 an n-dimensional array, ...).
     pub value_rank: i32,
+    /// The length of each dimension (0: any), empty when not given.
     pub array_dimensions: &'static [u32],
+    /// The longest string the field may hold (0: no limit).
     pub max_string_length: u32,
+    /// Whether the field is optional (a StructureWithOptionalFields).
     pub is_optional: bool,
 }
 
 /// A field of an enumeration's (or OptionSet's) DataTypeDefinition; also an EnumValues entry.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EnumRow {
+    /// The value (for an OptionSet, the bit number).
     pub value: i64,
+    /// The field's name.
     pub name: &'static str,
+    /// Its DisplayName text.
     pub display_name: &'static str,
+    /// Its description, if the nodeset gives one.
     pub description: Option<&'static str>,
 }
 
 /// StructureType of OPC UA Part 3.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StructureKind {
+    /// Every field is always present.
     Structure,
+    /// Fields marked optional may be absent (an encoding mask says which are present).
     StructureWithOptionalFields,
+    /// Exactly one field is present (a switch field says which).
     Union,
 }
 
 /// A DataTypeDefinition.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Def {
-    Structure { base: Id, default_encoding: Option<Id>, kind: StructureKind, fields: &'static [FieldRow] },
-    Enum { fields: &'static [EnumRow] },
+    /// A StructureDefinition.
+    Structure {
+        /// The supertype (BaseDataType's Structure, or another structure).
+        base: Id,
+        /// The DataTypeEncoding node of the default binary encoding, if the nodeset has one.
+        default_encoding: Option<Id>,
+        /// Structure, with optional fields, or union.
+        kind: StructureKind,
+        /// The fields, in order.
+        fields: &'static [FieldRow],
+    },
+    /// An EnumDefinition (of an enumeration or an OptionSet).
+    Enum {
+        /// The fields, in order.
+        fields: &'static [EnumRow],
+    },
 }
 
 /// An Argument of a method's InputArguments or OutputArguments.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ArgRow {
+    /// The argument's name.
     pub name: &'static str,
+    /// Its DataType.
     pub data_type: Id,
+    /// Its ValueRank.
     pub value_rank: i32,
+    /// The length of each dimension (0: any), empty when not given.
     pub array_dimensions: &'static [u32],
+    /// Its description, if the nodeset gives one.
     pub description: Option<&'static str>,
 }
 
 /// A node's initial value.
 #[derive(Clone, Copy, Debug)]
 pub enum Val {
+    /// No value in the nodeset.
     None,
+    /// A Boolean.
     Boolean(bool),
+    /// An SByte.
     SByte(i8),
+    /// A Byte.
     Byte(u8),
+    /// An Int16.
     Int16(i16),
+    /// A UInt16.
     UInt16(u16),
+    /// An Int32.
     Int32(i32),
+    /// A UInt32.
     UInt32(u32),
+    /// An Int64.
     Int64(i64),
+    /// A UInt64.
     UInt64(u64),
+    /// A Float.
     Float(f32),
+    /// A Double.
     Double(f64),
+    /// A String.
     String(&'static str),
     /// ISO 8601 text as written in the nodeset.
     DateTime(&'static str),
+    /// A Guid, as its 16 bytes.
     Guid([u8; 16]),
+    /// A ByteString.
     ByteString(&'static [u8]),
+    /// A NodeId.
     NodeId(Id),
+    /// An ExpandedNodeId (of this server).
     ExpandedNodeId(Id),
+    /// A StatusCode, as its 32 bits.
     StatusCode(u32),
+    /// A QualifiedName: table-local namespace index and name.
     QualifiedName(u16, &'static str),
+    /// A LocalizedText: locale, if any, and text.
     LocalizedText(Option<&'static str>, &'static str),
     /// A one-dimensional array; its items are all of one built-in type (given by its ns0 DataType id, so an
     /// empty array keeps its type).
@@ -188,44 +252,76 @@ pub enum Val {
 /// What kind of node a row is, with the attributes of that node class.
 #[derive(Clone, Copy, Debug)]
 pub enum Kind {
+    /// An Object.
     Object {
+        /// Its EventNotifier bits.
         event_notifier: u8,
     },
+    /// An ObjectType.
     ObjectType {
+        /// Whether it is abstract.
         is_abstract: bool,
     },
+    /// A Variable.
     Variable {
+        /// Its DataType.
         data_type: Id,
+        /// Its ValueRank.
         value_rank: i32,
+        /// The length of each dimension (0: any), empty when not given.
         array_dimensions: &'static [u32],
+        /// Its AccessLevel bits.
         access_level: u8,
+        /// Its UserAccessLevel bits.
         user_access_level: u8,
+        /// Whether the server keeps its history.
         historizing: bool,
+        /// Its MinimumSamplingInterval in milliseconds, if the nodeset gives one.
         minimum_sampling_interval: Option<f64>,
+        /// Its initial value.
         value: Val,
     },
+    /// A VariableType.
     VariableType {
+        /// Its DataType.
         data_type: Id,
+        /// Its ValueRank.
         value_rank: i32,
+        /// The length of each dimension (0: any), empty when not given.
         array_dimensions: &'static [u32],
+        /// Whether it is abstract.
         is_abstract: bool,
+        /// The default value of its instances.
         value: Val,
     },
+    /// A Method.
     Method {
+        /// Whether it can be called.
         executable: bool,
+        /// Whether the current user can call it.
         user_executable: bool,
     },
+    /// A ReferenceType.
     ReferenceType {
+        /// Whether the reference means the same in both directions.
         symmetric: bool,
+        /// Whether it is abstract.
         is_abstract: bool,
+        /// Its InverseName text, if it has one.
         inverse_name: Option<&'static str>,
     },
+    /// A DataType.
     DataType {
+        /// Whether it is abstract.
         is_abstract: bool,
+        /// Its DataTypeDefinition (structures and enumerations).
         definition: Option<Def>,
     },
+    /// A View.
     View {
+        /// Its EventNotifier bits.
         event_notifier: u8,
+        /// Whether following its references never loops.
         contains_no_loops: bool,
     },
 }
@@ -233,13 +329,19 @@ pub enum Kind {
 /// One node.
 #[derive(Clone, Copy, Debug)]
 pub struct NodeRow {
+    /// Its NodeId.
     pub id: Id,
     /// BrowseName: table-local namespace index and name.
     pub browse_name: (u16, &'static str),
+    /// Its DisplayName text.
     pub display_name: &'static str,
+    /// Its Description text, if the nodeset gives one.
     pub description: Option<&'static str>,
+    /// Its WriteMask bits.
     pub write_mask: u32,
+    /// Its UserWriteMask bits.
     pub user_write_mask: u32,
+    /// Its node class, with the attributes of that class.
     pub kind: Kind,
     /// References declared on this node (forward and inverse), as the nodeset declares them, when one of
     /// them has an identifier that is not numeric; otherwise empty, and they are in `nrefs`.
@@ -263,6 +365,7 @@ pub struct NodeSetTable {
     pub namespace_uri: &'static str,
     /// The model's version and publication date, from the nodeset.
     pub version: &'static str,
+    /// The model's publication date (ISO 8601), from the nodeset.
     pub publication_date: &'static str,
     /// Table-local namespace index to URI; index 0 is `http://opcfoundation.org/UA/`.
     pub namespaces: &'static [&'static str],
@@ -303,6 +406,7 @@ impl NodeSetTable {
 /// The RolePermissions and AccessRestrictions a nodeset gives one node.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct AccessRow {
+    /// The node.
     pub id: Id,
     /// The `AccessRestrictionType` bits, if the nodeset gives them.
     pub restrictions: Option<u16>,
@@ -379,10 +483,13 @@ impl Packed {
 /// incompatible generator version).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct TableError {
+    /// The namespace whose table does not decode.
     pub namespace_uri: &'static str,
-    /// 1-based line and column (in characters) within the table's text.
+    /// 1-based line (within the table's text).
     pub line: usize,
+    /// 1-based column, in characters.
     pub column: usize,
+    /// What is wrong there.
     pub message: String,
 }
 

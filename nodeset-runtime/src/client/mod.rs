@@ -177,21 +177,50 @@ impl ClientConfig {
 pub enum ClientError {
     /// No session, a failed service or a path that does not lead anywhere.
     Remote(RemoteError),
-    /// The server answered an operation with a Bad status (what was asked, the status).
-    Status { what: String, status: StatusCode },
-    /// The server refused a method call's arguments: the call's status and one status per argument.
-    Arguments { method: String, status: StatusCode, arguments: Vec<StatusCode> },
-    /// A value is not of the Rust type asked for (what was read, the value).
-    Type { what: String, value: Variant },
-    /// The node is not an instance of the handle's type (the node, its TypeDefinition if it has one).
-    WrongType { node: NodeId, type_definition: Option<NodeId>, expected: &'static str },
+    /// The server answered an operation with a Bad status.
+    Status {
+        /// What was asked (`read Robotics:MotionDeviceType/...`).
+        what: String,
+        /// The status the server answered.
+        status: StatusCode,
+    },
+    /// The server refused a method call's arguments.
+    Arguments {
+        /// The method called.
+        method: String,
+        /// The call's status.
+        status: StatusCode,
+        /// One status per input argument.
+        arguments: Vec<StatusCode>,
+    },
+    /// A value is not of the Rust type asked for.
+    Type {
+        /// What was read.
+        what: String,
+        /// The value the server gave.
+        value: Variant,
+    },
+    /// The node is not an instance of the handle's type.
+    WrongType {
+        /// The node.
+        node: NodeId,
+        /// Its TypeDefinition, if it has one.
+        type_definition: Option<NodeId>,
+        /// The type the handle needs.
+        expected: &'static str,
+    },
     /// The server's namespace table lacks a namespace a handle names.
     UnknownNamespace(String),
     /// Nothing happened in time (what was awaited).
     Timeout(String),
     /// A program ended in Halted (the program, the cause it gave: its `Result` output, or
     /// `BadInvalidState`).
-    Halted { program: String, cause: StatusCode },
+    Halted {
+        /// The program.
+        program: String,
+        /// The cause it gave.
+        cause: StatusCode,
+    },
 }
 
 impl std::fmt::Display for ClientError {

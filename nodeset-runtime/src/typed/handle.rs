@@ -22,11 +22,30 @@ pub enum BindError {
     /// No node with this id in the model node manager's address space.
     UnknownNode(NodeId),
     /// The node's class is not the one the handle needs.
-    WrongClass { node: NodeId, expected: NodeClass, found: NodeClass },
+    WrongClass {
+        /// The node.
+        node: NodeId,
+        /// The class the handle needs.
+        expected: NodeClass,
+        /// The node's class.
+        found: NodeClass,
+    },
     /// A mandatory child is missing.
-    MissingChild { parent: NodeId, browse_name: String },
+    MissingChild {
+        /// The node that lacks it.
+        parent: NodeId,
+        /// The child's BrowseName.
+        browse_name: String,
+    },
     /// A variable's ValueRank cannot be held by the handle's Rust type.
-    ValueRank { node: NodeId, value_rank: i32, rust_value_rank: i32 },
+    ValueRank {
+        /// The variable.
+        node: NodeId,
+        /// Its ValueRank.
+        value_rank: i32,
+        /// The ValueRank the Rust type holds.
+        rust_value_rank: i32,
+    },
     /// A namespace a handle names is not registered in the server.
     UnknownNamespace(String),
     /// A member marker's browse path does not follow [`MemberPath`](super::MemberPath)'s format (generated

@@ -95,7 +95,9 @@ pub struct TransitionRow {
 /// The states and transitions of a state machine type, as generated code declares them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct StateTable {
+    /// The states.
     pub states: &'static [StateRow],
+    /// The transitions.
     pub transitions: &'static [TransitionRow],
     /// The event type a transition raises (a concrete `TransitionEventType` subtype).
     pub event_type: Option<NsNodeId>,
@@ -539,9 +541,13 @@ pub const SKILL_TRANSITION_EVENT_TYPE: crate::NsNodeId =
 /// The states of a program (Part 10), which the driver treats specially.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ProgramState {
+    /// Ready to start (StateNumber 12).
     Ready,
+    /// Running (13).
     Running,
+    /// Suspended, to be resumed (14).
     Suspended,
+    /// Halted: ended in error or stopped; Reset makes it Ready (11).
     Halted,
 }
 
