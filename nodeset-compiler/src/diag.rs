@@ -7,14 +7,19 @@
 use crate::source::{SourceMap, Span};
 use std::fmt::Write as _;
 
+/// How serious a diagnostic is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Severity {
+    /// Makes the stage fail.
     Error,
+    /// Reported; the stage goes on (with the code's recovery).
     Warning,
+    /// Information only; no code has it as its default severity.
     Note,
 }
 
 impl Severity {
+    /// The word that starts the rendered header: `error`, `warning` or `note`.
     pub fn as_str(self) -> &'static str {
         match self {
             Severity::Error => "error",
@@ -193,7 +198,12 @@ pub enum SeverityError {
     /// The text names no code.
     UnknownCode(String),
     /// The code is an error with no safe recovery, so it cannot be warned about or allowed.
-    NotDemotable { code: Code, level: Level },
+    NotDemotable {
+        /// The code that was to be demoted.
+        code: Code,
+        /// The level asked for.
+        level: Level,
+    },
 }
 
 impl std::fmt::Display for SeverityError {
@@ -282,25 +292,35 @@ impl Severities {
 /// A secondary position with a message.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Label {
+    /// Where the label points.
     pub span: Span,
+    /// The text shown beside the position's `-` marks.
     pub message: String,
 }
 
+/// One problem found by a stage: its code, severity, message, positions, notes and help.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Diagnostic {
+    /// How severe it is: the code's default severity unless changed (see [`Diagnostics::apply`]).
     pub severity: Severity,
+    /// What kind of problem it is.
     pub code: Code,
+    /// The headline, shown after the severity and code (`error[NS0201]: ...`).
     pub message: String,
     /// The primary position, if the problem has one.
     pub span: Option<Span>,
     /// Text under the caret of the primary span.
     pub span_label: Option<String>,
+    /// Secondary positions, each marked with `-` and its message.
     pub labels: Vec<Label>,
+    /// Notes, shown after the source lines as `= note: ...`.
     pub notes: Vec<String>,
+    /// A suggestion, shown last as `= help: ...`.
     pub help: Option<String>,
 }
 
 impl Diagnostic {
+    /// A diagnostic of `code` at its default severity, with no position, labels, notes or help.
     pub fn new(code: Code, message: impl Into<String>) -> Diagnostic {
         Diagnostic {
             severity: code.default_severity(),
@@ -314,31 +334,37 @@ impl Diagnostic {
         }
     }
 
+    /// Sets the primary position.
     pub fn at(mut self, span: Span) -> Self {
         self.span = Some(span);
         self
     }
 
+    /// Sets the text under the caret of the primary position.
     pub fn with_span_label(mut self, label: impl Into<String>) -> Self {
         self.span_label = Some(label.into());
         self
     }
 
+    /// Adds a secondary position with a message.
     pub fn label(mut self, span: Span, message: impl Into<String>) -> Self {
         self.labels.push(Label { span, message: message.into() });
         self
     }
 
+    /// Adds a note.
     pub fn note(mut self, note: impl Into<String>) -> Self {
         self.notes.push(note.into());
         self
     }
 
+    /// Sets the help text, replacing any earlier one.
     pub fn help(mut self, help: impl Into<String>) -> Self {
         self.help = Some(help.into());
         self
     }
 
+    /// Whether the severity is [`Severity::Error`].
     pub fn is_error(&self) -> bool {
         self.severity == Severity::Error
     }
@@ -406,30 +432,37 @@ impl Diagnostic {
 /// Collects the diagnostics of a stage.
 #[derive(Clone, Debug, Default)]
 pub struct Diagnostics {
+    /// The diagnostics, in the order they were pushed until [`Diagnostics::sort`] sorts them.
     pub items: Vec<Diagnostic>,
 }
 
 impl Diagnostics {
+    /// An empty collector.
     pub fn new() -> Diagnostics {
         Diagnostics::default()
     }
 
+    /// Adds one diagnostic.
     pub fn push(&mut self, d: Diagnostic) {
         self.items.push(d);
     }
 
+    /// Appends every diagnostic of `other`.
     pub fn extend(&mut self, other: Diagnostics) {
         self.items.extend(other.items);
     }
 
+    /// Whether any diagnostic is an error.
     pub fn has_errors(&self) -> bool {
         self.items.iter().any(Diagnostic::is_error)
     }
 
+    /// The number of errors.
     pub fn error_count(&self) -> usize {
         self.items.iter().filter(|d| d.severity == Severity::Error).count()
     }
 
+    /// The number of warnings.
     pub fn warning_count(&self) -> usize {
         self.items.iter().filter(|d| d.severity == Severity::Warning).count()
     }
@@ -471,6 +504,7 @@ impl Diagnostics {
         self.items.dedup();
     }
 
+    /// Renders every diagnostic in order, each followed by an empty line.
     pub fn render(&self, sources: &SourceMap) -> String {
         let mut out = String::new();
         for d in &self.items {

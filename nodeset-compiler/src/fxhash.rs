@@ -5,6 +5,7 @@
 use std::collections::{HashMap, HashSet};
 use std::hash::{BuildHasherDefault, Hasher};
 
+/// The hasher: FxHasher's multiply-rotate scheme over 64-bit words.
 #[derive(Clone, Copy, Default)]
 pub struct FxHasher {
     hash: u64,
@@ -65,6 +66,9 @@ impl Hasher for FxHasher {
     }
 }
 
+/// Makes [`FxHasher`]s for hash maps and sets.
 pub type FxBuildHasher = BuildHasherDefault<FxHasher>;
+/// A [`HashMap`] hashed with [`FxHasher`].
 pub type FxHashMap<K, V> = HashMap<K, V, FxBuildHasher>;
+/// A [`HashSet`] hashed with [`FxHasher`].
 pub type FxHashSet<K> = HashSet<K, FxBuildHasher>;

@@ -20,6 +20,7 @@
 //! assert!(!out.diagnostics.has_errors());
 //! ```
 
+#![deny(missing_docs)]
 pub mod build;
 pub mod datatypes;
 pub mod diag;

@@ -24,41 +24,56 @@ pub const NS0_URI: &str = "http://opcfoundation.org/UA/";
 pub struct LoadOptions {
     /// Folders searched recursively for required models.
     pub model_dirs: Vec<PathBuf>,
+    /// Size and nesting limits for parsing each file.
     pub limits: Limits,
 }
 
 /// A model a loaded file defines.
 #[derive(Clone, Debug)]
 pub struct ModelInfo {
+    /// The ModelUri: the URI of the namespace the model defines.
     pub uri: String,
+    /// The `Version` attribute, if any (`None` for a model implied by a file without `<Models>`).
     pub version: Option<String>,
+    /// The `PublicationDate` attribute as written, if any.
     pub publication_date: Option<String>,
+    /// The `ModelVersion` attribute, if any.
     pub model_version: Option<String>,
+    /// The file that defines the model.
     pub file: FileId,
     /// Global namespace index of the model.
     pub ns: u16,
+    /// The models it requires, from its `<RequiredModel>` elements.
     pub required: Vec<RequiredInfo>,
     /// The `<RolePermissions>` of the `<Model>` element: the namespace's DefaultRolePermissions.
     pub default_role_permissions: Vec<crate::raw::RawRolePermission>,
     /// The `AccessRestrictions` of the `<Model>` element: the namespace's DefaultAccessRestrictions.
     pub default_access_restrictions: Option<u16>,
+    /// The `<Model>` element (the file's root element for an implied model).
     pub span: Span,
 }
 
+/// A requirement of one model on another: a `<RequiredModel>` element, or one the loader adds (the base namespace, and the namespaces a file without `<Models>` refers to).
 #[derive(Clone, Debug)]
 pub struct RequiredInfo {
+    /// The ModelUri of the required model.
     pub uri: String,
+    /// The lowest version accepted, if any.
     pub version: Option<String>,
+    /// The `PublicationDate` required, if any: checked when the loaded version equals the required one.
     pub publication_date: Option<String>,
+    /// The `<RequiredModel>` element (the file's root element for a requirement the loader adds).
     pub span: Span,
 }
 
 /// One parsed file with its namespace mapping and alias table.
 #[derive(Debug)]
 pub struct LoadedFile {
+    /// The parsed file.
     pub raw: RawNodeSet,
     /// Local namespace index to global index (`ns_map[0] == 0`).
     pub ns_map: Vec<u16>,
+    /// The file's aliases: each name to its target NodeId text (the first declaration of a name wins).
     pub aliases: FxHashMap<String, Spanned<String>>,
 }
 
@@ -148,19 +163,23 @@ pub fn resolve_node_id_str(
 /// Everything loaded, in dependency order.
 #[derive(Debug)]
 pub struct Loaded {
+    /// Every file read, named or found in a models folder, for spans and rendering.
     pub sources: SourceMap,
     /// Parsed files, each after the files it requires.
     pub files: Vec<LoadedFile>,
     /// The global namespace table: index 0 is the OPC UA namespace.
     pub namespaces: Vec<String>,
+    /// Every model the files define, declared or implied, in the order of [`Loaded::files`].
     pub models: Vec<ModelInfo>,
 }
 
 impl Loaded {
+    /// The loaded file with id `id`, if it is one of [`Loaded::files`].
     pub fn file(&self, id: FileId) -> Option<&LoadedFile> {
         self.files.iter().find(|f| f.raw.file == id)
     }
 
+    /// The model that defines global namespace `ns`, if any.
     pub fn model_of_namespace(&self, ns: u16) -> Option<&ModelInfo> {
         self.models.iter().find(|m| m.ns == ns)
     }
@@ -186,8 +205,15 @@ struct Header {
 
 /// A source of input: a file on disk or text held in memory (tests, fuzzing, build scripts).
 pub enum Input {
+    /// A file to read.
     Path(PathBuf),
-    Text { name: String, text: String },
+    /// Text held in memory.
+    Text {
+        /// The name shown in diagnostics, also used as the file's path.
+        name: String,
+        /// The file's contents.
+        text: String,
+    },
 }
 
 /// Loads the named inputs and the models they require.
@@ -943,6 +969,7 @@ pub fn nearest<'a>(name: &str, candidates: impl Iterator<Item = &'a str>) -> Opt
     best.map(|(_, c)| c)
 }
 
+/// The edit (Levenshtein) distance of `a` and `b`, counted in characters.
 pub fn edit_distance(a: &str, b: &str) -> usize {
     edit_distance_within(a, b, usize::MAX).unwrap_or(usize::MAX)
 }

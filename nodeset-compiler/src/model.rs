@@ -23,57 +23,106 @@ pub fn article(word: &str) -> &'static str {
 
 /// Well-known NodeIds of namespace 0.
 pub mod ids {
+    /// The References ReferenceType, root of all ReferenceTypes.
     pub const REFERENCES: u32 = 31;
+    /// The HierarchicalReferences ReferenceType.
     pub const HIERARCHICAL_REFERENCES: u32 = 33;
+    /// The HasChild ReferenceType.
     pub const HAS_CHILD: u32 = 34;
+    /// The Organizes ReferenceType.
     pub const ORGANIZES: u32 = 35;
+    /// The HasModellingRule ReferenceType.
     pub const HAS_MODELLING_RULE: u32 = 37;
+    /// The GeneratesEvent ReferenceType.
     pub const GENERATES_EVENT: u32 = 41;
+    /// The HasEncoding ReferenceType.
     pub const HAS_ENCODING: u32 = 38;
+    /// The HasTypeDefinition ReferenceType.
     pub const HAS_TYPE_DEFINITION: u32 = 40;
+    /// The Aggregates ReferenceType.
     pub const AGGREGATES: u32 = 44;
+    /// The HasSubtype ReferenceType.
     pub const HAS_SUBTYPE: u32 = 45;
+    /// The HasProperty ReferenceType.
     pub const HAS_PROPERTY: u32 = 46;
+    /// The HasComponent ReferenceType.
     pub const HAS_COMPONENT: u32 = 47;
+    /// The FromState ReferenceType.
     pub const FROM_STATE: u32 = 51;
+    /// The ToState ReferenceType.
     pub const TO_STATE: u32 = 52;
+    /// The HasCause ReferenceType.
     pub const HAS_CAUSE: u32 = 53;
+    /// The HasEffect ReferenceType.
     pub const HAS_EFFECT: u32 = 54;
+    /// The HasInterface ReferenceType.
     pub const HAS_INTERFACE: u32 = 17603;
+    /// The HasAddIn ReferenceType.
     pub const HAS_ADD_IN: u32 = 17604;
 
+    /// The Structure DataType.
     pub const STRUCTURE: u32 = 22;
+    /// The BaseDataType DataType, root of all DataTypes.
     pub const BASE_DATA_TYPE: u32 = 24;
+    /// The abstract Number DataType.
     pub const NUMBER: u32 = 26;
+    /// The abstract Integer DataType.
     pub const INTEGER: u32 = 27;
+    /// The abstract UInteger DataType.
     pub const UINTEGER: u32 = 28;
+    /// The Enumeration DataType.
     pub const ENUMERATION: u32 = 29;
+    /// The Decimal DataType.
     pub const DECIMAL: u32 = 50;
+    /// The OptionSet DataType.
     pub const OPTION_SET: u32 = 12755;
+    /// The Union DataType.
     pub const UNION: u32 = 12756;
+    /// The Argument DataType (method arguments).
     pub const ARGUMENT: u32 = 296;
+    /// The EnumValueType DataType (entries of an EnumValues property).
     pub const ENUM_VALUE_TYPE: u32 = 7594;
 
+    /// The BaseObjectType ObjectType.
     pub const BASE_OBJECT_TYPE: u32 = 58;
+    /// The FolderType ObjectType.
     pub const FOLDER_TYPE: u32 = 61;
+    /// The BaseVariableType VariableType.
     pub const BASE_VARIABLE_TYPE: u32 = 62;
+    /// The BaseDataVariableType VariableType.
     pub const BASE_DATA_VARIABLE_TYPE: u32 = 63;
+    /// The PropertyType VariableType.
     pub const PROPERTY_TYPE: u32 = 68;
+    /// The ModellingRuleType ObjectType.
     pub const MODELLING_RULE_TYPE: u32 = 77;
+    /// The BaseEventType ObjectType.
     pub const BASE_EVENT_TYPE: u32 = 2041;
+    /// The BaseInterfaceType ObjectType.
     pub const BASE_INTERFACE_TYPE: u32 = 17602;
+    /// The StateMachineType ObjectType.
     pub const STATE_MACHINE_TYPE: u32 = 2299;
+    /// The FiniteStateMachineType ObjectType.
     pub const FINITE_STATE_MACHINE_TYPE: u32 = 2771;
+    /// The StateType ObjectType.
     pub const STATE_TYPE: u32 = 2307;
+    /// The InitialStateType ObjectType.
     pub const INITIAL_STATE_TYPE: u32 = 2309;
+    /// The TransitionType ObjectType.
     pub const TRANSITION_TYPE: u32 = 2310;
+    /// The ProgramStateMachineType ObjectType.
     pub const PROGRAM_STATE_MACHINE_TYPE: u32 = 2391;
+    /// The TransitionEventType ObjectType.
     pub const TRANSITION_EVENT_TYPE: u32 = 2311;
 
+    /// The Mandatory ModellingRule.
     pub const MANDATORY: u32 = 78;
+    /// The Optional ModellingRule.
     pub const OPTIONAL: u32 = 80;
+    /// The ExposesItsArray ModellingRule.
     pub const EXPOSES_ITS_ARRAY: u32 = 83;
+    /// The OptionalPlaceholder ModellingRule.
     pub const OPTIONAL_PLACEHOLDER: u32 = 11508;
+    /// The MandatoryPlaceholder ModellingRule.
     pub const MANDATORY_PLACEHOLDER: u32 = 11510;
 }
 
@@ -82,23 +131,31 @@ pub mod ids {
 pub struct NodeIx(pub u32);
 
 impl NodeIx {
+    /// The index as a `usize`, for indexing [`Model::nodes`].
     pub fn index(self) -> usize {
         self.0 as usize
     }
 }
 
+/// The ModellingRule a node's HasModellingRule reference names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum ModellingRule {
+    /// Mandatory (i=78): every instance has the node.
     Mandatory,
+    /// Optional (i=80): an instance may have the node.
     Optional,
+    /// ExposesItsArray (i=83): the elements of the array value are exposed as nodes.
     ExposesItsArray,
+    /// OptionalPlaceholder (i=11508): instances may have any number of such nodes, none included.
     OptionalPlaceholder,
+    /// MandatoryPlaceholder (i=11510): instances have at least one such node.
     MandatoryPlaceholder,
     /// A rule node this compiler does not know.
     Other(NodeIx),
 }
 
 impl ModellingRule {
+    /// The rule's BrowseName (`Other` for a rule this compiler does not know).
     pub fn name(self) -> &'static str {
         match self {
             ModellingRule::Mandatory => "Mandatory",
@@ -110,10 +167,12 @@ impl ModellingRule {
         }
     }
 
+    /// Whether the rule is OptionalPlaceholder or MandatoryPlaceholder.
     pub fn is_placeholder(self) -> bool {
         matches!(self, ModellingRule::OptionalPlaceholder | ModellingRule::MandatoryPlaceholder)
     }
 
+    /// Whether the rule is Mandatory or MandatoryPlaceholder.
     pub fn is_mandatory(self) -> bool {
         matches!(self, ModellingRule::Mandatory | ModellingRule::MandatoryPlaceholder)
     }
@@ -122,8 +181,11 @@ impl ModellingRule {
 /// A reference as stored on a node: outgoing when `forward`, incoming otherwise.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct Reference {
+    /// The ReferenceType.
     pub reference_type: NodeIx,
+    /// The node at the other end.
     pub target: NodeIx,
+    /// Whether the reference points from this node to `target`.
     pub forward: bool,
     /// False for the inverse the resolver added on the other node.
     pub declared: bool,
@@ -134,63 +196,106 @@ pub struct Reference {
 /// Attributes that only some node classes have; `None` where the file leaves the default.
 #[derive(Clone, Debug, Default)]
 pub struct Attributes {
+    /// The WriteMask bits.
     pub write_mask: Option<u32>,
+    /// The UserWriteMask bits.
     pub user_write_mask: Option<u32>,
+    /// The AccessRestrictions bits; the model's DefaultAccessRestrictions where the node gives none.
     pub access_restrictions: Option<u16>,
+    /// The ReleaseStatus, as written.
     pub release_status: Option<String>,
+    /// The DataType of a Variable or VariableType, resolved; `None` if absent, unresolved or not a DataType.
     pub data_type: Option<NodeIx>,
+    /// The ValueRank.
     pub value_rank: Option<i32>,
+    /// The ArrayDimensions, one length per dimension (0 for an unknown length); empty if absent.
     pub array_dimensions: Vec<u32>,
+    /// The AccessLevel bits (0x01 CurrentRead, 0x02 CurrentWrite, ...).
     pub access_level: Option<u8>,
+    /// The UserAccessLevel bits.
     pub user_access_level: Option<u8>,
+    /// The AccessLevelEx bits.
     pub access_level_ex: Option<u32>,
+    /// The MinimumSamplingInterval, in milliseconds.
     pub minimum_sampling_interval: Option<f64>,
+    /// Whether the server collects the Variable's history (Historizing).
     pub historizing: Option<bool>,
+    /// Whether the Method can be called (Executable).
     pub executable: Option<bool>,
+    /// Whether the Method can be called by the current user (UserExecutable).
     pub user_executable: Option<bool>,
+    /// The EventNotifier bits of an Object or View.
     pub event_notifier: Option<u8>,
+    /// Whether the View contains no loops (ContainsNoLoops).
     pub contains_no_loops: Option<bool>,
+    /// Whether the type is abstract (IsAbstract).
     pub is_abstract: Option<bool>,
+    /// Whether the ReferenceType is symmetric (Symmetric).
     pub symmetric: Option<bool>,
+    /// The InverseNames of a ReferenceType, in the file's order.
     pub inverse_name: Vec<LocalizedText>,
+    /// The `<RolePermissions>` as written, roles not resolved (see `roles`).
     pub role_permissions: Vec<RawRolePermission>,
     /// The RolePermissions resolved: the role object and its `PermissionType` bits, in the file's order.
     /// An entry whose role names no Object is left out (NS0220).
     pub roles: Vec<(NodeIx, u32)>,
+    /// The texts of the `<Category>` elements, trimmed.
     pub category: Vec<String>,
+    /// The text of the `<Documentation>` element.
     pub documentation: Option<String>,
+    /// The node a Method's MethodDeclarationId names, resolved.
     pub method_declaration: Option<NodeIx>,
 }
 
+/// A node of the model, with its references and attributes resolved.
 #[derive(Clone, Debug)]
 pub struct Node {
+    /// The node's NodeId, with its global namespace index.
     pub id: NodeId,
+    /// The node's NodeClass.
     pub class: NodeClass,
+    /// The node's BrowseName, with its global namespace index.
     pub browse_name: QualifiedName,
+    /// The node's SymbolicName, if the file gives one.
     pub symbolic_name: Option<String>,
+    /// The node's DisplayNames, in the file's order (the first in the default locale).
     pub display_name: Vec<LocalizedText>,
+    /// The node's Descriptions, in the file's order (the first in the default locale).
     pub description: Vec<LocalizedText>,
+    /// The attributes that only some node classes have.
     pub attrs: Attributes,
     /// The element inside the node's `<Value>`, if any: read it with [`Model::value_element`] or
     /// [`Model::value_xml`], decode it with [`Model::value`].
     pub value: Option<ValueRef>,
     /// Boxed, as in the raw node: only DataTypes have one.
     pub definition: Option<Box<RawDefinition>>,
+    /// The children of the node's `<Extensions>` element.
     pub extensions: Vec<XmlElement>,
+    /// The node's references in both directions: those its element declares, then the inverses of those
+    /// other nodes declare (a reference declared twice is kept once).
     pub references: Vec<Reference>,
+    /// The supertype, named by the node's first inverse HasSubtype reference; `None` for a root type, and
+    /// where the supertype has another node class or closes a cycle.
     pub super_type: Option<NodeIx>,
+    /// The type the node's HasTypeDefinition reference names: an ObjectType for an Object, a VariableType
+    /// for a Variable; `None` if there is none or it is of another class.
     pub type_definition: Option<NodeIx>,
+    /// The ModellingRule the node's HasModellingRule reference names, if any.
     pub modelling_rule: Option<ModellingRule>,
     /// The node this one hangs under (ParentNodeId, or the source of its first inverse hierarchical reference).
     pub parent: Option<NodeIx>,
+    /// The file that declares the node.
     pub file: FileId,
     /// The start tag of the node's element.
     pub span: Span,
+    /// The value of the NodeId attribute (the start tag if the attribute is missing).
     pub node_id_span: Span,
+    /// The value of the BrowseName attribute (the start tag if the attribute is missing).
     pub browse_name_span: Span,
 }
 
 impl Node {
+    /// Whether the node is abstract (IsAbstract, false if not given).
     pub fn is_abstract(&self) -> bool {
         self.attrs.is_abstract.unwrap_or(false)
     }
@@ -209,11 +314,13 @@ impl Node {
 /// A member of a type: an instance declaration, own or inherited.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Member {
+    /// The member's BrowseName, by which a subtype or instance overrides it.
     pub browse_name: QualifiedName,
     /// The declaring node (the override, if a subtype redeclares the member).
     pub node: NodeIx,
     /// The type (or instance declaration) whose children list holds `node`.
     pub declared_in: NodeIx,
+    /// The hierarchical ReferenceType from `declared_in` to `node` (HasComponent, HasProperty, ...).
     pub reference_type: NodeIx,
     /// The member of a supertype this one overrides.
     pub overrides: Option<NodeIx>,
@@ -222,42 +329,67 @@ pub struct Member {
 /// A field of a structure, resolved.
 #[derive(Clone, Debug)]
 pub struct Field {
+    /// The field's Name.
     pub name: String,
+    /// The field's SymbolicName, if the file gives one.
     pub symbolic_name: Option<String>,
+    /// The field's DataType (BaseDataType if the file names none).
     pub data_type: NodeIx,
+    /// The field's ValueRank (-1, a scalar, if not given).
     pub value_rank: i32,
+    /// The field's ArrayDimensions; empty if not given.
     pub array_dimensions: Vec<u32>,
+    /// The field's MaxStringLength, if given.
     pub max_string_length: Option<u32>,
+    /// Whether the field is optional (IsOptional).
     pub is_optional: bool,
+    /// Whether the field may hold a subtype of its DataType (AllowSubTypes).
     pub allow_sub_types: bool,
+    /// The text of the field's first Description, if not empty.
     pub description: Option<String>,
     /// The structure that declares the field (a supertype for inherited fields).
     pub declared_in: NodeIx,
+    /// The start tag of the field's `<Field>` element.
     pub span: Span,
 }
 
+/// The kind of a structure, which decides how it is encoded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum StructureKind {
+    /// A structure without optional fields.
     Structure,
+    /// A structure with at least one optional field (IsOptional).
     StructureWithOptionalFields,
+    /// A union (IsUnion, or a subtype of Union).
     Union,
 }
 
+/// A value of an enumeration, or a bit of an OptionSet.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct EnumValue {
+    /// The name: a field's Name, or the text of an EnumStrings or EnumValues entry.
     pub name: String,
+    /// The value; for an OptionSet, the bit's position.
     pub value: i64,
+    /// The display name: a field's first DisplayName, or an EnumStrings or EnumValues entry's text.
     pub display_name: Option<String>,
+    /// The description: a field's first Description, or an EnumValues entry's, if any.
     pub description: Option<String>,
 }
 
+/// Where the values of an enumeration come from.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum EnumSource {
+    /// The fields of the DataType's `<Definition>` (an EnumStrings or EnumValues property that disagrees
+    /// decides, NS0219); also an enumeration with neither, which has no values.
     Definition,
+    /// The EnumStrings property: each value is the index of its string.
     EnumStrings,
+    /// The EnumValues property.
     EnumValues,
 }
 
+/// What a DataType is, which decides how its values are encoded.
 #[derive(Clone, Debug)]
 pub enum DataTypeKind {
     /// One of the 25 built-in types (or an abstract one such as Number, which has no encoding of its own).
@@ -266,18 +398,41 @@ pub enum DataTypeKind {
     AbstractBuiltin,
     /// A subtype of a built-in scalar type, encoded as that type (Duration as Double).
     Simple(BuiltinType),
-    Enumeration { values: Vec<EnumValue>, source: EnumSource },
+    /// An enumeration (Enumeration or a subtype), encoded as Int32.
+    Enumeration {
+        /// The values, without repeated values or names.
+        values: Vec<EnumValue>,
+        /// Where the values come from.
+        source: EnumSource,
+    },
     /// Bits of an unsigned integer (`IsOptionSet` definitions).
-    OptionSet { base: BuiltinType, bits: Vec<EnumValue> },
-    Structure { kind: StructureKind, fields: Vec<Field>, has_definition: bool },
+    OptionSet {
+        /// The nearest built-in type among the DataType and its supertypes (UInt32 if none): the encoding.
+        base: BuiltinType,
+        /// The named bits, without repeated positions or names.
+        bits: Vec<EnumValue>,
+    },
+    /// A structure (Structure or a subtype), encoded as an ExtensionObject.
+    Structure {
+        /// Plain, with optional fields, or a union.
+        kind: StructureKind,
+        /// All fields, inherited ones first.
+        fields: Vec<Field>,
+        /// Whether the DataType has a `<Definition>`; without one, `fields` are the inherited ones.
+        has_definition: bool,
+    },
 }
 
+/// A DataType, classified.
 #[derive(Clone, Debug)]
 pub struct DataTypeInfo {
+    /// The DataType node.
     pub node: NodeIx,
+    /// What kind of DataType it is.
     pub kind: DataTypeKind,
     /// The built-in type values of this DataType are encoded as.
     pub encoding: BuiltinType,
+    /// Whether the DataType is abstract (IsAbstract).
     pub is_abstract: bool,
     /// Encoding nodes (`Default Binary`, `Default XML`, `Default JSON`) by BrowseName.
     pub encodings: Vec<(String, NodeIx)>,
@@ -286,41 +441,65 @@ pub struct DataTypeInfo {
 /// A method argument decoded from an InputArguments or OutputArguments property.
 #[derive(Clone, Debug)]
 pub struct Argument {
+    /// The argument's Name.
     pub name: String,
+    /// The argument's DataType; `None` if the Argument gives none.
     pub data_type: Option<NodeIx>,
+    /// The argument's ValueRank (-1, a scalar, if not given).
     pub value_rank: i32,
+    /// The argument's ArrayDimensions; empty if not given.
     pub array_dimensions: Vec<u32>,
+    /// The text of the argument's Description, if not empty.
     pub description: Option<String>,
 }
 
+/// The arguments of a Method.
 #[derive(Clone, Debug, Default)]
 pub struct MethodInfo {
+    /// The arguments in its InputArguments property; empty if it has none or it cannot be decoded.
     pub inputs: Vec<Argument>,
+    /// The arguments in its OutputArguments property; empty if it has none or it cannot be decoded.
     pub outputs: Vec<Argument>,
 }
 
+/// A state of a state machine type: a member whose TypeDefinition is StateType or a subtype.
 #[derive(Clone, Debug)]
 pub struct State {
+    /// The state's instance declaration.
     pub node: NodeIx,
+    /// The name of the state's BrowseName.
     pub name: String,
+    /// The value of the state's StateNumber property, if it has one that fits a UInt32.
     pub number: Option<u32>,
+    /// Whether the state's TypeDefinition is InitialStateType or a subtype.
     pub initial: bool,
 }
 
+/// A transition of a state machine type: a member whose TypeDefinition is TransitionType or a subtype.
 #[derive(Clone, Debug)]
 pub struct Transition {
+    /// The transition's instance declaration.
     pub node: NodeIx,
+    /// The name of the transition's BrowseName.
     pub name: String,
+    /// The value of the transition's TransitionNumber property, if it has one that fits a UInt32.
     pub number: Option<u32>,
+    /// The target of the transition's FromState reference.
     pub from: Option<NodeIx>,
+    /// The target of the transition's ToState reference.
     pub to: Option<NodeIx>,
+    /// The targets of the transition's HasCause references.
     pub causes: Vec<NodeIx>,
+    /// The targets of the transition's HasEffect references.
     pub effects: Vec<NodeIx>,
 }
 
+/// The states and transitions of a state machine type, inherited ones included.
 #[derive(Clone, Debug, Default)]
 pub struct StateMachineInfo {
+    /// The states, in member order.
     pub states: Vec<State>,
+    /// The transitions, in member order.
     pub transitions: Vec<Transition>,
     /// The concrete event type a transition raises: the first TransitionEventType subtype the machine
     /// type (or a supertype, nearest first) names with GeneratesEvent; else the effect its transitions
@@ -332,7 +511,9 @@ pub struct StateMachineInfo {
 /// How a loaded file maps its local namespace indices and aliases (needed to decode its values).
 #[derive(Clone, Debug)]
 pub struct FileContext {
+    /// Local namespace index to global index (`ns_map[0] == 0`).
     pub ns_map: Vec<u16>,
+    /// The file's aliases by name: the NodeId each stands for, as written, with its span.
     pub aliases: FxHashMap<String, Spanned<String>>,
 }
 
@@ -371,14 +552,22 @@ impl FileContext {
 /// One model of every loaded file.
 #[derive(Debug)]
 pub struct Model {
+    /// The text of every loaded file.
     pub sources: SourceMap,
+    /// The global namespace table: index 0 is the OPC UA namespace.
     pub namespaces: Vec<String>,
+    /// The models the loaded files define (declared in `<Models>` or implied by a file without them).
     pub models: Vec<ModelInfo>,
+    /// Every node: files in dependency order, nodes in file order.
     pub nodes: Vec<Node>,
     pub(crate) index: FxHashMap<NodeId, NodeIx>,
+    /// The namespace indices and aliases of each file, needed to decode its values.
     pub files: BTreeMap<FileId, FileContext>,
+    /// Every DataType, classified.
     pub data_types: BTreeMap<NodeIx, DataTypeInfo>,
+    /// The arguments of every Method.
     pub methods: BTreeMap<NodeIx, MethodInfo>,
+    /// The states and transitions of each state machine type (StateMachineType or a subtype) that has any.
     pub state_machines: BTreeMap<NodeIx, StateMachineInfo>,
     /// Instance declarations of every ObjectType and VariableType, inherited ones included.
     pub members: BTreeMap<NodeIx, Vec<Member>>,
@@ -393,26 +582,32 @@ pub struct Model {
 }
 
 impl Model {
+    /// The node at `ix`.
     pub fn node(&self, ix: NodeIx) -> &Node {
         &self.nodes[ix.index()]
     }
 
+    /// The node with NodeId `id`, if loaded.
     pub fn lookup(&self, id: &NodeId) -> Option<NodeIx> {
         self.index.get(id).copied()
     }
 
+    /// The ns0 node with numeric identifier `n` (see [`ids`]), if loaded.
     pub fn ns0(&self, n: u32) -> Option<NodeIx> {
         self.lookup(&NodeId::numeric(0, n))
     }
 
+    /// The model that defines global namespace `ns`.
     pub fn model_of_namespace(&self, ns: u16) -> Option<&ModelInfo> {
         self.models.iter().find(|m| m.ns == ns)
     }
 
+    /// The URI of global namespace `ns` (empty if there is none).
     pub fn namespace_uri(&self, ns: u16) -> &str {
         self.namespaces.get(ns as usize).map(String::as_str).unwrap_or("")
     }
 
+    /// Whether `ix` is the ns0 node with numeric identifier `n`.
     pub fn is_ns0(&self, ix: NodeIx, n: u32) -> bool {
         self.node(ix).id.ns0() == Some(n)
     }
@@ -545,6 +740,7 @@ impl Model {
         depth
     }
 
+    /// Whether `reference_type` is HierarchicalReferences or a subtype, HasSubtype and its subtypes excepted.
     pub fn is_hierarchical(&self, reference_type: NodeIx) -> bool {
         self.hierarchical.get(reference_type.index()).copied().unwrap_or(false)
     }

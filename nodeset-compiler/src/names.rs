@@ -31,6 +31,7 @@
 
 use std::collections::BTreeMap;
 
+/// The letter case of a generated identifier.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Case {
     /// `MotionDeviceType`
@@ -43,9 +44,12 @@ pub enum Case {
     Preserve,
 }
 
+/// The language an identifier is for: it decides the keywords and reserved words, and the length cap.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Target {
+    /// Rust.
     Rust,
+    /// Modelica.
     Modelica,
 }
 
@@ -232,7 +236,9 @@ pub fn is_valid(s: &str, target: Target) -> bool {
 /// A collision found by [`Scope::finish`]: the identifier and the originals that map to it, sorted.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Collision<K> {
+    /// The identifier the originals map to.
     pub ident: String,
+    /// The originals that map to it, each with its key, sorted.
     pub members: Vec<(String, K)>,
 }
 
@@ -247,6 +253,7 @@ pub struct Scope<K: Ord + Clone> {
 }
 
 impl<K: Ord + Clone> Scope<K> {
+    /// An empty scope for identifiers in `case` for `target`.
     pub fn new(target: Target, case: Case) -> Scope<K> {
         Scope { target, case, reserved: Vec::new(), entries: Vec::new() }
     }
@@ -256,6 +263,7 @@ impl<K: Ord + Clone> Scope<K> {
         self.reserved.push(ident.to_string());
     }
 
+    /// Adds an original name with the key that identifies it.
     pub fn add(&mut self, original: &str, key: K) {
         self.entries.push((original.to_string(), key));
     }

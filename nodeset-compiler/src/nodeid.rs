@@ -9,9 +9,13 @@ use std::fmt;
 /// The identifier part of a NodeId.
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Identifier {
+    /// `i=N`: a numeric identifier.
     Numeric(u32),
+    /// `s=...`: a string identifier.
     String(Box<str>),
+    /// `g=...`: a GUID, as its 16 bytes in text order.
     Guid([u8; 16]),
+    /// `b=...`: an opaque identifier (a ByteString, written in base64).
     Opaque(Box<[u8]>),
 }
 
@@ -29,11 +33,14 @@ impl fmt::Display for Identifier {
 /// A NodeId with a global namespace index (an index into the model's namespace table).
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct NodeId {
+    /// The global namespace index.
     pub ns: u16,
+    /// The identifier within the namespace.
     pub id: Identifier,
 }
 
 impl NodeId {
+    /// The numeric NodeId `n` in namespace `ns`.
     pub const fn numeric(ns: u16, n: u32) -> NodeId {
         NodeId { ns, id: Identifier::Numeric(n) }
     }
@@ -69,7 +76,9 @@ pub enum NsRef {
 /// A NodeId as written in a file, before namespace mapping.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RawNodeId {
+    /// The namespace, as written.
     pub ns: NsRef,
+    /// The identifier.
     pub id: Identifier,
 }
 
@@ -169,6 +178,7 @@ pub fn parse_guid(s: &str) -> Option<[u8; 16]> {
     Some(out)
 }
 
+/// Writes 16 bytes in text order as lowercase `xxxxxxxx-xxxx-xxxx-xxxx-xxxxxxxxxxxx` (what [`parse_guid`] reads).
 pub fn format_guid(g: &[u8; 16]) -> String {
     let h: String = g.iter().map(|b| format!("{b:02x}")).collect();
     format!("{}-{}-{}-{}-{}", &h[0..8], &h[8..12], &h[12..16], &h[16..20], &h[20..32])
@@ -256,6 +266,7 @@ fn base64_each(s: &str, mut out: impl FnMut(u8)) -> bool {
     padding <= 2
 }
 
+/// Encodes `data` as standard base64, with `=` padding.
 pub fn base64_encode(data: &[u8]) -> String {
     let mut out = String::with_capacity(data.len().div_ceil(3) * 4);
     for chunk in data.chunks(3) {
@@ -275,7 +286,9 @@ pub fn base64_encode(data: &[u8]) -> String {
 /// A QualifiedName as written in a file: `Name` (namespace 0) or `N:Name`, N local to the file.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RawQualifiedName {
+    /// The namespace index, local to the file (0 without a prefix).
     pub ns: u16,
+    /// The name after the prefix.
     pub name: String,
 }
 
@@ -303,7 +316,9 @@ pub fn parse_qualified_name(s: &str) -> Result<RawQualifiedName, String> {
 /// A QualifiedName with a global namespace index.
 #[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct QualifiedName {
+    /// The global namespace index.
     pub ns: u16,
+    /// The name, without a namespace prefix.
     pub name: String,
 }
 

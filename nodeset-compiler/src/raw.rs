@@ -11,17 +11,26 @@ use crate::source::{FileId, Span, Spanned};
 /// The eight node classes of OPC UA.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum NodeClass {
+    /// An Object (`UAObject`).
     Object,
+    /// A Variable (`UAVariable`).
     Variable,
+    /// A Method (`UAMethod`).
     Method,
+    /// A View (`UAView`).
     View,
+    /// An ObjectType (`UAObjectType`).
     ObjectType,
+    /// A VariableType (`UAVariableType`).
     VariableType,
+    /// A ReferenceType (`UAReferenceType`).
     ReferenceType,
+    /// A DataType (`UADataType`).
     DataType,
 }
 
 impl NodeClass {
+    /// Every node class, in the order of the variants.
     pub const ALL: [NodeClass; 8] = [
         NodeClass::Object,
         NodeClass::Variable,
@@ -47,6 +56,7 @@ impl NodeClass {
         }
     }
 
+    /// The class whose NodeSet2 element name is `name` (`UAObject`, ...).
     pub fn from_element(name: &str) -> Option<NodeClass> {
         NodeClass::ALL.into_iter().find(|c| c.element() == name)
     }
@@ -70,6 +80,7 @@ impl NodeClass {
         }
     }
 
+    /// Whether the class is one of the four type classes (ObjectType, VariableType, ReferenceType, DataType).
     pub fn is_type(self) -> bool {
         matches!(
             self,
@@ -81,37 +92,60 @@ impl NodeClass {
 /// A localized text: `<DisplayName Locale="de-DE">…</DisplayName>`.
 #[derive(Clone, Debug, PartialEq, Eq, Default)]
 pub struct LocalizedText {
+    /// The `Locale`, such as `de-DE`; `None` when it is absent or empty.
     pub locale: Option<String>,
+    /// The text.
     pub text: String,
 }
 
+/// A `<RequiredModel>` of a `<Model>`: a model the file's model depends on.
 #[derive(Clone, Debug)]
 pub struct RawRequiredModel {
+    /// The ModelUri attribute (empty when missing).
     pub uri: String,
+    /// The Version attribute.
     pub version: Option<String>,
+    /// The PublicationDate attribute, as written.
     pub publication_date: Option<String>,
+    /// The ModelVersion attribute.
     pub model_version: Option<String>,
+    /// The XmlSchemaUri attribute.
     pub xml_schema_uri: Option<String>,
+    /// The span of the start tag.
     pub span: Span,
 }
 
+/// A `<Model>` of `<Models>`: a model the file defines.
 #[derive(Clone, Debug)]
 pub struct RawModel {
+    /// The ModelUri attribute (empty when missing).
     pub uri: String,
+    /// The Version attribute.
     pub version: Option<String>,
+    /// The PublicationDate attribute, as written.
     pub publication_date: Option<String>,
+    /// The ModelVersion attribute.
     pub model_version: Option<String>,
+    /// The XmlSchemaUri attribute.
     pub xml_schema_uri: Option<String>,
+    /// The `<RequiredModel>`s, in document order.
     pub required: Vec<RawRequiredModel>,
+    /// The model's `<RolePermissions>`.
     pub role_permissions: Vec<RawRolePermission>,
+    /// The AccessRestrictions attribute.
     pub access_restrictions: Option<u16>,
+    /// The span of the start tag.
     pub span: Span,
 }
 
+/// An `<Alias>` of `<Aliases>`: a name that stands for a NodeId.
 #[derive(Clone, Debug)]
 pub struct RawAlias {
+    /// The name (the `Alias` attribute).
     pub alias: String,
+    /// The NodeId the alias stands for: the element's trimmed text, with its span.
     pub target: Spanned<String>,
+    /// The span of the start tag.
     pub span: Span,
 }
 
@@ -123,6 +157,7 @@ pub struct RawAlias {
 /// string, while the parser has the text at hand, so that the resolver need not read the text again.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct RawStr {
+    /// Where the string was read in the file (for a string made by [`RawStr::owned`], the span given to it).
     pub span: Span,
     owned: Option<Box<str>>,
     numeric: Option<(u16, u32)>,
@@ -159,46 +194,73 @@ impl RawStr {
     }
 }
 
+/// A `<Reference>` of a node.
 #[derive(Clone, Debug)]
 pub struct RawReference {
+    /// The ReferenceType attribute (a NodeId or alias), trimmed.
     pub reference_type: RawStr,
+    /// The target node (a NodeId or alias): the element's trimmed text.
     pub target: RawStr,
+    /// The IsForward attribute; `true` when it is absent.
     pub is_forward: bool,
+    /// The span of the start tag.
     pub span: Span,
 }
 
+/// A `<RolePermission>`: a role and the permissions it is granted.
 #[derive(Clone, Debug)]
 pub struct RawRolePermission {
+    /// The role's NodeId (or alias): the element's trimmed text, with its span.
     pub role: Spanned<String>,
+    /// The Permissions attribute (a bit mask); 0 when absent or invalid.
     pub permissions: u32,
 }
 
 /// A field of a `<Definition>`.
 #[derive(Clone, Debug)]
 pub struct RawField {
+    /// The Name attribute (empty when missing).
     pub name: String,
+    /// The SymbolicName attribute.
     pub symbolic_name: Option<String>,
+    /// The DataType attribute (a NodeId or alias), with its span.
     pub data_type: Option<Spanned<String>>,
+    /// The ValueRank attribute.
     pub value_rank: Option<i32>,
+    /// The ArrayDimensions attribute, unparsed.
     pub array_dimensions: Option<String>,
+    /// The MaxStringLength attribute.
     pub max_string_length: Option<u32>,
+    /// The IsOptional attribute; `false` when absent.
     pub is_optional: bool,
+    /// The AllowSubTypes attribute; `false` when absent.
     pub allow_sub_types: bool,
+    /// The Value attribute (of an enumeration or option set field).
     pub value: Option<i64>,
+    /// The field's `<DisplayName>`s.
     pub display_names: Vec<LocalizedText>,
+    /// The field's `<Description>`s.
     pub descriptions: Vec<LocalizedText>,
+    /// The span of the start tag.
     pub span: Span,
 }
 
 /// A DataType's `<Definition>`.
 #[derive(Clone, Debug)]
 pub struct RawDefinition {
+    /// The Name attribute.
     pub name: String,
+    /// The SymbolicName attribute.
     pub symbolic_name: Option<String>,
+    /// The BaseType attribute, with its span.
     pub base_type: Option<Spanned<String>>,
+    /// The IsUnion attribute; `false` when absent.
     pub is_union: bool,
+    /// The IsOptionSet attribute; `false` when absent.
     pub is_option_set: bool,
+    /// The `<Field>`s, in document order.
     pub fields: Vec<RawField>,
+    /// The span of the start tag.
     pub span: Span,
 }
 
@@ -208,18 +270,23 @@ pub struct RawDefinition {
 pub struct XmlElement {
     /// Local name, without namespace prefix.
     pub name: String,
+    /// The attributes, local name and value, in document order.
     pub attributes: Vec<(String, String)>,
+    /// The child elements, in document order.
     pub children: Vec<XmlElement>,
     /// The concatenated text content (line endings normalised to `\n`).
     pub text: String,
+    /// The start tag.
     pub span: Span,
 }
 
 impl XmlElement {
+    /// The first child element named `name`, if any.
     pub fn child(&self, name: &str) -> Option<&XmlElement> {
         self.children.iter().find(|c| c.name == name)
     }
 
+    /// The value of the attribute named `name`, if present.
     pub fn attr(&self, name: &str) -> Option<&str> {
         self.attributes.iter().find(|(n, _)| n == name).map(|(_, v)| v.as_str())
     }
@@ -233,61 +300,97 @@ impl XmlElement {
 /// One node element, with every attribute of UANodeSet.xsd (class-specific ones are `None` elsewhere).
 #[derive(Clone, Debug)]
 pub struct RawNode {
+    /// The node class, from the element's name.
     pub class: NodeClass,
     /// The span of the start tag.
     pub span: Span,
+    /// The NodeId attribute, as written (empty when missing).
     pub node_id: RawStr,
+    /// The BrowseName attribute, as written (empty when missing).
     pub browse_name: RawStr,
     /// The BrowseName read as `N:Name` (local namespace index), when it is one: read by the parser while
     /// the text is at hand. `None` when it is malformed or missing; the resolver then reads the text and
     /// says what is wrong.
     pub qualified_name: Option<crate::nodeid::RawQualifiedName>,
+    /// The SymbolicName attribute.
     pub symbolic_name: Option<String>,
+    /// The WriteMask attribute.
     pub write_mask: Option<u32>,
+    /// The UserWriteMask attribute.
     pub user_write_mask: Option<u32>,
+    /// The AccessRestrictions attribute.
     pub access_restrictions: Option<u16>,
+    /// The HasNoPermissions attribute.
     pub has_no_permissions: Option<bool>,
+    /// The ReleaseStatus attribute, as written.
     pub release_status: Option<String>,
+    /// The `<DisplayName>`s, in document order.
     pub display_names: Vec<LocalizedText>,
+    /// The `<Description>`s, in document order.
     pub descriptions: Vec<LocalizedText>,
+    /// The texts of the `<Category>` elements, trimmed.
     pub category: Vec<String>,
+    /// The text of the `<Documentation>` element.
     pub documentation: Option<String>,
     /// The node's `<Reference>`s: a range of its file's [`RawNodeSet::references`] (read them with
     /// [`RawNodeSet::references_of`]). One list per file, not one per node: nearly every node has
     /// references, and a list of its own cost an allocation or more per node to build and free.
     pub references: RefRange,
+    /// The node's `<RolePermissions>`.
     pub role_permissions: Vec<RawRolePermission>,
+    /// The child elements of `<Extensions>`.
     pub extensions: Vec<XmlElement>,
     // Instance attributes.
+    /// The ParentNodeId attribute.
     pub parent_node_id: Option<RawStr>,
     // Variable and VariableType attributes.
+    /// The DataType attribute (a NodeId or alias).
     pub data_type: Option<RawStr>,
+    /// The ValueRank attribute.
     pub value_rank: Option<i32>,
+    /// The ArrayDimensions attribute, unparsed, with its span.
     pub array_dimensions: Option<Spanned<String>>,
+    /// The AccessLevel attribute (bit 0x01 CurrentRead, 0x02 CurrentWrite); a value above 255 is kept as its
+    /// low byte.
     pub access_level: Option<u8>,
+    /// The UserAccessLevel attribute; a value above 255 is kept as its low byte.
     pub user_access_level: Option<u8>,
+    /// The AccessLevelEx attribute.
     pub access_level_ex: Option<u32>,
+    /// The MinimumSamplingInterval attribute.
     pub minimum_sampling_interval: Option<f64>,
+    /// The Historizing attribute.
     pub historizing: Option<bool>,
     /// The element inside `<Value>`, if any, in the file's [`ValueArena`].
     pub value: Option<ValueRef>,
     // Method attributes.
+    /// The Executable attribute.
     pub executable: Option<bool>,
+    /// The UserExecutable attribute.
     pub user_executable: Option<bool>,
+    /// The MethodDeclarationId attribute.
     pub method_declaration_id: Option<RawStr>,
     // Object and View attributes.
+    /// The EventNotifier attribute.
     pub event_notifier: Option<u8>,
+    /// The ContainsNoLoops attribute.
     pub contains_no_loops: Option<bool>,
     // Type attributes.
+    /// The IsAbstract attribute.
     pub is_abstract: Option<bool>,
+    /// The Symmetric attribute of a ReferenceType.
     pub symmetric: Option<bool>,
+    /// The `<InverseName>`s of a ReferenceType, in document order.
     pub inverse_names: Vec<LocalizedText>,
     /// Boxed: only DataTypes have one, and every other node would carry its room.
     pub definition: Option<Box<RawDefinition>>,
+    /// The Purpose attribute of a DataType, as written.
     pub purpose: Option<String>,
 }
 
 impl RawNode {
+    /// A node of class `class` with start tag `span` and no attributes read yet: its NodeId and BrowseName
+    /// are empty strings spanning the start tag.
     pub fn new(class: NodeClass, span: Span) -> RawNode {
         // Until the attributes are read: empty strings spanning the start tag.
         let empty = RawStr::owned("", span);
@@ -337,15 +440,23 @@ impl RawNode {
 /// One parsed NodeSet2 file.
 #[derive(Clone, Debug)]
 pub struct RawNodeSet {
+    /// The file the set was read from.
     pub file: FileId,
+    /// The start tag of `<UANodeSet>`.
     pub root_span: Span,
+    /// The `<Uri>`s of `<NamespaceUris>`, trimmed, with their spans: the first is namespace index 1.
     pub namespace_uris: Vec<Spanned<String>>,
+    /// The `<Uri>`s of `<ServerUris>`, trimmed, with their spans.
     pub server_uris: Vec<Spanned<String>>,
+    /// The `<Model>`s of `<Models>`: the models the file defines.
     pub models: Vec<RawModel>,
+    /// The `<Alias>`es of `<Aliases>`, in document order.
     pub aliases: Vec<RawAlias>,
+    /// The node elements, in document order.
     pub nodes: Vec<RawNode>,
     /// The references of every node, in document order (see [`RawNode::references`]).
     pub references: Vec<RawReference>,
+    /// The LastModified attribute of `<UANodeSet>`, as written.
     pub last_modified: Option<String>,
     /// The elements of every `<Value>` of the file.
     pub values: ValueArena,
@@ -361,15 +472,19 @@ impl RawNodeSet {
 /// A node's references: the range `start..end` of its file's [`RawNodeSet::references`].
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RefRange {
+    /// The index of the node's first reference.
     pub start: u32,
+    /// The index after the node's last reference.
     pub end: u32,
 }
 
 impl RefRange {
+    /// The number of references.
     pub fn len(&self) -> usize {
         (self.end - self.start) as usize
     }
 
+    /// Whether the node has no references.
     pub fn is_empty(&self) -> bool {
         self.start == self.end
     }
@@ -553,6 +668,7 @@ impl ValueArena {
         self.elements.len()
     }
 
+    /// Whether the arena holds no elements.
     pub fn is_empty(&self) -> bool {
         self.elements.is_empty()
     }
@@ -609,6 +725,7 @@ impl<'a> ValueElement<'a> {
         })
     }
 
+    /// The value of the attribute named `name`, if present.
     pub fn attr(&self, name: &str) -> Option<&'a str> {
         self.attributes().find(|(k, _)| *k == name).map(|(_, v)| v)
     }
@@ -628,6 +745,7 @@ impl<'a> ValueElement<'a> {
         })
     }
 
+    /// The first child element named `name`, if any.
     pub fn child(&self, name: &str) -> Option<ValueElement<'a>> {
         self.children().find(|c| c.name() == name)
     }

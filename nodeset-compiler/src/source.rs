@@ -13,12 +13,16 @@ pub struct FileId(pub u32);
 /// A byte range in one source file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub struct Span {
+    /// The file the range is in.
     pub file: FileId,
+    /// Byte offset of the first byte.
     pub start: u32,
+    /// Byte offset just past the last byte (never before `start`).
     pub end: u32,
 }
 
 impl Span {
+    /// The span of bytes `start..end` of `file`; an `end` before `start` gives an empty span.
     pub fn new(file: FileId, start: usize, end: usize) -> Span {
         Span { file, start: start as u32, end: end.max(start) as u32 }
     }
@@ -27,16 +31,20 @@ impl Span {
 /// A value together with the span it was read from.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Spanned<T> {
+    /// The value.
     pub value: T,
+    /// Where it was read from.
     pub span: Span,
 }
 
 /// One loaded file: its path, the name used in messages, and its text (UTF-8, BOM removed).
 #[derive(Debug)]
 pub struct SourceFile {
+    /// The path the file was read from (for text held in memory, its name).
     pub path: PathBuf,
     /// The name shown in diagnostics: the path as the user gave it (or as found in a models folder).
     pub display: String,
+    /// The file's text (for a file that is not UTF-8, a copy made displayable for diagnostics).
     pub text: String,
     /// Whether the user named this file (as opposed to a dependency found in a models folder).
     pub named: bool,
@@ -44,6 +52,7 @@ pub struct SourceFile {
 }
 
 impl SourceFile {
+    /// A file with this path, display name and text; its line table is built when first needed.
     pub fn new(path: PathBuf, display: String, text: String, named: bool) -> SourceFile {
         SourceFile { path, display, text, named, line_starts: OnceLock::new() }
     }
@@ -93,31 +102,38 @@ pub struct SourceMap {
 }
 
 impl SourceMap {
+    /// An empty map.
     pub fn new() -> SourceMap {
         SourceMap::default()
     }
 
+    /// Adds a file and returns its id.
     pub fn add(&mut self, file: SourceFile) -> FileId {
         self.files.push(file);
         FileId(self.files.len() as u32 - 1)
     }
 
+    /// The file with id `id`. Panics for an id that is not of this map.
     pub fn get(&self, id: FileId) -> &SourceFile {
         &self.files[id.0 as usize]
     }
 
+    /// Every file with its id, in the order they were added.
     pub fn files(&self) -> impl Iterator<Item = (FileId, &SourceFile)> {
         self.files.iter().enumerate().map(|(i, f)| (FileId(i as u32), f))
     }
 
+    /// The id of the first file read from `path`, if any.
     pub fn find_path(&self, path: &Path) -> Option<FileId> {
         self.files.iter().position(|f| f.path == path).map(|i| FileId(i as u32))
     }
 
+    /// The number of files.
     pub fn len(&self) -> usize {
         self.files.len()
     }
 
+    /// Whether the map holds no file.
     pub fn is_empty(&self) -> bool {
         self.files.is_empty()
     }

@@ -8,17 +8,22 @@ use std::fmt::Write as _;
 /// Counts per namespace: nodes by class, types, instances.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct NamespaceCounts {
+    /// Nodes of each NodeClass.
     pub by_class: BTreeMap<NodeClass, usize>,
+    /// Nodes of a type class (ObjectType, VariableType, ReferenceType, DataType).
     pub types: usize,
+    /// Objects and Variables without a ModellingRule.
     pub instances: usize,
 }
 
 impl NamespaceCounts {
+    /// The number of nodes of the namespace.
     pub fn total(&self) -> usize {
         self.by_class.values().sum()
     }
 }
 
+/// The counts of every namespace that has nodes, by global namespace index.
 pub fn counts(model: &Model) -> BTreeMap<u16, NamespaceCounts> {
     let mut out: BTreeMap<u16, NamespaceCounts> = BTreeMap::new();
     for n in &model.nodes {

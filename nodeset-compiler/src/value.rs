@@ -65,34 +65,60 @@ impl<'a> XmlNode<'a> for ValueElement<'a> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 #[repr(u8)]
 pub enum BuiltinType {
+    /// Boolean: true or false.
     Boolean = 1,
+    /// SByte: a signed 8-bit integer.
     SByte = 2,
+    /// Byte: an unsigned 8-bit integer.
     Byte = 3,
+    /// Int16: a signed 16-bit integer.
     Int16 = 4,
+    /// UInt16: an unsigned 16-bit integer.
     UInt16 = 5,
+    /// Int32: a signed 32-bit integer.
     Int32 = 6,
+    /// UInt32: an unsigned 32-bit integer.
     UInt32 = 7,
+    /// Int64: a signed 64-bit integer.
     Int64 = 8,
+    /// UInt64: an unsigned 64-bit integer.
     UInt64 = 9,
+    /// Float: an IEEE 754 single-precision number.
     Float = 10,
+    /// Double: an IEEE 754 double-precision number.
     Double = 11,
+    /// String: a Unicode text.
     String = 12,
+    /// DateTime: a point in time.
     DateTime = 13,
+    /// Guid: a 16-byte globally unique identifier.
     Guid = 14,
+    /// ByteString: a sequence of bytes.
     ByteString = 15,
+    /// XmlElement: an XML fragment.
     XmlElement = 16,
+    /// NodeId: the identifier of a node.
     NodeId = 17,
+    /// ExpandedNodeId: a NodeId that may name its namespace by URI and its server.
     ExpandedNodeId = 18,
+    /// StatusCode: a 32-bit result code.
     StatusCode = 19,
+    /// QualifiedName: a name qualified by a namespace index.
     QualifiedName = 20,
+    /// LocalizedText: a text with an optional locale.
     LocalizedText = 21,
+    /// ExtensionObject: an encoded structure together with the id of its type.
     ExtensionObject = 22,
+    /// DataValue: a value with its status and timestamps.
     DataValue = 23,
+    /// Variant: a value of any built-in type.
     Variant = 24,
+    /// DiagnosticInfo: details of an error.
     DiagnosticInfo = 25,
 }
 
 impl BuiltinType {
+    /// Every built-in type, in the order of their ids.
     pub const ALL: [BuiltinType; 25] = [
         BuiltinType::Boolean,
         BuiltinType::SByte,
@@ -121,10 +147,12 @@ impl BuiltinType {
         BuiltinType::DiagnosticInfo,
     ];
 
+    /// The built-in type with ns0 numeric id `id`, if there is one.
     pub fn from_id(id: u32) -> Option<BuiltinType> {
         BuiltinType::ALL.get((id as usize).wrapping_sub(1)).copied()
     }
 
+    /// The type's ns0 numeric id.
     pub fn id(self) -> u32 {
         self as u32
     }
@@ -169,10 +197,12 @@ impl BuiltinType {
         }
     }
 
+    /// The built-in type whose scalar element is named `name` (see [`BuiltinType::xml_name`]).
     pub fn from_xml_name(name: &str) -> Option<BuiltinType> {
         BuiltinType::ALL.into_iter().find(|b| b.xml_name() == name)
     }
 
+    /// Whether the type is one of the eight integer types.
     pub fn is_integer(self) -> bool {
         matches!(
             self,
@@ -187,10 +217,12 @@ impl BuiltinType {
         )
     }
 
+    /// Whether the type is an unsigned integer type.
     pub fn is_unsigned(self) -> bool {
         matches!(self, BuiltinType::Byte | BuiltinType::UInt16 | BuiltinType::UInt32 | BuiltinType::UInt64)
     }
 
+    /// Whether the type is an integer type, Float or Double.
     pub fn is_number(self) -> bool {
         self.is_integer() || matches!(self, BuiltinType::Float | BuiltinType::Double)
     }
@@ -208,28 +240,51 @@ pub struct ExtensionObject {
 /// A decoded value.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Variant {
+    /// A Boolean.
     Boolean(bool),
+    /// An SByte.
     SByte(i8),
+    /// A Byte.
     Byte(u8),
+    /// An Int16.
     Int16(i16),
+    /// A UInt16.
     UInt16(u16),
+    /// An Int32.
     Int32(i32),
+    /// A UInt32.
     UInt32(u32),
+    /// An Int64.
     Int64(i64),
+    /// A UInt64.
     UInt64(u64),
+    /// A Float.
     Float(f32),
+    /// A Double.
     Double(f64),
+    /// A String.
     String(String),
+    /// A DateTime, as its trimmed text.
     DateTime(String),
+    /// A Guid, as the 16 bytes of its text order.
     Guid([u8; 16]),
+    /// A ByteString, decoded from base64.
     ByteString(Vec<u8>),
+    /// An XmlElement, as the tree of its element; DataValues and DiagnosticInfos are kept this way too.
     XmlElement(XmlElement),
+    /// A NodeId, as the [`NodeIdMapper`] maps it.
     NodeId(NodeId),
+    /// An ExpandedNodeId, as the [`NodeIdMapper`] maps it.
     ExpandedNodeId(NodeId),
+    /// A StatusCode, as its numeric code.
     StatusCode(u32),
+    /// A QualifiedName, its namespace index mapped by the [`NsMapper`].
     QualifiedName(QualifiedName),
+    /// A LocalizedText.
     LocalizedText(LocalizedText),
+    /// An ExtensionObject.
     ExtensionObject(Box<ExtensionObject>),
+    /// A Variant: the value inside it.
     Variant(Box<Variant>),
     /// `ListOf…`: the element type and the items.
     Array(BuiltinType, Vec<Variant>),
@@ -269,10 +324,12 @@ impl Variant {
         })
     }
 
+    /// Whether the value is a `ListOf…` array.
     pub fn is_array(&self) -> bool {
         matches!(self, Variant::Array(..))
     }
 
+    /// The value of an integer as an `i64`, if it is one and fits.
     pub fn as_i64(&self) -> Option<i64> {
         match *self {
             Variant::SByte(v) => Some(v.into()),

@@ -20,30 +20,41 @@ use std::path::{Path, PathBuf};
 /// One generated file, relative to its output folder.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct OutFile {
+    /// The path, relative to the output folder.
     pub path: PathBuf,
+    /// The text of the file.
     pub contents: String,
 }
 
+/// Whether [`write_tree`] changes the folder or only compares it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mode {
+    /// Make the folder hold exactly the generated files.
     Write,
+    /// Write nothing; only report what differs.
     Check,
 }
 
 /// What a write or check found.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Report {
+    /// Generated files the folder lacks, relative to it.
     pub added: Vec<PathBuf>,
+    /// Files whose contents differ from the generated ones.
     pub changed: Vec<PathBuf>,
+    /// Files in the folder that are not generated.
     pub removed: Vec<PathBuf>,
+    /// How many files are already identical.
     pub unchanged: usize,
 }
 
 impl Report {
+    /// Whether the folder already holds exactly the generated files.
     pub fn is_clean(&self) -> bool {
         self.added.is_empty() && self.changed.is_empty() && self.removed.is_empty()
     }
 
+    /// One line per new, changed or removed file (`  new: PATH`), each path joined to `dir`.
     pub fn describe(&self, dir: &Path) -> String {
         let mut s = String::new();
         for (what, list) in [("new", &self.added), ("changed", &self.changed), ("removed", &self.removed)] {

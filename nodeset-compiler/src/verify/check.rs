@@ -20,6 +20,7 @@ use std::collections::BTreeSet;
 /// and where on the server it was found.
 #[derive(Clone, Debug)]
 pub struct Finding {
+    /// What is wrong, pointing at the violated declaration in its NodeSet2 file.
     pub diagnostic: Diagnostic,
     /// The browse path from the Objects folder, BrowseNames joined by `/` (namespace prefixes as the
     /// server numbers them, as in `2:DeviceSet/4:Robot`).

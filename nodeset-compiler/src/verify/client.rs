@@ -30,6 +30,7 @@ use tokio_util::codec::FramedRead;
 /// How to reach the server.
 #[derive(Clone, Debug)]
 pub struct Connect {
+    /// The server's endpoint URL, `opc.tcp://HOST:PORT[/PATH]`.
     pub url: String,
     /// `None`, `Basic256Sha256`, `Aes128Sha256RsaOaep`, `Aes256Sha256RsaPss`.
     pub security_policy: String,

@@ -41,8 +41,11 @@ use std::collections::BTreeMap;
 /// (see [`Snapshot::namespaces`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct RemoteNode {
+    /// The node's NodeId.
     pub id: NodeId,
+    /// The node's NodeClass.
     pub class: NodeClass,
+    /// The node's BrowseName.
     pub browse_name: QualifiedName,
     /// Forward references of every type, in the order the server returned them.
     pub references: Vec<RemoteReference>,
@@ -57,7 +60,9 @@ pub struct RemoteNode {
 /// A forward reference of a [`RemoteNode`].
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct RemoteReference {
+    /// The NodeId of the reference's type.
     pub reference_type: NodeId,
+    /// The node the reference points to.
     pub target: NodeId,
 }
 
@@ -66,7 +71,9 @@ pub struct RemoteReference {
 pub enum RemoteValue {
     /// A null value (an empty Variant).
     Empty,
+    /// A scalar of this built-in type.
     Scalar(BuiltinType),
+    /// An array with elements of this built-in type.
     Array(BuiltinType),
 }
 

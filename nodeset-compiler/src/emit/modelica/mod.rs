@@ -131,7 +131,7 @@
 //! than `fill` (`expression shape mismatch`). rumoca lets an enclosing instance's redeclaration of an inherited
 //! alias replace a nested component's own (a MotionDeviceType's `ParameterSet` would replace the one of each
 //! AxisType in its Axes), so every object component repeats its class's choice for each alias that some class
-//! redeclares (`Axis axis(redeclare model ParameterSet = ...AxisType_ParameterSet)`, [`objects::Mod::Pin`]);
+//! redeclares (`Axis axis(redeclare model ParameterSet = ...AxisType_ParameterSet)`, `objects::Mod::Pin`);
 //! `tests/modelica/RumocaBehaviour` reproduces both the leak and the fix.
 //!
 //! # Limits
@@ -192,6 +192,7 @@ impl Default for ModelicaConfig {
 }
 
 impl ModelicaConfig {
+    /// The defaults: the models of the named files, with the base-namespace subset and the support package.
     pub fn new() -> ModelicaConfig {
         ModelicaConfig::default()
     }
@@ -208,11 +209,13 @@ impl ModelicaConfig {
         self
     }
 
+    /// Sets whether the used part of the base namespace is emitted as package `OpcUa`.
     pub fn base_subset(mut self, on: bool) -> ModelicaConfig {
         self.base_subset = on;
         self
     }
 
+    /// Sets whether the `OpcUaSupport` package is emitted.
     pub fn support_package(mut self, on: bool) -> ModelicaConfig {
         self.support_package = on;
         self
@@ -222,7 +225,9 @@ impl ModelicaConfig {
 /// The files and everything said about them.
 #[derive(Debug)]
 pub struct Generated {
+    /// The generated files, relative to the output folder.
     pub files: Vec<OutFile>,
+    /// The errors and warnings of generation.
     pub diagnostics: Diagnostics,
 }
 

@@ -31,6 +31,7 @@ pub struct Unit {
     pub quantity: &'static str,
     /// SI value = factor * value in the engineering unit + offset.
     pub factor: f64,
+    /// The offset of that conversion.
     pub offset: f64,
 }
 

@@ -50,6 +50,7 @@ use std::path::PathBuf;
 /// One namespace to generate.
 #[derive(Clone, Debug)]
 pub struct RustNamespace {
+    /// The namespace URI.
     pub uri: String,
     /// The module name (a Rust identifier), e.g. `robotics`.
     pub module: String,
@@ -58,6 +59,7 @@ pub struct RustNamespace {
 /// What to generate and how generated code reaches its dependencies.
 #[derive(Clone, Debug)]
 pub struct RustConfig {
+    /// The namespaces to generate, one module each.
     pub namespaces: Vec<RustNamespace>,
     /// Rust paths of namespaces generated elsewhere (URI -> path of their module, e.g.
     /// `nodeset_models::models::di`). Namespaces generated in this run are reached as `super::<module>`.
@@ -71,7 +73,9 @@ pub struct RustConfig {
 /// Generated files and the diagnostics of generation.
 #[derive(Debug, Default)]
 pub struct RustOutput {
+    /// The generated files, sorted by path, relative to the output folder (`<module>/<file>`).
     pub files: Vec<OutFile>,
+    /// The errors and warnings of generation.
     pub diagnostics: Diagnostics,
 }
 
@@ -83,7 +87,7 @@ pub fn default_module_name(uri: &str) -> String {
 
 /// Generates Rust for the configured namespaces.
 ///
-/// Each file of each namespace is generated on its own (a fresh [`Gen`] per file) and the files are spread
+/// Each file of each namespace is generated on its own (a fresh `Gen` per file) and the files are spread
 /// over the cores; files and diagnostics come out in the same order whatever the number of threads.
 pub fn generate(model: &Model, cfg: &RustConfig) -> RustOutput {
     let mut out = RustOutput::default();
