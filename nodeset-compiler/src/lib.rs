@@ -1,5 +1,71 @@
 //! nodeset-compiler: OPC UA NodeSet2 information models to typed Rust and Modelica.
 //!
+//! # From NodeSet2 files to a running server
+//!
+//! Say you have `nodesets/MyCell.NodeSet2.xml`, your cell's information model, which requires DI and Robotics,
+//! and the OPC Foundation's files in `nodesets/vendor` (`cargo xtask fetch-nodesets` pins them for this
+//! workspace).
+//!
+//! **1. Check the files.** `nodeset-compiler check nodesets/MyCell.NodeSet2.xml --models nodesets/vendor` finds
+//! the required models in the folder by ModelUri, resolves everything and prints each problem with
+//! `file:line:col`, the source line and a hint, like rustc. `--deny warnings` makes warnings errors; `--warn
+//! CODE` demotes an error that has a safe recovery (`nodeset-compiler codes` lists them). The library call is
+//! [`compile`] (see [Pipeline](#pipeline)).
+//!
+//! **2. Generate Rust in your crate's build script**, with [`build::Builder`]. Namespaces that another crate
+//! already holds are mapped to it instead of being generated again:
+//!
+//! ```rust,ignore
+//! // build.rs (build-dependency: nodeset-compiler)
+//! fn main() {
+//!     nodeset_compiler::build::Builder::new()
+//!         .file("nodesets/MyCell.NodeSet2.xml")
+//!         .models_dir("nodesets/vendor")
+//!         .extern_namespace("http://opcfoundation.org/UA/DI/", "nodeset_models::models::di")
+//!         .extern_namespace("http://opcfoundation.org/UA/Robotics/", "nodeset_models::models::robotics")
+//!         .generate()
+//!         .unwrap_or_else(|e| panic!("{e}"));
+//! }
+//!
+//! // src/lib.rs: one module per namespace, named by the URI's last segment (`my_cell`)
+//! include!(concat!(env!("OUT_DIR"), "/nodesets.rs"));
+//! ```
+//!
+//! Each namespace module holds NodeId constants that carry the namespace URI (`ids`), the data types with
+//! their encodings (`types`, and `TypeLoader`), the address space as a static table (`TABLE`) and typed
+//! handles of the instances (`objects`). A failed generation leaves the previous output as it was.
+//!
+//! **3. Serve it** with the runtime (`nodeset_models::runtime`, the crate `nodeset-runtime`):
+//!
+//! ```rust,ignore
+//! use nodeset_models::runtime::server::ServerConfig;
+//!
+//! #[tokio::main]
+//! async fn main() -> Result<(), String> {
+//!     // The namespaces of nodeset-models (DI, IA, Robotics, ...), dependencies first, then yours.
+//!     let config = nodeset_models::models::register(ServerConfig::new("My cell"))
+//!         .table(&my_cell_models::my_cell::TABLE)
+//!         .type_loader(my_cell_models::my_cell::TypeLoader)
+//!         .port(4840);
+//!     config.build()?.run().await
+//! }
+//! ```
+//!
+//! The server is secure by default: encrypted endpoints only, an application certificate created on first
+//! start in the PKI folder (`pki/<name>` by default), client certificates trusted by moving them from
+//! `rejected/` to `trusted/`, users
+//! from a user file with Argon2id hashes, and the RolePermissions of your nodeset applied to its nodes. A
+//! SecurityPolicy None endpoint exists only when asked for (`ServerConfig::insecure()`, for loopback tests).
+//!
+//! **4. And then:** `nodeset-compiler verify opc.tcp://host:4840/ nodesets/MyCell.NodeSet2.xml --models
+//! nodesets/vendor --pki verify-pki` checks any live server, whatever its stack, against the nodesets; the
+//! runtime's `client` binds the generated type handles to instances on a live server for typed reads, writes,
+//! subscriptions and program runs; `nodeset-compiler modelica nodesets/MyCell.NodeSet2.xml --models
+//! nodesets/vendor --out DIR` writes Modelica packages of the same model ([`emit::modelica`]). The workspace
+//! README walks through each with the pinned companion specifications.
+//!
+//! # Pipeline
+//!
 //! The pipeline, one module per stage:
 //!
 //! ```text
