@@ -280,9 +280,13 @@ fn companion_specs_and_the_example_pass_rumoca_and_the_example_simulates() {
     let expected = 1.0 - (-1.0f64).exp();
     assert!((at_t - expected).abs() < 1e-3, "ActualPosition at t = T is {at_t}, expected {expected}");
     assert!((end - 1.0).abs() < 1e-3, "ActualPosition at the end is {end}");
-    let robot = simulate(&target, "RoboticsExample.RobotDemo", "0.1");
-    let (_, a1) = value(&robot, "robot.axes.axisIdentifier[1].position");
-    let (_, a2) = value(&robot, "robot.axes.axisIdentifier[2].position");
+    // The robot: each axis of the placeholder follows its own first-order response, y(t) = target*(1 - exp(-t/T))
+    // with T = 0.1 s and 0.3 s.
+    let robot = simulate(&target, "RoboticsExample.RobotDemo", "0.2");
+    let (b1, a1) = value(&robot, "robot.axes.axisIdentifier[1].drive.y");
+    let (b2, a2) = value(&robot, "robot.axes.axisIdentifier[2].drive.y");
+    let (e1, e2) = (1.0 - (-2.0f64).exp(), -0.5 * (1.0 - (-2.0f64 / 3.0).exp()));
+    assert!((b1 - e1).abs() < 1e-3 && (b2 - e2).abs() < 1e-3, "at 0.2 s the axes are at {b1} and {b2}, expected {e1} and {e2}");
     assert!((a1 - 1.0).abs() < 1e-2 && (a2 + 0.5).abs() < 1e-2, "the robot's axes end at {a1} and {a2}");
     // Each axis inside the motion device keeps its own ParameterSet class (AxisType_ParameterSet, with
     // ActualPosition), not the motion device's: rumoca would otherwise let MotionDeviceType's redeclaration of

@@ -4,11 +4,14 @@ package RoboticsExample "A first-order robot axis built on the OPC UA Robotics c
     version="1.0.0",
     uses(OpcUaRobotics(version="1.02"), OpcUaSupport(version="0.1.0")),
     Documentation(info="<html>
-<p>A hand-written user library, not generated: it shows how the generated packages are meant to be used.
-<code>FirstOrderAxis</code> extends the generated <code>OpcUaRobotics.ObjectTypes.AxisType</code> and binds the
-OPC UA variables the model computes (ParameterSet/ActualPosition, ParameterSet/ActualSpeed) with modifiers;
-<code>RobotDemo</code> puts two such axes into a generated <code>MotionDeviceType</code> through its
-<code>&lt;AxisIdentifier&gt;</code> placeholder and moves them to their targets.</p>
+<p>A hand-written user library, not generated: it shows how the generated packages are meant to be used, the way
+a Modelica engineer wires up components. <code>DrivenAxis</code> extends the generated (partial)
+<code>OpcUaRobotics.ObjectTypes.AxisType</code> and <code>connect</code>s a first-order drive block to the input
+connectors ParameterSet/ActualPosition and ParameterSet/ActualSpeed, the values the axis publishes;
+<code>RobotDemo</code> puts two such axes into the complete variant of <code>MotionDeviceType</code> through the
+replaceable class of its <code>&lt;AxisIdentifier&gt;</code> placeholder and moves them to their targets. The blocks
+<code>FirstOrder</code> and <code>Constant</code> stand in for the Modelica Standard Library's, which this
+library does not use.</p>
 <p>The test <code>tests/tests/modelica.rs</code> checks and simulates this package with rumoca against the
 packages generated from the pinned Robotics, IA and DI NodeSet2 files.</p>
 </html>"));

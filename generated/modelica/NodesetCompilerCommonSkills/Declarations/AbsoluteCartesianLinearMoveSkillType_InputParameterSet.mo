@@ -3,7 +3,7 @@
 within NodesetCompilerCommonSkills.Declarations;
 model AbsoluteCartesianLinearMoveSkillType_InputParameterSet "InputParameterSet: The inputs of the absolute motion: TargetPose, Speed and Acceleration."
   extends NodesetCompilerCommonSkills.Declarations.MoveSkillType_InputParameterSet;
-  input OpcUa.Types.N3DFrame targetPose = OpcUa.Types.N3DFrame()
+  output OpcUa.Types.N3DFrame targetPose = OpcUa.Types.N3DFrame()
     "TargetPose: Pose the tool centre point moves to, in the base frame of the robot; millimetres and degrees."
     annotation (__OPCUA(browsePath="TargetPose", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1806", dataType="i=18814"));
   annotation (

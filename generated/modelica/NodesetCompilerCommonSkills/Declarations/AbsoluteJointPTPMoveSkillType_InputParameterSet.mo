@@ -3,9 +3,9 @@
 within NodesetCompilerCommonSkills.Declarations;
 model AbsoluteJointPTPMoveSkillType_InputParameterSet "InputParameterSet: The inputs of the joint motion: TargetJointPositions, Speed and Acceleration."
   extends NodesetCompilerCommonSkills.Declarations.MoveSkillType_InputParameterSet;
-  OpcUaSupport.RealInput targetJointPositions[:](each unit="rad", each displayUnit="deg", each quantity="Angle") = fill(0, 0)
+  OpcUaSupport.RealOutput targetJointPositions[:](each unit="rad", each displayUnit="deg", each quantity="Angle") = fill(0, 0)
     "TargetJointPositions: Target angle of every joint, in degrees, in the order of the joints from the base to the flange. The array has one element per joint of the robot."
-    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="TargetJointPositions", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1606", dataType="i=11", engineeringUnit="DD", siFactor=0.017453292519943295));
+    annotation (Placement(transformation(extent={{100,30},{120,50}})), __OPCUA(browsePath="TargetJointPositions", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1606", dataType="i=11", engineeringUnit="DD", siFactor=0.017453292519943295));
   annotation (
     Documentation(info="<html><p>The inputs of the joint motion: TargetJointPositions, Speed and Acceleration.</p><p>The class of <code>InputParameterSet</code> in CommonSkills:AbsoluteJointPTPMoveSkillType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

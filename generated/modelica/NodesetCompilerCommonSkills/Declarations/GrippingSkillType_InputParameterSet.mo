@@ -3,12 +3,12 @@
 within NodesetCompilerCommonSkills.Declarations;
 model GrippingSkillType_InputParameterSet "InputParameterSet: The inputs of the gripping: Action and GripForce."
   extends OpcUa.ObjectTypes.BaseObjectType;
-  input NodesetCompilerCommonSkills.Types.GripperActionEnumeration action = NodesetCompilerCommonSkills.Types.GripperActionEnumeration.Open
+  output NodesetCompilerCommonSkills.Types.GripperActionEnumeration action = NodesetCompilerCommonSkills.Types.GripperActionEnumeration.Open
     "Action: Whether the run opens or closes the gripper."
     annotation (__OPCUA(browsePath="Action", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1902", dataType="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1000"));
-  OpcUaSupport.RealInput gripForce(unit="N", quantity="Force") = 0
+  OpcUaSupport.RealOutput gripForce(unit="N", quantity="Force") = 0
     "GripForce: Force the jaws hold the part with when closing, in newtons; ignored when opening."
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="GripForce", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1903", dataType="i=11", engineeringUnit="NEW"));
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="GripForce", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1903", dataType="i=11", engineeringUnit="NEW"));
   annotation (
     Documentation(info="<html><p>The inputs of the gripping: Action and GripForce.</p><p>The class of <code>InputParameterSet</code> in CommonSkills:GrippingSkillType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

@@ -3,12 +3,12 @@
 within NodesetCompilerCommonSkills.Declarations;
 model MoveSkillType_InputParameterSet "InputParameterSet: The inputs of the motion: Speed and Acceleration, and the target the concrete move skill adds."
   extends OpcUa.ObjectTypes.BaseObjectType;
-  OpcUaSupport.RealInput speed = 0
+  OpcUaSupport.RealOutput speed = 0
     "Speed: Maximum speed of the motion, in the unit its EngineeringUnits name."
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="Speed", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1502", dataType="i=11"));
-  OpcUaSupport.RealInput acceleration = 0
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="Speed", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1502", dataType="i=11"));
+  OpcUaSupport.RealOutput acceleration = 0
     "Acceleration: Maximum acceleration of the motion, in the unit its EngineeringUnits name."
-    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="Acceleration", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1504", dataType="i=11"));
+    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="Acceleration", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1504", dataType="i=11"));
   annotation (
     Documentation(info="<html><p>The inputs of the motion: Speed and Acceleration, and the target the concrete move skill adds.</p><p>The class of <code>InputParameterSet</code> in CommonSkills:MoveSkillType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

@@ -3,9 +3,9 @@
 within NodesetCompilerCommonSkills.Declarations;
 model ProgramSkillStateMachineType_OutputParameterSet "OutputParameterSet: The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here)."
   extends OpcUa.ObjectTypes.BaseObjectType;
-  OpcUaSupport.IntegerOutput result = 0
+  OpcUaSupport.IntegerInput result
     "Result: Outcome of the last run: Good when it ended in Ready, the Bad code of the cause when it ended in Halted. Uncertain_InitialValue before the first run."
-    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="Result", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1303", dataType="i=19"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="Result", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1303", dataType="i=19"));
   annotation (
     Documentation(info="<html><p>The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here).</p><p>The class of <code>OutputParameterSet</code> in CommonSkills:ProgramSkillStateMachineType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

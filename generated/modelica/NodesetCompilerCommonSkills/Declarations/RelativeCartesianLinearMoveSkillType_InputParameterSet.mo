@@ -3,7 +3,7 @@
 within NodesetCompilerCommonSkills.Declarations;
 model RelativeCartesianLinearMoveSkillType_InputParameterSet "InputParameterSet: The inputs of the relative motion: PoseOffset, Speed and Acceleration."
   extends NodesetCompilerCommonSkills.Declarations.MoveSkillType_InputParameterSet;
-  input OpcUa.Types.N3DFrame poseOffset = OpcUa.Types.N3DFrame()
+  output OpcUa.Types.N3DFrame poseOffset = OpcUa.Types.N3DFrame()
     "PoseOffset: Displacement and rotation of the tool centre point, in the tool frame at the start of the motion; millimetres and degrees."
     annotation (__OPCUA(browsePath="PoseOffset", nodeId="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1706", dataType="i=18814"));
   annotation (

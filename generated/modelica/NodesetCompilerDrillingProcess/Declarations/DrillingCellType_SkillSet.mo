@@ -3,14 +3,14 @@
 within NodesetCompilerDrillingProcess.Declarations;
 model DrillingCellType_SkillSet "SkillSet: The process skills of the cell (ISkillSetType)."
   extends OpcUa.ObjectTypes.FolderType;
-  replaceable model ReferenceDrillBush = NodesetCompilerDrillingProcess.ObjectTypes.ReferenceDrillBushSkillType
+  replaceable model ReferenceDrillBush = NodesetCompilerDrillingProcess.Complete.ReferenceDrillBushSkillType constrainedby NodesetCompilerDrillingProcess.ObjectTypes.ReferenceDrillBushSkillType
     "Class of ReferenceDrillBush; redeclare it to use a model of your own";
   ReferenceDrillBush referenceDrillBush(
       redeclare model InputParameterSet = NodesetCompilerDrillingProcess.Declarations.ReferenceDrillBushSkillType_InputParameterSet,
       redeclare model OutputParameterSet = NodesetCompilerDrillingProcess.Declarations.ReferenceDrillBushSkillType_OutputParameterSet)
     "ReferenceDrillBush: Positions the end effector in front of the next drill bush."
     annotation (__OPCUA(browsePath="ReferenceDrillBush", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=3002", typeDefinition="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1000"));
-  replaceable model DrillHole = NodesetCompilerDrillingProcess.ObjectTypes.DrillHoleSkillType
+  replaceable model DrillHole = NodesetCompilerDrillingProcess.Complete.DrillHoleSkillType constrainedby NodesetCompilerDrillingProcess.ObjectTypes.DrillHoleSkillType
     "Class of DrillHole; redeclare it to use a model of your own";
   DrillHole drillHole(
       redeclare model InputParameterSet = NodesetCompilerDrillingProcess.Declarations.DrillHoleSkillType_InputParameterSet,

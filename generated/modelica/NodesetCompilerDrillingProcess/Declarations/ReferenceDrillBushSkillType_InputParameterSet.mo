@@ -3,12 +3,12 @@
 within NodesetCompilerDrillingProcess.Declarations;
 model ReferenceDrillBushSkillType_InputParameterSet "InputParameterSet: The inputs: HolePosition and ApproachDistance."
   extends OpcUa.ObjectTypes.BaseObjectType;
-  input OpcUa.Types.N3DFrame holePosition = OpcUa.Types.N3DFrame()
+  output OpcUa.Types.N3DFrame holePosition = OpcUa.Types.N3DFrame()
     "HolePosition: Rough pose of the drill bush in the base frame of the robot, from the template referencing camera: position of the bush face centre, Z along the bush axis into the part; millimetres and degrees."
     annotation (__OPCUA(browsePath="HolePosition", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1002", dataType="i=18814"));
-  OpcUaSupport.RealInput approachDistance(unit="m", displayUnit="mm", quantity="Length") = 0
+  OpcUaSupport.RealOutput approachDistance(unit="m", displayUnit="mm", quantity="Length") = 0
     "ApproachDistance: Distance in front of the bush face at which the end effector stops, in millimetres."
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="ApproachDistance", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1013", dataType="i=11", engineeringUnit="MMT", siFactor=0.001));
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="ApproachDistance", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1013", dataType="i=11", engineeringUnit="MMT", siFactor=0.001));
   annotation (
     Documentation(info="<html><p>The inputs: HolePosition and ApproachDistance.</p><p>The class of <code>InputParameterSet</code> in DrillingProcess:ReferenceDrillBushSkillType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

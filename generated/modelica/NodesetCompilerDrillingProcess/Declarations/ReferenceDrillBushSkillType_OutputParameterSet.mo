@@ -3,7 +3,7 @@
 within NodesetCompilerDrillingProcess.Declarations;
 model ReferenceDrillBushSkillType_OutputParameterSet "OutputParameterSet: The results: Result and ReferencedHolePosition."
   extends NodesetCompilerCommonSkills.Declarations.ProgramSkillStateMachineType_OutputParameterSet;
-  output OpcUa.Types.N3DFrame referencedHolePosition = OpcUa.Types.N3DFrame()
+  input OpcUa.Types.N3DFrame referencedHolePosition = OpcUa.Types.N3DFrame()
     "ReferencedHolePosition: Pose of the drill bush as the hole referencing unit measured it, in the base frame of the robot; millimetres and degrees. Valid after a run that ended in Ready."
     annotation (__OPCUA(browsePath="ReferencedHolePosition", nodeId="nsu=http://nodeset-compiler.dev/DrillingProcess/;i=1017", dataType="i=18814"));
   annotation (

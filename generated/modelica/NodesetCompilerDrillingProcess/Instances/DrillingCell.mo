@@ -3,7 +3,7 @@
 within NodesetCompilerDrillingProcess.Instances;
 model DrillingCell "DrillingCell: The template drilling cell for the vertical tail plane: its process skills in SkillSet."
   extends NodesetCompilerDrillingProcess.ObjectTypes.DrillingCellType(
-    skillSet(referenceDrillBush(deletable=false, autoDelete=false, recycleCount=0), drillHole(deletable=false, autoDelete=false, recycleCount=0)));
+    skillSet(referenceDrillBush(deletable=false, autoDelete=false, recycleCount=0, outputParameterSet(result=0), lastTransition=""), drillHole(deletable=false, autoDelete=false, recycleCount=0, outputParameterSet(result=0), lastTransition="")));
   annotation (
     Documentation(info="<html><p>The template drilling cell for the vertical tail plane: its process skills in SkillSet.</p><p>The instance DrillingCell of DrillingProcess:DrillingCellType (nsu=http://nodeset-compiler.dev/DrillingProcess/;i=4000).</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

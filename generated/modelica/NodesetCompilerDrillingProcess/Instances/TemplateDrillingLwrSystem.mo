@@ -5,7 +5,7 @@ model TemplateDrillingLwrSystem "TemplateDrillingLwrSystem: The mobile lightweig
   extends NodesetCompilerRobotCell.ObjectTypes.TemplateDrillingLwrSystemType(
     redeclare model MotionDeviceSystem = NodesetCompilerDrillingProcess.Declarations.TemplateDrillingLwrSystem_MotionDeviceSystem,
     motionDeviceSystem(redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType, redeclare model Controllers = NodesetCompilerRobotCell.Declarations.UR10eSystemType_Controllers, redeclare model MotionDevices = NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevices, redeclare model SafetyStates = NodesetCompilerRobotCell.Declarations.UR10eSystemType_SafetyStates),
-    drillingEndEffector(skillSet(templateDrilling(deletable=false, autoDelete=false, recycleCount=0))));
+    drillingEndEffector(skillSet(templateDrilling(deletable=false, autoDelete=false, recycleCount=0, outputParameterSet(result=0), lastTransition=""))));
   annotation (
     Documentation(info="<html><p>The mobile lightweight robot system of the cell: a UR10e carrying the drilling end effector.</p><p>The instance DeviceSet/TemplateDrillingLwrSystem of RobotCell:TemplateDrillingLwrSystemType (nsu=http://nodeset-compiler.dev/DrillingProcess/;i=5000).</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

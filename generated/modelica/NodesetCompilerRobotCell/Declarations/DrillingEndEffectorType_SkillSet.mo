@@ -3,7 +3,7 @@
 within NodesetCompilerRobotCell.Declarations;
 model DrillingEndEffectorType_SkillSet "SkillSet: The skills of the end effector (ISkillSetType): TemplateDrilling."
   extends OpcUa.ObjectTypes.FolderType;
-  replaceable model TemplateDrilling = NodesetCompilerRobotCell.ObjectTypes.TemplateDrillingSkillType
+  replaceable model TemplateDrilling = NodesetCompilerRobotCell.Complete.TemplateDrillingSkillType constrainedby NodesetCompilerRobotCell.ObjectTypes.TemplateDrillingSkillType
     "Class of TemplateDrilling; redeclare it to use a model of your own";
   TemplateDrilling templateDrilling(
       redeclare model InputParameterSet = NodesetCompilerRobotCell.Declarations.TemplateDrillingSkillType_InputParameterSet,

@@ -3,21 +3,21 @@
 within NodesetCompilerRobotCell.Declarations;
 model TemplateDrillingSkillType_InputParameterSet "InputParameterSet: The drilling parameters: HoleDiameter, Depth, FeedRate, SpindleSpeed and ClampForce."
   extends OpcUa.ObjectTypes.BaseObjectType;
-  OpcUaSupport.RealInput holeDiameter(unit="m", displayUnit="mm", quantity="Length") = 0
+  OpcUaSupport.RealOutput holeDiameter(unit="m", displayUnit="mm", quantity="Length") = 0
     "HoleDiameter: Nominal diameter of the hole, in millimetres; selects and checks the drill."
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="HoleDiameter", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=1002", dataType="i=11", engineeringUnit="MMT", siFactor=0.001));
-  OpcUaSupport.RealInput depth(unit="m", displayUnit="mm", quantity="Length") = 0
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="HoleDiameter", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=1002", dataType="i=11", engineeringUnit="MMT", siFactor=0.001));
+  OpcUaSupport.RealOutput depth(unit="m", displayUnit="mm", quantity="Length") = 0
     "Depth: Depth to drill, in millimetres, measured from the face of the drill bush."
-    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="Depth", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=1004", dataType="i=11", engineeringUnit="MMT", siFactor=0.001));
-  OpcUaSupport.RealInput feedRate = 0
+    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="Depth", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=1004", dataType="i=11", engineeringUnit="MMT", siFactor=0.001));
+  OpcUaSupport.RealOutput feedRate = 0
     "FeedRate: Feed of the drill along its axis, in millimetres per minute. [unit mm/min (UnitId 4732977): no Modelica unit]"
-    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="FeedRate", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=1006", dataType="i=11"));
-  OpcUaSupport.RealInput spindleSpeed = 0
+    annotation (Placement(transformation(extent={{100,30},{120,50}})), __OPCUA(browsePath="FeedRate", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=1006", dataType="i=11"));
+  OpcUaSupport.RealOutput spindleSpeed = 0
     "SpindleSpeed: Rotational speed of the spindle, in revolutions per minute. [unit r/min (UnitId 5394509): no Modelica unit]"
-    annotation (Placement(transformation(extent={{-120,10},{-100,30}})), __OPCUA(browsePath="SpindleSpeed", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=1008", dataType="i=11"));
-  OpcUaSupport.RealInput clampForce(unit="N", quantity="Force") = 0
+    annotation (Placement(transformation(extent={{100,10},{120,30}})), __OPCUA(browsePath="SpindleSpeed", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=1008", dataType="i=11"));
+  OpcUaSupport.RealOutput clampForce(unit="N", quantity="Force") = 0
     "ClampForce: Force the nose clamps the stack against the template with, in newtons."
-    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="ClampForce", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=1010", dataType="i=11", engineeringUnit="NEW"));
+    annotation (Placement(transformation(extent={{100,-10},{120,10}})), __OPCUA(browsePath="ClampForce", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=1010", dataType="i=11", engineeringUnit="NEW"));
   annotation (
     Documentation(info="<html><p>The drilling parameters: HoleDiameter, Depth, FeedRate, SpindleSpeed and ClampForce.</p><p>The class of <code>InputParameterSet</code> in RobotCell:TemplateDrillingSkillType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

@@ -3,7 +3,7 @@
 within NodesetCompilerRobotCell.Declarations;
 model UR10eSystemType_Controllers "Controllers: The controller of the UR10e."
   extends OpcUaRobotics.Declarations.MotionDeviceSystemType_Controllers;
-  replaceable model URController = NodesetCompilerRobotCell.Declarations.UR10eSystemType_ControllersURController
+  replaceable model URController = NodesetCompilerRobotCell.Complete.UR10eSystemType_ControllersURController constrainedby NodesetCompilerRobotCell.Declarations.UR10eSystemType_ControllersURController
     "Class of URController; redeclare it to use a model of your own";
   URController urController(
       redeclare model ParameterSet = OpcUaRobotics.Declarations.ControllerType_ParameterSet,

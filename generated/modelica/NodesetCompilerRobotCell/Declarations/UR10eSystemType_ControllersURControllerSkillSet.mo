@@ -3,21 +3,21 @@
 within NodesetCompilerRobotCell.Declarations;
 model UR10eSystemType_ControllersURControllerSkillSet "SkillSet: The basic move skills of the UR10e (ISkillSetType): AbsoluteJointPTPMove, RelativeCartesianLinearMove and AbsoluteCartesianLinearMove."
   extends OpcUa.ObjectTypes.FolderType;
-  replaceable model AbsoluteJointPTPMove = NodesetCompilerCommonSkills.ObjectTypes.AbsoluteJointPTPMoveSkillType
+  replaceable model AbsoluteJointPTPMove = NodesetCompilerCommonSkills.Complete.AbsoluteJointPTPMoveSkillType constrainedby NodesetCompilerCommonSkills.ObjectTypes.AbsoluteJointPTPMoveSkillType
     "Class of AbsoluteJointPTPMove; redeclare it to use a model of your own";
   AbsoluteJointPTPMove absoluteJointPTPMove(
       redeclare model InputParameterSet = NodesetCompilerCommonSkills.Declarations.AbsoluteJointPTPMoveSkillType_InputParameterSet,
       redeclare model OutputParameterSet = NodesetCompilerCommonSkills.Declarations.ProgramSkillStateMachineType_OutputParameterSet)
     "AbsoluteJointPTPMove: Moves the six joints point to point to TargetJointPositions."
     annotation (__OPCUA(browsePath="AbsoluteJointPTPMove", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4021", typeDefinition="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1600"));
-  replaceable model RelativeCartesianLinearMove = NodesetCompilerCommonSkills.ObjectTypes.RelativeCartesianLinearMoveSkillType
+  replaceable model RelativeCartesianLinearMove = NodesetCompilerCommonSkills.Complete.RelativeCartesianLinearMoveSkillType constrainedby NodesetCompilerCommonSkills.ObjectTypes.RelativeCartesianLinearMoveSkillType
     "Class of RelativeCartesianLinearMove; redeclare it to use a model of your own";
   RelativeCartesianLinearMove relativeCartesianLinearMove(
       redeclare model InputParameterSet = NodesetCompilerCommonSkills.Declarations.RelativeCartesianLinearMoveSkillType_InputParameterSet,
       redeclare model OutputParameterSet = NodesetCompilerCommonSkills.Declarations.ProgramSkillStateMachineType_OutputParameterSet)
     "RelativeCartesianLinearMove: Moves the tool centre point on a straight line by PoseOffset in the tool frame."
     annotation (__OPCUA(browsePath="RelativeCartesianLinearMove", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4044", typeDefinition="nsu=http://nodeset-compiler.dev/CommonSkills/;i=1700"));
-  replaceable model AbsoluteCartesianLinearMove = NodesetCompilerCommonSkills.ObjectTypes.AbsoluteCartesianLinearMoveSkillType
+  replaceable model AbsoluteCartesianLinearMove = NodesetCompilerCommonSkills.Complete.AbsoluteCartesianLinearMoveSkillType constrainedby NodesetCompilerCommonSkills.ObjectTypes.AbsoluteCartesianLinearMoveSkillType
     "Class of AbsoluteCartesianLinearMove; redeclare it to use a model of your own";
   AbsoluteCartesianLinearMove absoluteCartesianLinearMove(
       redeclare model InputParameterSet = NodesetCompilerCommonSkills.Declarations.AbsoluteCartesianLinearMoveSkillType_InputParameterSet,

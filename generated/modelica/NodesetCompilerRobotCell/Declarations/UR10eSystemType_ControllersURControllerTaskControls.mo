@@ -3,7 +3,7 @@
 within NodesetCompilerRobotCell.Declarations;
 model UR10eSystemType_ControllersURControllerTaskControls "TaskControls: The program task of the controller."
   extends OpcUaRobotics.Declarations.ControllerType_TaskControls;
-  replaceable model ProgramTask = OpcUaRobotics.ObjectTypes.TaskControlType
+  replaceable model ProgramTask = OpcUaRobotics.Complete.TaskControlType constrainedby OpcUaRobotics.ObjectTypes.TaskControlType
     "Class of ProgramTask; redeclare it to use a model of your own";
   ProgramTask programTask(redeclare model ParameterSet = OpcUaRobotics.Declarations.TaskControlType_ParameterSet)
     "ProgramTask: The one program task of the controller; the skills run through it."

@@ -3,7 +3,7 @@
 within NodesetCompilerRobotCell.Declarations;
 model UR10eSystemType_MotionDevices "MotionDevices: The arm of the UR10e."
   extends OpcUaRobotics.Declarations.MotionDeviceSystemType_MotionDevices;
-  replaceable model Manipulator = NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulator
+  replaceable model Manipulator = NodesetCompilerRobotCell.Complete.UR10eSystemType_MotionDevicesManipulator constrainedby NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulator
     "Class of Manipulator; redeclare it to use a model of your own";
   Manipulator manipulator(
       redeclare model ParameterSet = OpcUaRobotics.Declarations.MotionDeviceType_ParameterSet,

@@ -3,7 +3,7 @@
 within NodesetCompilerRobotCell.Declarations;
 model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the arm."
   extends OpcUaRobotics.Declarations.MotionDeviceType_Axes;
-  replaceable model Base = OpcUaRobotics.ObjectTypes.AxisType
+  replaceable model Base = OpcUaRobotics.Complete.AxisType constrainedby OpcUaRobotics.ObjectTypes.AxisType
     "Class of Base; redeclare it to use a model of your own";
   Base base(
       redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
@@ -11,7 +11,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Base: Joint 1 of the UR10e (base), rotary, limited to ±360°."
     annotation (__OPCUA(browsePath="Base", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4117", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
-  replaceable model Shoulder = OpcUaRobotics.ObjectTypes.AxisType
+  replaceable model Shoulder = OpcUaRobotics.Complete.AxisType constrainedby OpcUaRobotics.ObjectTypes.AxisType
     "Class of Shoulder; redeclare it to use a model of your own";
   Shoulder shoulder(
       redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
@@ -19,7 +19,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Shoulder: Joint 2 of the UR10e (shoulder), rotary, limited to ±360°."
     annotation (__OPCUA(browsePath="Shoulder", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4122", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
-  replaceable model Elbow = OpcUaRobotics.ObjectTypes.AxisType
+  replaceable model Elbow = OpcUaRobotics.Complete.AxisType constrainedby OpcUaRobotics.ObjectTypes.AxisType
     "Class of Elbow; redeclare it to use a model of your own";
   Elbow elbow(
       redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
@@ -27,7 +27,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Elbow: Joint 3 of the UR10e (elbow), rotary, limited to ±360°."
     annotation (__OPCUA(browsePath="Elbow", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4127", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
-  replaceable model Wrist1 = OpcUaRobotics.ObjectTypes.AxisType
+  replaceable model Wrist1 = OpcUaRobotics.Complete.AxisType constrainedby OpcUaRobotics.ObjectTypes.AxisType
     "Class of Wrist1; redeclare it to use a model of your own";
   Wrist1 wrist1(
       redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
@@ -35,7 +35,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Wrist1: Joint 4 of the UR10e (wrist 1), rotary, limited to ±360°."
     annotation (__OPCUA(browsePath="Wrist1", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4132", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
-  replaceable model Wrist2 = OpcUaRobotics.ObjectTypes.AxisType
+  replaceable model Wrist2 = OpcUaRobotics.Complete.AxisType constrainedby OpcUaRobotics.ObjectTypes.AxisType
     "Class of Wrist2; redeclare it to use a model of your own";
   Wrist2 wrist2(
       redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,
@@ -43,7 +43,7 @@ model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the 
       motionProfile=OpcUaRobotics.Types.AxisMotionProfileEnumeration.ROTARY)
     "Wrist2: Joint 5 of the UR10e (wrist 2), rotary, limited to ±360°."
     annotation (__OPCUA(browsePath="Wrist2", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4137", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
-  replaceable model Wrist3 = OpcUaRobotics.ObjectTypes.AxisType
+  replaceable model Wrist3 = OpcUaRobotics.Complete.AxisType constrainedby OpcUaRobotics.ObjectTypes.AxisType
     "Class of Wrist3; redeclare it to use a model of your own";
   Wrist3 wrist3(
       redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet,

@@ -3,32 +3,32 @@
 within NodesetCompilerRobotCell.Declarations;
 model UR10eSystemType_MotionDevicesManipulatorPowerTrains "PowerTrains: The six drive trains of the arm, one per joint."
   extends OpcUaRobotics.Declarations.MotionDeviceType_PowerTrains;
-  replaceable model BaseDrive = NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrainsBaseDrive
+  replaceable model BaseDrive = NodesetCompilerRobotCell.Complete.UR10eSystemType_MotionDevicesManipulatorPowerTrainsBaseDrive constrainedby NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrainsBaseDrive
     "Class of BaseDrive; redeclare it to use a model of your own";
   BaseDrive baseDrive(redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
     "BaseDrive: Drive train of the Base joint: its motor and gear."
     annotation (__OPCUA(browsePath="BaseDrive", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4149", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16794"));
-  replaceable model ShoulderDrive = NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrainsShoulderDrive
+  replaceable model ShoulderDrive = NodesetCompilerRobotCell.Complete.UR10eSystemType_MotionDevicesManipulatorPowerTrainsShoulderDrive constrainedby NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrainsShoulderDrive
     "Class of ShoulderDrive; redeclare it to use a model of your own";
   ShoulderDrive shoulderDrive(redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
     "ShoulderDrive: Drive train of the Shoulder joint: its motor and gear."
     annotation (__OPCUA(browsePath="ShoulderDrive", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4158", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16794"));
-  replaceable model ElbowDrive = NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrainsElbowDrive
+  replaceable model ElbowDrive = NodesetCompilerRobotCell.Complete.UR10eSystemType_MotionDevicesManipulatorPowerTrainsElbowDrive constrainedby NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrainsElbowDrive
     "Class of ElbowDrive; redeclare it to use a model of your own";
   ElbowDrive elbowDrive(redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
     "ElbowDrive: Drive train of the Elbow joint: its motor and gear."
     annotation (__OPCUA(browsePath="ElbowDrive", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4167", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16794"));
-  replaceable model Wrist1Drive = NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrainsWrist1Drive
+  replaceable model Wrist1Drive = NodesetCompilerRobotCell.Complete.UR10eSystemType_MotionDevicesManipulatorPowerTrainsWrist1Drive constrainedby NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrainsWrist1Drive
     "Class of Wrist1Drive; redeclare it to use a model of your own";
   Wrist1Drive wrist1Drive(redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
     "Wrist1Drive: Drive train of the Wrist1 joint: its motor and gear."
     annotation (__OPCUA(browsePath="Wrist1Drive", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4176", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16794"));
-  replaceable model Wrist2Drive = NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrainsWrist2Drive
+  replaceable model Wrist2Drive = NodesetCompilerRobotCell.Complete.UR10eSystemType_MotionDevicesManipulatorPowerTrainsWrist2Drive constrainedby NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrainsWrist2Drive
     "Class of Wrist2Drive; redeclare it to use a model of your own";
   Wrist2Drive wrist2Drive(redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
     "Wrist2Drive: Drive train of the Wrist2 joint: its motor and gear."
     annotation (__OPCUA(browsePath="Wrist2Drive", nodeId="nsu=http://nodeset-compiler.dev/RobotCell/;i=4185", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16794"));
-  replaceable model Wrist3Drive = NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrainsWrist3Drive
+  replaceable model Wrist3Drive = NodesetCompilerRobotCell.Complete.UR10eSystemType_MotionDevicesManipulatorPowerTrainsWrist3Drive constrainedby NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrainsWrist3Drive
     "Class of Wrist3Drive; redeclare it to use a model of your own";
   Wrist3Drive wrist3Drive(redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
     "Wrist3Drive: Drive train of the Wrist3 joint: its motor and gear."

@@ -3,7 +3,7 @@
 within NodesetCompilerRobotCell.Declarations;
 model UR10eSystemType_SafetyStates "SafetyStates: The safety state of the UR10e."
   extends OpcUaRobotics.Declarations.MotionDeviceSystemType_SafetyStates;
-  replaceable model SafetyState = OpcUaRobotics.ObjectTypes.SafetyStateType
+  replaceable model SafetyState = OpcUaRobotics.Complete.SafetyStateType constrainedby OpcUaRobotics.ObjectTypes.SafetyStateType
     "Class of SafetyState; redeclare it to use a model of your own";
   SafetyState safetyState(redeclare model ParameterSet = OpcUaRobotics.Declarations.SafetyStateType_ParameterSet)
     "SafetyState: Emergency stop, protective stop and operational mode of the UR10e."

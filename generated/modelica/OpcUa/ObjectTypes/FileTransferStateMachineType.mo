@@ -29,31 +29,31 @@ model FileTransferStateMachineType "FileTransferStateMachineType"
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput idleToReadPrepare = false
     "IdleToReadPrepare: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="IdleToReadPrepare", nodeId="i=15825", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="IdleToReadPrepare", nodeId="i=15825", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput readPrepareToReadTransfer = false
     "ReadPrepareToReadTransfer: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="ReadPrepareToReadTransfer", nodeId="i=15827", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="ReadPrepareToReadTransfer", nodeId="i=15827", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput readTransferToIdle = false
     "ReadTransferToIdle: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="ReadTransferToIdle", nodeId="i=15829", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-50},{-100,-30}})), __OPCUA(browsePath="ReadTransferToIdle", nodeId="i=15829", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput idleToApplyWrite = false
     "IdleToApplyWrite: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,10},{-100,30}})), __OPCUA(browsePath="IdleToApplyWrite", nodeId="i=15831", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-70},{-100,-50}})), __OPCUA(browsePath="IdleToApplyWrite", nodeId="i=15831", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput applyWriteToIdle = false
     "ApplyWriteToIdle: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="ApplyWriteToIdle", nodeId="i=15833", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-90},{-100,-70}})), __OPCUA(browsePath="ApplyWriteToIdle", nodeId="i=15833", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput readPrepareToError = false
     "ReadPrepareToError: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="ReadPrepareToError", nodeId="i=15835", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-110},{-100,-90}})), __OPCUA(browsePath="ReadPrepareToError", nodeId="i=15835", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput readTransferToError = false
     "ReadTransferToError: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,-50},{-100,-30}})), __OPCUA(browsePath="ReadTransferToError", nodeId="i=15837", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-130},{-100,-110}})), __OPCUA(browsePath="ReadTransferToError", nodeId="i=15837", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput applyWriteToError = false
     "ApplyWriteToError: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,-70},{-100,-50}})), __OPCUA(browsePath="ApplyWriteToError", nodeId="i=15839", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-150},{-100,-130}})), __OPCUA(browsePath="ApplyWriteToError", nodeId="i=15839", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput errorToIdle = false
     "ErrorToIdle: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,-90},{-100,-70}})), __OPCUA(browsePath="ErrorToIdle", nodeId="i=15841", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-170},{-100,-150}})), __OPCUA(browsePath="ErrorToIdle", nodeId="i=15841", typeDefinition="i=2310"));
 equation
   if stateMachineLevel == 1 then
     when idleToReadPrepare then

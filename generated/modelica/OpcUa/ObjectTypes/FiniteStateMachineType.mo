@@ -6,15 +6,15 @@ partial model FiniteStateMachineType "FiniteStateMachineType"
   parameter Boolean use_availableStates = false
     "Whether the optional AvailableStates exists"
     annotation (Evaluate=true);
-  OpcUaSupport.StringOutput availableStates[:] = fill("", 0) if use_availableStates
+  OpcUaSupport.StringInput availableStates[:] = fill("", 0) if use_availableStates
     "AvailableStates"
-    annotation (Placement(transformation(extent={{100,30},{120,50}})), __OPCUA(browsePath="AvailableStates", nodeId="i=17635", dataType="i=17"));
+    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="AvailableStates", nodeId="i=17635", dataType="i=17"));
   parameter Boolean use_availableTransitions = false
     "Whether the optional AvailableTransitions exists"
     annotation (Evaluate=true);
-  OpcUaSupport.StringOutput availableTransitions[:] = fill("", 0) if use_availableTransitions
+  OpcUaSupport.StringInput availableTransitions[:] = fill("", 0) if use_availableTransitions
     "AvailableTransitions"
-    annotation (Placement(transformation(extent={{100,10},{120,30}})), __OPCUA(browsePath="AvailableTransitions", nodeId="i=17636", dataType="i=17"));
+    annotation (Placement(transformation(extent={{-120,10},{-100,30}})), __OPCUA(browsePath="AvailableTransitions", nodeId="i=17636", dataType="i=17"));
   annotation (
     Documentation(info="<html><p>The ObjectType <code>FiniteStateMachineType</code> (i=2771), a subtype of <code>StateMachineType</code>. The information model gives it no description.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

@@ -15,7 +15,7 @@ model ProgramStateMachineType "ProgramStateMachineType"
   parameter Boolean use_programDiagnostic = false
     "Whether the optional ProgramDiagnostic exists"
     annotation (Evaluate=true);
-  output OpcUa.Types.ProgramDiagnostic2DataType programDiagnostic = OpcUa.Types.ProgramDiagnostic2DataType() if use_programDiagnostic
+  input OpcUa.Types.ProgramDiagnostic2DataType programDiagnostic = OpcUa.Types.ProgramDiagnostic2DataType() if use_programDiagnostic
     "ProgramDiagnostic"
     annotation (__OPCUA(browsePath="ProgramDiagnostic", nodeId="i=2399", dataType="i=24033"));
   parameter Boolean use_finalResultData = false
@@ -53,22 +53,22 @@ model ProgramStateMachineType "ProgramStateMachineType"
     "Number of the current state (CurrentState/Number); the nodeset marks no initial state, and a Program ready upon creation starts in Ready (OPC 10000-10, 5.2.3.2)";
   OpcUaSupport.BooleanInput reset = false
     "Reset: a rising edge stands for a call of the method Reset"
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="Reset", nodeId="i=2430"));
+    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="Reset", nodeId="i=2430"));
   OpcUaSupport.BooleanInput start = false
     "Start: a rising edge stands for a call of the method Start"
-    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="Start", nodeId="i=2426"));
+    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="Start", nodeId="i=2426"));
   OpcUaSupport.BooleanInput halt = false
     "Halt: a rising edge stands for a call of the method Halt"
-    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="Halt", nodeId="i=2429"));
+    annotation (Placement(transformation(extent={{-120,-50},{-100,-30}})), __OPCUA(browsePath="Halt", nodeId="i=2429"));
   OpcUaSupport.BooleanInput runningToReady = false
     "RunningToReady: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,10},{-100,30}})), __OPCUA(browsePath="RunningToReady", nodeId="i=2414", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-70},{-100,-50}})), __OPCUA(browsePath="RunningToReady", nodeId="i=2414", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput suspend = false
     "Suspend: a rising edge stands for a call of the method Suspend"
-    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="Suspend", nodeId="i=2427"));
+    annotation (Placement(transformation(extent={{-120,-90},{-100,-70}})), __OPCUA(browsePath="Suspend", nodeId="i=2427"));
   OpcUaSupport.BooleanInput resume = false
     "Resume: a rising edge stands for a call of the method Resume"
-    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="Resume", nodeId="i=2428"));
+    annotation (Placement(transformation(extent={{-120,-110},{-100,-90}})), __OPCUA(browsePath="Resume", nodeId="i=2428"));
   // Reset leads from Suspended both to Halted and, through SuspendedToReady, to Ready; the first transition is taken.
 equation
   if stateMachineLevel == 1 then

@@ -3,15 +3,15 @@
 within OpcUa.ObjectTypes;
 model StateMachineType "StateMachineType"
   extends OpcUa.ObjectTypes.BaseObjectType;
-  OpcUaSupport.StringOutput currentState = ""
+  OpcUaSupport.StringInput currentState
     "CurrentState"
-    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="CurrentState", nodeId="i=2769", dataType="i=21"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="CurrentState", nodeId="i=2769", dataType="i=21"));
   parameter Boolean use_lastTransition = false
     "Whether the optional LastTransition exists"
     annotation (Evaluate=true);
-  OpcUaSupport.StringOutput lastTransition = "" if use_lastTransition
+  OpcUaSupport.StringInput lastTransition if use_lastTransition
     "LastTransition"
-    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="LastTransition", nodeId="i=2770", dataType="i=21"));
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="LastTransition", nodeId="i=2770", dataType="i=21"));
   annotation (
     Documentation(info="<html><p>The ObjectType <code>StateMachineType</code> (i=2299), a subtype of <code>BaseObjectType</code>. The information model gives it no description.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

@@ -4,9 +4,9 @@ within OpcUaDI.ObjectTypes;
 model ConfirmationStateMachineType "ConfirmationStateMachineType"
   extends OpcUa.ObjectTypes.FiniteStateMachineType(final currentState=currentStateText);
   // Method Confirm(): call it through an OPC UA client.
-  OpcUaSupport.RealOutput confirmationTimeout = 0
+  OpcUaSupport.RealInput confirmationTimeout
     "ConfirmationTimeout"
-    annotation (Placement(transformation(extent={{100,-10},{120,10}})), __OPCUA(browsePath="ConfirmationTimeout", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=322", dataType="i=290"));
+    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="ConfirmationTimeout", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=322", dataType="i=290"));
   // State machine of ConfirmationStateMachineType: its states, and transitions driven by the trigger inputs.
   parameter Integer stateMachineLevel = 1
     "Which class drives the state machine: a subclass that adds states sets its own level"
@@ -23,10 +23,10 @@ model ConfirmationStateMachineType "ConfirmationStateMachineType"
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput notWaitingForConfirmToWaitingForConfirm = false
     "NotWaitingForConfirmToWaitingForConfirm: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="NotWaitingForConfirmToWaitingForConfirm", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=327", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="NotWaitingForConfirmToWaitingForConfirm", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=327", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput confirm = false
     "Confirm: a rising edge stands for a call of the method Confirm"
-    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="Confirm", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=321"));
+    annotation (Placement(transformation(extent={{-120,-50},{-100,-30}})), __OPCUA(browsePath="Confirm", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=321"));
 equation
   if stateMachineLevel == 1 then
     when notWaitingForConfirmToWaitingForConfirm then

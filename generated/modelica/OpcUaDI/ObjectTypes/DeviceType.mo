@@ -22,7 +22,7 @@ partial model DeviceType "DeviceType"
   parameter Boolean use_deviceHealth = false
     "Whether the optional DeviceHealth exists"
     annotation (Evaluate=true);
-  output OpcUaDI.Types.DeviceHealthEnumeration deviceHealth = OpcUaDI.Types.DeviceHealthEnumeration.NORMAL if use_deviceHealth
+  input OpcUaDI.Types.DeviceHealthEnumeration deviceHealth = OpcUaDI.Types.DeviceHealthEnumeration.NORMAL if use_deviceHealth
     "DeviceHealth"
     annotation (__OPCUA(browsePath="DeviceHealth", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6208", dataType="nsu=http://opcfoundation.org/UA/DI/;i=6244"));
   parameter Boolean use_deviceHealthAlarms = false

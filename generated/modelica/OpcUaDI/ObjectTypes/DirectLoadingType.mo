@@ -3,7 +3,7 @@
 within OpcUaDI.ObjectTypes;
 model DirectLoadingType "DirectLoadingType"
   extends OpcUaDI.ObjectTypes.PackageLoadingType;
-  output OpcUaDI.Types.UpdateBehavior updateBehavior = OpcUaDI.Types.UpdateBehavior()
+  input OpcUaDI.Types.UpdateBehavior updateBehavior = OpcUaDI.Types.UpdateBehavior()
     "UpdateBehavior"
     annotation (__OPCUA(browsePath="UpdateBehavior", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=169", dataType="nsu=http://opcfoundation.org/UA/DI/;i=333"));
   parameter Boolean use_writeTimeout = false

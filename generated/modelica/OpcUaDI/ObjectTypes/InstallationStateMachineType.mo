@@ -6,15 +6,15 @@ model InstallationStateMachineType "InstallationStateMachineType"
   parameter Boolean use_percentComplete = false
     "Whether the optional PercentComplete exists"
     annotation (Evaluate=true);
-  OpcUaSupport.IntegerOutput percentComplete(min=0, max=255) = 0 if use_percentComplete
+  OpcUaSupport.IntegerInput percentComplete(min=0, max=255) if use_percentComplete
     "PercentComplete"
-    annotation (Placement(transformation(extent={{100,-10},{120,10}})), __OPCUA(browsePath="PercentComplete", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=263", dataType="i=3"));
+    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="PercentComplete", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=263", dataType="i=3"));
   parameter Boolean use_installationDelay = false
     "Whether the optional InstallationDelay exists"
     annotation (Evaluate=true);
-  OpcUaSupport.RealOutput installationDelay = 0 if use_installationDelay
+  OpcUaSupport.RealInput installationDelay if use_installationDelay
     "InstallationDelay"
-    annotation (Placement(transformation(extent={{100,-30},{120,-10}})), __OPCUA(browsePath="InstallationDelay", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=264", dataType="i=290"));
+    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="InstallationDelay", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=264", dataType="i=290"));
   // Method InstallSoftwarePackage(String ManufacturerUri, String SoftwareRevision, String[] PatchIdentifiers, ByteString Hash): call it through an OPC UA client.
   // Method InstallFiles(NodeId[] NodeIds): call it through an OPC UA client.
   // Method Uninstall(): call it through an OPC UA client.
@@ -38,22 +38,22 @@ model InstallationStateMachineType "InstallationStateMachineType"
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput installSoftwarePackage = false
     "InstallSoftwarePackage: a rising edge stands for a call of the method InstallSoftwarePackage"
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="InstallSoftwarePackage", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=265"));
+    annotation (Placement(transformation(extent={{-120,-50},{-100,-30}})), __OPCUA(browsePath="InstallSoftwarePackage", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=265"));
   OpcUaSupport.BooleanInput installFiles = false
     "InstallFiles: a rising edge stands for a call of the method InstallFiles"
-    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="InstallFiles", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=268"));
+    annotation (Placement(transformation(extent={{-120,-70},{-100,-50}})), __OPCUA(browsePath="InstallFiles", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=268"));
   OpcUaSupport.BooleanInput uninstall = false
     "Uninstall: a rising edge stands for a call of the method Uninstall"
-    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="Uninstall", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=407"));
+    annotation (Placement(transformation(extent={{-120,-90},{-100,-70}})), __OPCUA(browsePath="Uninstall", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=407"));
   OpcUaSupport.BooleanInput installingToIdle = false
     "InstallingToIdle: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,10},{-100,30}})), __OPCUA(browsePath="InstallingToIdle", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=279", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-110},{-100,-90}})), __OPCUA(browsePath="InstallingToIdle", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=279", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput installingToError = false
     "InstallingToError: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="InstallingToError", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=281", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-130},{-100,-110}})), __OPCUA(browsePath="InstallingToError", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=281", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput resume = false
     "Resume: a rising edge stands for a call of the method Resume"
-    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="Resume", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=270"));
+    annotation (Placement(transformation(extent={{-120,-150},{-100,-130}})), __OPCUA(browsePath="Resume", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=270"));
 equation
   if stateMachineLevel == 1 then
     when installSoftwarePackage then

@@ -8,14 +8,14 @@ partial model PackageLoadingType "PackageLoadingType"
   CurrentVersion currentVersion
     "CurrentVersion"
     annotation (__OPCUA(browsePath="CurrentVersion", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=139", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=212"));
-  replaceable model FileTransfer = OpcUa.ObjectTypes.TemporaryFileTransferType
+  replaceable model FileTransfer = OpcUa.Complete.TemporaryFileTransferType constrainedby OpcUa.ObjectTypes.TemporaryFileTransferType
     "Class of FileTransfer; redeclare it to use a model of your own";
   FileTransfer fileTransfer
     "FileTransfer"
     annotation (__OPCUA(browsePath="FileTransfer", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=140", typeDefinition="i=15744"));
-  OpcUaSupport.StringOutput errorMessage = ""
+  OpcUaSupport.StringInput errorMessage
     "ErrorMessage"
-    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="ErrorMessage", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=151", dataType="i=21"));
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="ErrorMessage", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=151", dataType="i=21"));
   parameter Boolean use_writeBlockSize = false
     "Whether the optional WriteBlockSize exists"
     annotation (Evaluate=true);

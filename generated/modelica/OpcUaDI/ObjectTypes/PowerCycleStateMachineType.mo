@@ -19,10 +19,10 @@ model PowerCycleStateMachineType "PowerCycleStateMachineType"
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput notWaitingForPowerCycleToWaitingForPowerCycle = false
     "NotWaitingForPowerCycleToWaitingForPowerCycle: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="NotWaitingForPowerCycleToWaitingForPowerCycle", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=303", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="NotWaitingForPowerCycleToWaitingForPowerCycle", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=303", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput waitingForPowerCycleToNotWaitingForPowerCycle = false
     "WaitingForPowerCycleToNotWaitingForPowerCycle: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="WaitingForPowerCycleToNotWaitingForPowerCycle", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=305", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="WaitingForPowerCycleToNotWaitingForPowerCycle", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=305", typeDefinition="i=2310"));
 equation
   if stateMachineLevel == 1 then
     when notWaitingForPowerCycleToWaitingForPowerCycle then

@@ -6,9 +6,9 @@ model PrepareForUpdateStateMachineType "PrepareForUpdateStateMachineType"
   parameter Boolean use_percentComplete = false
     "Whether the optional PercentComplete exists"
     annotation (Evaluate=true);
-  OpcUaSupport.IntegerOutput percentComplete(min=0, max=255) = 0 if use_percentComplete
+  OpcUaSupport.IntegerInput percentComplete(min=0, max=255) if use_percentComplete
     "PercentComplete"
-    annotation (Placement(transformation(extent={{100,-10},{120,10}})), __OPCUA(browsePath="PercentComplete", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=227", dataType="i=3"));
+    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="PercentComplete", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=227", dataType="i=3"));
   // Method Prepare(): call it through an OPC UA client.
   // Method Abort(): call it through an OPC UA client.
   // Method Resume(): call it through an OPC UA client.
@@ -34,16 +34,16 @@ model PrepareForUpdateStateMachineType "PrepareForUpdateStateMachineType"
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput prepare = false
     "Prepare: a rising edge stands for a call of the method Prepare"
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="Prepare", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=228"));
+    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="Prepare", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=228"));
   OpcUaSupport.BooleanInput abort = false
     "Abort: a rising edge stands for a call of the method Abort"
-    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="Abort", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=229"));
+    annotation (Placement(transformation(extent={{-120,-50},{-100,-30}})), __OPCUA(browsePath="Abort", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=229"));
   OpcUaSupport.BooleanInput preparingToPreparedForUpdate = false
     "PreparingToPreparedForUpdate: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="PreparingToPreparedForUpdate", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=243", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-70},{-100,-50}})), __OPCUA(browsePath="PreparingToPreparedForUpdate", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=243", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput resume = false
     "Resume: a rising edge stands for a call of the method Resume"
-    annotation (Placement(transformation(extent={{-120,10},{-100,30}})), __OPCUA(browsePath="Resume", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=230"));
+    annotation (Placement(transformation(extent={{-120,-90},{-100,-70}})), __OPCUA(browsePath="Resume", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=230"));
 equation
   if stateMachineLevel == 1 then
     when prepare then

@@ -6,9 +6,9 @@ partial model SoftwareLoadingType "SoftwareLoadingType"
   parameter Boolean use_updateKey = false
     "Whether the optional UpdateKey exists"
     annotation (Evaluate=true);
-  OpcUaSupport.StringOutput updateKey = "" if use_updateKey
+  OpcUaSupport.StringInput updateKey if use_updateKey
     "UpdateKey"
-    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="UpdateKey", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=136", dataType="i=12"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="UpdateKey", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=136", dataType="i=12"));
   annotation (
     Documentation(info="<html><p>The ObjectType <code>DI:SoftwareLoadingType</code> (nsu=http://opcfoundation.org/UA/DI/;i=135), a subtype of <code>BaseObjectType</code>. The information model gives it no description.</p><p>The ObjectType is abstract, so the class is partial: extend it.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

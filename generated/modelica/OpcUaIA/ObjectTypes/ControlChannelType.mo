@@ -3,16 +3,16 @@
 within OpcUaIA.ObjectTypes;
 model ControlChannelType "ControlChannelType: Used for control channels of single colour elements within a stack element (e.g. RGB elements would use three ControlChannels, one for each controllable colour)."
   extends OpcUa.ObjectTypes.BaseObjectType;
-  input OpcUaIA.Types.SignalColor channelColor = OpcUaIA.Types.SignalColor.Off
+  output OpcUaIA.Types.SignalColor channelColor = OpcUaIA.Types.SignalColor.Off
     "ChannelColor: Indicates in what mode (continuously on, blinking, flashing) the channel operates when switched on."
     annotation (__OPCUA(browsePath="ChannelColor", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6024", dataType="nsu=http://opcfoundation.org/UA/IA/;i=3004"));
   parameter Boolean use_intensity = false
     "Whether the optional Intensity exists"
     annotation (Evaluate=true);
-  OpcUaSupport.RealInput intensity = 0 if use_intensity
+  OpcUaSupport.RealOutput intensity = 0 if use_intensity
     "Intensity: Shows the channel’s intensity, thus its brightness. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent."
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="Intensity", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6026", dataType="i=10"));
-  input OpcUaIA.Types.SignalModeLight signalMode = OpcUaIA.Types.SignalModeLight.Continuous
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="Intensity", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6026", dataType="i=10"));
+  output OpcUaIA.Types.SignalModeLight signalMode = OpcUaIA.Types.SignalModeLight.Continuous
     "SignalMode: Contains a list of audio signals used by this acoustic stacklight element."
     annotation (__OPCUA(browsePath="SignalMode", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6025", dataType="nsu=http://opcfoundation.org/UA/IA/;i=3005"));
   parameter Boolean signalOn = false

@@ -12,12 +12,12 @@ model StackElementAcousticType "StackElementAcousticType: Represents an acoustic
   parameter Boolean use_intensity = false
     "Whether the optional Intensity exists"
     annotation (Evaluate=true);
-  OpcUaSupport.RealInput intensity = 0 if use_intensity
+  OpcUaSupport.RealOutput intensity = 0 if use_intensity
     "Intensity: Indicates the sound pressure level of the acoustic signal when switched on. This value shall only have positive values. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent."
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="Intensity", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6021", dataType="i=10"));
-  OpcUaSupport.IntegerInput operationMode(min=0) = 0
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="Intensity", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6021", dataType="i=10"));
+  OpcUaSupport.IntegerOutput operationMode(min=0) = 0
     "OperationMode: Indicates what signal of the list of AcousticSignalType nodes is played when the acoustic element is switched on. It shall contain an index into the NumberInList of the respective AcousticSignalType Object of AcousticSignals."
-    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="OperationMode", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6020", dataType="i=28"));
+    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="OperationMode", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6020", dataType="i=28"));
   annotation (
     Documentation(info="<html><p>Represents an acoustic element in a stacklight.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

@@ -14,25 +14,25 @@ model StackElementLightType "StackElementLightType: Represents a lamp element in
   parameter Boolean use_intensity = false
     "Whether the optional Intensity exists"
     annotation (Evaluate=true);
-  OpcUaSupport.RealInput intensity = 0 if use_intensity
+  OpcUaSupport.RealOutput intensity = 0 if use_intensity
     "Intensity: Intensity of the lamp, thus its brightness. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent."
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="Intensity", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6018", dataType="i=10"));
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="Intensity", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6018", dataType="i=10"));
   parameter Boolean use_signalColor = false
     "Whether the optional SignalColor exists"
     annotation (Evaluate=true);
-  input OpcUaIA.Types.SignalColor signalColor = OpcUaIA.Types.SignalColor.Off if use_signalColor
+  output OpcUaIA.Types.SignalColor signalColor = OpcUaIA.Types.SignalColor.Off if use_signalColor
     "SignalColor: Indicates the colour the lamp element has when switched on."
     annotation (__OPCUA(browsePath="SignalColor", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6016", dataType="nsu=http://opcfoundation.org/UA/IA/;i=3004"));
   parameter Boolean use_signalMode = false
     "Whether the optional SignalMode exists"
     annotation (Evaluate=true);
-  input OpcUaIA.Types.SignalModeLight signalMode = OpcUaIA.Types.SignalModeLight.Continuous if use_signalMode
+  output OpcUaIA.Types.SignalModeLight signalMode = OpcUaIA.Types.SignalModeLight.Continuous if use_signalMode
     "SignalMode: Shows in what way the lamp is used (continuous light, flashing, blinking) when switched on."
     annotation (__OPCUA(browsePath="SignalMode", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6017", dataType="nsu=http://opcfoundation.org/UA/IA/;i=3005"));
   parameter Boolean use_signalRGBWValue = false
     "Whether the optional SignalRGBWValue exists"
     annotation (Evaluate=true);
-  input OpcUaIA.Types.RGBWDataType signalRGBWValue = OpcUaIA.Types.RGBWDataType() if use_signalRGBWValue
+  output OpcUaIA.Types.RGBWDataType signalRGBWValue = OpcUaIA.Types.RGBWDataType() if use_signalRGBWValue
     "SignalRGBWValue"
     annotation (__OPCUA(browsePath="SignalRGBWValue", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6052", dataType="nsu=http://opcfoundation.org/UA/IA/;i=3007"));
   annotation (

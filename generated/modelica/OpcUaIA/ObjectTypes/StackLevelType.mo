@@ -3,12 +3,12 @@
 within OpcUaIA.ObjectTypes;
 model StackLevelType "StackLevelType: Contains information relevant to a stacklight operating as a level meter. The whole stack is controlled by a percentual value."
   extends OpcUa.ObjectTypes.BaseObjectType;
-  input OpcUaIA.Types.LevelDisplayMode displayMode = OpcUaIA.Types.LevelDisplayMode.Dimmed
+  output OpcUaIA.Types.LevelDisplayMode displayMode = OpcUaIA.Types.LevelDisplayMode.Dimmed
     "DisplayMode: Indicates in what way the percentual value is displayed with the stacklight."
     annotation (__OPCUA(browsePath="DisplayMode", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6012", dataType="nsu=http://opcfoundation.org/UA/IA/;i=3003"));
-  OpcUaSupport.RealInput levelPercent = 0
+  OpcUaSupport.RealOutput levelPercent = 0
     "LevelPercent: Shows the percentual value the stacklight is representing. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent."
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="LevelPercent", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6010", dataType="i=10"));
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="LevelPercent", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6010", dataType="i=10"));
   annotation (
     Documentation(info="<html><p>Contains information relevant to a stacklight operating as a level meter. The whole stack is controlled by a percentual value.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

@@ -6,7 +6,7 @@ model StacklightType "StacklightType: Entry point to a stacklight with the possi
   parameter Boolean use_deviceHealth = false
     "Whether the optional DeviceHealth exists"
     annotation (Evaluate=true);
-  input OpcUaDI.Types.DeviceHealthEnumeration deviceHealth = OpcUaDI.Types.DeviceHealthEnumeration.NORMAL if use_deviceHealth
+  output OpcUaDI.Types.DeviceHealthEnumeration deviceHealth = OpcUaDI.Types.DeviceHealthEnumeration.NORMAL if use_deviceHealth
     "DeviceHealth: Contains the health status information of the stacklight."
     annotation (__OPCUA(browsePath="DeviceHealth", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6038", dataType="nsu=http://opcfoundation.org/UA/DI/;i=6244"));
   parameter Boolean use_deviceHealthAlarms = false

@@ -6,18 +6,18 @@ model AxisType_ParameterSet "ParameterSet: Flat list of Parameters"
   parameter Boolean use_actualAcceleration = false
     "Whether the optional ActualAcceleration exists"
     annotation (Evaluate=true);
-  OpcUaSupport.RealOutput actualAcceleration = 0 if use_actualAcceleration
+  OpcUaSupport.RealInput actualAcceleration if use_actualAcceleration
     "ActualAcceleration: The ActualAcceleration variable provides the axis acceleration. Applicable acceleration limits of the axis shall be provided by the EURange property of the AnalogUnitType."
-    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="ActualAcceleration", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16674", dataType="i=11"));
-  OpcUaSupport.RealOutput actualPosition = 0
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="ActualAcceleration", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16674", dataType="i=11"));
+  OpcUaSupport.RealInput actualPosition
     "ActualPosition: The axis position inclusive Unit and RangeOfMotion."
-    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="ActualPosition", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16662", dataType="i=11"));
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="ActualPosition", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16662", dataType="i=11"));
   parameter Boolean use_actualSpeed = false
     "Whether the optional ActualSpeed exists"
     annotation (Evaluate=true);
-  OpcUaSupport.RealOutput actualSpeed = 0 if use_actualSpeed
+  OpcUaSupport.RealInput actualSpeed if use_actualSpeed
     "ActualSpeed: The axis speed on load side (after gear/spindle) inclusive Unit."
-    annotation (Placement(transformation(extent={{100,30},{120,50}})), __OPCUA(browsePath="ActualSpeed", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16668", dataType="i=11"));
+    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="ActualSpeed", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16668", dataType="i=11"));
   annotation (
     Documentation(info="<html><p>Flat list of Parameters</p><p>The class of <code>ParameterSet</code> in Robotics:AxisType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

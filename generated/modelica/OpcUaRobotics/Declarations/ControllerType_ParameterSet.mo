@@ -6,51 +6,51 @@ model ControllerType_ParameterSet "ParameterSet: Flat list of Parameters"
   parameter Boolean use_cabinetFanSpeed = false
     "Whether the optional CabinetFanSpeed exists"
     annotation (Evaluate=true);
-  OpcUaSupport.RealOutput cabinetFanSpeed = 0 if use_cabinetFanSpeed
+  OpcUaSupport.RealInput cabinetFanSpeed if use_cabinetFanSpeed
     "CabinetFanSpeed: The speed of the cabinet fan."
-    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="CabinetFanSpeed", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17365", dataType="i=11"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="CabinetFanSpeed", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17365", dataType="i=11"));
   parameter Boolean use_cpuFanSpeed = false
     "Whether the optional CPUFanSpeed exists"
     annotation (Evaluate=true);
-  OpcUaSupport.RealOutput cpuFanSpeed = 0 if use_cpuFanSpeed
+  OpcUaSupport.RealInput cpuFanSpeed if use_cpuFanSpeed
     "CPUFanSpeed: The speed of the CPU fan."
-    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="CPUFanSpeed", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17371", dataType="i=11"));
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="CPUFanSpeed", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17371", dataType="i=11"));
   parameter Boolean use_inputVoltage = false
     "Whether the optional InputVoltage exists"
     annotation (Evaluate=true);
-  OpcUaSupport.RealOutput inputVoltage = 0 if use_inputVoltage
+  OpcUaSupport.RealInput inputVoltage if use_inputVoltage
     "InputVoltage: The input voltage of the controller which can be a configured value. To distinguish between an AC or DC supply the optional property Definition of the base type DataItemType shall be used."
-    annotation (Placement(transformation(extent={{100,30},{120,50}})), __OPCUA(browsePath="InputVoltage", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17377", dataType="i=11"));
+    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="InputVoltage", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17377", dataType="i=11"));
   parameter Boolean use_startUpTime = false
     "Whether the optional StartUpTime exists"
     annotation (Evaluate=true);
-  OpcUaSupport.RealOutput startUpTime(unit="s") = 0 if use_startUpTime
+  OpcUaSupport.RealInput startUpTime(unit="s") if use_startUpTime
     "StartUpTime: The date and time of the last start-up of the controller."
-    annotation (Placement(transformation(extent={{100,10},{120,30}})), __OPCUA(browsePath="StartUpTime", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15366", dataType="i=13"));
+    annotation (Placement(transformation(extent={{-120,10},{-100,30}})), __OPCUA(browsePath="StartUpTime", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15366", dataType="i=13"));
   parameter Boolean use_temperature = false
     "Whether the optional Temperature exists"
     annotation (Evaluate=true);
-  OpcUaSupport.RealOutput temperature = 0 if use_temperature
+  OpcUaSupport.RealInput temperature if use_temperature
     "Temperature: The controller temperature given by a temperature sensor inside of the controller."
-    annotation (Placement(transformation(extent={{100,-10},{120,10}})), __OPCUA(browsePath="Temperature", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17383", dataType="i=11"));
+    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="Temperature", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17383", dataType="i=11"));
   parameter Boolean use_totalEnergyConsumption = false
     "Whether the optional TotalEnergyConsumption exists"
     annotation (Evaluate=true);
-  OpcUaSupport.RealOutput totalEnergyConsumption = 0 if use_totalEnergyConsumption
+  OpcUaSupport.RealInput totalEnergyConsumption if use_totalEnergyConsumption
     "TotalEnergyConsumption: The total accumulated energy consumed by the motion devices related with this controller instance."
-    annotation (Placement(transformation(extent={{100,-30},{120,-10}})), __OPCUA(browsePath="TotalEnergyConsumption", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17359", dataType="i=11"));
+    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="TotalEnergyConsumption", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17359", dataType="i=11"));
   parameter Boolean use_totalPowerOnTime = false
     "Whether the optional TotalPowerOnTime exists"
     annotation (Evaluate=true);
-  OpcUaSupport.StringOutput totalPowerOnTime = "" if use_totalPowerOnTime
+  OpcUaSupport.StringInput totalPowerOnTime if use_totalPowerOnTime
     "TotalPowerOnTime: The total accumulated time the controller was powered on."
-    annotation (Placement(transformation(extent={{100,-50},{120,-30}})), __OPCUA(browsePath="TotalPowerOnTime", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17358", dataType="i=12879"));
+    annotation (Placement(transformation(extent={{-120,-50},{-100,-30}})), __OPCUA(browsePath="TotalPowerOnTime", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17358", dataType="i=12879"));
   parameter Boolean use_upsState = false
     "Whether the optional UpsState exists"
     annotation (Evaluate=true);
-  OpcUaSupport.StringOutput upsState = "" if use_upsState
+  OpcUaSupport.StringInput upsState if use_upsState
     "UpsState: The vendor specific status of an integrated UPS or accumulator system."
-    annotation (Placement(transformation(extent={{100,-70},{120,-50}})), __OPCUA(browsePath="UpsState", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15365", dataType="i=12"));
+    annotation (Placement(transformation(extent={{-120,-70},{-100,-50}})), __OPCUA(browsePath="UpsState", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15365", dataType="i=12"));
   annotation (
     Documentation(info="<html><p>Flat list of Parameters</p><p>The class of <code>ParameterSet</code> in Robotics:ControllerType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

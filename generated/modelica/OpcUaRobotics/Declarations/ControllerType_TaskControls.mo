@@ -6,7 +6,7 @@ model ControllerType_TaskControls "TaskControls: TaskControls is a container for
   parameter Integer nTaskControlIdentifier(min=0) = 0
     "Number of <TaskControlIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
-  replaceable model TaskControlIdentifier = OpcUaRobotics.ObjectTypes.TaskControlType
+  replaceable model TaskControlIdentifier = OpcUaRobotics.Complete.TaskControlType constrainedby OpcUaRobotics.ObjectTypes.TaskControlType
     "Class of <TaskControlIdentifier>; redeclare it to use a model of your own";
   TaskControlIdentifier taskControlIdentifier[nTaskControlIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.TaskControlType_ParameterSet)
     "<TaskControlIdentifier>"

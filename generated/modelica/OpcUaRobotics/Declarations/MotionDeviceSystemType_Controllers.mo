@@ -6,7 +6,7 @@ model MotionDeviceSystemType_Controllers "Controllers: Contains the set of contr
   parameter Integer nControllerIdentifier(min=0) = 0
     "Number of <ControllerIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
-  replaceable model ControllerIdentifier = OpcUaRobotics.ObjectTypes.ControllerType
+  replaceable model ControllerIdentifier = OpcUaRobotics.Complete.ControllerType constrainedby OpcUaRobotics.ObjectTypes.ControllerType
     "Class of <ControllerIdentifier>; redeclare it to use a model of your own";
   ControllerIdentifier controllerIdentifier[nControllerIdentifier](
       redeclare model ParameterSet = OpcUaRobotics.Declarations.ControllerType_ParameterSet,

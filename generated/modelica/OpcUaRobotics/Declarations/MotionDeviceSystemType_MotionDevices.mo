@@ -6,7 +6,7 @@ model MotionDeviceSystemType_MotionDevices "MotionDevices: Contains any kinemati
   parameter Integer nMotionDeviceIdentifier(min=0) = 0
     "Number of <MotionDeviceIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
-  replaceable model MotionDeviceIdentifier = OpcUaRobotics.ObjectTypes.MotionDeviceType
+  replaceable model MotionDeviceIdentifier = OpcUaRobotics.Complete.MotionDeviceType constrainedby OpcUaRobotics.ObjectTypes.MotionDeviceType
     "Class of <MotionDeviceIdentifier>; redeclare it to use a model of your own";
   MotionDeviceIdentifier motionDeviceIdentifier[nMotionDeviceIdentifier](
       redeclare model ParameterSet = OpcUaRobotics.Declarations.MotionDeviceType_ParameterSet,

@@ -6,7 +6,7 @@ model MotionDeviceSystemType_SafetyStates "SafetyStates: Contains safety-related
   parameter Integer nSafetyStateIdentifier(min=0) = 0
     "Number of <SafetyStateIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
-  replaceable model SafetyStateIdentifier = OpcUaRobotics.ObjectTypes.SafetyStateType
+  replaceable model SafetyStateIdentifier = OpcUaRobotics.Complete.SafetyStateType constrainedby OpcUaRobotics.ObjectTypes.SafetyStateType
     "Class of <SafetyStateIdentifier>; redeclare it to use a model of your own";
   SafetyStateIdentifier safetyStateIdentifier[nSafetyStateIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.SafetyStateType_ParameterSet)
     "<SafetyStateIdentifier>"

@@ -6,7 +6,7 @@ model MotionDeviceType_Axes "Axes: Axes is a container for one or more instances
   parameter Integer nAxisIdentifier(min=0) = 0
     "Number of <AxisIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
-  replaceable model AxisIdentifier = OpcUaRobotics.ObjectTypes.AxisType
+  replaceable model AxisIdentifier = OpcUaRobotics.Complete.AxisType constrainedby OpcUaRobotics.ObjectTypes.AxisType
     "Class of <AxisIdentifier>; redeclare it to use a model of your own";
   AxisIdentifier axisIdentifier[nAxisIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet)
     "<AxisIdentifier>"

@@ -6,18 +6,18 @@ model MotionDeviceType_ParameterSet "ParameterSet: Flat list of Parameters"
   parameter Boolean use_inControl = false
     "Whether the optional InControl exists"
     annotation (Evaluate=true);
-  OpcUaSupport.BooleanOutput inControl = false if use_inControl
+  OpcUaSupport.BooleanInput inControl if use_inControl
     "InControl: InControl provides the information if the actuators (in most cases a motor) of the motion device are powered up and in control: \"true\". The motion device might be in a standstill."
-    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="InControl", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16364", dataType="i=1"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="InControl", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16364", dataType="i=1"));
   parameter Boolean use_onPath = false
     "Whether the optional OnPath exists"
     annotation (Evaluate=true);
-  OpcUaSupport.BooleanOutput onPath = false if use_onPath
+  OpcUaSupport.BooleanInput onPath if use_onPath
     "OnPath: OnPath is true if the motion device is on or near enough the planned program path such that program execution can continue. If the MotionDevice deviates too much from this path in case of errors or an emergency stop, this value becomes false. If OnPath is false, the motion device needs repositioning to continue program execution."
-    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="OnPath", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16363", dataType="i=1"));
-  OpcUaSupport.RealOutput speedOverride = 0
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="OnPath", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16363", dataType="i=1"));
+  OpcUaSupport.RealInput speedOverride
     "SpeedOverride: SpeedOverride provides the current speed setting in percent of programmed speed (0 - 100%)."
-    annotation (Placement(transformation(extent={{100,30},{120,50}})), __OPCUA(browsePath="SpeedOverride", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16365", dataType="i=11"));
+    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="SpeedOverride", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16365", dataType="i=11"));
   annotation (
     Documentation(info="<html><p>Flat list of Parameters</p><p>The class of <code>ParameterSet</code> in Robotics:MotionDeviceType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

@@ -6,7 +6,7 @@ model MotionDeviceType_PowerTrains "PowerTrains: PowerTrains is a container for 
   parameter Integer nPowerTrainIdentifier(min=0) = 0
     "Number of <PowerTrainIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
-  replaceable model PowerTrainIdentifier = OpcUaRobotics.ObjectTypes.PowerTrainType
+  replaceable model PowerTrainIdentifier = OpcUaRobotics.Complete.PowerTrainType constrainedby OpcUaRobotics.ObjectTypes.PowerTrainType
     "Class of <PowerTrainIdentifier>; redeclare it to use a model of your own";
   PowerTrainIdentifier powerTrainIdentifier[nPowerTrainIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
     "<PowerTrainIdentifier>"

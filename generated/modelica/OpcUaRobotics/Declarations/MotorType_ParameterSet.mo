@@ -6,18 +6,18 @@ model MotorType_ParameterSet "ParameterSet: Flat list of Parameters"
   parameter Boolean use_brakeReleased = false
     "Whether the optional BrakeReleased exists"
     annotation (Evaluate=true);
-  OpcUaSupport.BooleanOutput brakeReleased = false if use_brakeReleased
+  OpcUaSupport.BooleanInput brakeReleased if use_brakeReleased
     "BrakeReleased: Indicates an optional variable used only for motors with brakes. If BrakeReleased is TRUE the motor is free to run. FALSE means that the motor shaft is locked by the brake."
-    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="BrakeReleased", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17150", dataType="i=1"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="BrakeReleased", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17150", dataType="i=1"));
   parameter Boolean use_effectiveLoadRate = false
     "Whether the optional EffectiveLoadRate exists"
     annotation (Evaluate=true);
-  OpcUaSupport.IntegerOutput effectiveLoadRate(min=0, max=65535) = 0 if use_effectiveLoadRate
+  OpcUaSupport.IntegerInput effectiveLoadRate(min=0, max=65535) if use_effectiveLoadRate
     "EffectiveLoadRate: EffectiveLoadRate is expressed as a percentage of maximum continuous load. The Joule integral is typically used to calculate the current load. Duration should be defined and documented by the vendor."
-    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="EffectiveLoadRate", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6776", dataType="i=5"));
-  OpcUaSupport.RealOutput motorTemperature = 0
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="EffectiveLoadRate", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6776", dataType="i=5"));
+  OpcUaSupport.RealInput motorTemperature
     "MotorTemperature: The motor temperature provides the temperature of the motor. If there is no temperature sensor the value is set to \\\"null\\\"."
-    annotation (Placement(transformation(extent={{100,30},{120,50}})), __OPCUA(browsePath="MotorTemperature", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6757", dataType="i=11"));
+    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="MotorTemperature", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6757", dataType="i=11"));
   annotation (
     Documentation(info="<html><p>Flat list of Parameters</p><p>The class of <code>ParameterSet</code> in Robotics:MotorType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

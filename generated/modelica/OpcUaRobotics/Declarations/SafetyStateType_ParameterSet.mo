@@ -3,15 +3,15 @@
 within OpcUaRobotics.Declarations;
 model SafetyStateType_ParameterSet "ParameterSet: Flat list of Parameters"
   extends OpcUa.ObjectTypes.BaseObjectType;
-  OpcUaSupport.BooleanOutput emergencyStop = false
+  OpcUaSupport.BooleanInput emergencyStop
     "EmergencyStop: The EmergencyStop variable is TRUE if one or more of the emergency stop functions in the robot system are active, FALSE otherwise. If the EmergencyStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed emergency stop functions are active."
-    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="EmergencyStop", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15882", dataType="i=1"));
-  output OpcUaRobotics.Types.OperationalModeEnumeration operationalMode = OpcUaRobotics.Types.OperationalModeEnumeration.OTHER
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="EmergencyStop", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15882", dataType="i=1"));
+  input OpcUaRobotics.Types.OperationalModeEnumeration operationalMode = OpcUaRobotics.Types.OperationalModeEnumeration.OTHER
     "OperationalMode: The OperationalMode variable provides information about the current operational mode. Allowed values are described in OperationalModeEnumeration, see ISO 10218-1:2011 Ch.5.7 Operational Modes."
     annotation (__OPCUA(browsePath="OperationalMode", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15912", dataType="nsu=http://opcfoundation.org/UA/Robotics/;i=3006"));
-  OpcUaSupport.BooleanOutput protectiveStop = false
+  OpcUaSupport.BooleanInput protectiveStop
     "ProtectiveStop: The ProtectiveStop variable is TRUE if one or more of the enabled protective stop functions in the system are active, FALSE otherwise. If the ProtectiveStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed protective stop functions are enabled and active."
-    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="ProtectiveStop", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15913", dataType="i=1"));
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="ProtectiveStop", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15913", dataType="i=1"));
   annotation (
     Documentation(info="<html><p>Flat list of Parameters</p><p>The class of <code>ParameterSet</code> in Robotics:SafetyStateType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

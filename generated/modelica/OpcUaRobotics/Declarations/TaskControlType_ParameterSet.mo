@@ -6,15 +6,15 @@ model TaskControlType_ParameterSet "ParameterSet: Flat list of Parameters"
   parameter Boolean use_executionMode = false
     "Whether the optional ExecutionMode exists"
     annotation (Evaluate=true);
-  output OpcUaRobotics.Types.ExecutionModeEnumeration executionMode = OpcUaRobotics.Types.ExecutionModeEnumeration.CYCLE if use_executionMode
+  input OpcUaRobotics.Types.ExecutionModeEnumeration executionMode = OpcUaRobotics.Types.ExecutionModeEnumeration.CYCLE if use_executionMode
     "ExecutionMode: Execution mode of the task control (continuous or step-wise)."
     annotation (__OPCUA(browsePath="ExecutionMode", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17876", dataType="nsu=http://opcfoundation.org/UA/Robotics/;i=18191"));
-  OpcUaSupport.BooleanOutput taskProgramLoaded = false
+  OpcUaSupport.BooleanInput taskProgramLoaded
     "TaskProgramLoaded: The TaskProgramLoaded variable is TRUE if a task program is loaded in the task control, FALSE otherwise."
-    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="TaskProgramLoaded", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17875", dataType="i=1"));
-  OpcUaSupport.StringOutput taskProgramName = ""
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="TaskProgramLoaded", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17875", dataType="i=1"));
+  OpcUaSupport.StringInput taskProgramName
     "TaskProgramName: A customer given identifier for the task program."
-    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="TaskProgramName", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17874", dataType="i=12"));
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="TaskProgramName", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17874", dataType="i=12"));
   annotation (
     Documentation(info="<html><p>Flat list of Parameters</p><p>The class of <code>ParameterSet</code> in Robotics:TaskControlType: BaseObjectType with the children this declaration adds or changes.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

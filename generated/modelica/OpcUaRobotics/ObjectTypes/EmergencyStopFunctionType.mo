@@ -3,9 +3,9 @@
 within OpcUaRobotics.ObjectTypes;
 model EmergencyStopFunctionType "EmergencyStopFunctionType: According to ISO 10218-1:2011 Ch.5.5.2 Emergency stop the robot shall have one or more emergency stop functions."
   extends OpcUa.ObjectTypes.BaseObjectType;
-  OpcUaSupport.BooleanOutput active = false
+  OpcUaSupport.BooleanInput active
     "Active: The Active variable is TRUE if this particular emergency stop function is active, e.g. that the emergency stop button is pressed, FALSE otherwise."
-    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="Active", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17232", dataType="i=1"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="Active", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17232", dataType="i=1"));
   parameter String name = ""
     "Name: The Name of the EmergencyStopFunctionType provides a manufacturer-specific emergency stop function identifier within the safety system."
     annotation (__OPCUA(browsePath="Name", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17231", dataType="i=12"));

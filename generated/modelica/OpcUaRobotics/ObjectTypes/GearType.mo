@@ -7,15 +7,15 @@ model GearType "GearType: The GearType describes a gear in a powertrain, e.g. a 
     final use_model_=true,
     final use_productCode=true,
     final use_serialNumber=true);
-  output OpcUa.Types.RationalNumber gearRatio = OpcUa.Types.RationalNumber()
+  input OpcUa.Types.RationalNumber gearRatio = OpcUa.Types.RationalNumber()
     "GearRatio: The transmission ratio of the gear expressed as a fraction as input velocity (motor side) by output velocity (load side)."
     annotation (__OPCUA(browsePath="GearRatio", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15941", dataType="i=18806"));
   parameter Boolean use_pitch = false
     "Whether the optional Pitch exists"
     annotation (Evaluate=true);
-  OpcUaSupport.RealOutput pitch = 0 if use_pitch
+  OpcUaSupport.RealInput pitch if use_pitch
     "Pitch: Pitch describes the distance covered in millimeters (mm) for linear motion per one revolution of the output side of the driving unit. Pitch is used in combination with GearRatio to describe the overall transmission from input to output of the gear."
-    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="Pitch", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17165", dataType="i=11"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="Pitch", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17165", dataType="i=11"));
   annotation (
     Documentation(info="<html><p>The GearType describes a gear in a powertrain, e.g. a gear box or a spindle.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

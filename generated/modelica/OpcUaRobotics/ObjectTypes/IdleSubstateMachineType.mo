@@ -3,9 +3,9 @@
 within OpcUaRobotics.ObjectTypes;
 model IdleSubstateMachineType "IdleSubstateMachineType"
   extends OpcUa.ObjectTypes.FiniteStateMachineType(final use_lastTransition=true, final currentState=currentStateText);
-  OpcUaSupport.IntegerInput lastTransitionReason(min=-32768, max=32767) = 0
+  OpcUaSupport.IntegerOutput lastTransitionReason(min=-32768, max=32767) = 0
     "LastTransitionReason"
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6029", dataType="i=4"));
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6029", dataType="i=4"));
   // State machine of IdleSubstateMachineType: its states, and transitions driven by the trigger inputs.
   parameter Integer stateMachineLevel = 1
     "Which class drives the state machine: a subclass that adds states sets its own level"
@@ -22,10 +22,10 @@ model IdleSubstateMachineType "IdleSubstateMachineType"
     "Number of the current state (CurrentState/Number)";
   OpcUaSupport.BooleanInput gettingReadyToStandBy = false
     "GettingReadyToStandBy: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="GettingReadyToStandBy", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5018", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="GettingReadyToStandBy", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5018", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput standByToGettingReady = false
     "StandByToGettingReady: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="StandByToGettingReady", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5019", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="StandByToGettingReady", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5019", typeDefinition="i=2310"));
 equation
   if stateMachineLevel == 1 then
     when gettingReadyToStandBy then

@@ -6,18 +6,18 @@ model LoadType "LoadType: The LoadType is for describing loads mounted on the mo
   parameter Boolean use_centerOfMass = false
     "Whether the optional CenterOfMass exists"
     annotation (Evaluate=true);
-  output OpcUa.Types.N3DFrame centerOfMass = OpcUa.Types.N3DFrame() if use_centerOfMass
+  input OpcUa.Types.N3DFrame centerOfMass = OpcUa.Types.N3DFrame() if use_centerOfMass
     "CenterOfMass: The position and orientation of the center of the mass related to the mounting point using a FrameType. X, Y, Z define the position of the center of gravity relative to the mounting point coordinate system. A, B, C define the orientation of the principal axes of inertia relative to the mounting point coordinate system. Orientation A, B, C can be \"0\" for systems which do not need these values."
     annotation (__OPCUA(browsePath="CenterOfMass", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6013", dataType="i=18814"));
   parameter Boolean use_inertia = false
     "Whether the optional Inertia exists"
     annotation (Evaluate=true);
-  output OpcUa.Types.N3DVector inertia = OpcUa.Types.N3DVector() if use_inertia
+  input OpcUa.Types.N3DVector inertia = OpcUa.Types.N3DVector() if use_inertia
     "Inertia: The Inertia uses the VectorType to describe the three values of the principal moments of inertia with respect to the mounting point coordinate system. If inertia values are provided for rotary axis the CenterOfMass shall be completely filled as well."
     annotation (__OPCUA(browsePath="Inertia", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18170", dataType="i=18808"));
-  OpcUaSupport.RealOutput mass = 0
+  OpcUaSupport.RealInput mass
     "Mass: The weight of the load mounted on one mounting point."
-    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="Mass", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6723", dataType="i=11"));
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="Mass", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6723", dataType="i=11"));
   annotation (
     Documentation(info="<html><p>The LoadType is for describing loads mounted on the motion device typically by an integrator or a customer.</p></html>"),
     Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid, radius=10), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}),

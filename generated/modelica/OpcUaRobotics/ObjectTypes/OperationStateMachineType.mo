@@ -6,16 +6,16 @@ partial model OperationStateMachineType "OperationStateMachineType"
   parameter Boolean use_configuredDefaultStopMode = false
     "Whether the optional ConfiguredDefaultStopMode exists"
     annotation (Evaluate=true);
-  OpcUaSupport.IntegerInput configuredDefaultStopMode(min=-32768, max=32767) = 0 if use_configuredDefaultStopMode
+  OpcUaSupport.IntegerOutput configuredDefaultStopMode(min=-32768, max=32767) = 0 if use_configuredDefaultStopMode
     "ConfiguredDefaultStopMode"
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="ConfiguredDefaultStopMode", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6009", dataType="i=4"));
-  OpcUaSupport.IntegerInput lastTransitionReason(min=-32768, max=32767) = 0
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="ConfiguredDefaultStopMode", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6009", dataType="i=4"));
+  OpcUaSupport.IntegerOutput lastTransitionReason(min=-32768, max=32767) = 0
     "LastTransitionReason"
-    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6007", dataType="i=4"));
+    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6007", dataType="i=4"));
   parameter Boolean use_possibleStopModes = false
     "Whether the optional PossibleStopModes exists"
     annotation (Evaluate=true);
-  input OpcUa.Types.EnumValueType possibleStopModes[5] = {OpcUa.Types.EnumValueType(value = 1.0, displayName = "OnPath", description = "Stop program execution in a controlled manner along the programmed path"), OpcUa.Types.EnumValueType(value = 2.0, displayName = "EndOfCycle", description = "Stop program execution when the current production cycle has been finished"), OpcUa.Types.EnumValueType(value = 3.0, displayName = "ProcessStop", description = "Application dependent stop instruction that stops program execution at a favourable point for the application, e.g. at the end of a paint stroke or sealing bead"), OpcUa.Types.EnumValueType(value = 4.0, displayName = "QuickStop", description = "This stop is performed by ramping down motion as fast as possible using optimum motor performance. The robot may not stay on the path"), OpcUa.Types.EnumValueType(value = 5.0, displayName = "EndOfInstruction", description = "This stop can be used to stop the program execution when the current instruction is completed")} if use_possibleStopModes
+  output OpcUa.Types.EnumValueType possibleStopModes[5] = {OpcUa.Types.EnumValueType(value = 1.0, displayName = "OnPath", description = "Stop program execution in a controlled manner along the programmed path"), OpcUa.Types.EnumValueType(value = 2.0, displayName = "EndOfCycle", description = "Stop program execution when the current production cycle has been finished"), OpcUa.Types.EnumValueType(value = 3.0, displayName = "ProcessStop", description = "Application dependent stop instruction that stops program execution at a favourable point for the application, e.g. at the end of a paint stroke or sealing bead"), OpcUa.Types.EnumValueType(value = 4.0, displayName = "QuickStop", description = "This stop is performed by ramping down motion as fast as possible using optimum motor performance. The robot may not stay on the path"), OpcUa.Types.EnumValueType(value = 5.0, displayName = "EndOfInstruction", description = "This stop can be used to stop the program execution when the current instruction is completed")} if use_possibleStopModes
     "PossibleStopModes"
     annotation (__OPCUA(browsePath="PossibleStopModes", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6008", dataType="i=7594"));
   // Method Start() returns (Int32 Status): call it through an OPC UA client.
@@ -39,22 +39,22 @@ partial model OperationStateMachineType "OperationStateMachineType"
     "Number of the current state (CurrentState/Number); the nodeset marks no initial state, so it starts in Executing, the first state";
   OpcUaSupport.BooleanInput executingToIdle = false
     "ExecutingToIdle: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="ExecutingToIdle", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5013", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="ExecutingToIdle", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5013", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput stop = false
     "Stop: a rising edge stands for a call of the method Stop"
-    annotation (Placement(transformation(extent={{-120,10},{-100,30}})), __OPCUA(browsePath="Stop", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=7002"));
+    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="Stop", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=7002"));
   OpcUaSupport.BooleanInput idleToIdle = false
     "IdleToIdle: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="IdleToIdle", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5014", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-50},{-100,-30}})), __OPCUA(browsePath="IdleToIdle", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5014", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput idleToReady = false
     "IdleToReady: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="IdleToReady", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5009", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-70},{-100,-50}})), __OPCUA(browsePath="IdleToReady", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5009", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput start = false
     "Start: a rising edge stands for a call of the method Start"
-    annotation (Placement(transformation(extent={{-120,-50},{-100,-30}})), __OPCUA(browsePath="Start", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=7001"));
+    annotation (Placement(transformation(extent={{-120,-90},{-100,-70}})), __OPCUA(browsePath="Start", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=7001"));
   OpcUaSupport.BooleanInput readyToIdle = false
     "ReadyToIdle: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,-70},{-100,-50}})), __OPCUA(browsePath="ReadyToIdle", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5008", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-110},{-100,-90}})), __OPCUA(browsePath="ReadyToIdle", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5008", typeDefinition="i=2310"));
 equation
   if stateMachineLevel == 1 then
     when executingToIdle then

@@ -3,12 +3,12 @@
 within OpcUaRobotics.ObjectTypes;
 model ProtectiveStopFunctionType "ProtectiveStopFunctionType: According to ISO 10218-1:2011 Ch.5.5.3 the robot shall have one or more protective stop functions designed for the connection of external protective devices."
   extends OpcUa.ObjectTypes.BaseObjectType;
-  OpcUaSupport.BooleanOutput active = false
+  OpcUaSupport.BooleanInput active
     "Active: – The Active variable is TRUE if this particular protective stop function is active, i.e. that a stop is initiated, FALSE otherwise. If Enabled is FALSE then Active shall be FALSE."
-    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="Active", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17236", dataType="i=1"));
-  OpcUaSupport.BooleanOutput enabled = false
+    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="Active", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17236", dataType="i=1"));
+  OpcUaSupport.BooleanInput enabled
     "Enabled: – The Enabled variable is TRUE if this protective stop function is currently supervising the system, FALSE otherwise. A protective stop function may or may not be enabled at all times, e.g. the protective stop function of the safety doors are typically enabled in automatic operational mode and disabled in manual mode. On the other hand for example, the protective stop function of the teach pendant enabling device is enabled in manual modes and disabled in automatic modes."
-    annotation (Placement(transformation(extent={{100,50},{120,70}})), __OPCUA(browsePath="Enabled", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17235", dataType="i=1"));
+    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="Enabled", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17235", dataType="i=1"));
   parameter String name = ""
     "Name: The Name of the ProtectiveStopFunctionType provides a manufacturer-specific protective stop function identifier within the safety system."
     annotation (__OPCUA(browsePath="Name", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=17234", dataType="i=12"));

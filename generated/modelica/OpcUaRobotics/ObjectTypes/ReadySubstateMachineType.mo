@@ -3,9 +3,9 @@
 within OpcUaRobotics.ObjectTypes;
 model ReadySubstateMachineType "ReadySubstateMachineType"
   extends OpcUa.ObjectTypes.FiniteStateMachineType(final use_lastTransition=true, final currentState=currentStateText);
-  OpcUaSupport.IntegerInput lastTransitionReason(min=-32768, max=32767) = 0
+  OpcUaSupport.IntegerOutput lastTransitionReason(min=-32768, max=32767) = 0
     "LastTransitionReason"
-    annotation (Placement(transformation(extent={{-120,70},{-100,90}})), __OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6046", dataType="i=4"));
+    annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="LastTransitionReason", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6046", dataType="i=4"));
   // Method ResetToProgramStart() returns (Int32 Status): call it through an OPC UA client.
   // State machine of ReadySubstateMachineType: its states, and transitions driven by the trigger inputs.
   parameter Integer stateMachineLevel = 1
@@ -23,10 +23,10 @@ model ReadySubstateMachineType "ReadySubstateMachineType"
     "Number of the current state (CurrentState/Number); the nodeset marks no initial state, so it starts in AtProgramStart, the first state";
   OpcUaSupport.BooleanInput programStartToSuspended = false
     "ProgramStartToSuspended: a rising edge takes this transition, for which the nodeset gives no cause"
-    annotation (Placement(transformation(extent={{-120,50},{-100,70}})), __OPCUA(browsePath="ProgramStartToSuspended", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5025", typeDefinition="i=2310"));
+    annotation (Placement(transformation(extent={{-120,-10},{-100,10}})), __OPCUA(browsePath="ProgramStartToSuspended", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5025", typeDefinition="i=2310"));
   OpcUaSupport.BooleanInput resetToProgramStart = false
     "ResetToProgramStart: a rising edge stands for a call of the method ResetToProgramStart"
-    annotation (Placement(transformation(extent={{-120,30},{-100,50}})), __OPCUA(browsePath="ResetToProgramStart", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=7003"));
+    annotation (Placement(transformation(extent={{-120,-30},{-100,-10}})), __OPCUA(browsePath="ResetToProgramStart", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=7003"));
 equation
   if stateMachineLevel == 1 then
     when programStartToSuspended then

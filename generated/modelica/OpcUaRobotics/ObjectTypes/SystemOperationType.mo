@@ -11,7 +11,7 @@ model SystemOperationType "SystemOperationType"
   Conditions conditions if use_conditions
     "Conditions"
     annotation (__OPCUA(browsePath="Conditions", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5050", typeDefinition="i=61"));
-  replaceable model SystemOperationStateMachine = OpcUaRobotics.ObjectTypes.SystemOperationStateMachineType
+  replaceable model SystemOperationStateMachine = OpcUaRobotics.Complete.SystemOperationStateMachineType constrainedby OpcUaRobotics.ObjectTypes.SystemOperationStateMachineType
     "Class of SystemOperationStateMachine; redeclare it to use a model of your own";
   SystemOperationStateMachine systemOperationStateMachine
     "SystemOperationStateMachine"

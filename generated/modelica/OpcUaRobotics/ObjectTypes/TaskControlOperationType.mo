@@ -9,7 +9,7 @@ model TaskControlOperationType "TaskControlOperationType"
   parameter OpcUa.Types.NodeId motionDevicesUnderControl[:] = fill("", 0) if use_motionDevicesUnderControl
     "MotionDevicesUnderControl"
     annotation (__OPCUA(browsePath="MotionDevicesUnderControl", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=6131", dataType="i=17"));
-  replaceable model TaskControlStateMachine = OpcUaRobotics.ObjectTypes.TaskControlStateMachineType
+  replaceable model TaskControlStateMachine = OpcUaRobotics.Complete.TaskControlStateMachineType constrainedby OpcUaRobotics.ObjectTypes.TaskControlStateMachineType
     "Class of TaskControlStateMachine; redeclare it to use a model of your own";
   TaskControlStateMachine taskControlStateMachine
     "TaskControlStateMachine"

@@ -4,11 +4,11 @@
 //! read or write block of `OpcUaSupport.Interfaces` per scalar Real, Integer, Boolean or String variable of
 //! the instance, with the variable's NodeId, browse path and unit conversion:
 //!
-//! * a variable clients may write (AccessLevel CurrentWrite, an input connector of the class) takes its value
+//! * a variable clients may write (AccessLevel CurrentWrite, an output connector of the class, which the model hands on) takes its value
 //!   from a read block, through a modifier of the `extends` clause
 //!   (`extends Instances.DrillingCell(skillSet(referenceDrillBush(inputParameterSet(approachDistance=
 //!   readSkillSetReferenceDrillBushInputParameterSetApproachDistance.y))))`);
-//! * a variable clients may only read (an output connector) is written by a write block whose input an
+//! * a variable clients may only read (an input connector, which the physics computing it connects to) is written by a write block whose input an
 //!   equation binds to it (`writeSkillSetDrillHoleOutputParameterSetResult.u = skillSet.drillHole.outputParameterSet.result`).
 //!
 //! The block classes are replaceable (`replaceable block ReadReal = OpcUaSupport.Loopback.ReadReal
@@ -175,7 +175,7 @@ impl Ctx<'_> {
         } else {
             s.push_str(&format!("  extends {pkg}.Instances.{class}(\n    {extends});\n"));
         }
-        for (kind, _) in &kinds {
+        for kind in kinds.keys() {
             s.push_str(&format!(
                 "  replaceable block {kind} = {sup}.Loopback.{kind} constrainedby {sup}.Interfaces.{kind}\n    {};\n",
                 string_literal(&format!(
@@ -240,7 +240,7 @@ impl Ctx<'_> {
             let cond = conditional || e.use_flag.is_some();
             path.push(e.ident.clone());
             match (&e.kind, child.class) {
-                (ElemKind::Signal { ty, dims }, NodeClass::Variable) if e.count.is_none() => {
+                (ElemKind::Signal { ty, dims, .. }, NodeClass::Variable) if e.count.is_none() => {
                     out.push(Var {
                         node: c,
                         path: path.clone(),

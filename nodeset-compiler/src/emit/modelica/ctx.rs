@@ -271,6 +271,54 @@ impl<'a> Ctx<'a> {
         }
     }
 
+    /// The class a component of `key` is declared with: the class, or its complete variant when members of its
+    /// components are inputs nothing binds (Modelica tools refuse components of partial classes).
+    pub fn component_class_path(&mut self, key: &ClassKey) -> String {
+        if self.class_infos.get(key).is_some_and(|i| i.is_partial_by_inputs()) {
+            self.complete_path(key)
+        } else {
+            self.class_path(key)
+        }
+    }
+
+    /// The qualified name of a class's complete variant, `<Pkg>.Complete.<Ident>`.
+    pub fn complete_path(&mut self, key: &ClassKey) -> String {
+        self.class_path(key); // what it records as needed
+        let ns = match key {
+            ClassKey::Type(t) => self.m.node(*t).id.ns,
+            ClassKey::Decl(owner, _) => self.m.node(owner.node()).id.ns,
+        };
+        let ident = self.complete_ident(key);
+        format!("{}.Complete.{ident}", self.pkg[ns as usize])
+    }
+
+    /// The identifier of a class's complete variant: the class's own; for a declaration class that an ObjectType
+    /// of the namespace already names, with `_Declaration` (and a number) added.
+    pub fn complete_ident(&mut self, key: &ClassKey) -> String {
+        match key {
+            ClassKey::Type(t) => {
+                let names = self.names(self.m.node(*t).id.ns);
+                names.object_types[t].clone()
+            }
+            ClassKey::Decl(owner, path) => {
+                let names = self.names(self.m.node(owner.node()).id.ns);
+                let decl = self.decl_names.get(&(*owner, path.clone())).cloned().unwrap_or_else(|| class_ident(path));
+                let base = decl_class_ident(&names.owners[owner], &decl);
+                let taken = |x: &String| names.object_types.values().any(|t| t == x);
+                if !taken(&base) {
+                    return base;
+                }
+                let mut ident = format!("{base}_Declaration");
+                let mut k = 2;
+                while taken(&ident) {
+                    ident = format!("{base}_Declaration{k}");
+                    k += 1;
+                }
+                ident
+            }
+        }
+    }
+
     pub fn is_event_type(&self, t: NodeIx) -> bool {
         self.m.is_subtype_of_ns0(t, ids::BASE_EVENT_TYPE)
     }

@@ -214,10 +214,10 @@ impl Ctx<'_> {
                             let (prefix, tyname) = match &ty {
                                 super::types::MType::Scalar { base, .. } => (
                                     String::new(),
-                                    format!("{sup}.{}{}", base.name(), if writable { "Input" } else { "Output" }),
+                                    format!("{sup}.{}{}", base.name(), if writable { "Output" } else { "Input" }),
                                 ),
                                 other => (
-                                    (if writable { "input " } else { "output " }).to_string(),
+                                    (if writable { "output " } else { "input " }).to_string(),
                                     other.type_name().to_string(),
                                 ),
                             };

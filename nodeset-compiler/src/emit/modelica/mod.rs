@@ -35,6 +35,7 @@
 //!   ObjectTypes/             one model per ObjectType (partial when abstract), one record per event type
 //!   Declarations/            classes of instance declarations that add children to their type, named
 //!                            <Owner>_<BrowsePath> (AxisType_ParameterSet)
+//!   Complete/                the complete variant of each class with inputs nothing binds (see ObjectTypes)
 //!   Instances/               one model per top-level instance and `Objects` with the `Nodes` record
 //!     Bindings/             each instance with a read or write block per variable (see `bindings.rs`)
 //!   Examples/                each instance as a model that simulates as it is, with an `experiment` annotation
@@ -81,13 +82,18 @@
 //!
 //! * An ObjectType becomes a `model` that `extends` the class of its supertype (across packages); an abstract
 //!   one becomes a `partial model`; an event type (subtype of BaseEventType) becomes a `record` of its
-//!   fields. Every generated model is balanced as it stands (outputs carry a binding, like
-//!   `Modelica.Blocks.Sources.RealExpression`): extend it and bind what the model computes with modifiers
-//!   (`extends AxisType(parameterSet(actualPosition=q))`).
-//! * A property becomes a `parameter`; a data variable becomes an `OpcUaSupport` output connector, or an
-//!   input connector when its AccessLevel has CurrentWrite (0x02); enumerations and records use `output` /
-//!   `input` components. The value in the nodeset is the binding, else zero, false, "" or the record's
-//!   defaults. A Real with EngineeringUnits holds its SI value, as the Modelica Standard Library does
+//!   fields.
+//! * A property becomes a `parameter`. A data variable the model publishes (AccessLevel without CurrentWrite)
+//!   becomes an `OpcUaSupport` input connector that nothing binds: the physics computing it connects to it
+//!   (`connect(drive.y, parameterSet.actualPosition)`). A variable clients write becomes an output connector
+//!   bound to the value in the nodeset (else zero, false, ""), which the model hands on. Arrays, enumerations
+//!   and records keep the nodeset's value (`input`/`output` components); so does everything in an instance.
+//! * A class whose components hold unbound inputs is unbalanced, so it is a `partial model`; its complete
+//!   variant `<Pkg>.Complete.<Ident>` extends it and binds each of them (and its own) to the nodeset's value
+//!   (`extends AxisType(parameterSet(actualPosition=0, ...))`). Modelica tools refuse components of partial
+//!   classes, so a component or a class alias whose class is partial uses the complete variant
+//!   (`replaceable model AxisIdentifier = ...Complete.AxisType constrainedby ...ObjectTypes.AxisType`). An
+//!   instance binds its unbound inputs itself, to the instance's values, and is complete. A Real with EngineeringUnits holds its SI value, as the Modelica Standard Library does
 //!   (`unit="m", displayUnit="mm", quantity="Length"`; a value from the nodeset is converted), and its
 //!   `__OPCUA` annotation keeps the UNECE code and the conversion from the OPC UA value (`engineeringUnit=
 //!   "MMT", siFactor=0.001`; see `units.rs`).
@@ -452,6 +458,7 @@ impl Output {
                 ("Types", "DataTypes"),
                 ("ObjectTypes", "ObjectTypes"),
                 ("Declarations", "Classes of instance declarations"),
+                ("Complete", "Complete variants of the partial classes"),
                 ("Instances", "Instances"),
                 ("Examples", "Examples"),
             ] {
@@ -676,13 +683,70 @@ fn emit_owner(ctx: &mut Ctx, owner: Owner, out: &mut Output) {
         let body = render_class(ctx, decl, &ident);
         out.add(ns, "Declarations", &ident, body);
     }
+    if let (Owner::Type(t), Some(main)) = (owner, &plan.main) {
+        emit_complete(ctx, &ctx::ClassKey::Type(t), main, out);
+    }
+    for (path, decl) in &plan.decls {
+        emit_complete(ctx, &ctx::ClassKey::Decl(owner, path.clone()), decl, out);
+    }
     ctx.plans.insert(owner, plan);
 }
 
+/// The complete variant of a class with inputs nothing binds: the class with each of them bound to its value
+/// in the nodeset, so that it simulates as it is (`<Pkg>.Complete.<Ident>`).
+fn emit_complete(ctx: &mut Ctx, key: &ctx::ClassKey, plan: &ClassPlan, out: &mut Output) {
+    let Some(info) = ctx.class_infos.get(key).cloned() else { return };
+    if info.free.is_empty() {
+        return;
+    }
+    let mut mods = Vec::new();
+    for f in info.free.iter() {
+        let value = ctx.value_of(f.node, &f.ty, None);
+        objects::bind_free(&mut mods, &f.path, value);
+    }
+    let base = ctx.class_path(key);
+    let ident = ctx.complete_ident(key);
+    let ns = match key {
+        ctx::ClassKey::Type(t) => ctx.m.node(*t).id.ns,
+        ctx::ClassKey::Decl(o, _) => ctx.m.node(o.node()).id.ns,
+    };
+    let listed: Vec<String> = info
+        .free
+        .iter()
+        .map(|f| {
+            let p: Vec<&str> = f.path.iter().map(|(i, _)| i.as_str()).collect();
+            format!("<code>{}</code>", p.join("."))
+        })
+        .collect();
+    let doc = format!(
+        "<p><code>{}</code> with each input that nothing binds bound to its value in the nodeset, so that it \
+         simulates as it is: {}. To compute them, extend <code>{}</code> instead and connect them.</p>",
+        text::html_escape(&base),
+        listed.join(", "),
+        text::html_escape(&base)
+    );
+    let keyword = if plan.keyword == "partial model" && !matches!(key, ctx::ClassKey::Type(t) if ctx.m.node(*t).is_abstract()) {
+        "model"
+    } else {
+        plan.keyword
+    };
+    let body = format!(
+        "{keyword} {ident} {}\n  extends {base}{};\n  annotation (\n    {},\n    {},\n    {});\nend {ident};\n",
+        plan.desc,
+        render_mods(ctx, &mods, 2),
+        text::documentation(&doc),
+        text::MODEL_ICON,
+        plan.opcua
+    );
+    out.add(ns, "Complete", &ident, body);
+}
+
+/// A class name where a component is declared (or a class alias or redeclaration names the class of one): a
+/// class partial by its inputs is replaced by its complete variant.
 fn type_ref(ctx: &mut Ctx, t: &TypeRef) -> String {
     match t {
         TypeRef::Path(p) => p.clone(),
-        TypeRef::Class(k) => ctx.class_path(k),
+        TypeRef::Class(k) => ctx.component_class_path(k),
     }
 }
 
@@ -734,7 +798,7 @@ fn pinned(ctx: &mut Ctx, class: &ctx::ClassKey) -> Vec<String> {
     for e in &info.elements {
         if let (Some(alias), ElemKind::Object { class: k }) = (&e.alias, &e.kind) {
             if ctx.redeclared.contains(alias) {
-                parts.push(format!("redeclare model {alias} = {}", ctx.class_path(k)));
+                parts.push(format!("redeclare model {alias} = {}", ctx.component_class_path(k)));
             }
         }
     }
@@ -791,7 +855,10 @@ fn render_mods(ctx: &mut Ctx, mods: &[Mod], indent: usize) -> String {
 fn render_class(ctx: &mut Ctx, plan: &ClassPlan, ident: &str) -> String {
     let mut s = format!("{} {ident} {}\n", plan.keyword, plan.desc);
     if let Some((base, mods)) = &plan.extends {
-        let base = type_ref(ctx, base);
+        let base = match base {
+            TypeRef::Path(p) => p.clone(),
+            TypeRef::Class(k) => ctx.class_path(k),
+        };
         let mods = render_mods(ctx, mods, 2);
         s.push_str(&format!("  extends {base}{mods};\n"));
     }
@@ -799,8 +866,16 @@ fn render_class(ctx: &mut Ctx, plan: &ClassPlan, ident: &str) -> String {
         match item {
             Item::Comment(c) => s.push_str(&format!("  // {c}\n")),
             Item::Alias { ident, class, desc } => {
+                // A complete variant as the default: a redeclaration may choose any model that extends the
+                // partial class (and connects the inputs the variant binds).
+                let constraint = match class {
+                    TypeRef::Class(k) if ctx.class_infos.get(k).is_some_and(|i| i.is_partial_by_inputs()) => {
+                        format!(" constrainedby {}", ctx.class_path(k))
+                    }
+                    _ => String::new(),
+                };
                 let class = type_ref(ctx, class);
-                s.push_str(&format!("  replaceable model {ident} = {class}\n    {desc};\n"));
+                s.push_str(&format!("  replaceable model {ident} = {class}{constraint}\n    {desc};\n"));
             }
             Item::Decl { prefix, ty, ident, dims, mods, value, cond, desc, annotation } => {
                 let ty = type_ref(ctx, ty);

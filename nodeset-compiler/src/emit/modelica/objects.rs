@@ -33,6 +33,27 @@ pub struct ClassInfo {
     pub state_machine: Option<Rc<super::statemachine::SmInfo>>,
     /// The connectors on its icon.
     pub placed: Placed,
+    /// The input connectors nothing binds, in the class itself and in its components (see [`Free`]).
+    pub free: Rc<Vec<Free>>,
+}
+
+impl ClassInfo {
+    /// Whether a component of the class leaves inputs unbound, so the class is partial and its components use
+    /// its complete variant (`<Pkg>.Complete...`), which binds them to the nodeset's values.
+    pub fn is_partial_by_inputs(&self) -> bool {
+        self.free.iter().any(|f| f.path.len() > 1)
+    }
+}
+
+/// An input connector nothing binds: a value the model publishes, which the physics that computes it
+/// `connect`s to. The complete variant of a class binds it to the nodeset's value.
+#[derive(Debug, Clone)]
+pub struct Free {
+    /// The component path, each step with whether that component is an array (`each` for what follows).
+    pub path: Vec<(String, bool)>,
+    /// The node whose value the complete variant binds.
+    pub node: NodeIx,
+    pub ty: MType,
 }
 
 #[derive(Debug, Clone)]
@@ -50,6 +71,9 @@ pub struct Element {
     /// The replaceable class alias of an object (`replaceable model Axes = ...; Axes axes;`), which subclasses
     /// and users redeclare.
     pub alias: Option<String>,
+    /// The free inputs of an object whose members this class modifies without a class of its own (else those of
+    /// its class).
+    pub nested_free: Option<Rc<Vec<Free>>>,
 }
 
 #[derive(Debug, Clone)]
@@ -61,6 +85,8 @@ pub enum ElemKind {
     Signal {
         ty: MType,
         dims: Option<Vec<Option<u32>>>,
+        /// An input connector nothing binds (see [`Free`]).
+        free: bool,
     },
     Object {
         class: ClassKey,
@@ -292,10 +318,14 @@ impl Ctx<'_> {
         if let Some(sm) = self.plan_state_machine(t, base.as_ref(), &mut body) {
             state_machine = Some(Rc::new(sm));
         }
-        let partial = node.is_abstract();
+        let free = Rc::new(self.free_of(&body.elements));
+        let by_inputs = free.iter().any(|f| f.path.len() > 1);
+        let partial = node.is_abstract() || by_inputs;
         let mut doc = node.doc().map(text::html_paragraphs).unwrap_or_else(|| undescribed(m, t, "ObjectType"));
-        if partial {
+        if node.is_abstract() {
             doc.push_str("<p>The ObjectType is abstract, so the class is partial: extend it.</p>");
+        } else if by_inputs {
+            doc.push_str(COMPLETE_NOTE);
         }
         let plan = ClassPlan {
             keyword: if partial { "partial model" } else { "model" },
@@ -318,6 +348,7 @@ impl Ctx<'_> {
             local_replaceable: body.local_replaceable,
             state_machine,
             placed: body.placed,
+            free,
         }
     }
 
@@ -390,6 +421,7 @@ impl Ctx<'_> {
                     use_flag: None,
                     count: None,
                     alias: None,
+                    nested_free: None,
                 });
                 continue;
             }
@@ -439,6 +471,7 @@ impl Ctx<'_> {
                 use_flag: None,
                 count: None,
                 alias: None,
+                nested_free: None,
             });
         }
         let mut doc = node.doc().map(text::html_paragraphs).unwrap_or_else(|| undescribed(m, t, "EventType"));
@@ -464,6 +497,7 @@ impl Ctx<'_> {
             local_replaceable: false,
             state_machine: None,
             placed: Placed::default(),
+            free: Rc::new(Vec::new()),
         }
     }
 
@@ -715,8 +749,52 @@ impl Ctx<'_> {
                 }
             }
         }
+        if mode == Mode::Instance {
+            // An instance is complete: every input nothing binds yet gets the instance's value.
+            for f in self.free_of(&elements) {
+                let value = self.value_of(f.node, &f.ty, None);
+                bind_free(&mut body.mods, &f.path, value);
+            }
+            for e in &mut elements {
+                if let ElemKind::Signal { free, .. } = &mut e.kind {
+                    *free = false;
+                }
+                if matches!(e.kind, ElemKind::Object { .. }) {
+                    e.nested_free = Some(Rc::new(Vec::new()));
+                }
+            }
+        }
         body.elements = elements;
         body
+    }
+
+    /// The free inputs of a class with these elements: its own, and those of its components. A component whose
+    /// class leaves inputs of its components free uses the complete variant, which binds them all.
+    pub fn free_of(&self, elements: &[Element]) -> Vec<Free> {
+        let mut out = Vec::new();
+        for e in elements {
+            match &e.kind {
+                ElemKind::Signal { free: true, ty, .. } => {
+                    out.push(Free { path: vec![(e.ident.clone(), false)], node: e.node, ty: ty.clone() })
+                }
+                ElemKind::Object { class } => {
+                    let inner = match &e.nested_free {
+                        Some(f) => f.clone(),
+                        None => match self.class_infos.get(class) {
+                            Some(info) if !info.is_partial_by_inputs() => info.free.clone(),
+                            _ => continue,
+                        },
+                    };
+                    for f in inner.iter() {
+                        let mut path = vec![(e.ident.clone(), e.count.is_some())];
+                        path.extend(f.path.iter().cloned());
+                        out.push(Free { path, node: f.node, ty: f.ty.clone() });
+                    }
+                }
+                _ => {}
+            }
+        }
+        out
     }
 
     /// The class an object child is an instance of: its TypeDefinition, or BaseObjectType.
@@ -851,6 +929,7 @@ impl Ctx<'_> {
             use_flag: None,
             count: None,
             alias: None,
+            nested_free: None,
         };
         if self.is_reference(o) {
             return self.plan_reference(ident, o, rule, body, element);
@@ -994,9 +1073,13 @@ impl Ctx<'_> {
                         sattrs.extend(attrs);
                     }
                     let mods = attr_mods(&sattrs, dims.is_some());
+                    // A value the model publishes is an input connector that the physics computing it connects
+                    // to; a type leaves it unbound (its complete variant binds it). Arrays and values of other
+                    // types keep the nodeset's value, as does everything in an instance.
+                    let free = mode == Mode::Type && !writable && prefix.is_empty() && dims.is_none();
                     // A connector (no input/output prefix) gets its place on the icon.
                     let annotation = if prefix.is_empty() {
-                        format!("{}, {annotation}", body.placed.next(writable))
+                        format!("{}, {annotation}", body.placed.next(!writable))
                     } else {
                         annotation
                     };
@@ -1006,12 +1089,12 @@ impl Ctx<'_> {
                         ident: ident.clone(),
                         dims: dims_s,
                         mods,
-                        value: Some(value),
+                        value: (!free).then_some(value),
                         cond,
                         desc,
                         annotation,
                     });
-                    element.kind = ElemKind::Signal { ty, dims };
+                    element.kind = ElemKind::Signal { ty, dims, free };
                 }
                 element
             }
@@ -1042,6 +1125,21 @@ impl Ctx<'_> {
                                 self.add_decl(owner, &child_path, o.node, &td_info, sub)
                             } else {
                                 mods = sub.mods;
+                                let free = self.free_of(&sub.elements);
+                                if td_info.is_partial_by_inputs() {
+                                    // A component of the complete variant: bind what this node gives here,
+                                    // unless the class is replaceable (a modifier on the component would bind
+                                    // the inputs of any model a user plugs in; the variant's defaults stay).
+                                    if alias.is_none() {
+                                        for f in free {
+                                            let value = self.value_of(f.node, &f.ty, None);
+                                            bind_free(&mut mods, &f.path, value);
+                                        }
+                                    }
+                                    element.nested_free = Some(Rc::new(Vec::new()));
+                                } else {
+                                    element.nested_free = Some(Rc::new(free));
+                                }
                                 ClassKey::Type(td)
                             }
                         }
@@ -1117,16 +1215,19 @@ impl Ctx<'_> {
         let m = self.m;
         let n = m.node(node);
         let key = ClassKey::Decl(owner, path.to_string());
+        let free = Rc::new(self.free_of(&sub.elements));
+        let by_inputs = free.iter().any(|f| f.path.len() > 1);
         let plan =
             ClassPlan {
-                keyword: "model",
+                keyword: if by_inputs { "partial model" } else { "model" },
                 desc: text::description(&n.browse_name.name, n.doc()),
                 doc_html: format!(
-                "{}<p>The class of <code>{}</code> in {}: {} with the children this declaration adds or changes.</p>",
+                "{}<p>The class of <code>{}</code> in {}: {} with the children this declaration adds or changes.</p>{}",
                 n.doc().map(text::html_paragraphs).unwrap_or_default(),
                 text::html_escape(path),
                 text::html_escape(&m.qualified(owner.node())),
-                text::html_escape(&n.type_definition.map(|t| m.qualified(t)).unwrap_or_else(|| "BaseObjectType".into()))
+                text::html_escape(&n.type_definition.map(|t| m.qualified(t)).unwrap_or_else(|| "BaseObjectType".into())),
+                if by_inputs { COMPLETE_NOTE } else { "" }
             ),
                 extends: Some((TypeRef::Class(base.key.clone()), sub.mods)),
                 items: sub.items,
@@ -1145,6 +1246,7 @@ impl Ctx<'_> {
             local_replaceable: sub.local_replaceable,
             state_machine: starting_in(base.state_machine.clone(), sub.initial),
             placed: sub.placed,
+            free,
         };
         self.class_infos.insert(key.clone(), Rc::new(info));
         key
@@ -1206,7 +1308,12 @@ impl Ctx<'_> {
                         }
                     }
                 }
-                let value = if m.value(o.node).is_some() {
+                // A free input keeps no value here: the complete variant (or, in an instance, the binding of
+                // every free input at the end of the body) takes it from this node.
+                let free = matches!(e.kind, ElemKind::Signal { free: true, .. });
+                let value = if free {
+                    None
+                } else if m.value(o.node).is_some() {
                     let v = self.explicit_value(o.node, ty, dims.as_deref());
                     if v.is_none() {
                         body.items.push(Item::Comment(format!(
@@ -1276,6 +1383,22 @@ impl Ctx<'_> {
                 let child_path = join_path(path, &n.browse_name.name);
                 let sub = self.plan_body(owner, &child_path, Some(&base_info), &children, mode, constraint_local);
                 if !sub.adds && !changed {
+                    let mut sub = sub;
+                    let free = self.free_of(&sub.elements);
+                    if old.as_ref().is_some_and(|c| c.is_partial_by_inputs()) {
+                        // The component is of the complete variant, which binds the free inputs to the values
+                        // of the class: bind the ones this node gives here, unless the class is replaceable
+                        // (see `plan_new`).
+                        if e.alias.is_none() {
+                            for f in free {
+                                let value = self.value_of(f.node, &f.ty, None);
+                                bind_free(&mut sub.mods, &f.path, value);
+                            }
+                        }
+                        updated.nested_free = Some(Rc::new(Vec::new()));
+                    } else {
+                        updated.nested_free = Some(Rc::new(free));
+                    }
                     if !sub.mods.is_empty() {
                         body.mods.push(Mod::Nested { ident: e.ident.clone(), mods: sub.mods });
                     }
@@ -1309,6 +1432,7 @@ impl Ctx<'_> {
                 body.mods.push(Mod::Nested { ident: e.ident.clone(), mods: vec![Mod::Pin { class: key.clone() }] });
                 body.adds = true;
                 updated.kind = ElemKind::Object { class: key };
+                updated.nested_free = None;
                 Some(updated)
             }
         }
@@ -1407,6 +1531,45 @@ fn count_decl(count: &str, original: &str, rule: Option<ModellingRule>) -> Item 
     }
 }
 
+/// The note on a class that is partial because members of its components are inputs nothing binds.
+pub const COMPLETE_NOTE: &str = "<p>Members of its components are inputs that nothing binds (values the model \
+publishes, which the physics computing them connects to), so the class is partial: extend it and connect them, or \
+use its complete variant in the package <code>Complete</code>, which binds them to the nodeset's values.</p>";
+
+/// Adds `path = value` to a modification list, inside the modifiers already there for the same components
+/// (`a(b(x(unit="m")))` becomes `a(b(x(unit="m")=v))`); `each` after an array component.
+pub fn bind_free(mods: &mut Vec<Mod>, path: &[(String, bool)], value: String) {
+    bind_at(mods, path, value, false)
+}
+
+fn bind_at(mods: &mut Vec<Mod>, path: &[(String, bool)], value: String, each: bool) {
+    let Some(((first, array), rest)) = path.split_first() else { return };
+    let ident = if each { format!("each {first}") } else { first.clone() };
+    if rest.is_empty() {
+        for m in mods.iter_mut() {
+            if let Mod::Value { ident: i, value: v @ None, .. } = m {
+                if *i == ident {
+                    *v = Some(value);
+                    return;
+                }
+            }
+        }
+        mods.push(Mod::Value { ident, is_final: false, attrs: Vec::new(), value: Some(value) });
+        return;
+    }
+    for m in mods.iter_mut() {
+        if let Mod::Nested { ident: i, mods: inner } = m {
+            if *i == ident {
+                bind_at(inner, rest, value, *array);
+                return;
+            }
+        }
+    }
+    let mut inner = Vec::new();
+    bind_at(&mut inner, rest, value, *array);
+    mods.push(Mod::Nested { ident, mods: inner });
+}
+
 /// Attribute modifiers (`unit="m"`) of a declaration; `each` for an array.
 pub fn attr_mods(attrs: &[String], array: bool) -> Vec<Mod> {
     attrs
@@ -1420,9 +1583,11 @@ pub fn attr_mods(attrs: &[String], array: bool) -> Vec<Mod> {
 }
 
 /// The declared type of a signal: a connector of OpcUaSupport for the predefined types, else the type with an
-/// `input`/`output` prefix; with the attributes an alias type would have carried.
+/// `input`/`output` prefix; with the attributes an alias type would have carried. A value the model publishes
+/// (clients only read it) is an input, computed outside and connected in; a value clients write is an output,
+/// which the model hands on to the physics.
 fn signal_type(ty: &MType, writable: bool) -> (String, String, Vec<String>) {
-    let dir = if writable { "Input" } else { "Output" };
+    let dir = if writable { "Output" } else { "Input" };
     match ty {
         MType::Scalar { base, min, max, unit, .. } => {
             let mut attrs = Vec::new();
@@ -1437,7 +1602,7 @@ fn signal_type(ty: &MType, writable: bool) -> (String, String, Vec<String>) {
             }
             (String::new(), format!("{}.{}{dir}", super::support::PACKAGE, base.name()), attrs)
         }
-        other => ((if writable { "input" } else { "output" }).into(), other.type_name().to_string(), Vec::new()),
+        other => ((if writable { "output" } else { "input" }).into(), other.type_name().to_string(), Vec::new()),
     }
 }
 

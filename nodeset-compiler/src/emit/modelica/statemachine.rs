@@ -349,6 +349,11 @@ impl Ctx<'_> {
             // The text follows the number: a final binding to a variable that the equation of the driving level
             // sets, so neither an instance nor a user can give the text a value of its own.
             body.mods.retain(|x| !matches!(x, Mod::Value { ident, .. } if ident == cur));
+            for e in body.elements.iter_mut().filter(|e| e.ident == *cur) {
+                if let ElemKind::Signal { free, .. } = &mut e.kind {
+                    *free = false;
+                }
+            }
             body.mods.push(Mod::Value {
                 ident: cur.clone(),
                 is_final: true,

@@ -139,7 +139,7 @@ fn colliding_names_are_renamed_and_reported() {
     for decl in [
         "String type_ =",
         "parameter String model_ =",
-        "OpcUaSupport.RealOutput input_ =",
+        "OpcUaSupport.RealInput input_\n",
         "modeA =",
         "modeA_2 =",
         "self_2 =",
@@ -245,6 +245,34 @@ fn robotics_files() -> Vec<crate::write::OutFile> {
 
 fn contents<'a>(files: &'a [crate::write::OutFile], path: &str) -> &'a str {
     &files.iter().find(|f| f.path.ends_with(path)).unwrap_or_else(|| panic!("no {path}")).contents
+}
+
+#[test]
+fn published_values_are_unbound_inputs_and_complete_variants_bind_them() {
+    let files = robotics_files();
+    // ActualPosition is published (clients read it): an input connector nothing binds, for the physics to
+    // connect to; so AxisType, whose ParameterSet holds it, is partial.
+    let set = contents(&files, "OpcUaRobotics/Declarations/AxisType_ParameterSet.mo");
+    assert!(set.contains("  OpcUaSupport.RealInput actualPosition\n"), "{set}");
+    assert!(set.starts_with("// ") && set.contains("\nmodel AxisType_ParameterSet "), "{set}");
+    let axis = contents(&files, "OpcUaRobotics/ObjectTypes/AxisType.mo");
+    assert!(axis.contains("\npartial model AxisType "), "{axis}");
+    // The complete variant binds every free input to the nodeset's value.
+    let complete = contents(&files, "OpcUaRobotics/Complete/AxisType.mo");
+    assert!(
+        complete.contains("  extends OpcUaRobotics.ObjectTypes.AxisType(\n    parameterSet(actualAcceleration=0, actualPosition=0, actualSpeed=0),"),
+        "{complete}"
+    );
+    // A placeholder's replaceable class defaults to the complete variant and accepts any model extending the
+    // partial class.
+    let axes = contents(&files, "OpcUaRobotics/Declarations/MotionDeviceType_Axes.mo");
+    assert!(
+        axes.contains("replaceable model AxisIdentifier = OpcUaRobotics.Complete.AxisType constrainedby OpcUaRobotics.ObjectTypes.AxisType"),
+        "{axes}"
+    );
+    // A value clients write is an output connector with the nodeset's value.
+    let level = contents(&files, "OpcUaIA/ObjectTypes/StackLevelType.mo");
+    assert!(level.contains("  OpcUaSupport.RealOutput levelPercent = 0\n"), "{level}");
 }
 
 #[test]

@@ -26,11 +26,18 @@ the NodeId and BrowseName.</p>
 
 <h4>Members</h4>
 <ul>
-<li>A property is a <code>parameter</code>. A data variable is a connector of this package:
-<code>RealOutput</code> where clients may only read it, <code>RealInput</code> where they may write it
-(AccessLevel CurrentWrite). The value in the nodeset is its binding, else zero, false or an empty string.</li>
+<li>A property is a <code>parameter</code>. A data variable is a connector of this package. A value the
+model publishes (clients may only read it) is an input, <code>RealInput</code>, that nothing binds: the physics
+that computes it connects to it. A value clients may write (AccessLevel CurrentWrite) is an output,
+<code>RealOutput</code>, bound to the value in the nodeset (else zero, false or an empty string), which the model
+hands on to the physics.</li>
+<li>A class whose components hold such inputs is partial. Its complete variant, <code>Complete.X</code>,
+binds every one of them to the nodeset's value and simulates as it is; instances are complete too.</li>
 <li>An object is a component whose class is a replaceable alias: <code>replaceable model Axes =
-...Declarations.MotionDeviceType_Axes; Axes axes;</code>. Redeclare the alias to use a model of your own.</li>
+...Declarations.MotionDeviceType_Axes; Axes axes;</code>. Redeclare the alias to use a model of your own. Where
+the class is partial, the alias defaults to its complete variant and is constrained by the class
+(<code>replaceable model AxisIdentifier = OpcUaRobotics.Complete.AxisType constrainedby
+OpcUaRobotics.ObjectTypes.AxisType</code>).</li>
 <li>An optional member exists when <code>use_x = true</code>: <code>parameter Boolean use_x = false</code>,
 <code>X x if use_x</code>.</li>
 <li>A placeholder <code>&lt;X&gt;</code> is an array: <code>parameter Integer nX</code>, <code>replaceable model
@@ -42,18 +49,20 @@ Resume, Halt, Reset of a program or skill) are Boolean trigger inputs: a rising 
 </ul>
 
 <h4>Using a generated model</h4>
-<p>Extend a type and bind what your model computes with modifiers:</p>
-<pre>model FirstOrderAxis
-  extends OpcUaRobotics.ObjectTypes.AxisType(
-    parameterSet(actualPosition=position, use_actualSpeed=true, actualSpeed=der(position)));
-  parameter Real T(unit=\"s\") = 0.2;
-  Real position(unit=\"rad\", start=0, fixed=true);
+<p>Extend a type and connect what your model computes to the inputs it publishes (optional members such as
+ActualSpeed once switched on):</p>
+<pre>model DrivenAxis
+  extends OpcUaRobotics.ObjectTypes.AxisType(parameterSet(use_actualSpeed=true));
+  FirstOrder drive(T=0.2, u=1);
 equation
-  der(position) = (1 - position)/T;
-end FirstOrderAxis;</pre>
+  connect(drive.y, parameterSet.actualPosition);
+  connect(drive.dy, parameterSet.actualSpeed);
+end DrivenAxis;</pre>
 <p>and fill placeholders by redeclaring their class and setting their count:</p>
 <pre>extends OpcUaRobotics.Declarations.MotionDeviceType_Axes(
-  nAxisIdentifier=2, redeclare model AxisIdentifier = FirstOrderAxis);</pre>
+  nAxisIdentifier=2, redeclare model AxisIdentifier = DrivenAxis);</pre>
+<p>Where nothing computes a published value, use the complete variant (<code>OpcUaRobotics.Complete.AxisType</code>),
+or bind the value with a modifier.</p>
 
 <h4>Binding to OPC UA</h4>
 <p><code>Instances.Bindings</code> holds each instance again, extended by one block per variable: a variable
