@@ -4,12 +4,13 @@
 //! read or write block of `OpcUaSupport.Interfaces` per scalar Real, Integer, Boolean or String variable of
 //! the instance, with the variable's NodeId, browse path and unit conversion:
 //!
-//! * a variable clients may write (AccessLevel CurrentWrite, an output connector of the class, which the model hands on) takes its value
-//!   from a read block, through a modifier of the `extends` clause
+//! * a variable clients may write (AccessLevel CurrentWrite, an output connector of the class, which the model
+//!   hands on) takes its value from a read block, through a modifier of the `extends` clause
 //!   (`extends Instances.DrillingCell(skillSet(referenceDrillBush(inputParameterSet(approachDistance=
 //!   readSkillSetReferenceDrillBushInputParameterSetApproachDistance.y))))`);
-//! * a variable clients may only read (an input connector, which the physics computing it connects to) is written by a write block whose input an
-//!   equation binds to it (`writeSkillSetDrillHoleOutputParameterSetResult.u = skillSet.drillHole.outputParameterSet.result`).
+//! * a variable clients may only read (an input connector, which the physics computing it connects to) is
+//!   written by a write block whose input an equation binds to it
+//!   (`writeSkillSetDrillHoleOutputParameterSetResult.u = skillSet.drillHole.outputParameterSet.result`).
 //!
 //! The block classes are replaceable (`replaceable block ReadReal = OpcUaSupport.Loopback.ReadReal
 //! constrainedby OpcUaSupport.Interfaces.ReadReal`): the default, Loopback, needs no server, so a bound
@@ -20,7 +21,7 @@
 //! not read).
 
 use super::ctx::{node_id_text, Ctx};
-use super::objects::{ElemKind, Element};
+use super::plan::{ElemKind, Element};
 use super::text::{self, string_literal};
 use super::types::{Base, MType};
 use crate::model::NodeIx;

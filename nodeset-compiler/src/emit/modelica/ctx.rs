@@ -1,7 +1,7 @@
 //! The state of one generation run: package names, the name tables of every namespace, what the ns0 subset
 //! needs, and the diagnostics found on the way.
 
-use super::objects::{ClassInfo, Deferred, OwnerPlan};
+use super::plan::{ClassInfo, Deferred, OwnerPlan};
 use super::types::RecordInfo;
 use crate::diag::{Code, Diagnostic, Diagnostics, Severity};
 use crate::model::{ids, Model, NodeIx};
@@ -90,14 +90,14 @@ pub struct Ctx<'a> {
     pub nesting: usize,
     pub deferred: Vec<Deferred>,
     /// The replaceable class aliases that some planned class redeclares (filled once planning is done). A
-    /// component repeats its class's choice for each of them ([`Mod::Pin`](super::objects::Mod::Pin)).
+    /// component repeats its class's choice for each of them ([`Mod::Pin`](super::plan::Mod::Pin)).
     pub redeclared: BTreeSet<String>,
     /// The instance declarations that would make a class contain itself; they become reference parameters
     /// (see `recursion.rs`).
     pub cuts: BTreeSet<NodeIx>,
     /// The elements and taken identifiers of each top-level instance's class, for its binding model (see
     /// `bindings.rs`).
-    pub instance_classes: BTreeMap<NodeIx, (Vec<super::objects::Element>, BTreeSet<String>)>,
+    pub instance_classes: BTreeMap<NodeIx, (Vec<super::plan::Element>, BTreeSet<String>)>,
 }
 
 impl<'a> Ctx<'a> {
@@ -267,54 +267,6 @@ impl<'a> Ctx<'a> {
                 // against a type graph too deep to plan.
                 let decl = self.decl_names.get(&(*owner, path.clone())).cloned().unwrap_or_else(|| class_ident(path));
                 format!("{}.Declarations.{}", self.pkg[ns as usize], decl_class_ident(&names.owners[owner], &decl))
-            }
-        }
-    }
-
-    /// The class a component of `key` is declared with: the class, or its complete variant when members of its
-    /// components are inputs nothing binds (Modelica tools refuse components of partial classes).
-    pub fn component_class_path(&mut self, key: &ClassKey) -> String {
-        if self.class_infos.get(key).is_some_and(|i| i.is_partial_by_inputs()) {
-            self.complete_path(key)
-        } else {
-            self.class_path(key)
-        }
-    }
-
-    /// The qualified name of a class's complete variant, `<Pkg>.Complete.<Ident>`.
-    pub fn complete_path(&mut self, key: &ClassKey) -> String {
-        self.class_path(key); // what it records as needed
-        let ns = match key {
-            ClassKey::Type(t) => self.m.node(*t).id.ns,
-            ClassKey::Decl(owner, _) => self.m.node(owner.node()).id.ns,
-        };
-        let ident = self.complete_ident(key);
-        format!("{}.Complete.{ident}", self.pkg[ns as usize])
-    }
-
-    /// The identifier of a class's complete variant: the class's own; for a declaration class that an ObjectType
-    /// of the namespace already names, with `_Declaration` (and a number) added.
-    pub fn complete_ident(&mut self, key: &ClassKey) -> String {
-        match key {
-            ClassKey::Type(t) => {
-                let names = self.names(self.m.node(*t).id.ns);
-                names.object_types[t].clone()
-            }
-            ClassKey::Decl(owner, path) => {
-                let names = self.names(self.m.node(owner.node()).id.ns);
-                let decl = self.decl_names.get(&(*owner, path.clone())).cloned().unwrap_or_else(|| class_ident(path));
-                let base = decl_class_ident(&names.owners[owner], &decl);
-                let taken = |x: &String| names.object_types.values().any(|t| t == x);
-                if !taken(&base) {
-                    return base;
-                }
-                let mut ident = format!("{base}_Declaration");
-                let mut k = 2;
-                while taken(&ident) {
-                    ident = format!("{base}_Declaration{k}");
-                    k += 1;
-                }
-                ident
             }
         }
     }

@@ -8,7 +8,8 @@
 //! variable of the instances with its NodeId, DataType and initial value.
 
 use super::ctx::{identifier_text, node_id_text, node_id_type, Ctx, Owner};
-use super::objects::{escape_browse_name, ClassPlan, Mode, TypeRef};
+use super::objects::escape_browse_name;
+use super::plan::{ClassPlan, Mode, TypeRef};
 use super::text::{self, string_literal};
 use crate::model::{ids, Model, NodeIx};
 use crate::raw::NodeClass;

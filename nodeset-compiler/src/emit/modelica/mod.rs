@@ -137,7 +137,7 @@
 //! than `fill` (`expression shape mismatch`). rumoca lets an enclosing instance's redeclaration of an inherited
 //! alias replace a nested component's own (a MotionDeviceType's `ParameterSet` would replace the one of each
 //! AxisType in its Axes), so every object component repeats its class's choice for each alias that some class
-//! redeclares (`Axis axis(redeclare model ParameterSet = ...AxisType_ParameterSet)`, `objects::Mod::Pin`);
+//! redeclares (`Axis axis(redeclare model ParameterSet = ...AxisType_ParameterSet)`, `plan::Mod::Pin`);
 //! `tests/modelica/RumocaBehaviour` reproduces both the leak and the fix.
 //!
 //! # Limits
@@ -147,11 +147,31 @@
 //! record lists all of them.
 //! Children that an instance declaration adds to an inherited component that is not replaceable are left
 //! out with a warning.
+//!
+//! # Where each concern lives
+//!
+//! Planning decides every class, then `mod.rs` renders the plans and writes the package skeleton.
+//!
+//! | File | Concern |
+//! |---|---|
+//! | `ctx.rs` | the planning context: package and class names, caches, diagnostics |
+//! | `plan.rs` | what planning produces: class plans, elements, modifiers |
+//! | `objects.rs` | the class of an ObjectType or an event type, a class body from a base and children, values |
+//! | `members.rs` | one member: new (parameter, connector, component, reference, method) or overriding |
+//! | `complete.rs` | unbound inputs, partial classes and their complete variants |
+//! | `statemachine.rs` | state machines: states, triggers, the equations that drive them |
+//! | `instances.rs`, `bindings.rs` | instances, `Objects` with the `Nodes` record, binding models, examples |
+//! | `types.rs`, `units.rs` | DataTypes, literals, engineering units |
+//! | `recursion.rs` | containment cut where a class would contain itself |
+//! | `text.rs`, `support.rs` | text helpers, icons; the hand-written `OpcUaSupport` package |
 
 mod bindings;
+mod complete;
 mod ctx;
 mod instances;
+mod members;
 mod objects;
+mod plan;
 mod recursion;
 mod statemachine;
 pub mod support;
@@ -166,7 +186,7 @@ use crate::names::{is_valid, Case, Scope, Target};
 use crate::raw::NodeClass;
 use crate::write::OutFile;
 use ctx::{Ctx, Need, Owner};
-use objects::{ClassPlan, ElemKind, Item, Mod, OwnerPlan, TypeRef};
+use plan::{ClassPlan, ElemKind, Item, Mod, OwnerPlan, TypeRef};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 use text::string_literal;
@@ -684,61 +704,12 @@ fn emit_owner(ctx: &mut Ctx, owner: Owner, out: &mut Output) {
         out.add(ns, "Declarations", &ident, body);
     }
     if let (Owner::Type(t), Some(main)) = (owner, &plan.main) {
-        emit_complete(ctx, &ctx::ClassKey::Type(t), main, out);
+        complete::emit_complete(ctx, &ctx::ClassKey::Type(t), main, out);
     }
     for (path, decl) in &plan.decls {
-        emit_complete(ctx, &ctx::ClassKey::Decl(owner, path.clone()), decl, out);
+        complete::emit_complete(ctx, &ctx::ClassKey::Decl(owner, path.clone()), decl, out);
     }
     ctx.plans.insert(owner, plan);
-}
-
-/// The complete variant of a class with inputs nothing binds: the class with each of them bound to its value
-/// in the nodeset, so that it simulates as it is (`<Pkg>.Complete.<Ident>`).
-fn emit_complete(ctx: &mut Ctx, key: &ctx::ClassKey, plan: &ClassPlan, out: &mut Output) {
-    let Some(info) = ctx.class_infos.get(key).cloned() else { return };
-    if info.free.is_empty() {
-        return;
-    }
-    let mut mods = Vec::new();
-    for f in info.free.iter() {
-        let value = ctx.value_of(f.node, &f.ty, None);
-        objects::bind_free(&mut mods, &f.path, value);
-    }
-    let base = ctx.class_path(key);
-    let ident = ctx.complete_ident(key);
-    let ns = match key {
-        ctx::ClassKey::Type(t) => ctx.m.node(*t).id.ns,
-        ctx::ClassKey::Decl(o, _) => ctx.m.node(o.node()).id.ns,
-    };
-    let listed: Vec<String> = info
-        .free
-        .iter()
-        .map(|f| {
-            let p: Vec<&str> = f.path.iter().map(|(i, _)| i.as_str()).collect();
-            format!("<code>{}</code>", p.join("."))
-        })
-        .collect();
-    let doc = format!(
-        "<p><code>{}</code> with each input that nothing binds bound to its value in the nodeset, so that it \
-         simulates as it is: {}. To compute them, extend <code>{}</code> instead and connect them.</p>",
-        text::html_escape(&base),
-        listed.join(", "),
-        text::html_escape(&base)
-    );
-    let keyword = if plan.keyword == "partial model" && !matches!(key, ctx::ClassKey::Type(t) if ctx.m.node(*t).is_abstract()) {
-        "model"
-    } else {
-        plan.keyword
-    };
-    let body = format!(
-        "{keyword} {ident} {}\n  extends {base}{};\n  annotation (\n    {},\n    {},\n    {});\nend {ident};\n",
-        plan.desc,
-        render_mods(ctx, &mods, 2),
-        text::documentation(&doc),
-        text::MODEL_ICON,
-        plan.opcua
-    );
-    out.add(ns, "Complete", &ident, body);
 }
 
 /// A class name where a component is declared (or a class alias or redeclaration names the class of one): a

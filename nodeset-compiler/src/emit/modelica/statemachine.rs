@@ -39,7 +39,7 @@
 //! state in the nodeset's order. The description of `currentStateNumber` says which rule applied.
 
 use super::ctx::{component_original, Ctx};
-use super::objects::{Body, ClassInfo, ElemKind, Item, Mod, TypeRef};
+use super::plan::{Body, ClassInfo, ElemKind, Item, Mod, TypeRef};
 use super::text::string_literal;
 use super::types::{Base, MType};
 use crate::model::{ids, Model, NodeIx};

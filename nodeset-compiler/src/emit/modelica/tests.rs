@@ -4,7 +4,7 @@
 //! does not exist, so these properties are checked here, on the generator's own tables.
 
 use super::ctx::{ClassKey, Ctx};
-use super::objects::ElemKind;
+use super::plan::ElemKind;
 use super::*;
 use crate::load::Input;
 use crate::model::DataTypeKind;

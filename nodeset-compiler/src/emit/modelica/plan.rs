@@ -1,0 +1,231 @@
+//! What planning produces: the plan of each class (its members, modifiers and equations) and what a planned class
+//! offers to the classes built on it. `objects.rs` and `members.rs` plan, `mod.rs` renders.
+
+use super::ctx::{ClassKey, Owner};
+use super::types::MType;
+use crate::model::NodeIx;
+use crate::nodeid::QualifiedName;
+use std::collections::BTreeSet;
+use std::rc::Rc;
+
+/// What a planned class offers to classes built on it.
+#[derive(Debug, Clone)]
+pub struct ClassInfo {
+    pub key: ClassKey,
+    pub elements: Vec<Element>,
+    /// Every identifier the class uses (elements, `use_` flags, counts, state machine names).
+    pub taken: BTreeSet<String>,
+    /// Whether the class declares replaceable elements itself (not through `extends`); a redeclaration may
+    /// only use a class with local replaceable elements when its constraining class has some too (MLS 6.4,
+    /// as rumoca checks it).
+    pub local_replaceable: bool,
+    /// The state machine this class (or a base class) drives.
+    pub state_machine: Option<Rc<super::statemachine::SmInfo>>,
+    /// The connectors on its icon.
+    pub placed: Placed,
+    /// The input connectors nothing binds, in the class itself and in its components (see [`Free`]).
+    pub free: Rc<Vec<Free>>,
+}
+
+impl ClassInfo {
+    /// Whether a component of the class leaves inputs unbound, so the class is partial and its components use
+    /// its complete variant (`<Pkg>.Complete...`), which binds them to the nodeset's values.
+    pub fn is_partial_by_inputs(&self) -> bool {
+        self.free.iter().any(|f| f.path.len() > 1)
+    }
+}
+
+/// An input connector nothing binds: a value the model publishes, which the physics that computes it
+/// `connect`s to. The complete variant of a class binds it to the nodeset's value.
+#[derive(Debug, Clone)]
+pub struct Free {
+    /// The component path, each step with whether that component is an array (`each` for what follows).
+    pub path: Vec<(String, bool)>,
+    /// The node whose value the complete variant binds.
+    pub node: NodeIx,
+    pub ty: MType,
+}
+
+#[derive(Debug, Clone)]
+pub struct Element {
+    pub bn: QualifiedName,
+    pub ident: String,
+    pub node: NodeIx,
+    /// The reference from the parent (HasProperty, HasComponent, ...).
+    pub rt: NodeIx,
+    /// An optional element that a base class already made present (`final use_x = true`).
+    pub present: bool,
+    pub kind: ElemKind,
+    pub use_flag: Option<String>,
+    pub count: Option<String>,
+    /// The replaceable class alias of an object (`replaceable model Axes = ...; Axes axes;`), which subclasses
+    /// and users redeclare.
+    pub alias: Option<String>,
+    /// The free inputs of an object whose members this class modifies without a class of its own (else those of
+    /// its class).
+    pub nested_free: Option<Rc<Vec<Free>>>,
+}
+
+#[derive(Debug, Clone)]
+pub enum ElemKind {
+    Parameter {
+        ty: MType,
+        dims: Option<Vec<Option<u32>>>,
+    },
+    Signal {
+        ty: MType,
+        dims: Option<Vec<Option<u32>>>,
+        /// An input connector nothing binds (see [`Free`]).
+        free: bool,
+    },
+    Object {
+        class: ClassKey,
+    },
+    Method,
+    /// A child held by a reference that is not containment (Requires, Moves, ...), or whose containment would
+    /// make the class contain itself: a `String` parameter with the NodeId of the target (an array of them for
+    /// a placeholder).
+    Reference {
+        array: bool,
+    },
+    /// Declared nowhere (no Modelica type); the name stays taken.
+    Skipped,
+}
+
+/// A class name in generated text: a fixed path or a class that is named once its owner is planned.
+#[derive(Debug, Clone, PartialEq)]
+pub enum TypeRef {
+    Path(String),
+    Class(ClassKey),
+}
+
+#[derive(Debug, Clone)]
+pub enum Mod {
+    Value {
+        ident: String,
+        is_final: bool,
+        attrs: Vec<String>,
+        value: Option<String>,
+    },
+    Nested {
+        ident: String,
+        mods: Vec<Mod>,
+    },
+    /// `redeclare model <Alias> = <class>`.
+    Redeclare {
+        ident: String,
+        class: TypeRef,
+    },
+    /// On a component of `class`: the class's own choice for each of its replaceable aliases that some class
+    /// redeclares, repeated as `redeclare model <Alias> = <class of Alias in class>` (see
+    /// [`Ctx::redeclared`](super::ctx::Ctx::redeclared)). Equivalent Modelica; rumoca 0.10.2 needs it, because it
+    /// lets an enclosing instance's redeclaration of an alias replace the nested class's own.
+    Pin {
+        class: ClassKey,
+    },
+}
+
+#[derive(Debug, Clone)]
+pub enum Item {
+    Comment(String),
+    /// `replaceable model <ident> = <class> "desc";`
+    Alias {
+        ident: String,
+        class: TypeRef,
+        desc: String,
+    },
+    Decl {
+        prefix: String,
+        ty: TypeRef,
+        ident: String,
+        dims: String,
+        mods: Vec<Mod>,
+        value: Option<String>,
+        cond: Option<String>,
+        desc: String,
+        annotation: String,
+    },
+}
+
+/// A class ready to be written.
+#[derive(Debug, Clone)]
+pub struct ClassPlan {
+    pub keyword: &'static str,
+    pub desc: String,
+    pub doc_html: String,
+    pub extends: Option<(TypeRef, Vec<Mod>)>,
+    pub items: Vec<Item>,
+    pub equations: Vec<String>,
+    pub opcua: String,
+}
+
+/// The classes of one owner (an ObjectType or a top-level instance).
+#[derive(Debug, Default)]
+pub struct OwnerPlan {
+    pub main: Option<ClassPlan>,
+    pub decls: Vec<(String, ClassPlan)>,
+}
+
+/// A child of the node a class is planned for, with the reference that holds it.
+#[derive(Debug, Clone, Copy)]
+pub struct Own {
+    pub node: NodeIx,
+    pub rt: NodeIx,
+}
+
+/// A declaration class whose base is a type still being planned (types that contain each other through
+/// placeholders); planned as soon as that type is complete.
+#[derive(Debug, Clone)]
+pub struct Deferred {
+    pub owner: Owner,
+    pub path: String,
+    pub node: NodeIx,
+    pub td: NodeIx,
+    pub children: Vec<Own>,
+    pub mode: Mode,
+}
+
+/// What planning a class body produced.
+#[derive(Debug, Default)]
+pub struct Body {
+    pub mods: Vec<Mod>,
+    pub items: Vec<Item>,
+    pub equations: Vec<String>,
+    pub elements: Vec<Element>,
+    pub taken: BTreeSet<String>,
+    pub local_replaceable: bool,
+    /// The body declares or redeclares something, so it needs a class of its own (modifiers alone do not).
+    pub adds: bool,
+    /// The state the inherited state machine starts in here, when a child CurrentState names another one.
+    pub initial: Option<usize>,
+    /// How many input and output connectors the class has placed on its icon (inherited ones included).
+    pub placed: Placed,
+}
+
+/// How many input connectors (left edge of the icon) and output connectors (right edge) a class places.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Placed {
+    pub inputs: usize,
+    pub outputs: usize,
+}
+
+impl Placed {
+    /// The `Placement` of the next input (or output) connector: inputs down the left edge of the icon,
+    /// outputs down the right one, 20 units apart from the top, as in the Modelica Standard Library's blocks.
+    pub fn next(&mut self, input: bool) -> String {
+        let i = if input { &mut self.inputs } else { &mut self.outputs };
+        let y = 80 - 20 * *i as i64;
+        *i += 1;
+        let (x0, x1) = if input { (-120, -100) } else { (100, 120) };
+        format!("Placement(transformation(extent={{{{{x0},{}}},{{{x1},{}}}}}))", y - 10, y + 10)
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mode {
+    /// An ObjectType or the class of an instance declaration: children without a ModellingRule are not
+    /// instantiated.
+    Type,
+    /// An instance: every child is part of it, optional members are present when a child is.
+    Instance,
+}
