@@ -23,7 +23,7 @@
 use super::ctx::{node_id_text, Ctx};
 use super::plan::{ElemKind, Element};
 use super::text::{self, string_literal};
-use super::types::{Base, MType};
+use super::plan::{Base, MType};
 use crate::model::NodeIx;
 use crate::raw::NodeClass;
 use std::collections::BTreeMap;

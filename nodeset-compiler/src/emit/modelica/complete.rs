@@ -4,10 +4,9 @@
 //! it is; components and class aliases whose class is partial use it (Modelica tools refuse components of partial
 //! classes).
 
-use super::ctx::{self, class_ident, decl_class_ident, ClassKey, Ctx};
-use super::plan::{ClassPlan, ElemKind, Element, Free, Mod};
+use super::ctx::{class_ident, decl_class_ident, Ctx};
+use super::plan::{ClassKey, ClassPlan, ElemKind, Element, Free, Mod, TypeRef};
 use super::text;
-use super::{render_mods, Output};
 
 impl Ctx<'_> {
     /// The free inputs of a class with these elements: its own, and those of its components. A component whose
@@ -127,12 +126,13 @@ fn bind_at(mods: &mut Vec<Mod>, path: &[(String, bool)], value: String, each: bo
     mods.push(Mod::Nested { ident, mods: inner });
 }
 
-/// The complete variant of a class with inputs nothing binds: the class with each of them bound to its value
-/// in the nodeset, so that it simulates as it is (`<Pkg>.Complete.<Ident>`).
-pub(super) fn emit_complete(ctx: &mut Ctx, key: &ctx::ClassKey, plan: &ClassPlan, out: &mut Output) {
-    let Some(info) = ctx.class_infos.get(key).cloned() else { return };
+/// The plan of the complete variant of a class with inputs nothing binds: the class with each of them bound to
+/// its value in the nodeset, so that it simulates as it is (`<Pkg>.Complete.<Ident>`); with its namespace and
+/// identifier. `None` for a class that binds all its inputs.
+pub fn complete_plan(ctx: &mut Ctx, key: &ClassKey, plan: &ClassPlan) -> Option<(u16, String, ClassPlan)> {
+    let info = ctx.class_infos.get(key).cloned()?;
     if info.free.is_empty() {
-        return;
+        return None;
     }
     let mut mods = Vec::new();
     for f in info.free.iter() {
@@ -142,8 +142,8 @@ pub(super) fn emit_complete(ctx: &mut Ctx, key: &ctx::ClassKey, plan: &ClassPlan
     let base = ctx.class_path(key);
     let ident = ctx.complete_ident(key);
     let ns = match key {
-        ctx::ClassKey::Type(t) => ctx.m.node(*t).id.ns,
-        ctx::ClassKey::Decl(o, _) => ctx.m.node(o.node()).id.ns,
+        ClassKey::Type(t) => ctx.m.node(*t).id.ns,
+        ClassKey::Decl(o, _) => ctx.m.node(o.node()).id.ns,
     };
     let listed: Vec<String> = info
         .free
@@ -153,22 +153,23 @@ pub(super) fn emit_complete(ctx: &mut Ctx, key: &ctx::ClassKey, plan: &ClassPlan
             format!("<code>{}</code>", p.join("."))
         })
         .collect();
-    let doc = format!(
+    let doc_html = format!(
         "<p><code>{}</code> with each input that nothing binds bound to its value in the nodeset, so that it \
          simulates as it is: {}. To compute them, extend <code>{}</code> instead and connect them.</p>",
         text::html_escape(&base),
         listed.join(", "),
         text::html_escape(&base)
     );
-    let abstract_type = matches!(key, ctx::ClassKey::Type(t) if ctx.m.node(*t).is_abstract());
+    let abstract_type = matches!(key, ClassKey::Type(t) if ctx.m.node(*t).is_abstract());
     let keyword = if plan.keyword == "partial model" && !abstract_type { "model" } else { plan.keyword };
-    let body = format!(
-        "{keyword} {ident} {}\n  extends {base}{};\n  annotation (\n    {},\n    {},\n    {});\nend {ident};\n",
-        plan.desc,
-        render_mods(ctx, &mods, 2),
-        text::documentation(&doc),
-        text::MODEL_ICON,
-        plan.opcua
-    );
-    out.add(ns, "Complete", &ident, body);
+    let variant = ClassPlan {
+        keyword,
+        desc: plan.desc.clone(),
+        doc_html,
+        extends: Some((TypeRef::Class(key.clone()), mods)),
+        items: Vec::new(),
+        equations: Vec::new(),
+        opcua: plan.opcua.clone(),
+    };
+    Some((ns, ident, variant))
 }

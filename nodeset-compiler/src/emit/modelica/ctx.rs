@@ -1,8 +1,7 @@
 //! The state of one generation run: package names, the name tables of every namespace, what the ns0 subset
 //! needs, and the diagnostics found on the way.
 
-use super::plan::{ClassInfo, Deferred, OwnerPlan};
-use super::types::RecordInfo;
+use super::plan::{ClassInfo, ClassKey, Deferred, Owner, OwnerPlan, RecordInfo};
 use crate::diag::{Code, Diagnostic, Diagnostics, Severity};
 use crate::model::{ids, Model, NodeIx};
 use crate::names::{sanitize, Case, Collision, Scope, Target};
@@ -10,6 +9,54 @@ use crate::nodeid::{Identifier, NodeId};
 use crate::raw::NodeClass;
 use std::collections::{BTreeMap, BTreeSet};
 use std::rc::Rc;
+
+/// The NodeId of the ObjectsFolder.
+pub const OBJECTS_FOLDER: u32 = 85;
+
+/// The Server object: what hangs below it (NamespaceMetadata, diagnostics) describes the server, not the
+/// plant, and is not an instance of the information model.
+const SERVER: u32 = 2253;
+
+/// Whether a node hangs below the ObjectsFolder through instances only (no type, no instance declaration, not
+/// below the Server object).
+fn below_objects(m: &Model, ix: NodeIx) -> bool {
+    let mut cur = m.node(ix).parent;
+    let mut steps = 0;
+    while let Some(p) = cur {
+        let n = m.node(p);
+        if n.id.ns0() == Some(OBJECTS_FOLDER) {
+            return true;
+        }
+        if n.id.ns0() == Some(SERVER) {
+            return false;
+        }
+        if n.class.is_type() || n.modelling_rule.is_some() {
+            return false;
+        }
+        steps += 1;
+        if steps > 64 {
+            return false;
+        }
+        cur = n.parent;
+    }
+    false
+}
+
+/// The entry points of a namespace's instances: objects and variables of the namespace below the
+/// ObjectsFolder whose parent belongs to another namespace (or is the ObjectsFolder), in node order.
+pub fn top_level(m: &Model, ns: u16) -> Vec<NodeIx> {
+    (0..m.nodes.len() as u32)
+        .map(NodeIx)
+        .filter(|&ix| {
+            let n = m.node(ix);
+            n.id.ns == ns
+                && matches!(n.class, NodeClass::Object | NodeClass::Variable)
+                && n.modelling_rule.is_none()
+                && n.parent.is_some_and(|p| m.node(p).id.ns != ns)
+                && below_objects(m, ix)
+        })
+        .collect()
+}
 
 /// The class of an owner's declaration in `Declarations`: `<Owner>_<Path>`, unique in the namespace (neither
 /// part contains a `_` the other could complete), and never the name of the class alias it is redeclared
@@ -23,30 +70,6 @@ pub fn decl_class_ident(owner_ident: &str, decl: &str) -> String {
 /// class per level. Companion specifications nest fewer than twenty; a model nested deeper (thousands of
 /// levels overflowed the stack) is cut here with an NS0302 warning.
 pub const MAX_NESTING: usize = 64;
-
-/// Who owns a set of instance-declaration classes: an ObjectType or a top-level instance.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum Owner {
-    Type(NodeIx),
-    Instance(NodeIx),
-}
-
-impl Owner {
-    pub fn node(self) -> NodeIx {
-        match self {
-            Owner::Type(ix) | Owner::Instance(ix) => ix,
-        }
-    }
-}
-
-/// A generated class, before it has a Modelica name.
-#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
-pub enum ClassKey {
-    /// The class of an ObjectType (`<Pkg>.ObjectTypes.<Name>`).
-    Type(NodeIx),
-    /// The class of an instance declaration that adds to its type, by its browse path below the owner.
-    Decl(Owner, String),
-}
 
 /// Something of the ns0 subset that generated code refers to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
@@ -149,7 +172,7 @@ impl<'a> Ctx<'a> {
         let mut owners: Scope<Owner> = self.scope();
         let mut instances: Scope<NodeIx> = self.scope();
         instances.reserve("Objects");
-        let top = super::instances::top_level(m, ns);
+        let top = top_level(m, ns);
         for (i, n) in m.nodes.iter().enumerate() {
             if n.id.ns != ns {
                 continue;

@@ -7,7 +7,8 @@
 //! holds one component per top-level instance and the DLR-style `OpcUaSupport.Nodes` record that lists every
 //! variable of the instances with its NodeId, DataType and initial value.
 
-use super::ctx::{identifier_text, node_id_text, node_id_type, Ctx, Owner};
+use super::ctx::{identifier_text, node_id_text, node_id_type, Ctx, OBJECTS_FOLDER};
+use super::plan::Owner;
 use super::objects::escape_browse_name;
 use super::plan::{ClassPlan, Mode, TypeRef};
 use super::text::{self, string_literal};
@@ -15,54 +16,6 @@ use crate::model::{ids, Model, NodeIx};
 use crate::raw::NodeClass;
 use crate::value::{BuiltinType, Variant};
 use std::collections::BTreeSet;
-
-/// The NodeId of the ObjectsFolder.
-const OBJECTS_FOLDER: u32 = 85;
-
-/// The Server object: what hangs below it (NamespaceMetadata, diagnostics) describes the server, not the
-/// plant, and is not an instance of the information model.
-const SERVER: u32 = 2253;
-
-/// Whether a node hangs below the ObjectsFolder through instances only (no type, no instance declaration, not
-/// below the Server object).
-fn below_objects(m: &Model, ix: NodeIx) -> bool {
-    let mut cur = m.node(ix).parent;
-    let mut steps = 0;
-    while let Some(p) = cur {
-        let n = m.node(p);
-        if n.id.ns0() == Some(OBJECTS_FOLDER) {
-            return true;
-        }
-        if n.id.ns0() == Some(SERVER) {
-            return false;
-        }
-        if n.class.is_type() || n.modelling_rule.is_some() {
-            return false;
-        }
-        steps += 1;
-        if steps > 64 {
-            return false;
-        }
-        cur = n.parent;
-    }
-    false
-}
-
-/// The entry points of a namespace's instances: objects and variables of the namespace below the
-/// ObjectsFolder whose parent belongs to another namespace (or is the ObjectsFolder), in node order.
-pub fn top_level(m: &Model, ns: u16) -> Vec<NodeIx> {
-    (0..m.nodes.len() as u32)
-        .map(NodeIx)
-        .filter(|&ix| {
-            let n = m.node(ix);
-            n.id.ns == ns
-                && matches!(n.class, NodeClass::Object | NodeClass::Variable)
-                && n.modelling_rule.is_none()
-                && n.parent.is_some_and(|p| m.node(p).id.ns != ns)
-                && below_objects(m, ix)
-        })
-        .collect()
-}
 
 /// The BrowseNames from the ObjectsFolder to a node, '/'-separated.
 pub fn path_from_objects(m: &Model, ix: NodeIx) -> String {
@@ -207,13 +160,13 @@ impl Ctx<'_> {
                 NodeClass::Variable => {
                     let ty = n.attrs.data_type.map(|d| self.mtype(d));
                     match ty {
-                        Some(ty) if !matches!(ty, super::types::MType::Unmapped(_)) => {
+                        Some(ty) if !matches!(ty, super::plan::MType::Unmapped(_)) => {
                             let dims = Self::dims(n.attrs.value_rank.unwrap_or(-1), &n.attrs.array_dimensions);
                             let value = self.value_of(top, &ty, dims.as_deref());
                             let writable = n.attrs.access_level.unwrap_or(1) & 0x02 != 0;
                             let dims_s = dims.as_deref().map(super::types::dims_text).unwrap_or_default();
                             let (prefix, tyname) = match &ty {
-                                super::types::MType::Scalar { base, .. } => (
+                                super::plan::MType::Scalar { base, .. } => (
                                     String::new(),
                                     format!("{sup}.{}{}", base.name(), if writable { "Output" } else { "Input" }),
                                 ),
@@ -226,7 +179,7 @@ impl Ctx<'_> {
                                 "  {prefix}{tyname} {ident}{dims_s} = {value} {desc}\n    annotation ({annotation});\n"
                             ));
                         }
-                        Some(super::types::MType::Unmapped(why)) => {
+                        Some(super::plan::MType::Unmapped(why)) => {
                             s.push_str(&format!("  // {} is left out: {why}.\n", n.browse_name.name));
                         }
                         _ => s.push_str(&format!("  // {} is left out: it has no DataType.\n", n.browse_name.name)),

@@ -3,11 +3,13 @@
 //! redeclaration with a class of its own).
 
 use super::complete::{bind_free, COMPLETE_NOTE};
-use super::ctx::{count_name, node_id_text, ClassKey, Ctx, Owner};
+use super::ctx::{count_name, node_id_text, Ctx};
+use super::plan::{ClassKey, Owner};
 use super::objects::{join_path, starting_in};
 use super::plan::{Body, ClassInfo, ClassPlan, ElemKind, Element, Item, Mod, Mode, Own, TypeRef, Deferred};
 use super::text::{self, string_literal};
-use super::types::{dims_text, Base, MType};
+use super::types::dims_text;
+use super::plan::{Base, MType};
 use crate::model::{ids, ModellingRule, NodeIx};
 use crate::nodeid::QualifiedName;
 use crate::raw::NodeClass;

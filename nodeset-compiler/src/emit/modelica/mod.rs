@@ -150,12 +150,13 @@
 //!
 //! # Where each concern lives
 //!
-//! Planning decides every class, then `mod.rs` renders the plans and writes the package skeleton.
+//! Planning decides every class, then `mod.rs` renders the plans and writes the package skeleton. The files
+//! import each other in one direction only, from the planners down to `ctx.rs` and `plan.rs`.
 //!
 //! | File | Concern |
 //! |---|---|
-//! | `ctx.rs` | the planning context: package and class names, caches, diagnostics |
-//! | `plan.rs` | what planning produces: class plans, elements, modifiers |
+//! | `plan.rs` | what planning produces: classes, elements, modifiers, DataType forms, state machines |
+//! | `ctx.rs` | the planning context: package and class names, the top-level instances, caches, diagnostics |
 //! | `objects.rs` | the class of an ObjectType or an event type, a class body from a base and children, values |
 //! | `members.rs` | one member: new (parameter, connector, component, reference, method) or overriding |
 //! | `complete.rs` | unbound inputs, partial classes and their complete variants |
@@ -185,7 +186,8 @@ use crate::model::{Model, NodeIx};
 use crate::names::{is_valid, Case, Scope, Target};
 use crate::raw::NodeClass;
 use crate::write::OutFile;
-use ctx::{Ctx, Need, Owner};
+use ctx::{Ctx, Need};
+use plan::Owner;
 use plan::{ClassPlan, ElemKind, Item, Mod, OwnerPlan, TypeRef};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
@@ -632,7 +634,7 @@ fn emit_namespace(ctx: &mut Ctx, ns: u16, out: &mut Output) {
         }
     }
     for &ix in &nodes {
-        if m.node(ix).class == NodeClass::ObjectType && ctx.class_infos.contains_key(&ctx::ClassKey::Type(ix)) {
+        if m.node(ix).class == NodeClass::ObjectType && ctx.class_infos.contains_key(&plan::ClassKey::Type(ix)) {
             emit_owner(ctx, Owner::Type(ix), out);
         }
     }
@@ -703,11 +705,17 @@ fn emit_owner(ctx: &mut Ctx, owner: Owner, out: &mut Output) {
         let body = render_class(ctx, decl, &ident);
         out.add(ns, "Declarations", &ident, body);
     }
-    if let (Owner::Type(t), Some(main)) = (owner, &plan.main) {
-        complete::emit_complete(ctx, &ctx::ClassKey::Type(t), main, out);
-    }
-    for (path, decl) in &plan.decls {
-        complete::emit_complete(ctx, &ctx::ClassKey::Decl(owner, path.clone()), decl, out);
+    // The complete variants of the classes that leave inputs unbound (`complete.rs`).
+    let mains = plan.main.iter().filter_map(|main| match owner {
+        Owner::Type(t) => Some((plan::ClassKey::Type(t), main)),
+        Owner::Instance(_) => None,
+    });
+    let decls = plan.decls.iter().map(|(path, decl)| (plan::ClassKey::Decl(owner, path.clone()), decl));
+    for (key, class) in mains.chain(decls) {
+        if let Some((ns, ident, variant)) = complete::complete_plan(ctx, &key, class) {
+            let body = render_class(ctx, &variant, &ident);
+            out.add(ns, "Complete", &ident, body);
+        }
     }
     ctx.plans.insert(owner, plan);
 }
@@ -763,7 +771,7 @@ fn render_parts(ctx: &mut Ctx, mods: &[Mod]) -> Vec<String> {
 }
 
 /// The redeclarations a [`Mod::Pin`] on a component of `class` stands for, one per alias.
-fn pinned(ctx: &mut Ctx, class: &ctx::ClassKey) -> Vec<String> {
+fn pinned(ctx: &mut Ctx, class: &plan::ClassKey) -> Vec<String> {
     let Some(info) = ctx.class_infos.get(class).cloned() else { return Vec::new() };
     let mut parts = Vec::new();
     for e in &info.elements {

@@ -8,10 +8,12 @@
 //! browse path is relative to the object the enclosing class stands for.
 
 use super::complete::{bind_free, COMPLETE_NOTE};
-use super::ctx::{component_original, count_name, node_id_text, undescribed, ClassKey, Ctx, Owner, MAX_NESTING};
+use super::ctx::{component_original, count_name, node_id_text, undescribed, Ctx, MAX_NESTING};
+use super::plan::{ClassKey, Owner};
 use super::plan::{Body, ClassInfo, ClassPlan, ElemKind, Element, Item, Mode, Own, OwnerPlan, Placed, TypeRef};
 use super::text::{self, string_literal};
-use super::types::{as_i128, dims_text, Base, MType};
+use super::types::{as_i128, dims_text};
+use super::plan::{Base, MType};
 use super::units::Unit;
 use crate::model::{ids, NodeIx};
 use crate::nodeid::QualifiedName;
@@ -551,11 +553,11 @@ impl Ctx<'_> {
 
 /// A state machine that starts in state `initial` instead of its own initial state.
 pub(super) fn starting_in(
-    sm: Option<Rc<super::statemachine::SmInfo>>,
+    sm: Option<Rc<super::plan::SmInfo>>,
     initial: Option<usize>,
-) -> Option<Rc<super::statemachine::SmInfo>> {
+) -> Option<Rc<super::plan::SmInfo>> {
     match (sm, initial) {
-        (Some(sm), Some(i)) => Some(Rc::new(super::statemachine::SmInfo { initial: i, ..(*sm).clone() })),
+        (Some(sm), Some(i)) => Some(Rc::new(super::plan::SmInfo { initial: i, ..(*sm).clone() })),
         (sm, _) => sm,
     }
 }

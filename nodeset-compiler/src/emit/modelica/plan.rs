@@ -1,10 +1,9 @@
 //! What planning produces: the plan of each class (its members, modifiers and equations) and what a planned class
 //! offers to the classes built on it. `objects.rs` and `members.rs` plan, `mod.rs` renders.
 
-use super::ctx::{ClassKey, Owner};
-use super::types::MType;
-use crate::model::NodeIx;
+use crate::model::{Field, NodeIx};
 use crate::nodeid::QualifiedName;
+use crate::value::BuiltinType;
 use std::collections::BTreeSet;
 use std::rc::Rc;
 
@@ -20,7 +19,7 @@ pub struct ClassInfo {
     /// as rumoca checks it).
     pub local_replaceable: bool,
     /// The state machine this class (or a base class) drives.
-    pub state_machine: Option<Rc<super::statemachine::SmInfo>>,
+    pub state_machine: Option<Rc<SmInfo>>,
     /// The connectors on its icon.
     pub placed: Placed,
     /// The input connectors nothing binds, in the class itself and in its components (see [`Free`]).
@@ -228,4 +227,130 @@ pub enum Mode {
     Type,
     /// An instance: every child is part of it, optional members are present when a child is.
     Instance,
+}
+
+/// Who owns a set of instance-declaration classes: an ObjectType or a top-level instance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Owner {
+    Type(NodeIx),
+    Instance(NodeIx),
+}
+
+impl Owner {
+    pub fn node(self) -> NodeIx {
+        match self {
+            Owner::Type(ix) | Owner::Instance(ix) => ix,
+        }
+    }
+}
+
+/// A generated class, before it has a Modelica name.
+#[derive(Clone, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum ClassKey {
+    /// The class of an ObjectType (`<Pkg>.ObjectTypes.<Name>`).
+    Type(NodeIx),
+    /// The class of an instance declaration that adds to its type, by its browse path below the owner.
+    Decl(Owner, String),
+}
+
+/// The state machine a class drives: the names its subclasses reuse.
+#[derive(Debug, Clone)]
+pub struct SmInfo {
+    pub level: u32,
+    pub level_param: String,
+    pub var: String,
+    /// State node -> constant.
+    pub states: Vec<(NodeIx, String)>,
+    /// The StateNumber of each state (the nodeset's, or the one given here), in the order of `states`.
+    pub numbers: Vec<u32>,
+    /// The index in `states` of the state the machine starts in.
+    pub initial: usize,
+    /// The `CurrentState` component, and the variable its final binding reads (the DisplayName of the current
+    /// state, set by an equation of the level that drives the machine); `None` when the class has no String
+    /// CurrentState.
+    pub text: Option<(String, String)>,
+    /// Cause (method or transition) node -> trigger input.
+    pub triggers: Vec<(NodeIx, String)>,
+    /// The BrowseNames of the states and transitions covered.
+    pub nodes: BTreeSet<QualifiedName>,
+}
+
+/// The predefined Modelica type a mapped OPC UA type is built on.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Base {
+    Real,
+    Integer,
+    Boolean,
+    String,
+}
+
+impl Base {
+    pub fn name(self) -> &'static str {
+        match self {
+            Base::Real => "Real",
+            Base::Integer => "Integer",
+            Base::Boolean => "Boolean",
+            Base::String => "String",
+        }
+    }
+}
+
+/// The Modelica form of an OPC UA DataType.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MType {
+    /// A predefined type, directly or through a `type` of a Types package (`class`), with the attributes the
+    /// alias carries (so connectors, which are declared on the predefined type, can repeat them).
+    Scalar {
+        base: Base,
+        class: Option<String>,
+        min: Option<&'static str>,
+        max: Option<&'static str>,
+        unit: Option<&'static str>,
+        builtin: BuiltinType,
+    },
+    Enum {
+        class: String,
+        dt: NodeIx,
+    },
+    Record {
+        class: String,
+        dt: NodeIx,
+    },
+    /// No faithful mapping; the reason, for the comment that replaces the declaration.
+    Unmapped(String),
+}
+
+impl MType {
+    /// The type name used in declarations of parameters and record fields.
+    pub fn type_name(&self) -> &str {
+        match self {
+            MType::Scalar { base, class, .. } => class.as_deref().unwrap_or(base.name()),
+            MType::Enum { class, .. } | MType::Record { class, .. } => class,
+            MType::Unmapped(_) => "",
+        }
+    }
+}
+
+/// Field names of a structure (or bits of an OptionSet), inherited ones included.
+#[derive(Debug)]
+pub struct RecordInfo {
+    pub fields: Vec<RecField>,
+    pub taken: BTreeSet<String>,
+    /// The structure this record `extends` (a supertype with fields of its own).
+    pub extends: Option<NodeIx>,
+}
+
+#[derive(Debug, Clone)]
+pub struct RecField {
+    pub name: String,
+    pub ident: String,
+    /// `has_<ident>` of an optional field.
+    pub has_flag: Option<String>,
+    /// `n<Ident>`, the length of an array of records of unknown length (which needs a size).
+    pub count: Option<String>,
+    pub field: Option<Field>,
+    pub bit: Option<i64>,
+    pub description: Option<String>,
+    /// Declared by a supertype (and inherited through `extends`).
+    pub inherited: bool,
 }

@@ -39,36 +39,14 @@
 //! state in the nodeset's order. The description of `currentStateNumber` says which rule applied.
 
 use super::ctx::{component_original, Ctx};
-use super::plan::{Body, ClassInfo, ElemKind, Item, Mod, TypeRef};
+use super::plan::{Body, ClassInfo, ElemKind, Item, Mod, SmInfo, TypeRef};
 use super::text::string_literal;
-use super::types::{Base, MType};
+use super::plan::{Base, MType};
 use crate::model::{ids, Model, NodeIx};
 use crate::nodeid::QualifiedName;
 use crate::value::Variant;
 use std::collections::BTreeSet;
 use std::rc::Rc;
-
-/// The state machine a class drives: the names its subclasses reuse.
-#[derive(Debug, Clone)]
-pub struct SmInfo {
-    pub level: u32,
-    pub level_param: String,
-    pub var: String,
-    /// State node -> constant.
-    pub states: Vec<(NodeIx, String)>,
-    /// The StateNumber of each state (the nodeset's, or the one given here), in the order of `states`.
-    pub numbers: Vec<u32>,
-    /// The index in `states` of the state the machine starts in.
-    pub initial: usize,
-    /// The `CurrentState` component, and the variable its final binding reads (the DisplayName of the current
-    /// state, set by an equation of the level that drives the machine); `None` when the class has no String
-    /// CurrentState.
-    pub text: Option<(String, String)>,
-    /// Cause (method or transition) node -> trigger input.
-    pub triggers: Vec<(NodeIx, String)>,
-    /// The BrowseNames of the states and transitions covered.
-    pub nodes: BTreeSet<QualifiedName>,
-}
 
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
 enum Key {

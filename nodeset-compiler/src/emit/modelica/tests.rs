@@ -3,7 +3,8 @@
 //! rumoca accepts duplicate enumeration literals and does not complain about a modifier of an element that
 //! does not exist, so these properties are checked here, on the generator's own tables.
 
-use super::ctx::{ClassKey, Ctx};
+use super::ctx::Ctx;
+use super::plan::ClassKey;
 use super::plan::ElemKind;
 use super::*;
 use crate::load::Input;

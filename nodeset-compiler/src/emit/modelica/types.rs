@@ -2,6 +2,7 @@
 //! Modelica literals.
 
 use super::ctx::{node_id_text, Ctx};
+use super::plan::{Base, MType, RecField, RecordInfo};
 use super::text::{self, string_literal};
 use crate::model::{ids, DataTypeKind, EnumValue, Field, NodeIx, StructureKind};
 use crate::nodeid::{format_guid, QualifiedName};
@@ -10,62 +11,6 @@ use crate::source::FileId;
 use crate::value::{BuiltinType, Variant};
 use std::collections::BTreeSet;
 use std::rc::Rc;
-
-/// The predefined Modelica type a mapped OPC UA type is built on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Base {
-    Real,
-    Integer,
-    Boolean,
-    String,
-}
-
-impl Base {
-    pub fn name(self) -> &'static str {
-        match self {
-            Base::Real => "Real",
-            Base::Integer => "Integer",
-            Base::Boolean => "Boolean",
-            Base::String => "String",
-        }
-    }
-}
-
-/// The Modelica form of an OPC UA DataType.
-#[derive(Clone, Debug, PartialEq)]
-pub enum MType {
-    /// A predefined type, directly or through a `type` of a Types package (`class`), with the attributes the
-    /// alias carries (so connectors, which are declared on the predefined type, can repeat them).
-    Scalar {
-        base: Base,
-        class: Option<String>,
-        min: Option<&'static str>,
-        max: Option<&'static str>,
-        unit: Option<&'static str>,
-        builtin: BuiltinType,
-    },
-    Enum {
-        class: String,
-        dt: NodeIx,
-    },
-    Record {
-        class: String,
-        dt: NodeIx,
-    },
-    /// No faithful mapping; the reason, for the comment that replaces the declaration.
-    Unmapped(String),
-}
-
-impl MType {
-    /// The type name used in declarations of parameters and record fields.
-    pub fn type_name(&self) -> &str {
-        match self {
-            MType::Scalar { base, class, .. } => class.as_deref().unwrap_or(base.name()),
-            MType::Enum { class, .. } | MType::Record { class, .. } => class,
-            MType::Unmapped(_) => "",
-        }
-    }
-}
 
 /// How a built-in type maps: its base, attributes, and whether it needs a `type` of its own in `OpcUa.Types`.
 struct BuiltinMap {
@@ -141,30 +86,6 @@ fn builtin_map(b: BuiltinType) -> Result<BuiltinMap, &'static str> {
         B::Variant => Err("BaseDataType stands for any type (a Variant), which has no Modelica type"),
         B::DiagnosticInfo => Err("DiagnosticInfo has no Modelica type"),
     }
-}
-
-/// Field names of a structure (or bits of an OptionSet), inherited ones included.
-#[derive(Debug)]
-pub struct RecordInfo {
-    pub fields: Vec<RecField>,
-    pub taken: BTreeSet<String>,
-    /// The structure this record `extends` (a supertype with fields of its own).
-    pub extends: Option<NodeIx>,
-}
-
-#[derive(Debug, Clone)]
-pub struct RecField {
-    pub name: String,
-    pub ident: String,
-    /// `has_<ident>` of an optional field.
-    pub has_flag: Option<String>,
-    /// `n<Ident>`, the length of an array of records of unknown length (which needs a size).
-    pub count: Option<String>,
-    pub field: Option<Field>,
-    pub bit: Option<i64>,
-    pub description: Option<String>,
-    /// Declared by a supertype (and inherited through `extends`).
-    pub inherited: bool,
 }
 
 impl Ctx<'_> {
