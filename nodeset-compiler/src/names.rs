@@ -9,12 +9,17 @@
 //!    followed by lower case (`HTTPServer` → `HTTP` `Server`). A run of capitals ending in a lone `s` is one
 //!    word (`IOs`, `PLCs`). Digits stay with the letters before them (`Axis1`), and a leading number stays
 //!    with the letters after it when they are capitals (`3DFrame` → `3D` `Frame`).
+//!
+//!    With [`Case::Preserve`] (Modelica), a name that already is an identifier of ASCII letters, digits and
+//!    underscores starting with a letter keeps its spelling: `MANUAL_REDUCED_SPEED` stays as it is, where the
+//!    other cases give `ManualReducedSpeed`, `manual_reduced_speed`. Rules 5 and 7 still apply to it.
 //! 3. Characters outside ASCII are kept as `uXXXX` (their code point), so distinct names stay distinct.
 //! 4. The words are joined in the requested case. A name that then starts with a digit gets the prefix `N`
 //!    (`n` in snake case): `3DFrameType` → `N3DFrameType`, `n3d_frame`.
 //! 5. A Rust keyword becomes a raw identifier (`r#type`, `r#match`); the ones that cannot be raw (`self`,
-//!    `Self`, `super`, `crate`, `_`) get a trailing underscore. A Modelica reserved word or predefined type
-//!    name (`model`, `input`, `Real`, `time`, ...) gets a trailing underscore.
+//!    `Self`, `super`, `crate`, `_`) get a trailing underscore. A Modelica reserved word, predefined type
+//!    name or annotation name (`model`, `input`, `Real`, `time`, `Documentation`, `Icon`, ...) gets a trailing
+//!    underscore.
 //! 6. An empty result (a name of punctuation only) becomes `_` followed by the code points (`Precise+` is
 //!    fine, `+` alone becomes `u002b`).
 //! 7. A Modelica identifier longer than [`MAX_IDENT_LEN`] bytes keeps its first 103 bytes and ends in 16 hex
@@ -78,6 +83,10 @@ pub const MODELICA_RESERVED: &[&str] = &[
     "sample", "pre", "edge", "change", "reinit", "assert", "terminate", "cardinality", "size", "ndims", "abs",
     "sign", "sqrt", "min", "max", "sum", "product", "fill", "zeros", "ones", "noEvent", "smooth", "homotopy",
     "delay", "initial", "terminal", "Modelica",
+    // Annotations the generator writes, and the graphical records inside them: a class of one of these names
+    // would read as the annotation to some tools and to every reader.
+    "Documentation", "Icon", "Diagram", "Placement", "Rectangle", "Text", "Line", "Polygon", "Ellipse", "Bitmap",
+    "experiment", "Evaluate",
 ];
 
 /// Splits a name into words per the module rules (brackets and punctuation removed).
@@ -179,8 +188,8 @@ pub fn cap_len(name: String, case: Case) -> String {
 
 /// The identifier for `original` in `case` for `target`. Always a valid identifier of the target language.
 pub fn sanitize(original: &str, case: Case, target: Target) -> String {
-    let ws = words(original);
-    let mut name = join(&ws, case);
+    let bare = original.strip_prefix('<').and_then(|s| s.strip_suffix('>')).unwrap_or(original);
+    let mut name = if case == Case::Preserve && is_plain(bare) { bare.to_string() } else { join(&words(original), case) };
     if name.is_empty() {
         name = original.chars().map(|c| format!("u{:04x}", c as u32)).collect();
         if name.is_empty() {
@@ -209,6 +218,12 @@ pub fn sanitize(original: &str, case: Case, target: Target) -> String {
         Target::Modelica => cap_len(name, case),
         Target::Rust => name,
     }
+}
+
+/// Rule 2, for [`Case::Preserve`]: whether a name is already written the way every target spells an identifier (ASCII letters,
+/// digits and underscores, starting with a letter), so that [`Case::Preserve`] keeps it as it is.
+fn is_plain(s: &str) -> bool {
+    s.starts_with(|c: char| c.is_ascii_alphabetic()) && s.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
 }
 
 /// Whether `s` is a valid identifier of the target (used by tests and debug assertions).
@@ -332,9 +347,16 @@ mod tests {
             ("Run-1", Case::Snake, Target::Rust, "run_1"),
             ("Axis1", Case::Snake, Target::Rust, "axis1"),
             ("Model", Case::Preserve, Target::Modelica, "Model"),
+            ("MANUAL_REDUCED_SPEED", Case::Preserve, Target::Modelica, "MANUAL_REDUCED_SPEED"),
+            ("<Axis_Identifier>", Case::Preserve, Target::Modelica, "Axis_Identifier"),
+            ("Mode-A", Case::Preserve, Target::Modelica, "ModeA"),
+            ("_x", Case::Preserve, Target::Modelica, "x"),
+            ("MANUAL_REDUCED_SPEED", Case::UpperCamel, Target::Rust, "ManualReducedSpeed"),
             ("model", Case::Preserve, Target::Modelica, "model_"),
             ("Real", Case::Preserve, Target::Modelica, "Real_"),
             ("input", Case::Preserve, Target::Modelica, "input_"),
+            ("Documentation", Case::Preserve, Target::Modelica, "Documentation_"),
+            ("Documentation", Case::UpperCamel, Target::Rust, "Documentation"),
             ("+", Case::Snake, Target::Rust, "u002b"),
             ("Größe", Case::Snake, Target::Rust, "gr_u00f6_u00df_e"),
         ];

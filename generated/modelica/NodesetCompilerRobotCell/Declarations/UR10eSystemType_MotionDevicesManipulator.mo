@@ -6,7 +6,7 @@ partial model UR10eSystemType_MotionDevicesManipulator "Manipulator: The six-joi
     manufacturer="Universal Robots A/S",
     model_="UR10e",
     redeclare model Axes = NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorAxes,
-    motionDeviceCategory=OpcUaRobotics.Types.MotionDeviceCategoryEnumeration.ARTICULATEDROBOT,
+    motionDeviceCategory=OpcUaRobotics.Types.MotionDeviceCategoryEnumeration.ARTICULATED_ROBOT,
     redeclare model PowerTrains = NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrains);
   annotation (
     Documentation(info="<html><p>The six-joint UR10e arm.</p><p>The class of <code>MotionDevices/Manipulator</code> in RobotCell:UR10eSystemType: Robotics:MotionDeviceType with the children this declaration adds or changes.</p><p>Members of its components are inputs that nothing binds (values the model publishes, which the physics computing them connects to), so the class is partial: extend it and connect them, or use its complete variant in the package <code>Complete</code>, which binds them to the nodeset's values.</p></html>"),

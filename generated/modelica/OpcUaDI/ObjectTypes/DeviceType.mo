@@ -44,9 +44,9 @@ partial model DeviceType "DeviceType"
   parameter Boolean use_documentation = false
     "Whether the optional Documentation exists"
     annotation (Evaluate=true);
-  replaceable model Documentation = OpcUa.ObjectTypes.FolderType
+  replaceable model Documentation_ = OpcUa.ObjectTypes.FolderType
     "Class of Documentation; redeclare it to use a model of your own";
-  Documentation documentation if use_documentation
+  Documentation_ documentation if use_documentation
     "Documentation"
     annotation (__OPCUA(browsePath="Documentation", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6211", typeDefinition="i=61"));
   parameter Boolean use_protocolSupport = false

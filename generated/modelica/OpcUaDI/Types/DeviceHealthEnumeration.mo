@@ -4,9 +4,9 @@ within OpcUaDI.Types;
 type DeviceHealthEnumeration = enumeration(
     NORMAL "NORMAL = 0: This device functions normally.",
     FAILURE "FAILURE = 1: Malfunction of the device or any of its peripherals.",
-    CHECKFUNCTION "CHECK_FUNCTION = 2: Functional checks are currently performed.",
-    OFFSPEC "OFF_SPEC = 3: The device is currently working outside of its specified range or that internal diagnoses indicate deviations from measured or set values.",
-    MAINTENANCEREQUIRED "MAINTENANCE_REQUIRED = 4: This element is working, but a maintenance operation is required.")
+    CHECK_FUNCTION "CHECK_FUNCTION = 2: Functional checks are currently performed.",
+    OFF_SPEC "OFF_SPEC = 3: The device is currently working outside of its specified range or that internal diagnoses indicate deviations from measured or set values.",
+    MAINTENANCE_REQUIRED "MAINTENANCE_REQUIRED = 4: This element is working, but a maintenance operation is required.")
   "DeviceHealthEnumeration"
   annotation (
     Documentation(info="<html><p>The DataType <code>DI:DeviceHealthEnumeration</code> (nsu=http://opcfoundation.org/UA/DI/;i=6244), a subtype of <code>Enumeration</code>. The information model gives it no description.</p><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaDI.EnumerationValues.DeviceHealthEnumeration[Integer(x)]</code>.</p></html>"),

@@ -4,7 +4,7 @@ within OpcUaIA.Types;
 type StacklightOperationMode = enumeration(
     Segmented "Segmented = 0: Stacklight is used as stack of individual lights",
     Levelmeter "Levelmeter = 1: Stacklight is used as level meter",
-    RunningLight "Running_Light = 2: The whole stack acts as a running light",
+    Running_Light "Running_Light = 2: The whole stack acts as a running light",
     Other "Other = 3: Stacklight is used in a way not defined in this version of the specification")
   "StacklightOperationMode: Contains the values used to indicate how a stacklight (as a whole unit) is used."
   annotation (

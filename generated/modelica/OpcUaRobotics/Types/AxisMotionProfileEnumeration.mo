@@ -4,9 +4,9 @@ within OpcUaRobotics.Types;
 type AxisMotionProfileEnumeration = enumeration(
     OTHER "OTHER = 0: Any motion-profile which is not defined by the AxisMotionProfileEnumeration.",
     ROTARY "ROTARY = 1: Rotary motion is a rotation along a circular path with defined limits. Motion movement is not going always in the same direction. Control unit is mainly degree.",
-    ROTARYENDLESS "ROTARY_ENDLESS = 2: Rotary motion is a rotation along a circular path with no limits. Motion movement is going endless in the same direction. Control unit is mainly degree.",
+    ROTARY_ENDLESS "ROTARY_ENDLESS = 2: Rotary motion is a rotation along a circular path with no limits. Motion movement is going endless in the same direction. Control unit is mainly degree.",
     LINEAR "LINEAR = 3: Linear motion is a one dimensional motion along a straight line with defined limits. Motion movement is not going always in the same direction. Control unit is mainly mm.",
-    LINEARENDLESS "LINEAR_ENDLESS = 4: Linear motion is a one dimensional motion along a straight line with no limits. Motion movement is going endless in the same direction. Control unit is mainly mm.")
+    LINEAR_ENDLESS "LINEAR_ENDLESS = 4: Linear motion is a one dimensional motion along a straight line with no limits. Motion movement is going endless in the same direction. Control unit is mainly mm.")
   "AxisMotionProfileEnumeration"
   annotation (
     Documentation(info="<html><p>The DataType <code>Robotics:AxisMotionProfileEnumeration</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=3008), a subtype of <code>Enumeration</code>. The information model gives it no description.</p><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaRobotics.EnumerationValues.AxisMotionProfileEnumeration[Integer(x)]</code>.</p></html>"),

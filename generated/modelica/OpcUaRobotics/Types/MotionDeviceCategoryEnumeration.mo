@@ -3,12 +3,12 @@
 within OpcUaRobotics.Types;
 type MotionDeviceCategoryEnumeration = enumeration(
     OTHER "OTHER = 0: Any MotionDevice which is not defined by the MotionDeviceCategoryEnumeration.",
-    ARTICULATEDROBOT "ARTICULATED_ROBOT = 1: This robot design features rotary joints and can range from simple two joint structures to 10 or more joints. The arm is connected to the base with a twisting joint. The links in the arm are connected by rotary joints.",
-    SCARAROBOT "SCARA_ROBOT = 2: The robot has two parallel rotary joints that ensure compliance in a specified plane.",
-    CARTESIANROBOT "CARTESIAN_ROBOT = 3: Cartesian robots have three linear joints that use the Cartesian coordinate system (X, Y, and Z). They also may have an attached wrist to allow for rotational movement. The three prismatic joints provide linear movement along the axis.",
-    SPHERICALROBOT "SPHERICAL_ROBOT = 4: The arm is connected to the base with a twisting joint and a combination of two rotary joints and one linear joint. The axes form a polar coordinate system and create a spherical shaped work envelope.",
-    PARALLELROBOT "PARALLEL_ROBOT = 5: These spider like robots are built from jointed parallelograms connected to a common base. The parallelograms move a single EOAT in a dome-shaped work area.",
-    CYLINDRICALROBOT "CYLINDRICAL_ROBOT = 6: The robot has at least one rotary joint at the base and at least one prismatic joint to connect the links. The rotary joint uses a rotational motion along the joint axis, while the prismatic joint moves in a linear motion. Cylindrical robots operate within a cylindrical-shaped work envelope.")
+    ARTICULATED_ROBOT "ARTICULATED_ROBOT = 1: This robot design features rotary joints and can range from simple two joint structures to 10 or more joints. The arm is connected to the base with a twisting joint. The links in the arm are connected by rotary joints.",
+    SCARA_ROBOT "SCARA_ROBOT = 2: The robot has two parallel rotary joints that ensure compliance in a specified plane.",
+    CARTESIAN_ROBOT "CARTESIAN_ROBOT = 3: Cartesian robots have three linear joints that use the Cartesian coordinate system (X, Y, and Z). They also may have an attached wrist to allow for rotational movement. The three prismatic joints provide linear movement along the axis.",
+    SPHERICAL_ROBOT "SPHERICAL_ROBOT = 4: The arm is connected to the base with a twisting joint and a combination of two rotary joints and one linear joint. The axes form a polar coordinate system and create a spherical shaped work envelope.",
+    PARALLEL_ROBOT "PARALLEL_ROBOT = 5: These spider like robots are built from jointed parallelograms connected to a common base. The parallelograms move a single EOAT in a dome-shaped work area.",
+    CYLINDRICAL_ROBOT "CYLINDRICAL_ROBOT = 6: The robot has at least one rotary joint at the base and at least one prismatic joint to connect the links. The rotary joint uses a rotational motion along the joint axis, while the prismatic joint moves in a linear motion. Cylindrical robots operate within a cylindrical-shaped work envelope.")
   "MotionDeviceCategoryEnumeration"
   annotation (
     Documentation(info="<html><p>The DataType <code>Robotics:MotionDeviceCategoryEnumeration</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=18193), a subtype of <code>Enumeration</code>. The information model gives it no description.</p><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaRobotics.EnumerationValues.MotionDeviceCategoryEnumeration[Integer(x)]</code>.</p></html>"),

@@ -3,10 +3,10 @@
 within OpcUaRobotics.Types;
 type OperationalModeEnumeration = enumeration(
     OTHER "OTHER = 0: Other for when there is a system-boot (unknown) or a failure of the safety, there is no valid operational mode.",
-    MANUALREDUCEDSPEED "MANUAL_REDUCED_SPEED = 1: \"Manual reduced speed\" - name according to ISO 10218-1:2011.",
-    MANUALHIGHSPEED "MANUAL_HIGH_SPEED = 2: \"Manual high speed\" - name according to ISO 10218-1:2011.",
+    MANUAL_REDUCED_SPEED "MANUAL_REDUCED_SPEED = 1: \"Manual reduced speed\" - name according to ISO 10218-1:2011.",
+    MANUAL_HIGH_SPEED "MANUAL_HIGH_SPEED = 2: \"Manual high speed\" - name according to ISO 10218-1:2011.",
     AUTOMATIC "AUTOMATIC = 3: \"Automatic\" - name according to ISO 10218-1:2011.",
-    AUTOMATICEXTERNAL "AUTOMATIC_EXTERNAL = 4: \"Automatic external\" - Same as \"Automatic\" but with external control, e.g. by a PLC.")
+    AUTOMATIC_EXTERNAL "AUTOMATIC_EXTERNAL = 4: \"Automatic external\" - Same as \"Automatic\" but with external control, e.g. by a PLC.")
   "OperationalModeEnumeration"
   annotation (
     Documentation(info="<html><p>The DataType <code>Robotics:OperationalModeEnumeration</code> (nsu=http://opcfoundation.org/UA/Robotics/;i=3006), a subtype of <code>Enumeration</code>. The information model gives it no description.</p><p>The OPC UA value of a literal <code>x</code> is <code>OpcUaRobotics.EnumerationValues.OperationalModeEnumeration[Integer(x)]</code>.</p></html>"),

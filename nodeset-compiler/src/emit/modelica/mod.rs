@@ -120,7 +120,8 @@
 //! # Names
 //!
 //! Every identifier comes from [`crate::names::Scope`] with `Target::Modelica` and `Case::Preserve`: class
-//! names keep the BrowseName (`3DFrameType` -> `N3DFrameType`), component names start with their first word
+//! names keep the BrowseName (`3DFrameType` -> `N3DFrameType`; a BrowseName that already is an identifier keeps
+//! its spelling, so the enumeration literal `MANUAL_REDUCED_SPEED` stays as it is), component names start with their first word
 //! in lower case (`ActualPosition` -> `actualPosition`, `Model` -> `model_`), reserved words get a trailing
 //! underscore, and names that collide in one scope get `_2`, `_3`, ... in the sorted order of the originals
 //! (with a warning). Each scope reserves the names of the top-level packages and every name a base class

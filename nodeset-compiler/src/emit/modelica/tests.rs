@@ -277,6 +277,19 @@ fn published_values_are_unbound_inputs_and_complete_variants_bind_them() {
 }
 
 #[test]
+fn names_keep_their_spelling_where_legal_and_never_name_an_annotation() {
+    let files = robotics_files();
+    // DI's ISupportInfoType has an optional folder Documentation: its class is not called like the annotation.
+    let support = contents(&files, "OpcUaDI/ObjectTypes/ISupportInfoType.mo");
+    assert!(support.contains("  replaceable model Documentation_ = OpcUa.ObjectTypes.FolderType\n"), "{support}");
+    assert!(!support.contains("model Documentation "), "{support}");
+    let category = contents(&files, "OpcUaRobotics/Types/MotionDeviceCategoryEnumeration.mo");
+    assert!(category.contains("\n    ARTICULATED_ROBOT \"ARTICULATED_ROBOT = 1: "), "{category}");
+    let mode = contents(&files, "OpcUaRobotics/Types/OperationalModeEnumeration.mo");
+    assert!(mode.contains("\n    MANUAL_REDUCED_SPEED \""), "{mode}");
+}
+
+#[test]
 fn references_that_are_not_containment_name_their_target() {
     let files = robotics_files();
     // AxisType Requires <PowerTrainIdentifier>; PowerTrainType Moves <AxisIdentifier> and HasSlave
