@@ -2,7 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within NodesetCompilerRobotCell.Declarations;
 model UR10eSystemType_Controllers "Controllers: The controller of the UR10e."
-  extends OpcUaRobotics.Declarations.MotionDeviceSystemType_Controllers;
+  extends OpcUaRobotics.Declarations.MotionDeviceSystemType_Controllers(nControllerIdentifier(min=0)=0);
   replaceable model URController = NodesetCompilerRobotCell.Complete.UR10eSystemType_ControllersURController constrainedby NodesetCompilerRobotCell.Declarations.UR10eSystemType_ControllersURController
     "Class of URController; redeclare it to use a model of your own";
   URController urController(

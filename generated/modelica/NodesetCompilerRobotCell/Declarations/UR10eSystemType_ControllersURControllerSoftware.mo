@@ -2,7 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within NodesetCompilerRobotCell.Declarations;
 model UR10eSystemType_ControllersURControllerSoftware "Software: The software running on the controller."
-  extends OpcUaRobotics.Declarations.ControllerType_Software;
+  extends OpcUaRobotics.Declarations.ControllerType_Software(nSoftwareIdentifier(min=0)=0);
   replaceable model PolyScope = OpcUaDI.ObjectTypes.SoftwareType
     "Class of PolyScope; redeclare it to use a model of your own";
   PolyScope polyScope(

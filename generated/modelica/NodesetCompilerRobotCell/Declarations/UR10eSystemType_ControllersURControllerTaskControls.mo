@@ -2,7 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within NodesetCompilerRobotCell.Declarations;
 model UR10eSystemType_ControllersURControllerTaskControls "TaskControls: The program task of the controller."
-  extends OpcUaRobotics.Declarations.ControllerType_TaskControls;
+  extends OpcUaRobotics.Declarations.ControllerType_TaskControls(nTaskControlIdentifier(min=0)=0);
   replaceable model ProgramTask = OpcUaRobotics.Complete.TaskControlType constrainedby OpcUaRobotics.ObjectTypes.TaskControlType
     "Class of ProgramTask; redeclare it to use a model of your own";
   ProgramTask programTask(redeclare model ParameterSet = OpcUaRobotics.Declarations.TaskControlType_ParameterSet)

@@ -2,7 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within NodesetCompilerRobotCell.Declarations;
 model UR10eSystemType_MotionDevices "MotionDevices: The arm of the UR10e."
-  extends OpcUaRobotics.Declarations.MotionDeviceSystemType_MotionDevices;
+  extends OpcUaRobotics.Declarations.MotionDeviceSystemType_MotionDevices(nMotionDeviceIdentifier(min=0)=0);
   replaceable model Manipulator = NodesetCompilerRobotCell.Complete.UR10eSystemType_MotionDevicesManipulator constrainedby NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulator
     "Class of Manipulator; redeclare it to use a model of your own";
   Manipulator manipulator(

@@ -2,7 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within NodesetCompilerRobotCell.Declarations;
 model UR10eSystemType_MotionDevicesManipulatorAxes "Axes: The six joints of the arm."
-  extends OpcUaRobotics.Declarations.MotionDeviceType_Axes;
+  extends OpcUaRobotics.Declarations.MotionDeviceType_Axes(nAxisIdentifier(min=0)=0);
   replaceable model Base = OpcUaRobotics.Complete.AxisType constrainedby OpcUaRobotics.ObjectTypes.AxisType
     "Class of Base; redeclare it to use a model of your own";
   Base base(

@@ -2,7 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within NodesetCompilerRobotCell.Declarations;
 model UR10eSystemType_MotionDevicesManipulatorPowerTrains "PowerTrains: The six drive trains of the arm, one per joint."
-  extends OpcUaRobotics.Declarations.MotionDeviceType_PowerTrains;
+  extends OpcUaRobotics.Declarations.MotionDeviceType_PowerTrains(nPowerTrainIdentifier(min=0)=0);
   replaceable model BaseDrive = NodesetCompilerRobotCell.Complete.UR10eSystemType_MotionDevicesManipulatorPowerTrainsBaseDrive constrainedby NodesetCompilerRobotCell.Declarations.UR10eSystemType_MotionDevicesManipulatorPowerTrainsBaseDrive
     "Class of BaseDrive; redeclare it to use a model of your own";
   BaseDrive baseDrive(redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)

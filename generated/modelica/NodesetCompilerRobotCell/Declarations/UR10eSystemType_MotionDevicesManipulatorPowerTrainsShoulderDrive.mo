@@ -2,7 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within NodesetCompilerRobotCell.Declarations;
 partial model UR10eSystemType_MotionDevicesManipulatorPowerTrainsShoulderDrive "ShoulderDrive: Drive train of the Shoulder joint: its motor and gear."
-  extends OpcUaRobotics.ObjectTypes.PowerTrainType;
+  extends OpcUaRobotics.ObjectTypes.PowerTrainType(nMotorIdentifier(min=0)=0);
   replaceable model Motor = OpcUaRobotics.Complete.MotorType constrainedby OpcUaRobotics.ObjectTypes.MotorType
     "Class of Motor; redeclare it to use a model of your own";
   Motor motor(

@@ -2,7 +2,7 @@
 // Do not edit: regenerate with `cargo xtask generate`.
 within NodesetCompilerRobotCell.Declarations;
 model UR10eSystemType_SafetyStates "SafetyStates: The safety state of the UR10e."
-  extends OpcUaRobotics.Declarations.MotionDeviceSystemType_SafetyStates;
+  extends OpcUaRobotics.Declarations.MotionDeviceSystemType_SafetyStates(nSafetyStateIdentifier(min=0)=0);
   replaceable model SafetyState = OpcUaRobotics.Complete.SafetyStateType constrainedby OpcUaRobotics.ObjectTypes.SafetyStateType
     "Class of SafetyState; redeclare it to use a model of your own";
   SafetyState safetyState(redeclare model ParameterSet = OpcUaRobotics.Declarations.SafetyStateType_ParameterSet)

@@ -12,6 +12,8 @@ model FileDirectoryType "FileDirectoryType"
   parameter Integer nFileName(min=0) = 0
     "Number of <FileName> (OptionalPlaceholder)"
     annotation (Evaluate=true);
+  parameter String fileNameBrowseNames[nFileName] = fill("<FileName>", nFileName)
+    "BrowseNames of the <FileName> elements";
   replaceable model FileName = OpcUa.ObjectTypes.FileType
     "Class of <FileName>; redeclare it to use a model of your own";
   FileName fileName[nFileName]

@@ -6,6 +6,8 @@ model OrderedListType "OrderedListType"
   parameter Integer nOrderedObject(min=0) = 0
     "Number of <OrderedObject> (OptionalPlaceholder)"
     annotation (Evaluate=true);
+  parameter String orderedObjectBrowseNames[nOrderedObject] = fill("<OrderedObject>", nOrderedObject)
+    "BrowseNames of the <OrderedObject> elements";
   replaceable model OrderedObject = OpcUa.Declarations.OrderedListType_OrderedObject
     "Class of <OrderedObject>; redeclare it to use a model of your own";
   OrderedObject orderedObject[nOrderedObject]

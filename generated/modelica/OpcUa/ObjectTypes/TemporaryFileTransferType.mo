@@ -12,6 +12,8 @@ partial model TemporaryFileTransferType "TemporaryFileTransferType"
   parameter Integer nTransferState(min=0) = 0
     "Number of <TransferState> (OptionalPlaceholder)"
     annotation (Evaluate=true);
+  parameter String transferStateBrowseNames[nTransferState] = fill("<TransferState>", nTransferState)
+    "BrowseNames of the <TransferState> elements";
   replaceable model TransferState = OpcUa.ObjectTypes.FileTransferStateMachineType
     "Class of <TransferState>; redeclare it to use a model of your own";
   TransferState transferState[nTransferState]

@@ -3,9 +3,11 @@
 within OpcUaDI.Declarations;
 model ISupportInfoType_DocumentationFiles "DocumentationFiles"
   extends OpcUa.ObjectTypes.FolderType;
-  parameter Integer nDocumentFileId(min=0) = 0
+  parameter Integer nDocumentFileId(min=1) = 1
     "Number of <DocumentFileId> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String documentFileIdBrowseNames[nDocumentFileId] = fill("<DocumentFileId>", nDocumentFileId)
+    "BrowseNames of the <DocumentFileId> elements";
   replaceable model DocumentFileId = OpcUa.ObjectTypes.FileType
     "Class of <DocumentFileId>; redeclare it to use a model of your own";
   DocumentFileId documentFileId[nDocumentFileId]

@@ -11,6 +11,8 @@ model ConfigurableObjectType "ConfigurableObjectType"
   parameter Integer nObjectIdentifier(min=0) = 0
     "Number of <ObjectIdentifier> (OptionalPlaceholder)"
     annotation (Evaluate=true);
+  parameter String objectIdentifierBrowseNames[nObjectIdentifier] = fill("<ObjectIdentifier>", nObjectIdentifier)
+    "BrowseNames of the <ObjectIdentifier> elements";
   replaceable model ObjectIdentifier = OpcUa.ObjectTypes.BaseObjectType
     "Class of <ObjectIdentifier>; redeclare it to use a model of your own";
   ObjectIdentifier objectIdentifier[nObjectIdentifier]

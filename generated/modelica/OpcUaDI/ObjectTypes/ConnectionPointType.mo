@@ -8,9 +8,11 @@ partial model ConnectionPointType "ConnectionPointType"
   NetworkAddress networkAddress
     "NetworkAddress"
     annotation (__OPCUA(browsePath="NetworkAddress", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6354", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=1005"));
-  parameter Integer nProfileIdentifier(min=0) = 0
+  parameter Integer nProfileIdentifier(min=1) = 1
     "Number of <ProfileIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String profileIdentifierBrowseNames[nProfileIdentifier] = fill("<ProfileIdentifier>", nProfileIdentifier)
+    "BrowseNames of the <ProfileIdentifier> elements";
   replaceable model ProfileIdentifier = OpcUaDI.ObjectTypes.ProtocolType
     "Class of <ProfileIdentifier>; redeclare it to use a model of your own";
   ProfileIdentifier profileIdentifier[nProfileIdentifier]

@@ -14,6 +14,8 @@ partial model DeviceType "DeviceType"
   parameter Integer nCpIdentifier(min=0) = 0
     "Number of <CPIdentifier> (OptionalPlaceholder)"
     annotation (Evaluate=true);
+  parameter String cpIdentifierBrowseNames[nCpIdentifier] = fill("<CPIdentifier>", nCpIdentifier)
+    "BrowseNames of the <CPIdentifier> elements";
   replaceable model CPIdentifier = OpcUaDI.ObjectTypes.ConnectionPointType
     "Class of <CPIdentifier>; redeclare it to use a model of your own";
   CPIdentifier cpIdentifier[nCpIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)

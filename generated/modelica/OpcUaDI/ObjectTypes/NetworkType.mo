@@ -3,9 +3,11 @@
 within OpcUaDI.ObjectTypes;
 model NetworkType "NetworkType"
   extends OpcUa.ObjectTypes.BaseObjectType;
-  parameter Integer nProfileIdentifier(min=0) = 0
+  parameter Integer nProfileIdentifier(min=1) = 1
     "Number of <ProfileIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String profileIdentifierBrowseNames[nProfileIdentifier] = fill("<ProfileIdentifier>", nProfileIdentifier)
+    "BrowseNames of the <ProfileIdentifier> elements";
   replaceable model ProfileIdentifier = OpcUaDI.ObjectTypes.ProtocolType
     "Class of <ProfileIdentifier>; redeclare it to use a model of your own";
   ProfileIdentifier profileIdentifier[nProfileIdentifier]

@@ -22,6 +22,8 @@ partial model TopologyElementType "TopologyElementType"
   parameter Integer nGroupIdentifier(min=0) = 0
     "Number of <GroupIdentifier> (OptionalPlaceholder)"
     annotation (Evaluate=true);
+  parameter String groupIdentifierBrowseNames[nGroupIdentifier] = fill("<GroupIdentifier>", nGroupIdentifier)
+    "BrowseNames of the <GroupIdentifier> elements";
   replaceable model GroupIdentifier = OpcUaDI.ObjectTypes.FunctionalGroupType
     "Class of <GroupIdentifier>; redeclare it to use a model of your own";
   GroupIdentifier groupIdentifier[nGroupIdentifier]

@@ -6,12 +6,16 @@ model CalibrationTargetType_CalibrationTargetFeatures "CalibrationTargetFeatures
   parameter Integer nCalibrationValue(min=0) = 0
     "Number of <CalibrationValue> (OptionalPlaceholder)"
     annotation (Evaluate=true);
+  parameter String calibrationValueBrowseNames[nCalibrationValue] = fill("<CalibrationValue>", nCalibrationValue)
+    "BrowseNames of the <CalibrationValue> elements";
   OpcUaSupport.RealOutput calibrationValue[nCalibrationValue] = fill(0, nCalibrationValue)
     "<CalibrationValue>: A calibration value indicates the value the calibration target provides for calibration and includes its quantity and engineering unit."
     annotation (Placement(transformation(extent={{100,70},{120,90}})), __OPCUA(browsePath="<CalibrationValue>", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6064", dataType="i=26"));
   parameter Integer nCapacityRange(min=0) = 0
     "Number of <CapacityRange> (OptionalPlaceholder)"
     annotation (Evaluate=true);
+  parameter String capacityRangeBrowseNames[nCapacityRange] = fill("<CapacityRange>", nCapacityRange)
+    "BrowseNames of the <CapacityRange> elements";
   output OpcUa.Types.Range capacityRange[nCapacityRange] = fill(OpcUa.Types.Range(), nCapacityRange)
     "<CapacityRange>: A capacity range indicates a range (low and high value) as well as a resolution, and thus defines a number of values the calibration target provides for calibration and includes the quantity and engineering unit."
     annotation (__OPCUA(browsePath="<CapacityRange>", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6066", dataType="i=884"));

@@ -6,6 +6,8 @@ model StackElementLightType "StackElementLightType: Represents a lamp element in
   parameter Integer nControlChannel(min=0) = 0
     "Number of <ControlChannel> (OptionalPlaceholder)"
     annotation (Evaluate=true);
+  parameter String controlChannelBrowseNames[nControlChannel] = fill("<ControlChannel>", nControlChannel)
+    "BrowseNames of the <ControlChannel> elements";
   replaceable model ControlChannel = OpcUaIA.ObjectTypes.ControlChannelType
     "Class of <ControlChannel>; redeclare it to use a model of your own";
   ControlChannel controlChannel[nControlChannel]

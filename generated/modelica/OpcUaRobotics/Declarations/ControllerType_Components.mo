@@ -3,9 +3,11 @@
 within OpcUaRobotics.Declarations;
 model ControllerType_Components "Components: Components is a container for one or more instances of subtypes of ComponentType defined in OPC UA DI. The listed components are installed in the motion device system, e.g. a processing-unit, a power-supply, an IO-board or a drive, and have an electrical interface to the controller."
   extends OpcUa.ObjectTypes.FolderType;
-  parameter Integer nComponentIdentifier(min=0) = 0
+  parameter Integer nComponentIdentifier(min=1) = 1
     "Number of <ComponentIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String componentIdentifierBrowseNames[nComponentIdentifier] = fill("<ComponentIdentifier>", nComponentIdentifier)
+    "BrowseNames of the <ComponentIdentifier> elements";
   replaceable model ComponentIdentifier = OpcUaDI.ObjectTypes.ComponentType
     "Class of <ComponentIdentifier>; redeclare it to use a model of your own";
   ComponentIdentifier componentIdentifier[nComponentIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)

@@ -3,9 +3,11 @@
 within OpcUaRobotics.Declarations;
 model ControllerType_Software "Software: Software is a container for one or more instances of SoftwareType defined in OPC UA DI."
   extends OpcUa.ObjectTypes.FolderType;
-  parameter Integer nSoftwareIdentifier(min=0) = 0
+  parameter Integer nSoftwareIdentifier(min=1) = 1
     "Number of <SoftwareIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String softwareIdentifierBrowseNames[nSoftwareIdentifier] = fill("<SoftwareIdentifier>", nSoftwareIdentifier)
+    "BrowseNames of the <SoftwareIdentifier> elements";
   replaceable model SoftwareIdentifier = OpcUaDI.ObjectTypes.SoftwareType
     "Class of <SoftwareIdentifier>; redeclare it to use a model of your own";
   SoftwareIdentifier softwareIdentifier[nSoftwareIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)

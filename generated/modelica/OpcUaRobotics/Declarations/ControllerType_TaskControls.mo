@@ -3,9 +3,11 @@
 within OpcUaRobotics.Declarations;
 model ControllerType_TaskControls "TaskControls: TaskControls is a container for one or more instances of TaskControlType."
   extends OpcUa.ObjectTypes.FolderType;
-  parameter Integer nTaskControlIdentifier(min=0) = 0
+  parameter Integer nTaskControlIdentifier(min=1) = 1
     "Number of <TaskControlIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String taskControlIdentifierBrowseNames[nTaskControlIdentifier] = fill("<TaskControlIdentifier>", nTaskControlIdentifier)
+    "BrowseNames of the <TaskControlIdentifier> elements";
   replaceable model TaskControlIdentifier = OpcUaRobotics.Complete.TaskControlType constrainedby OpcUaRobotics.ObjectTypes.TaskControlType
     "Class of <TaskControlIdentifier>; redeclare it to use a model of your own";
   TaskControlIdentifier taskControlIdentifier[nTaskControlIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.TaskControlType_ParameterSet)

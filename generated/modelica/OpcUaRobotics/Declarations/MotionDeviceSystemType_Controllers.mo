@@ -3,9 +3,11 @@
 within OpcUaRobotics.Declarations;
 model MotionDeviceSystemType_Controllers "Controllers: Contains the set of controllers in the motion device system."
   extends OpcUa.ObjectTypes.FolderType;
-  parameter Integer nControllerIdentifier(min=0) = 0
+  parameter Integer nControllerIdentifier(min=1) = 1
     "Number of <ControllerIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String controllerIdentifierBrowseNames[nControllerIdentifier] = fill("<ControllerIdentifier>", nControllerIdentifier)
+    "BrowseNames of the <ControllerIdentifier> elements";
   replaceable model ControllerIdentifier = OpcUaRobotics.Complete.ControllerType constrainedby OpcUaRobotics.ObjectTypes.ControllerType
     "Class of <ControllerIdentifier>; redeclare it to use a model of your own";
   ControllerIdentifier controllerIdentifier[nControllerIdentifier](

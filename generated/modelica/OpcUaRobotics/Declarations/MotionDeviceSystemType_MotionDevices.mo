@@ -3,9 +3,11 @@
 within OpcUaRobotics.Declarations;
 model MotionDeviceSystemType_MotionDevices "MotionDevices: Contains any kinematic or motion device which is part of the motion device system."
   extends OpcUa.ObjectTypes.FolderType;
-  parameter Integer nMotionDeviceIdentifier(min=0) = 0
+  parameter Integer nMotionDeviceIdentifier(min=1) = 1
     "Number of <MotionDeviceIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String motionDeviceIdentifierBrowseNames[nMotionDeviceIdentifier] = fill("<MotionDeviceIdentifier>", nMotionDeviceIdentifier)
+    "BrowseNames of the <MotionDeviceIdentifier> elements";
   replaceable model MotionDeviceIdentifier = OpcUaRobotics.Complete.MotionDeviceType constrainedby OpcUaRobotics.ObjectTypes.MotionDeviceType
     "Class of <MotionDeviceIdentifier>; redeclare it to use a model of your own";
   MotionDeviceIdentifier motionDeviceIdentifier[nMotionDeviceIdentifier](

@@ -3,9 +3,11 @@
 within OpcUaRobotics.Declarations;
 model MotionDeviceSystemType_SafetyStates "SafetyStates: Contains safety-related data from motion device system."
   extends OpcUa.ObjectTypes.FolderType;
-  parameter Integer nSafetyStateIdentifier(min=0) = 0
+  parameter Integer nSafetyStateIdentifier(min=1) = 1
     "Number of <SafetyStateIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String safetyStateIdentifierBrowseNames[nSafetyStateIdentifier] = fill("<SafetyStateIdentifier>", nSafetyStateIdentifier)
+    "BrowseNames of the <SafetyStateIdentifier> elements";
   replaceable model SafetyStateIdentifier = OpcUaRobotics.Complete.SafetyStateType constrainedby OpcUaRobotics.ObjectTypes.SafetyStateType
     "Class of <SafetyStateIdentifier>; redeclare it to use a model of your own";
   SafetyStateIdentifier safetyStateIdentifier[nSafetyStateIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.SafetyStateType_ParameterSet)

@@ -3,9 +3,11 @@
 within OpcUaRobotics.Declarations;
 model MotionDeviceType_AdditionalComponents "AdditionalComponents: AdditionalComponents is a container for one or more instances of subtypes of ComponentType defined in OPC UA DI. The listed components are installed at the motion device, e.g. an IO-board."
   extends OpcUa.ObjectTypes.FolderType;
-  parameter Integer nAdditionalComponentIdentifier(min=0) = 0
+  parameter Integer nAdditionalComponentIdentifier(min=1) = 1
     "Number of <AdditionalComponentIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String additionalComponentIdentifierBrowseNames[nAdditionalComponentIdentifier] = fill("<AdditionalComponentIdentifier>", nAdditionalComponentIdentifier)
+    "BrowseNames of the <AdditionalComponentIdentifier> elements";
   replaceable model AdditionalComponentIdentifier = OpcUa.ObjectTypes.BaseObjectType
     "Class of <AdditionalComponentIdentifier>; redeclare it to use a model of your own";
   AdditionalComponentIdentifier additionalComponentIdentifier[nAdditionalComponentIdentifier]

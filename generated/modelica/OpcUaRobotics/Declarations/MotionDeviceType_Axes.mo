@@ -3,9 +3,11 @@
 within OpcUaRobotics.Declarations;
 model MotionDeviceType_Axes "Axes: Axes is a container for one or more instances of the AxisType."
   extends OpcUa.ObjectTypes.FolderType;
-  parameter Integer nAxisIdentifier(min=0) = 0
+  parameter Integer nAxisIdentifier(min=1) = 1
     "Number of <AxisIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String axisIdentifierBrowseNames[nAxisIdentifier] = fill("<AxisIdentifier>", nAxisIdentifier)
+    "BrowseNames of the <AxisIdentifier> elements";
   replaceable model AxisIdentifier = OpcUaRobotics.Complete.AxisType constrainedby OpcUaRobotics.ObjectTypes.AxisType
     "Class of <AxisIdentifier>; redeclare it to use a model of your own";
   AxisIdentifier axisIdentifier[nAxisIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet)

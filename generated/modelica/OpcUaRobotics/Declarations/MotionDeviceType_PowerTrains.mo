@@ -3,9 +3,11 @@
 within OpcUaRobotics.Declarations;
 model MotionDeviceType_PowerTrains "PowerTrains: PowerTrains is a container for one or more instances of the PowerTrainType."
   extends OpcUa.ObjectTypes.FolderType;
-  parameter Integer nPowerTrainIdentifier(min=0) = 0
+  parameter Integer nPowerTrainIdentifier(min=1) = 1
     "Number of <PowerTrainIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String powerTrainIdentifierBrowseNames[nPowerTrainIdentifier] = fill("<PowerTrainIdentifier>", nPowerTrainIdentifier)
+    "BrowseNames of the <PowerTrainIdentifier> elements";
   replaceable model PowerTrainIdentifier = OpcUaRobotics.Complete.PowerTrainType constrainedby OpcUaRobotics.ObjectTypes.PowerTrainType
     "Class of <PowerTrainIdentifier>; redeclare it to use a model of your own";
   PowerTrainIdentifier powerTrainIdentifier[nPowerTrainIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)

@@ -3,9 +3,11 @@
 within OpcUaRobotics.Declarations;
 partial model SafetyStateType_EmergencyStopFunctions "EmergencyStopFunctions: EmergencyStopFunctions is a container for one or more instances of the EmergencyStopFunctionType."
   extends OpcUa.ObjectTypes.FolderType;
-  parameter Integer nEmergencyStopFunctionIdentifier(min=0) = 0
+  parameter Integer nEmergencyStopFunctionIdentifier(min=1) = 1
     "Number of <EmergencyStopFunctionIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String emergencyStopFunctionIdentifierBrowseNames[nEmergencyStopFunctionIdentifier] = fill("<EmergencyStopFunctionIdentifier>", nEmergencyStopFunctionIdentifier)
+    "BrowseNames of the <EmergencyStopFunctionIdentifier> elements";
   replaceable model EmergencyStopFunctionIdentifier = OpcUaRobotics.ObjectTypes.EmergencyStopFunctionType
     "Class of <EmergencyStopFunctionIdentifier>; redeclare it to use a model of your own";
   EmergencyStopFunctionIdentifier emergencyStopFunctionIdentifier[nEmergencyStopFunctionIdentifier]

@@ -3,9 +3,11 @@
 within OpcUaRobotics.Declarations;
 partial model SafetyStateType_ProtectiveStopFunctions "ProtectiveStopFunctions: ProtectiveStopFunctions is a container for one or more instances of the ProtectiveStopFunctionType."
   extends OpcUa.ObjectTypes.FolderType;
-  parameter Integer nProtectiveStopFunctionIdentifier(min=0) = 0
+  parameter Integer nProtectiveStopFunctionIdentifier(min=1) = 1
     "Number of <ProtectiveStopFunctionIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String protectiveStopFunctionIdentifierBrowseNames[nProtectiveStopFunctionIdentifier] = fill("<ProtectiveStopFunctionIdentifier>", nProtectiveStopFunctionIdentifier)
+    "BrowseNames of the <ProtectiveStopFunctionIdentifier> elements";
   replaceable model ProtectiveStopFunctionIdentifier = OpcUaRobotics.ObjectTypes.ProtectiveStopFunctionType
     "Class of <ProtectiveStopFunctionIdentifier>; redeclare it to use a model of your own";
   ProtectiveStopFunctionIdentifier protectiveStopFunctionIdentifier[nProtectiveStopFunctionIdentifier]

@@ -4,9 +4,11 @@ within OpcUaRobotics.Declarations;
 model SystemOperationType_Conditions "Conditions"
   extends OpcUa.ObjectTypes.FolderType;
   // <AcknowledgeableCondition> is an event (AcknowledgeableConditionType); the children of its instance declaration are not represented.
-  parameter Integer nAcknowledgeableCondition(min=0) = 0
+  parameter Integer nAcknowledgeableCondition(min=1) = 1
     "Number of <AcknowledgeableCondition> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String acknowledgeableConditionBrowseNames[nAcknowledgeableCondition] = fill("<AcknowledgeableCondition>", nAcknowledgeableCondition)
+    "BrowseNames of the <AcknowledgeableCondition> elements";
   OpcUa.ObjectTypes.AcknowledgeableConditionType acknowledgeableCondition[nAcknowledgeableCondition]
     "<AcknowledgeableCondition>"
     annotation (__OPCUA(browsePath="<AcknowledgeableCondition>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=5059", typeDefinition="i=2881"));

@@ -6,6 +6,8 @@ model TaskControlType_TaskModules "TaskModules"
   parameter Integer nTaskModule(min=0) = 0
     "Number of <TaskModule> (OptionalPlaceholder)"
     annotation (Evaluate=true);
+  parameter String taskModuleBrowseNames[nTaskModule] = fill("<TaskModule>", nTaskModule)
+    "BrowseNames of the <TaskModule> elements";
   replaceable model TaskModule = OpcUaRobotics.ObjectTypes.TaskModuleType
     "Class of <TaskModule>; redeclare it to use a model of your own";
   TaskModule taskModule[nTaskModule]

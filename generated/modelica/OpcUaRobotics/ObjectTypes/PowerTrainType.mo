@@ -12,14 +12,18 @@ partial model PowerTrainType "PowerTrainType: The PowerTrainType represents inst
   parameter Integer nGearIdentifier(min=0) = 0
     "Number of <GearIdentifier> (OptionalPlaceholder)"
     annotation (Evaluate=true);
+  parameter String gearIdentifierBrowseNames[nGearIdentifier] = fill("<GearIdentifier>", nGearIdentifier)
+    "BrowseNames of the <GearIdentifier> elements";
   replaceable model GearIdentifier = OpcUaRobotics.ObjectTypes.GearType
     "Class of <GearIdentifier>; redeclare it to use a model of your own";
   GearIdentifier gearIdentifier[nGearIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
     "<GearIdentifier>"
     annotation (__OPCUA(browsePath="<GearIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16041", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1022"));
-  parameter Integer nMotorIdentifier(min=0) = 0
+  parameter Integer nMotorIdentifier(min=1) = 1
     "Number of <MotorIdentifier> (MandatoryPlaceholder: a conforming object has at least one)"
     annotation (Evaluate=true);
+  parameter String motorIdentifierBrowseNames[nMotorIdentifier] = fill("<MotorIdentifier>", nMotorIdentifier)
+    "BrowseNames of the <MotorIdentifier> elements";
   replaceable model MotorIdentifier = OpcUaRobotics.Complete.MotorType constrainedby OpcUaRobotics.ObjectTypes.MotorType
     "Class of <MotorIdentifier>; redeclare it to use a model of your own";
   MotorIdentifier motorIdentifier[nMotorIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.MotorType_ParameterSet)

@@ -98,6 +98,22 @@ impl Ctx<'_> {
         element
     }
 
+    /// The count of a placeholder component and the BrowseNames of its elements; returns the count's name.
+    fn placeholder_decls(
+        &mut self,
+        body: &mut Body,
+        ident: &str,
+        original: &str,
+        rule: Option<ModellingRule>,
+        node: NodeIx,
+    ) -> String {
+        let count = self.derived_name(body, count_name(ident), node);
+        body.items.push(count_decl(&count, original, rule));
+        let names = self.derived_name(body, format!("{ident}BrowseNames"), node);
+        body.items.push(browse_names_decl(&names, &count, original));
+        count
+    }
+
     /// A name derived from an element's (`use_x`, `nX`), unique in the class.
     fn derived_name(&mut self, body: &mut Body, candidate: String, node: NodeIx) -> String {
         let mut name = candidate.clone();
@@ -229,8 +245,7 @@ impl Ctx<'_> {
                     value = format!("fill({}, {c})", self.default_literal(&ty));
                 }
                 if placeholder {
-                    let count = self.derived_name(body, count_name(&ident), o.node);
-                    body.items.push(count_decl(&count, &bn.name, rule));
+                    let count = self.placeholder_decls(body, &ident, &bn.name, rule, o.node);
                     let mut d = vec![None];
                     d.extend(dims.clone().unwrap_or_default());
                     let default = self.default_literal(&ty);
@@ -384,8 +399,7 @@ impl Ctx<'_> {
                 let mut cond = None;
                 let mut dims_s = String::new();
                 if placeholder {
-                    let count = self.derived_name(body, count_name(&ident), o.node);
-                    body.items.push(count_decl(&count, &bn.name, rule));
+                    let count = self.placeholder_decls(body, &ident, &bn.name, rule, o.node);
                     dims_s = format!("[{count}]");
                     element.count = Some(count);
                 } else if optional {
@@ -701,21 +715,39 @@ fn use_decl(flag: &str, original: &str) -> Item {
     }
 }
 
+/// The count of a placeholder: at least one, and one by default, where the placeholder is mandatory.
 fn count_decl(count: &str, original: &str, rule: Option<ModellingRule>) -> Item {
-    let what = match rule {
-        Some(ModellingRule::MandatoryPlaceholder) => "MandatoryPlaceholder: a conforming object has at least one",
-        _ => "OptionalPlaceholder",
+    let (what, min) = match rule {
+        Some(ModellingRule::MandatoryPlaceholder) => ("MandatoryPlaceholder: a conforming object has at least one", "1"),
+        _ => ("OptionalPlaceholder", "0"),
     };
     Item::Decl {
         prefix: "parameter".into(),
         ty: TypeRef::Path("Integer".into()),
         ident: count.to_string(),
         dims: String::new(),
-        mods: vec![Mod::Value { ident: "min".into(), is_final: false, attrs: Vec::new(), value: Some("0".into()) }],
-        value: Some("0".into()),
+        mods: vec![Mod::Value { ident: "min".into(), is_final: false, attrs: Vec::new(), value: Some(min.into()) }],
+        value: Some(min.into()),
         cond: None,
         desc: string_literal(&format!("Number of {original} ({what})")),
         annotation: "Evaluate=true".into(),
+    }
+}
+
+/// The BrowseNames of a placeholder's elements, which the server chooses: the placeholder's own BrowseName
+/// (`<AxisIdentifier>`) until a user names them, so that a binding by browse path fails loudly, not on a
+/// node of another name.
+fn browse_names_decl(names: &str, count: &str, original: &str) -> Item {
+    Item::Decl {
+        prefix: "parameter".into(),
+        ty: TypeRef::Path("String".into()),
+        ident: names.to_string(),
+        dims: format!("[{count}]"),
+        mods: Vec::new(),
+        value: Some(format!("fill({}, {count})", string_literal(original))),
+        cond: None,
+        desc: string_literal(&format!("BrowseNames of the {original} elements")),
+        annotation: String::new(),
     }
 }
 

@@ -103,8 +103,11 @@
 //!   object redeclares the alias (`redeclare model ParameterSet = ...AxisType_ParameterSet`), and a user
 //!   plugs in a model of their own the same way.
 //! * Optional: `parameter Boolean use_x = false` and `X x if use_x`; a subtype that makes it Mandatory writes
-//!   `final use_x = true`. Placeholder `<X>`: `parameter Integer nX(min=0) = 0`, `replaceable model X = ...`
-//!   and `X x[nX]`.
+//!   `final use_x = true`. Placeholder `<X>`: `parameter Integer nX(min=0) = 0` (`(min=1) = 1` for a
+//!   MandatoryPlaceholder), `parameter String xBrowseNames[nX] = fill("<X>", nX)` (the elements' BrowseNames,
+//!   which a user sets), `replaceable model X = ...` and `X x[nX]`. Where named children fill a mandatory
+//!   placeholder (always in an instance; in a type, children of the placeholder's NodeClass and TypeDefinition
+//!   or a subtype), the array is empty: `nX(min=0)=0`.
 //! * Only containment makes a component: a child held by HasChild (HasComponent, HasProperty,
 //!   HasOrderedComponent, ...) or Organizes. A child held by any other reference (Requires, Moves, HasSlave,
 //!   Controls, IsDrivenBy, ...) lives elsewhere and becomes `parameter String x = ""` (an array sized by its

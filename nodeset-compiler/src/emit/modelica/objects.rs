@@ -10,7 +10,7 @@
 use super::complete::{bind_free, COMPLETE_NOTE};
 use super::ctx::{component_original, count_name, node_id_text, undescribed, Ctx, MAX_NESTING};
 use super::plan::{ClassKey, Owner};
-use super::plan::{Body, ClassInfo, ClassPlan, ElemKind, Element, Item, Mode, Own, OwnerPlan, Placed, TypeRef};
+use super::plan::{Body, ClassInfo, ClassPlan, ElemKind, Element, Item, Mod, Mode, Own, OwnerPlan, Placed, TypeRef};
 use super::text::{self, string_literal};
 use super::types::{as_i128, dims_text};
 use super::plan::{Base, MType};
@@ -531,6 +531,22 @@ impl Ctx<'_> {
                 }
             }
         }
+        // The elements that fill a placeholder here are named components. So the placeholder's array, one
+        // element by default where it is mandatory, is empty: always in an instance (it holds what the nodeset
+        // gives it), in a type when a new child fits the placeholder.
+        let inherited = base.map_or(0, |b| b.elements.len());
+        for e in &elements[..inherited] {
+            let mandatory = m.node(e.node).modelling_rule == Some(crate::model::ModellingRule::MandatoryPlaceholder);
+            let Some(count) = e.count.as_ref().filter(|_| mandatory) else { continue };
+            if mode == Mode::Instance || own.iter().any(|o| !by_bn.contains_key(&m.node(o.node).browse_name) && self.fills(*o, e)) {
+                body.mods.push(Mod::Value {
+                    ident: count.clone(),
+                    is_final: false,
+                    attrs: vec!["min=0".into()],
+                    value: Some("0".into()),
+                });
+            }
+        }
         if mode == Mode::Instance {
             // An instance is complete: every input nothing binds yet gets the instance's value.
             for f in self.free_of(&elements) {
@@ -548,6 +564,18 @@ impl Ctx<'_> {
         }
         body.elements = elements;
         body
+    }
+
+    /// Whether child `o` fits placeholder `e`: a node of its NodeClass, with its TypeDefinition or a subtype.
+    fn fills(&self, o: Own, e: &Element) -> bool {
+        let m = self.m;
+        let (child, decl) = (m.node(o.node), m.node(e.node));
+        child.class == decl.class
+            && match (child.type_definition, decl.type_definition) {
+                (Some(c), Some(d)) => m.is_subtype_of(c, d),
+                (_, None) => true,
+                (None, Some(_)) => false,
+            }
     }
 }
 

@@ -277,6 +277,34 @@ fn published_values_are_unbound_inputs_and_complete_variants_bind_them() {
 }
 
 #[test]
+fn mandatory_placeholders_hold_one_element_until_named_children_fill_them() {
+    let files = robotics_files();
+    // A MotionDevice has at least one axis: one by default, never fewer; the elements' BrowseNames are parameters,
+    // the placeholder's own until a user names them.
+    let axes = contents(&files, "OpcUaRobotics/Declarations/MotionDeviceType_Axes.mo");
+    assert!(axes.contains("  parameter Integer nAxisIdentifier(min=1) = 1\n"), "{axes}");
+    assert!(axes.contains("  extends OpcUa.ObjectTypes.FolderType;\n"), "the placeholder does not fill itself: {axes}");
+    assert!(
+        axes.contains("  parameter String axisIdentifierBrowseNames[nAxisIdentifier] = fill(\"<AxisIdentifier>\", nAxisIdentifier)\n"),
+        "{axes}"
+    );
+    // An optional placeholder stays empty.
+    let modules = contents(&files, "OpcUaRobotics/Declarations/TaskControlType_TaskModules.mo");
+    assert!(modules.contains("  parameter Integer nTaskModule(min=0) = 0\n"), "{modules}");
+    assert!(modules.contains("  parameter String taskModuleBrowseNames[nTaskModule] = "), "{modules}");
+
+    let skills = skills_with(str::to_string);
+    // A type whose own children fit the placeholder (the UR10e's six named axes) empties its array.
+    let ur_axes = contents(&skills, "NodesetCompilerRobotCell/Declarations/UR10eSystemType_MotionDevicesManipulatorAxes.mo");
+    assert!(ur_axes.contains("  extends OpcUaRobotics.Declarations.MotionDeviceType_Axes(nAxisIdentifier(min=0)=0);\n"), "{ur_axes}");
+    // An instance holds what the nodeset gives it: every mandatory placeholder's array is empty.
+    let system = contents(&skills, "NodesetCompilerDrillingProcess/Declarations/TemplateDrillingLwrSystem_MotionDeviceSystem.mo");
+    for count in ["nControllerIdentifier", "nMotionDeviceIdentifier", "nSafetyStateIdentifier", "nAxisIdentifier"] {
+        assert!(system.contains(&format!("{count}(min=0)=0")), "{count}: {system}");
+    }
+}
+
+#[test]
 fn names_keep_their_spelling_where_legal_and_never_name_an_annotation() {
     let files = robotics_files();
     // DI's ISupportInfoType has an optional folder Documentation: its class is not called like the annotation.

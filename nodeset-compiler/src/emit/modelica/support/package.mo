@@ -40,8 +40,11 @@ the class is partial, the alias defaults to its complete variant and is constrai
 OpcUaRobotics.ObjectTypes.AxisType</code>).</li>
 <li>An optional member exists when <code>use_x = true</code>: <code>parameter Boolean use_x = false</code>,
 <code>X x if use_x</code>.</li>
-<li>A placeholder <code>&lt;X&gt;</code> is an array: <code>parameter Integer nX</code>, <code>replaceable model
-X</code>, <code>X x[nX]</code>.</li>
+<li>A placeholder <code>&lt;X&gt;</code> is an array: <code>parameter Integer nX</code> (at least one, and one by
+default, where the placeholder is mandatory), <code>parameter String xBrowseNames[nX]</code> (the elements'
+BrowseNames, <code>\"&lt;X&gt;\"</code> until you name them), <code>replaceable model X</code>, <code>X x[nX]</code>.
+Where named components fill a mandatory placeholder (in an instance, or a type that names them), its array is
+empty: <code>nX(min=0)=0</code>.</li>
 <li>A member held by a non-hierarchical reference (Requires, Moves, HasSlave, ...) lives elsewhere: it is
 <code>parameter String x</code>, the NodeId of its target.</li>
 <li>Methods are comments: call them through an OPC UA client. The methods of a state machine (Start, Suspend,
@@ -60,7 +63,8 @@ equation
 end DrivenAxis;</pre>
 <p>and fill placeholders by redeclaring their class and setting their count:</p>
 <pre>extends OpcUaRobotics.Declarations.MotionDeviceType_Axes(
-  nAxisIdentifier=2, redeclare model AxisIdentifier = DrivenAxis);</pre>
+  nAxisIdentifier=2, axisIdentifierBrowseNames={\"Axis1\", \"Axis2\"},
+  redeclare model AxisIdentifier = DrivenAxis);</pre>
 <p>Where nothing computes a published value, use the complete variant (<code>OpcUaRobotics.Complete.AxisType</code>),
 or bind the value with a modifier.</p>
 
