@@ -16,7 +16,7 @@ model CalibrationTargetType_CalibrationTargetFeatures "CalibrationTargetFeatures
     annotation (Evaluate=true);
   parameter String capacityRangeBrowseNames[nCapacityRange] = fill("<CapacityRange>", nCapacityRange)
     "BrowseNames of the <CapacityRange> elements";
-  output OpcUa.Types.Range capacityRange[nCapacityRange] = fill(OpcUa.Types.Range(), nCapacityRange)
+  output OpcUa.Types.Range capacityRange[nCapacityRange] = {OpcUa.Types.Range() for i in 1:nCapacityRange}
     "<CapacityRange>: A capacity range indicates a range (low and high value) as well as a resolution, and thus defines a number of values the calibration target provides for calibration and includes the quantity and engineering unit."
     annotation (__OPCUA(browsePath="<CapacityRange>", nodeId="nsu=http://opcfoundation.org/UA/IA/;i=6066", dataType="i=884"));
   annotation (

@@ -252,7 +252,12 @@ impl Ctx<'_> {
                     let sizes: Vec<String> = std::iter::once(count.clone())
                         .chain(d[1..].iter().map(|x| x.unwrap_or(0).to_string()))
                         .collect();
-                    value = format!("fill({default}, {})", sizes.join(", "));
+                    value = match (&ty, sizes.as_slice()) {
+                        // rumoca 0.10.2 rejects `fill(R(), n)` of a record with a record field once n > 0
+                        // ("expression shape mismatch"); the comprehension is the same array.
+                        (MType::Record { .. }, [n]) => format!("{{{default} for i in 1:{n}}}"),
+                        _ => format!("fill({default}, {})", sizes.join(", ")),
+                    };
                     dims = Some(d);
                     element.count = Some(count);
                 } else if optional {
