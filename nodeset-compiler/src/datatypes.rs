@@ -12,13 +12,15 @@ use std::collections::{BTreeMap, HashMap};
 pub(crate) fn classify(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeIx, DataTypeInfo> {
     let types: Vec<NodeIx> =
         (0..model.nodes.len() as u32).map(NodeIx).filter(|&ix| model.node(ix).class == NodeClass::DataType).collect();
-    // Supertypes first, so inherited fields are known.
+    // Supertypes first, so inherited fields are known; enumerations last, so that the EnumValueType
+    // structures of their EnumValues properties can be decoded.
     let depths = model.type_depths();
-    let mut order: Vec<(u32, NodeIx)> = types.iter().map(|&t| (depths[t.index()], t)).collect();
+    let mut order: Vec<(bool, u32, NodeIx)> =
+        types.iter().map(|&t| (model.is_subtype_of_ns0(t, ids::ENUMERATION), depths[t.index()], t)).collect();
     order.sort();
     let has_encoding = model.ns0(ids::HAS_ENCODING);
     let mut out: BTreeMap<NodeIx, DataTypeInfo> = BTreeMap::new();
-    for (_, t) in order {
+    for (_, _, t) in order {
         let node = model.node(t);
         let chain = model.super_chain(t);
         let ns0_in_chain = |n: u32| chain.iter().any(|&c| model.node(c).id.ns0() == Some(n));
@@ -37,7 +39,7 @@ pub(crate) fn classify(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeI
         } else if matches!(node.id.ns0(), Some(ids::BASE_DATA_TYPE | ids::NUMBER | ids::INTEGER | ids::UINTEGER | ids::DECIMAL)) {
             DataTypeKind::AbstractBuiltin
         } else if ns0_in_chain(ids::ENUMERATION) {
-            enumeration(model, t, diags)
+            enumeration(model, t, &out, diags)
         } else if def.is_some_and(|d| d.is_option_set) {
             let base = base_builtin.unwrap_or(BuiltinType::UInt32);
             let bits: Vec<EnumValue> = def
@@ -137,7 +139,7 @@ fn structure(model: &Model, t: NodeIx, done: &BTreeMap<NodeIx, DataTypeInfo>, di
         let array_dimensions =
             f.array_dimensions.as_deref().map(|a| a.split(',').filter_map(|x| x.trim().parse().ok()).collect()).unwrap_or_default();
         own.push(Field {
-            name: f.name.clone(),
+            name: f.name.as_str().into(),
             symbolic_name: f.symbolic_name.clone(),
             data_type,
             value_rank: f.value_rank.unwrap_or(-1),
@@ -158,7 +160,7 @@ fn structure(model: &Model, t: NodeIx, done: &BTreeMap<NodeIx, DataTypeInfo>, di
     fields.extend(own);
     let mut seen: HashMap<&str, usize> = HashMap::new();
     for (i, f) in fields.iter().enumerate() {
-        if let Some(&j) = seen.get(f.name.as_str()) {
+        if let Some(&j) = seen.get(&*f.name) {
             diags.push(
                 Diagnostic::new(Code::DuplicateEnumValue, format!("structure `{}` has two fields named `{}`", node.browse_name.name, f.name))
                     .at(f.span)
@@ -183,9 +185,9 @@ fn structure(model: &Model, t: NodeIx, done: &BTreeMap<NodeIx, DataTypeInfo>, di
 /// UANodeSet.xsd says; where the DataType also has an EnumValues or EnumStrings property and the two
 /// disagree (a missing Value colliding with a real one, or another value), the property decides and NS0219
 /// names the choice. Without fields, the property alone gives them.
-fn enumeration(model: &Model, t: NodeIx, diags: &mut Diagnostics) -> DataTypeKind {
+fn enumeration(model: &Model, t: NodeIx, done: &DataTypes, diags: &mut Diagnostics) -> DataTypeKind {
     let node = model.node(t);
-    let property = enum_property(model, t);
+    let property = enum_property(model, t, done);
     if let Some(def) = &node.definition {
         if !def.fields.is_empty() {
             let mut values: Vec<EnumValue> = def
@@ -237,7 +239,7 @@ struct EnumProperty {
     span: Span,
 }
 
-fn enum_property(model: &Model, t: NodeIx) -> Option<EnumProperty> {
+fn enum_property(model: &Model, t: NodeIx, done: &DataTypes) -> Option<EnumProperty> {
     for (_, child) in model.children(t) {
         let c = model.node(child);
         if c.browse_name.ns != 0 {
@@ -247,7 +249,7 @@ fn enum_property(model: &Model, t: NodeIx) -> Option<EnumProperty> {
         if which != "EnumStrings" && which != "EnumValues" {
             continue;
         }
-        let Some(Ok(v)) = model.value(child) else { continue };
+        let Some(Ok(v)) = model.value_with(child, done) else { continue };
         let items = match v {
             Variant::Array(_, items) => items,
             other => vec![other],
@@ -265,11 +267,8 @@ fn enum_property(model: &Model, t: NodeIx) -> Option<EnumProperty> {
                     description: None,
                 }),
                 Variant::ExtensionObject(eo) => {
-                    let Some(body) = eo.body else { continue };
-                    let value = body.child_text("Value").and_then(|v| v.trim().parse().ok()).unwrap_or(i as i64);
-                    let text = body.child("DisplayName").and_then(|d| d.child_text("Text")).unwrap_or("").to_string();
-                    let description = body.child("Description").and_then(|d| d.child_text("Text")).map(str::to_string).filter(|d| !d.is_empty());
-                    values.push(EnumValue { name: text.clone(), value, display_name: Some(text), description });
+                    let Some(s) = eo.structure() else { continue };
+                    values.push(EnumValue::from_enum_value_type(s, i as i64));
                 }
                 _ => {}
             }

@@ -12,6 +12,9 @@ use crate::source::{FileId, SourceMap, Span, Spanned};
 use crate::value::{BuiltinType, Content, Variant};
 use std::collections::BTreeMap;
 
+mod values;
+pub(crate) use values::DataTypes;
+
 /// "a" or "an" before a node class or type name, for messages.
 pub fn article(word: &str) -> &'static str {
     if word.starts_with(['A', 'E', 'I', 'O', 'U', 'a', 'e', 'i', 'o', 'u']) {
@@ -330,7 +333,7 @@ pub struct Member {
 #[derive(Clone, Debug)]
 pub struct Field {
     /// The field's Name.
-    pub name: String,
+    pub name: std::sync::Arc<str>,
     /// The field's SymbolicName, if the file gives one.
     pub symbolic_name: Option<String>,
     /// The field's DataType (BaseDataType if the file names none).
@@ -777,62 +780,6 @@ impl Model {
         out
     }
 
-    /// The element inside a node's `<Value>`, read in place from its file's text.
-    pub fn value_element(&self, ix: NodeIx) -> Option<ValueElement<'_>> {
-        let node = self.node(ix);
-        let value = node.value?;
-        let arena = self.value_arenas.get(node.file.0 as usize)?;
-        Some(arena.element(value, &self.sources.get(node.file).text))
-    }
-
-    /// The element inside a node's `<Value>` as an owned tree, built on each call (with the spans of the
-    /// file it was read from). To only read a value, [`Model::value_element`] needs no copy.
-    pub fn value_xml(&self, ix: NodeIx) -> Option<XmlElement> {
-        self.value_element(ix).map(|e| e.to_xml())
-    }
-
-    /// Decodes a node's value, mapping the NodeIds in it through its file's namespace table.
-    pub fn value(&self, ix: NodeIx) -> Option<Result<Variant, String>> {
-        self.decode_value(ix, Content::All)
-    }
-
-    /// [`Model::value`], copying as much as `content` says.
-    pub(crate) fn decode_value(&self, ix: NodeIx, content: Content) -> Option<Result<Variant, String>> {
-        let el = self.value_element(ix)?;
-        Some(self.decode_node_in_file(self.node(ix).file, el, content))
-    }
-
-    /// Decodes an XML value written in `file`.
-    pub fn decode_in_file(&self, file: FileId, xml: &XmlElement) -> Result<Variant, String> {
-        self.decode_node_in_file(file, xml, Content::All)
-    }
-
-    fn decode_node_in_file<'a, E: crate::value::XmlNode<'a>>(&self, file: FileId, el: E, content: Content) -> Result<Variant, String> {
-        let ctx = self.files.get(&file);
-        let ids = |s: &str| -> Result<NodeId, String> {
-            let ctx = ctx.ok_or("unknown file")?;
-            self.map_node_id(ctx, s)
-        };
-        let ns = |i: u16| ctx.and_then(|c| c.ns_map.get(i as usize).copied());
-        crate::value::decode_node(el, &ids, &ns, content)
-    }
-
-    pub(crate) fn map_node_id(&self, ctx: &FileContext, s: &str) -> Result<NodeId, String> {
-        let s = s.trim();
-        let text = ctx.aliases.get(s).map(|t| t.value.as_str()).unwrap_or(s);
-        let raw = crate::nodeid::parse_node_id(text)?;
-        let ns = match raw.ns {
-            crate::nodeid::NsRef::Index(i) => {
-                *ctx.ns_map.get(i as usize).ok_or_else(|| format!("namespace index {i} is not declared"))?
-            }
-            crate::nodeid::NsRef::Uri(u) => {
-                self.namespaces.iter().position(|n| *n == u).ok_or_else(|| format!("namespace `{u}` is not loaded"))?
-                    as u16
-            }
-        };
-        Ok(NodeId { ns, id: raw.id })
-    }
-
     /// Finds a node by `ns=…;i=…` (global index), `nsu=URI;…`, or a BrowseName (`Name` or `URI#Name`,
     /// searching types first).
     pub fn find(&self, query: &str) -> Vec<NodeIx> {
@@ -861,6 +808,15 @@ impl Model {
             .collect();
         hits.sort_by_key(|&ix| (!self.node(ix).class.is_type(), ix));
         hits
+    }
+
+    /// A NodeId for messages: `i=85` in ns0, `nsu=URI;i=5` elsewhere (indices differ between files).
+    pub fn display_id(&self, id: &NodeId) -> String {
+        if id.ns == 0 {
+            id.to_string()
+        } else {
+            format!("nsu={};{}", self.namespace_uri(id.ns), id.id)
+        }
     }
 
     /// Whether a namespace is the OPC UA base namespace.

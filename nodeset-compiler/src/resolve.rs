@@ -10,7 +10,7 @@ use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::load::Loaded;
 use crate::model::*;
 use crate::nodeid::{parse_qualified_name, NodeId, QualifiedName};
-use crate::raw::{NodeClass, RawRolePermission, RawStr, ValueArena, ValueElement};
+use crate::raw::{NodeClass, RawRolePermission, RawStr, ValueArena};
 use crate::source::{SourceMap, Span};
 use crate::value::{BuiltinType, Content, Variant};
 use std::collections::{BTreeMap, HashSet};
@@ -282,24 +282,17 @@ fn link(model: &mut Model, own: OwnReferences, incoming: Vec<(NodeIx, Reference)
     // Pass 3: hierarchy flags, supertypes, type definitions, modelling rules, parents.
     link_types(model, broken, diags);
 
-    // Passes 4 to 6 and 8 only read the model and do not depend on one another, except the value check on
-    // the data types: instance declarations and method arguments on one thread, data types and values on
-    // this one. Each pass keeps its diagnostics, which are added in pass order.
+    // Passes 4 to 6 and 8 only read the model and do not depend on one another, except on the data types:
+    // the method arguments (Argument structures) and the value check need them. So two rounds of two threads:
+    // instance declarations beside the data types, then method arguments beside the value check. Each pass
+    // keeps its diagnostics, which are added in pass order.
     let m = &*model;
-    let ((members, members_said, methods, methods_said), (data_types, data_types_said, values_said)) = crate::join(
-        || {
-            let (mut members_said, mut methods_said) = (Diagnostics::new(), Diagnostics::new());
-            let members = build_members(m, &mut members_said);
-            let methods = methods(m, &mut methods_said);
-            (members, members_said, methods, methods_said)
-        },
-        || {
-            let (mut data_types_said, mut values_said) = (Diagnostics::new(), Diagnostics::new());
-            let data_types = crate::datatypes::classify(m, &mut data_types_said);
-            check_values(m, &data_types, &mut values_said);
-            (data_types, data_types_said, values_said)
-        },
+    let ((members, members_said), (data_types, data_types_said)) = crate::join(
+        || said(|d| build_members(m, d)),
+        || said(|d| crate::datatypes::classify(m, d)),
     );
+    let ((methods, methods_said), (_, values_said)) =
+        crate::join(|| said(|d| methods(m, &data_types, d)), || said(|d| check_values(m, &data_types, d)));
     model.members = members;
     model.data_types = data_types;
     model.methods = methods;
@@ -309,6 +302,12 @@ fn link(model: &mut Model, own: OwnReferences, incoming: Vec<(NodeIx, Reference)
     // Pass 7: state machines, from the instance declarations.
     state_machines(model, diags);
     diags.extend(values_said);
+}
+
+/// Runs a pass that reports into diagnostics of its own, so that passes on two threads can be merged in order.
+fn said<T>(pass: impl FnOnce(&mut Diagnostics) -> T) -> (T, Diagnostics) {
+    let mut d = Diagnostics::new();
+    (pass(&mut d), d)
 }
 
 /// What pass 2 reads: the model with every node indexed, and the raw files it came from.
@@ -627,26 +626,18 @@ fn redefinition(
         && value(pfi, a) == value(r.file, b)
         && fields(p.definition.as_deref()) == fields(b.definition.as_deref());
     if identical {
-        Diagnostic::new(Code::IdenticalRedefinition, format!("NodeId `{}` is defined again, identically", display_id(model, &r.id)))
+        Diagnostic::new(Code::IdenticalRedefinition, format!("NodeId `{}` is defined again, identically", model.display_id(&r.id)))
             .at(b_span)
             .with_span_label("an identical copy")
             .label(p.node_id_span, "first defined here")
             .note("the copy is ignored; the node loaded first is used")
             .help("remove the copy from the file, or load the file that defines the node without it")
     } else {
-        Diagnostic::new(Code::DuplicateNodeId, format!("NodeId `{}` is defined twice", display_id(model, &r.id)))
+        Diagnostic::new(Code::DuplicateNodeId, format!("NodeId `{}` is defined twice", model.display_id(&r.id)))
             .at(b_span)
             .with_span_label("defined again here, differently")
             .label(p.node_id_span, "first defined here")
             .help("every node needs its own NodeId; the second definition is ignored")
-    }
-}
-
-pub(crate) fn display_id(model: &Model, id: &NodeId) -> String {
-    if id.ns == 0 {
-        id.to_string()
-    } else {
-        format!("nsu={};{}", model.namespace_uri(id.ns), id.id)
     }
 }
 
@@ -658,7 +649,7 @@ fn dangling(model: &Model, from: NodeIx, id: &NodeId, span: Span) -> Diagnostic 
     };
     let code = if same_model { Code::DanglingReference } else { Code::DanglingForeignReference };
     let owner = model.models.iter().find(|m| m.ns == id.ns);
-    let mut d = Diagnostic::new(code, format!("`{}` names no node", display_id(model, id)))
+    let mut d = Diagnostic::new(code, format!("`{}` names no node", model.display_id(id)))
         .at(span)
         .with_span_label("no node has this NodeId");
     if let Some(o) = owner {
@@ -929,8 +920,8 @@ fn collision(model: &Model, parent: NodeIx, a: NodeIx, b: NodeIx, diags: &mut Di
                 "`{}` has two children named `{}`: {} and {}",
                 model.node(parent).browse_name.name,
                 na.browse_name.name,
-                display_id(model, &na.id),
-                display_id(model, &nb.id)
+                model.display_id(&na.id),
+                model.display_id(&nb.id)
             ),
         )
         .at(nb.browse_name_span)
@@ -941,7 +932,7 @@ fn collision(model: &Model, parent: NodeIx, a: NodeIx, b: NodeIx, diags: &mut Di
 }
 
 /// Pass 6: the arguments of every method.
-fn methods(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeIx, MethodInfo> {
+fn methods(model: &Model, types: &DataTypes, diags: &mut Diagnostics) -> BTreeMap<NodeIx, MethodInfo> {
     let mut out = BTreeMap::new();
     for i in 0..model.nodes.len() {
         let ix = NodeIx(i as u32);
@@ -956,9 +947,8 @@ fn methods(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeIx, MethodInf
                 (0, "OutputArguments") => 1,
                 _ => continue,
             };
-            // The value is checked by decoding it without copies; the arguments are then read in place.
-            let (Some(value), Some(el)) = (model.decode_value(child, Content::Shape), model.value_element(child)) else { continue };
-            let args = match value.and_then(|v| decode_arguments(model, c.file, v, el)) {
+            let Some(value) = model.value_with(child, types) else { continue };
+            let args = match value.and_then(|v| decode_arguments(model, v)) {
                 Ok(a) => a,
                 Err(why) => {
                     diags.push(
@@ -980,39 +970,23 @@ fn methods(model: &Model, diags: &mut Diagnostics) -> BTreeMap<NodeIx, MethodInf
     out
 }
 
-/// The arguments in a decoded InputArguments or OutputArguments value; `el` is the value's element, from
-/// which the Argument structures are read.
-fn decode_arguments(model: &Model, file: crate::source::FileId, v: Variant, el: ValueElement<'_>) -> Result<Vec<Argument>, String> {
-    // An array's items are its element's children, one for one.
-    let items: Vec<(Variant, ValueElement<'_>)> = match v {
-        Variant::Array(_, items) => items.into_iter().zip(el.children()).collect(),
-        other => vec![(other, el)],
+/// The arguments in a decoded InputArguments or OutputArguments value: Argument structures, one or an array.
+fn decode_arguments(model: &Model, v: Variant) -> Result<Vec<Argument>, String> {
+    let items = match v {
+        Variant::Array(_, items) => items,
+        other => vec![other],
     };
-    let ctx = &model.files[&file];
-    let mut out = Vec::new();
-    for (it, item) in items {
-        let Variant::ExtensionObject(_) = it else { return Err("an element is not an ExtensionObject".into()) };
-        let body = item.child("Body").and_then(|b| b.children().next()).ok_or("an Argument has no body")?;
-        let name = body.child_text("Name").unwrap_or("").trim().to_string();
-        let data_type = match body.child("DataType").and_then(|d| d.child_text("Identifier")) {
-            Some(t) => {
-                let id = model.map_node_id(ctx, t)?;
-                Some(model.lookup(&id).ok_or_else(|| format!("argument `{name}` has DataType {} which names no node", display_id(model, &id)))?)
-            }
-            None => None,
-        };
-        let value_rank = match body.child_text("ValueRank") {
-            Some(t) => t.trim().parse().map_err(|_| format!("ValueRank `{}` is not a number", t.trim()))?,
-            None => -1,
-        };
-        let array_dimensions = body
-            .child("ArrayDimensions")
-            .map(|a| a.children().filter_map(|c| c.text().trim().parse().ok()).collect())
-            .unwrap_or_default();
-        let description = body.child("Description").and_then(|d| d.child_text("Text")).map(|s| s.to_string()).filter(|s| !s.is_empty());
-        out.push(Argument { name, data_type, value_rank, array_dimensions, description });
-    }
-    Ok(out)
+    items
+        .iter()
+        .map(|it| match it {
+            Variant::ExtensionObject(eo) => match eo.structure() {
+                Some(s) => Argument::from_structure(model, s),
+                None if eo.body.is_none() => Err("an Argument has no body".into()),
+                None => Err("an element's TypeId names no Argument encoding".into()),
+            },
+            _ => Err("an element is not an ExtensionObject".into()),
+        })
+        .collect()
 }
 
 fn state_machines(model: &mut Model, diags: &mut Diagnostics) {

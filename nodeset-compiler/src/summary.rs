@@ -55,7 +55,7 @@ pub fn render(model: &Model) -> String {
 pub fn show_type(model: &Model, t: NodeIx, depth: usize) -> String {
     let mut s = String::new();
     let node = model.node(t);
-    let _ = writeln!(s, "{} {} ({})", node.class.name(), model.qualified(t), crate::resolve::display_id(model, &node.id));
+    let _ = writeln!(s, "{} {} ({})", node.class.name(), model.qualified(t), model.display_id(&node.id));
     let chain: Vec<String> = model.super_chain(t).iter().skip(1).map(|&c| model.qualified(c)).collect();
     if !chain.is_empty() {
         let _ = writeln!(s, "  supertypes: {}", chain.join(" -> "));

@@ -2,12 +2,16 @@
 //!
 //! The parser keeps a value in its file's [`ValueArena`](crate::raw::ValueArena); a value can also be an
 //! owned [`XmlElement`] tree. This module turns either into a [`Variant`]: every built-in scalar, `ListOf…`
-//! arrays, and ExtensionObjects whose TypeId is resolved and whose body is kept as a tree (its fields are
-//! decoded against the DataType's definition by whoever needs them). NodeIds inside values are written with
-//! file-local namespace indices, so decoding takes a function that maps them.
+//! arrays, and ExtensionObjects whose TypeId is resolved and whose body is kept as a tree. NodeIds inside values
+//! are written with file-local namespace indices, so decoding takes a function that maps them.
+//!
+//! [`Model::value`](crate::model::Model::value) is where a node's value is decoded: it also decodes every
+//! structure body against its DataType's definition ([`Structure`]), so that what the resolver and the emitters
+//! read is typed data, never XML or a file's namespace table.
 
 use crate::nodeid::{base64_decode, base64_valid, parse_guid, NodeId, QualifiedName};
 use crate::raw::{LocalizedText, ValueElement, XmlElement};
+use std::sync::Arc;
 
 /// An element as the decoder reads it: an owned [`XmlElement`] or a [`ValueElement`] read in place.
 pub(crate) trait XmlNode<'a>: Copy {
@@ -15,6 +19,8 @@ pub(crate) trait XmlNode<'a>: Copy {
     fn text(self) -> &'a str;
     fn children(self) -> impl Iterator<Item = Self>;
     fn to_xml(self) -> XmlElement;
+    /// The element as read in place, if it is one (structure bodies are decoded only from those).
+    fn in_place(self) -> Option<ValueElement<'a>>;
 
     fn child(self, name: &str) -> Option<Self> {
         self.children().find(|c| c.name() == name)
@@ -41,6 +47,10 @@ impl<'a> XmlNode<'a> for &'a XmlElement {
     fn to_xml(self) -> XmlElement {
         self.clone()
     }
+
+    fn in_place(self) -> Option<ValueElement<'a>> {
+        None
+    }
 }
 
 impl<'a> XmlNode<'a> for ValueElement<'a> {
@@ -58,6 +68,10 @@ impl<'a> XmlNode<'a> for ValueElement<'a> {
 
     fn to_xml(self) -> XmlElement {
         ValueElement::to_xml(&self)
+    }
+
+    fn in_place(self) -> Option<ValueElement<'a>> {
+        Some(self)
     }
 }
 
@@ -228,13 +242,72 @@ impl BuiltinType {
     }
 }
 
-/// An ExtensionObject from a value: its encoding or type id and its body as a tree.
+/// An ExtensionObject from a value: its encoding or type id and its body.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ExtensionObject {
     /// The TypeId as written (usually the XML encoding node, sometimes the DataType itself).
     pub type_id: Option<NodeId>,
-    /// The element inside `<Body>`, whose name is the structure's name.
-    pub body: Option<XmlElement>,
+    /// What `<Body>` holds, if anything.
+    pub body: Option<Body>,
+}
+
+impl ExtensionObject {
+    /// The structure, if the body was decoded against its DataType's definition.
+    pub fn structure(&self) -> Option<&Structure> {
+        match &self.body {
+            Some(Body::Structure(s)) => Some(s),
+            _ => None,
+        }
+    }
+}
+
+/// The body of an ExtensionObject.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Body {
+    /// The fields, decoded against the definition of the DataType the TypeId names. [`Model::value`]
+    /// decodes every body it can this way.
+    ///
+    /// [`Model::value`]: crate::model::Model::value
+    Structure(Structure),
+    /// The element inside `<Body>` as written: the TypeId names no structure with a definition, or the value
+    /// was decoded without the model's DataTypes ([`decode`]).
+    Xml(XmlElement),
+}
+
+/// A structure value, decoded against its DataType's definition (inherited fields included). NodeIds and
+/// QualifiedNames in it are mapped like those of any value.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Structure {
+    /// The DataType.
+    pub data_type: NodeId,
+    /// A union's SwitchField, if the value gives one.
+    pub switch_field: Option<u32>,
+    /// The fields the value gives, in the definition's order; a field it leaves out is absent. A field that
+    /// does not decode holds the reason. An array field (ValueRank 0 or more) is a [`Variant::Array`].
+    pub fields: Vec<(Arc<str>, Result<Variant, String>)>,
+}
+
+impl Structure {
+    /// A field's value: `None` if the value leaves it out, the reason if it does not decode.
+    pub fn get(&self, name: &str) -> Option<&Result<Variant, String>> {
+        self.fields.iter().find(|(n, _)| &**n == name).map(|(_, v)| v)
+    }
+
+    /// A field's value, if the value gives it and it decodes.
+    pub fn field(&self, name: &str) -> Option<&Variant> {
+        self.get(name).and_then(|v| v.as_ref().ok())
+    }
+
+    /// The text of a String, LocalizedText or QualifiedName field; `None` if absent, empty or of another type.
+    pub fn text(&self, name: &str) -> Option<&str> {
+        match self.field(name)? {
+            Variant::String(s) => Some(s.as_str()),
+            Variant::LocalizedText(t) => Some(t.text.as_str()),
+            Variant::QualifiedName(q) => Some(q.name.as_str()),
+            _ => None,
+        }
+        .filter(|s| !s.is_empty())
+    }
 }
 
 /// A decoded value.
@@ -361,22 +434,42 @@ pub(crate) enum Content {
     Shape,
 }
 
+/// Decodes the body of an ExtensionObject into a [`Structure`], for [`Decoder::structures`]: the model, which
+/// knows the DataTypes.
+pub(crate) trait Structures {
+    /// The fields of `body`, if `type_id` names a structure with a definition; `depth` is the nesting so far.
+    fn structure(&self, type_id: &NodeId, body: ValueElement<'_>, depth: usize) -> Option<Structure>;
+}
+
+/// What decoding needs besides the element: the mappers, how much to copy, and who decodes structure bodies.
+#[derive(Clone, Copy)]
+pub(crate) struct Decoder<'d> {
+    /// Maps NodeIds written in the file.
+    pub ids: &'d NodeIdMapper<'d>,
+    /// Maps namespace indices written in the file.
+    pub ns: &'d NsMapper<'d>,
+    /// How much to copy.
+    pub content: Content,
+    /// Decodes structure bodies read in place; without it (or for owned trees) a body is kept as XML.
+    pub structures: Option<&'d dyn Structures>,
+}
+
 /// Decodes one value element. Errors name the element and what is wrong with it.
 pub fn decode(el: &XmlElement, ids: &NodeIdMapper, ns: &NsMapper) -> Result<Variant, String> {
-    decode_node(el, ids, ns, Content::All)
+    decode_node(el, Decoder { ids, ns, content: Content::All, structures: None })
 }
 
 /// Decodes one value element read in place from its file's value arena.
 pub fn decode_element(el: ValueElement<'_>, ids: &NodeIdMapper, ns: &NsMapper) -> Result<Variant, String> {
-    decode_node(el, ids, ns, Content::All)
+    decode_node(el, Decoder { ids, ns, content: Content::All, structures: None })
 }
 
-/// Decodes an element, copying as much as `content` says.
-pub(crate) fn decode_node<'a, E: XmlNode<'a>>(el: E, ids: &NodeIdMapper, ns: &NsMapper, content: Content) -> Result<Variant, String> {
-    decode_depth(el, ids, ns, 0, content)
+/// Decodes an element as `d` says.
+pub(crate) fn decode_node<'a, E: XmlNode<'a>>(el: E, d: Decoder) -> Result<Variant, String> {
+    decode_depth(el, d, 0)
 }
 
-fn decode_depth<'a, E: XmlNode<'a>>(el: E, ids: &NodeIdMapper, ns: &NsMapper, depth: usize, content: Content) -> Result<Variant, String> {
+fn decode_depth<'a, E: XmlNode<'a>>(el: E, d: Decoder, depth: usize) -> Result<Variant, String> {
     if depth > 64 {
         return Err("the value is nested more than 64 levels deep".into());
     }
@@ -388,12 +481,12 @@ fn decode_depth<'a, E: XmlNode<'a>>(el: E, ids: &NodeIdMapper, ns: &NsMapper, de
             if c.name() != item {
                 return Err(format!("<{}> inside <{name}>: expected <{item}>", c.name()));
             }
-            items.push(scalar(b, c, ids, ns, depth, content)?);
+            items.push(scalar(b, c, d, depth)?);
         }
         return Ok(Variant::Array(b, items));
     }
     let b = BuiltinType::from_xml_name(name).ok_or_else(|| format!("<{name}> is not a built-in type"))?;
-    scalar(b, el, ids, ns, depth, content)
+    scalar(b, el, d, depth)
 }
 
 fn num<'a, T: std::str::FromStr, E: XmlNode<'a>>(el: E) -> Result<T, String> {
@@ -422,18 +515,13 @@ pub fn decode_scalar(
     ns: &NsMapper,
     depth: usize,
 ) -> Result<Variant, String> {
-    scalar(b, el, ids, ns, depth, Content::All)
+    scalar(b, el, Decoder { ids, ns, content: Content::All, structures: None }, depth)
 }
 
-fn scalar<'a, E: XmlNode<'a>>(
-    b: BuiltinType,
-    el: E,
-    ids: &NodeIdMapper,
-    ns: &NsMapper,
-    depth: usize,
-    content: Content,
-) -> Result<Variant, String> {
-    let all = content == Content::All;
+/// Decodes an element known to hold a scalar of type `b`, as `d` says.
+pub(crate) fn scalar<'a, E: XmlNode<'a>>(b: BuiltinType, el: E, d: Decoder, depth: usize) -> Result<Variant, String> {
+    let (ids, ns) = (d.ids, d.ns);
+    let all = d.content == Content::All;
     // The text of `el` if everything is copied, else an empty string.
     let copy = |s: &str| if all { s.to_string() } else { String::new() };
     Ok(match b {
@@ -503,7 +591,16 @@ fn scalar<'a, E: XmlNode<'a>>(
                 Some(t) if !t.trim().is_empty() => Some(ids(t.trim())?),
                 _ => None,
             };
-            let body = if all { el.child("Body").and_then(|b| b.children().next()).map(XmlNode::to_xml) } else { None };
+            let body = match el.child("Body").and_then(|b| b.children().next()) {
+                Some(b) if all => {
+                    let decoded = match (d.structures, &type_id, b.in_place()) {
+                        (Some(st), Some(t), Some(b)) => st.structure(t, b, depth + 1),
+                        _ => None,
+                    };
+                    Some(decoded.map_or_else(|| Body::Xml(b.to_xml()), Body::Structure))
+                }
+                _ => None,
+            };
             Variant::ExtensionObject(Box::new(ExtensionObject { type_id, body }))
         }
         BuiltinType::Variant => {
@@ -513,7 +610,7 @@ fn scalar<'a, E: XmlNode<'a>>(
             } else {
                 inner
             };
-            Variant::Variant(Box::new(decode_depth(inner, ids, ns, depth + 1, content)?))
+            Variant::Variant(Box::new(decode_depth(inner, d, depth + 1)?))
         }
         BuiltinType::DataValue | BuiltinType::DiagnosticInfo => Variant::XmlElement(el.to_xml()),
     })
@@ -567,8 +664,8 @@ mod tests {
             el("Variant", "", vec![]),
         ];
         for c in &cases {
-            let all = decode_node(c, &ids, &ns, Content::All);
-            let shape = decode_node(c, &ids, &ns, Content::Shape);
+            let all = decode_node(c, Decoder { ids: &ids, ns: &ns, content: Content::All, structures: None });
+            let shape = decode_node(c, Decoder { ids: &ids, ns: &ns, content: Content::Shape, structures: None });
             match (&all, &shape) {
                 (Ok(a), Ok(s)) => assert_eq!((a.builtin(), a.is_array()), (s.builtin(), s.is_array()), "{c:?}"),
                 (Err(a), Err(s)) => assert_eq!(a, s),
@@ -602,7 +699,8 @@ mod tests {
         match decode(&eo, &ids, &ns).unwrap() {
             Variant::ExtensionObject(e) => {
                 assert_eq!(e.type_id, Some(NodeId::numeric(11, 5)));
-                assert_eq!(e.body.unwrap().child_text("Name"), Some("X"));
+                let Some(Body::Xml(body)) = e.body else { panic!("{:?}", e.body) };
+                assert_eq!(body.child_text("Name"), Some("X"));
             }
             other => panic!("{other:?}"),
         }

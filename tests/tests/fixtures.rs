@@ -81,7 +81,7 @@ fn struct_of(m: &Model, t: NodeIx) -> (StructureKind, &[Field]) {
 
 /// `(field name, DataType BrowseName)` of every field, inherited ones first.
 fn field_types<'a>(m: &'a Model, fields: &'a [Field]) -> Vec<(&'a str, &'a str)> {
-    fields.iter().map(|f| (f.name.as_str(), name(m, f.data_type))).collect()
+    fields.iter().map(|f| (&*f.name, name(m, f.data_type))).collect()
 }
 
 fn enum_values(m: &Model, t: NodeIx) -> Vec<(String, i64)> {
@@ -188,7 +188,7 @@ fn structure() {
     assert_eq!(m.node(calibrated).super_type, Some(record));
     let (kind, fields) = struct_of(m, calibrated);
     assert_eq!(kind, StructureKind::Structure);
-    let names: Vec<&str> = fields.iter().map(|f| f.name.as_str()).collect();
+    let names: Vec<&str> = fields.iter().map(|f| &*f.name).collect();
     assert_eq!(
         names,
         ["Valid", "Count", "Value", "Label", "Title", "Source", "Timestamp", "Location", "CalibrationDate", "Offset"]
@@ -207,7 +207,7 @@ fn optional_fields() {
     let (kind, fields) = struct_of(m, t);
     assert_eq!(kind, StructureKind::StructureWithOptionalFields);
     let shape: Vec<(&str, &str, bool)> =
-        fields.iter().map(|f| (f.name.as_str(), name(m, f.data_type), f.is_optional)).collect();
+        fields.iter().map(|f| (&*f.name, name(m, f.data_type), f.is_optional)).collect();
     assert_eq!(
         shape,
         [
@@ -268,9 +268,11 @@ fn enum_gaps() {
         .map(|it| {
             let Variant::ExtensionObject(eo) = it else { panic!("{it:?}") };
             assert_eq!(eo.type_id.as_ref().and_then(|t| t.ns0()), Some(7616), "EnumValueType's Default XML encoding");
-            let body = eo.body.as_ref().expect("body");
-            let text = body.child("DisplayName").and_then(|d| d.child_text("Text")).expect("DisplayName");
-            (text.to_string(), body.child_text("Value").expect("Value").trim().parse().expect("a number"))
+            // Decoded against EnumValueType's definition: typed fields, no XML.
+            let s = eo.structure().expect("an EnumValueType structure");
+            assert_eq!(m.lookup(&s.data_type), m.ns0(ids::ENUM_VALUE_TYPE));
+            assert_eq!(s.field("Value").map(|v| v.builtin()), Some(Some(BuiltinType::Int64)));
+            (s.text("DisplayName").expect("DisplayName").to_string(), s.field("Value").and_then(Variant::as_i64).expect("Value"))
         })
         .collect();
     assert_eq!(from_property, expected);
@@ -332,14 +334,14 @@ fn abstract_base() {
         assert_eq!(m.node(ix).super_type, Some(shape), "{t}");
         let (kind, fields) = struct_of(m, ix);
         assert_eq!(kind, StructureKind::Structure, "{t}");
-        assert_eq!(fields.iter().map(|f| f.name.as_str()).collect::<Vec<_>>(), own, "{t}");
+        assert_eq!(fields.iter().map(|f| &*f.name).collect::<Vec<_>>(), own, "{t}");
         assert_eq!(fields[0].declared_in, shape, "{t} inherits Name from Shape");
     }
     let plan = ty(m, &u, "CuttingPlan");
     let (_, fields) = struct_of(m, plan);
     let shape_fields: Vec<(&str, NodeIx, i32, &[u32], bool)> = fields
         .iter()
-        .map(|f| (f.name.as_str(), f.data_type, f.value_rank, f.array_dimensions.as_slice(), f.allow_sub_types))
+        .map(|f| (&*f.name, f.data_type, f.value_rank, f.array_dimensions.as_slice(), f.allow_sub_types))
         .collect();
     assert_eq!(shape_fields[1..], [("Outline", shape, -1, &[][..], true), ("Holes", shape, 1, &[0][..], true)]);
     assert!(!shape_fields[0].4, "Title does not allow subtypes");
@@ -365,7 +367,7 @@ fn arrays() {
     let (_, fields) = struct_of(m, ty(m, &u, "SampleSet"));
     let shape: Vec<(&str, &str, i32, &[u32])> = fields
         .iter()
-        .map(|f| (f.name.as_str(), name(m, f.data_type), f.value_rank, f.array_dimensions.as_slice()))
+        .map(|f| (&*f.name, name(m, f.data_type), f.value_rank, f.array_dimensions.as_slice()))
         .collect();
     assert_eq!(
         shape,
@@ -415,7 +417,7 @@ fn names() {
     assert!(m.find("3DFrame").iter().any(|&x| m.node(x).id.ns == 0), "ns0 defines a 3DFrame too");
     let (_, fields) = struct_of(m, frame);
     assert_eq!(
-        fields.iter().map(|f| f.name.as_str()).collect::<Vec<_>>(),
+        fields.iter().map(|f| &*f.name).collect::<Vec<_>>(),
         ["_x", "x_", "match", "Type", "Real", "input"]
     );
 

@@ -191,7 +191,7 @@ impl Check<'_> {
                 };
                 let fields_ok = fields.len() == f.len()
                     && fields.iter().zip(f.iter()).all(|(a, b)| {
-                        a.name == b.name
+                        *a.name == *b.name
                             && a.description.as_deref() == b.description
                             && self.same_ix(&b.data_type, a.data_type)
                             && a.value_rank == b.value_rank

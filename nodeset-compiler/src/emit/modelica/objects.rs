@@ -404,15 +404,15 @@ impl Ctx<'_> {
             }
         };
         let Ok(Variant::ExtensionObject(eo)) = m.value(eu)? else { return None };
-        let body = eo.body.as_ref()?;
-        let id: i32 = body.child_text("UnitId")?.trim().parse().ok()?;
+        let eu = eo.structure()?;
+        let id = i32::try_from(eu.field("UnitId")?.as_i64()?).ok()?;
         if id == -1 {
             return None;
         }
         match super::units::modelica_unit(id) {
             Some(u) => Some(Ok(u)),
             None => {
-                let shown = body.child("DisplayName").and_then(|d| d.child_text("Text")).unwrap_or("").to_string();
+                let shown = eu.text("DisplayName").unwrap_or("").to_string();
                 Some(Err(if shown.is_empty() { format!("UnitId {id}") } else { format!("{shown} (UnitId {id})") }))
             }
         }

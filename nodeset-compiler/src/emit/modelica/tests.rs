@@ -493,3 +493,30 @@ fn every_class_is_documented_and_has_an_icon_and_every_connector_a_place() {
     let offences = convention_offences(&bare);
     assert_eq!(offences.len(), 3, "{offences:?}");
 }
+
+#[test]
+fn values_are_written_from_typed_data_a_structure_field_by_field() {
+    use crate::nodeid::NodeId;
+    use crate::raw::LocalizedText;
+    use crate::value::{Body, ExtensionObject, Structure, Variant};
+    let out = robotics();
+    let m = &out.model;
+    let all: BTreeSet<u16> = (0..m.namespaces.len() as u16).collect();
+    let mut ctx = Ctx::new(m, (0..m.namespaces.len()).map(|i| format!("P{i}")).collect(), all, None);
+    let file = m.node(m.ns0(crate::model::ids::ARGUMENT).unwrap()).file;
+    // EUInformation (i=887): fields by name, an absent field keeps its default, a field that did not decode too.
+    let eu = m.ns0(887).unwrap();
+    let s = Structure {
+        data_type: NodeId::numeric(0, 887),
+        switch_field: None,
+        fields: vec![
+            ("UnitId".into(), Ok(Variant::Int32(5066068))),
+            ("DisplayName".into(), Ok(Variant::LocalizedText(LocalizedText { locale: None, text: "mm".into() }))),
+            ("Description".into(), Err("field `Description`: broken".into())),
+        ],
+    };
+    let v = Variant::ExtensionObject(Box::new(ExtensionObject { type_id: None, body: Some(Body::Structure(s)) }));
+    let record = ctx.mtype(eu);
+    let lit = ctx.literal(&v, &record, file).expect("a record literal");
+    assert!(lit.ends_with("EUInformation(unitId = 5066068, displayName = \"mm\")"), "{lit}");
+}

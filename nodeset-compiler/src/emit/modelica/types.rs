@@ -6,9 +6,8 @@ use super::plan::{Base, MType, RecField, RecordInfo};
 use super::text::{self, string_literal};
 use crate::model::{ids, DataTypeKind, EnumValue, Field, NodeIx, StructureKind};
 use crate::nodeid::{format_guid, QualifiedName};
-use crate::raw::XmlElement;
 use crate::source::FileId;
-use crate::value::{BuiltinType, Variant};
+use crate::value::{BuiltinType, Structure, Variant};
 use std::collections::BTreeSet;
 use std::rc::Rc;
 
@@ -216,7 +215,7 @@ impl Ctx<'_> {
                     })
                     .unwrap_or_default();
                 let inherited: BTreeSet<String> = out.iter().map(|f| f.name.clone()).collect();
-                let own: Vec<Field> = fields.into_iter().filter(|f| !inherited.contains(&f.name)).collect();
+                let own: Vec<Field> = fields.into_iter().filter(|f| !inherited.contains(&*f.name)).collect();
                 let mut scope = self.scope::<usize>();
                 for t in &taken {
                     scope.reserve(t);
@@ -229,7 +228,7 @@ impl Ctx<'_> {
                 }
                 let (names, collisions) = scope.finish();
                 let what = format!("record {}", self.m.qualified(dt));
-                self.report(&what, "fields", collisions, |i| (dt, Some(own[*i].name.clone())));
+                self.report(&what, "fields", collisions, |i| (dt, Some(own[*i].name.to_string())));
                 if kind == StructureKind::Union {
                     taken.insert("switchField".into());
                 }
@@ -257,7 +256,7 @@ impl Ctx<'_> {
                         c
                     });
                     out.push(RecField {
-                        name: f.name.clone(),
+                        name: f.name.to_string(),
                         ident,
                         has_flag,
                         count,
@@ -408,8 +407,8 @@ impl Ctx<'_> {
                 lits.iter().find(|(e, _)| e.value as i128 == x).map(|(_, n)| format!("{class}.{n}"))
             }
             (MType::Record { dt, .. }, Variant::ExtensionObject(eo)) => {
-                let body = eo.body.as_ref()?;
-                self.record_literal(*dt, body, file)
+                let s = eo.structure()?;
+                self.record_literal(*dt, s, file)
             }
             _ => None,
         }
@@ -440,9 +439,9 @@ impl Ctx<'_> {
         }
     }
 
-    /// The record constructor of a structure value written in XML (`<EUInformation><UnitId>..</UnitId>...`).
-    /// Fields the XML leaves out keep their defaults.
-    fn record_literal(&mut self, dt: NodeIx, body: &XmlElement, file: FileId) -> Option<String> {
+    /// The record constructor of a structure value (`EUInformation(unitId = 5066068, ...)`). Fields the value
+    /// leaves out, or that do not fit their Modelica type, keep their defaults.
+    fn record_literal(&mut self, dt: NodeIx, s: &Structure, file: FileId) -> Option<String> {
         self.depth += 1;
         if self.depth > 32 {
             self.depth -= 1;
@@ -456,25 +455,19 @@ impl Ctx<'_> {
             self.depth -= 1;
             return Some(format!("{class}()"));
         }
-        let is_union = matches!(
-            self.m.data_types.get(&dt).map(|i| &i.kind),
-            Some(DataTypeKind::Structure { kind: StructureKind::Union, .. })
-        );
-        if is_union {
-            if let Some(sw) = body.child_text("SwitchField").and_then(|t| t.trim().parse::<i64>().ok()) {
-                args.push(format!("switchField = {sw}"));
-            }
+        if let Some(sw) = s.switch_field {
+            args.push(format!("switchField = {sw}"));
         }
         for f in info.fields.iter() {
             let Some(field) = &f.field else { continue };
-            let Some(el) = body.child(&f.name) else { continue };
+            let Some(v) = s.field(&f.name) else { continue };
             let ty = self.mtype(field.data_type);
             if matches!(ty, MType::Unmapped(_)) {
                 continue;
             }
             let value = if field.value_rank >= 0 {
-                let items: Option<Vec<String>> =
-                    el.children.iter().map(|c| self.xml_scalar(c, &ty, field.data_type, file)).collect();
+                let Variant::Array(_, items) = v else { continue };
+                let items: Option<Vec<String>> = items.iter().map(|it| self.literal(it, &ty, file)).collect();
                 // An empty array keeps the default: `{}` has no element type.
                 let items = items.filter(|i| !i.is_empty());
                 if let (Some(c), Some(i)) = (&f.count, &items) {
@@ -482,7 +475,7 @@ impl Ctx<'_> {
                 }
                 items.map(|i| format!("{{{}}}", i.join(", ")))
             } else {
-                self.xml_scalar(el, &ty, field.data_type, file)
+                self.literal(v, &ty, file)
             };
             if let Some(v) = value {
                 if let Some(flag) = &f.has_flag {
@@ -493,71 +486,6 @@ impl Ctx<'_> {
         }
         self.depth -= 1;
         Some(format!("{class}({})", args.join(", ")))
-    }
-
-    /// One field value written in XML as a literal of `ty`.
-    fn xml_scalar(&mut self, el: &XmlElement, ty: &MType, dt: NodeIx, file: FileId) -> Option<String> {
-        let t = el.text.trim();
-        match ty {
-            MType::Scalar { base, builtin, .. } => match builtin {
-                BuiltinType::LocalizedText => Some(string_literal(el.child_text("Text").unwrap_or(""))),
-                BuiltinType::QualifiedName => {
-                    let name = el.child_text("Name").unwrap_or("");
-                    let ns: u16 = el.child_text("NamespaceIndex").and_then(|n| n.trim().parse().ok()).unwrap_or(0);
-                    let ns = self.m.files.get(&file).and_then(|c| c.ns_map.get(ns as usize).copied()).unwrap_or(0);
-                    Some(string_literal(&qualified_name_text(self, &QualifiedName { ns, name: name.to_string() })))
-                }
-                BuiltinType::NodeId | BuiltinType::ExpandedNodeId => {
-                    let id = el.child_text("Identifier").unwrap_or("").trim();
-                    let ctx = self.m.files.get(&file)?;
-                    let text = match self.m_map_node_id(ctx, id) {
-                        Some(n) => node_id_text(self.m, &n),
-                        None => String::new(),
-                    };
-                    Some(string_literal(&text))
-                }
-                BuiltinType::Guid => Some(string_literal(el.child_text("String").unwrap_or(t))),
-                BuiltinType::DateTime => text::unix_seconds(t).and_then(text::real_literal),
-                _ => match base {
-                    Base::Boolean => match t {
-                        "true" | "1" => Some("true".into()),
-                        "false" | "0" => Some("false".into()),
-                        _ => None,
-                    },
-                    Base::Integer => {
-                        let x: i128 = t.parse().ok()?;
-                        if *builtin == BuiltinType::StatusCode {
-                            Some((x as u32 as i32).to_string())
-                        } else {
-                            i32::try_from(x).ok().map(|x| x.to_string())
-                        }
-                    }
-                    Base::Real => {
-                        let x: f64 = t.parse().ok()?;
-                        text::real_literal(x)
-                    }
-                    Base::String => Some(string_literal(&el.text)),
-                },
-            },
-            MType::Enum { class, .. } => {
-                // XML writes an enumeration as `Name_5`.
-                let value: i64 = t.rsplit('_').next()?.parse().ok()?;
-                let class = class.clone();
-                let lits = self.enum_literals(dt);
-                lits.iter().find(|(e, _)| e.value == value).map(|(_, n)| format!("{class}.{n}"))
-            }
-            MType::Record { dt, .. } => self.record_literal(*dt, el, file),
-            MType::Unmapped(_) => None,
-        }
-    }
-
-    fn m_map_node_id(&self, ctx: &crate::model::FileContext, s: &str) -> Option<crate::nodeid::NodeId> {
-        let raw = crate::nodeid::parse_node_id(s).ok()?;
-        let ns = match raw.ns {
-            crate::nodeid::NsRef::Index(i) => *ctx.ns_map.get(i as usize)?,
-            crate::nodeid::NsRef::Uri(u) => self.m.namespaces.iter().position(|n| *n == u)? as u16,
-        };
-        Some(crate::nodeid::NodeId { ns, id: raw.id })
     }
 
     /// The `type` of a built-in or simple DataType, a `record` of a structure or OptionSet, or the

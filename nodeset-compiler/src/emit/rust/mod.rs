@@ -436,7 +436,7 @@ impl<'m> Gen<'m> {
         let list: Vec<String> = c
             .members
             .iter()
-            .map(|(orig, ix)| format!("`{orig}` ({})", crate::resolve::display_id(model, &model.node(*ix).id)))
+            .map(|(orig, ix)| format!("`{orig}` ({})", model.display_id(&model.node(*ix).id)))
             .collect();
         let first = c.members.first().map(|(_, ix)| *ix);
         let mut d = Diagnostic::new(
@@ -540,7 +540,7 @@ impl<'m> Gen<'m> {
             let n = model.node(t);
             let info = &model.data_types[&t];
             let name_id = ident(&name);
-            let mut text = format!("`{}` ({}).", n.browse_name.name, crate::resolve::display_id(model, &n.id));
+            let mut text = format!("`{}` ({}).", n.browse_name.name, model.display_id(&n.id));
             if let Some(d) = n.doc() {
                 text.push_str("\n\n");
                 text.push_str(d);
@@ -809,13 +809,6 @@ impl<'m> Gen<'m> {
                 quote! { #rt::IdKind::Opaque(#bytes) }
             }
         }
-    }
-
-    /// Maps a NodeId string written inside a value of one of this namespace's files.
-    fn map_value_node_id(&self, text: &str) -> Option<crate::nodeid::NodeId> {
-        let m = self.model.model_of_namespace(self.ns)?;
-        let ctx = self.model.files.get(&m.file)?;
-        self.model.map_node_id(ctx, text).ok()
     }
 }
 

@@ -683,7 +683,7 @@ impl Gen<'_> {
         for (name, t) in ordered {
             let n = model.node(t);
             let all = self.type_members(t);
-            let mut text = format!("Handle of an instance of `{}` ({}).", n.browse_name.name, crate::resolve::display_id(model, &n.id));
+            let mut text = format!("Handle of an instance of `{}` ({}).", n.browse_name.name, model.display_id(&n.id));
             if let Some(d) = n.doc() {
                 text.push_str("\n\n");
                 text.push_str(d);

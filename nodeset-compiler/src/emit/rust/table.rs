@@ -14,10 +14,10 @@
 
 use super::{lit, path, Gen};
 use crate::diag::{Code, Diagnostic};
-use crate::model::{ids, DataTypeKind, NodeIx, StructureKind};
+use crate::model::{ids, Argument, DataTypeKind, EnumValue, NodeIx, StructureKind};
 use crate::nodeid::{Identifier, NodeId};
 use crate::raw::NodeClass;
-use crate::value::{BuiltinType, Variant};
+use crate::value::{BuiltinType, Structure, Variant};
 use crate::write::OutFile;
 use proc_macro2::Literal;
 use quote::quote;
@@ -472,65 +472,46 @@ impl Gen<'_> {
 
     /// Arrays of Argument or EnumValueType structures (the ExtensionObject values every nodeset has).
     fn struct_array_text(&self, out: &mut String, items: &[Variant], local: &dyn Fn(u16) -> u16) -> bool {
-        let model = self.model;
-        let type_of = |v: &Variant| -> Option<u32> {
-            let Variant::ExtensionObject(eo) = v else { return None };
-            let ix = model.lookup(eo.type_id.as_ref()?)?;
-            // The TypeId is usually the encoding node; go to its DataType.
-            let n = model.node(ix);
-            if n.class == NodeClass::DataType {
-                return n.id.ns0();
-            }
-            let has_enc = model.ns0(ids::HAS_ENCODING)?;
-            n.references.iter().find(|r| !r.forward && r.reference_type == has_enc).and_then(|r| model.node(r.target).id.ns0())
-        };
-        let Some(kind) = items.first().and_then(type_of) else { return false };
-        if !items.iter().all(|i| type_of(i) == Some(kind)) {
-            return false;
-        }
-        let bodies: Vec<&crate::raw::XmlElement> = items
+        let structures: Option<Vec<&Structure>> = items
             .iter()
-            .filter_map(|i| match i {
-                Variant::ExtensionObject(eo) => eo.body.as_ref(),
+            .map(|i| match i {
+                Variant::ExtensionObject(eo) => eo.structure(),
                 _ => None,
             })
             .collect();
-        if bodies.len() != items.len() {
+        let Some(structures) = structures else { return false };
+        let Some(kind) = structures.first().and_then(|s| s.data_type.ns0()) else { return false };
+        if !structures.iter().all(|s| s.data_type.ns0() == Some(kind)) {
             return false;
         }
-        let description = |b: &crate::raw::XmlElement| -> Option<String> {
-            b.child("Description").and_then(|d| d.child_text("Text")).filter(|t| !t.is_empty()).map(str::to_string)
-        };
         match kind {
             ids::ARGUMENT => {
                 // On failure the caller discards what was written.
                 out.push_str("Arguments:{");
-                for b in &bodies {
-                    let dt_text = b.child("DataType").and_then(|d| d.child_text("Identifier")).unwrap_or("i=24");
-                    let Some(dt) = self.map_value_node_id(dt_text) else { return false };
+                for s in &structures {
+                    let Ok(a) = Argument::from_structure(self.model, s) else { return false };
+                    let dt = match a.data_type {
+                        Some(dt) => self.model.node(dt).id.clone(),
+                        None => NodeId::numeric(0, ids::BASE_DATA_TYPE),
+                    };
                     out.push(' ');
-                    str_lit(out, b.child_text("Name").unwrap_or("").trim());
+                    str_lit(out, &a.name);
                     out.push(' ');
                     table_id(out, local(dt.ns), &dt.id);
-                    let vr: i32 = b.child_text("ValueRank").and_then(|t| t.trim().parse().ok()).unwrap_or(-1);
-                    let _ = write!(out, " {vr} ");
-                    let d: Vec<u32> = b
-                        .child("ArrayDimensions")
-                        .map(|a| a.children.iter().filter_map(|c| c.text.trim().parse().ok()).collect())
-                        .unwrap_or_default();
-                    dims(out, &d);
+                    let _ = write!(out, " {} ", a.value_rank);
+                    dims(out, &a.array_dimensions);
                     out.push(' ');
-                    opt_str(out, description(b).as_deref());
+                    opt_str(out, a.description.as_deref());
                 }
                 out.push_str(" }");
                 true
             }
             ids::ENUM_VALUE_TYPE => {
                 out.push_str("EnumValues:");
-                list(out, &bodies, |out, b| {
-                    let value: i64 = b.child_text("Value").and_then(|t| t.trim().parse().ok()).unwrap_or(0);
-                    let dn = b.child("DisplayName").and_then(|d| d.child_text("Text")).unwrap_or("");
-                    enum_row(out, value, dn, dn, description(b).as_deref());
+                list(out, &structures, |out, s| {
+                    let v = EnumValue::from_enum_value_type(s, 0);
+                    let dn = v.display_name.as_deref().unwrap_or("");
+                    enum_row(out, v.value, dn, dn, v.description.as_deref());
                 });
                 true
             }
