@@ -621,7 +621,8 @@ fn to_si(v: &Variant, unit: &Unit) -> Option<Variant> {
             return Some(Variant::Array(*ty, items?));
         }
         Variant::Variant(inner) => return to_si(inner, unit),
-        Variant::Float(f) => *f as f64,
+        // The Float as written (its shortest text), not its binary value widened: 0.1, not 0.10000000149011612.
+        Variant::Float(f) => f.to_string().parse().unwrap_or(*f as f64),
         Variant::Double(f) => *f,
         other => as_i128(other)? as f64,
     };

@@ -495,7 +495,7 @@ fn every_class_is_documented_and_has_an_icon_and_every_connector_a_place() {
 }
 
 #[test]
-fn values_are_written_from_typed_data_a_structure_field_by_field() {
+fn values_are_written_from_typed_data_a_float_as_its_shortest_text_and_a_structure_field_by_field() {
     use crate::nodeid::NodeId;
     use crate::raw::LocalizedText;
     use crate::value::{Body, ExtensionObject, Structure, Variant};
@@ -504,6 +504,8 @@ fn values_are_written_from_typed_data_a_structure_field_by_field() {
     let all: BTreeSet<u16> = (0..m.namespaces.len() as u16).collect();
     let mut ctx = Ctx::new(m, (0..m.namespaces.len()).map(|i| format!("P{i}")).collect(), all, None);
     let file = m.node(m.ns0(crate::model::ids::ARGUMENT).unwrap()).file;
+    let float = ctx.mtype(m.ns0(10).unwrap());
+    assert_eq!(ctx.literal(&Variant::Float(0.1), &float, file).as_deref(), Some("0.1"));
     // EUInformation (i=887): fields by name, an absent field keeps its default, a field that did not decode too.
     let eu = m.ns0(887).unwrap();
     let s = Structure {

@@ -395,7 +395,8 @@ impl Ctx<'_> {
                     };
                 }
                 match v {
-                    Variant::Float(f) => text::real_literal(*f as f64),
+                    // A Float's shortest text, read as a Double: `0.1`, not `0.10000000149011612`.
+                    Variant::Float(f) => text::real_literal(f.to_string().parse().ok()?),
                     Variant::Double(f) => text::real_literal(*f),
                     other => as_i128(other).map(|x| x.to_string()),
                 }
