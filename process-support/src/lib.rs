@@ -140,10 +140,11 @@ pub fn cargo_artifacts(dir: &Path, args: &[&str]) -> Result<Vec<Artifact>, Strin
 mod tests {
     use super::*;
 
-    /// A shell "server": prints a line, then its URL, then on SIGTERM `ending` and exits with `code`.
+    /// A shell "server": prints a line, then its URL, then on SIGTERM `ending` and exits with `code`. The trap
+    /// is set before the first line, so that a SIGTERM sent as soon as a line arrives finds it.
     fn server(ending: &str, code: i32) -> Process {
         let script = format!(
-            "echo starting; echo 'listening on opc.tcp://127.0.0.1:4840/'; trap 'echo {ending}; exit {code}' TERM; while true; do sleep 0.05; done"
+            "trap 'echo {ending}; exit {code}' TERM; echo starting; echo 'listening on opc.tcp://127.0.0.1:4840/'; while true; do sleep 0.05; done"
         );
         Process::spawn(Command::new("sh").args(["-c", &script])).unwrap()
     }
