@@ -18,7 +18,9 @@ partial model DeviceType "DeviceType"
     "BrowseNames of the <CPIdentifier> elements";
   replaceable model CPIdentifier = OpcUaDI.ObjectTypes.ConnectionPointType
     "Class of <CPIdentifier>; redeclare it to use a model of your own";
-  CPIdentifier cpIdentifier[nCpIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
+  replaceable model CPIdentifier_ParameterSet = OpcUa.ObjectTypes.BaseObjectType
+    "Class of ParameterSet in CPIdentifier; redeclare it together with CPIdentifier";
+  CPIdentifier cpIdentifier[nCpIdentifier](redeclare model ParameterSet = CPIdentifier_ParameterSet)
     "<CPIdentifier>"
     annotation (__OPCUA(browsePath="<CPIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/DI/;i=6571", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=6308"));
   parameter Boolean use_deviceHealth = false

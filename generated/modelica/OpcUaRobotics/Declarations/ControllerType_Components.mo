@@ -10,7 +10,9 @@ model ControllerType_Components "Components: Components is a container for one o
     "BrowseNames of the <ComponentIdentifier> elements";
   replaceable model ComponentIdentifier = OpcUaDI.ObjectTypes.ComponentType
     "Class of <ComponentIdentifier>; redeclare it to use a model of your own";
-  ComponentIdentifier componentIdentifier[nComponentIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
+  replaceable model ComponentIdentifier_ParameterSet = OpcUa.ObjectTypes.BaseObjectType
+    "Class of ParameterSet in ComponentIdentifier; redeclare it together with ComponentIdentifier";
+  ComponentIdentifier componentIdentifier[nComponentIdentifier](redeclare model ParameterSet = ComponentIdentifier_ParameterSet)
     "<ComponentIdentifier>: The intention is to integrate inside this container devices which are defined in other companion specifications using DI."
     annotation (__OPCUA(browsePath="<ComponentIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18813", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=15063"));
   annotation (

@@ -10,7 +10,9 @@ model ControllerType_Software "Software: Software is a container for one or more
     "BrowseNames of the <SoftwareIdentifier> elements";
   replaceable model SoftwareIdentifier = OpcUaDI.ObjectTypes.SoftwareType
     "Class of <SoftwareIdentifier>; redeclare it to use a model of your own";
-  SoftwareIdentifier softwareIdentifier[nSoftwareIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
+  replaceable model SoftwareIdentifier_ParameterSet = OpcUa.ObjectTypes.BaseObjectType
+    "Class of ParameterSet in SoftwareIdentifier; redeclare it together with SoftwareIdentifier";
+  SoftwareIdentifier softwareIdentifier[nSoftwareIdentifier](redeclare model ParameterSet = SoftwareIdentifier_ParameterSet)
     "<SoftwareIdentifier>"
     annotation (__OPCUA(browsePath="<SoftwareIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18847", typeDefinition="nsu=http://opcfoundation.org/UA/DI/;i=15106"));
   annotation (

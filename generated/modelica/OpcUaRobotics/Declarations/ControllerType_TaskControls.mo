@@ -10,7 +10,9 @@ model ControllerType_TaskControls "TaskControls: TaskControls is a container for
     "BrowseNames of the <TaskControlIdentifier> elements";
   replaceable model TaskControlIdentifier = OpcUaRobotics.Complete.TaskControlType constrainedby OpcUaRobotics.ObjectTypes.TaskControlType
     "Class of <TaskControlIdentifier>; redeclare it to use a model of your own";
-  TaskControlIdentifier taskControlIdentifier[nTaskControlIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.TaskControlType_ParameterSet)
+  replaceable model TaskControlIdentifier_ParameterSet = OpcUaRobotics.Declarations.TaskControlType_ParameterSet
+    "Class of ParameterSet in TaskControlIdentifier; redeclare it together with TaskControlIdentifier";
+  TaskControlIdentifier taskControlIdentifier[nTaskControlIdentifier](redeclare model ParameterSet = TaskControlIdentifier_ParameterSet)
     "<TaskControlIdentifier>"
     annotation (__OPCUA(browsePath="<TaskControlIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=18881", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1011"));
   annotation (

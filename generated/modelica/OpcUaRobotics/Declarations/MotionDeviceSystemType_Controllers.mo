@@ -10,10 +10,16 @@ model MotionDeviceSystemType_Controllers "Controllers: Contains the set of contr
     "BrowseNames of the <ControllerIdentifier> elements";
   replaceable model ControllerIdentifier = OpcUaRobotics.Complete.ControllerType constrainedby OpcUaRobotics.ObjectTypes.ControllerType
     "Class of <ControllerIdentifier>; redeclare it to use a model of your own";
+  replaceable model ControllerIdentifier_ParameterSet = OpcUaRobotics.Declarations.ControllerType_ParameterSet
+    "Class of ParameterSet in ControllerIdentifier; redeclare it together with ControllerIdentifier";
+  replaceable model ControllerIdentifier_Software = OpcUaRobotics.Declarations.ControllerType_Software
+    "Class of Software in ControllerIdentifier; redeclare it together with ControllerIdentifier";
+  replaceable model ControllerIdentifier_TaskControls = OpcUaRobotics.Declarations.ControllerType_TaskControls
+    "Class of TaskControls in ControllerIdentifier; redeclare it together with ControllerIdentifier";
   ControllerIdentifier controllerIdentifier[nControllerIdentifier](
-      redeclare model ParameterSet = OpcUaRobotics.Declarations.ControllerType_ParameterSet,
-      redeclare model Software = OpcUaRobotics.Declarations.ControllerType_Software,
-      redeclare model TaskControls = OpcUaRobotics.Declarations.ControllerType_TaskControls)
+      redeclare model ParameterSet = ControllerIdentifier_ParameterSet,
+      redeclare model Software = ControllerIdentifier_Software,
+      redeclare model TaskControls = ControllerIdentifier_TaskControls)
     "<ControllerIdentifier>"
     annotation (__OPCUA(browsePath="<ControllerIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15405", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1003"));
   annotation (

@@ -10,10 +10,16 @@ model MotionDeviceSystemType_MotionDevices "MotionDevices: Contains any kinemati
     "BrowseNames of the <MotionDeviceIdentifier> elements";
   replaceable model MotionDeviceIdentifier = OpcUaRobotics.Complete.MotionDeviceType constrainedby OpcUaRobotics.ObjectTypes.MotionDeviceType
     "Class of <MotionDeviceIdentifier>; redeclare it to use a model of your own";
+  replaceable model MotionDeviceIdentifier_ParameterSet = OpcUaRobotics.Declarations.MotionDeviceType_ParameterSet
+    "Class of ParameterSet in MotionDeviceIdentifier; redeclare it together with MotionDeviceIdentifier";
+  replaceable model MotionDeviceIdentifier_Axes = OpcUaRobotics.Declarations.MotionDeviceType_Axes
+    "Class of Axes in MotionDeviceIdentifier; redeclare it together with MotionDeviceIdentifier";
+  replaceable model MotionDeviceIdentifier_PowerTrains = OpcUaRobotics.Declarations.MotionDeviceType_PowerTrains
+    "Class of PowerTrains in MotionDeviceIdentifier; redeclare it together with MotionDeviceIdentifier";
   MotionDeviceIdentifier motionDeviceIdentifier[nMotionDeviceIdentifier](
-      redeclare model ParameterSet = OpcUaRobotics.Declarations.MotionDeviceType_ParameterSet,
-      redeclare model Axes = OpcUaRobotics.Declarations.MotionDeviceType_Axes,
-      redeclare model PowerTrains = OpcUaRobotics.Declarations.MotionDeviceType_PowerTrains)
+      redeclare model ParameterSet = MotionDeviceIdentifier_ParameterSet,
+      redeclare model Axes = MotionDeviceIdentifier_Axes,
+      redeclare model PowerTrains = MotionDeviceIdentifier_PowerTrains)
     "<MotionDeviceIdentifier>"
     annotation (__OPCUA(browsePath="<MotionDeviceIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15008", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1004"));
   annotation (

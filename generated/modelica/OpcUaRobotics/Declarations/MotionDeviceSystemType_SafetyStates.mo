@@ -10,7 +10,9 @@ model MotionDeviceSystemType_SafetyStates "SafetyStates: Contains safety-related
     "BrowseNames of the <SafetyStateIdentifier> elements";
   replaceable model SafetyStateIdentifier = OpcUaRobotics.Complete.SafetyStateType constrainedby OpcUaRobotics.ObjectTypes.SafetyStateType
     "Class of <SafetyStateIdentifier>; redeclare it to use a model of your own";
-  SafetyStateIdentifier safetyStateIdentifier[nSafetyStateIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.SafetyStateType_ParameterSet)
+  replaceable model SafetyStateIdentifier_ParameterSet = OpcUaRobotics.Declarations.SafetyStateType_ParameterSet
+    "Class of ParameterSet in SafetyStateIdentifier; redeclare it together with SafetyStateIdentifier";
+  SafetyStateIdentifier safetyStateIdentifier[nSafetyStateIdentifier](redeclare model ParameterSet = SafetyStateIdentifier_ParameterSet)
     "<SafetyStateIdentifier>"
     annotation (__OPCUA(browsePath="<SafetyStateIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15697", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1013"));
   annotation (

@@ -10,7 +10,9 @@ model MotionDeviceType_Axes "Axes: Axes is a container for one or more instances
     "BrowseNames of the <AxisIdentifier> elements";
   replaceable model AxisIdentifier = OpcUaRobotics.Complete.AxisType constrainedby OpcUaRobotics.ObjectTypes.AxisType
     "Class of <AxisIdentifier>; redeclare it to use a model of your own";
-  AxisIdentifier axisIdentifier[nAxisIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet)
+  replaceable model AxisIdentifier_ParameterSet = OpcUaRobotics.Declarations.AxisType_ParameterSet
+    "Class of ParameterSet in AxisIdentifier; redeclare it together with AxisIdentifier";
+  AxisIdentifier axisIdentifier[nAxisIdentifier](redeclare model ParameterSet = AxisIdentifier_ParameterSet)
     "<AxisIdentifier>"
     annotation (__OPCUA(browsePath="<AxisIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15743", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16601"));
   annotation (

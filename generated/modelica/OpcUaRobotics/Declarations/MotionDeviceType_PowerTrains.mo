@@ -10,7 +10,9 @@ model MotionDeviceType_PowerTrains "PowerTrains: PowerTrains is a container for 
     "BrowseNames of the <PowerTrainIdentifier> elements";
   replaceable model PowerTrainIdentifier = OpcUaRobotics.Complete.PowerTrainType constrainedby OpcUaRobotics.ObjectTypes.PowerTrainType
     "Class of <PowerTrainIdentifier>; redeclare it to use a model of your own";
-  PowerTrainIdentifier powerTrainIdentifier[nPowerTrainIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
+  replaceable model PowerTrainIdentifier_ParameterSet = OpcUa.ObjectTypes.BaseObjectType
+    "Class of ParameterSet in PowerTrainIdentifier; redeclare it together with PowerTrainIdentifier";
+  PowerTrainIdentifier powerTrainIdentifier[nPowerTrainIdentifier](redeclare model ParameterSet = PowerTrainIdentifier_ParameterSet)
     "<PowerTrainIdentifier>"
     annotation (__OPCUA(browsePath="<PowerTrainIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15905", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=16794"));
   annotation (

@@ -16,7 +16,9 @@ partial model PowerTrainType "PowerTrainType: The PowerTrainType represents inst
     "BrowseNames of the <GearIdentifier> elements";
   replaceable model GearIdentifier = OpcUaRobotics.ObjectTypes.GearType
     "Class of <GearIdentifier>; redeclare it to use a model of your own";
-  GearIdentifier gearIdentifier[nGearIdentifier](redeclare model ParameterSet = OpcUa.ObjectTypes.BaseObjectType)
+  replaceable model GearIdentifier_ParameterSet = OpcUa.ObjectTypes.BaseObjectType
+    "Class of ParameterSet in GearIdentifier; redeclare it together with GearIdentifier";
+  GearIdentifier gearIdentifier[nGearIdentifier](redeclare model ParameterSet = GearIdentifier_ParameterSet)
     "<GearIdentifier>"
     annotation (__OPCUA(browsePath="<GearIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=16041", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1022"));
   parameter Integer nMotorIdentifier(min=1) = 1
@@ -26,7 +28,9 @@ partial model PowerTrainType "PowerTrainType: The PowerTrainType represents inst
     "BrowseNames of the <MotorIdentifier> elements";
   replaceable model MotorIdentifier = OpcUaRobotics.Complete.MotorType constrainedby OpcUaRobotics.ObjectTypes.MotorType
     "Class of <MotorIdentifier>; redeclare it to use a model of your own";
-  MotorIdentifier motorIdentifier[nMotorIdentifier](redeclare model ParameterSet = OpcUaRobotics.Declarations.MotorType_ParameterSet)
+  replaceable model MotorIdentifier_ParameterSet = OpcUaRobotics.Declarations.MotorType_ParameterSet
+    "Class of ParameterSet in MotorIdentifier; redeclare it together with MotorIdentifier";
+  MotorIdentifier motorIdentifier[nMotorIdentifier](redeclare model ParameterSet = MotorIdentifier_ParameterSet)
     "<MotorIdentifier>"
     annotation (__OPCUA(browsePath="<MotorIdentifier>", nodeId="nsu=http://opcfoundation.org/UA/Robotics/;i=15998", typeDefinition="nsu=http://opcfoundation.org/UA/Robotics/;i=1019"));
   parameter Integer nPowerTrainIdentifier(min=0) = 0

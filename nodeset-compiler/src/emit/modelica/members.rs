@@ -4,12 +4,13 @@
 
 use super::complete::{bind_free, COMPLETE_NOTE};
 use super::ctx::{count_name, node_id_text, Ctx};
-use super::plan::{ClassKey, Owner};
 use super::objects::{join_path, starting_in};
-use super::plan::{Body, ClassInfo, ClassPlan, ElemKind, Element, Item, Mod, Mode, Own, TypeRef, Deferred};
+use super::plan::{
+    pin_alias, Base, Body, ClassInfo, ClassKey, ClassPlan, Deferred, ElemKind, Element, Item, MType, Mod, Mode, Own,
+    Owner, Pinned, TypeRef,
+};
 use super::text::{self, string_literal};
 use super::types::dims_text;
-use super::plan::{Base, MType};
 use crate::model::{ids, ModellingRule, NodeIx};
 use crate::nodeid::QualifiedName;
 use crate::raw::NodeClass;
@@ -114,6 +115,38 @@ impl Ctx<'_> {
         count
     }
 
+    /// The names a pin on a component of `class` may hold a choice for: the class's aliases and, for its
+    /// components declared through one, their pin aliases ([`Pinned`]); whether or not some class redeclares them.
+    fn pin_candidates(&self, class: &ClassKey) -> BTreeSet<String> {
+        let mut out = BTreeSet::new();
+        let Some(info) = self.class_infos.get(class) else { return out };
+        for e in &info.elements {
+            let ElemKind::Object { class: k } = &e.kind else { continue };
+            out.extend(e.alias.clone());
+            if let Some(p) = &e.pinned {
+                out.extend(self.pin_candidates(k).iter().map(|a| pin_alias(&p.pin, a)));
+            }
+        }
+        out
+    }
+
+    /// The prefix of the aliases that hold the pins of a component of `class` declared through `alias`
+    /// ([`Pinned::pin`]): the alias, or `<alias>_2`, ... when one of the names it makes is taken. Takes them all.
+    fn pin_prefix(&self, body: &mut Body, alias: &str, class: &ClassKey) -> String {
+        let names = self.pin_candidates(class);
+        let free = |pin: &str| {
+            names.iter().map(|a| pin_alias(pin, a)).all(|n| !body.taken.contains(&n) && !self.reserved.contains(&n))
+        };
+        let mut pin = alias.to_string();
+        let mut k = 2;
+        while !free(&pin) {
+            pin = format!("{alias}_{k}");
+            k += 1;
+        }
+        body.taken.extend(names.iter().map(|a| pin_alias(&pin, a)));
+        pin
+    }
+
     /// A name derived from an element's (`use_x`, `nX`), unique in the class.
     fn derived_name(&mut self, body: &mut Body, candidate: String, node: NodeIx) -> String {
         let mut name = candidate.clone();
@@ -166,6 +199,7 @@ impl Ctx<'_> {
             use_flag: None,
             count: None,
             alias: None,
+            pinned: None,
             nested_free: None,
         };
         if self.is_reference(o) {
@@ -428,8 +462,18 @@ impl Ctx<'_> {
                     }
                     None => TypeRef::Class(class.clone()),
                 };
-                if !event {
-                    mods.insert(0, Mod::Pin { class: class.clone() });
+                match (&alias, event) {
+                    (_, true) => {}
+                    // An array declared through an alias: the pins name aliases of this class, which derived
+                    // classes redeclare (`Mod::PinVia`; pymoca misreads a derived class's change of a pin on an
+                    // array sized by a parameter).
+                    (Some(a), false) if placeholder => {
+                        let pin = self.pin_prefix(body, a, &class);
+                        body.items.push(Item::PinAliases { alias: a.clone(), pin: pin.clone(), class: class.clone() });
+                        mods.insert(0, Mod::PinVia { pin: pin.clone(), class: class.clone() });
+                        element.pinned = Some(Pinned { declared: class.clone(), pin });
+                    }
+                    (_, false) => mods.insert(0, Mod::Pin { class: class.clone() }),
                 }
                 body.items.push(Item::Decl {
                     prefix: String::new(),
@@ -663,13 +707,21 @@ impl Ctx<'_> {
                     return Some(updated);
                 };
                 let key = self.add_decl(owner, &child_path, o.node, &base_info, sub);
-                body.mods.push(Mod::Redeclare { ident: alias, class: TypeRef::Class(key.clone()) });
+                body.mods.push(Mod::Redeclare { ident: alias.clone(), class: TypeRef::Class(key.clone()) });
                 // The component's declaration repeats the choices of the class it was declared with
                 // (`Mod::Pin`). That is an outer modification of the class plugged in here, so it would win
                 // over this class's own choices (Modelica 7.2.4) and hide the members they add: repeat this
                 // class's choices on the component, which is more outer still. (pymoca rejects the modifiers
                 // of the added members otherwise; `tests/modelica/planted`, `PinnedOverride`.)
-                body.mods.push(Mod::Nested { ident: e.ident.clone(), mods: vec![Mod::Pin { class: key.clone() }] });
+                match &e.pinned {
+                    Some(p) => body.mods.push(Mod::Repin {
+                        ident: e.ident.clone(),
+                        pin: p.pin.clone(),
+                        class: key.clone(),
+                        declared: p.declared.clone(),
+                    }),
+                    None => body.mods.push(Mod::Nested { ident: e.ident.clone(), mods: vec![Mod::Pin { class: key.clone() }] }),
+                }
                 body.adds = true;
                 updated.kind = ElemKind::Object { class: key };
                 updated.nested_free = None;

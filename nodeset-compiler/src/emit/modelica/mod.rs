@@ -144,6 +144,15 @@
 //! redeclares (`Axis axis(redeclare model ParameterSet = ...AxisType_ParameterSet)`, `plan::Mod::Pin`);
 //! `tests/modelica/RumocaBehaviour` reproduces both the leak and the fix.
 //!
+//! pymoca 0.12.0, the second checker, has its own misreading: when a derived class changes such a repeated
+//! choice on an array component sized by a parameter (a placeholder), pymoca keeps the declaration's
+//! (`tests/modelica/PymocaBehaviour`). So a placeholder's array, declared through a class alias, repeats each
+//! choice through an alias of the enclosing class, `replaceable model AxisIdentifier_ParameterSet = ...;
+//! AxisIdentifier axisIdentifier[n](redeclare model ParameterSet = AxisIdentifier_ParameterSet)`
+//! (`plan::Mod::PinVia`, `plan::Pinned`), and a
+//! derived class redeclares that alias at class level (`plan::Mod::Repin`). These pin aliases are redeclared,
+//! so they leak like any other and are repeated in turn; the set of repeated aliases grows until it holds.
+//!
 //! # Limits
 //!
 //! VariableTypes have no classes: a variable is a connector of its value, and of the properties of a
@@ -191,8 +200,7 @@ use crate::names::{is_valid, Case, Scope, Target};
 use crate::raw::NodeClass;
 use crate::write::OutFile;
 use ctx::{Ctx, Need};
-use plan::Owner;
-use plan::{ClassPlan, ElemKind, Item, Mod, OwnerPlan, TypeRef};
+use plan::{pin_alias, ClassPlan, ElemKind, Item, Mod, Owner, OwnerPlan, TypeRef};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 use text::string_literal;
@@ -391,7 +399,16 @@ pub fn generate_with_diagnostics(model: &Model, cfg: &ModelicaConfig) -> Generat
     for &ns in &full {
         plan_namespace(&mut ctx, ns);
     }
+    // A pin alias counts once a derived class redeclares it, which it does for the choices that count: grow the
+    // set until it holds.
     ctx.redeclared = redeclared_aliases(&ctx.plans);
+    loop {
+        let more = repinned_aliases(&ctx);
+        if more.is_subset(&ctx.redeclared) {
+            break;
+        }
+        ctx.redeclared.extend(more);
+    }
     let mut out = Output::default();
     let mut done_needs: BTreeSet<Need> = BTreeSet::new();
     for &ns in &full {
@@ -760,6 +777,7 @@ fn render_mod(ctx: &mut Ctx, m: &Mod) -> String {
         }
         Mod::Redeclare { ident, class } => format!("redeclare model {ident} = {}", type_ref(ctx, class)),
         Mod::Pin { class } => pinned(ctx, class).join(", "),
+        Mod::PinVia { .. } | Mod::Repin { .. } => render_parts(ctx, std::slice::from_ref(m)).join(", "),
     }
 }
 
@@ -768,6 +786,20 @@ fn render_parts(ctx: &mut Ctx, mods: &[Mod]) -> Vec<String> {
     mods.iter()
         .flat_map(|x| match x {
             Mod::Pin { class } => pinned(ctx, class),
+            Mod::PinVia { pin, class } => {
+                pins(ctx, class).into_iter().map(|(a, _)| format!("redeclare model {a} = {}", pin_alias(pin, &a))).collect()
+            }
+            Mod::Repin { ident, pin, class, declared } => {
+                let old: BTreeSet<String> = pin_choices(ctx, declared).into_iter().map(|(a, _)| a).collect();
+                let (via, nested): (Vec<_>, Vec<_>) = pins(ctx, class).into_iter().partition(|(a, _)| old.contains(a));
+                let mut parts: Vec<String> =
+                    via.into_iter().map(|(a, path)| format!("redeclare model {} = {path}", pin_alias(pin, &a))).collect();
+                if !nested.is_empty() {
+                    let inner: Vec<String> = nested.into_iter().map(|(a, path)| format!("redeclare model {a} = {path}")).collect();
+                    parts.push(format!("{ident}({})", inner.join(", ")));
+                }
+                parts
+            }
             _ => vec![render_mod(ctx, x)],
         })
         .filter(|s| !s.is_empty())
@@ -776,45 +808,103 @@ fn render_parts(ctx: &mut Ctx, mods: &[Mod]) -> Vec<String> {
 
 /// The redeclarations a [`Mod::Pin`] on a component of `class` stands for, one per alias.
 fn pinned(ctx: &mut Ctx, class: &plan::ClassKey) -> Vec<String> {
-    let Some(info) = ctx.class_infos.get(class).cloned() else { return Vec::new() };
-    let mut parts = Vec::new();
-    for e in &info.elements {
-        if let (Some(alias), ElemKind::Object { class: k }) = (&e.alias, &e.kind) {
-            if ctx.redeclared.contains(alias) {
-                parts.push(format!("redeclare model {alias} = {}", ctx.component_class_path(k)));
-            }
-        }
-    }
-    parts
+    pins(ctx, class).into_iter().map(|(a, path)| format!("redeclare model {a} = {path}")).collect()
 }
 
-/// The aliases that some class redeclares (`redeclare model X = ...` in any modification of any plan).
-fn redeclared_aliases(plans: &BTreeMap<Owner, OwnerPlan>) -> BTreeSet<String> {
-    fn walk(mods: &[Mod], out: &mut BTreeSet<String>) {
-        for m in mods {
-            match m {
-                Mod::Redeclare { ident, .. } => {
-                    out.insert(ident.clone());
-                }
-                Mod::Nested { mods, .. } => walk(mods, out),
-                Mod::Value { .. } | Mod::Pin { .. } => {}
-            }
-        }
+/// The choices a pin on a component of `class` repeats: each of its aliases that some class redeclares, with
+/// the class `class` chooses for it.
+fn pins(ctx: &mut Ctx, class: &plan::ClassKey) -> Vec<(String, String)> {
+    pin_classes(ctx, class).into_iter().map(|(a, path, _)| (a, path)).collect()
+}
+
+/// [`pins`], with the class that constrains each choice when the choice is a complete variant (the partial
+/// class, as the alias it repeats is constrained: a redeclaration may choose any model extending it).
+fn pin_classes(ctx: &mut Ctx, class: &plan::ClassKey) -> Vec<(String, String, Option<String>)> {
+    let mut out = Vec::new();
+    for (alias, k) in pin_choices(ctx, class) {
+        let partial = ctx.class_infos.get(&k).is_some_and(|i| i.is_partial_by_inputs());
+        let constraint = partial.then(|| ctx.class_path(&k));
+        out.push((alias, ctx.component_class_path(&k), constraint));
     }
-    let mut out = BTreeSet::new();
-    for plan in plans.values() {
-        for class in plan.main.iter().chain(plan.decls.iter().map(|(_, c)| c)) {
-            if let Some((_, mods)) = &class.extends {
-                walk(mods, &mut out);
-            }
-            for item in &class.items {
-                if let Item::Decl { mods, .. } = item {
-                    walk(mods, &mut out);
+    out
+}
+
+/// The choices of `class` that a pin repeats, by name: each alias of its components that some class redeclares
+/// ([`Ctx::redeclared`](ctx::Ctx::redeclared)) and, for a component declared through an alias, each of the pin
+/// aliases holding that component's pins that some class redeclares ([`plan::Pinned`]); with the class chosen.
+/// A pin alias is redeclared by a derived class ([`Mod::Repin`]) and, like any alias, leaks into nested
+/// components in rumoca, so it is pinned like one.
+fn pin_choices(ctx: &Ctx, class: &plan::ClassKey) -> Vec<(String, plan::ClassKey)> {
+    let Some(info) = ctx.class_infos.get(class) else { return Vec::new() };
+    let mut out = Vec::new();
+    for e in &info.elements {
+        let ElemKind::Object { class: k } = &e.kind else { continue };
+        if let Some(alias) = e.alias.as_ref().filter(|a| ctx.redeclared.contains(*a)) {
+            out.push((alias.clone(), k.clone()));
+        }
+        if let Some(p) = &e.pinned {
+            // The pin aliases the declaring class has, with the choices of the component's class here.
+            let declared: BTreeSet<String> = pin_choices(ctx, &p.declared).into_iter().map(|(a, _)| a).collect();
+            for (a, c) in pin_choices(ctx, k) {
+                let name = pin_alias(&p.pin, &a);
+                if declared.contains(&a) && ctx.redeclared.contains(&name) {
+                    out.push((name, c));
                 }
             }
         }
     }
     out
+}
+
+/// The pin aliases that derived classes redeclare ([`Mod::Repin`]), given the aliases known to be redeclared.
+fn repinned_aliases(ctx: &Ctx) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    each_mod(&ctx.plans, &mut |m| {
+        if let Mod::Repin { pin, class, declared, .. } = m {
+            let old: BTreeSet<String> = pin_choices(ctx, declared).into_iter().map(|(a, _)| a).collect();
+            for (a, _) in pin_choices(ctx, class) {
+                if old.contains(&a) {
+                    out.insert(pin_alias(pin, &a));
+                }
+            }
+        }
+    });
+    out
+}
+
+/// The aliases that some class redeclares (`redeclare model X = ...` in any modification of any plan).
+fn redeclared_aliases(plans: &BTreeMap<Owner, OwnerPlan>) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    each_mod(plans, &mut |m| {
+        if let Mod::Redeclare { ident, .. } = m {
+            out.insert(ident.clone());
+        }
+    });
+    out
+}
+
+/// Calls `f` with every modifier of every plan, nested ones included.
+fn each_mod(plans: &BTreeMap<Owner, OwnerPlan>, f: &mut impl FnMut(&Mod)) {
+    fn walk(mods: &[Mod], f: &mut impl FnMut(&Mod)) {
+        for m in mods {
+            f(m);
+            if let Mod::Nested { mods, .. } = m {
+                walk(mods, f);
+            }
+        }
+    }
+    for plan in plans.values() {
+        for class in plan.main.iter().chain(plan.decls.iter().map(|(_, c)| c)) {
+            if let Some((_, mods)) = &class.extends {
+                walk(mods, f);
+            }
+            for item in &class.items {
+                if let Item::Decl { mods, .. } = item {
+                    walk(mods, f);
+                }
+            }
+        }
+    }
 }
 
 /// A modification list: inline when short, else one modifier per line.
@@ -859,6 +949,13 @@ fn render_class(ctx: &mut Ctx, plan: &ClassPlan, ident: &str) -> String {
                 };
                 let class = type_ref(ctx, class);
                 s.push_str(&format!("  replaceable model {ident} = {class}{constraint}\n    {desc};\n"));
+            }
+            Item::PinAliases { alias, pin, class } => {
+                for (a, path, constraint) in pin_classes(ctx, class) {
+                    let desc = string_literal(&format!("Class of {a} in {alias}; redeclare it together with {alias}"));
+                    let constraint = constraint.map(|c| format!(" constrainedby {c}")).unwrap_or_default();
+                    s.push_str(&format!("  replaceable model {} = {path}{constraint}\n    {desc};\n", pin_alias(pin, &a)));
+                }
             }
             Item::Decl { prefix, ty, ident, dims, mods, value, cond, desc, annotation } => {
                 let ty = type_ref(ctx, ty);

@@ -203,6 +203,7 @@ impl Ctx<'_> {
                     use_flag: None,
                     count: None,
                     alias: None,
+                    pinned: None,
                     nested_free: None,
                 });
                 continue;
@@ -253,6 +254,7 @@ impl Ctx<'_> {
                 use_flag: None,
                 count: None,
                 alias: None,
+                pinned: None,
                 nested_free: None,
             });
         }

@@ -60,9 +60,27 @@ pub struct Element {
     /// The replaceable class alias of an object (`replaceable model Axes = ...; Axes axes;`), which subclasses
     /// and users redeclare.
     pub alias: Option<String>,
+    /// For a placeholder's array declared through an alias: where its pins are held ([`Pinned`]).
+    pub pinned: Option<Pinned>,
     /// The free inputs of an object whose members this class modifies without a class of its own (else those of
     /// its class).
     pub nested_free: Option<Rc<Vec<Free>>>,
+}
+
+/// A placeholder's array declared through an alias: its pins name aliases of the declaring class
+/// ([`Item::PinAliases`]), which derived classes redeclare ([`Mod::Repin`]).
+#[derive(Debug, Clone)]
+pub struct Pinned {
+    /// The class it was declared with.
+    pub declared: ClassKey,
+    /// The prefix of the declaring class's aliases that hold the pins: `<pin>_<A>` holds the choice for alias `A`
+    /// ([`pin_alias`]). The alias's own name unless one of those names is taken.
+    pub pin: String,
+}
+
+/// The alias of a declaring class that holds the pinned choice for alias `alias` of a component ([`Pinned::pin`]).
+pub fn pin_alias(pin: &str, alias: &str) -> String {
+    format!("{pin}_{alias}")
 }
 
 #[derive(Debug, Clone)]
@@ -122,6 +140,23 @@ pub enum Mod {
     Pin {
         class: ClassKey,
     },
+    /// On a placeholder's array declared through an alias: [`Mod::Pin`], each choice named by an alias of the
+    /// enclosing class, `redeclare model <A> = <pin>_<A>` ([`Pinned`], [`Item::PinAliases`]). pymoca 0.12.0 does
+    /// not let a derived class override a declaration's redeclaration on an array sized by a parameter, so derived
+    /// classes redeclare those aliases instead ([`Mod::Repin`]); rumoca reads the pin like [`Mod::Pin`].
+    PinVia {
+        pin: String,
+        class: ClassKey,
+    },
+    /// In a derived class that redeclares the alias of component `ident` to `class`: `redeclare model
+    /// <pin>_<A> = <class of A in class>` for each choice pinned where the component was declared
+    /// (`declared`), and `ident(redeclare model <A> = ...)` for the choices only `class` has.
+    Repin {
+        ident: String,
+        pin: String,
+        class: ClassKey,
+        declared: ClassKey,
+    },
 }
 
 #[derive(Debug, Clone)]
@@ -132,6 +167,13 @@ pub enum Item {
         ident: String,
         class: TypeRef,
         desc: String,
+    },
+    /// `replaceable model <pin>_<A> = <class of A in class>` for each choice a [`Mod::PinVia`] names, on the
+    /// component declared through `alias`.
+    PinAliases {
+        alias: String,
+        pin: String,
+        class: ClassKey,
     },
     Decl {
         prefix: String,

@@ -522,3 +522,57 @@ fn values_are_written_from_typed_data_a_float_as_its_shortest_text_and_a_structu
     let lit = ctx.literal(&v, &record, file).expect("a record literal");
     assert!(lit.ends_with("EUInformation(unitId = 5066068, displayName = \"mm\")"), "{lit}");
 }
+
+/// The Modelica package of Scales V2, its text changed by `patch`.
+fn scales_with(patch: impl Fn(&str) -> String) -> Vec<crate::write::OutFile> {
+    let v = workspace().join("nodesets/vendor");
+    let path = v.join("Opc.Ua.Scales.NodeSet2.xml");
+    let text = patch(&std::fs::read_to_string(&path).unwrap());
+    let out = compile(
+        vec![Input::Text { name: path.display().to_string(), text }],
+        &Options { model_dirs: vec![v], ..Options::default() },
+    );
+    assert!(out.ok(), "{}", out.render_diagnostics());
+    generate(&out.model, &ModelicaConfig::new().namespace("http://opcfoundation.org/UA/Scales/V2/")).unwrap()
+}
+
+#[test]
+fn a_placeholder_array_repeats_its_choices_through_aliases_that_derived_classes_redeclare() {
+    // Scales' ProductionPreset holds products in a placeholder, each with a replaceable Statistic. The array
+    // repeats the product class's choice (for rumoca) through an alias of the Products class...
+    let files = scales_with(str::to_string);
+    let products = contents(&files, "OpcUaScalesV2/Declarations/ProductionPresetType_Products.mo");
+    assert!(products.contains("  replaceable model Product_Statistic = OpcUaScalesV2.ObjectTypes.StatisticType\n"), "{products}");
+    assert!(products.contains("  Product product_[nProduct_](redeclare model Statistic = Product_Statistic)\n"), "{products}");
+    // ... which the checkweigher's Products class redeclares at class level, not on the array (pymoca 0.12.0
+    // keeps the declaration's choice then, `tests/modelica/PymocaBehaviour`).
+    let checkweigher = contents(&files, "OpcUaScalesV2/Declarations/CheckweigherType_ProductionPresetProducts.mo");
+    assert!(
+        checkweigher.contains(
+            "    redeclare model Product_Statistic = OpcUaScalesV2.Declarations.CheckweigherType_ProductionPresetProductsProductStatistic,\n"
+        ),
+        "{checkweigher}"
+    );
+    assert!(!checkweigher.contains("redeclare model Statistic"), "{checkweigher}");
+
+    // An element of the class already named like a pin alias: the pin aliases take the next free prefix.
+    let object = r#"<UAObject NodeId="ns=1;i=99999" BrowseName="1:Product_Statistic" ParentNodeId="ns=1;i=75">
+    <DisplayName>Product_Statistic</DisplayName>
+    <References>
+      <Reference ReferenceType="HasTypeDefinition">i=61</Reference>
+      <Reference ReferenceType="HasModellingRule">i=80</Reference>
+      <Reference ReferenceType="HasComponent" IsForward="false">ns=1;i=75</Reference>
+    </References>
+  </UAObject>
+  "#;
+    let files = scales_with(|text| {
+        let at = text.find(r#"<UAObject NodeId="ns=1;i=92""#).unwrap();
+        format!("{}{object}{}", &text[..at], &text[at..])
+    });
+    let products = contents(&files, "OpcUaScalesV2/Declarations/ProductionPresetType_Products.mo");
+    assert!(products.contains("  replaceable model Product_Statistic = OpcUa.ObjectTypes.FolderType\n"), "{products}");
+    assert!(products.contains("  replaceable model Product_2_Statistic = OpcUaScalesV2.ObjectTypes.StatisticType\n"), "{products}");
+    assert!(products.contains("  Product product_[nProduct_](redeclare model Statistic = Product_2_Statistic)\n"), "{products}");
+    let checkweigher = contents(&files, "OpcUaScalesV2/Declarations/CheckweigherType_ProductionPresetProducts.mo");
+    assert!(checkweigher.contains("    redeclare model Product_2_Statistic = "), "{checkweigher}");
+}

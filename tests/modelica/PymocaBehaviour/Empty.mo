@@ -1,0 +1,3 @@
+within PymocaBehaviour;
+model Empty "Nothing"
+end Empty;
