@@ -4,13 +4,16 @@
 //! [`cargo_artifacts`]), started as a child process ([`Process::spawn`]) that prints `listening on <url>`
 //! when it is ready. [`Process`] reads its stdout line by line on a thread of its own, so a test can wait for
 //! a line with a timeout, and kills the process when dropped; [`Process::stop`] ends it with SIGTERM instead
-//! and checks that it stopped cleanly.
+//! and checks that it stopped cleanly. [`workspace`] says where the workspace, its cargo and its target folder
+//! are.
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::time::Duration;
+
+pub mod workspace;
 
 /// How long [`Process::line`] waits: a cold example server starts within a few seconds, a loaded CI machine
 /// needs more.

@@ -41,7 +41,9 @@ enum Command {
     /// Fetch the pinned official NodeSet2 files into `nodesets/vendor/` and verify them against
     /// `nodesets/node-opcua-nodesets.lock`.
     FetchNodesets(fetch::Args),
-    /// Time the compiler (front end and Rust back end) against its targets and async-opcua-codegen (a report, not a test).
+    /// Time the compiler and the runtime against their targets and async-opcua-codegen (a report, not a test;
+    /// the program `bench/`, whose arguments pass through: `cargo xtask bench --help`).
+    #[command(disable_help_flag = true)]
     Bench(bench::Args),
     /// Generate Rust for every resolvable ua-nodeset file into one crate and `cargo check` it.
     Corpus(corpus::Args),

@@ -10,7 +10,7 @@ use std::time::{Instant, SystemTime};
 use bench_support::{median, min, Report};
 
 use super::{verdict, Step};
-use crate::util::cargo as cargo_command;
+use process_support::workspace::cargo as cargo_command;
 
 /// Median and min of some wall times, and the median CPU time, in seconds.
 #[derive(Clone, Copy)]

@@ -43,7 +43,7 @@ use super::peer::{
     PEER_VERSION, write_crate,
 };
 use super::{build, run_report, verdict, Args, Step, NAMESPACES};
-use crate::util::{display_path, target_dir};
+use process_support::workspace::{display_path, target_dir};
 
 /// Targets: emission time, generated lines of DI + Robotics, cold crate-only build, import.
 const EMIT_MS: f64 = 25.0;

@@ -31,13 +31,13 @@ use std::time::{Duration, Instant};
 use super::verdict;
 use bench_support::Report;
 use process_support::Process;
-use crate::util::target_dir;
+use process_support::workspace::target_dir;
 
 /// The target for the robot cell, in milliseconds.
 const TARGET_MS: f64 = 1000.0;
 
 fn cargo_build(root: &Path, release: bool, args: &[&str]) -> Result<(), String> {
-    let status = crate::util::cargo()
+    let status = process_support::workspace::cargo()
         .current_dir(root)
         .args(["build", "--quiet"])
         .args(release.then_some("--release"))

@@ -12,7 +12,7 @@ use bench_support::Report;
 use super::builds::{cargo, exec, time_builds, Builds};
 use super::rust::{count_rs, Sizes, RELEASE_RUNS};
 use super::{build, verdict, Args, Step, NAMESPACES};
-use crate::util::display_path;
+use process_support::workspace::display_path;
 
 /// The XML schema of ns0 in the tree.
 const NS0_XSD: &str = "Schema/Opc.Ua.Types.xsd";
