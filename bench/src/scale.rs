@@ -14,9 +14,9 @@
 
 use bench_support::{median, ms_since};
 use nodeset_compiler::emit::modelica::{generate_with_diagnostics, ModelicaConfig};
-use nodeset_compiler::emit::rust::{self as rust_emit, RustConfig, RustNamespace};
+use nodeset_compiler::emit::rust as rust_emit;
 use nodeset_compiler::load::Input;
-use nodeset_compiler::{compile, Compiled, Options};
+use nodeset_compiler::{compile, Compiled, Options, RustOptions};
 use nodeset_tests::synth::{self, Shape};
 use std::path::Path;
 use std::time::Instant;
@@ -45,12 +45,8 @@ fn time(vendor: &Path, text: &str, runs: usize) -> Result<Times, String> {
         if !out.ok() {
             return Err(format!("a synthetic model does not compile:\n{}", out.render_diagnostics()));
         }
-        let cfg = RustConfig {
-            namespaces: vec![RustNamespace { uri: synth::URI.into(), module: "synth".into() }],
-            extern_paths: Default::default(),
-            runtime_path: "nodeset_models::runtime".into(),
-            command: "cargo xtask bench --scenario scale".into(),
-        };
+        let cfg = RustOptions { command: "cargo xtask bench --scenario scale".into(), ..RustOptions::default() }
+            .config(&out.model);
         let t = Instant::now();
         let r = rust_emit::generate(&out.model, &cfg);
         rust.push(ms_since(t));

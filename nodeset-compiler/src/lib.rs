@@ -254,12 +254,16 @@ impl RustOptions {
             generated: model.models.iter().filter(|m| model.sources.get(m.file).named).map(|m| m.uri.clone()).collect(),
             ..emit::plan::Plan::default()
         };
-        let modules = named.module_names(&self.modules);
-        let namespaces = named
-            .generated
-            .iter()
-            .map(|u| emit::rust::RustNamespace { uri: u.clone(), module: modules[u].clone() })
-            .collect();
+        self.config_of(&named.generated)
+    }
+
+    /// The emitter's configuration for the namespaces `uris`, generated in this order (the order in which
+    /// `mod.rs` registers them, [`generate_rust`]), each module named by [`emit::plan::Plan::module_names`].
+    pub fn config_of(&self, uris: &[String]) -> emit::rust::RustConfig {
+        let plan = emit::plan::Plan { generated: uris.to_vec(), ..emit::plan::Plan::default() };
+        let modules = plan.module_names(&self.modules);
+        let namespaces =
+            uris.iter().map(|u| emit::rust::RustNamespace { uri: u.clone(), module: modules[u].clone() }).collect();
         emit::rust::RustConfig {
             namespaces,
             extern_paths: self.extern_paths.clone(),
@@ -277,16 +281,24 @@ impl Compiled {
     }
 }
 
-/// Generates Rust for `model` and finalises the emitter's diagnostics: the files and the rendered warnings,
-/// or [`Error::Diagnostics`].
+/// Generates Rust for `model` as one module tree: each namespace's files, the `mod.rs` that declares the
+/// namespaces and registers them with a server in `cfg`'s order (dependencies first), and `rustfmt.toml`. The
+/// emitter's diagnostics, with `earlier` ones (such as planning's), are finalised: the files and the rendered
+/// warnings, or [`Error::Diagnostics`].
 pub fn generate_rust(
     model: &model::Model,
     cfg: &emit::rust::RustConfig,
+    earlier: diag::Diagnostics,
     severities: &Severities,
 ) -> Result<(Vec<write::OutFile>, String), Error> {
     let mut gen = emit::rust::generate(model, cfg);
+    gen.diagnostics.extend(earlier);
     let rendered = gen.diagnostics.finalize(severities, &model.sources, "Rust generation failed")?;
-    Ok((gen.files, rendered))
+    let mut files = gen.files;
+    let list: Vec<(String, String)> = cfg.namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
+    files.push(emit::rust::models_mod(&list, &cfg.runtime_path, &cfg.command));
+    files.push(emit::rust::rustfmt_toml());
+    Ok((files, rendered))
 }
 
 /// Generates Modelica for `model` and finalises the emitter's diagnostics, like [`generate_rust`].
@@ -324,22 +336,9 @@ pub fn run_rust(model: &model::Model, rust: &RustOptions, severities: &Severitie
     let (plan, mut planning) = emit::plan::plan(model, &rust.extern_paths, true);
     // A refused plan (NS0303 not demoted) stops before anything is generated.
     planning.finalize(severities, &model.sources, STAGE)?;
-    let modules = plan.module_names(&rust.modules);
-    let namespaces: Vec<emit::rust::RustNamespace> =
-        plan.generated.iter().map(|u| emit::rust::RustNamespace { uri: u.clone(), module: modules[u].clone() }).collect();
-    let list: Vec<(String, String)> = namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
-    let cfg = emit::rust::RustConfig {
-        namespaces,
-        extern_paths: rust.extern_paths.clone(),
-        runtime_path: rust.runtime_path.clone(),
-        command: rust.command.clone(),
-    };
-    let mut gen = emit::rust::generate(model, &cfg);
-    gen.diagnostics.extend(planning);
-    let warnings = gen.diagnostics.finalize(severities, &model.sources, STAGE)?;
-    let mut files = gen.files;
-    files.push(emit::rust::models_mod(&list, &cfg.runtime_path, &cfg.command));
-    files.push(emit::rust::rustfmt_toml());
+    let cfg = rust.config_of(&plan.generated);
+    let modules = cfg.namespaces.iter().map(|n| (n.uri.clone(), n.module.clone())).collect();
+    let (files, warnings) = generate_rust(model, &cfg, planning, severities)?;
     Ok(RustRun { plan, modules, files, warnings })
 }
 

@@ -7,10 +7,9 @@
 //! stale.
 
 use crate::util::workspace_root;
-use nodeset_compiler::emit::rust::{self as rust_emit, RustConfig, RustNamespace};
 use nodeset_compiler::load::Input;
 use nodeset_compiler::write::{write_trees, Mode, OutFile};
-use nodeset_compiler::{compile, Options};
+use nodeset_compiler::{compile, Options, RustOptions};
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, clap::Args)]
@@ -59,30 +58,24 @@ pub fn plan_into(crate_dir: &Path, extra_inputs: &[PathBuf], deny_warnings: bool
     eprint!("{}", out.checked(&opts.severities).map_err(left)?);
     let model = &out.model;
 
-    let mut namespaces = Vec::new();
+    // Rust: the modules in this file's order, which is the order `mod.rs` registers them in.
+    let mut rust = RustOptions { runtime_path: "crate::runtime".into(), command: COMMAND.into(), ..RustOptions::default() };
+    let mut uris = Vec::new();
     for (file, module) in NAMESPACES {
         let m = model
             .models
             .iter()
             .find(|m| model.sources.get(m.file).path.file_name() == Path::new(file).file_name())
             .ok_or_else(|| format!("{file} defines no model"))?;
-        namespaces.push(RustNamespace { uri: m.uri.clone(), module: (*module).to_string() });
+        rust.modules.insert(m.uri.clone(), (*module).to_string());
+        uris.push(m.uri.clone());
     }
-    let cfg = RustConfig {
-        namespaces: namespaces.clone(),
-        extern_paths: Default::default(),
-        runtime_path: "crate::runtime".into(),
-        command: COMMAND.into(),
-    };
-    let (mut rust, warnings) = nodeset_compiler::generate_rust(model, &cfg, &opts.severities).map_err(left)?;
+    let cfg = rust.config_of(&uris);
+    let (rust, warnings) =
+        nodeset_compiler::generate_rust(model, &cfg, Default::default(), &opts.severities).map_err(left)?;
     eprint!("{warnings}");
-    let modules: Vec<(String, String)> = namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
-    rust.push(rust_emit::models_mod(&modules, &cfg.runtime_path, COMMAND));
-    rust.push(rust_emit::rustfmt_toml());
     // Modelica: one package per namespace (and the used part of ns0, and the support package).
-    let mcfg = namespaces
-        .iter()
-        .fold(nodeset_compiler::emit::modelica::ModelicaConfig::new(), |c, n| c.namespace(n.uri.clone()));
+    let mcfg = uris.iter().fold(nodeset_compiler::emit::modelica::ModelicaConfig::new(), |c, u| c.namespace(u.clone()));
     let (modelica, warnings) = nodeset_compiler::generate_modelica(model, &mcfg, &opts.severities).map_err(left)?;
     eprint!("{warnings}");
     Ok(vec![(crate_dir.join("src/models"), rust), (crate_dir.join("modelica"), modelica)])
