@@ -46,7 +46,8 @@ fn time(vendor: &Path, text: &str, runs: usize) -> Result<Times, String> {
             return Err(format!("a synthetic model does not compile:\n{}", out.render_diagnostics()));
         }
         let cfg = RustOptions { command: "cargo xtask bench --scenario scale".into(), ..RustOptions::default() }
-            .config(&out.model);
+            .config(&out.model)
+            .map_err(|e| e.to_string())?;
         let t = Instant::now();
         let r = rust_emit::generate(&out.model, &cfg);
         rust.push(ms_since(t));

@@ -24,9 +24,9 @@
 //!
 //! Output: progress on stderr, and on stdout one line `BENCH key=value ...` (times in ms, memory in KiB).
 
-use nodeset_compiler::emit::rust::{self as rust_emit, RustConfig, RustNamespace};
+use nodeset_compiler::emit::rust as rust_emit;
 use nodeset_compiler::load::Input;
-use nodeset_compiler::{compile, Options};
+use nodeset_compiler::{compile, Options, RustOptions};
 use std::collections::BTreeMap;
 use std::hint::black_box;
 use std::path::{Path, PathBuf};
@@ -120,7 +120,12 @@ fn generate_cmd(mut args: impl Iterator<Item = String>) -> Result<(), String> {
         }
         let t1 = Instant::now();
         let model = &out.model;
-        let mut namespaces = Vec::new();
+        let mut options = RustOptions {
+            runtime_path: "crate::runtime".into(),
+            command: COMMAND.into(),
+            ..RustOptions::default()
+        };
+        let mut uris = Vec::new();
         for (file, module) in NAMESPACES {
             let m = model
                 .models
@@ -134,24 +139,12 @@ fn generate_cmd(mut args: impl Iterator<Item = String>) -> Result<(), String> {
                         .is_some_and(|n| n == *file)
                 })
                 .ok_or_else(|| format!("{file} defines no model"))?;
-            namespaces.push(RustNamespace {
-                uri: m.uri.clone(),
-                module: (*module).to_string(),
-            });
+            options.modules.insert(m.uri.clone(), (*module).to_string());
+            uris.push(m.uri.clone());
         }
-        let cfg = RustConfig {
-            namespaces: namespaces.clone(),
-            extern_paths: Default::default(),
-            runtime_path: "crate::runtime".into(),
-            command: COMMAND.into(),
-        };
+        let cfg = options.config_of(&uris).map_err(|e| e.to_string())?;
         let mut rust = rust_emit::generate(model, &cfg);
-        let modules: Vec<(String, String)> = namespaces
-            .iter()
-            .map(|n| (n.module.clone(), n.uri.clone()))
-            .collect();
-        rust.files.push(rust_emit::models_mod(&modules, &cfg.runtime_path, COMMAND));
-        rust.files.push(rust_emit::rustfmt_toml());
+        rust.files.extend(rust_emit::top_files(&cfg));
         let t_emit = ms_since(t1);
         let c2 = process_cpu_ms();
         compile_ms.push(t_compile);

@@ -148,7 +148,7 @@ impl Builder {
         }
         out.checked(&opts.severities)?;
         let model = &out.model;
-        let cfg = self.rust.config(model);
+        let cfg = self.rust.config(model)?;
         let mut gen = crate::emit::rust::generate(model, &cfg);
         gen.diagnostics.finalize(&opts.severities, &model.sources, "Rust generation failed")?;
         if self.cargo_output {

@@ -249,27 +249,40 @@ impl Default for RustOptions {
 impl RustOptions {
     /// The emitter's configuration for `model`: one module for each model of a file the user named, named by
     /// [`emit::plan::Plan::module_names`] (so two URIs that end alike get two modules).
-    pub fn config(&self, model: &model::Model) -> emit::rust::RustConfig {
-        let named = emit::plan::Plan {
-            generated: model.models.iter().filter(|m| model.sources.get(m.file).named).map(|m| m.uri.clone()).collect(),
-            ..emit::plan::Plan::default()
-        };
-        self.config_of(&named.generated)
+    pub fn config(&self, model: &model::Model) -> Result<emit::rust::RustConfig, Error> {
+        let named: Vec<String> =
+            model.models.iter().filter(|m| model.sources.get(m.file).named).map(|m| m.uri.clone()).collect();
+        self.config_of(&named)
     }
 
     /// The emitter's configuration for the namespaces `uris`, generated in this order (the order in which
     /// `mod.rs` registers them, [`generate_rust`]), each module named by [`emit::plan::Plan::module_names`].
-    pub fn config_of(&self, uris: &[String]) -> emit::rust::RustConfig {
+    /// [`Error::Config`] when a path is not a Rust path ([`RustOptions::paths`]).
+    pub fn config_of(&self, uris: &[String]) -> Result<emit::rust::RustConfig, Error> {
+        let (extern_paths, runtime_path) = self.paths()?;
         let plan = emit::plan::Plan { generated: uris.to_vec(), ..emit::plan::Plan::default() };
         let modules = plan.module_names(&self.modules);
         let namespaces =
             uris.iter().map(|u| emit::rust::RustNamespace { uri: u.clone(), module: modules[u].clone() }).collect();
-        emit::rust::RustConfig {
-            namespaces,
-            extern_paths: self.extern_paths.clone(),
-            runtime_path: self.runtime_path.clone(),
-            command: self.command.clone(),
+        Ok(emit::rust::RustConfig { namespaces, extern_paths, runtime_path, command: self.command.clone() })
+    }
+
+    /// The extern paths and the runtime path, each checked to be a Rust path: [`Error::Config`] names the first
+    /// that is not. Front doors call it before compiling, so that a typo costs nothing.
+    pub fn paths(&self) -> Result<(BTreeMap<String, emit::rust::RustPath>, emit::rust::RustPath), Error> {
+        let runtime = emit::rust::RustPath::new(&self.runtime_path).map_err(|e| {
+            Error::Config(format!("the runtime path {e}; give the path of the runtime module, such as `nodeset_models::runtime`"))
+        })?;
+        let mut externs = BTreeMap::new();
+        for (uri, text) in &self.extern_paths {
+            let path = emit::rust::RustPath::new(text).map_err(|e| {
+                Error::Config(format!(
+                    "the extern path of {uri}: {e}; give the path of the module generated for that namespace, such as `nodeset_models::models::di`"
+                ))
+            })?;
+            externs.insert(uri.clone(), path);
         }
+        Ok((externs, runtime))
     }
 }
 
@@ -295,9 +308,7 @@ pub fn generate_rust(
     gen.diagnostics.extend(earlier);
     let rendered = gen.diagnostics.finalize(severities, &model.sources, "Rust generation failed")?;
     let mut files = gen.files;
-    let list: Vec<(String, String)> = cfg.namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
-    files.push(emit::rust::models_mod(&list, &cfg.runtime_path, &cfg.command));
-    files.push(emit::rust::rustfmt_toml());
+    files.extend(emit::rust::top_files(cfg));
     Ok((files, rendered))
 }
 
@@ -336,7 +347,7 @@ pub fn run_rust(model: &model::Model, rust: &RustOptions, severities: &Severitie
     let (plan, mut planning) = emit::plan::plan(model, &rust.extern_paths, true);
     // A refused plan (NS0303 not demoted) stops before anything is generated.
     planning.finalize(severities, &model.sources, STAGE)?;
-    let cfg = rust.config_of(&plan.generated);
+    let cfg = rust.config_of(&plan.generated)?;
     let modules = cfg.namespaces.iter().map(|n| (n.uri.clone(), n.module.clone())).collect();
     let (files, warnings) = generate_rust(model, &cfg, planning, severities)?;
     Ok(RustRun { plan, modules, files, warnings })

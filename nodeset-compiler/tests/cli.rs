@@ -1,5 +1,6 @@
 //! The `nodeset-compiler` command as a user runs it, where no server or nodeset is needed: `verify` with bad
-//! input ends with a clear message and exit status 2, never a panic, and `codes` lists the verify codes.
+//! input ends with a clear message and exit status 2, `rust` with a path that is not a Rust path with one and
+//! status 1, never a panic; and `codes` lists the verify codes.
 //!
 //! Being an integration test of this package, it also makes `cargo test --workspace` build the command with
 //! the workspace's features, so the live tests in `tests/tests/verify.rs` take it from that build.
@@ -12,6 +13,25 @@ fn run(args: &[&str]) -> Output {
 
 fn free_port() -> u16 {
     std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
+}
+
+#[test]
+fn rust_refuses_a_path_that_is_not_a_rust_path_before_reading_anything() {
+    let out = std::env::temp_dir().join(format!("nodeset-cli-paths-{}", std::process::id()));
+    // The input does not exist either: the paths are checked first, and nothing is written.
+    let cases: [(&[&str], &str); 2] = [
+        (&["--extern", "http://opcfoundation.org/UA/DI/=my crate::di"], "the extern path of http://opcfoundation.org/UA/DI/: `my crate::di` is not a Rust path"),
+        (&["--runtime", "1bad::runtime"], "the runtime path `1bad::runtime` is not a Rust path"),
+    ];
+    for (flags, message) in cases {
+        let mut args = vec!["rust", "missing.NodeSet2.xml", "--out", out.to_str().unwrap()];
+        args.extend_from_slice(flags);
+        let output = run(&args);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(1), "{flags:?}: {stderr}");
+        assert!(stderr.starts_with("error: ") && stderr.contains(message) && !stderr.contains("panicked"), "{stderr}");
+        assert!(!out.exists(), "{flags:?} wrote {}", out.display());
+    }
 }
 
 #[test]

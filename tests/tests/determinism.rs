@@ -10,7 +10,7 @@
 //! header command), so all four runs are compared file by file, byte by byte.
 
 use nodeset_compiler::emit::modelica::{generate_with_diagnostics, ModelicaConfig};
-use nodeset_compiler::emit::rust::{self as rust_emit, RustConfig, RustNamespace};
+use nodeset_compiler::emit::rust::{self as rust_emit, RustConfig, RustNamespace, RustPath};
 use nodeset_compiler::load::Input;
 use nodeset_compiler::{compile, Options};
 use std::collections::BTreeMap;
@@ -54,14 +54,12 @@ fn in_process(files: &[PathBuf]) -> Output {
     let cfg = RustConfig {
         namespaces: namespaces.clone(),
         extern_paths: Default::default(),
-        runtime_path: "nodeset_models::runtime".into(),
+        runtime_path: RustPath::new("nodeset_models::runtime").unwrap(),
         command: command.into(),
     };
     let mut rust = rust_emit::generate(model, &cfg);
     assert!(!rust.diagnostics.has_errors(), "{}", rust.diagnostics.render(&model.sources));
-    let list: Vec<(String, String)> = namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
-    rust.files.push(rust_emit::models_mod(&list, &cfg.runtime_path, command));
-    rust.files.push(rust_emit::rustfmt_toml());
+    rust.files.extend(rust_emit::top_files(&cfg));
     let modelica = generate_with_diagnostics(model, &ModelicaConfig::new());
     assert!(!modelica.diagnostics.has_errors(), "{}", modelica.diagnostics.render(&model.sources));
     let mut files = Output::new();

@@ -4,7 +4,7 @@
 //! runtime's own decoder into exactly the model's nodes of that namespace, in the model's order, with their
 //! attributes, declared references, data type definitions and values.
 
-use nodeset_compiler::emit::rust::{default_module_name, generate, RustConfig, RustNamespace};
+use nodeset_compiler::emit::rust::{default_module_name, generate, RustConfig, RustNamespace, RustPath};
 use nodeset_compiler::load::Input;
 use nodeset_compiler::model::{DataTypeKind, Model, NodeIx, StructureKind};
 use nodeset_compiler::nodeid::{Identifier, NodeId};
@@ -300,10 +300,10 @@ fn check_file(file: &PathBuf, opts: &Options) -> Result<(usize, usize), String> 
         if model.sources.get(m.file).named {
             namespaces.push(RustNamespace { uri: m.uri.clone(), module: format!("{}_{i}", default_module_name(&m.uri)) });
         } else {
-            extern_paths.insert(m.uri.clone(), format!("crate::dep_{i}"));
+            extern_paths.insert(m.uri.clone(), RustPath::new(&format!("crate::dep_{i}")).unwrap());
         }
     }
-    let cfg = RustConfig { namespaces: namespaces.clone(), extern_paths, runtime_path: "crate::runtime".into(), command: "test".into() };
+    let cfg = RustConfig { namespaces: namespaces.clone(), extern_paths, runtime_path: RustPath::new("crate::runtime").unwrap(), command: "test".into() };
     let generated = generate(model, &cfg);
     let (mut tables, mut rows) = (0, 0);
     for ns_cfg in &namespaces {

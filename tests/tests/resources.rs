@@ -93,7 +93,7 @@ fn generate_both(text: String) -> (Vec<nodeset_compiler::write::OutFile>, nodese
     let cfg = rust::RustConfig {
         namespaces: vec![rust::RustNamespace { uri: synth::URI.into(), module: "synth".into() }],
         extern_paths: Default::default(),
-        runtime_path: "nodeset_models::runtime".into(),
+        runtime_path: rust::RustPath::new("nodeset_models::runtime").unwrap(),
         command: "test".into(),
     };
     let r = rust::generate(&out.model, &cfg);

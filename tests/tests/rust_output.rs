@@ -39,7 +39,7 @@ fixture!(
 /// model the plan generates, and returns the code of `module` and the rendered diagnostics of loading,
 /// planning and generation.
 fn generate_case(case: &str, only: Option<&str>) -> (String, String) {
-    use nodeset_compiler::emit::rust::{generate, RustConfig, RustNamespace};
+    use nodeset_compiler::emit::rust::{generate, RustConfig, RustNamespace, RustPath};
     use nodeset_compiler::load::Input;
     use nodeset_compiler::{compile, Options};
     let dir = root().join("tests/fixtures").join(case);
@@ -59,7 +59,7 @@ fn generate_case(case: &str, only: Option<&str>) -> (String, String) {
     let cfg = RustConfig {
         namespaces,
         extern_paths: Default::default(),
-        runtime_path: "nodeset_models::runtime".into(),
+        runtime_path: RustPath::new("nodeset_models::runtime").unwrap(),
         command: "test".into(),
     };
     let gen = generate(model, &cfg);
@@ -99,7 +99,7 @@ fn recursive_structures_are_boxed_on_the_cycle() {
 /// namespace without its dependency's module.
 #[test]
 fn members_of_one_name_in_two_namespaces_get_two_struct_names() {
-    use nodeset_compiler::emit::rust::{generate, RustConfig, RustNamespace};
+    use nodeset_compiler::emit::rust::{generate, RustConfig, RustNamespace, RustPath};
     use nodeset_compiler::load::Input;
     use nodeset_compiler::{compile, Options};
     let (_, diagnostics) = generate_case("name_collision", Some("Example.NameCollision.NodeSet2.xml"));
@@ -110,7 +110,7 @@ fn members_of_one_name_in_two_namespaces_get_two_struct_names() {
     let cfg = RustConfig {
         namespaces: vec![RustNamespace { uri: "http://example.com/fixtures/name_collision/".into(), module: "name_collision".into() }],
         extern_paths: Default::default(),
-        runtime_path: "nodeset_models::runtime".into(),
+        runtime_path: RustPath::new("nodeset_models::runtime").unwrap(),
         command: "test".into(),
     };
     let gen = generate(&compiled.model, &cfg);
@@ -186,7 +186,7 @@ fn assert_prettyplease_layout(what: &str, text: &str) {
 /// identifiers, and descriptions with blank lines, tabs, quotes and trailing spaces.
 #[test]
 fn ids_text_is_what_prettyplease_prints() {
-    use nodeset_compiler::emit::rust::{generate, RustConfig, RustNamespace};
+    use nodeset_compiler::emit::rust::{generate, RustConfig, RustNamespace, RustPath};
     use nodeset_compiler::load::Input;
     use nodeset_compiler::{compile, Options};
 
@@ -222,7 +222,7 @@ fn ids_text_is_what_prettyplease_prints() {
     let cfg = RustConfig {
         namespaces: vec![RustNamespace { uri: uri.into(), module: "layout".into() }],
         extern_paths: Default::default(),
-        runtime_path: "crate::runtime".into(),
+        runtime_path: RustPath::new("crate::runtime").unwrap(),
         command: "test".into(),
     };
     let rust = generate(&out.model, &cfg);

@@ -70,7 +70,7 @@ pub fn plan_into(crate_dir: &Path, extra_inputs: &[PathBuf], deny_warnings: bool
         rust.modules.insert(m.uri.clone(), (*module).to_string());
         uris.push(m.uri.clone());
     }
-    let cfg = rust.config_of(&uris);
+    let cfg = rust.config_of(&uris).map_err(left)?;
     let (rust, warnings) =
         nodeset_compiler::generate_rust(model, &cfg, Default::default(), &opts.severities).map_err(left)?;
     eprint!("{warnings}");

@@ -43,7 +43,7 @@ use crate::raw::NodeClass;
 use crate::value::BuiltinType;
 use crate::write::OutFile;
 use proc_macro2::{Ident, Literal, Span, TokenStream};
-use quote::quote;
+use quote::{quote, ToTokens};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 
@@ -63,9 +63,9 @@ pub struct RustConfig {
     pub namespaces: Vec<RustNamespace>,
     /// Rust paths of namespaces generated elsewhere (URI -> path of their module, e.g.
     /// `nodeset_models::models::di`). Namespaces generated in this run are reached as `super::<module>`.
-    pub extern_paths: BTreeMap<String, String>,
+    pub extern_paths: BTreeMap<String, RustPath>,
     /// Path of the runtime module (`crate::runtime` inside nodeset-models, `nodeset_models::runtime` elsewhere).
-    pub runtime_path: String,
+    pub runtime_path: RustPath,
     /// The command that regenerates the output, for file headers.
     pub command: String,
 }
@@ -171,8 +171,32 @@ fn ident(s: &str) -> Ident {
     }
 }
 
-fn path(s: &str) -> TokenStream {
-    s.parse().unwrap_or_else(|_| panic!("internal error: `{s}` is not a Rust path"))
+/// A Rust path such as `crate::runtime` or `nodeset_models::models::di`, checked when it is made (a path a user
+/// gives is refused there, with the reason, and never reaches the generator as text to splice). It keeps its
+/// text, so that a configuration can be shared by the generator's threads, which syn's tokens cannot.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RustPath(String);
+
+impl RustPath {
+    /// The path written as `text`, or why it is not a Rust path.
+    pub fn new(text: &str) -> Result<RustPath, String> {
+        match syn::parse_str::<syn::Path>(text) {
+            Ok(_) => Ok(RustPath(text.trim().to_string())),
+            Err(e) => Err(format!("`{text}` is not a Rust path ({e})")),
+        }
+    }
+
+    /// The path as written.
+    pub fn as_str(&self) -> &str {
+        &self.0
+    }
+}
+
+impl ToTokens for RustPath {
+    fn to_tokens(&self, tokens: &mut TokenStream) {
+        let path: syn::Path = syn::parse_str(&self.0).expect("a RustPath is checked when it is made");
+        path.to_tokens(tokens);
+    }
 }
 
 fn doc(text: &str) -> TokenStream {
@@ -332,7 +356,7 @@ impl<'m> Gen<'m> {
                 groups.entry(n.class).or_default().push(NodeIx(i as u32));
             }
         }
-        let runtime = path(&self.cfg.runtime_path);
+        let runtime = &self.cfg.runtime_path;
         let mut mods = Vec::new();
         let mut bodies: Vec<String> = Vec::new();
         for (class, nodes) in groups {
@@ -401,8 +425,7 @@ impl<'m> Gen<'m> {
                 Identifier::Numeric(v) => ("id", vec![v.to_string()]),
                 Identifier::String(s) => ("NsNodeId::string", vec!["NS".to_string(), Literal::string(s).to_string()]),
                 other => {
-                    let idk = self.id_kind(other);
-                    let idk = path(&idk.to_string().replacen("rt ::", &format!("{} ::", self.cfg.runtime_path), 1));
+                    let idk = self.id_kind(other, &self.cfg.runtime_path.to_token_stream());
                     let name = ident(name);
                     let item = quote! { pub const #name: NsNodeId = NsNodeId { namespace_uri: NS, id: #idk }; };
                     let file: syn::File = syn::parse2(quote! { mod m { #item } }).expect("internal error: a NodeId constant does not parse");
@@ -483,7 +506,7 @@ impl<'m> Gen<'m> {
         }
         let uri = model.namespace_uri(n.id.ns);
         let module = if let Some(p) = self.cfg.extern_paths.get(uri) {
-            path(p)
+            p.to_token_stream()
         } else if let Some(m) = self.cfg.namespaces.iter().find(|m| m.uri == uri) {
             let m = ident(&m.module);
             quote! { super::super::#m }
@@ -534,7 +557,7 @@ impl<'m> Gen<'m> {
         let model = self.model;
         let mut items = Vec::new();
         let mut loader = Vec::new();
-        let runtime = path(&self.cfg.runtime_path);
+        let runtime = &self.cfg.runtime_path;
         let types: Vec<(NodeIx, String)> = self.type_names.iter().map(|(k, v)| (*k, v.clone())).collect();
         for (t, name) in types {
             let n = model.node(t);
@@ -789,8 +812,8 @@ impl<'m> Gen<'m> {
 
     // ----- the address space table -----------------------------------------------------------------
 
-    fn id_kind(&self, id: &Identifier) -> TokenStream {
-        let rt = quote! { rt };
+    /// An `IdKind` value, the type named through the runtime path `rt`.
+    fn id_kind(&self, id: &Identifier, rt: &TokenStream) -> TokenStream {
         match id {
             Identifier::Numeric(v) => {
                 let v = Literal::u32_unsuffixed(*v);
@@ -881,9 +904,16 @@ fn builtin_type(b: BuiltinType) -> TokenStream {
     }
 }
 
+/// The files at the top of a folder that holds the namespaces of `cfg`, one module each: `mod.rs`, which declares
+/// them and registers all of them with a server in `cfg`'s order (dependencies first), and `rustfmt.toml`.
+pub fn top_files(cfg: &RustConfig) -> [OutFile; 2] {
+    let modules: Vec<(String, String)> = cfg.namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
+    [models_mod(&modules, &cfg.runtime_path, &cfg.command), rustfmt_toml()]
+}
+
 /// The `mod.rs` of a folder holding several generated namespaces (`modules`: module name and namespace URI,
 /// dependencies first), with `register`, which adds all of them to a server configuration in that order.
-pub fn models_mod(modules: &[(String, String)], runtime_path: &str, command: &str) -> OutFile {
+fn models_mod(modules: &[(String, String)], runtime: &RustPath, command: &str) -> OutFile {
     let items: Vec<TokenStream> = modules
         .iter()
         .map(|(m, uri)| {
@@ -892,7 +922,6 @@ pub fn models_mod(modules: &[(String, String)], runtime_path: &str, command: &st
             quote! { #[doc = #d] pub mod #m; }
         })
         .collect();
-    let runtime: syn::Path = syn::parse_str(runtime_path).expect("internal error: runtime path");
     let adds = modules.iter().map(|(m, _)| {
         let m = ident(m);
         quote! { .table(&#m::TABLE).type_loader(#m::TypeLoader) }
@@ -915,7 +944,7 @@ pub fn models_mod(modules: &[(String, String)], runtime_path: &str, command: &st
 }
 
 /// The rustfmt configuration that keeps `cargo fmt` off generated files.
-pub fn rustfmt_toml() -> OutFile {
+fn rustfmt_toml() -> OutFile {
     OutFile {
         path: PathBuf::from("rustfmt.toml"),
         contents: "# Generated code is formatted by nodeset-compiler (prettyplease); rustfmt leaves it alone.\ndisable_all_formatting = true\n".into(),

@@ -34,10 +34,10 @@ use std::fmt::Write as _;
 use std::rc::Rc;
 
 use proc_macro2::{Literal, TokenStream};
-use quote::quote;
+use quote::{quote, ToTokens};
 
 use super::programs::Item;
-use super::{doc, ident, lit, path, Gen};
+use super::{doc, ident, lit, Gen};
 use crate::model::{DataTypeKind, Model, ModellingRule, NodeIx};
 use crate::nodeid::Identifier;
 use crate::names::{Case, Scope, Target};
@@ -163,7 +163,7 @@ impl Gen<'_> {
     pub(super) fn module_path(&self, ns: u16) -> Option<TokenStream> {
         let uri = self.model.namespace_uri(ns);
         if let Some(p) = self.cfg.extern_paths.get(uri) {
-            Some(path(p))
+            Some(p.to_token_stream())
         } else {
             let m = self.cfg.namespaces.iter().find(|m| m.uri == uri)?;
             let m = ident(&m.module);
@@ -378,7 +378,7 @@ impl Gen<'_> {
             let v = Literal::u32_unsuffixed(*v);
             return quote! { rt::NsNodeId::numeric(NS[#k], #v) };
         }
-        let kind = self.id_kind(&id.id);
+        let kind = self.id_kind(&id.id, &quote! { rt });
         quote! { rt::NsNodeId { namespace_uri: NS[#k], id: #kind } }
     }
 
@@ -723,7 +723,7 @@ impl Gen<'_> {
                 markers.push(self.markers("variable_members", name, &all, base.as_ref().map(|(s, p)| (*s, p)), &mut uris));
             }
         }
-        let runtime = path(&self.cfg.runtime_path);
+        let runtime = &self.cfg.runtime_path;
         let mut ns_list: Vec<(&String, &usize)> = uris.iter().collect();
         ns_list.sort_by_key(|(_, i)| **i);
         let ns_items = ns_list.iter().map(|(u, _)| lit(u));

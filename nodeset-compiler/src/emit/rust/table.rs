@@ -12,7 +12,7 @@
 //! quoted with `"`, `\`, line breaks and control characters escaped; floats are printed the way Rust parses
 //! them back to the same value.
 
-use super::{lit, path, Gen};
+use super::{lit, Gen};
 use crate::diag::{Code, Diagnostic};
 use crate::model::{ids, Argument, DataTypeKind, EnumValue, NodeIx, StructureKind};
 use crate::nodeid::{Identifier, NodeId};
@@ -287,7 +287,7 @@ impl Gen<'_> {
         let date = lit(m.and_then(|m| m.publication_date.as_deref()).unwrap_or(""));
         let ns_uris: Vec<Literal> = locals.iter().map(|&g| lit(model.namespace_uri(g))).collect();
         let own = local(self.ns);
-        let runtime = path(&self.cfg.runtime_path);
+        let runtime = &self.cfg.runtime_path;
         let head = quote! {
             //! The address space of this namespace as data, imported into a server by the runtime.
             use #runtime as rt;
