@@ -259,6 +259,7 @@ impl RustOptions {
     /// `mod.rs` registers them, [`generate_rust`]), each module named by [`emit::plan::Plan::module_names`].
     /// [`Error::Config`] when a path is not a Rust path ([`RustOptions::paths`]).
     pub fn config_of(&self, uris: &[String]) -> Result<emit::rust::RustConfig, Error> {
+        self.check_modules()?;
         let (extern_paths, runtime_path) = self.paths()?;
         let plan = emit::plan::Plan { generated: uris.to_vec(), ..emit::plan::Plan::default() };
         let modules = plan.module_names(&self.modules);
@@ -267,8 +268,32 @@ impl RustOptions {
         Ok(emit::rust::RustConfig { namespaces, extern_paths, runtime_path, command: self.command.clone() })
     }
 
+    /// Checks every setting before anything is read, so that a typo costs nothing: the module names
+    /// ([`RustOptions::check_modules`]) and the paths ([`RustOptions::paths`]).
+    pub fn check(&self) -> Result<(), Error> {
+        self.check_modules()?;
+        self.paths().map(|_| ())
+    }
+
+    /// Each module name given is a Rust identifier that is not a keyword, and no two namespaces share one:
+    /// [`Error::Config`] otherwise, naming the first offender.
+    pub fn check_modules(&self) -> Result<(), Error> {
+        let mut seen: BTreeMap<&str, &str> = BTreeMap::new();
+        for (uri, name) in &self.modules {
+            if syn::parse_str::<syn::Ident>(name).is_err() {
+                return Err(Error::Config(format!(
+                    "the module name of {uri}, `{name}`, is not a Rust identifier (or is a keyword); give one such as `robotics`"
+                )));
+            }
+            if let Some(other) = seen.insert(name, uri) {
+                return Err(Error::Config(format!("{other} and {uri} are both given the module name `{name}`; give each its own")));
+            }
+        }
+        Ok(())
+    }
+
     /// The extern paths and the runtime path, each checked to be a Rust path: [`Error::Config`] names the first
-    /// that is not. Front doors call it before compiling, so that a typo costs nothing.
+    /// that is not.
     pub fn paths(&self) -> Result<(BTreeMap<String, emit::rust::RustPath>, emit::rust::RustPath), Error> {
         let runtime = emit::rust::RustPath::new(&self.runtime_path).map_err(|e| {
             Error::Config(format!("the runtime path {e}; give the path of the runtime module, such as `nodeset_models::runtime`"))

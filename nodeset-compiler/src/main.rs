@@ -233,7 +233,7 @@ fn rust_command(common: &Common, out: &Path, externs: &[String], modules: &[Stri
         runtime_path: runtime.to_string(),
         command: "nodeset-compiler rust ...".into(),
     };
-    rust.paths()?;
+    rust.check()?;
     let (compiled, opts) = compile_checked(common)?;
     // Every required model that is not mapped with --extern is generated too, so the output compiles alone.
     let run = nodeset_compiler::run_rust(&compiled.model, &rust, &opts.severities)?;

@@ -1,5 +1,5 @@
 //! The `nodeset-compiler` command as a user runs it, where no server or nodeset is needed: `verify` with bad
-//! input ends with a clear message and exit status 2, `rust` with a path that is not a Rust path with one and
+//! input ends with a clear message and exit status 2, `rust` with a bad path or module name with one and
 //! status 1, never a panic; and `codes` lists the verify codes.
 //!
 //! Being an integration test of this package, it also makes `cargo test --workspace` build the command with
@@ -16,12 +16,15 @@ fn free_port() -> u16 {
 }
 
 #[test]
-fn rust_refuses_a_path_that_is_not_a_rust_path_before_reading_anything() {
+fn rust_refuses_a_bad_path_or_module_name_before_reading_anything() {
     let out = std::env::temp_dir().join(format!("nodeset-cli-paths-{}", std::process::id()));
     // The input does not exist either: the paths are checked first, and nothing is written.
-    let cases: [(&[&str], &str); 2] = [
+    let cases: [(&[&str], &str); 5] = [
         (&["--extern", "http://opcfoundation.org/UA/DI/=my crate::di"], "the extern path of http://opcfoundation.org/UA/DI/: `my crate::di` is not a Rust path"),
         (&["--runtime", "1bad::runtime"], "the runtime path `1bad::runtime` is not a Rust path"),
+        (&["--module", "http://a.org/=1 bad"], "the module name of http://a.org/, `1 bad`, is not a Rust identifier"),
+        (&["--module", "http://a.org/=type"], "the module name of http://a.org/, `type`, is not a Rust identifier (or is a keyword)"),
+        (&["--module", "http://a.org/=x", "--module", "http://b.org/=x"], "http://a.org/ and http://b.org/ are both given the module name `x`"),
     ];
     for (flags, message) in cases {
         let mut args = vec!["rust", "missing.NodeSet2.xml", "--out", out.to_str().unwrap()];
