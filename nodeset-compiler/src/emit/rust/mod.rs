@@ -160,7 +160,7 @@ struct Gen<'m> {
     /// `objects.rs` item names and handle names per namespace, computed on demand.
     item_names_cache: std::cell::RefCell<BTreeMap<u16, std::rc::Rc<BTreeMap<(NodeIx, programs::Item), String>>>>,
     handle_names_cache: std::cell::RefCell<BTreeMap<u16, std::rc::Rc<BTreeMap<NodeIx, String>>>>,
-    value_type_cache: std::cell::RefCell<std::collections::HashMap<(Option<NodeIx>, i32), TokenStream>>,
+    value_type_cache: std::cell::RefCell<std::collections::HashMap<(Option<NodeIx>, i32), syn::Type>>,
     ns0_types: BTreeSet<&'static str>,
 }
 

@@ -172,28 +172,30 @@ impl Gen<'_> {
     }
 
     /// The Rust path of a type's handle, if it has one reachable from this module.
-    pub(super) fn handle_path(&self, t: NodeIx, names: &BTreeMap<NodeIx, String>) -> Option<TokenStream> {
+    pub(super) fn handle_path(&self, t: NodeIx, names: &BTreeMap<NodeIx, String>) -> Option<syn::Path> {
         let n = self.model.node(t);
         if n.id.ns == self.ns {
             let name = ident(names.get(&t)?);
-            return Some(quote! { #name });
+            return Some(syn::Path::from(name));
         }
         if n.id.ns == 0 || !self.has_handle(t) {
             return None;
         }
         let module = self.module_path(n.id.ns)?;
         let name = ident(self.handle_names(n.id.ns).get(&t)?);
-        Some(quote! { #module::objects::#name })
+        Some(syn::parse_quote! { #module::objects::#name })
     }
 
     /// The Rust value type of a DataType and ValueRank, as typed handles use it (memoized: thousands of
     /// members share a few dozen types).
-    pub(super) fn value_type(&self, dt: Option<NodeIx>, value_rank: i32) -> TokenStream {
+    pub(super) fn value_type(&self, dt: Option<NodeIx>, value_rank: i32) -> syn::Type {
         if let Some(t) = self.value_type_cache.borrow().get(&(dt, value_rank)) {
             return t.clone();
         }
+        let tokens = self.compute_value_type(dt, value_rank);
+        let mut t: syn::Type = syn::parse_quote! { #tokens };
         // objects.rs names async-opcua's types through its `ua` alias.
-        let t = alias_ua(self.compute_value_type(dt, value_rank));
+        each_path(&mut t, &mut alias_ua);
         self.value_type_cache.borrow_mut().insert((dt, value_rank), t.clone());
         t
     }
@@ -202,7 +204,7 @@ impl Gen<'_> {
         let variant = quote! { opcua::types::Variant };
         let Some(dt) = dt else { return variant };
         let scalar = self.scalar_value_type(dt);
-        if scalar.to_string() == variant.to_string() {
+        if is_variant(&scalar) {
             return variant;
         }
         match value_rank {
@@ -240,12 +242,12 @@ impl Gen<'_> {
             DataTypeKind::Structure { .. } if info.is_abstract => quote! { opcua::types::ExtensionObject },
             DataTypeKind::Structure { .. } | DataTypeKind::Enumeration { .. } | DataTypeKind::OptionSet { .. } => {
                 let t = self.rust_type(dt);
-                if t.to_string().contains("Variant") { quote! { opcua::types::Variant } } else { t }
+                if is_variant(&t) { quote! { opcua::types::Variant } } else { t }
             }
             DataTypeKind::Simple(_) => self.rust_type(dt),
         };
         // Types of this namespace are named bare in types.rs; objects.rs reaches them through `super`.
-        if n.id.ns == self.ns && !t.to_string().contains("::") {
+        if n.id.ns == self.ns && syn::parse2::<syn::Ident>(t.clone()).is_ok() {
             return quote! { super::types::#t };
         }
         t
@@ -315,7 +317,7 @@ impl Gen<'_> {
             let _ = write!(out, "{}:{} {:?} {rule} ", n.browse_name.ns, n.browse_name.name, n.class);
             match n.class {
                 NodeClass::Variable => {
-                    let _ = write!(out, "{}", self.value_type(n.attrs.data_type, n.attrs.value_rank.unwrap_or(-1)));
+                    out.push_str(&type_text(&self.value_type(n.attrs.data_type, n.attrs.value_rank.unwrap_or(-1))));
                 }
                 NodeClass::Method => {
                     let _ = write!(out, "{}", self.method_type(m));
@@ -334,34 +336,29 @@ impl Gen<'_> {
     }
 
     fn method_type(&self, decl: NodeIx) -> TokenStream {
-        let info = self.model.methods.get(&decl).cloned().unwrap_or_default();
-        let tuple = |args: &[crate::model::Argument]| -> TokenStream {
-            let items: Vec<TokenStream> = args.iter().map(|a| self.value_type(a.data_type, a.value_rank)).collect();
-            if items.len() > 12 {
-                quote! { Vec<ua::Variant> }
-            } else {
-                quote! { (#(#items,)*) }
-            }
-        };
-        let (i, o) = (tuple(&info.inputs), tuple(&info.outputs));
+        let (i, o) = self.method_io(decl);
         quote! { t::Method<#i, #o> }
     }
 
-    /// A method's input and output tuples as text, seen from `members::<Owner>` (two modules below
-    /// objects.rs): `(String,)`, `()`, `Vec<ua::Variant>` beyond twelve arguments.
-    fn method_io_text(&self, decl: NodeIx) -> (String, String) {
+    /// A method's input and output types: the tuples of its Argument definitions (`(String,)`, `()`), or
+    /// `Vec<ua::Variant>` beyond twelve arguments.
+    fn method_io(&self, decl: NodeIx) -> (syn::Type, syn::Type) {
         let info = self.model.methods.get(&decl).cloned().unwrap_or_default();
-        let tuple = |args: &[crate::model::Argument]| -> String {
-            let items: Vec<String> =
-                args.iter().map(|a| from_members_module(&type_text(&self.value_type(a.data_type, a.value_rank)))).collect();
-            match items.len() {
-                0 => "()".to_owned(),
-                1 => format!("({},)", items[0]),
-                n if n > 12 => "Vec<ua::Variant>".to_owned(),
-                _ => format!("({})", items.join(", ")),
+        let tuple = |args: &[crate::model::Argument]| -> syn::Type {
+            let items: Vec<syn::Type> = args.iter().map(|a| self.value_type(a.data_type, a.value_rank)).collect();
+            if items.len() > 12 {
+                syn::parse_quote! { Vec<ua::Variant> }
+            } else {
+                syn::parse_quote! { (#(#items,)*) }
             }
         };
         (tuple(&info.inputs), tuple(&info.outputs))
+    }
+
+    /// A method's input and output types as the members macro names them, from `members::<Owner>`.
+    fn method_io_text(&self, decl: NodeIx) -> (String, String) {
+        let (i, o) = self.method_io(decl);
+        (type_text(&from_members_module(i)), type_text(&from_members_module(o)))
     }
 
     /// Index of a namespace URI in the file's `NS` table.
@@ -436,7 +433,7 @@ impl Gen<'_> {
                 NodeClass::Object => match n.type_definition.and_then(|t| self.handle_path(t, names)) {
                     Some(h) => {
                         boxed = true;
-                        h
+                        h.to_token_stream()
                     }
                     None => quote! { t::ObjectNode },
                 },
@@ -590,7 +587,7 @@ impl Gen<'_> {
         macro_name: &str,
         type_name: &str,
         members: &[(NodeIx, NodeIx)],
-        base: Option<(NodeIx, &TokenStream)>,
+        base: Option<(NodeIx, &syn::Path)>,
         uris: &mut BTreeMap<String, usize>,
     ) -> String {
         let model = self.model;
@@ -605,15 +602,18 @@ impl Gen<'_> {
                     .filter(|m| ours[m.name.as_str()].key(model) == m.key(model))
                     .map(|m| m.name)
                     .collect();
-                // `Name` or `path::objects::Name`, seen from objects.rs; the markers are in `members::Name`,
-                // and seen from `members::<Owner>`, two modules down.
-                let text = handle.to_string().replace(' ', "");
-                let module = match text.rsplit_once("::") {
-                    None => format!("super::{text}"),
-                    Some((m, last)) if m.starts_with("super::") => format!("super::super::{m}::members::{last}"),
-                    Some((m, last)) => format!("{m}::members::{last}"),
+                // `Name` or `path::objects::Name`, seen from objects.rs; the markers are in `members::Name` of
+                // the module that holds the handle, here seen from `members::<Owner>`.
+                let mut module = handle.clone();
+                let name = module.segments.pop().map(|last| last.into_value());
+                module.segments.pop_punct();
+                let module: syn::Type = if module.segments.is_empty() {
+                    syn::parse_quote! { super::#name }
+                } else {
+                    let module = from_members_module(syn::Type::Path(syn::TypePath { qself: None, path: module }));
+                    syn::parse_quote! { #module::members::#name }
                 };
-                inherited = Some((module, same));
+                inherited = Some((type_text(&module), same));
             }
         }
         let mut items = String::new();
@@ -642,15 +642,7 @@ impl Gen<'_> {
                 continue;
             }
             let rank = n.attrs.value_rank.unwrap_or(-1);
-            let scalar = type_text(&self.value_type(n.attrs.data_type, -1));
-            let scalar = if scalar.contains("Variant") {
-                "ua::Variant".to_string()
-            } else if scalar.starts_with("super::") {
-                // Paths relative to objects.rs, seen from `members::<Owner>` two modules down.
-                format!("super::super::{scalar}")
-            } else {
-                scalar
-            };
+            let scalar = type_text(&from_members_module(self.value_type(n.attrs.data_type, -1)));
             let writable = n.attrs.access_level.unwrap_or(1) & 2 != 0;
             let path: Vec<String> = r.qpath.iter().map(|(ns, s)| format!("{}:{}", self.ns_index(uris, *ns), escape_segment(s))).collect();
             let _ = writeln!(
@@ -702,7 +694,7 @@ impl Gen<'_> {
                     None => all.clone(),
                 };
                 let base_for_markers = base.clone();
-                let body = self.handle_struct(name, &text, None, base.map(|(_, p)| p), &own, &names, &mut uris, nested_prefix(name), 0);
+                let body = self.handle_struct(name, &text, None, base.map(|(_, p)| p.to_token_stream()), &own, &names, &mut uris, nested_prefix(name), 0);
                 let machine = self.state_machine_items(t, name, &names, &item_names, &mut uris);
                 items.push(quote! {
                     #body
@@ -756,63 +748,117 @@ impl Gen<'_> {
     }
 }
 
-/// `opcua::types::X` -> `ua::X` throughout a token stream (objects.rs imports `opcua::types as ua`; the
-/// value types are computed by code shared with types.rs, which names the full path).
-fn alias_ua(tokens: TokenStream) -> TokenStream {
-    use proc_macro2::{Group, Ident, Punct, Spacing, Span, TokenTree};
-    let tts: Vec<TokenTree> = tokens.into_iter().collect();
-    let is_ident = |t: &TokenTree, s: &str| matches!(t, TokenTree::Ident(i) if i == s);
-    let is_colon = |t: &TokenTree| matches!(t, TokenTree::Punct(p) if p.as_char() == ':');
-    let mut out: Vec<TokenTree> = Vec::with_capacity(tts.len());
-    let mut i = 0;
-    while i < tts.len() {
-        if i + 5 < tts.len()
-            && is_ident(&tts[i], "opcua")
-            && is_colon(&tts[i + 1])
-            && is_colon(&tts[i + 2])
-            && is_ident(&tts[i + 3], "types")
-            && is_colon(&tts[i + 4])
-            && is_colon(&tts[i + 5])
-        {
-            out.push(TokenTree::Ident(Ident::new("ua", Span::call_site())));
-            out.push(TokenTree::Punct(Punct::new(':', Spacing::Joint)));
-            out.push(TokenTree::Punct(Punct::new(':', Spacing::Alone)));
-            i += 6;
-            continue;
-        }
-        out.push(match &tts[i] {
-            TokenTree::Group(g) => {
-                let mut ng = Group::new(g.delimiter(), alias_ua(g.stream()));
-                ng.set_span(g.span());
-                TokenTree::Group(ng)
+/// Whether a type is async-opcua's `Variant` (`opcua::types::Variant`).
+fn is_variant(t: &TokenStream) -> bool {
+    syn::parse2::<syn::Path>(t.clone()).is_ok_and(|p| {
+        p.leading_colon.is_none()
+            && p.segments.len() == 3
+            && ["opcua", "types", "Variant"].iter().zip(&p.segments).all(|(s, seg)| seg.ident == s && seg.arguments.is_none())
+    })
+}
+
+/// Calls `f` on every path in a type, inner ones (generic arguments, tuple elements) first.
+fn each_path(ty: &mut syn::Type, f: &mut impl FnMut(&mut syn::Path)) {
+    match ty {
+        syn::Type::Path(p) => {
+            for seg in p.path.segments.iter_mut() {
+                if let syn::PathArguments::AngleBracketed(args) = &mut seg.arguments {
+                    for arg in args.args.iter_mut() {
+                        if let syn::GenericArgument::Type(t) = arg {
+                            each_path(t, f);
+                        }
+                    }
+                }
             }
-            t => t.clone(),
-        });
-        i += 1;
-    }
-    out.into_iter().collect()
-}
-
-/// A type's tokens as a person writes them (`Vec<ua::LocalizedText>`, `super::types::Mode`).
-fn type_text(tokens: &TokenStream) -> String {
-    tokens.to_string().replace(" :: ", "::").replace(":: ", "::").replace(" < ", "<").replace(" >", ">").replace("opcua::types::", "ua::")
-}
-
-/// A type's text as objects.rs names it, seen from `members::<Owner>`, two modules down: each path that
-/// starts with `super::` gets two more.
-fn from_members_module(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    let mut rest = text;
-    while let Some(i) = rest.find("super::") {
-        out.push_str(&rest[..i]);
-        if !out.ends_with("::") {
-            out.push_str("super::super::");
+            f(&mut p.path);
         }
-        out.push_str("super::");
-        rest = &rest[i + "super::".len()..];
+        syn::Type::Tuple(t) => t.elems.iter_mut().for_each(|e| each_path(e, f)),
+        syn::Type::Array(syn::TypeArray { elem, .. })
+        | syn::Type::Slice(syn::TypeSlice { elem, .. })
+        | syn::Type::Reference(syn::TypeReference { elem, .. })
+        | syn::Type::Paren(syn::TypeParen { elem, .. })
+        | syn::Type::Group(syn::TypeGroup { elem, .. }) => each_path(elem, f),
+        _ => {}
     }
-    out.push_str(rest);
+}
+
+/// `opcua::types::X` -> `ua::X` (objects.rs imports `opcua::types as ua`; the value types are computed by code
+/// shared with types.rs, which names the full path).
+fn alias_ua(path: &mut syn::Path) {
+    let is = |i: usize, s: &str| path.segments.get(i).is_some_and(|seg| seg.ident == s);
+    if path.leading_colon.is_none() && path.segments.len() > 2 && is(0, "opcua") && is(1, "types") {
+        let rest: Vec<syn::PathSegment> = path.segments.iter().skip(2).cloned().collect();
+        path.segments = std::iter::once(syn::PathSegment::from(ident("ua"))).chain(rest).collect();
+    }
+}
+
+/// A type named in objects.rs, as named from `members::<Owner>`, two modules down: each path relative to
+/// objects.rs (`super::types::Mode`) climbs two modules more.
+fn from_members_module(mut ty: syn::Type) -> syn::Type {
+    each_path(&mut ty, &mut |path| {
+        if path.leading_colon.is_none() && path.segments.first().is_some_and(|s| s.ident == "super") {
+            for _ in 0..2 {
+                path.segments.insert(0, syn::PathSegment::from(ident("super")));
+            }
+        }
+    });
+    ty
+}
+
+/// A type as a person writes it, for the members macros' text (`Vec<ua::LocalizedText>`, `(String,)`,
+/// `super::types::Mode`). Value types are paths, with type arguments, and tuples of them; any other form is
+/// written as its tokens, which is the same Rust with other spacing.
+fn type_text(ty: &syn::Type) -> String {
+    let mut out = String::new();
+    write_type(ty, &mut out);
     out
+}
+
+fn write_type(ty: &syn::Type, out: &mut String) {
+    match ty {
+        syn::Type::Path(syn::TypePath { qself: None, path }) => {
+            if path.leading_colon.is_some() {
+                out.push_str("::");
+            }
+            for (i, seg) in path.segments.iter().enumerate() {
+                if i > 0 {
+                    out.push_str("::");
+                }
+                out.push_str(&seg.ident.to_string());
+                match &seg.arguments {
+                    syn::PathArguments::None => {}
+                    syn::PathArguments::AngleBracketed(args) => {
+                        out.push('<');
+                        for (j, arg) in args.args.iter().enumerate() {
+                            if j > 0 {
+                                out.push_str(", ");
+                            }
+                            match arg {
+                                syn::GenericArgument::Type(t) => write_type(t, out),
+                                other => out.push_str(&other.to_token_stream().to_string()),
+                            }
+                        }
+                        out.push('>');
+                    }
+                    other => out.push_str(&other.to_token_stream().to_string()),
+                }
+            }
+        }
+        syn::Type::Tuple(t) => {
+            out.push('(');
+            for (j, e) in t.elems.iter().enumerate() {
+                if j > 0 {
+                    out.push_str(", ");
+                }
+                write_type(e, out);
+            }
+            if t.elems.len() == 1 {
+                out.push(',');
+            }
+            out.push(')');
+        }
+        other => out.push_str(&other.to_token_stream().to_string()),
+    }
 }
 
 /// The prefix of nested handle struct names of a type (`AxisType` -> `AxisType_`).
@@ -822,16 +868,36 @@ fn nested_prefix(name: &str) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::from_members_module;
+    use super::{each_path, alias_ua, from_members_module, type_text};
+
+    fn seen_from_members(ty: syn::Type) -> String {
+        type_text(&from_members_module(ty))
+    }
 
     #[test]
     fn types_named_from_objects_rs_are_renamed_for_the_members_modules() {
-        assert_eq!(from_members_module("String"), "String");
-        assert_eq!(from_members_module("ua::NodeId"), "ua::NodeId");
-        assert_eq!(from_members_module("super::types::Mode"), "super::super::super::types::Mode");
+        assert_eq!(seen_from_members(syn::parse_quote!(String)), "String");
+        assert_eq!(seen_from_members(syn::parse_quote!(ua::NodeId)), "ua::NodeId");
+        assert_eq!(seen_from_members(syn::parse_quote!(super::types::Mode)), "super::super::super::types::Mode");
         assert_eq!(
-            from_members_module("Vec<super::super::di::types::A>"),
+            seen_from_members(syn::parse_quote!(Vec<super::super::di::types::A>)),
             "Vec<super::super::super::super::di::types::A>"
         );
+        assert_eq!(
+            seen_from_members(syn::parse_quote!((super::types::A, Vec<i32>, ::ext::B,))),
+            "(super::super::super::types::A, Vec<i32>, ::ext::B)"
+        );
+        assert_eq!(seen_from_members(syn::parse_quote!((super::types::A,))), "(super::super::super::types::A,)");
+        assert_eq!(seen_from_members(syn::parse_quote!(())), "()");
+    }
+
+    #[test]
+    fn async_opcua_types_are_named_through_the_ua_alias() {
+        let mut ty: syn::Type = syn::parse_quote!(Vec<opcua::types::LocalizedText>);
+        each_path(&mut ty, &mut alias_ua);
+        assert_eq!(type_text(&ty), "Vec<ua::LocalizedText>");
+        let mut ty: syn::Type = syn::parse_quote!(::opcua::types::X);
+        each_path(&mut ty, &mut alias_ua);
+        assert_eq!(type_text(&ty), "::opcua::types::X", "an absolute path is not the alias's");
     }
 }

@@ -19,7 +19,7 @@
 use std::collections::BTreeMap;
 
 use proc_macro2::{Literal, TokenStream};
-use quote::quote;
+use quote::{quote, ToTokens};
 
 use super::{doc, ident, lit, Gen};
 use crate::model::{ids, ModellingRule, NodeIx, StateMachineInfo};
@@ -181,7 +181,7 @@ impl Gen<'_> {
         for &(v, rule) in &vars {
             let n = model.node(v);
             let vt = self.value_type(n.attrs.data_type, n.attrs.value_rank.unwrap_or(-1));
-            let ty = if rule == ModellingRule::Mandatory { vt } else { quote! { Option<#vt> } };
+            let ty = if rule == ModellingRule::Mandatory { vt.to_token_stream() } else { quote! { Option<#vt> } };
             let fname = ident(&fnames[&v]);
             let mut text = format!("`{}` ({}).", n.browse_name.name, rule.name());
             if let Some(d) = n.doc() {
