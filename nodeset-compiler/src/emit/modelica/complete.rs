@@ -5,7 +5,7 @@
 //! classes).
 
 use super::ctx::{class_ident, decl_class_ident, Ctx};
-use super::plan::{ClassKey, ClassPlan, ElemKind, Element, Free, Mod, TypeRef};
+use super::plan::{ClassKey, ClassPlan, ElemKind, Element, Free, Mod, TypeRef, Value};
 use super::text;
 
 impl Ctx<'_> {
@@ -94,11 +94,11 @@ use its complete variant in the package <code>Complete</code>, which binds them 
 
 /// Adds `path = value` to a modification list, inside the modifiers already there for the same components
 /// (`a(b(x(unit="m")))` becomes `a(b(x(unit="m")=v))`); `each` after an array component.
-pub fn bind_free(mods: &mut Vec<Mod>, path: &[(String, bool)], value: String) {
+pub fn bind_free(mods: &mut Vec<Mod>, path: &[(String, bool)], value: Value) {
     bind_at(mods, path, value, false)
 }
 
-fn bind_at(mods: &mut Vec<Mod>, path: &[(String, bool)], value: String, each: bool) {
+fn bind_at(mods: &mut Vec<Mod>, path: &[(String, bool)], value: Value, each: bool) {
     let Some(((first, array), rest)) = path.split_first() else { return };
     let ident = if each { format!("each {first}") } else { first.clone() };
     if rest.is_empty() {
@@ -136,8 +136,7 @@ pub fn complete_plan(ctx: &mut Ctx, key: &ClassKey, plan: &ClassPlan) -> Option<
     }
     let mut mods = Vec::new();
     for f in info.free.iter() {
-        let value = ctx.value_of(f.node, &f.ty, None);
-        bind_free(&mut mods, &f.path, value);
+        bind_free(&mut mods, &f.path, f.value());
     }
     let base = ctx.class_path(key);
     let ident = ctx.complete_ident(key);

@@ -7,7 +7,7 @@ use super::ctx::{count_name, node_id_text, Ctx};
 use super::objects::{join_path, starting_in};
 use super::plan::{
     pin_alias, Base, Body, ClassInfo, ClassKey, ClassPlan, Deferred, ElemKind, Element, Item, MType, Mod, Mode, Own,
-    Owner, Pinned, TypeRef,
+    Owner, Pinned, TypeRef, Value,
 };
 use super::text::{self, string_literal};
 use super::types::dims_text;
@@ -91,7 +91,7 @@ impl Ctx<'_> {
             ident,
             dims,
             mods: Vec::new(),
-            value: Some(value),
+            value: Some(value.into()),
             cond: None,
             desc,
             annotation,
@@ -273,24 +273,21 @@ impl Ctx<'_> {
                         }
                     }
                 }
-                let mut value = self.value_of(o.node, &ty, dims.as_deref());
+                let mut value = Value::Of { node: o.node, ty: ty.clone(), dims: dims.clone() };
                 let mut cond = None;
                 if let Some(c) = &record_count {
-                    value = format!("fill({}, {c})", self.default_literal(&ty));
+                    value = Value::Fill { ty: ty.clone(), sizes: vec![c.clone()] };
                 }
                 if placeholder {
                     let count = self.placeholder_decls(body, &ident, &bn.name, rule, o.node);
                     let mut d = vec![None];
                     d.extend(dims.clone().unwrap_or_default());
-                    let default = self.default_literal(&ty);
                     let sizes: Vec<String> = std::iter::once(count.clone())
                         .chain(d[1..].iter().map(|x| x.unwrap_or(0).to_string()))
                         .collect();
                     value = match (&ty, sizes.as_slice()) {
-                        // rumoca 0.10.2 rejects `fill(R(), n)` of a record with a record field once n > 0
-                        // ("expression shape mismatch"); the comprehension is the same array.
-                        (MType::Record { .. }, [n]) => format!("{{{default} for i in 1:{n}}}"),
-                        _ => format!("fill({default}, {})", sizes.join(", ")),
+                        (MType::Record { .. }, [n]) => Value::Each { ty: ty.clone(), count: n.clone() },
+                        _ => Value::Fill { ty: ty.clone(), sizes },
                     };
                     dims = Some(d);
                     element.count = Some(count);
@@ -407,8 +404,7 @@ impl Ctx<'_> {
                                     // the inputs of any model a user plugs in; the variant's defaults stay).
                                     if alias.is_none() {
                                         for f in free {
-                                            let value = self.value_of(f.node, &f.ty, None);
-                                            bind_free(&mut mods, &f.path, value);
+                                            bind_free(&mut mods, &f.path, f.value());
                                         }
                                     }
                                     element.nested_free = Some(Rc::new(Vec::new()));
@@ -574,7 +570,7 @@ impl Ctx<'_> {
                         ident: e.ident.clone(),
                         is_final: false,
                         attrs: Vec::new(),
-                        value: Some(string_literal(&node_id_text(m, &n.id))),
+                        value: Some(string_literal(&node_id_text(m, &n.id)).into()),
                     });
                 }
                 Some(updated)
@@ -605,9 +601,11 @@ impl Ctx<'_> {
                             n.browse_name.name
                         )));
                     }
-                    // The same value as the inherited declaration needs no modifier.
+                    // The same value as the inherited declaration needs no modifier: planning compares the two
+                    // as they would be written, and leaves the writing to rendering.
                     let inherited = self.explicit_value(e.node, ty, dims.as_deref());
                     v.filter(|x| inherited.as_ref() != Some(x))
+                        .map(|_| Value::Of { node: o.node, ty: ty.clone(), dims: dims.clone() })
                 } else {
                     None
                 };
@@ -675,8 +673,7 @@ impl Ctx<'_> {
                         // (see `plan_new`).
                         if e.alias.is_none() {
                             for f in free {
-                                let value = self.value_of(f.node, &f.ty, None);
-                                bind_free(&mut sub.mods, &f.path, value);
+                                bind_free(&mut sub.mods, &f.path, f.value());
                             }
                         }
                         updated.nested_free = Some(Rc::new(Vec::new()));
@@ -801,7 +798,7 @@ fn browse_names_decl(names: &str, count: &str, original: &str) -> Item {
         ident: names.to_string(),
         dims: format!("[{count}]"),
         mods: Vec::new(),
-        value: Some(format!("fill({}, {count})", string_literal(original))),
+        value: Some(format!("fill({}, {count})", string_literal(original)).into()),
         cond: None,
         desc: string_literal(&format!("BrowseNames of the {original} elements")),
         annotation: String::new(),
@@ -815,7 +812,7 @@ pub fn attr_mods(attrs: &[String], array: bool) -> Vec<Mod> {
         .filter_map(|a| {
             let (k, v) = a.split_once('=')?;
             let ident = if array { format!("each {k}") } else { k.to_string() };
-            Some(Mod::Value { ident, is_final: false, attrs: Vec::new(), value: Some(v.to_string()) })
+            Some(Mod::Value { ident, is_final: false, attrs: Vec::new(), value: Some(v.into()) })
         })
         .collect()
 }

@@ -200,7 +200,7 @@ use crate::names::{is_valid, Case, Scope, Target};
 use crate::raw::NodeClass;
 use crate::write::OutFile;
 use ctx::{Ctx, Need};
-use plan::{pin_alias, ClassPlan, ElemKind, Item, Mod, Owner, OwnerPlan, TypeRef};
+use plan::{pin_alias, ClassPlan, ElemKind, Item, Mod, Owner, OwnerPlan, TypeRef, Value};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::PathBuf;
 use text::string_literal;
@@ -312,6 +312,24 @@ fn package_words(uri: &str) -> String {
 
 /// Generates the packages and reports everything found.
 pub fn generate_with_diagnostics(model: &Model, cfg: &ModelicaConfig) -> Generated {
+    match plan(model, cfg) {
+        Ok(planned) => render(planned, cfg),
+        Err(diagnostics) => Generated { files: Vec::new(), diagnostics },
+    }
+}
+
+/// What planning hands to rendering: the plans and facts of every class of the emitted namespaces (in the
+/// context), which namespaces are emitted in full, and the base namespace when only its subset is.
+struct Planned<'a> {
+    ctx: Ctx<'a>,
+    full: BTreeSet<u16>,
+    subset: Option<u16>,
+    diags: Diagnostics,
+}
+
+/// The planning step: package names, then the plan of every class of the emitted namespaces, and the aliases
+/// that derived classes redeclare. It writes no Modelica; a configuration error ends it with its diagnostics.
+fn plan<'a>(model: &'a Model, cfg: &ModelicaConfig) -> Result<Planned<'a>, Diagnostics> {
     let mut diags = Diagnostics::new();
     // Which namespaces to emit.
     let mut uris: Vec<String> = cfg.namespaces.clone();
@@ -376,7 +394,7 @@ pub fn generate_with_diagnostics(model: &Model, cfg: &ModelicaConfig) -> Generat
         }
     }
     if diags.has_errors() {
-        return Generated { files: Vec::new(), diagnostics: diags };
+        return Err(diags);
     }
     let ns0 = model.namespaces.iter().position(|n| n == NS0_URI).map(|i| i as u16);
     let subset = if cfg.base_subset && ns0.is_some_and(|n| !full.contains(&n)) { ns0 } else { None };
@@ -409,6 +427,14 @@ pub fn generate_with_diagnostics(model: &Model, cfg: &ModelicaConfig) -> Generat
         }
         ctx.redeclared.extend(more);
     }
+    Ok(Planned { ctx, full, subset, diags })
+}
+
+/// The rendering step: every planned class as Modelica, then the classes of the base namespace that those
+/// need, until nothing new is needed; then the package files around them.
+fn render(planned: Planned, cfg: &ModelicaConfig) -> Generated {
+    let Planned { mut ctx, full, subset, diags } = planned;
+    let model = ctx.m;
     let mut out = Output::default();
     let mut done_needs: BTreeSet<Need> = BTreeSet::new();
     for &ns in &full {
@@ -762,7 +788,7 @@ fn render_mod(ctx: &mut Ctx, m: &Mod) -> String {
                 s.push_str(&format!("({})", attrs.join(", ")));
             }
             if let Some(v) = value {
-                s.push_str(&format!("={v}"));
+                s.push_str(&format!("={}", render_value(ctx, v)));
             }
             s
         }
@@ -925,6 +951,16 @@ fn render_mods(ctx: &mut Ctx, mods: &[Mod], indent: usize) -> String {
     }
 }
 
+/// A planned value as Modelica.
+fn render_value(ctx: &mut Ctx, v: &Value) -> String {
+    match v {
+        Value::Text(t) => t.clone(),
+        Value::Of { node, ty, dims } => ctx.value_of(*node, ty, dims.as_deref()),
+        Value::Fill { ty, sizes } => format!("fill({}, {})", ctx.default_literal(ty), sizes.join(", ")),
+        Value::Each { ty, count } => format!("{{{} for i in 1:{count}}}", ctx.default_literal(ty)),
+    }
+}
+
 fn render_class(ctx: &mut Ctx, plan: &ClassPlan, ident: &str) -> String {
     let mut s = format!("{} {ident} {}\n", plan.keyword, plan.desc);
     if let Some((base, mods)) = &plan.extends {
@@ -967,7 +1003,7 @@ fn render_class(ctx: &mut Ctx, plan: &ClassPlan, ident: &str) -> String {
                 line.push_str(&format!("{ty} {ident}{dims}"));
                 line.push_str(&render_mods(ctx, mods, 4));
                 if let Some(v) = value {
-                    line.push_str(&format!(" = {v}"));
+                    line.push_str(&format!(" = {}", render_value(ctx, v)));
                 }
                 if let Some(c) = cond {
                     line.push_str(&format!(" if {c}"));
@@ -1003,3 +1039,5 @@ fn render_class(ctx: &mut Ctx, plan: &ClassPlan, ident: &str) -> String {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod plan_tests;

@@ -10,7 +10,7 @@
 use super::complete::{bind_free, COMPLETE_NOTE};
 use super::ctx::{component_original, count_name, node_id_text, undescribed, Ctx, MAX_NESTING};
 use super::plan::{ClassKey, Owner};
-use super::plan::{Body, ClassInfo, ClassPlan, ElemKind, Element, Item, Mod, Mode, Own, OwnerPlan, Placed, TypeRef};
+use super::plan::{Body, ClassInfo, ClassPlan, ElemKind, Element, Item, Mod, Mode, Own, OwnerPlan, Placed, TypeRef, Value};
 use super::text::{self, string_literal};
 use super::types::{as_i128, dims_text};
 use super::plan::{Base, MType};
@@ -209,7 +209,7 @@ impl Ctx<'_> {
                 continue;
             }
             let mut dims = Self::dims(n.attrs.value_rank.unwrap_or(-1), &n.attrs.array_dimensions);
-            let mut value = self.value_of(o.node, &ty, dims.as_deref());
+            let mut value = Value::Of { node: o.node, ty: ty.clone(), dims: dims.clone() };
             let mut dims_s = dims.as_deref().map(dims_text).unwrap_or_default();
             if dims.as_ref().is_some_and(|d| d.len() == 1 && d[0].is_none()) {
                 // As in the records of DataTypes: the length of an array of unknown length is a field.
@@ -229,7 +229,7 @@ impl Ctx<'_> {
                     desc: string_literal(&format!("Number of elements of {}", n.browse_name.name)),
                     annotation: String::new(),
                 });
-                value = format!("fill({}, {count})", self.default_literal(&ty));
+                value = Value::Fill { ty: ty.clone(), sizes: vec![count.clone()] };
                 dims_s = format!("[{count}]");
                 dims = Some(vec![None]);
             }
@@ -552,8 +552,7 @@ impl Ctx<'_> {
         if mode == Mode::Instance {
             // An instance is complete: every input nothing binds yet gets the instance's value.
             for f in self.free_of(&elements) {
-                let value = self.value_of(f.node, &f.ty, None);
-                bind_free(&mut body.mods, &f.path, value);
+                bind_free(&mut body.mods, &f.path, f.value());
             }
             for e in &mut elements {
                 if let ElemKind::Signal { free, .. } = &mut e.kind {

@@ -45,6 +45,13 @@ pub struct Free {
     pub ty: MType,
 }
 
+impl Free {
+    /// What a complete class binds the input to: the node's value.
+    pub fn value(&self) -> Value {
+        Value::Of { node: self.node, ty: self.ty.clone(), dims: None }
+    }
+}
+
 #[derive(Debug, Clone)]
 pub struct Element {
     pub bn: QualifiedName,
@@ -116,13 +123,52 @@ pub enum TypeRef {
     Class(ClassKey),
 }
 
+/// The value a declaration or modifier binds, as planning decides it; written as Modelica when the class is
+/// rendered (`mod.rs`, `render_value`), so planning never turns the nodeset's values into text.
+#[derive(Debug, Clone)]
+pub enum Value {
+    /// An expression the planning rule writes itself: a fixed literal (`0`, `true`), a NodeId string, or names
+    /// (`fill("", nAxis)`).
+    Text(String),
+    /// What the nodeset gives `node`, in SI where it has an engineering unit, if it fits `ty` and `dims`; else
+    /// the default of `ty` (of the array `dims`).
+    Of {
+        node: NodeIx,
+        ty: MType,
+        dims: Option<Vec<Option<u32>>>,
+    },
+    /// The default of `ty` repeated over `sizes` (counts' names or lengths): `fill(default, n, ...)`.
+    Fill {
+        ty: MType,
+        sizes: Vec<String>,
+    },
+    /// The default of `ty`, `count` times, as a comprehension: `{default for i in 1:count}` (rumoca 0.10.2
+    /// rejects `fill(R(), n)` of a record with a record field once n > 0: "expression shape mismatch").
+    Each {
+        ty: MType,
+        count: String,
+    },
+}
+
+impl From<&str> for Value {
+    fn from(text: &str) -> Value {
+        Value::Text(text.to_string())
+    }
+}
+
+impl From<String> for Value {
+    fn from(text: String) -> Value {
+        Value::Text(text)
+    }
+}
+
 #[derive(Debug, Clone)]
 pub enum Mod {
     Value {
         ident: String,
         is_final: bool,
         attrs: Vec<String>,
-        value: Option<String>,
+        value: Option<Value>,
     },
     Nested {
         ident: String,
@@ -181,7 +227,7 @@ pub enum Item {
         ident: String,
         dims: String,
         mods: Vec<Mod>,
-        value: Option<String>,
+        value: Option<Value>,
         cond: Option<String>,
         desc: String,
         annotation: String,

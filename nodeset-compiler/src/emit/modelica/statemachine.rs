@@ -260,7 +260,7 @@ impl Ctx<'_> {
                 ident: level_param.clone(),
                 dims: String::new(),
                 mods: Vec::new(),
-                value: Some(level.to_string()),
+                value: Some(level.to_string().into()),
                 cond: None,
                 desc: string_literal(
                     "Which class drives the state machine: a subclass that adds states sets its own level",
@@ -272,7 +272,7 @@ impl Ctx<'_> {
                 ident: level_param.clone(),
                 is_final: false,
                 attrs: Vec::new(),
-                value: Some(level.to_string()),
+                value: Some(level.to_string().into()),
             });
         }
         for (i, s) in info.states.iter().enumerate() {
@@ -293,7 +293,7 @@ impl Ctx<'_> {
                 ident: states[i].clone(),
                 dims: String::new(),
                 mods: Vec::new(),
-                value: Some(numbers[i].to_string()),
+                value: Some(numbers[i].to_string().into()),
                 cond: None,
                 desc: string_literal(&d),
                 annotation: self.opcua_annotation(s.node),
@@ -336,7 +336,7 @@ impl Ctx<'_> {
                 ident: cur.clone(),
                 is_final: true,
                 attrs: Vec::new(),
-                value: Some(text_var.clone()),
+                value: Some(text_var.clone().into()),
             });
             body.items.push(Item::Decl {
                 prefix: String::new(),
@@ -363,7 +363,7 @@ impl Ctx<'_> {
                         ident: "start".into(),
                         is_final: false,
                         attrs: Vec::new(),
-                        value: Some(states[initial].clone()),
+                        value: Some(states[initial].clone().into()),
                     },
                     Mod::Value {
                         ident: "fixed".into(),

@@ -26,7 +26,7 @@ fn load(files: &[PathBuf], dirs: Vec<PathBuf>) -> crate::Compiled {
     out
 }
 
-fn robotics() -> crate::Compiled {
+pub(super) fn robotics() -> crate::Compiled {
     let v = workspace().join("nodesets/vendor");
     load(&[v.join("Opc.Ua.Robotics.NodeSet2.xml")], vec![v])
 }
