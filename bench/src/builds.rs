@@ -12,6 +12,9 @@ use bench_support::{median, min, Report};
 use super::{verdict, Step};
 use process_support::workspace::cargo as cargo_command;
 
+/// Release builds run once: they are slow, and the release profile compiles without incremental.
+pub(super) const RELEASE_RUNS: usize = 1;
+
 /// Median and min of some wall times, and the median CPU time, in seconds.
 #[derive(Clone, Copy)]
 pub(super) struct Times {

@@ -62,6 +62,7 @@ mod peer;
 mod robots;
 mod rust;
 mod scale;
+mod size;
 mod verify;
 
 /// The files of the `robotics` scenario, in `nodesets/vendor/`.

@@ -9,8 +9,8 @@ use std::time::Instant;
 
 use bench_support::Report;
 
-use super::builds::{cargo, exec, time_builds, Builds};
-use super::rust::{count_rs, Sizes, RELEASE_RUNS};
+use super::builds::{cargo, exec, time_builds, Builds, RELEASE_RUNS};
+use super::size::{count_rs, Sizes};
 use super::{build, verdict, Args, Step, NAMESPACES};
 use process_support::workspace::display_path;
 

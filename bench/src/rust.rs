@@ -37,7 +37,8 @@ use std::time::Instant;
 
 use bench_support::{median, Report};
 
-use super::builds::{cargo, exec, interleave, print_builds, time_builds, Builds, Interleaved, Times};
+use super::builds::{cargo, exec, interleave, print_builds, time_builds, Builds, Interleaved, Times, RELEASE_RUNS};
+use super::size::{count_rs, sum, Size, Sizes};
 use super::peer::{
     run_peer, scaled, Peer, Yardstick, Yardsticks, PEER, PEER_BUILD_STATED_S, PEER_CRATE, PEER_RUN_STATED_MS,
     PEER_VERSION, write_crate,
@@ -54,42 +55,10 @@ const IMPORT_MS: f64 = 1.0;
 const RUNTIME_CRATE: &str = "nodeset-runtime";
 /// The CLI's output for DI + IA + Robotics (the peer's inputs) as a crate of its own on nodeset-runtime.
 const THREE_CRATE: &str = "nodeset-models-di-ia-robotics";
-/// Release builds run once: they are slow, and the release profile compiles without incremental.
-pub(super) const RELEASE_RUNS: usize = 1;
 /// Our crate, and the file touched before an incremental build (the peer's counterpart is its Robotics
 /// types module).
 const CRATE: &str = "nodeset-models";
 const TOUCHED: &str = "generated/src/models/robotics/types.rs";
-
-/// Files, lines and bytes of some generated Rust.
-#[derive(Clone, Copy, Default, PartialEq)]
-pub(super) struct Size {
-    pub(super) files: usize,
-    pub(super) lines: usize,
-    pub(super) bytes: usize,
-}
-
-impl std::ops::Add for Size {
-    type Output = Size;
-    fn add(self, o: Size) -> Size {
-        Size {
-            files: self.files + o.files,
-            lines: self.lines + o.lines,
-            bytes: self.bytes + o.bytes,
-        }
-    }
-}
-
-/// Sizes per module, in `NAMESPACES` order.
-pub(super) type Sizes = Vec<(&'static str, Size)>;
-
-/// The sum of the sizes of `modules`.
-fn sum(sizes: &Sizes, modules: &[&str]) -> Size {
-    sizes
-        .iter()
-        .filter(|(m, _)| modules.contains(m))
-        .fold(Size::default(), |a, (_, s)| a + *s)
-}
 
 /// Everything the scenario measured; every step may have failed, with the reason.
 struct Results {
@@ -392,29 +361,6 @@ fn write_three_crate(root: &Path, dir: &Path) -> Step<()> {
                pub use nodeset_runtime as runtime;\npub mod models;\n";
     let what = "the CLI's output for DI + IA + Robotics as a crate";
     write_crate(root, dir, THREE_CRATE, what, &manifest, "lib.rs", lib)
-}
-
-/// Files, lines and bytes of the `.rs` files under `dir`.
-pub(super) fn count_rs(dir: &Path) -> Step<Size> {
-    let mut size = Size::default();
-    let entries =
-        fs::read_dir(dir).map_err(|e| format!("cannot read {}: {e}", dir.display()))?;
-    for e in entries.flatten() {
-        let p = e.path();
-        if p.is_dir() {
-            size = size + count_rs(&p)?;
-        } else if p.extension().is_some_and(|x| x == "rs") {
-            let text = fs::read_to_string(&p)
-                .map_err(|e| format!("cannot read {}: {e}", p.display()))?;
-            size = size
-                + Size {
-                    files: 1,
-                    lines: text.lines().count(),
-                    bytes: text.len(),
-                };
-        }
-    }
-    Ok(size)
 }
 
 /// KiB in MiB.
