@@ -15,7 +15,7 @@
 //! **2. Generate Rust in your crate's build script**, with [`build::Builder`]. Namespaces that another crate
 //! already holds are mapped to it instead of being generated again:
 //!
-//! ```rust,ignore
+//! ```rust,no_run
 //! // build.rs (build-dependency: nodeset-compiler)
 //! fn main() {
 //!     nodeset_compiler::build::Builder::new()
@@ -26,10 +26,10 @@
 //!         .generate()
 //!         .unwrap_or_else(|e| panic!("{e}"));
 //! }
-//!
-//! // src/lib.rs: one module per namespace, named by the URI's last segment (`my_cell`)
-//! include!(concat!(env!("OUT_DIR"), "/nodesets.rs"));
 //! ```
+//!
+//! and in `src/lib.rs`, `include!(concat!(env!("OUT_DIR"), "/nodesets.rs"));`: one module per namespace, named
+//! by the URI's last segment (`my_cell`).
 //!
 //! Each namespace module holds NodeId constants that carry the namespace URI (`ids`), the data types with
 //! their encodings (`types`, and `TypeLoader`), the address space as a static table (`TABLE`) and typed
@@ -37,7 +37,9 @@
 //!
 //! **3. Serve it** with the runtime (`nodeset_models::runtime`, the crate `nodeset-runtime`):
 //!
-//! ```rust,ignore
+//! ```rust,no_run
+//! # // Your crate, from step 2; here a namespace of nodeset-models stands in for it.
+//! # mod my_cell_models { pub use nodeset_models::models::drilling_process as my_cell; }
 //! use nodeset_models::runtime::server::ServerConfig;
 //!
 //! #[tokio::main]
