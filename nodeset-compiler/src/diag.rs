@@ -483,12 +483,12 @@ impl Diagnostics {
     /// The end of every stage and front door: applies `severities`, sorts, renders, and fails when errors
     /// remain. Returns the rendered diagnostics either way (the caller prints or passes them on); `stage`
     /// says what failed (`"the NodeSet2 files do not compile"`).
-    pub fn finalize(&mut self, severities: &Severities, sources: &SourceMap, stage: &str) -> Result<String, crate::Error> {
+    pub fn finalize(&mut self, severities: &Severities, sources: &SourceMap, stage: &str) -> Result<String, Error> {
         self.apply(severities);
         self.sort(sources);
         let rendered = self.render(sources);
         if self.has_errors() {
-            return Err(crate::Error::Diagnostics { stage: stage.to_string(), errors: self.error_count(), rendered });
+            return Err(Error::Diagnostics { stage: stage.to_string(), errors: self.error_count(), rendered });
         }
         Ok(rendered)
     }
@@ -512,6 +512,67 @@ impl Diagnostics {
             out.push('\n');
         }
         out
+    }
+}
+
+/// Everything that can stop a front door, typed so that callers can tell a bad input from a bad setting
+/// from a failed write.
+#[derive(Debug)]
+pub enum Error {
+    /// A stage found errors in the input: `stage` says which, `rendered` holds every diagnostic as rustc
+    /// would print them.
+    Diagnostics {
+        /// What failed, such as "the NodeSet2 files do not compile".
+        stage: String,
+        /// The number of errors.
+        errors: usize,
+        /// The rendered diagnostics, warnings included.
+        rendered: String,
+    },
+    /// A severity setting was refused (an unknown code, or an error that cannot be demoted).
+    Severity(SeverityError),
+    /// A setting is malformed or missing (`--extern` without `=`, no `OUT_DIR`).
+    Config(String),
+    /// Writing or comparing the output failed.
+    Write(String),
+    /// Check mode found output that differs from what would be generated.
+    Stale(String),
+}
+
+impl Error {
+    /// The rendered diagnostics an [`Error::Diagnostics`] carries (empty for the other kinds).
+    pub fn diagnostics(&self) -> &str {
+        match self {
+            Error::Diagnostics { rendered, .. } => rendered,
+            _ => "",
+        }
+    }
+}
+
+impl std::fmt::Display for Error {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Error::Diagnostics { stage, errors, rendered } => {
+                write!(f, "{stage} ({errors} error(s)); nothing was written:\n{rendered}")
+            }
+            Error::Severity(e) => e.fmt(f),
+            Error::Config(m) | Error::Write(m) | Error::Stale(m) => f.write_str(m),
+        }
+    }
+}
+
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Error::Severity(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+impl From<SeverityError> for Error {
+    fn from(e: SeverityError) -> Error {
+        Error::Severity(e)
     }
 }
 

@@ -98,6 +98,7 @@ pub mod load;
 pub mod model;
 pub mod names;
 pub mod nodeid;
+mod par;
 pub mod parse;
 pub mod raw;
 pub mod resolve;
@@ -107,6 +108,7 @@ pub mod value;
 pub mod verify;
 pub mod write;
 
+pub use diag::Error;
 use diag::{Diagnostics, Severities, Severity};
 use load::{Input, LoadOptions};
 use std::collections::BTreeMap;
@@ -124,67 +126,6 @@ pub struct Options {
     pub all_warnings: bool,
     /// Size limits of the XML reader.
     pub limits: parse::Limits,
-}
-
-/// Everything that can stop a front door, typed so that callers can tell a bad input from a bad setting
-/// from a failed write.
-#[derive(Debug)]
-pub enum Error {
-    /// A stage found errors in the input: `stage` says which, `rendered` holds every diagnostic as rustc
-    /// would print them.
-    Diagnostics {
-        /// What failed, such as "the NodeSet2 files do not compile".
-        stage: String,
-        /// The number of errors.
-        errors: usize,
-        /// The rendered diagnostics, warnings included.
-        rendered: String,
-    },
-    /// A severity setting was refused (an unknown code, or an error that cannot be demoted).
-    Severity(diag::SeverityError),
-    /// A setting is malformed or missing (`--extern` without `=`, no `OUT_DIR`).
-    Config(String),
-    /// Writing or comparing the output failed.
-    Write(String),
-    /// Check mode found output that differs from what would be generated.
-    Stale(String),
-}
-
-impl Error {
-    /// The rendered diagnostics an [`Error::Diagnostics`] carries (empty for the other kinds).
-    pub fn diagnostics(&self) -> &str {
-        match self {
-            Error::Diagnostics { rendered, .. } => rendered,
-            _ => "",
-        }
-    }
-}
-
-impl std::fmt::Display for Error {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Error::Diagnostics { stage, errors, rendered } => {
-                write!(f, "{stage} ({errors} error(s)); nothing was written:\n{rendered}")
-            }
-            Error::Severity(e) => e.fmt(f),
-            Error::Config(m) | Error::Write(m) | Error::Stale(m) => f.write_str(m),
-        }
-    }
-}
-
-impl std::error::Error for Error {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            Error::Severity(e) => Some(e),
-            _ => None,
-        }
-    }
-}
-
-impl From<diag::SeverityError> for Error {
-    fn from(e: diag::SeverityError) -> Error {
-        Error::Severity(e)
-    }
 }
 
 /// The model and everything said about it.
@@ -405,54 +346,6 @@ pub fn run_modelica(model: &model::Model, packages: &BTreeMap<String, String>, s
     cfg.package_names = packages.clone();
     let (files, warnings) = generate_modelica(model, &cfg, severities)?;
     Ok(ModelicaRun { plan, files, warnings })
-}
-
-/// The number of threads the compiler uses: the cores this process may run on.
-pub(crate) fn cores() -> usize {
-    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
-    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
-}
-
-/// Runs `a` and `b` and returns both results: `a` on another thread where there is more than one core.
-/// A panic in `a` is passed on.
-pub(crate) fn join<A: Send, B>(a: impl FnOnce() -> A + Send, b: impl FnOnce() -> B) -> (A, B) {
-    if cores() == 1 {
-        return (a(), b());
-    }
-    std::thread::scope(|s| {
-        let other = s.spawn(a);
-        let rb = b();
-        let ra = other.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
-        (ra, rb)
-    })
-}
-
-/// Maps `f` over `items` on up to [`cores`] threads; the results are in the order of `items`. Threads take
-/// the next item when they finish one, so put the expensive items first. A panic in `f` is passed on.
-pub(crate) fn par_map<T: Sync, R: Send>(items: &[T], f: impl Fn(&T) -> R + Sync) -> Vec<R> {
-    let threads = cores().min(items.len());
-    if threads <= 1 {
-        return items.iter().map(f).collect();
-    }
-    let next = std::sync::atomic::AtomicUsize::new(0);
-    let work = || {
-        let mut done = Vec::new();
-        loop {
-            let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-            let Some(item) = items.get(i) else { return done };
-            done.push((i, f(item)));
-        }
-    };
-    let mut all: Vec<(usize, R)> = std::thread::scope(|s| {
-        let others: Vec<_> = (1..threads).map(|_| s.spawn(work)).collect();
-        let mut all = work();
-        for t in others {
-            all.extend(t.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)));
-        }
-        all
-    });
-    all.sort_by_key(|(i, _)| *i);
-    all.into_iter().map(|(_, r)| r).collect()
 }
 
 fn finish(model: model::Model, mut diags: Diagnostics, opts: &Options) -> Compiled {

@@ -190,7 +190,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
             .unwrap_or(pending.len())
     };
     let (first, second) = pending.split_at(half);
-    let (later, earlier) = crate::join(|| pass.links(second), || pass.links(first));
+    let (later, earlier) = crate::par::join(|| pass.links(second), || pass.links(first));
     let mut seen_refs: FxHashSet<(NodeIx, NodeIx, NodeIx)> = FxHashSet::with_capacity_and_hasher(total * 3, Default::default());
     // The declared references of every node, in node order (node `i`'s end at `own_end[i]`), and
     // the inverses they give their targets: each node's list is built from both in `link`, in one go.
@@ -227,7 +227,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
     drop(pending);
     // The raw files are not needed any more: another thread frees them while this one goes on.
     let own = OwnReferences { references: own, ends: own_end, found: found_all };
-    crate::join(move || drop(files), || link(&mut model, own, incoming, &broken, diags));
+    crate::par::join(move || drop(files), || link(&mut model, own, incoming, &broken, diags));
     model
 }
 
@@ -287,12 +287,12 @@ fn link(model: &mut Model, own: OwnReferences, incoming: Vec<(NodeIx, Reference)
     // instance declarations beside the data types, then method arguments beside the value check. Each pass
     // keeps its diagnostics, which are added in pass order.
     let m = &*model;
-    let ((members, members_said), (data_types, data_types_said)) = crate::join(
+    let ((members, members_said), (data_types, data_types_said)) = crate::par::join(
         || said(|d| build_members(m, d)),
         || said(|d| crate::datatypes::classify(m, d)),
     );
     let ((methods, methods_said), (_, values_said)) =
-        crate::join(|| said(|d| methods(m, &data_types, d)), || said(|d| check_values(m, &data_types, d)));
+        crate::par::join(|| said(|d| methods(m, &data_types, d)), || said(|d| check_values(m, &data_types, d)));
     model.members = members;
     model.data_types = data_types;
     model.methods = methods;

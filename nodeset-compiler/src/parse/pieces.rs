@@ -23,7 +23,7 @@ const MIN_PIECE: usize = 256 * 1024;
 /// Parses files, each with its diagnostics, on all cores; the results are those of [`super::parse`] on
 /// each file, in the order of `files`.
 pub fn parse_files(files: &[(FileId, &str)], limits: &Limits) -> Vec<(Option<RawNodeSet>, Diagnostics)> {
-    let threads = crate::cores();
+    let threads = crate::par::cores();
     let total: usize = files.iter().map(|(_, t)| t.len()).sum();
     // About three pieces per thread, so that pieces of different sizes even out across the threads.
     let piece_len = (total / (threads * 3)).max(MIN_PIECE);

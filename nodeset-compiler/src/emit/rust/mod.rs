@@ -105,7 +105,7 @@ pub fn generate(model: &Model, cfg: &RustConfig) -> RustOutput {
             }
         }
     }
-    let done = crate::par_map(&jobs, |&(i, ns, part)| {
+    let done = crate::par::par_map(&jobs, |&(i, ns, part)| {
         let mut g = Gen::new(model, cfg, ns, &cfg.namespaces[i].module);
         let file = g.part(part);
         (file, g.diags)
