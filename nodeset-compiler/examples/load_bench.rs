@@ -197,40 +197,11 @@ fn jobs(cli: &Cli) -> Result<Vec<Job>, String> {
     }
 }
 
-/// The models a file defines, from its `<Models>` header: ModelUri, Version, PublicationDate.
-fn declared_models(path: &Path) -> Vec<(String, Option<String>, Option<String>)> {
-    use quick_xml::events::Event;
-    let Ok(text) = std::fs::read_to_string(path) else {
-        return Vec::new();
-    };
-    let mut reader = quick_xml::Reader::from_str(&text);
-    let mut out = Vec::new();
-    loop {
-        match reader.read_event() {
-            Ok(Event::Start(e)) | Ok(Event::Empty(e)) if e.local_name().as_ref() == b"Model" => {
-                let get = |k: &[u8]| {
-                    e.attributes()
-                        .flatten()
-                        .find(|a| a.key.local_name().as_ref() == k)
-                        .and_then(|a| a.unescape_value().ok().map(|v| v.into_owned()))
-                };
-                if let Some(uri) = get(b"ModelUri") {
-                    out.push((uri, get(b"Version"), get(b"PublicationDate")));
-                }
-            }
-            Ok(Event::End(e)) if e.local_name().as_ref() == b"Models" => break,
-            Ok(Event::Eof) | Err(_) => break,
-            _ => {}
-        }
-    }
-    out
-}
-
 /// Splits files into sets that name every ModelUri at most once: newest versions first, so the first set
 /// holds the newest version of every model and later sets the older versions (and duplicates).
 fn model_sets(files: &[PathBuf]) -> Vec<Vec<PathBuf>> {
     let mut by_age: Vec<(&PathBuf, Vec<(String, Option<String>, Option<String>)>)> =
-        files.iter().map(|f| (f, declared_models(f))).collect();
+        files.iter().map(|f| (f, nodeset_compiler::load::declared_models(f).unwrap_or_default())).collect();
     // Newest first (version, then publication date), ties by path so the plan never depends on the walk.
     by_age.sort_by(|(pa, a), (pb, b)| {
         let key = |m: &[(String, Option<String>, Option<String>)]| {

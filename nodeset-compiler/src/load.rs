@@ -716,7 +716,13 @@ pub fn find_model_files(dirs: &[PathBuf], uris: &[String]) -> BTreeMap<String, P
 /// The models the header of a NodeSet2 file declares (URIs), without parsing the rest; `None` if the file
 /// cannot be read or is not a NodeSet2 file.
 pub fn models_of_file(path: &Path) -> Option<Vec<String>> {
-    scan_header(path).map(|h| h.models.into_iter().map(|(uri, _, _)| uri).collect())
+    declared_models(path).map(|models| models.into_iter().map(|(uri, _, _)| uri).collect())
+}
+
+/// The models the header of a NodeSet2 file declares, each as its ModelUri, Version and PublicationDate, read
+/// as the loader reads them when it looks for required models; `None` as for [`models_of_file`].
+pub fn declared_models(path: &Path) -> Option<Vec<(String, Option<String>, Option<String>)>> {
+    scan_header(path).map(|h| h.models)
 }
 
 /// Lists every NodeSet2 file under the folders with the models its header declares.
