@@ -118,6 +118,8 @@ codes! {
         Some("the property decides the values");
     BadRolePermission = "NS0220", Error, "a RolePermission names a node that is not a role",
         Some("the entry is dropped: the node grants that role nothing");
+    IncompatibleOverride = "NS0221", Warning, "a declaration overrides one of a supertype it is not compatible with",
+        Some("the override is used as declared");
     // Generating code.
     NameCollision = "NS0301", Warning, "two names map to one identifier in generated code", Some("the names are told apart by a suffix");
     UnsupportedFeature = "NS0302", Warning, "a model feature has no faithful representation in generated code",

@@ -574,6 +574,10 @@ pub struct Model {
     pub state_machines: BTreeMap<NodeIx, StateMachineInfo>,
     /// Instance declarations of every ObjectType and VariableType, inherited ones included.
     pub members: BTreeMap<NodeIx, Vec<Member>>,
+    /// The declaration each InstanceDeclaration overrides: the one at the same browse path in the
+    /// fully-inherited hierarchy of its supertype, or among the members its parent declaration inherits
+    /// (`resolve/inherit.rs`). [`Model::instance_members`] follows these links.
+    pub overridden: BTreeMap<NodeIx, NodeIx>,
     pub(crate) hierarchical: Vec<bool>,
     /// Each node's entry and exit time in a depth-first walk of the supertype forest, so that
     /// [`Model::is_subtype_of`] is one comparison (see [`Model::index_subtypes`]); empty until then.
@@ -756,28 +760,57 @@ impl Model {
         })
     }
 
-    /// The children of an instance declaration or instance: its type's members, overridden by its own children.
+    /// The children of an instance declaration or instance, fully inherited (OPC UA Part 3, 6.3.3): its own
+    /// children, then those of the declarations it overrides at the same browse path (nearest first, see
+    /// [`Model::overridden`]), then the members with a ModellingRule of their TypeDefinitions; at each
+    /// BrowseName the first of these wins. Members keep the order of the TypeDefinition's, then come the
+    /// names the declarations add, farthest first.
     pub fn instance_members(&self, ix: NodeIx) -> Vec<Member> {
-        let node = self.node(ix);
+        let chain = self.override_chain(ix);
+        let mut out: Vec<Member> = Vec::new();
         // Only members with a ModellingRule are instantiated; a type's own rule-less children (such as
         // DefaultInstanceBrowseName, or the states of a state machine type) stay on the type.
-        let mut out: Vec<Member> = match node.type_definition.and_then(|t| self.members.get(&t)) {
-            Some(m) => m.iter().filter(|m| self.node(m.node).modelling_rule.is_some()).cloned().collect(),
-            None => Vec::new(),
-        };
-        for (rt, child) in self.children(ix) {
-            let bn = self.node(child).browse_name.clone();
-            match out.iter_mut().find(|m| m.browse_name == bn) {
-                Some(m) => {
-                    m.overrides = Some(m.node);
-                    m.node = child;
-                    m.declared_in = ix;
-                    m.reference_type = rt;
+        let mut tds: Vec<NodeIx> = Vec::new();
+        for &c in &chain {
+            if let Some(t) = self.node(c).type_definition.filter(|t| !tds.contains(t)) {
+                tds.push(t);
+            }
+        }
+        for t in tds {
+            for m in self.members.get(&t).into_iter().flatten() {
+                if self.node(m.node).modelling_rule.is_some() && !out.iter().any(|o| o.browse_name == m.browse_name) {
+                    out.push(m.clone());
                 }
-                None => out.push(Member { browse_name: bn, node: child, declared_in: ix, reference_type: rt, overrides: None }),
+            }
+        }
+        for &c in chain.iter().rev() {
+            for (rt, child) in self.children(c) {
+                let bn = &self.node(child).browse_name;
+                match out.iter_mut().find(|m| m.browse_name == *bn) {
+                    Some(m) => {
+                        m.overrides = Some(m.node);
+                        m.node = child;
+                        m.declared_in = c;
+                        m.reference_type = rt;
+                    }
+                    None => out.push(Member { browse_name: bn.clone(), node: child, declared_in: c, reference_type: rt, overrides: None }),
+                }
             }
         }
         out
+    }
+
+    /// `ix` and the declarations it overrides at its browse path, nearest first ([`Model::overridden`]).
+    pub fn override_chain(&self, ix: NodeIx) -> Vec<NodeIx> {
+        let mut chain = vec![ix];
+        while let Some(&next) = self.overridden.get(chain.last().unwrap_or(&ix)) {
+            // The resolver links no cycle; the bound keeps a hand-made model from looping.
+            if chain.contains(&next) || chain.len() > 64 {
+                break;
+            }
+            chain.push(next);
+        }
+        chain
     }
 
     /// Finds a node by `ns=…;i=…` (global index), `nsu=URI;…`, or a BrowseName (`Name` or `URI#Name`,

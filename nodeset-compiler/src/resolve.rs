@@ -15,6 +15,8 @@ use crate::source::{SourceMap, Span};
 use crate::value::{BuiltinType, Content, Variant};
 use std::collections::{BTreeMap, HashSet};
 
+mod inherit;
+
 /// Builds the model. Problems go to `diags`; the model is returned even when there are errors, with the
 /// offending parts left out, so that later checks can still report what they find.
 pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
@@ -32,6 +34,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         methods: BTreeMap::new(),
         state_machines: BTreeMap::new(),
         members: BTreeMap::new(),
+        overridden: BTreeMap::new(),
         hierarchical: Vec::new(),
         subtype_spans: Vec::new(),
         ns0_type_names: FxHashMap::default(),
@@ -297,6 +300,8 @@ fn link(model: &mut Model, own: OwnReferences, incoming: Vec<(NodeIx, Reference)
     model.data_types = data_types;
     model.methods = methods;
     diags.extend(members_said);
+    // Pass 5: what each declaration overrides, from the members of every type.
+    model.overridden = inherit::overrides(model, diags);
     diags.extend(data_types_said);
     diags.extend(methods_said);
     // Pass 7: state machines, from the instance declarations.

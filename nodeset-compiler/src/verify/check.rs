@@ -493,7 +493,23 @@ impl<'a> Checker<'a> {
         }
         for m in placeholders {
             let member = model.node(m.node);
-            if member.modelling_rule == Some(ModellingRule::MandatoryPlaceholder) && !used.contains(&m.node) {
+            // A MandatoryPlaceholder is filled by any child that fits it, a declared member included: DI's
+            // `ParameterSet/<ParameterIdentifier>` is filled by Robotics' `ParameterSet/SpeedOverride`.
+            let fitting = |id: &NodeId| {
+                let Some(child) = snap.nodes.get(id) else { return false };
+                let reference = self.reference_to(node, id);
+                let child_type = self.target_of(child, ids::HAS_TYPE_DEFINITION).and_then(|t| self.lookup(t));
+                child.class == member.class
+                    && reference.is_none_or(|r| model.is_subtype_of(r, m.reference_type))
+                    && match (member.type_definition, child_type) {
+                        (Some(want), Some(have)) => model.is_subtype_of(have, want),
+                        _ => true,
+                    }
+            };
+            if member.modelling_rule == Some(ModellingRule::MandatoryPlaceholder)
+                && !used.contains(&m.node)
+                && !children.iter().any(fitting)
+            {
                 let want = member.type_definition.map(|t| model.qualified(t)).unwrap_or_else(|| member.class.name().to_owned());
                 let d = Diagnostic::new(
                     Code::MissingMember,

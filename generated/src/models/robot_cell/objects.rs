@@ -87,7 +87,9 @@ pub struct LwrSystemType {
     /// The members inherited from the supertype (also reached through `Deref`).
     pub base: super::super::di::objects::ComponentType,
     /// `MotionDeviceSystem` (Mandatory). The robot: its controllers, manipulators and safety states. Any MotionDeviceSystemType; instances use the subtype of their robot, such as UR10eSystemType.
-    pub motion_device_system: LwrSystemType_MotionDeviceSystem,
+    pub motion_device_system: Box<
+        super::super::robotics::objects::MotionDeviceSystemType,
+    >,
     /// `SkillSet` (Mandatory). The skills of the system as a whole (ISkillSetType). The skills of its parts are in their own SkillSets, such as the one of the robot controller.
     pub skill_set: t::ObjectNode,
 }
@@ -104,111 +106,6 @@ impl t::Handle for LwrSystemType {
     }
 }
 t::deref_base!(LwrSystemType => super::super::di::objects::ComponentType);
-/// `MotionDeviceSystem`, a member of `LwrSystemType` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct LwrSystemType_MotionDeviceSystem {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `ParameterSet` (Optional).
-    pub parameter_set: Option<LwrSystemType_MotionDeviceSystem_ParameterSet>,
-    /// `MethodSet` (Optional).
-    pub method_set: Option<t::ObjectNode>,
-    /// `<GroupIdentifier>` (OptionalPlaceholder).
-    pub group_identifier: t::Placeholders<
-        super::super::di::objects::FunctionalGroupType,
-    >,
-    /// `Identification` (Optional).
-    pub identification: Option<Box<super::super::di::objects::FunctionalGroupType>>,
-    /// `Lock` (Optional).
-    pub lock: Option<Box<super::super::di::objects::LockingServicesType>>,
-    /// `Manufacturer` (Optional).
-    pub manufacturer: Option<t::Variable<ua::LocalizedText>>,
-    /// `ManufacturerUri` (Optional).
-    pub manufacturer_uri: Option<t::Variable<String>>,
-    /// `Model` (Optional).
-    pub model: Option<t::Variable<ua::LocalizedText>>,
-    /// `HardwareRevision` (Optional).
-    pub hardware_revision: Option<t::Variable<String>>,
-    /// `SoftwareRevision` (Optional).
-    pub software_revision: Option<t::Variable<String>>,
-    /// `DeviceRevision` (Optional).
-    pub device_revision: Option<t::Variable<String>>,
-    /// `ProductCode` (Optional).
-    pub product_code: Option<t::Variable<String>>,
-    /// `DeviceManual` (Optional).
-    pub device_manual: Option<t::Variable<String>>,
-    /// `DeviceClass` (Optional).
-    pub device_class: Option<t::Variable<String>>,
-    /// `SerialNumber` (Optional).
-    pub serial_number: Option<t::Variable<String>>,
-    /// `ProductInstanceUri` (Optional).
-    pub product_instance_uri: Option<t::Variable<String>>,
-    /// `RevisionCounter` (Optional).
-    pub revision_counter: Option<t::Variable<i32>>,
-    /// `AssetId` (Optional).
-    pub asset_id: Option<t::Variable<String>>,
-    /// `ComponentName` (Optional).
-    pub component_name: Option<t::Variable<ua::LocalizedText>>,
-    /// `Controllers` (Mandatory). The controllers of the MotionDeviceSystem.
-    pub controllers: t::ObjectNode,
-    /// `MotionDevices` (Mandatory). The manipulators of the MotionDeviceSystem.
-    pub motion_devices: t::ObjectNode,
-    /// `SafetyStates` (Mandatory). The safety states of the MotionDeviceSystem.
-    pub safety_states: t::ObjectNode,
-}
-t::debug_handle!(LwrSystemType_MotionDeviceSystem);
-impl t::Handle for LwrSystemType_MotionDeviceSystem {
-    #[inline]
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            parameter_set: b.build_optional(id, NS[1], "ParameterSet"),
-            method_set: b.build_optional(id, NS[1], "MethodSet"),
-            group_identifier: b
-                .build_placeholders(id, rt::NsNodeId::numeric(NS[1], 1005)),
-            identification: b.build_optional(id, NS[1], "Identification"),
-            lock: b.build_optional(id, NS[1], "Lock"),
-            manufacturer: b.build_optional(id, NS[1], "Manufacturer"),
-            manufacturer_uri: b.build_optional(id, NS[1], "ManufacturerUri"),
-            model: b.build_optional(id, NS[1], "Model"),
-            hardware_revision: b.build_optional(id, NS[1], "HardwareRevision"),
-            software_revision: b.build_optional(id, NS[1], "SoftwareRevision"),
-            device_revision: b.build_optional(id, NS[1], "DeviceRevision"),
-            product_code: b.build_optional(id, NS[1], "ProductCode"),
-            device_manual: b.build_optional(id, NS[1], "DeviceManual"),
-            device_class: b.build_optional(id, NS[1], "DeviceClass"),
-            serial_number: b.build_optional(id, NS[1], "SerialNumber"),
-            product_instance_uri: b.build_optional(id, NS[1], "ProductInstanceUri"),
-            revision_counter: b.build_optional(id, NS[1], "RevisionCounter"),
-            asset_id: b.build_optional(id, NS[1], "AssetId"),
-            component_name: b.build_optional(id, NS[1], "ComponentName"),
-            controllers: b.build_child(id, NS[4], "Controllers"),
-            motion_devices: b.build_child(id, NS[4], "MotionDevices"),
-            safety_states: b.build_child(id, NS[4], "SafetyStates"),
-        }
-    }
-}
-/// `ParameterSet`, a member of `LwrSystemType_MotionDeviceSystem` with children of its own.
-#[derive(Clone)]
-#[allow(non_camel_case_types, non_snake_case)]
-pub struct LwrSystemType_MotionDeviceSystem_ParameterSet {
-    /// The instance.
-    pub node: t::ObjectNode,
-    /// `<ParameterIdentifier>` (MandatoryPlaceholder).
-    pub parameter_identifier: t::Placeholders<t::Variable<ua::Variant>>,
-}
-t::debug_handle!(LwrSystemType_MotionDeviceSystem_ParameterSet);
-impl t::Handle for LwrSystemType_MotionDeviceSystem_ParameterSet {
-    #[inline]
-    fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-        Self {
-            node: b.build_this(id),
-            parameter_identifier: b
-                .build_placeholders(id, rt::NsNodeId::numeric(NS[3], 63)),
-        }
-    }
-}
 t::object_type!(LwrSystemType, rt::NsNodeId::numeric(NS[0], 3000), "LwrSystemType");
 /// Handle of an instance of `TemplateDrillingLwrSystemType` (nsu=http://nodeset-compiler.dev/RobotCell/;i=5000).
 ///
@@ -373,6 +270,10 @@ t::deref_base!(
 pub struct Ur10eSystemType_Controllers {
     /// The instance.
     pub node: t::ObjectNode,
+    /// `<ControllerIdentifier>` (MandatoryPlaceholder).
+    pub controller_identifier: t::Placeholders<
+        super::super::robotics::objects::ControllerType,
+    >,
     /// `URController` (Mandatory). The UR10e control box. Besides the Robotics controller data it offers the basic move skills of the robot in SkillSet (ISkillSetType).
     pub ur_controller: Ur10eSystemType_Controllers_URController,
 }
@@ -382,6 +283,8 @@ impl t::Handle for Ur10eSystemType_Controllers {
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
+            controller_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[4], 1003)),
             ur_controller: b.build_child(id, NS[0], "URController"),
         }
     }
@@ -503,6 +406,10 @@ impl t::Handle for Ur10eSystemType_Controllers_URController {
 pub struct Ur10eSystemType_MotionDevices {
     /// The instance.
     pub node: t::ObjectNode,
+    /// `<MotionDeviceIdentifier>` (MandatoryPlaceholder).
+    pub motion_device_identifier: t::Placeholders<
+        super::super::robotics::objects::MotionDeviceType,
+    >,
     /// `Manipulator` (Mandatory). The six-joint UR10e arm.
     pub manipulator: Ur10eSystemType_MotionDevices_Manipulator,
 }
@@ -512,6 +419,8 @@ impl t::Handle for Ur10eSystemType_MotionDevices {
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
+            motion_device_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[4], 1004)),
             manipulator: b.build_child(id, NS[0], "Manipulator"),
         }
     }
@@ -618,6 +527,10 @@ impl t::Handle for Ur10eSystemType_MotionDevices_Manipulator {
 pub struct Ur10eSystemType_SafetyStates {
     /// The instance.
     pub node: t::ObjectNode,
+    /// `<SafetyStateIdentifier>` (MandatoryPlaceholder).
+    pub safety_state_identifier: t::Placeholders<
+        super::super::robotics::objects::SafetyStateType,
+    >,
     /// `SafetyState` (Mandatory). Emergency stop, protective stop and operational mode of the UR10e.
     pub safety_state: Box<super::super::robotics::objects::SafetyStateType>,
 }
@@ -627,6 +540,8 @@ impl t::Handle for Ur10eSystemType_SafetyStates {
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
+            safety_state_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[4], 1013)),
             safety_state: b.build_child(id, NS[0], "SafetyState"),
         }
     }
@@ -1019,6 +934,7 @@ pub mod members {
         Controllers__URController__SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__AvailableStates: ua::NodeId, 1, "4:Controllers/0:URController/4:SystemOperation/4:SystemOperationStateMachine/4:IdleSubstateMachine/3:AvailableStates", false false false;
         Controllers__URController__SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__AvailableTransitions: ua::NodeId, 1, "4:Controllers/0:URController/4:SystemOperation/4:SystemOperationStateMachine/4:IdleSubstateMachine/3:AvailableTransitions", false false false;
         Controllers__URController__SystemOperation__SystemOperationStateMachine__IdleSubstateMachine__LastTransitionReason: i16, -1, "4:Controllers/0:URController/4:SystemOperation/4:SystemOperationStateMachine/4:IdleSubstateMachine/4:LastTransitionReason", false false true;
+        Controllers__URController__TaskControls__ProgramTask__ParameterSet__ExecutionMode: super::super::super::super::robotics::types::ExecutionModeEnumeration, -1, "4:Controllers/0:URController/4:TaskControls/0:ProgramTask/1:ParameterSet/4:ExecutionMode", false false false;
         Controllers__URController__TaskControls__ProgramTask__ParameterSet__TaskProgramLoaded: bool, -1, "4:Controllers/0:URController/4:TaskControls/0:ProgramTask/1:ParameterSet/4:TaskProgramLoaded", true false false;
         Controllers__URController__TaskControls__ProgramTask__ParameterSet__TaskProgramName: String, -1, "4:Controllers/0:URController/4:TaskControls/0:ProgramTask/1:ParameterSet/4:TaskProgramName", true false false;
         Controllers__URController__TaskControls__ProgramTask__Identification__UIElement: ua::Variant, -1, "4:Controllers/0:URController/4:TaskControls/0:ProgramTask/1:Identification/1:UIElement", false false false;
@@ -1077,6 +993,8 @@ pub mod members {
         Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__InputParameterSet__Acceleration: f64, -1, "4:Controllers/0:URController/2:SkillSet/0:AbsoluteCartesianLinearMove/2:InputParameterSet/2:Acceleration", true false true;
         Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__InputParameterSet__TargetPose: ua::ThreeDFrame, -1, "4:Controllers/0:URController/2:SkillSet/0:AbsoluteCartesianLinearMove/2:InputParameterSet/2:TargetPose", true false true;
         Controllers__URController__SkillSet__AbsoluteCartesianLinearMove__OutputParameterSet__Result: ua::StatusCode, -1, "4:Controllers/0:URController/2:SkillSet/0:AbsoluteCartesianLinearMove/2:OutputParameterSet/2:Result", true false false;
+        MotionDevices__Manipulator__ParameterSet__InControl: bool, -1, "4:MotionDevices/0:Manipulator/1:ParameterSet/4:InControl", false false false;
+        MotionDevices__Manipulator__ParameterSet__OnPath: bool, -1, "4:MotionDevices/0:Manipulator/1:ParameterSet/4:OnPath", false false false;
         MotionDevices__Manipulator__ParameterSet__SpeedOverride: f64, -1, "4:MotionDevices/0:Manipulator/1:ParameterSet/4:SpeedOverride", true false false;
         MotionDevices__Manipulator__Identification__UIElement: ua::Variant, -1, "4:MotionDevices/0:Manipulator/1:Identification/1:UIElement", false false false;
         MotionDevices__Manipulator__Lock__Locked: bool, -1, "4:MotionDevices/0:Manipulator/1:Lock/1:Locked", false false false;
@@ -1097,7 +1015,9 @@ pub mod members {
         MotionDevices__Manipulator__RevisionCounter: i32, -1, "4:MotionDevices/0:Manipulator/1:RevisionCounter", false false false;
         MotionDevices__Manipulator__AssetId: String, -1, "4:MotionDevices/0:Manipulator/1:AssetId", false false false;
         MotionDevices__Manipulator__ComponentName: ua::LocalizedText, -1, "4:MotionDevices/0:Manipulator/1:ComponentName", false false false;
+        MotionDevices__Manipulator__Axes__Base__ParameterSet__ActualAcceleration: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Base/1:ParameterSet/4:ActualAcceleration", false false false;
         MotionDevices__Manipulator__Axes__Base__ParameterSet__ActualPosition: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Base/1:ParameterSet/4:ActualPosition", true false false;
+        MotionDevices__Manipulator__Axes__Base__ParameterSet__ActualSpeed: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Base/1:ParameterSet/4:ActualSpeed", false false false;
         MotionDevices__Manipulator__Axes__Base__Identification__UIElement: ua::Variant, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Base/1:Identification/1:UIElement", false false false;
         MotionDevices__Manipulator__Axes__Base__Lock__Locked: bool, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Base/1:Lock/1:Locked", false false false;
         MotionDevices__Manipulator__Axes__Base__Lock__LockingClient: String, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Base/1:Lock/1:LockingClient", false false false;
@@ -1121,7 +1041,9 @@ pub mod members {
         MotionDevices__Manipulator__Axes__Base__AdditionalLoad__Inertia: ua::ThreeDVector, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Base/4:AdditionalLoad/4:Inertia", false false false;
         MotionDevices__Manipulator__Axes__Base__AdditionalLoad__Mass: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Base/4:AdditionalLoad/4:Mass", false false false;
         MotionDevices__Manipulator__Axes__Base__MotionProfile: super::super::super::super::robotics::types::AxisMotionProfileEnumeration, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Base/4:MotionProfile", true true false;
+        MotionDevices__Manipulator__Axes__Shoulder__ParameterSet__ActualAcceleration: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Shoulder/1:ParameterSet/4:ActualAcceleration", false false false;
         MotionDevices__Manipulator__Axes__Shoulder__ParameterSet__ActualPosition: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Shoulder/1:ParameterSet/4:ActualPosition", true false false;
+        MotionDevices__Manipulator__Axes__Shoulder__ParameterSet__ActualSpeed: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Shoulder/1:ParameterSet/4:ActualSpeed", false false false;
         MotionDevices__Manipulator__Axes__Shoulder__Identification__UIElement: ua::Variant, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Shoulder/1:Identification/1:UIElement", false false false;
         MotionDevices__Manipulator__Axes__Shoulder__Lock__Locked: bool, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Shoulder/1:Lock/1:Locked", false false false;
         MotionDevices__Manipulator__Axes__Shoulder__Lock__LockingClient: String, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Shoulder/1:Lock/1:LockingClient", false false false;
@@ -1145,7 +1067,9 @@ pub mod members {
         MotionDevices__Manipulator__Axes__Shoulder__AdditionalLoad__Inertia: ua::ThreeDVector, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Shoulder/4:AdditionalLoad/4:Inertia", false false false;
         MotionDevices__Manipulator__Axes__Shoulder__AdditionalLoad__Mass: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Shoulder/4:AdditionalLoad/4:Mass", false false false;
         MotionDevices__Manipulator__Axes__Shoulder__MotionProfile: super::super::super::super::robotics::types::AxisMotionProfileEnumeration, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Shoulder/4:MotionProfile", true true false;
+        MotionDevices__Manipulator__Axes__Elbow__ParameterSet__ActualAcceleration: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Elbow/1:ParameterSet/4:ActualAcceleration", false false false;
         MotionDevices__Manipulator__Axes__Elbow__ParameterSet__ActualPosition: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Elbow/1:ParameterSet/4:ActualPosition", true false false;
+        MotionDevices__Manipulator__Axes__Elbow__ParameterSet__ActualSpeed: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Elbow/1:ParameterSet/4:ActualSpeed", false false false;
         MotionDevices__Manipulator__Axes__Elbow__Identification__UIElement: ua::Variant, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Elbow/1:Identification/1:UIElement", false false false;
         MotionDevices__Manipulator__Axes__Elbow__Lock__Locked: bool, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Elbow/1:Lock/1:Locked", false false false;
         MotionDevices__Manipulator__Axes__Elbow__Lock__LockingClient: String, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Elbow/1:Lock/1:LockingClient", false false false;
@@ -1169,7 +1093,9 @@ pub mod members {
         MotionDevices__Manipulator__Axes__Elbow__AdditionalLoad__Inertia: ua::ThreeDVector, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Elbow/4:AdditionalLoad/4:Inertia", false false false;
         MotionDevices__Manipulator__Axes__Elbow__AdditionalLoad__Mass: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Elbow/4:AdditionalLoad/4:Mass", false false false;
         MotionDevices__Manipulator__Axes__Elbow__MotionProfile: super::super::super::super::robotics::types::AxisMotionProfileEnumeration, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Elbow/4:MotionProfile", true true false;
+        MotionDevices__Manipulator__Axes__Wrist1__ParameterSet__ActualAcceleration: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist1/1:ParameterSet/4:ActualAcceleration", false false false;
         MotionDevices__Manipulator__Axes__Wrist1__ParameterSet__ActualPosition: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist1/1:ParameterSet/4:ActualPosition", true false false;
+        MotionDevices__Manipulator__Axes__Wrist1__ParameterSet__ActualSpeed: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist1/1:ParameterSet/4:ActualSpeed", false false false;
         MotionDevices__Manipulator__Axes__Wrist1__Identification__UIElement: ua::Variant, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist1/1:Identification/1:UIElement", false false false;
         MotionDevices__Manipulator__Axes__Wrist1__Lock__Locked: bool, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist1/1:Lock/1:Locked", false false false;
         MotionDevices__Manipulator__Axes__Wrist1__Lock__LockingClient: String, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist1/1:Lock/1:LockingClient", false false false;
@@ -1193,7 +1119,9 @@ pub mod members {
         MotionDevices__Manipulator__Axes__Wrist1__AdditionalLoad__Inertia: ua::ThreeDVector, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist1/4:AdditionalLoad/4:Inertia", false false false;
         MotionDevices__Manipulator__Axes__Wrist1__AdditionalLoad__Mass: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist1/4:AdditionalLoad/4:Mass", false false false;
         MotionDevices__Manipulator__Axes__Wrist1__MotionProfile: super::super::super::super::robotics::types::AxisMotionProfileEnumeration, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist1/4:MotionProfile", true true false;
+        MotionDevices__Manipulator__Axes__Wrist2__ParameterSet__ActualAcceleration: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist2/1:ParameterSet/4:ActualAcceleration", false false false;
         MotionDevices__Manipulator__Axes__Wrist2__ParameterSet__ActualPosition: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist2/1:ParameterSet/4:ActualPosition", true false false;
+        MotionDevices__Manipulator__Axes__Wrist2__ParameterSet__ActualSpeed: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist2/1:ParameterSet/4:ActualSpeed", false false false;
         MotionDevices__Manipulator__Axes__Wrist2__Identification__UIElement: ua::Variant, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist2/1:Identification/1:UIElement", false false false;
         MotionDevices__Manipulator__Axes__Wrist2__Lock__Locked: bool, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist2/1:Lock/1:Locked", false false false;
         MotionDevices__Manipulator__Axes__Wrist2__Lock__LockingClient: String, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist2/1:Lock/1:LockingClient", false false false;
@@ -1217,7 +1145,9 @@ pub mod members {
         MotionDevices__Manipulator__Axes__Wrist2__AdditionalLoad__Inertia: ua::ThreeDVector, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist2/4:AdditionalLoad/4:Inertia", false false false;
         MotionDevices__Manipulator__Axes__Wrist2__AdditionalLoad__Mass: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist2/4:AdditionalLoad/4:Mass", false false false;
         MotionDevices__Manipulator__Axes__Wrist2__MotionProfile: super::super::super::super::robotics::types::AxisMotionProfileEnumeration, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist2/4:MotionProfile", true true false;
+        MotionDevices__Manipulator__Axes__Wrist3__ParameterSet__ActualAcceleration: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist3/1:ParameterSet/4:ActualAcceleration", false false false;
         MotionDevices__Manipulator__Axes__Wrist3__ParameterSet__ActualPosition: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist3/1:ParameterSet/4:ActualPosition", true false false;
+        MotionDevices__Manipulator__Axes__Wrist3__ParameterSet__ActualSpeed: f64, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist3/1:ParameterSet/4:ActualSpeed", false false false;
         MotionDevices__Manipulator__Axes__Wrist3__Identification__UIElement: ua::Variant, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist3/1:Identification/1:UIElement", false false false;
         MotionDevices__Manipulator__Axes__Wrist3__Lock__Locked: bool, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist3/1:Lock/1:Locked", false false false;
         MotionDevices__Manipulator__Axes__Wrist3__Lock__LockingClient: String, -1, "4:MotionDevices/0:Manipulator/4:Axes/0:Wrist3/1:Lock/1:LockingClient", false false false;

@@ -92,6 +92,8 @@ t::deref_base!(AxisType => super::super::di::objects::ComponentType);
 pub struct AxisType_ParameterSet {
     /// The instance.
     pub node: t::ObjectNode,
+    /// `<ParameterIdentifier>` (MandatoryPlaceholder).
+    pub parameter_identifier: t::Placeholders<t::Variable<ua::Variant>>,
     /// `ActualAcceleration` (Optional). : The ActualAcceleration variable provides the axis acceleration. Applicable acceleration limits of the axis shall be provided by the EURange property of the AnalogUnitType.
     pub actual_acceleration: Option<t::Variable<f64>>,
     /// `ActualPosition` (Mandatory). The axis position inclusive Unit and RangeOfMotion.
@@ -105,6 +107,8 @@ impl t::Handle for AxisType_ParameterSet {
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
+            parameter_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[2], 63)),
             actual_acceleration: b.build_optional(id, NS[0], "ActualAcceleration"),
             actual_position: b.build_child(id, NS[0], "ActualPosition"),
             actual_speed: b.build_optional(id, NS[0], "ActualSpeed"),
@@ -190,6 +194,8 @@ t::deref_base!(ControllerType => super::super::di::objects::ComponentType);
 pub struct ControllerType_ParameterSet {
     /// The instance.
     pub node: t::ObjectNode,
+    /// `<ParameterIdentifier>` (MandatoryPlaceholder).
+    pub parameter_identifier: t::Placeholders<t::Variable<ua::Variant>>,
     /// `CabinetFanSpeed` (Optional). The speed of the cabinet fan.
     pub cabinet_fan_speed: Option<t::Variable<f64>>,
     /// `CPUFanSpeed` (Optional). The speed of the CPU fan.
@@ -213,6 +219,8 @@ impl t::Handle for ControllerType_ParameterSet {
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
+            parameter_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[2], 63)),
             cabinet_fan_speed: b.build_optional(id, NS[0], "CabinetFanSpeed"),
             cpu_fan_speed: b.build_optional(id, NS[0], "CPUFanSpeed"),
             input_voltage: b.build_optional(id, NS[0], "InputVoltage"),
@@ -770,6 +778,8 @@ t::deref_base!(MotionDeviceType => super::super::di::objects::ComponentType);
 pub struct MotionDeviceType_ParameterSet {
     /// The instance.
     pub node: t::ObjectNode,
+    /// `<ParameterIdentifier>` (MandatoryPlaceholder).
+    pub parameter_identifier: t::Placeholders<t::Variable<ua::Variant>>,
     /// `InControl` (Optional). InControl provides the information if the actuators (in most cases a motor) of the motion device are powered up and in control: "true". The motion device might be in a standstill.
     pub in_control: Option<t::Variable<bool>>,
     /// `OnPath` (Optional). OnPath is true if the motion device is on or near enough the planned program path such that program execution can continue. If the MotionDevice deviates too much from this path in case of errors or an emergency stop, this value becomes false. If OnPath is false, the motion device needs repositioning to continue program execution.
@@ -783,6 +793,8 @@ impl t::Handle for MotionDeviceType_ParameterSet {
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
+            parameter_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[2], 63)),
             in_control: b.build_optional(id, NS[0], "InControl"),
             on_path: b.build_optional(id, NS[0], "OnPath"),
             speed_override: b.build_child(id, NS[0], "SpeedOverride"),
@@ -901,6 +913,8 @@ t::deref_base!(MotorType => super::super::di::objects::ComponentType);
 pub struct MotorType_ParameterSet {
     /// The instance.
     pub node: t::ObjectNode,
+    /// `<ParameterIdentifier>` (MandatoryPlaceholder).
+    pub parameter_identifier: t::Placeholders<t::Variable<ua::Variant>>,
     /// `BrakeReleased` (Optional). Indicates an optional variable used only for motors with brakes. If BrakeReleased is TRUE the motor is free to run. FALSE means that the motor shaft is locked by the brake.
     pub brake_released: Option<t::Variable<bool>>,
     /// `EffectiveLoadRate` (Optional). EffectiveLoadRate is expressed as a percentage of maximum continuous load. The Joule integral is typically used to calculate the current load. Duration should be defined and documented by the vendor.
@@ -914,6 +928,8 @@ impl t::Handle for MotorType_ParameterSet {
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
+            parameter_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[2], 63)),
             brake_released: b.build_optional(id, NS[0], "BrakeReleased"),
             effective_load_rate: b.build_optional(id, NS[0], "EffectiveLoadRate"),
             motor_temperature: b.build_child(id, NS[0], "MotorTemperature"),
@@ -1363,6 +1379,8 @@ t::deref_base!(SafetyStateType => super::super::di::objects::ComponentType);
 pub struct SafetyStateType_ParameterSet {
     /// The instance.
     pub node: t::ObjectNode,
+    /// `<ParameterIdentifier>` (MandatoryPlaceholder).
+    pub parameter_identifier: t::Placeholders<t::Variable<ua::Variant>>,
     /// `EmergencyStop` (Mandatory). The EmergencyStop variable is TRUE if one or more of the emergency stop functions in the robot system are active, FALSE otherwise. If the EmergencyStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed emergency stop functions are active.
     pub emergency_stop: t::Variable<bool>,
     /// `OperationalMode` (Mandatory). The OperationalMode variable provides information about the current operational mode. Allowed values are described in OperationalModeEnumeration, see ISO 10218-1:2011 Ch.5.7 Operational Modes.
@@ -1376,6 +1394,8 @@ impl t::Handle for SafetyStateType_ParameterSet {
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
+            parameter_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[2], 63)),
             emergency_stop: b.build_child(id, NS[0], "EmergencyStop"),
             operational_mode: b.build_child(id, NS[0], "OperationalMode"),
             protective_stop: b.build_child(id, NS[0], "ProtectiveStop"),
@@ -1838,6 +1858,8 @@ t::deref_base!(TaskControlType => super::super::di::objects::ComponentType);
 pub struct TaskControlType_ParameterSet {
     /// The instance.
     pub node: t::ObjectNode,
+    /// `<ParameterIdentifier>` (MandatoryPlaceholder).
+    pub parameter_identifier: t::Placeholders<t::Variable<ua::Variant>>,
     /// `ExecutionMode` (Optional). Execution mode of the task control (continuous or step-wise).
     pub execution_mode: Option<t::Variable<super::types::ExecutionModeEnumeration>>,
     /// `TaskProgramLoaded` (Mandatory). The TaskProgramLoaded variable is TRUE if a task program is loaded in the task control, FALSE otherwise.
@@ -1851,6 +1873,8 @@ impl t::Handle for TaskControlType_ParameterSet {
     fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
         Self {
             node: b.build_this(id),
+            parameter_identifier: b
+                .build_placeholders(id, rt::NsNodeId::numeric(NS[2], 63)),
             execution_mode: b.build_optional(id, NS[0], "ExecutionMode"),
             task_program_loaded: b.build_child(id, NS[0], "TaskProgramLoaded"),
             task_program_name: b.build_child(id, NS[0], "TaskProgramName"),
