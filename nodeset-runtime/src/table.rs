@@ -45,6 +45,10 @@
 //! - A node with RolePermissions or AccessRestrictions in its nodeset has a second line after its row,
 //!   `Access Id restrictions Role=permissions*`: the AccessRestrictions bits or `~`, then each role
 //!   object's Id and its `PermissionType` bits, in the nodeset's order ([`AccessRow`]).
+//! - An InstanceDeclaration that overrides another (the one at the same browse path in its supertype's, or
+//!   its parent declaration's, fully-inherited hierarchy, as the compiler's resolved model computes it) has a
+//!   line after its row, `Overrides Id OverriddenId` ([`OverrideRow`]); `instantiate` merges the members of
+//!   the two.
 //!
 //! For example, a property and a structure data type of DI:
 //!
@@ -59,7 +63,7 @@ mod packed;
 #[cfg(test)]
 mod tests;
 
-pub use packed::{decode, decode_access};
+pub use packed::{decode, decode_access, decode_overrides};
 
 /// The identifier part of a NodeId in a table.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -403,6 +407,15 @@ impl NodeSetTable {
         }
     }
 
+    /// The InstanceDeclarations that override another, in table order (none for [`Nodes::Rows`]). Decoded
+    /// on the first call, like [`NodeSetTable::rows`].
+    pub fn overrides(&self) -> Result<&[OverrideRow], TableError> {
+        match &self.nodes {
+            Nodes::Rows(_) => Ok(&[]),
+            Nodes::Packed(p) => p.overrides.get_or_init(|| decode_overrides(p.text)).as_deref().map_err(|e| self.error(e)),
+        }
+    }
+
     /// The error of packed text that does not decode, as the table reports it.
     fn error(&self, (line, column, message): &(usize, usize, String)) -> TableError {
         TableError { namespace_uri: self.namespace_uri, line: *line, column: *column, message: message.clone() }
@@ -424,6 +437,18 @@ pub struct AccessRow {
 /// How the line of a node's RolePermissions and AccessRestrictions starts.
 const ACCESS: &str = "Access ";
 
+/// An InstanceDeclaration and the declaration it overrides at its browse path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OverrideRow {
+    /// The overriding declaration.
+    pub id: Id,
+    /// The declaration it overrides (of a supertype, or of its parent declaration's TypeDefinition).
+    pub overridden: Id,
+}
+
+/// How the line of a declaration's override starts.
+const OVERRIDES: &str = "Overrides ";
+
 /// The rows of a [`NodeSetTable`].
 #[derive(Debug)]
 pub enum Nodes {
@@ -439,12 +464,13 @@ pub struct Packed {
     text: &'static str,
     rows: OnceLock<Result<Box<[NodeRow]>, (usize, usize, String)>>,
     access: OnceLock<Result<Box<[AccessRow]>, (usize, usize, String)>>,
+    overrides: OnceLock<Result<Box<[OverrideRow]>, (usize, usize, String)>>,
 }
 
 impl Packed {
     /// Packed text, decoded on first use.
     pub const fn new(text: &'static str) -> Packed {
-        Packed { text, rows: OnceLock::new(), access: OnceLock::new() }
+        Packed { text, rows: OnceLock::new(), access: OnceLock::new(), overrides: OnceLock::new() }
     }
 
     /// The text as the table holds it.

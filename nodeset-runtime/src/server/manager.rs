@@ -135,6 +135,9 @@ pub struct ModelNodes {
     method_handlers: RwLock<HashMap<NodeId, Arc<dyn MethodHandler>>>,
     /// The AccessRestrictions the tables give their nodes (the nodes without any are not listed).
     restrictions: HashMap<NodeId, AccessRestrictionType>,
+    /// The declaration each InstanceDeclaration of the tables overrides (the compiler's `Overrides` rows),
+    /// which `instantiate` follows to merge members by browse path.
+    overrides: HashMap<NodeId, NodeId>,
 }
 
 /// The node manager type as async-opcua's `ServerHandle::node_managers()` holds it.
@@ -181,7 +184,8 @@ impl ModelNodes {
                     warn!("the table of {} claims namespace 0; it is not served", t.namespace_uri);
                     return false;
                 }
-                if let Err(e) = t.rows() {
+                // Rows and override rows both decide what the server has; a table with either damaged is refused.
+                if let Err(e) = t.rows().map(drop).and_then(|()| t.overrides().map(drop)) {
                     error!("{e}; the table is not served");
                     return false;
                 }
@@ -211,6 +215,7 @@ impl ModelNodes {
             space.load_into_type_tree(&mut tree);
         }
         let restrictions = access_restrictions(&served);
+        let overrides = overrides(&served);
         let mut namespaces = namespace_metadata(&served);
         super::namespace_objects::fold_into(space, &context.type_tree.read(), &mut namespaces);
         if !namespaces.iter().any(|m| m.namespace_index == instance_ns) {
@@ -231,6 +236,7 @@ impl ModelNodes {
             write_handlers: Default::default(),
             method_handlers: Default::default(),
             restrictions,
+            overrides,
         }
     }
 
@@ -719,7 +725,8 @@ impl ModelManager {
             let tree = self.nodes().type_tree.read();
             let core_space = core.as_ref().map(|c| c.address_space().read());
             let space = self.node_manager.address_space().read();
-            let spaces = Spaces { core: core_space.as_deref(), model: &space, tree: &tree };
+            let overrides = &self.nodes().overrides;
+            let spaces = Spaces { core: core_space.as_deref(), model: &space, tree: &tree, overrides };
             let id = options.node_id_or(self.instance_namespace(), browse_name.name.as_ref());
             let mut planner = Planner { spaces, options, used: Default::default(), out: Vec::new() };
             planner.root(type_id, parent, browse_name, id)?;
@@ -797,6 +804,21 @@ fn mirror_fields(
             changed.push((child, AttributeId::Value));
         }
     }
+}
+
+/// The declaration each InstanceDeclaration of the served tables overrides, by server NodeId.
+fn overrides(served: &[ServedTable]) -> HashMap<NodeId, NodeId> {
+    let mut out = HashMap::new();
+    for t in served {
+        // The table's override rows were decoded when it was accepted.
+        let Ok(rows) = t.table.overrides() else { continue };
+        for row in rows {
+            if let (Some(decl), Some(over)) = (t.map.try_id(row.id), t.map.try_id(row.overridden)) {
+                out.insert(decl, over);
+            }
+        }
+    }
+    out
 }
 
 /// The AccessRestrictions the served tables give their nodes, by server NodeId.

@@ -4,27 +4,48 @@ use super::*;
 
 /// Decodes the `Access` lines of packed text.
 pub fn decode_access(text: &'static str) -> Result<Box<[AccessRow]>, (usize, usize, String)> {
+    decode_lines(text, ACCESS, |c| {
+        let id = c.id()?;
+        c.sp()?;
+        let restrictions = if c.eat(b'~') { None } else { Some(c.num("AccessRestrictions")?) };
+        let mut roles = Vec::new();
+        while c.eat(b' ') {
+            let role = c.id()?;
+            c.expect(b'=')?;
+            roles.push((role, c.num("PermissionType bits")?));
+        }
+        match c.peek() {
+            None => Ok(AccessRow { id, restrictions, roles }),
+            Some(f) => Err(format!("unexpected `{}` after the access row", f as char)),
+        }
+    })
+}
+
+/// Decodes the `Overrides` lines of packed text.
+pub fn decode_overrides(text: &'static str) -> Result<Box<[OverrideRow]>, (usize, usize, String)> {
+    decode_lines(text, OVERRIDES, |c| {
+        let id = c.id()?;
+        c.sp()?;
+        let overridden = c.id()?;
+        match c.peek() {
+            None => Ok(OverrideRow { id, overridden }),
+            Some(f) => Err(format!("unexpected `{}` after the override row", f as char)),
+        }
+    })
+}
+
+/// Decodes each line of packed text that starts with `prefix` with `row`; an error is (line, column, message).
+fn decode_lines<T>(
+    text: &'static str,
+    prefix: &str,
+    mut row: impl FnMut(&mut Cursor) -> Result<T, String>,
+) -> Result<Box<[T]>, (usize, usize, String)> {
     let mut out = Vec::new();
     for (n, line) in text.split('\n').enumerate() {
-        let Some(rest) = line.strip_prefix(ACCESS) else { continue };
+        let Some(rest) = line.strip_prefix(prefix) else { continue };
         let mut c = Cursor { s: line, b: line.as_bytes(), i: line.len() - rest.len() };
-        let row = (|| {
-            let id = c.id()?;
-            c.sp()?;
-            let restrictions = if c.eat(b'~') { None } else { Some(c.num("AccessRestrictions")?) };
-            let mut roles = Vec::new();
-            while c.eat(b' ') {
-                let role = c.id()?;
-                c.expect(b'=')?;
-                roles.push((role, c.num("PermissionType bits")?));
-            }
-            match c.peek() {
-                None => Ok(AccessRow { id, restrictions, roles }),
-                Some(f) => Err(format!("unexpected `{}` after the access row", f as char)),
-            }
-        })();
-        match row {
-            Ok(row) => out.push(row),
+        match row(&mut c) {
+            Ok(r) => out.push(r),
             Err(message) => {
                 let column = line.get(..c.i.min(line.len())).map_or(c.i, |p| p.chars().count()) + 1;
                 return Err((n + 1, column, message));
@@ -44,7 +65,7 @@ pub fn decode(text: &'static str) -> Result<Box<[NodeRow]>, (usize, usize, Strin
     let mut ranges: Vec<(usize, usize)> = Vec::with_capacity(text.len() / 128);
     let mut refs: Vec<Ref> = Vec::new();
     for (n, line) in text.split('\n').enumerate() {
-        if line.is_empty() || line.starts_with(ACCESS) {
+        if line.is_empty() || line.starts_with(ACCESS) || line.starts_with(OVERRIDES) {
             continue;
         }
         let mut c = Cursor { s: line, b: line.as_bytes(), i: 0 };

@@ -11,7 +11,7 @@
 //! the declaration's reference from its parent; instances carry no ModellingRule. Methods are copied per
 //! instance with their argument properties, so each instance can have its own implementation.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::fmt;
 
 use opcua::nodes::{Base, DefaultTypeTree, Method as MethodNode, NodeType, Object, TypeTree, Variable as VariableNode};
@@ -170,6 +170,9 @@ pub(crate) struct Spaces<'a> {
     /// The generated tables and the instances.
     pub model: &'a AddressSpace,
     pub tree: &'a DefaultTypeTree,
+    /// The declaration each InstanceDeclaration overrides at its browse path, as the compiler's resolved
+    /// model computed it (the tables' `Overrides` rows).
+    pub overrides: &'a HashMap<NodeId, NodeId>,
 }
 
 /// A node to insert, with its references (source, target, type).
@@ -265,11 +268,29 @@ impl<'a> Spaces<'a> {
         out
     }
 
-    /// The members of an instance of declaration `decl` whose TypeDefinition is `type_id`.
+    /// The members of an instance of declaration `decl` whose TypeDefinition is `type_id`: the fully-inherited
+    /// hierarchy at the declaration's browse path. Its own children win, then those of the declarations it
+    /// overrides (nearest first, following the compiler's links), then the members of the TypeDefinitions,
+    /// `type_id` first; the same merge as the compiler's `Model::instance_members`, on the same links.
     fn decl_members(&self, decl: Option<&NodeId>, type_id: Option<&NodeId>) -> Vec<Decl> {
+        let mut chain: Vec<NodeId> = decl.into_iter().cloned().collect();
+        while let Some(next) = chain.last().and_then(|d| self.overrides.get(d)) {
+            if chain.contains(next) || chain.len() > MAX_DEPTH {
+                break;
+            }
+            chain.push(next.clone());
+        }
         let mut out = type_id.map(|t| self.type_members(t)).unwrap_or_default();
-        if let Some(decl) = decl {
-            for d in self.declared_children(decl) {
+        for over in chain.iter().skip(1) {
+            let Some(t) = self.type_definition(over) else { continue };
+            for d in self.type_members(&t) {
+                if !out.iter().any(|m| m.browse_name == d.browse_name) {
+                    out.push(d);
+                }
+            }
+        }
+        for c in chain.iter().rev() {
+            for d in self.declared_children(c) {
                 match out.iter_mut().find(|m| m.browse_name == d.browse_name) {
                     Some(m) => *m = d,
                     None => out.push(d),
@@ -277,6 +298,38 @@ impl<'a> Spaces<'a> {
             }
         }
         out
+    }
+
+    /// Whether an instance of declaration `member` stands in the place of `placeholder`: the same NodeClass
+    /// and a TypeDefinition that is the placeholder's or a subtype of it.
+    fn fills(&self, member: &Decl, placeholder: &Decl) -> bool {
+        let class = |d: &Decl| self.find(&d.id).map(|n| n.node_class());
+        if class(member).is_none() || class(member) != class(placeholder) {
+            return false;
+        }
+        match (self.type_definition(&member.id), self.type_definition(&placeholder.id)) {
+            (Some(have), Some(want)) => self.is_subtype(&have, &want),
+            _ => true,
+        }
+    }
+
+    /// Whether type `t` is `of` or a subtype of it, by the HasSubtype references of the address spaces (the
+    /// type tree holds ns0's types only once the server runs, and instances are often created before).
+    fn is_subtype(&self, t: &NodeId, of: &NodeId) -> bool {
+        let mut cur = Some(t.clone());
+        for _ in 0..MAX_DEPTH {
+            let Some(c) = cur else { return false };
+            if c == *of {
+                return true;
+            }
+            cur = [Some(self.model), self.core].into_iter().flatten().find_map(|space| {
+                space
+                    .find_references(&c, Some((ReferenceTypeId::HasSubtype, false)), self.tree, BrowseDirection::Inverse)
+                    .next()
+                    .map(|r| r.target_node.clone())
+            });
+        }
+        false
     }
 }
 
@@ -382,6 +435,7 @@ impl<'a> Planner<'a> {
         if depth >= MAX_DEPTH {
             return Err(InstantiateError::TooDeep(path.to_owned()));
         }
+        let siblings = members.clone();
         for decl in members {
             let name = decl.browse_name.name.as_ref().to_owned();
             let member_path = format!("{path}{name}");
@@ -400,7 +454,10 @@ impl<'a> Planner<'a> {
                 }
                 Rule::MandatoryPlaceholder | Rule::OptionalPlaceholder => {
                     let names = self.options.placeholders.get(&member_path).cloned().unwrap_or_default();
-                    if names.is_empty() && decl.rule == Rule::MandatoryPlaceholder {
+                    // A Mandatory sibling that fits the placeholder fills it (DI's
+                    // `ParameterSet/<ParameterIdentifier>` is filled by Robotics' `SpeedOverride`).
+                    let filled = siblings.iter().any(|m| m.rule == Rule::Mandatory && self.spaces.fills(m, &decl));
+                    if names.is_empty() && decl.rule == Rule::MandatoryPlaceholder && !filled {
                         return Err(InstantiateError::MissingPlaceholder(member_path));
                     }
                     if !names.is_empty() {

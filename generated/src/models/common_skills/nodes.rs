@@ -27,65 +27,113 @@ Object 1:1301 1:"InputParameterSet" = "The inputs of the skill: one writable var
 Object 1:1302 1:"OutputParameterSet" = "The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here)." 0 0 0 0:40>0:58 0:37>0:78 0:47>1:1303
 Variable 1:1303 1:"Result" = "Outcome of the last run: Good when it ended in Ready, the Bad code of the cause when it ended in Halted. Uncertain_InitialValue before the first run." 0 0 0:19 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
 Method 1:1304 0:"Start" = "Starts the skill with the current values of InputParameterSet (Ready to Running)." 0 0 1 1 0:37>0:78
+Overrides 1:1304 0:2426
 Method 1:1305 0:"Suspend" = "Pauses the running skill so that Resume can continue it (Running to Suspended)." 0 0 1 1 0:37>0:80
+Overrides 1:1305 0:2427
 Method 1:1306 0:"Resume" = "Continues the suspended skill (Suspended to Running)." 0 0 1 1 0:37>0:80
+Overrides 1:1306 0:2428
 Method 1:1307 0:"Halt" = "Aborts the skill (Ready, Running or Suspended to Halted)." 0 0 1 1 0:37>0:78
+Overrides 1:1307 0:2429
 Method 1:1308 0:"Reset" = "Brings the halted skill back to Ready so that it can be started again." 0 0 1 1 0:37>0:78
+Overrides 1:1308 0:2430
 ObjectType 1:1400 1:"CompositeSkillType" = "A skill that runs other skills one after another, possibly of other devices and servers (for example move, drill, move). If a skill it uses is unavailable it suspends, if one halts it halts, so the state of the innermost skill reaches the outermost; Suspend and Resume are therefore Mandatory." 0 0 1 0:45<1:1300 0:47>1:1401 0:47>1:1402
 Method 1:1401 0:"Suspend" = "Pauses the composite skill after the skill it is running has paused or finished." 0 0 1 1 0:37>0:78
+Overrides 1:1401 1:1305
 Method 1:1402 0:"Resume" = "Continues the composite skill with the skill it had paused in." 0 0 1 1 0:37>0:78
+Overrides 1:1402 1:1306
 ObjectType 1:1500 1:"MoveSkillType" = "A robot motion. Each concrete move skill fixes the target and the units of Speed and Acceleration; the run ends in Ready when the robot stands at the target, in Halted when the motion was stopped (an emergency or protective stop, or Halt)." 0 0 1 0:45<1:1300 0:47>1:1501
 Object 1:1501 1:"InputParameterSet" = "The inputs of the motion: Speed and Acceleration, and the target the concrete move skill adds." 0 0 0 0:40>0:58 0:37>0:78 0:47>1:1502 0:47>1:1504
+Overrides 1:1501 1:1301
 Variable 1:1502 1:"Speed" = "Maximum speed of the motion, in the unit its EngineeringUnits name." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1503
 Variable 1:1503 0:"EngineeringUnits" = "Unit of Speed, fixed by each concrete move skill (°/s for joint motions, mm/s for Cartesian motions)." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:1503 0:17502
 Variable 1:1504 1:"Acceleration" = "Maximum acceleration of the motion, in the unit its EngineeringUnits name." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1505
 Variable 1:1505 0:"EngineeringUnits" = "Unit of Acceleration, fixed by each concrete move skill (°/s² for joint motions, mm/s² for Cartesian motions)." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:1505 0:17502
 ObjectType 1:1600 1:"AbsoluteJointPTPMoveSkillType" = "Point-to-point motion in joint space: every joint moves to its target angle, all joints start and stop together; the path of the tool between is not a straight line." 0 0 0 0:45<1:1500 0:47>1:1601
 Object 1:1601 1:"InputParameterSet" = "The inputs of the joint motion: TargetJointPositions, Speed and Acceleration." 0 0 0 0:40>0:58 0:37>0:78 0:47>1:1602 0:47>1:1604 0:47>1:1606
+Overrides 1:1601 1:1501
 Variable 1:1602 1:"Speed" = "Maximum joint speed of the leading joint, in degrees per second." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1603
+Overrides 1:1602 1:1502
 Variable 1:1603 0:"EngineeringUnits" = "Unit of Speed: degree per second." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:1603 1:1503
 Variable 1:1604 1:"Acceleration" = "Maximum joint acceleration of the leading joint, in degrees per second squared." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1605
+Overrides 1:1604 1:1504
 Variable 1:1605 0:"EngineeringUnits" = "Unit of Acceleration: degree per second squared." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:1605 1:1505
 Variable 1:1606 1:"TargetJointPositions" = "Target angle of every joint, in degrees, in the order of the joints from the base to the flange. The array has one element per joint of the robot." 0 0 0:11 1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1607
 Variable 1:1607 0:"EngineeringUnits" = "Unit of TargetJointPositions: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:1607 0:17502
 ObjectType 1:1700 1:"RelativeCartesianLinearMoveSkillType" = "Linear Cartesian motion relative to where the tool is: the tool centre point moves on a straight line by PoseOffset, expressed in the tool frame (the frame of the tool centre point when the motion starts). Used for short approach and retreat motions, such as moving a drill nose into a drill bush along tool Z." 0 0 0 0:45<1:1500 0:47>1:1701
 Object 1:1701 1:"InputParameterSet" = "The inputs of the relative motion: PoseOffset, Speed and Acceleration." 0 0 0 0:40>0:58 0:37>0:78 0:47>1:1702 0:47>1:1704 0:47>1:1706
+Overrides 1:1701 1:1501
 Variable 1:1702 1:"Speed" = "Maximum speed of the tool centre point along the path, in millimetres per second." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1703
+Overrides 1:1702 1:1502
 Variable 1:1703 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:1703 1:1503
 Variable 1:1704 1:"Acceleration" = "Maximum acceleration of the tool centre point along the path, in millimetres per second squared." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1705
+Overrides 1:1704 1:1504
 Variable 1:1705 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:1705 1:1505
 Variable 1:1706 1:"PoseOffset" = "Displacement and rotation of the tool centre point, in the tool frame at the start of the motion; millimetres and degrees." 0 0 0:18814 -1 [] 3 3 0 ~ ~ 0:40>0:18791 0:37>0:78 0:47>1:1707 0:47>1:1712
 Variable 1:1707 0:"CartesianCoordinates" = "Position part of PoseOffset: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 3 3 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>1:1708 0:47>1:1709 0:47>1:1710 0:47>1:1711
+Overrides 1:1707 0:18796
 Variable 1:1708 0:"LengthUnit" = "Unit of X, Y and Z of PoseOffset: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:1708 0:18773
 Variable 1:1709 0:"X" = "X coordinate of PoseOffset." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 1:1709 0:18798
 Variable 1:1710 0:"Y" = "Y coordinate of PoseOffset." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 1:1710 0:18799
 Variable 1:1711 0:"Z" = "Z coordinate of PoseOffset." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 1:1711 0:18800
 Variable 1:1712 0:"Orientation" = "Orientation part of PoseOffset: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 3 3 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>1:1713 0:47>1:1714 0:47>1:1715 0:47>1:1716
+Overrides 1:1712 0:18792
 Variable 1:1713 0:"AngleUnit" = "Unit of A, B and C of PoseOffset: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:1713 0:18780
 Variable 1:1714 0:"A" = "Rotation of PoseOffset about the X axis (roll)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 1:1714 0:19074
 Variable 1:1715 0:"B" = "Rotation of PoseOffset about the Y axis (pitch)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 1:1715 0:19075
 Variable 1:1716 0:"C" = "Rotation of PoseOffset about the Z axis (yaw)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 1:1716 0:19076
 ObjectType 1:1800 1:"AbsoluteCartesianLinearMoveSkillType" = "Linear Cartesian motion to an absolute pose: the tool centre point moves on a straight line to TargetPose, expressed in the base frame of the robot." 0 0 0 0:45<1:1500 0:47>1:1801
 Object 1:1801 1:"InputParameterSet" = "The inputs of the absolute motion: TargetPose, Speed and Acceleration." 0 0 0 0:40>0:58 0:37>0:78 0:47>1:1802 0:47>1:1804 0:47>1:1806
+Overrides 1:1801 1:1501
 Variable 1:1802 1:"Speed" = "Maximum speed of the tool centre point along the path, in millimetres per second." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1803
+Overrides 1:1802 1:1502
 Variable 1:1803 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:1803 1:1503
 Variable 1:1804 1:"Acceleration" = "Maximum acceleration of the tool centre point along the path, in millimetres per second squared." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1805
+Overrides 1:1804 1:1504
 Variable 1:1805 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:1805 1:1505
 Variable 1:1806 1:"TargetPose" = "Pose the tool centre point moves to, in the base frame of the robot; millimetres and degrees." 0 0 0:18814 -1 [] 3 3 0 ~ ~ 0:40>0:18791 0:37>0:78 0:47>1:1807 0:47>1:1812
 Variable 1:1807 0:"CartesianCoordinates" = "Position part of TargetPose: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 3 3 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>1:1808 0:47>1:1809 0:47>1:1810 0:47>1:1811
+Overrides 1:1807 0:18796
 Variable 1:1808 0:"LengthUnit" = "Unit of X, Y and Z of TargetPose: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:1808 0:18773
 Variable 1:1809 0:"X" = "X coordinate of TargetPose." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 1:1809 0:18798
 Variable 1:1810 0:"Y" = "Y coordinate of TargetPose." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 1:1810 0:18799
 Variable 1:1811 0:"Z" = "Z coordinate of TargetPose." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 1:1811 0:18800
 Variable 1:1812 0:"Orientation" = "Orientation part of TargetPose: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 3 3 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>1:1813 0:47>1:1814 0:47>1:1815 0:47>1:1816
+Overrides 1:1812 0:18792
 Variable 1:1813 0:"AngleUnit" = "Unit of A, B and C of TargetPose: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:1813 0:18780
 Variable 1:1814 0:"A" = "Rotation of TargetPose about the X axis (roll)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 1:1814 0:19074
 Variable 1:1815 0:"B" = "Rotation of TargetPose about the Y axis (pitch)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 1:1815 0:19075
 Variable 1:1816 0:"C" = "Rotation of TargetPose about the Z axis (yaw)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 1:1816 0:19076
 ObjectType 1:1900 1:"GrippingSkillType" = "Opening or closing a gripper. The run ends in Ready when the jaws have reached their end position or, when closing, hold the part with GripForce; in Halted when they could not." 0 0 0 0:45<1:1300 0:47>1:1901
 Object 1:1901 1:"InputParameterSet" = "The inputs of the gripping: Action and GripForce." 0 0 0 0:40>0:58 0:37>0:78 0:47>1:1902 0:47>1:1903
+Overrides 1:1901 1:1301
 Variable 1:1902 1:"Action" = "Whether the run opens or closes the gripper." 0 0 1:1000 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
 Variable 1:1903 1:"GripForce" = "Force the jaws hold the part with when closing, in newtons; ignored when opening." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1904
 Variable 1:1904 0:"EngineeringUnits" = "Unit of GripForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:1904 0:17502
 "#)),
 };

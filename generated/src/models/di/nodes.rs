@@ -43,17 +43,25 @@ Object 1:6567 1:"<GroupIdentifier>" = ~ 0 0 0 0:40>1:1005 0:37>0:11508
 Object 1:6014 1:"Identification" = ~ 0 0 0 0:40>1:1005 0:37>0:80
 Object 1:6161 1:"Lock" = ~ 0 0 0 0:46>1:6468 0:46>1:6163 0:46>1:6164 0:46>1:6165 0:47>1:6166 0:47>1:6169 0:47>1:6171 0:47>1:6173 0:40>1:6388 0:37>0:80
 Variable 1:6468 1:"Locked" = ~ 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6468 1:6534
 Variable 1:6163 1:"LockingClient" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6163 1:6390
 Variable 1:6164 1:"LockingUser" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6164 1:6391
 Variable 1:6165 1:"RemainingLockTime" = ~ 0 0 0:290 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6165 1:6392
 Method 1:6166 1:"InitLock" = ~ 0 0 1 1 0:46>1:6167 0:46>1:6168 0:37>0:78
+Overrides 1:6166 1:6393
 Variable 1:6167 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Context" 0:12 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:6168 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "InitLockStatus" 0:6 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:6169 1:"RenewLock" = ~ 0 0 1 1 0:46>1:6170 0:37>0:78
+Overrides 1:6169 1:6396
 Variable 1:6170 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "RenewLockStatus" 0:6 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:6171 1:"ExitLock" = ~ 0 0 1 1 0:46>1:6172 0:37>0:78
+Overrides 1:6171 1:6398
 Variable 1:6172 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "ExitLockStatus" 0:6 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:6173 1:"BreakLock" = ~ 0 0 1 1 0:46>1:6174 0:37>0:78
+Overrides 1:6173 1:6400
 Variable 1:6174 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "BreakLockStatus" 0:6 -1 [] ~ } 0:40>0:68 0:37>0:78
 ObjectType 1:15035 1:"IVendorNameplateType" = ~ 0 0 1 0:46>1:15036 0:46>1:15037 0:46>1:15038 0:46>1:15039 0:46>1:15040 0:46>1:15041 0:46>1:15042 0:46>1:15043 0:46>1:15044 0:46>1:15045 0:46>1:15046 0:46>1:15047 0:46>1:23 0:46>1:24 0:45<0:17602
 Variable 1:15036 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
@@ -84,23 +92,33 @@ Variable 1:15058 1:"<DocumentIdentifier>" = ~ 0 0 0:15 -1 [] 1 1 0 ~ ~ 0:40>0:63
 Object 1:27 1:"DocumentationFiles" = ~ 0 0 0 0:47>1:28 0:40>0:61 0:37>0:80
 Object 1:28 1:"<DocumentFileId>" = ~ 0 0 0 0:46>1:29 0:46>1:30 0:46>1:31 0:46>1:32 0:47>1:36 0:47>1:39 0:47>1:63 0:47>1:66 0:47>1:68 0:47>1:71 0:40>0:11575 0:37>0:11510
 Variable 1:29 0:"Size" = ~ 0 0 0:9 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:29 0:11576
 Variable 1:30 0:"Writable" = ~ 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:30 0:12686
 Variable 1:31 0:"UserWritable" = ~ 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:31 0:12687
 Variable 1:32 0:"OpenCount" = ~ 0 0 0:5 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:32 0:11579
 Method 1:36 0:"Open" = ~ 0 0 1 1 0:46>1:37 0:46>1:38 0:37>0:78
+Overrides 1:36 0:11580
 Variable 1:37 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Mode" 0:3 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:38 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "FileHandle" 0:7 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:39 0:"Close" = ~ 0 0 1 1 0:46>1:62 0:37>0:78
+Overrides 1:39 0:11583
 Variable 1:62 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "FileHandle" 0:7 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:63 0:"Read" = ~ 0 0 1 1 0:46>1:64 0:46>1:65 0:37>0:78
+Overrides 1:63 0:11585
 Variable 1:64 0:"InputArguments" = ~ 0 0 0:296 1 [2] 1 1 0 ~ Arguments:{ "FileHandle" 0:7 -1 [] ~ "Length" 0:6 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:65 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Data" 0:15 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:66 0:"Write" = ~ 0 0 1 1 0:46>1:67 0:37>0:78
+Overrides 1:66 0:11588
 Variable 1:67 0:"InputArguments" = ~ 0 0 0:296 1 [2] 1 1 0 ~ Arguments:{ "FileHandle" 0:7 -1 [] ~ "Data" 0:15 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:68 0:"GetPosition" = ~ 0 0 1 1 0:46>1:69 0:46>1:70 0:37>0:78
+Overrides 1:68 0:11590
 Variable 1:69 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "FileHandle" 0:7 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:70 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Position" 0:9 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:71 0:"SetPosition" = ~ 0 0 1 1 0:46>1:72 0:37>0:78
+Overrides 1:71 0:11593
 Variable 1:72 0:"InputArguments" = ~ 0 0 0:296 1 [2] 1 1 0 ~ Arguments:{ "FileHandle" 0:7 -1 [] ~ "Position" 0:9 -1 [] ~ } 0:40>0:68 0:37>0:78
 Object 1:15059 1:"ProtocolSupport" = ~ 0 0 0 0:47>1:15060 0:40>0:61 0:37>0:80
 Variable 1:15060 1:"<ProtocolSupportIdentifier>" = ~ 0 0 0:15 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:11510
@@ -130,19 +148,32 @@ Variable 1:15098 1:"AssetId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
 Variable 1:15099 1:"ComponentName" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
 ObjectType 1:1002 1:"DeviceType" = ~ 0 0 1 0:46>1:6003 0:46>1:15100 0:46>1:6004 0:46>1:6008 0:46>1:6007 0:46>1:6006 0:46>1:15101 0:46>1:6005 0:46>1:6470 0:46>1:6001 0:46>1:15102 0:46>1:6002 0:47>1:6571 0:47>1:6208 0:47>1:15105 0:47>1:6209 0:47>1:6211 0:47>1:6213 0:47>1:6215 0:17603>1:15054 0:17603>1:15051 0:45<1:15063
 Variable 1:6003 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6003 1:15086
 Variable 1:15100 1:"ManufacturerUri" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 1:15100 1:15087
 Variable 1:6004 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6004 1:15088
 Variable 1:6008 1:"HardwareRevision" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6008 1:15089
 Variable 1:6007 1:"SoftwareRevision" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6007 1:15090
 Variable 1:6006 1:"DeviceRevision" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6006 1:15091
 Variable 1:15101 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 1:15101 1:15092
 Variable 1:6005 1:"DeviceManual" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6005 1:15093
 Variable 1:6470 1:"DeviceClass" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 1:6470 1:15094
 Variable 1:6001 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6001 1:15095
 Variable 1:15102 1:"ProductInstanceUri" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 1:15102 1:15096
 Variable 1:6002 1:"RevisionCounter" = ~ 0 0 0:6 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6002 1:15097
 Object 1:6571 1:"<CPIdentifier>" = ~ 0 0 0 0:47>1:6592 0:47>1:6499 0:40>1:6308 0:37>0:11508
 Object 1:6592 1:"NetworkAddress" = ~ 0 0 0 0:40>1:1005 0:37>0:78
+Overrides 1:6592 1:6354
 Variable 1:6208 1:"DeviceHealth" = ~ 0 0 1:6244 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
 Object 1:15105 1:"DeviceHealthAlarms" = ~ 0 0 0 0:40>0:61 0:37>0:80
 Object 1:6209 1:"DeviceTypeImage" = ~ 0 0 0 0:47>1:6210 0:40>0:61 0:37>0:80
@@ -155,8 +186,11 @@ Object 1:6215 1:"ImageSet" = ~ 0 0 0 0:47>1:6216 0:40>0:61 0:37>0:80
 Variable 1:6216 1:"<ImageIdentifier>" = ~ 0 0 0:30 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:11510
 ObjectType 1:15106 1:"SoftwareType" = ~ 0 0 0 0:46>1:15129 0:46>1:15131 0:46>1:15133 0:45<1:15063
 Variable 1:15129 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:15129 1:15086
 Variable 1:15131 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:15131 1:15088
 Variable 1:15133 1:"SoftwareRevision" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:15133 1:15090
 ObjectType 1:1003 1:"BlockType" = ~ 0 0 1 0:46>1:6009 0:46>1:6010 0:46>1:6011 0:46>1:6012 0:46>1:6013 0:45<1:1001
 Variable 1:6009 1:"RevisionCounter" = ~ 0 0 0:6 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
 Variable 1:6010 1:"ActualMode" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
@@ -186,6 +220,7 @@ ObjectType 1:479 1:"SubstanceVolumeIndicationType" = "Indicates the volume of a 
 ObjectType 1:1005 1:"FunctionalGroupType" = ~ 0 0 0 0:47>1:6027 0:47>1:6243 0:45<0:61
 Object 1:6027 1:"<GroupIdentifier>" = ~ 0 0 0 0:47>1:6242 0:40>1:1005 0:37>0:11508
 Variable 1:6242 1:"UIElement" = ~ 0 0 0:24 -1 [] 1 1 0 ~ ~ 0:40>1:6246 0:37>0:80
+Overrides 1:6242 1:6243
 Variable 1:6243 1:"UIElement" = ~ 0 0 0:24 -1 [] 1 1 0 ~ ~ 0:40>1:6246 0:37>0:80
 Object 1:73 1:"Configuration" = ~ 0 0 0 0:40>1:1005
 Object 1:74 1:"Tuning" = ~ 0 0 0 0:40>1:1005
@@ -210,17 +245,25 @@ Object 1:6248 1:"<CPIdentifier>" = ~ 0 0 0 0:47>1:6292 0:47>1:6499 0:40>1:6308 0
 Object 1:6292 1:"NetworkAddress" = ~ 0 0 0 0:40>1:1005 0:37>0:78
 Object 1:6294 1:"Lock" = ~ 0 0 0 0:46>1:6497 0:46>1:6296 0:46>1:6297 0:46>1:6298 0:47>1:6299 0:47>1:6302 0:47>1:6304 0:47>1:6306 0:40>1:6388 0:37>0:80
 Variable 1:6497 1:"Locked" = ~ 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6497 1:6534
 Variable 1:6296 1:"LockingClient" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6296 1:6390
 Variable 1:6297 1:"LockingUser" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6297 1:6391
 Variable 1:6298 1:"RemainingLockTime" = ~ 0 0 0:290 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6298 1:6392
 Method 1:6299 1:"InitLock" = ~ 0 0 1 1 0:46>1:6300 0:46>1:6301 0:37>0:78
+Overrides 1:6299 1:6393
 Variable 1:6300 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Context" 0:12 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:6301 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "InitLockStatus" 0:6 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:6302 1:"RenewLock" = ~ 0 0 1 1 0:46>1:6303 0:37>0:78
+Overrides 1:6302 1:6396
 Variable 1:6303 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "RenewLockStatus" 0:6 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:6304 1:"ExitLock" = ~ 0 0 1 1 0:46>1:6305 0:37>0:78
+Overrides 1:6304 1:6398
 Variable 1:6305 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "ExitLockStatus" 0:6 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:6306 1:"BreakLock" = ~ 0 0 1 1 0:46>1:6307 0:37>0:78
+Overrides 1:6306 1:6400
 Variable 1:6307 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "BreakLockStatus" 0:6 -1 [] ~ } 0:40>0:68 0:37>0:78
 ObjectType 1:6308 1:"ConnectionPointType" = ~ 0 0 1 0:47>1:6354 0:47>1:6499 1:6030>1:6599 0:45<1:1001
 Object 1:6354 1:"NetworkAddress" = ~ 0 0 0 0:40>1:1005 0:37>0:78
@@ -258,30 +301,47 @@ ObjectType 1:1 1:"SoftwareUpdateType" = ~ 0 0 0 0:47>1:2 0:47>1:4 0:47>1:40 0:47
 Object 1:2 1:"Loading" = ~ 0 0 0 0:40>1:135 0:37>0:80
 Object 1:4 1:"PrepareForUpdate" = ~ 0 0 0 0:47>1:5 0:47>1:19 0:47>1:20 0:40>1:213 0:37>0:80
 Variable 1:5 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:46>1:6 0:40>0:2760 0:37>0:78
+Overrides 1:5 0:2772
 Variable 1:6 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:6 0:3728
 Method 1:19 1:"Prepare" = ~ 0 0 1 1 0:37>0:78
+Overrides 1:19 1:228
 Method 1:20 1:"Abort" = ~ 0 0 1 1 0:37>0:78
+Overrides 1:20 1:229
 Object 1:40 1:"Installation" = ~ 0 0 0 0:47>1:41 0:47>1:61 0:40>1:249 0:37>0:80
 Variable 1:41 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:46>1:42 0:40>0:2760 0:37>0:78
+Overrides 1:41 0:2772
 Variable 1:42 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:42 0:3728
 Method 1:61 1:"Resume" = ~ 0 0 1 1 0:37>0:78
+Overrides 1:61 1:270
 Object 1:76 1:"PowerCycle" = ~ 0 0 0 0:47>1:77 0:40>1:285 0:37>0:80
 Variable 1:77 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:46>1:78 0:40>0:2760 0:37>0:78
+Overrides 1:77 0:2772
 Variable 1:78 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:78 0:3728
 Object 1:98 1:"Confirmation" = ~ 0 0 0 0:47>1:99 0:47>1:112 0:47>1:113 0:40>1:307 0:37>0:80
 Variable 1:99 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:46>1:100 0:40>0:2760 0:37>0:78
+Overrides 1:99 0:2772
 Variable 1:100 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:100 0:3728
 Method 1:112 1:"Confirm" = ~ 0 0 1 1 0:37>0:78
+Overrides 1:112 1:321
 Variable 1:113 1:"ConfirmationTimeout" = ~ 0 0 0:290 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 1:113 1:322
 Object 1:122 1:"Parameters" = ~ 0 0 0 0:46>1:123 0:47>1:124 0:47>1:127 0:47>1:130 0:40>0:15744 0:37>0:80
 Variable 1:123 0:"ClientProcessingTimeout" = ~ 0 0 0:290 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:123 0:15745
 Method 1:124 0:"GenerateFileForRead" = ~ 0 0 1 1 0:46>1:125 0:46>1:126 0:37>0:78
+Overrides 1:124 0:15746
 Variable 1:125 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "GenerateOptions" 0:24 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:126 0:"OutputArguments" = ~ 0 0 0:296 1 [3] 1 1 0 ~ Arguments:{ "FileNodeId" 0:17 -1 [] ~ "FileHandle" 0:7 -1 [] ~ "CompletionStateMachine" 0:17 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:127 0:"GenerateFileForWrite" = ~ 0 0 1 1 0:46>1:128 0:46>1:129 0:37>0:78
+Overrides 1:127 0:15749
 Variable 1:128 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "GenerateOptions" 0:24 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:129 0:"OutputArguments" = ~ 0 0 0:296 1 [2] 1 1 0 ~ Arguments:{ "FileNodeId" 0:17 -1 [] ~ "FileHandle" 0:7 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:130 0:"CloseAndCommit" = ~ 0 0 1 1 0:46>1:131 0:46>1:132 0:37>0:78
+Overrides 1:130 0:15751
 Variable 1:131 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "FileHandle" 0:7 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:132 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "CompletionStateMachine" 0:17 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:133 1:"UpdateStatus" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
@@ -296,17 +356,24 @@ Variable 1:136 1:"UpdateKey" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
 ObjectType 1:137 1:"PackageLoadingType" = ~ 0 0 1 0:47>1:139 0:47>1:140 0:47>1:151 0:46>1:152 0:45<1:135
 Object 1:139 1:"CurrentVersion" = ~ 0 0 0 0:46>1:345 0:46>1:346 0:46>1:347 0:40>1:212 0:37>0:78
 Variable 1:345 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:345 1:380
 Variable 1:346 1:"ManufacturerUri" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:346 1:381
 Variable 1:347 1:"SoftwareRevision" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:347 1:382
 Object 1:140 1:"FileTransfer" = ~ 0 0 0 0:46>1:141 0:47>1:142 0:47>1:145 0:47>1:148 0:40>0:15744 0:37>0:78
 Variable 1:141 0:"ClientProcessingTimeout" = ~ 0 0 0:290 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:141 0:15745
 Method 1:142 0:"GenerateFileForRead" = ~ 0 0 1 1 0:46>1:143 0:46>1:144 0:37>0:78
+Overrides 1:142 0:15746
 Variable 1:143 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "GenerateOptions" 0:24 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:144 0:"OutputArguments" = ~ 0 0 0:296 1 [3] 1 1 0 ~ Arguments:{ "FileNodeId" 0:17 -1 [] ~ "FileHandle" 0:7 -1 [] ~ "CompletionStateMachine" 0:17 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:145 0:"GenerateFileForWrite" = ~ 0 0 1 1 0:46>1:146 0:46>1:147 0:37>0:78
+Overrides 1:145 0:15749
 Variable 1:146 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "GenerateOptions" 0:24 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:147 0:"OutputArguments" = ~ 0 0 0:296 1 [2] 1 1 0 ~ Arguments:{ "FileNodeId" 0:17 -1 [] ~ "FileHandle" 0:7 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:148 0:"CloseAndCommit" = ~ 0 0 1 1 0:46>1:149 0:46>1:150 0:37>0:78
+Overrides 1:148 0:15751
 Variable 1:149 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "FileHandle" 0:7 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:150 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "CompletionStateMachine" 0:17 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:151 1:"ErrorMessage" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
@@ -317,26 +384,36 @@ Variable 1:170 1:"WriteTimeout" = ~ 0 0 0:290 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:8
 ObjectType 1:171 1:"CachedLoadingType" = ~ 0 0 0 0:47>1:187 0:47>1:188 0:47>1:189 0:45<1:137
 Object 1:187 1:"PendingVersion" = ~ 0 0 0 0:46>1:366 0:46>1:367 0:46>1:368 0:40>1:212 0:37>0:78
 Variable 1:366 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:366 1:380
 Variable 1:367 1:"ManufacturerUri" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:367 1:381
 Variable 1:368 1:"SoftwareRevision" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:368 1:382
 Object 1:188 1:"FallbackVersion" = ~ 0 0 0 0:46>1:373 0:46>1:374 0:46>1:375 0:40>1:212 0:37>0:80
 Variable 1:373 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:373 1:380
 Variable 1:374 1:"ManufacturerUri" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:374 1:381
 Variable 1:375 1:"SoftwareRevision" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 1:375 1:382
 Method 1:189 1:"GetUpdateBehavior" = ~ 0 0 1 1 0:46>1:190 0:46>1:191 0:37>0:78
 Variable 1:190 0:"InputArguments" = ~ 0 0 0:296 1 [3] 1 1 0 ~ Arguments:{ "ManufacturerUri" 0:12 -1 [] ~ "SoftwareRevision" 0:12 -1 [] ~ "PatchIdentifiers" 0:12 1 [0] ~ } 0:40>0:68 0:37>0:78
 Variable 1:191 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "UpdateBehavior" 1:333 -1 [] ~ } 0:40>0:68 0:37>0:78
 ObjectType 1:192 1:"FileSystemLoadingType" = ~ 0 0 0 0:47>1:194 0:47>1:206 0:47>1:209 0:45<1:135
 Object 1:194 0:"FileSystem" = ~ 0 0 0 0:47>1:195 0:47>1:198 0:47>1:201 0:47>1:203 0:40>0:13353 0:37>0:78
 Method 1:195 0:"CreateDirectory" = ~ 0 0 1 1 0:46>1:196 0:46>1:197 0:37>0:78
+Overrides 1:195 0:13387
 Variable 1:196 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "DirectoryName" 0:12 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:197 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "DirectoryNodeId" 0:17 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:198 0:"CreateFile" = ~ 0 0 1 1 0:46>1:199 0:46>1:200 0:37>0:78
+Overrides 1:198 0:13390
 Variable 1:199 0:"InputArguments" = ~ 0 0 0:296 1 [2] 1 1 0 ~ Arguments:{ "FileName" 0:12 -1 [] ~ "RequestFileOpen" 0:1 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:200 0:"OutputArguments" = ~ 0 0 0:296 1 [2] 1 1 0 ~ Arguments:{ "FileNodeId" 0:17 -1 [] ~ "FileHandle" 0:7 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:201 0:"Delete" = ~ 0 0 1 1 0:46>1:202 0:37>0:78
+Overrides 1:201 0:13393
 Variable 1:202 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "ObjectToDelete" 0:17 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:203 0:"MoveOrCopy" = ~ 0 0 1 1 0:46>1:204 0:46>1:205 0:37>0:78
+Overrides 1:203 0:13395
 Variable 1:204 0:"InputArguments" = ~ 0 0 0:296 1 [4] 1 1 0 ~ Arguments:{ "ObjectToMoveOrCopy" 0:17 -1 [] ~ "TargetDirectory" 0:17 -1 [] ~ "CreateCopy" 0:1 -1 [] ~ "NewName" 0:12 -1 [] ~ } 0:40>0:68 0:37>0:78
 Variable 1:205 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "NewNodeId" 0:17 -1 [] ~ } 0:40>0:68 0:37>0:78
 Method 1:206 1:"GetUpdateBehavior" = ~ 0 0 1 1 0:46>1:207 0:46>1:208 0:37>0:78
@@ -367,22 +444,31 @@ Method 1:229 1:"Abort" = ~ 0 0 1 1 0:53<1:241 0:53<1:247 0:37>0:78
 Method 1:230 1:"Resume" = ~ 0 0 1 1 0:53<1:245 0:37>0:80
 Object 1:231 1:"Idle" = ~ 0 0 0 0:46>1:232 0:51<1:239 0:52<1:241 0:52<1:247 0:40>0:2309
 Variable 1:232 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:40>0:68 0:37>0:78
+Overrides 1:232 0:2308
 Object 1:233 1:"Preparing" = ~ 0 0 0 0:46>1:234 0:52<1:239 0:51<1:241 0:51<1:243 0:40>0:2307
 Variable 1:234 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:40>0:68 0:37>0:78
+Overrides 1:234 0:2308
 Object 1:235 1:"PreparedForUpdate" = ~ 0 0 0 0:46>1:236 0:52<1:243 0:51<1:245 0:40>0:2307
 Variable 1:236 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:3 0:40>0:68 0:37>0:78
+Overrides 1:236 0:2308
 Object 1:237 1:"Resuming" = ~ 0 0 0 0:46>1:238 0:52<1:245 0:51<1:247 0:40>0:2307
 Variable 1:238 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:4 0:40>0:68 0:37>0:78
+Overrides 1:238 0:2308
 Object 1:239 1:"IdleToPreparing" = ~ 0 0 0 0:46>1:240 0:54>0:2311 0:40>0:2310
 Variable 1:240 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:12 0:40>0:68 0:37>0:78
+Overrides 1:240 0:2312
 Object 1:241 1:"PreparingToIdle" = ~ 0 0 0 0:46>1:242 0:54>0:2311 0:40>0:2310
 Variable 1:242 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:21 0:40>0:68 0:37>0:78
+Overrides 1:242 0:2312
 Object 1:243 1:"PreparingToPreparedForUpdate" = ~ 0 0 0 0:46>1:244 0:54>0:2311 0:40>0:2310
 Variable 1:244 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:23 0:40>0:68 0:37>0:78
+Overrides 1:244 0:2312
 Object 1:245 1:"PreparedForUpdateToResuming" = ~ 0 0 0 0:46>1:246 0:54>0:2311 0:40>0:2310
 Variable 1:246 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:34 0:40>0:68 0:37>0:78
+Overrides 1:246 0:2312
 Object 1:247 1:"ResumingToIdle" = ~ 0 0 0 0:46>1:248 0:54>0:2311 0:40>0:2310
 Variable 1:248 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:41 0:40>0:68 0:37>0:78
+Overrides 1:248 0:2312
 ObjectType 1:249 1:"InstallationStateMachineType" = ~ 0 0 0 0:47>1:263 0:47>1:264 0:47>1:265 0:47>1:268 0:47>1:407 0:47>1:270 0:47>1:271 0:47>1:273 0:47>1:275 0:47>1:277 0:47>1:279 0:47>1:281 0:47>1:283 0:45<0:2771
 Variable 1:263 1:"PercentComplete" = ~ 0 0 0:3 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
 Variable 1:264 1:"InstallationDelay" = ~ 0 0 0:290 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
@@ -394,38 +480,53 @@ Method 1:407 1:"Uninstall" = ~ 0 0 1 1 0:53<1:277 0:37>0:80
 Method 1:270 1:"Resume" = ~ 0 0 1 1 0:53<1:283 0:37>0:78
 Object 1:271 1:"Idle" = ~ 0 0 0 0:46>1:272 0:51<1:277 0:52<1:279 0:52<1:283 0:40>0:2309
 Variable 1:272 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:40>0:68 0:37>0:78
+Overrides 1:272 0:2308
 Object 1:273 1:"Installing" = ~ 0 0 0 0:46>1:274 0:52<1:277 0:51<1:279 0:51<1:281 0:40>0:2307
 Variable 1:274 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:40>0:68 0:37>0:78
+Overrides 1:274 0:2308
 Object 1:275 1:"Error" = ~ 0 0 0 0:46>1:276 0:52<1:281 0:51<1:283 0:40>0:2307
 Variable 1:276 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:3 0:40>0:68 0:37>0:78
+Overrides 1:276 0:2308
 Object 1:277 1:"IdleToInstalling" = ~ 0 0 0 0:46>1:387 0:54>0:2311 0:40>0:2310
 Variable 1:387 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:12 0:40>0:68 0:37>0:78
+Overrides 1:387 0:2312
 Object 1:279 1:"InstallingToIdle" = ~ 0 0 0 0:46>1:280 0:54>0:2311 0:40>0:2310
 Variable 1:280 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:21 0:40>0:68 0:37>0:78
+Overrides 1:280 0:2312
 Object 1:281 1:"InstallingToError" = ~ 0 0 0 0:46>1:282 0:54>0:2311 0:40>0:2310
 Variable 1:282 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:23 0:40>0:68 0:37>0:78
+Overrides 1:282 0:2312
 Object 1:283 1:"ErrorToIdle" = ~ 0 0 0 0:46>1:284 0:54>0:2311 0:40>0:2310
 Variable 1:284 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:31 0:40>0:68 0:37>0:78
+Overrides 1:284 0:2312
 ObjectType 1:285 1:"PowerCycleStateMachineType" = ~ 0 0 0 0:47>1:299 0:47>1:301 0:47>1:303 0:47>1:305 0:45<0:2771
 Object 1:299 1:"NotWaitingForPowerCycle" = ~ 0 0 0 0:46>1:300 0:51<1:303 0:52<1:305 0:40>0:2309
 Variable 1:300 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:40>0:68 0:37>0:78
+Overrides 1:300 0:2308
 Object 1:301 1:"WaitingForPowerCycle" = ~ 0 0 0 0:46>1:302 0:52<1:303 0:51<1:305 0:40>0:2307
 Variable 1:302 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:40>0:68 0:37>0:78
+Overrides 1:302 0:2308
 Object 1:303 1:"NotWaitingForPowerCycleToWaitingForPowerCycle" = ~ 0 0 0 0:46>1:304 0:54>0:2311 0:40>0:2310
 Variable 1:304 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:12 0:40>0:68 0:37>0:78
+Overrides 1:304 0:2312
 Object 1:305 1:"WaitingForPowerCycleToNotWaitingForPowerCycle" = ~ 0 0 0 0:46>1:306 0:54>0:2311 0:40>0:2310
 Variable 1:306 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:21 0:40>0:68 0:37>0:78
+Overrides 1:306 0:2312
 ObjectType 1:307 1:"ConfirmationStateMachineType" = ~ 0 0 0 0:47>1:321 0:47>1:322 0:47>1:323 0:47>1:325 0:47>1:327 0:47>1:329 0:45<0:2771
 Method 1:321 1:"Confirm" = ~ 0 0 1 1 0:53<1:329 0:37>0:78
 Variable 1:322 1:"ConfirmationTimeout" = ~ 0 0 0:290 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
 Object 1:323 1:"NotWaitingForConfirm" = ~ 0 0 0 0:46>1:324 0:51<1:327 0:52<1:329 0:40>0:2309
 Variable 1:324 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:40>0:68 0:37>0:78
+Overrides 1:324 0:2308
 Object 1:325 1:"WaitingForConfirm" = ~ 0 0 0 0:46>1:326 0:52<1:327 0:51<1:329 0:40>0:2307
 Variable 1:326 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:40>0:68 0:37>0:78
+Overrides 1:326 0:2308
 Object 1:327 1:"NotWaitingForConfirmToWaitingForConfirm" = ~ 0 0 0 0:46>1:328 0:54>0:2311 0:40>0:2310
 Variable 1:328 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:12 0:40>0:68 0:37>0:78
+Overrides 1:328 0:2312
 Object 1:329 1:"WaitingForConfirmToNotWaitingForConfirm" = ~ 0 0 0 0:46>1:330 0:54>0:2311 0:40>0:2310
 Variable 1:330 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:21 0:40>0:68 0:37>0:78
+Overrides 1:330 0:2312
 DataType 1:408 1:"SoftwareClass" = ~ 0 0 0 Enum { 0 "Firmware" = "The software update is used for the firmware of a physical device." 1 "Application" = "The software update is used for an executable software." 2 "Configuration" = "The software update is used for the configuration of a device or application." 3 "Solution" = "The software update is used to install a solution with several software package to several components." } 0:46>1:409 0:45<0:29
 Variable 1:409 0:"EnumStrings" = ~ 0 0 0:21 1 [4] 1 1 0 ~ Array:21 { LocalizedText:~:"Firmware" LocalizedText:~:"Application" LocalizedText:~:"Configuration" LocalizedText:~:"Solution" } 0:40>0:68
 DataType 1:410 1:"LocationIndicationType" = ~ 0 0 0 Enum { 0 "Visual" = "Location indication through optical signals, such as blinking LEDs, if supported by the device." 1 "Audible" = "Location indication through auditory signals, such as sounds or beeps, if supported by the device." } 0:46>1:411 0:45<0:5

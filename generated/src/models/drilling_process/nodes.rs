@@ -22,122 +22,225 @@ pub static TABLE: rt::table::NodeSetTable = rt::table::NodeSetTable {
     nodes: rt::table::Nodes::Packed(rt::table::Packed::new(r#"
 ObjectType 5:1000 5:"ReferenceDrillBushSkillType" = "Brings the drilling end effector in front of a drill bush: moves the robot to the rough pose of the bush measured by the template referencing camera (AbsoluteCartesianLinearMove), measures the bush with the hole referencing unit of the end effector, corrects position and perpendicularity and stops ApproachDistance in front of the bush. The corrected pose of the bush is the result." 0 0 0 0:45<1:1400 0:47>5:1001 0:47>5:1015
 Object 5:1001 1:"InputParameterSet" = "The inputs: HolePosition and ApproachDistance." 0 0 0 0:40>0:58 0:37>0:78 0:47>5:1002 0:47>5:1013
+Overrides 5:1001 1:1301
 Variable 5:1002 5:"HolePosition" = "Rough pose of the drill bush in the base frame of the robot, from the template referencing camera: position of the bush face centre, Z along the bush axis into the part; millimetres and degrees." 0 0 0:18814 -1 [] 3 3 0 ~ ~ 0:40>0:18791 0:37>0:78 0:47>5:1003 0:47>5:1008
 Variable 5:1003 0:"CartesianCoordinates" = "Position part of HolePosition: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 3 3 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>5:1004 0:47>5:1005 0:47>5:1006 0:47>5:1007
+Overrides 5:1003 0:18796
 Variable 5:1004 0:"LengthUnit" = "Unit of X, Y and Z of HolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:1004 0:18773
 Variable 5:1005 0:"X" = "X coordinate of HolePosition." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:1005 0:18798
 Variable 5:1006 0:"Y" = "Y coordinate of HolePosition." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:1006 0:18799
 Variable 5:1007 0:"Z" = "Z coordinate of HolePosition." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:1007 0:18800
 Variable 5:1008 0:"Orientation" = "Orientation part of HolePosition: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 3 3 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>5:1009 0:47>5:1010 0:47>5:1011 0:47>5:1012
+Overrides 5:1008 0:18792
 Variable 5:1009 0:"AngleUnit" = "Unit of A, B and C of HolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:1009 0:18780
 Variable 5:1010 0:"A" = "Rotation of HolePosition about the X axis (roll)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:1010 0:19074
 Variable 5:1011 0:"B" = "Rotation of HolePosition about the Y axis (pitch)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:1011 0:19075
 Variable 5:1012 0:"C" = "Rotation of HolePosition about the Z axis (yaw)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:1012 0:19076
 Variable 5:1013 5:"ApproachDistance" = "Distance in front of the bush face at which the end effector stops, in millimetres." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:1014
 Variable 5:1014 0:"EngineeringUnits" = "Unit of ApproachDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:1014 0:17502
 Object 5:1015 1:"OutputParameterSet" = "The results: Result and ReferencedHolePosition." 0 0 0 0:40>0:58 0:37>0:78 0:47>5:1016 0:47>5:1017
+Overrides 5:1015 1:1302
 Variable 5:1016 1:"Result" = "Outcome of the last run: Good when it ended in Ready, the Bad code of the cause when it ended in Halted. Uncertain_InitialValue before the first run." 0 0 0:19 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:1016 1:1303
 Variable 5:1017 5:"ReferencedHolePosition" = "Pose of the drill bush as the hole referencing unit measured it, in the base frame of the robot; millimetres and degrees. Valid after a run that ended in Ready." 0 0 0:18814 -1 [] 1 1 0 ~ ~ 0:40>0:18791 0:37>0:78 0:47>5:1018 0:47>5:1023
 Variable 5:1018 0:"CartesianCoordinates" = "Position part of ReferencedHolePosition: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 1 1 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>5:1019 0:47>5:1020 0:47>5:1021 0:47>5:1022
+Overrides 5:1018 0:18796
 Variable 5:1019 0:"LengthUnit" = "Unit of X, Y and Z of ReferencedHolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:1019 0:18773
 Variable 5:1020 0:"X" = "X coordinate of ReferencedHolePosition." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:1020 0:18798
 Variable 5:1021 0:"Y" = "Y coordinate of ReferencedHolePosition." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:1021 0:18799
 Variable 5:1022 0:"Z" = "Z coordinate of ReferencedHolePosition." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:1022 0:18800
 Variable 5:1023 0:"Orientation" = "Orientation part of ReferencedHolePosition: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 1 1 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>5:1024 0:47>5:1025 0:47>5:1026 0:47>5:1027
+Overrides 5:1023 0:18792
 Variable 5:1024 0:"AngleUnit" = "Unit of A, B and C of ReferencedHolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:1024 0:18780
 Variable 5:1025 0:"A" = "Rotation of ReferencedHolePosition about the X axis (roll)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:1025 0:19074
 Variable 5:1026 0:"B" = "Rotation of ReferencedHolePosition about the Y axis (pitch)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:1026 0:19075
 Variable 5:1027 0:"C" = "Rotation of ReferencedHolePosition about the Z axis (yaw)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:1027 0:19076
 ObjectType 5:2000 5:"DrillHoleSkillType" = "Drills one hole through the drill bush the end effector is in front of: moves the nose into the bush by InsertionDistance along tool Z (RelativeCartesianLinearMove), runs TemplateDrilling of the end effector with the drilling parameters, and moves back out by the same distance (RelativeCartesianLinearMove)." 0 0 0 0:45<1:1400 0:47>5:2001
 Object 5:2001 1:"InputParameterSet" = "The inputs: InsertionDistance and the drilling parameters passed to TemplateDrilling." 0 0 0 0:40>0:58 0:37>0:78 0:47>5:2002 0:47>5:2004 0:47>5:2006 0:47>5:2008 0:47>5:2010 0:47>5:2012
+Overrides 5:2001 1:1301
 Variable 5:2002 5:"InsertionDistance" = "Distance the nose moves along tool Z into the drill bush before drilling and back out after, in millimetres." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:2003
 Variable 5:2003 0:"EngineeringUnits" = "Unit of InsertionDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:2003 0:17502
 Variable 5:2004 5:"HoleDiameter" = "Nominal diameter of the hole, in millimetres; selects and checks the drill." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:2005
 Variable 5:2005 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:2005 0:17502
 Variable 5:2006 5:"Depth" = "Depth to drill, in millimetres, measured from the face of the drill bush." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:2007
 Variable 5:2007 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:2007 0:17502
 Variable 5:2008 5:"FeedRate" = "Feed of the drill along its axis, in millimetres per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:2009
 Variable 5:2009 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:2009 0:17502
 Variable 5:2010 5:"SpindleSpeed" = "Rotational speed of the spindle, in revolutions per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:2011
 Variable 5:2011 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:2011 0:17502
 Variable 5:2012 5:"ClampForce" = "Force the nose clamps the stack against the template with, in newtons." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:2013
 Variable 5:2013 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:2013 0:17502
 ObjectType 5:3000 5:"DrillingCellType" = "A template drilling work cell: offers the process skills ReferenceDrillBush and DrillHole, which a process controller runs once per hole, using the skills of the robot system and its end effector." 0 0 0 0:45<0:58 0:17603>1:1200 0:47>5:3001
 Object 5:3001 1:"SkillSet" = "The process skills of the cell (ISkillSetType)." 0 0 0 0:40>0:61 0:37>0:78 0:47>5:3002 0:47>5:3045
 Object 5:3002 5:"ReferenceDrillBush" = "Positions the end effector in front of the next drill bush." 0 0 1 0:40>5:1000 0:37>0:78 0:47>5:3003 0:47>5:3006 0:46>5:3010 0:46>5:3011 0:46>5:3012 0:47>5:3013 0:47>5:3014 0:47>5:3015 0:47>5:3016 0:47>5:3017 0:47>5:3018 0:47>5:3032
 Variable 5:3003 0:"CurrentState" = "The state the ReferenceDrillBush skill is in: Ready, Running, Suspended or Halted." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:2760 0:37>0:78 0:46>5:3004 0:46>5:3005
+Overrides 5:3003 0:3830
 Variable 5:3004 0:"Id" = "NodeId of the current state (a state of ProgramStateMachineType)." 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3004 0:3831
 Variable 5:3005 0:"Number" = "Number of the current state: Halted 11, Ready 12, Running 13, Suspended 14." 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3005 0:3833
 Variable 5:3006 0:"LastTransition" = "The last state change of the ReferenceDrillBush skill." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:2767 0:37>0:78 0:46>5:3007 0:46>5:3008 0:46>5:3009
+Overrides 5:3006 0:3835
 Variable 5:3007 0:"Id" = "NodeId of the last transition (a transition of ProgramStateMachineType)." 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3007 0:3836
 Variable 5:3008 0:"Number" = "Number of the last transition, as ProgramStateMachineType numbers them." 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3008 0:3838
 Variable 5:3009 0:"TransitionTime" = "When the last transition happened." 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3009 0:3839
 Variable 5:3010 0:"Deletable" = "Whether a client may delete the ReferenceDrillBush skill; false, the skill belongs to its owner." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3010 0:2393
 Variable 5:3011 0:"AutoDelete" = "Whether the server removes the ReferenceDrillBush skill when a run ends; false, the skill stays." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3011 0:2394
 Variable 5:3012 0:"RecycleCount" = "How often the ReferenceDrillBush skill has been reset from Halted to Ready." 0 0 0:6 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3012 0:2395
 Method 5:3013 0:"Start" = "Starts the skill with the current values of InputParameterSet (Ready to Running)." 0 0 1 1 0:37>0:78
+Overrides 5:3013 1:1304
 Method 5:3014 0:"Suspend" = "Pauses the composite skill after the skill it is running has paused or finished." 0 0 1 1 0:37>0:78
+Overrides 5:3014 1:1401
 Method 5:3015 0:"Resume" = "Continues the composite skill with the skill it had paused in." 0 0 1 1 0:37>0:78
+Overrides 5:3015 1:1402
 Method 5:3016 0:"Halt" = "Aborts the skill (Ready, Running or Suspended to Halted)." 0 0 1 1 0:37>0:78
+Overrides 5:3016 1:1307
 Method 5:3017 0:"Reset" = "Brings the halted skill back to Ready so that it can be started again." 0 0 1 1 0:37>0:78
+Overrides 5:3017 1:1308
 Object 5:3018 1:"InputParameterSet" = "The inputs: HolePosition and ApproachDistance." 0 0 0 0:40>0:58 0:37>0:78 0:47>5:3019 0:47>5:3030
+Overrides 5:3018 5:1001
 Variable 5:3019 5:"HolePosition" = "Rough pose of the drill bush in the base frame of the robot, from the template referencing camera: position of the bush face centre, Z along the bush axis into the part; millimetres and degrees." 0 0 0:18814 -1 [] 3 3 0 ~ ~ 0:40>0:18791 0:37>0:78 0:47>5:3020 0:47>5:3025
+Overrides 5:3019 5:1002
 Variable 5:3020 0:"CartesianCoordinates" = "Position part of HolePosition: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 3 3 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>5:3021 0:47>5:3022 0:47>5:3023 0:47>5:3024
+Overrides 5:3020 5:1003
 Variable 5:3021 0:"LengthUnit" = "Unit of X, Y and Z of HolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3021 5:1004
 Variable 5:3022 0:"X" = "X coordinate of HolePosition." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:3022 5:1005
 Variable 5:3023 0:"Y" = "Y coordinate of HolePosition." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:3023 5:1006
 Variable 5:3024 0:"Z" = "Z coordinate of HolePosition." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:3024 5:1007
 Variable 5:3025 0:"Orientation" = "Orientation part of HolePosition: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 3 3 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>5:3026 0:47>5:3027 0:47>5:3028 0:47>5:3029
+Overrides 5:3025 5:1008
 Variable 5:3026 0:"AngleUnit" = "Unit of A, B and C of HolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3026 5:1009
 Variable 5:3027 0:"A" = "Rotation of HolePosition about the X axis (roll)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:3027 5:1010
 Variable 5:3028 0:"B" = "Rotation of HolePosition about the Y axis (pitch)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:3028 5:1011
 Variable 5:3029 0:"C" = "Rotation of HolePosition about the Z axis (yaw)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:3029 5:1012
 Variable 5:3030 5:"ApproachDistance" = "Distance in front of the bush face at which the end effector stops, in millimetres." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:3031
+Overrides 5:3030 5:1013
 Variable 5:3031 0:"EngineeringUnits" = "Unit of ApproachDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3031 5:1014
 Object 5:3032 1:"OutputParameterSet" = "The results: Result and ReferencedHolePosition." 0 0 0 0:40>0:58 0:37>0:78 0:47>5:3033 0:47>5:3034
+Overrides 5:3032 5:1015
 Variable 5:3033 1:"Result" = "Outcome of the last run: Good when it ended in Ready, the Bad code of the cause when it ended in Halted. Uncertain_InitialValue before the first run." 0 0 0:19 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:3033 5:1016
 Variable 5:3034 5:"ReferencedHolePosition" = "Pose of the drill bush as the hole referencing unit measured it, in the base frame of the robot; millimetres and degrees. Valid after a run that ended in Ready." 0 0 0:18814 -1 [] 1 1 0 ~ ~ 0:40>0:18791 0:37>0:78 0:47>5:3035 0:47>5:3040
+Overrides 5:3034 5:1017
 Variable 5:3035 0:"CartesianCoordinates" = "Position part of ReferencedHolePosition: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 1 1 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>5:3036 0:47>5:3037 0:47>5:3038 0:47>5:3039
+Overrides 5:3035 5:1018
 Variable 5:3036 0:"LengthUnit" = "Unit of X, Y and Z of ReferencedHolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3036 5:1019
 Variable 5:3037 0:"X" = "X coordinate of ReferencedHolePosition." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:3037 5:1020
 Variable 5:3038 0:"Y" = "Y coordinate of ReferencedHolePosition." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:3038 5:1021
 Variable 5:3039 0:"Z" = "Z coordinate of ReferencedHolePosition." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:3039 5:1022
 Variable 5:3040 0:"Orientation" = "Orientation part of ReferencedHolePosition: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 1 1 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>5:3041 0:47>5:3042 0:47>5:3043 0:47>5:3044
+Overrides 5:3040 5:1023
 Variable 5:3041 0:"AngleUnit" = "Unit of A, B and C of ReferencedHolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3041 5:1024
 Variable 5:3042 0:"A" = "Rotation of ReferencedHolePosition about the X axis (roll)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:3042 5:1025
 Variable 5:3043 0:"B" = "Rotation of ReferencedHolePosition about the Y axis (pitch)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:3043 5:1026
 Variable 5:3044 0:"C" = "Rotation of ReferencedHolePosition about the Z axis (yaw)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:3044 5:1027
 Object 5:3045 5:"DrillHole" = "Drills the hole of the drill bush the end effector is in front of." 0 0 1 0:40>5:2000 0:37>0:78 0:47>5:3046 0:47>5:3049 0:46>5:3053 0:46>5:3054 0:46>5:3055 0:47>5:3056 0:47>5:3057 0:47>5:3058 0:47>5:3059 0:47>5:3060 0:47>5:3061 0:47>5:3074
 Variable 5:3046 0:"CurrentState" = "The state the DrillHole skill is in: Ready, Running, Suspended or Halted." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:2760 0:37>0:78 0:46>5:3047 0:46>5:3048
+Overrides 5:3046 0:3830
 Variable 5:3047 0:"Id" = "NodeId of the current state (a state of ProgramStateMachineType)." 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3047 0:3831
 Variable 5:3048 0:"Number" = "Number of the current state: Halted 11, Ready 12, Running 13, Suspended 14." 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3048 0:3833
 Variable 5:3049 0:"LastTransition" = "The last state change of the DrillHole skill." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:2767 0:37>0:78 0:46>5:3050 0:46>5:3051 0:46>5:3052
+Overrides 5:3049 0:3835
 Variable 5:3050 0:"Id" = "NodeId of the last transition (a transition of ProgramStateMachineType)." 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3050 0:3836
 Variable 5:3051 0:"Number" = "Number of the last transition, as ProgramStateMachineType numbers them." 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3051 0:3838
 Variable 5:3052 0:"TransitionTime" = "When the last transition happened." 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3052 0:3839
 Variable 5:3053 0:"Deletable" = "Whether a client may delete the DrillHole skill; false, the skill belongs to its owner." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3053 0:2393
 Variable 5:3054 0:"AutoDelete" = "Whether the server removes the DrillHole skill when a run ends; false, the skill stays." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3054 0:2394
 Variable 5:3055 0:"RecycleCount" = "How often the DrillHole skill has been reset from Halted to Ready." 0 0 0:6 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3055 0:2395
 Method 5:3056 0:"Start" = "Starts the skill with the current values of InputParameterSet (Ready to Running)." 0 0 1 1 0:37>0:78
+Overrides 5:3056 1:1304
 Method 5:3057 0:"Suspend" = "Pauses the composite skill after the skill it is running has paused or finished." 0 0 1 1 0:37>0:78
+Overrides 5:3057 1:1401
 Method 5:3058 0:"Resume" = "Continues the composite skill with the skill it had paused in." 0 0 1 1 0:37>0:78
+Overrides 5:3058 1:1402
 Method 5:3059 0:"Halt" = "Aborts the skill (Ready, Running or Suspended to Halted)." 0 0 1 1 0:37>0:78
+Overrides 5:3059 1:1307
 Method 5:3060 0:"Reset" = "Brings the halted skill back to Ready so that it can be started again." 0 0 1 1 0:37>0:78
+Overrides 5:3060 1:1308
 Object 5:3061 1:"InputParameterSet" = "The inputs: InsertionDistance and the drilling parameters passed to TemplateDrilling." 0 0 0 0:40>0:58 0:37>0:78 0:47>5:3062 0:47>5:3064 0:47>5:3066 0:47>5:3068 0:47>5:3070 0:47>5:3072
+Overrides 5:3061 5:2001
 Variable 5:3062 5:"InsertionDistance" = "Distance the nose moves along tool Z into the drill bush before drilling and back out after, in millimetres." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:3063
+Overrides 5:3062 5:2002
 Variable 5:3063 0:"EngineeringUnits" = "Unit of InsertionDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3063 5:2003
 Variable 5:3064 5:"HoleDiameter" = "Nominal diameter of the hole, in millimetres; selects and checks the drill." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:3065
+Overrides 5:3064 5:2004
 Variable 5:3065 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3065 5:2005
 Variable 5:3066 5:"Depth" = "Depth to drill, in millimetres, measured from the face of the drill bush." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:3067
+Overrides 5:3066 5:2006
 Variable 5:3067 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3067 5:2007
 Variable 5:3068 5:"FeedRate" = "Feed of the drill along its axis, in millimetres per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:3069
+Overrides 5:3068 5:2008
 Variable 5:3069 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3069 5:2009
 Variable 5:3070 5:"SpindleSpeed" = "Rotational speed of the spindle, in revolutions per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:3071
+Overrides 5:3070 5:2010
 Variable 5:3071 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3071 5:2011
 Variable 5:3072 5:"ClampForce" = "Force the nose clamps the stack against the template with, in newtons." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:3073
+Overrides 5:3072 5:2012
 Variable 5:3073 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 5:3073 5:2013
 Object 5:3074 1:"OutputParameterSet" = "The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here)." 0 0 0 0:40>0:58 0:37>0:78 0:47>5:3075
+Overrides 5:3074 1:1302
 Variable 5:3075 1:"Result" = "Outcome of the last run: Good when it ended in Ready, the Bad code of the cause when it ended in Halted. Uncertain_InitialValue before the first run." 0 0 0:19 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 5:3075 1:1303
 Object 5:4000 5:"DrillingCell" = "The template drilling cell for the vertical tail plane: its process skills in SkillSet." 0 0 0 0:35<0:85 0:40>5:3000 0:47>5:4001
 Object 5:4001 1:"SkillSet" = "The process skills of the cell (ISkillSetType)." 0 0 0 0:40>0:61 0:47>5:4002 0:47>5:4045
 Object 5:4002 5:"ReferenceDrillBush" = "Positions the end effector in front of the next drill bush." 0 0 1 0:40>5:1000 0:47>5:4003 0:47>5:4006 0:46>5:4010 0:46>5:4011 0:46>5:4012 0:47>5:4013 0:47>5:4014 0:47>5:4015 0:47>5:4016 0:47>5:4017 0:47>5:4018 0:47>5:4032

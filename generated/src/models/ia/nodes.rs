@@ -62,9 +62,12 @@ Object 2:5011 2:"CalibrationTargetCategory" = "Defines what category the calibra
 Object 2:5013 2:"CalibrationTargetFeatures" = "A folder containing information about the features of a calibration target, that is, what can be calibrated with the calibration target." 0 0 0 0:37>0:78 0:40>0:61 0:47>2:6064 0:47>2:6066
 Variable 2:6064 2:"<CalibrationValue>" = "A calibration value indicates the value the calibration target provides for calibration and includes its quantity and engineering unit." 0 0 0:26 -1 [] 3 3 0 ~ ~ 0:37>0:11508 0:40>2:2002 0:46>2:6065
 Variable 2:6065 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 3 3 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 2:6065 2:6057
 Variable 2:6066 2:"<CapacityRange>" = "A capacity range indicates a range (low and high value) as well as a resolution, and thus defines a number of values the calibration target provides for calibration and includes the quantity and engineering unit." 0 0 0:884 -1 [] 3 3 0 ~ ~ 0:37>0:11508 0:40>2:2003 0:46>2:6067 0:46>2:6068
 Variable 2:6067 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 3 3 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 2:6067 2:6058
 Variable 2:6068 2:"Resolution" = ~ 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 2:6068 2:6059
 Variable 2:6063 2:"CertificateUri" = "Contains the Uri of a certificate of the calibration target, in case the calibration target is certified and the information available. Otherwise, the Property should be omitted." 0 0 0:12 -1 [] 3 3 0 ~ ~ 0:40>0:68 0:37>0:80
 Object 2:5010 1:"Identification" = "Provides identification information." 0 0 0 0:37>0:78 0:40>1:1005 0:46>2:6080 0:46>2:6081 0:46>2:6076 0:46>2:6082 0:46>2:6075 0:46>2:6073 0:17603>1:15048 0:17603>1:15035 0:46>2:6069 0:46>2:6070 0:46>2:6071 0:46>2:6072 0:46>2:6078 0:46>2:6079 0:46>2:6077 0:46>2:6074
 Variable 2:6080 1:"AssetId" = ~ 0 0 0:12 -1 [] 3 3 0 ~ ~ 0:40>0:68 0:37>0:80
@@ -89,15 +92,21 @@ ObjectType 2:1008 2:"ControlChannelType" = "Used for control channels of single 
 Variable 2:6024 2:"ChannelColor" = "Indicates in what mode (continuously on, blinking, flashing) the channel operates when switched on." 0 0 2:3004 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:63
 Variable 2:6026 2:"Intensity" = "Shows the channel’s intensity, thus its brightness. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent." 0 0 0:10 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:2368 0:46>2:6027
 Variable 2:6027 0:"EURange" = ~ 0 0 0:884 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 2:6027 0:2369
 Variable 2:6025 2:"SignalMode" = "Contains a list of audio signals used by this acoustic stacklight element." 0 0 2:3005 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:63
 Variable 2:6023 2:"SignalOn" = "Indicates if the colour is switched on." 0 0 0:1 -1 [] 3 3 0 ~ ~ 0:40>0:68 0:37>0:78
 ObjectType 2:1002 2:"BasicStacklightType" = "Entry point to a stacklight containing elements of the stacklight as well as additional information valid for the whole unit." 0 0 0 0:45<0:23518 0:49>2:5006 0:47>2:5001 0:46>2:6009 0:47>2:5005
 Object 2:5006 0:"<OrderedObject>" = "Represent the stack elements (lamps and acoustic elements) the stacklight is composed of. The HasOrderedComponent Reference shall represent the ordering from the base of the stacklight." 0 0 0 0:37>0:11508 0:40>2:1005 0:46>2:6037
+Overrides 2:5006 0:23519
 Variable 2:6037 0:"NumberInList" = "Enumerate the stacklight elements counting upwards beginning from the base of the stacklight." 0 0 0:28 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 2:6037 0:23521
 Object 2:5001 2:"StackLevel" = "Valid if the stacklight is used in “Levelmeter” StacklightMode. If so, the whole stack is controlled by a single percentual value. In this case, the SignalOn parameter of any stack element of StackElementLightType has no meaning." 0 0 0 0:37>0:80 0:40>2:1003 0:47>2:6034 0:47>2:6035
 Variable 2:6034 2:"DisplayMode" = "Indicates in what way the percentual value is displayed with the stacklight." 0 0 2:3003 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:63
+Overrides 2:6034 2:6012
 Variable 2:6035 2:"LevelPercent" = "Shows the percentual value the stacklight is representing. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent." 0 0 0:10 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:2368 0:46>2:6036
+Overrides 2:6035 2:6010
 Variable 2:6036 0:"EURange" = ~ 0 0 0:884 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 2:6036 2:6011
 Variable 2:6009 2:"StacklightMode" = "Shows in what way (stack of individual lights, level meter, running light) the stacklight unit is used." 0 0 2:3002 -1 [] 3 3 0 ~ ~ 0:40>0:68 0:37>0:78
 Object 2:5005 2:"StackRunning" = "Valid if the stacklight is used in “Running_Light” StacklightMode." 0 0 0 0:37>0:80 0:40>2:1004
 ObjectType 2:1010 2:"StacklightType" = "Entry point to a stacklight with the possibility to show the stacklight’s health status." 0 0 0 0:45<2:1002 0:47>2:6038 0:47>2:5007 0:17603>1:15051
@@ -110,17 +119,24 @@ Variable 2:6013 2:"SignalOn" = "Indicates if the signal emitted by the stack ele
 ObjectType 2:1007 2:"StackElementAcousticType" = "Represents an acoustic element in a stacklight." 0 0 0 0:45<2:1005 0:47>2:5003 0:47>2:6021 0:47>2:6020
 Object 2:5003 2:"AcousticSignals" = "Contains a list of audio signals used by this acoustic stacklight element." 0 0 0 0:40>0:23518 0:37>0:78 0:49>2:5004
 Object 2:5004 0:"<OrderedObject>" = "Represents an acoustic signal." 0 0 0 0:37>0:11510 0:40>2:1009 0:46>2:6030
+Overrides 2:5004 0:23519
 Variable 2:6030 0:"NumberInList" = "Enumerate the acoustic signals. Instances of StackElementAcousticType index into this number using the OperationMode Property." 0 0 0:28 -1 [] 3 3 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 2:6030 0:23521
 Variable 2:6021 2:"Intensity" = "Indicates the sound pressure level of the acoustic signal when switched on. This value shall only have positive values. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent." 0 0 0:10 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:2368 0:46>2:6022
 Variable 2:6022 0:"EURange" = ~ 0 0 0:884 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 2:6022 0:2369
 Variable 2:6020 2:"OperationMode" = "Indicates what signal of the list of AcousticSignalType nodes is played when the acoustic element is switched on. It shall contain an index into the NumberInList of the respective AcousticSignalType Object of AcousticSignals." 0 0 0:28 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:63
 ObjectType 2:1006 2:"StackElementLightType" = "Represents a lamp element in a stacklight." 0 0 0 0:45<2:1005 0:47>2:5002 0:47>2:6018 0:47>2:6016 0:47>2:6017 0:47>2:6052
 Object 2:5002 2:"<ControlChannel>" = "The list of <ControlChannel> instances shows the control information for each independent colour channel of the stacked element." 0 0 0 0:37>0:11508 0:40>2:1008 0:47>2:6031 0:47>2:6032 0:46>2:6033
 Variable 2:6031 2:"ChannelColor" = "Indicates in what mode (continuously on, blinking, flashing) the channel operates when switched on." 0 0 2:3004 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:63
+Overrides 2:6031 2:6024
 Variable 2:6032 2:"SignalMode" = "Contains a list of audio signals used by this acoustic stacklight element." 0 0 2:3005 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:63
+Overrides 2:6032 2:6025
 Variable 2:6033 2:"SignalOn" = "Indicates if the colour is switched on." 0 0 0:1 -1 [] 3 3 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 2:6033 2:6023
 Variable 2:6018 2:"Intensity" = "Intensity of the lamp, thus its brightness. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent." 0 0 0:10 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:2368 0:46>2:6019
 Variable 2:6019 0:"EURange" = ~ 0 0 0:884 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 2:6019 0:2369
 Variable 2:6016 2:"SignalColor" = "Indicates the colour the lamp element has when switched on." 0 0 2:3004 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:63
 Variable 2:6017 2:"SignalMode" = "Shows in what way the lamp is used (continuous light, flashing, blinking) when switched on." 0 0 2:3005 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:63
 Variable 2:6052 2:"SignalRGBWValue" = ~ 0 0 2:3007 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:63
@@ -128,6 +144,7 @@ ObjectType 2:1003 2:"StackLevelType" = "Contains information relevant to a stack
 Variable 2:6012 2:"DisplayMode" = "Indicates in what way the percentual value is displayed with the stacklight." 0 0 2:3003 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:63
 Variable 2:6010 2:"LevelPercent" = "Shows the percentual value the stacklight is representing. The mandatory EURange Property of the Variable indicates the lowest and highest value and thereby allows to calculate the percentage represented by the value. The lowest value is interpreted as 0 percent, the highest is interpreted as 100 percent." 0 0 0:10 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:2368 0:46>2:6011
 Variable 2:6011 0:"EURange" = ~ 0 0 0:884 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 2:6011 0:2369
 ObjectType 2:1004 2:"StackRunningType" = "Contains information relevant to a stacklight operating as a running light. This base type does not define any specific information, but can be extended." 0 0 0 0:45<0:58
 Object 2:5008 2:"http://opcfoundation.org/UA/IA/" = ~ 0 0 0 0:40>0:11616 0:46>2:6039 0:46>2:6040 0:46>2:6041 0:46>2:6042 0:46>2:6043 0:46>2:6044 0:46>2:6045 0:47<0:11715
 Variable 2:6039 0:"IsNamespaceSubset" = ~ 0 0 0:1 -1 [] 1 1 0 ~ Boolean:0 0:40>0:68

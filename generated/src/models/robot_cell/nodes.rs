@@ -21,295 +21,545 @@ pub static TABLE: rt::table::NodeSetTable = rt::table::NodeSetTable {
     nodes: rt::table::Nodes::Packed(rt::table::Packed::new(r#"
 ObjectType 4:1000 4:"TemplateDrillingSkillType" = "Drilling one hole through a drilling template: the end effector locks its expanding mandrel in the drill bush it sits in, clamps the stack with ClampForce, drills to Depth and retracts the drill. The run ends in Ready with the mandrel released, so the robot can move the end effector out of the bush." 0 0 0 0:45<1:1300 0:47>4:1001
 Object 4:1001 1:"InputParameterSet" = "The drilling parameters: HoleDiameter, Depth, FeedRate, SpindleSpeed and ClampForce." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:1002 0:47>4:1004 0:47>4:1006 0:47>4:1008 0:47>4:1010
+Overrides 4:1001 1:1301
 Variable 4:1002 4:"HoleDiameter" = "Nominal diameter of the hole, in millimetres; selects and checks the drill." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:1003
 Variable 4:1003 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:1003 0:17502
 Variable 4:1004 4:"Depth" = "Depth to drill, in millimetres, measured from the face of the drill bush." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:1005
 Variable 4:1005 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:1005 0:17502
 Variable 4:1006 4:"FeedRate" = "Feed of the drill along its axis, in millimetres per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:1007
 Variable 4:1007 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:1007 0:17502
 Variable 4:1008 4:"SpindleSpeed" = "Rotational speed of the spindle, in revolutions per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:1009
 Variable 4:1009 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:1009 0:17502
 Variable 4:1010 4:"ClampForce" = "Force the nose clamps the stack against the template with, in newtons." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:1011
 Variable 4:1011 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:1011 0:17502
 ObjectType 4:2000 4:"DrillingEndEffectorType" = "A drilling end effector for template drilling, carried by a robot: a drilling unit with a concentric collet nose and an expanding mandrel that locks into the drill bushes of a drilling template. Its skill TemplateDrilling drills one hole." 0 0 0 0:45<2:15063 0:17603>1:1200 0:46>4:2001 0:46>4:2002 0:46>4:2003 0:47>4:2004
 Variable 4:2001 2:"Manufacturer" = "Manufacturer of the end effector." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2001 2:15086
 Variable 4:2002 2:"Model" = "Model name of the end effector." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2002 2:15088
 Variable 4:2003 2:"SerialNumber" = "Serial number of the end effector." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2003 2:15095
 Object 4:2004 1:"SkillSet" = "The skills of the end effector (ISkillSetType): TemplateDrilling." 0 0 0 0:40>0:61 0:37>0:78 0:47>4:2005
 Object 4:2005 4:"TemplateDrilling" = "Drills one hole through the drill bush the end effector sits in." 0 0 1 0:40>4:1000 0:37>0:78 0:47>4:2006 0:47>4:2009 0:46>4:2013 0:46>4:2014 0:46>4:2015 0:47>4:2016 0:47>4:2017 0:47>4:2018 0:47>4:2019 0:47>4:2030
 Variable 4:2006 0:"CurrentState" = "The state the TemplateDrilling skill is in: Ready, Running, Suspended or Halted." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:2760 0:37>0:78 0:46>4:2007 0:46>4:2008
+Overrides 4:2006 0:3830
 Variable 4:2007 0:"Id" = "NodeId of the current state (a state of ProgramStateMachineType)." 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2007 0:3831
 Variable 4:2008 0:"Number" = "Number of the current state: Halted 11, Ready 12, Running 13, Suspended 14." 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2008 0:3833
 Variable 4:2009 0:"LastTransition" = "The last state change of the TemplateDrilling skill." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:2767 0:37>0:78 0:46>4:2010 0:46>4:2011 0:46>4:2012
+Overrides 4:2009 0:3835
 Variable 4:2010 0:"Id" = "NodeId of the last transition (a transition of ProgramStateMachineType)." 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2010 0:3836
 Variable 4:2011 0:"Number" = "Number of the last transition, as ProgramStateMachineType numbers them." 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2011 0:3838
 Variable 4:2012 0:"TransitionTime" = "When the last transition happened." 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2012 0:3839
 Variable 4:2013 0:"Deletable" = "Whether a client may delete the TemplateDrilling skill; false, the skill belongs to its owner." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2013 0:2393
 Variable 4:2014 0:"AutoDelete" = "Whether the server removes the TemplateDrilling skill when a run ends; false, the skill stays." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2014 0:2394
 Variable 4:2015 0:"RecycleCount" = "How often the TemplateDrilling skill has been reset from Halted to Ready." 0 0 0:6 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2015 0:2395
 Method 4:2016 0:"Start" = "Starts the skill with the current values of InputParameterSet (Ready to Running)." 0 0 1 1 0:37>0:78
+Overrides 4:2016 1:1304
 Method 4:2017 0:"Halt" = "Aborts the skill (Ready, Running or Suspended to Halted)." 0 0 1 1 0:37>0:78
+Overrides 4:2017 1:1307
 Method 4:2018 0:"Reset" = "Brings the halted skill back to Ready so that it can be started again." 0 0 1 1 0:37>0:78
+Overrides 4:2018 1:1308
 Object 4:2019 1:"InputParameterSet" = "The drilling parameters: HoleDiameter, Depth, FeedRate, SpindleSpeed and ClampForce." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:2020 0:47>4:2022 0:47>4:2024 0:47>4:2026 0:47>4:2028
+Overrides 4:2019 4:1001
 Variable 4:2020 4:"HoleDiameter" = "Nominal diameter of the hole, in millimetres; selects and checks the drill." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:2021
+Overrides 4:2020 4:1002
 Variable 4:2021 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2021 4:1003
 Variable 4:2022 4:"Depth" = "Depth to drill, in millimetres, measured from the face of the drill bush." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:2023
+Overrides 4:2022 4:1004
 Variable 4:2023 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2023 4:1005
 Variable 4:2024 4:"FeedRate" = "Feed of the drill along its axis, in millimetres per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:2025
+Overrides 4:2024 4:1006
 Variable 4:2025 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2025 4:1007
 Variable 4:2026 4:"SpindleSpeed" = "Rotational speed of the spindle, in revolutions per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:2027
+Overrides 4:2026 4:1008
 Variable 4:2027 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2027 4:1009
 Variable 4:2028 4:"ClampForce" = "Force the nose clamps the stack against the template with, in newtons." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:2029
+Overrides 4:2028 4:1010
 Variable 4:2029 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:2029 4:1011
 Object 4:2030 1:"OutputParameterSet" = "The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here)." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:2031
+Overrides 4:2030 1:1302
 Variable 4:2031 1:"Result" = "Outcome of the last run: Good when it ended in Ready, the Bad code of the cause when it ended in Halted. Uncertain_InitialValue before the first run." 0 0 0:19 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:2031 1:1303
 ObjectType 4:3000 4:"LwrSystemType" = "A lightweight robot system: a collaborative robot arm with its controller (MotionDeviceSystem, as the Robotics companion specification models it) and the skills of the system as a whole in SkillSet. Subtypes add the end effectors of an application." 0 0 0 0:45<2:15063 0:17603>1:1200 0:47>4:3001 0:47>4:3005
 Object 4:3001 4:"MotionDeviceSystem" = "The robot: its controllers, manipulators and safety states. Any MotionDeviceSystemType; instances use the subtype of their robot, such as UR10eSystemType." 0 0 0 0:40>3:1002 0:37>0:78 0:47>4:3002 0:47>4:3003 0:47>4:3004
 Object 4:3002 3:"Controllers" = "The controllers of the MotionDeviceSystem." 0 0 0 0:40>0:61 0:37>0:78
+Overrides 4:3002 3:5001
 Object 4:3003 3:"MotionDevices" = "The manipulators of the MotionDeviceSystem." 0 0 0 0:40>0:61 0:37>0:78
+Overrides 4:3003 3:5002
 Object 4:3004 3:"SafetyStates" = "The safety states of the MotionDeviceSystem." 0 0 0 0:40>0:61 0:37>0:78
+Overrides 4:3004 3:5010
 Object 4:3005 1:"SkillSet" = "The skills of the system as a whole (ISkillSetType). The skills of its parts are in their own SkillSets, such as the one of the robot controller." 0 0 0 0:40>0:61 0:37>0:78
 ObjectType 4:4000 4:"UR10eSystemType" = "A Universal Robots UR10e as a Robotics motion device system: the six-joint arm (12.5 kg payload, 1300 mm reach) and its controller. The controller offers the three basic move skills of CommonSkills in its SkillSet, so composite skills can drive any robot that offers the same skills." 0 0 0 0:45<3:1002 0:47>4:4001 0:47>4:4108 0:47>4:4203
 Object 4:4001 3:"Controllers" = "The controller of the UR10e." 0 0 0 0:40>0:61 0:37>0:78 0:47>4:4002
+Overrides 4:4001 3:5001
 Object 4:4002 4:"URController" = "The UR10e control box. Besides the Robotics controller data it offers the basic move skills of the robot in SkillSet (ISkillSetType)." 0 0 0 0:40>3:1003 0:37>0:78 0:17603>1:1200 0:46>4:4003 0:46>4:4004 0:46>4:4005 0:46>4:4006 0:47>4:4007 0:47>4:4009 0:47>4:4014 0:47>4:4020
 Variable 4:4003 2:"Manufacturer" = "Manufacturer of the controller." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68 0:37>0:78
+Overrides 4:4003 3:17237
 Variable 4:4004 2:"Model" = "Model name of the controller." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"UR e-Series control box" 0:40>0:68 0:37>0:78
+Overrides 4:4004 3:17239
 Variable 4:4005 2:"ProductCode" = "Product code of the URController, as its manufacturer orders it." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4005 3:17245
 Variable 4:4006 2:"SerialNumber" = "Serial number of the URController." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4006 3:17240
 Object 4:4007 3:"CurrentUser" = "The user logged in at the URController." 0 0 0 0:40>3:18175 0:37>0:78 0:46>4:4008
+Overrides 4:4007 3:17249
 Variable 4:4008 3:"Level" = "Access level of the user logged in at the URController." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4008 3:17250
 Object 4:4009 3:"Software" = "The software running on the controller." 0 0 0 0:40>0:61 0:37>0:78 0:47>4:4010
+Overrides 4:4009 3:15800
 Object 4:4010 4:"PolyScope" = "The robot operating software of the controller." 0 0 0 0:40>2:15106 0:37>0:78 0:46>4:4011 0:46>4:4012 0:46>4:4013
 Variable 4:4011 2:"Manufacturer" = "Manufacturer of the robot software." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68 0:37>0:78
+Overrides 4:4011 2:15129
 Variable 4:4012 2:"Model" = "Name of the robot software." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"PolyScope" 0:40>0:68 0:37>0:78
+Overrides 4:4012 2:15131
 Variable 4:4013 2:"SoftwareRevision" = "Revision of the PolyScope." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4013 2:15133
 Object 4:4014 3:"TaskControls" = "The program task of the controller." 0 0 0 0:40>0:61 0:37>0:78 0:47>4:4015
+Overrides 4:4014 3:15826
 Object 4:4015 4:"ProgramTask" = "The one program task of the controller; the skills run through it." 0 0 0 0:40>3:1011 0:37>0:78 0:47>4:4016 0:46>4:4019
 Object 4:4016 2:"ParameterSet" = "Runtime values of the ProgramTask." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4017 0:47>4:4018
+Overrides 4:4016 3:15883
 Variable 4:4017 3:"TaskProgramLoaded" = "Whether a program is loaded in the ProgramTask." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4017 3:17875
 Variable 4:4018 3:"TaskProgramName" = "Name of the program loaded in the ProgramTask." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4018 3:17874
 Variable 4:4019 2:"ComponentName" = "Name of the ProgramTask for users." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4019 3:17873
 Object 4:4020 1:"SkillSet" = "The basic move skills of the UR10e (ISkillSetType): AbsoluteJointPTPMove, RelativeCartesianLinearMove and AbsoluteCartesianLinearMove." 0 0 0 0:40>0:61 0:37>0:78 0:47>4:4021 0:47>4:4044 0:47>4:4076
 Object 4:4021 4:"AbsoluteJointPTPMove" = "Moves the six joints point to point to TargetJointPositions." 0 0 1 0:40>1:1600 0:37>0:78 0:47>4:4022 0:47>4:4025 0:46>4:4029 0:46>4:4030 0:46>4:4031 0:47>4:4032 0:47>4:4033 0:47>4:4034 0:47>4:4035 0:47>4:4042
 Variable 4:4022 0:"CurrentState" = "The state the AbsoluteJointPTPMove skill is in: Ready, Running, Suspended or Halted." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:2760 0:37>0:78 0:46>4:4023 0:46>4:4024
+Overrides 4:4022 0:3830
 Variable 4:4023 0:"Id" = "NodeId of the current state (a state of ProgramStateMachineType)." 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4023 0:3831
 Variable 4:4024 0:"Number" = "Number of the current state: Halted 11, Ready 12, Running 13, Suspended 14." 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4024 0:3833
 Variable 4:4025 0:"LastTransition" = "The last state change of the AbsoluteJointPTPMove skill." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:2767 0:37>0:78 0:46>4:4026 0:46>4:4027 0:46>4:4028
+Overrides 4:4025 0:3835
 Variable 4:4026 0:"Id" = "NodeId of the last transition (a transition of ProgramStateMachineType)." 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4026 0:3836
 Variable 4:4027 0:"Number" = "Number of the last transition, as ProgramStateMachineType numbers them." 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4027 0:3838
 Variable 4:4028 0:"TransitionTime" = "When the last transition happened." 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4028 0:3839
 Variable 4:4029 0:"Deletable" = "Whether a client may delete the AbsoluteJointPTPMove skill; false, the skill belongs to its owner." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4029 0:2393
 Variable 4:4030 0:"AutoDelete" = "Whether the server removes the AbsoluteJointPTPMove skill when a run ends; false, the skill stays." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4030 0:2394
 Variable 4:4031 0:"RecycleCount" = "How often the AbsoluteJointPTPMove skill has been reset from Halted to Ready." 0 0 0:6 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4031 0:2395
 Method 4:4032 0:"Start" = "Starts the skill with the current values of InputParameterSet (Ready to Running)." 0 0 1 1 0:37>0:78
+Overrides 4:4032 1:1304
 Method 4:4033 0:"Halt" = "Aborts the skill (Ready, Running or Suspended to Halted)." 0 0 1 1 0:37>0:78
+Overrides 4:4033 1:1307
 Method 4:4034 0:"Reset" = "Brings the halted skill back to Ready so that it can be started again." 0 0 1 1 0:37>0:78
+Overrides 4:4034 1:1308
 Object 4:4035 1:"InputParameterSet" = "The inputs of the joint motion: TargetJointPositions (six angles), Speed and Acceleration." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4036 0:47>4:4038 0:47>4:4040
+Overrides 4:4035 1:1601
 Variable 4:4036 1:"Speed" = "Maximum joint speed of the leading joint, in degrees per second." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4037
+Overrides 4:4036 1:1602
 Variable 4:4037 0:"EngineeringUnits" = "Unit of Speed: degree per second." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4037 1:1603
 Variable 4:4038 1:"Acceleration" = "Maximum joint acceleration of the leading joint, in degrees per second squared." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4039
+Overrides 4:4038 1:1604
 Variable 4:4039 0:"EngineeringUnits" = "Unit of Acceleration: degree per second squared." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4039 1:1605
 Variable 4:4040 1:"TargetJointPositions" = "Target angles of the six joints from Base to Wrist3, in degrees." 0 0 0:11 1 [6] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4041
+Overrides 4:4040 1:1606
 Variable 4:4041 0:"EngineeringUnits" = "Unit of TargetJointPositions: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4041 1:1607
 Object 4:4042 1:"OutputParameterSet" = "The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here)." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4043
+Overrides 4:4042 1:1302
 Variable 4:4043 1:"Result" = "Outcome of the last run: Good when it ended in Ready, the Bad code of the cause when it ended in Halted. Uncertain_InitialValue before the first run." 0 0 0:19 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4043 1:1303
 Object 4:4044 4:"RelativeCartesianLinearMove" = "Moves the tool centre point on a straight line by PoseOffset in the tool frame." 0 0 1 0:40>1:1700 0:37>0:78 0:47>4:4045 0:47>4:4048 0:46>4:4052 0:46>4:4053 0:46>4:4054 0:47>4:4055 0:47>4:4056 0:47>4:4057 0:47>4:4058 0:47>4:4074
 Variable 4:4045 0:"CurrentState" = "The state the RelativeCartesianLinearMove skill is in: Ready, Running, Suspended or Halted." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:2760 0:37>0:78 0:46>4:4046 0:46>4:4047
+Overrides 4:4045 0:3830
 Variable 4:4046 0:"Id" = "NodeId of the current state (a state of ProgramStateMachineType)." 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4046 0:3831
 Variable 4:4047 0:"Number" = "Number of the current state: Halted 11, Ready 12, Running 13, Suspended 14." 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4047 0:3833
 Variable 4:4048 0:"LastTransition" = "The last state change of the RelativeCartesianLinearMove skill." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:2767 0:37>0:78 0:46>4:4049 0:46>4:4050 0:46>4:4051
+Overrides 4:4048 0:3835
 Variable 4:4049 0:"Id" = "NodeId of the last transition (a transition of ProgramStateMachineType)." 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4049 0:3836
 Variable 4:4050 0:"Number" = "Number of the last transition, as ProgramStateMachineType numbers them." 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4050 0:3838
 Variable 4:4051 0:"TransitionTime" = "When the last transition happened." 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4051 0:3839
 Variable 4:4052 0:"Deletable" = "Whether a client may delete the RelativeCartesianLinearMove skill; false, the skill belongs to its owner." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4052 0:2393
 Variable 4:4053 0:"AutoDelete" = "Whether the server removes the RelativeCartesianLinearMove skill when a run ends; false, the skill stays." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4053 0:2394
 Variable 4:4054 0:"RecycleCount" = "How often the RelativeCartesianLinearMove skill has been reset from Halted to Ready." 0 0 0:6 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4054 0:2395
 Method 4:4055 0:"Start" = "Starts the skill with the current values of InputParameterSet (Ready to Running)." 0 0 1 1 0:37>0:78
+Overrides 4:4055 1:1304
 Method 4:4056 0:"Halt" = "Aborts the skill (Ready, Running or Suspended to Halted)." 0 0 1 1 0:37>0:78
+Overrides 4:4056 1:1307
 Method 4:4057 0:"Reset" = "Brings the halted skill back to Ready so that it can be started again." 0 0 1 1 0:37>0:78
+Overrides 4:4057 1:1308
 Object 4:4058 1:"InputParameterSet" = "The inputs of the relative motion: PoseOffset, Speed and Acceleration." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4059 0:47>4:4061 0:47>4:4063
+Overrides 4:4058 1:1701
 Variable 4:4059 1:"Speed" = "Maximum speed of the tool centre point along the path, in millimetres per second." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4060
+Overrides 4:4059 1:1702
 Variable 4:4060 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4060 1:1703
 Variable 4:4061 1:"Acceleration" = "Maximum acceleration of the tool centre point along the path, in millimetres per second squared." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4062
+Overrides 4:4061 1:1704
 Variable 4:4062 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4062 1:1705
 Variable 4:4063 1:"PoseOffset" = "Displacement and rotation of the tool centre point, in the tool frame at the start of the motion; millimetres and degrees." 0 0 0:18814 -1 [] 3 3 0 ~ ~ 0:40>0:18791 0:37>0:78 0:47>4:4064 0:47>4:4069
+Overrides 4:4063 1:1706
 Variable 4:4064 0:"CartesianCoordinates" = "Position part of PoseOffset: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 3 3 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>4:4065 0:47>4:4066 0:47>4:4067 0:47>4:4068
+Overrides 4:4064 1:1707
 Variable 4:4065 0:"LengthUnit" = "Unit of X, Y and Z of PoseOffset: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4065 1:1708
 Variable 4:4066 0:"X" = "X coordinate of PoseOffset." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4066 1:1709
 Variable 4:4067 0:"Y" = "Y coordinate of PoseOffset." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4067 1:1710
 Variable 4:4068 0:"Z" = "Z coordinate of PoseOffset." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4068 1:1711
 Variable 4:4069 0:"Orientation" = "Orientation part of PoseOffset: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 3 3 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>4:4070 0:47>4:4071 0:47>4:4072 0:47>4:4073
+Overrides 4:4069 1:1712
 Variable 4:4070 0:"AngleUnit" = "Unit of A, B and C of PoseOffset: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4070 1:1713
 Variable 4:4071 0:"A" = "Rotation of PoseOffset about the X axis (roll)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4071 1:1714
 Variable 4:4072 0:"B" = "Rotation of PoseOffset about the Y axis (pitch)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4072 1:1715
 Variable 4:4073 0:"C" = "Rotation of PoseOffset about the Z axis (yaw)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4073 1:1716
 Object 4:4074 1:"OutputParameterSet" = "The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here)." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4075
+Overrides 4:4074 1:1302
 Variable 4:4075 1:"Result" = "Outcome of the last run: Good when it ended in Ready, the Bad code of the cause when it ended in Halted. Uncertain_InitialValue before the first run." 0 0 0:19 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4075 1:1303
 Object 4:4076 4:"AbsoluteCartesianLinearMove" = "Moves the tool centre point on a straight line to TargetPose in the base frame." 0 0 1 0:40>1:1800 0:37>0:78 0:47>4:4077 0:47>4:4080 0:46>4:4084 0:46>4:4085 0:46>4:4086 0:47>4:4087 0:47>4:4088 0:47>4:4089 0:47>4:4090 0:47>4:4106
 Variable 4:4077 0:"CurrentState" = "The state the AbsoluteCartesianLinearMove skill is in: Ready, Running, Suspended or Halted." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:2760 0:37>0:78 0:46>4:4078 0:46>4:4079
+Overrides 4:4077 0:3830
 Variable 4:4078 0:"Id" = "NodeId of the current state (a state of ProgramStateMachineType)." 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4078 0:3831
 Variable 4:4079 0:"Number" = "Number of the current state: Halted 11, Ready 12, Running 13, Suspended 14." 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4079 0:3833
 Variable 4:4080 0:"LastTransition" = "The last state change of the AbsoluteCartesianLinearMove skill." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:2767 0:37>0:78 0:46>4:4081 0:46>4:4082 0:46>4:4083
+Overrides 4:4080 0:3835
 Variable 4:4081 0:"Id" = "NodeId of the last transition (a transition of ProgramStateMachineType)." 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4081 0:3836
 Variable 4:4082 0:"Number" = "Number of the last transition, as ProgramStateMachineType numbers them." 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4082 0:3838
 Variable 4:4083 0:"TransitionTime" = "When the last transition happened." 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4083 0:3839
 Variable 4:4084 0:"Deletable" = "Whether a client may delete the AbsoluteCartesianLinearMove skill; false, the skill belongs to its owner." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4084 0:2393
 Variable 4:4085 0:"AutoDelete" = "Whether the server removes the AbsoluteCartesianLinearMove skill when a run ends; false, the skill stays." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4085 0:2394
 Variable 4:4086 0:"RecycleCount" = "How often the AbsoluteCartesianLinearMove skill has been reset from Halted to Ready." 0 0 0:6 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4086 0:2395
 Method 4:4087 0:"Start" = "Starts the skill with the current values of InputParameterSet (Ready to Running)." 0 0 1 1 0:37>0:78
+Overrides 4:4087 1:1304
 Method 4:4088 0:"Halt" = "Aborts the skill (Ready, Running or Suspended to Halted)." 0 0 1 1 0:37>0:78
+Overrides 4:4088 1:1307
 Method 4:4089 0:"Reset" = "Brings the halted skill back to Ready so that it can be started again." 0 0 1 1 0:37>0:78
+Overrides 4:4089 1:1308
 Object 4:4090 1:"InputParameterSet" = "The inputs of the absolute motion: TargetPose, Speed and Acceleration." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4091 0:47>4:4093 0:47>4:4095
+Overrides 4:4090 1:1801
 Variable 4:4091 1:"Speed" = "Maximum speed of the tool centre point along the path, in millimetres per second." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4092
+Overrides 4:4091 1:1802
 Variable 4:4092 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4092 1:1803
 Variable 4:4093 1:"Acceleration" = "Maximum acceleration of the tool centre point along the path, in millimetres per second squared." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4094
+Overrides 4:4093 1:1804
 Variable 4:4094 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4094 1:1805
 Variable 4:4095 1:"TargetPose" = "Pose the tool centre point moves to, in the base frame of the robot; millimetres and degrees." 0 0 0:18814 -1 [] 3 3 0 ~ ~ 0:40>0:18791 0:37>0:78 0:47>4:4096 0:47>4:4101
+Overrides 4:4095 1:1806
 Variable 4:4096 0:"CartesianCoordinates" = "Position part of TargetPose: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 3 3 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>4:4097 0:47>4:4098 0:47>4:4099 0:47>4:4100
+Overrides 4:4096 1:1807
 Variable 4:4097 0:"LengthUnit" = "Unit of X, Y and Z of TargetPose: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4097 1:1808
 Variable 4:4098 0:"X" = "X coordinate of TargetPose." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4098 1:1809
 Variable 4:4099 0:"Y" = "Y coordinate of TargetPose." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4099 1:1810
 Variable 4:4100 0:"Z" = "Z coordinate of TargetPose." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4100 1:1811
 Variable 4:4101 0:"Orientation" = "Orientation part of TargetPose: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 3 3 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>4:4102 0:47>4:4103 0:47>4:4104 0:47>4:4105
+Overrides 4:4101 1:1812
 Variable 4:4102 0:"AngleUnit" = "Unit of A, B and C of TargetPose: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4102 1:1813
 Variable 4:4103 0:"A" = "Rotation of TargetPose about the X axis (roll)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4103 1:1814
 Variable 4:4104 0:"B" = "Rotation of TargetPose about the Y axis (pitch)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4104 1:1815
 Variable 4:4105 0:"C" = "Rotation of TargetPose about the Z axis (yaw)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4105 1:1816
 Object 4:4106 1:"OutputParameterSet" = "The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here)." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4107
+Overrides 4:4106 1:1302
 Variable 4:4107 1:"Result" = "Outcome of the last run: Good when it ended in Ready, the Bad code of the cause when it ended in Halted. Uncertain_InitialValue before the first run." 0 0 0:19 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4107 1:1303
 Object 4:4108 3:"MotionDevices" = "The arm of the UR10e." 0 0 0 0:40>0:61 0:37>0:78 0:47>4:4109
+Overrides 4:4108 3:5002
 Object 4:4109 4:"Manipulator" = "The six-joint UR10e arm." 0 0 0 0:40>3:1004 0:37>0:78 0:47>4:4110 0:46>4:4112 0:46>4:4113 0:46>4:4114 0:46>4:4115 0:47>4:4116 0:46>4:4147 0:47>4:4148
 Object 4:4110 2:"ParameterSet" = "Runtime values of the Manipulator." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4111
+Overrides 4:4110 3:5029
 Variable 4:4111 3:"SpeedOverride" = "Speed override of the Manipulator in percent of the programmed speed." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4111 3:16365
 Variable 4:4112 2:"Manufacturer" = "Manufacturer of the arm." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68 0:37>0:78
+Overrides 4:4112 3:16351
 Variable 4:4113 2:"Model" = "Model name of the arm." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"UR10e" 0:40>0:68 0:37>0:78
+Overrides 4:4113 3:16353
 Variable 4:4114 2:"ProductCode" = "Product code of the Manipulator, as its manufacturer orders it." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4114 3:16359
 Variable 4:4115 2:"SerialNumber" = "Serial number of the Manipulator." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4115 3:16354
 Object 4:4116 3:"Axes" = "The six joints of the arm." 0 0 0 0:40>0:61 0:37>0:78 0:47>4:4117 0:47>4:4122 0:47>4:4127 0:47>4:4132 0:47>4:4137 0:47>4:4142
+Overrides 4:4116 3:15305
 Object 4:4117 4:"Base" = "Joint 1 of the UR10e (base), rotary, limited to ±360°." 0 0 0 0:40>3:16601 0:37>0:78 0:47>4:4118 0:46>4:4121
 Object 4:4118 2:"ParameterSet" = "Runtime values of the Base joint." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4119
+Overrides 4:4118 3:16602
 Variable 4:4119 3:"ActualPosition" = "Actual angle of the Base joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4120
+Overrides 4:4119 3:16662
 Variable 4:4120 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4120 3:16667
 Variable 4:4121 3:"MotionProfile" = "Motion profile of the Base joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68 0:37>0:78
+Overrides 4:4121 3:16637
 Object 4:4122 4:"Shoulder" = "Joint 2 of the UR10e (shoulder), rotary, limited to ±360°." 0 0 0 0:40>3:16601 0:37>0:78 0:47>4:4123 0:46>4:4126
 Object 4:4123 2:"ParameterSet" = "Runtime values of the Shoulder joint." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4124
+Overrides 4:4123 3:16602
 Variable 4:4124 3:"ActualPosition" = "Actual angle of the Shoulder joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4125
+Overrides 4:4124 3:16662
 Variable 4:4125 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4125 3:16667
 Variable 4:4126 3:"MotionProfile" = "Motion profile of the Shoulder joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68 0:37>0:78
+Overrides 4:4126 3:16637
 Object 4:4127 4:"Elbow" = "Joint 3 of the UR10e (elbow), rotary, limited to ±360°." 0 0 0 0:40>3:16601 0:37>0:78 0:47>4:4128 0:46>4:4131
 Object 4:4128 2:"ParameterSet" = "Runtime values of the Elbow joint." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4129
+Overrides 4:4128 3:16602
 Variable 4:4129 3:"ActualPosition" = "Actual angle of the Elbow joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4130
+Overrides 4:4129 3:16662
 Variable 4:4130 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4130 3:16667
 Variable 4:4131 3:"MotionProfile" = "Motion profile of the Elbow joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68 0:37>0:78
+Overrides 4:4131 3:16637
 Object 4:4132 4:"Wrist1" = "Joint 4 of the UR10e (wrist 1), rotary, limited to ±360°." 0 0 0 0:40>3:16601 0:37>0:78 0:47>4:4133 0:46>4:4136
 Object 4:4133 2:"ParameterSet" = "Runtime values of the Wrist1 joint." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4134
+Overrides 4:4133 3:16602
 Variable 4:4134 3:"ActualPosition" = "Actual angle of the Wrist1 joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4135
+Overrides 4:4134 3:16662
 Variable 4:4135 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4135 3:16667
 Variable 4:4136 3:"MotionProfile" = "Motion profile of the Wrist1 joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68 0:37>0:78
+Overrides 4:4136 3:16637
 Object 4:4137 4:"Wrist2" = "Joint 5 of the UR10e (wrist 2), rotary, limited to ±360°." 0 0 0 0:40>3:16601 0:37>0:78 0:47>4:4138 0:46>4:4141
 Object 4:4138 2:"ParameterSet" = "Runtime values of the Wrist2 joint." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4139
+Overrides 4:4138 3:16602
 Variable 4:4139 3:"ActualPosition" = "Actual angle of the Wrist2 joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4140
+Overrides 4:4139 3:16662
 Variable 4:4140 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4140 3:16667
 Variable 4:4141 3:"MotionProfile" = "Motion profile of the Wrist2 joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68 0:37>0:78
+Overrides 4:4141 3:16637
 Object 4:4142 4:"Wrist3" = "Joint 6 of the UR10e (wrist 3), rotary, limited to ±360°." 0 0 0 0:40>3:16601 0:37>0:78 0:47>4:4143 0:46>4:4146
 Object 4:4143 2:"ParameterSet" = "Runtime values of the Wrist3 joint." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4144
+Overrides 4:4143 3:16602
 Variable 4:4144 3:"ActualPosition" = "Actual angle of the Wrist3 joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4145
+Overrides 4:4144 3:16662
 Variable 4:4145 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4145 3:16667
 Variable 4:4146 3:"MotionProfile" = "Motion profile of the Wrist3 joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68 0:37>0:78
+Overrides 4:4146 3:16637
 Variable 4:4147 3:"MotionDeviceCategory" = "Kinematic category of the arm: an articulated robot." 0 0 3:18193 -1 [] 1 1 0 ~ Int32:1 0:40>0:68 0:37>0:78
+Overrides 4:4147 3:16362
 Object 4:4148 3:"PowerTrains" = "The six drive trains of the arm, one per joint." 0 0 0 0:40>0:61 0:37>0:78 0:47>4:4149 0:47>4:4158 0:47>4:4167 0:47>4:4176 0:47>4:4185 0:47>4:4194
+Overrides 4:4148 3:16443
 Object 4:4149 4:"BaseDrive" = "Drive train of the Base joint: its motor and gear." 0 0 0 0:40>3:16794 0:37>0:78 0:47>4:4150
 Object 4:4150 4:"Motor" = "Motor of the Base joint." 0 0 0 0:40>3:1019 0:37>0:78 0:47>4:4151 0:46>4:4154 0:46>4:4155 0:46>4:4156 0:46>4:4157
 Object 4:4151 2:"ParameterSet" = "Runtime values of the Base motor." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4152
+Overrides 4:4151 3:5105
 Variable 4:4152 3:"MotorTemperature" = "Temperature of the Base motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4153
+Overrides 4:4152 3:6757
 Variable 4:4153 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4153 3:6762
 Variable 4:4154 2:"Manufacturer" = "Manufacturer of the Base motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68 0:37>0:78
+Overrides 4:4154 3:17101
 Variable 4:4155 2:"Model" = "Model name of the Base motor." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4155 3:17103
 Variable 4:4156 2:"ProductCode" = "Product code of the Base motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4156 3:17109
 Variable 4:4157 2:"SerialNumber" = "Serial number of the Base motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4157 3:17104
 Object 4:4158 4:"ShoulderDrive" = "Drive train of the Shoulder joint: its motor and gear." 0 0 0 0:40>3:16794 0:37>0:78 0:47>4:4159
 Object 4:4159 4:"Motor" = "Motor of the Shoulder joint." 0 0 0 0:40>3:1019 0:37>0:78 0:47>4:4160 0:46>4:4163 0:46>4:4164 0:46>4:4165 0:46>4:4166
 Object 4:4160 2:"ParameterSet" = "Runtime values of the Shoulder motor." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4161
+Overrides 4:4160 3:5105
 Variable 4:4161 3:"MotorTemperature" = "Temperature of the Shoulder motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4162
+Overrides 4:4161 3:6757
 Variable 4:4162 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4162 3:6762
 Variable 4:4163 2:"Manufacturer" = "Manufacturer of the Shoulder motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68 0:37>0:78
+Overrides 4:4163 3:17101
 Variable 4:4164 2:"Model" = "Model name of the Shoulder motor." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4164 3:17103
 Variable 4:4165 2:"ProductCode" = "Product code of the Shoulder motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4165 3:17109
 Variable 4:4166 2:"SerialNumber" = "Serial number of the Shoulder motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4166 3:17104
 Object 4:4167 4:"ElbowDrive" = "Drive train of the Elbow joint: its motor and gear." 0 0 0 0:40>3:16794 0:37>0:78 0:47>4:4168
 Object 4:4168 4:"Motor" = "Motor of the Elbow joint." 0 0 0 0:40>3:1019 0:37>0:78 0:47>4:4169 0:46>4:4172 0:46>4:4173 0:46>4:4174 0:46>4:4175
 Object 4:4169 2:"ParameterSet" = "Runtime values of the Elbow motor." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4170
+Overrides 4:4169 3:5105
 Variable 4:4170 3:"MotorTemperature" = "Temperature of the Elbow motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4171
+Overrides 4:4170 3:6757
 Variable 4:4171 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4171 3:6762
 Variable 4:4172 2:"Manufacturer" = "Manufacturer of the Elbow motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68 0:37>0:78
+Overrides 4:4172 3:17101
 Variable 4:4173 2:"Model" = "Model name of the Elbow motor." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4173 3:17103
 Variable 4:4174 2:"ProductCode" = "Product code of the Elbow motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4174 3:17109
 Variable 4:4175 2:"SerialNumber" = "Serial number of the Elbow motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4175 3:17104
 Object 4:4176 4:"Wrist1Drive" = "Drive train of the Wrist1 joint: its motor and gear." 0 0 0 0:40>3:16794 0:37>0:78 0:47>4:4177
 Object 4:4177 4:"Motor" = "Motor of the Wrist1 joint." 0 0 0 0:40>3:1019 0:37>0:78 0:47>4:4178 0:46>4:4181 0:46>4:4182 0:46>4:4183 0:46>4:4184
 Object 4:4178 2:"ParameterSet" = "Runtime values of the Wrist1 motor." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4179
+Overrides 4:4178 3:5105
 Variable 4:4179 3:"MotorTemperature" = "Temperature of the Wrist1 motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4180
+Overrides 4:4179 3:6757
 Variable 4:4180 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4180 3:6762
 Variable 4:4181 2:"Manufacturer" = "Manufacturer of the Wrist1 motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68 0:37>0:78
+Overrides 4:4181 3:17101
 Variable 4:4182 2:"Model" = "Model name of the Wrist1 motor." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4182 3:17103
 Variable 4:4183 2:"ProductCode" = "Product code of the Wrist1 motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4183 3:17109
 Variable 4:4184 2:"SerialNumber" = "Serial number of the Wrist1 motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4184 3:17104
 Object 4:4185 4:"Wrist2Drive" = "Drive train of the Wrist2 joint: its motor and gear." 0 0 0 0:40>3:16794 0:37>0:78 0:47>4:4186
 Object 4:4186 4:"Motor" = "Motor of the Wrist2 joint." 0 0 0 0:40>3:1019 0:37>0:78 0:47>4:4187 0:46>4:4190 0:46>4:4191 0:46>4:4192 0:46>4:4193
 Object 4:4187 2:"ParameterSet" = "Runtime values of the Wrist2 motor." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4188
+Overrides 4:4187 3:5105
 Variable 4:4188 3:"MotorTemperature" = "Temperature of the Wrist2 motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4189
+Overrides 4:4188 3:6757
 Variable 4:4189 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4189 3:6762
 Variable 4:4190 2:"Manufacturer" = "Manufacturer of the Wrist2 motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68 0:37>0:78
+Overrides 4:4190 3:17101
 Variable 4:4191 2:"Model" = "Model name of the Wrist2 motor." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4191 3:17103
 Variable 4:4192 2:"ProductCode" = "Product code of the Wrist2 motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4192 3:17109
 Variable 4:4193 2:"SerialNumber" = "Serial number of the Wrist2 motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4193 3:17104
 Object 4:4194 4:"Wrist3Drive" = "Drive train of the Wrist3 joint: its motor and gear." 0 0 0 0:40>3:16794 0:37>0:78 0:47>4:4195
 Object 4:4195 4:"Motor" = "Motor of the Wrist3 joint." 0 0 0 0:40>3:1019 0:37>0:78 0:47>4:4196 0:46>4:4199 0:46>4:4200 0:46>4:4201 0:46>4:4202
 Object 4:4196 2:"ParameterSet" = "Runtime values of the Wrist3 motor." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4197
+Overrides 4:4196 3:5105
 Variable 4:4197 3:"MotorTemperature" = "Temperature of the Wrist3 motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4198
+Overrides 4:4197 3:6757
 Variable 4:4198 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4198 3:6762
 Variable 4:4199 2:"Manufacturer" = "Manufacturer of the Wrist3 motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68 0:37>0:78
+Overrides 4:4199 3:17101
 Variable 4:4200 2:"Model" = "Model name of the Wrist3 motor." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4200 3:17103
 Variable 4:4201 2:"ProductCode" = "Product code of the Wrist3 motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4201 3:17109
 Variable 4:4202 2:"SerialNumber" = "Serial number of the Wrist3 motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:4202 3:17104
 Object 4:4203 3:"SafetyStates" = "The safety state of the UR10e." 0 0 0 0:40>0:61 0:37>0:78 0:47>4:4204
+Overrides 4:4203 3:5010
 Object 4:4204 4:"SafetyState" = "Emergency stop, protective stop and operational mode of the UR10e." 0 0 0 0:40>3:1013 0:37>0:78 0:47>4:4205
 Object 4:4205 2:"ParameterSet" = "Runtime values of the SafetyState." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4206 0:47>4:4207 0:47>4:4208
+Overrides 4:4205 3:5016
 Variable 4:4206 3:"EmergencyStop" = "True while an emergency stop of the robot is active." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4206 3:15882
 Variable 4:4207 3:"OperationalMode" = "Operational mode of the robot: manual (reduced or high speed) or automatic." 0 0 3:3006 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4207 3:15912
 Variable 4:4208 3:"ProtectiveStop" = "True while a protective stop of the robot is active." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:4208 3:15913
 ObjectType 4:5000 4:"TemplateDrillingLwrSystemType" = "A lightweight robot system for template drilling: the robot of LwrSystemType carrying a drilling end effector. Composite skills such as DrillHole combine the move skills of the robot controller with the TemplateDrilling skill of the end effector." 0 0 0 0:45<4:3000 0:47>4:5001
 Object 4:5001 4:"DrillingEndEffector" = "The drilling end effector mounted on the flange of the robot." 0 0 0 0:40>4:2000 0:37>0:78 0:46>4:5002 0:46>4:5003 0:46>4:5004 0:47>4:5005
 Variable 4:5002 2:"Manufacturer" = "Manufacturer of the end effector." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5002 4:2001
 Variable 4:5003 2:"Model" = "Model name of the end effector." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5003 4:2002
 Variable 4:5004 2:"SerialNumber" = "Serial number of the end effector." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5004 4:2003
 Object 4:5005 1:"SkillSet" = "The skills of the end effector (ISkillSetType): TemplateDrilling." 0 0 0 0:40>0:61 0:37>0:78 0:47>4:5006
+Overrides 4:5005 4:2004
 Object 4:5006 4:"TemplateDrilling" = "Drills one hole through the drill bush the end effector sits in." 0 0 1 0:40>4:1000 0:37>0:78 0:47>4:5007 0:47>4:5010 0:46>4:5014 0:46>4:5015 0:46>4:5016 0:47>4:5017 0:47>4:5018 0:47>4:5019 0:47>4:5020 0:47>4:5031
+Overrides 4:5006 4:2005
 Variable 4:5007 0:"CurrentState" = "The state the TemplateDrilling skill is in: Ready, Running, Suspended or Halted." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:2760 0:37>0:78 0:46>4:5008 0:46>4:5009
+Overrides 4:5007 4:2006
 Variable 4:5008 0:"Id" = "NodeId of the current state (a state of ProgramStateMachineType)." 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5008 4:2007
 Variable 4:5009 0:"Number" = "Number of the current state: Halted 11, Ready 12, Running 13, Suspended 14." 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5009 4:2008
 Variable 4:5010 0:"LastTransition" = "The last state change of the TemplateDrilling skill." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:2767 0:37>0:78 0:46>4:5011 0:46>4:5012 0:46>4:5013
+Overrides 4:5010 4:2009
 Variable 4:5011 0:"Id" = "NodeId of the last transition (a transition of ProgramStateMachineType)." 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5011 4:2010
 Variable 4:5012 0:"Number" = "Number of the last transition, as ProgramStateMachineType numbers them." 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5012 4:2011
 Variable 4:5013 0:"TransitionTime" = "When the last transition happened." 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5013 4:2012
 Variable 4:5014 0:"Deletable" = "Whether a client may delete the TemplateDrilling skill; false, the skill belongs to its owner." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5014 4:2013
 Variable 4:5015 0:"AutoDelete" = "Whether the server removes the TemplateDrilling skill when a run ends; false, the skill stays." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5015 4:2014
 Variable 4:5016 0:"RecycleCount" = "How often the TemplateDrilling skill has been reset from Halted to Ready." 0 0 0:6 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5016 4:2015
 Method 4:5017 0:"Start" = "Starts the skill with the current values of InputParameterSet (Ready to Running)." 0 0 1 1 0:37>0:78
+Overrides 4:5017 4:2016
 Method 4:5018 0:"Halt" = "Aborts the skill (Ready, Running or Suspended to Halted)." 0 0 1 1 0:37>0:78
+Overrides 4:5018 4:2017
 Method 4:5019 0:"Reset" = "Brings the halted skill back to Ready so that it can be started again." 0 0 1 1 0:37>0:78
+Overrides 4:5019 4:2018
 Object 4:5020 1:"InputParameterSet" = "The drilling parameters: HoleDiameter, Depth, FeedRate, SpindleSpeed and ClampForce." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:5021 0:47>4:5023 0:47>4:5025 0:47>4:5027 0:47>4:5029
+Overrides 4:5020 4:2019
 Variable 4:5021 4:"HoleDiameter" = "Nominal diameter of the hole, in millimetres; selects and checks the drill." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:5022
+Overrides 4:5021 4:2020
 Variable 4:5022 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5022 4:2021
 Variable 4:5023 4:"Depth" = "Depth to drill, in millimetres, measured from the face of the drill bush." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:5024
+Overrides 4:5023 4:2022
 Variable 4:5024 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5024 4:2023
 Variable 4:5025 4:"FeedRate" = "Feed of the drill along its axis, in millimetres per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:5026
+Overrides 4:5025 4:2024
 Variable 4:5026 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5026 4:2025
 Variable 4:5027 4:"SpindleSpeed" = "Rotational speed of the spindle, in revolutions per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:5028
+Overrides 4:5027 4:2026
 Variable 4:5028 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5028 4:2027
 Variable 4:5029 4:"ClampForce" = "Force the nose clamps the stack against the template with, in newtons." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:5030
+Overrides 4:5029 4:2028
 Variable 4:5030 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 4:5030 4:2029
 Object 4:5031 1:"OutputParameterSet" = "The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here)." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:5032
+Overrides 4:5031 4:2030
 Variable 4:5032 1:"Result" = "Outcome of the last run: Good when it ended in Ready, the Bad code of the cause when it ended in Halted. Uncertain_InitialValue before the first run." 0 0 0:19 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 4:5032 4:2031
 "#)),
 };

@@ -34,6 +34,7 @@ mod recursion;
 mod table;
 
 pub use objects::marker_name;
+pub use table::NodeTable;
 
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::model::{ids, DataTypeKind, Model, NodeIx, StructureKind};
@@ -83,6 +84,20 @@ pub struct RustOutput {
 pub fn default_module_name(uri: &str) -> String {
     let seg = uri.trim_end_matches('/').rsplit(['/', ':']).next().unwrap_or(uri);
     names::sanitize(seg, Case::Snake, Target::Rust)
+}
+
+/// The node tables of `cfg`'s namespaces, as data (what each `nodes.rs` holds), with the diagnostics of
+/// building them: for a server built in memory, with no Rust compiled.
+pub fn node_tables(model: &Model, cfg: &RustConfig) -> (Vec<NodeTable>, Diagnostics) {
+    let mut diags = Diagnostics::new();
+    let mut tables = Vec::new();
+    for ns_cfg in &cfg.namespaces {
+        let Some(ns) = model.namespaces.iter().position(|u| *u == ns_cfg.uri) else { continue };
+        let mut g = Gen::new(model, cfg, ns as u16, &ns_cfg.module);
+        tables.push(g.table_data());
+        diags.extend(g.diags);
+    }
+    (tables, diags)
 }
 
 /// Generates Rust for the configured namespaces.

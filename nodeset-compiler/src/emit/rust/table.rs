@@ -130,8 +130,64 @@ fn raw_string(text: &str) -> String {
     format!("r{hashes}\"{text}\"{hashes}")
 }
 
+/// The node table of one namespace, the data of a generated `nodes.rs`: what the runtime's `NodeSetTable`
+/// holds (see `nodeset-runtime/src/table.rs` for the packed format of `rows`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct NodeTable {
+    /// The namespace the table defines.
+    pub namespace_uri: String,
+    /// The model's version, or empty.
+    pub version: String,
+    /// The model's publication date, or empty.
+    pub publication_date: String,
+    /// Table-local namespace index to URI; index 0 is the OPC UA namespace.
+    pub namespaces: Vec<String>,
+    /// The index of `namespace_uri` in `namespaces`.
+    pub own: u16,
+    /// The packed rows, one line per node.
+    pub rows: String,
+}
+
 impl Gen<'_> {
     pub(super) fn nodes_file(&mut self) -> OutFile {
+        let table = self.table_data();
+        let uri = lit(&table.namespace_uri);
+        let version = lit(&table.version);
+        let date = lit(&table.publication_date);
+        let ns_uris: Vec<Literal> = table.namespaces.iter().map(|u| lit(u)).collect();
+        let own = table.own;
+        let rows = table.rows;
+        let runtime = &self.cfg.runtime_path;
+        let head = quote! {
+            //! The address space of this namespace as data, imported into a server by the runtime.
+            use #runtime as rt;
+        };
+        let head_file: syn::File = syn::parse2(head).expect("internal error: the table head does not parse");
+        let mut text = prettyplease::unparse(&head_file);
+        let table_head = quote! {
+            pub static TABLE: rt::table::NodeSetTable = rt::table::NodeSetTable {
+                namespace_uri: #uri,
+                version: #version,
+                publication_date: #date,
+                namespaces: &[#(#ns_uris),*],
+                own: #own,
+                nodes: rt::table::Nodes::Packed(rt::table::Packed::new(ROWS)),
+            };
+        };
+        let table_file: syn::File = syn::parse2(table_head).expect("internal error: table does not parse");
+        let table_text = prettyplease::unparse(&table_file);
+        let table_text = table_text.replacen("ROWS", &raw_string(&format!("\n{rows}")), 1);
+        text.push('\n');
+        text.push_str(
+            "/// Every node of this namespace, one line per node, in the packed format of [`rt::table`] (decoded on\n\
+             /// first use).\n",
+        );
+        text.push_str(&table_text);
+        OutFile { path: PathBuf::from(&self.module).join("nodes.rs"), contents: format!("{}{text}", self.header("Address space")) }
+    }
+
+    /// The node table of the namespace as data: what `nodes.rs` holds, for a server built in memory.
+    pub(super) fn table_data(&mut self) -> NodeTable {
         let model = self.model;
         // Table-local namespace indices: 0 is ns0, then every namespace a row refers to, in global order.
         let mut used: BTreeSet<u16> = BTreeSet::new();
@@ -271,6 +327,15 @@ impl Gen<'_> {
                 }
                 out.push('\n');
             }
+            // The declaration this one overrides at its browse path (`Model::overridden`), on a line of its
+            // own, so that the runtime's `instantiate` merges the members the model merged.
+            if let Some(&over) = self.model.overridden.get(&ix) {
+                out.push_str("Overrides ");
+                id_of(out, ix);
+                out.push(' ');
+                id_of(out, over);
+                out.push('\n');
+            }
         }
         if dropped_values > 0 {
             self.diags.push(
@@ -281,39 +346,15 @@ impl Gen<'_> {
                 .help("Argument and EnumValueType values are supported; other ExtensionObject values are not yet"),
             );
         }
-        let uri = lit(self.uri());
         let m = model.model_of_namespace(self.ns);
-        let version = lit(m.and_then(|m| m.version.as_deref()).unwrap_or(""));
-        let date = lit(m.and_then(|m| m.publication_date.as_deref()).unwrap_or(""));
-        let ns_uris: Vec<Literal> = locals.iter().map(|&g| lit(model.namespace_uri(g))).collect();
-        let own = local(self.ns);
-        let runtime = &self.cfg.runtime_path;
-        let head = quote! {
-            //! The address space of this namespace as data, imported into a server by the runtime.
-            use #runtime as rt;
-        };
-        let head_file: syn::File = syn::parse2(head).expect("internal error: the table head does not parse");
-        let mut text = prettyplease::unparse(&head_file);
-        let table_head = quote! {
-            pub static TABLE: rt::table::NodeSetTable = rt::table::NodeSetTable {
-                namespace_uri: #uri,
-                version: #version,
-                publication_date: #date,
-                namespaces: &[#(#ns_uris),*],
-                own: #own,
-                nodes: rt::table::Nodes::Packed(rt::table::Packed::new(ROWS)),
-            };
-        };
-        let table_file: syn::File = syn::parse2(table_head).expect("internal error: table does not parse");
-        let table_text = prettyplease::unparse(&table_file);
-        let table_text = table_text.replacen("ROWS", &raw_string(&format!("\n{rows}")), 1);
-        text.push('\n');
-        text.push_str(
-            "/// Every node of this namespace, one line per node, in the packed format of [`rt::table`] (decoded on\n\
-             /// first use).\n",
-        );
-        text.push_str(&table_text);
-        OutFile { path: PathBuf::from(&self.module).join("nodes.rs"), contents: format!("{}{text}", self.header("Address space")) }
+        NodeTable {
+            namespace_uri: self.uri().to_owned(),
+            version: m.and_then(|m| m.version.clone()).unwrap_or_default(),
+            publication_date: m.and_then(|m| m.publication_date.clone()).unwrap_or_default(),
+            namespaces: locals.iter().map(|&g| model.namespace_uri(g).to_owned()).collect(),
+            own: local(self.ns),
+            rows,
+        }
     }
 
     /// Appends the definition of a data type, or `~`.
