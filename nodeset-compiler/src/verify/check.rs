@@ -382,7 +382,8 @@ impl<'a> Checker<'a> {
                 let d = Diagnostic::new(
                     Code::WrongValueType,
                     format!("`{path}` holds {shape} {got:?}, but its DataType is {want} and its ValueRank {rank}"),
-                );
+                )
+                .help("a client decodes the value by its DataType: give it the DataType's encoding (an enumeration is an Int32)");
                 self.push(at(d, format!("declared with the DataType {}", model.qualified(dt))), path, &node.id);
             }
         }
