@@ -53,8 +53,9 @@ macro_rules! codes {
 }
 
 const NO: Option<&str> = None;
-/// What demoting a finding of `verify` does: verification goes on either way, so only the exit status changes.
-const VERIFY_RECOVERY: Option<&str> = Some("the finding is reported as a warning (or, allowed, not at all) and does not fail verify");
+/// What demoting a finding of the instance rules does: checking goes on either way, so only the exit status
+/// changes.
+const VERIFY_RECOVERY: Option<&str> = Some("the finding is reported as a warning (or, allowed, not at all) and does not fail check or verify");
 
 codes! {
     // Reading and parsing one file.
@@ -100,7 +101,7 @@ codes! {
     UnknownFieldType = "NS0207", Error, "a structure field has an unknown DataType", NO;
     DuplicateEnumValue = "NS0208", Error, "an enumeration, OptionSet or structure repeats a value or a name",
         Some("the later entry is dropped");
-    ValueTypeMismatch = "NS0209", Warning, "a value contradicts its DataType", Some("the value is kept as written");
+    ValueTypeMismatch = "NS0209", Warning, "a value in a type contradicts its DataType (an instance's value: NS0406)", Some("the value is kept as written");
     BadSubtype = "NS0210", Error, "a HasSubtype reference joins nodes of different classes",
         Some("the wrong supertype is ignored (of several supertypes, the first is used)");
     MissingTypeDefinition = "NS0211", Warning, "an instance has no TypeDefinition", Some("the instance is generated without a type");
@@ -126,8 +127,9 @@ codes! {
         Some("the feature is left out of the generated code");
     Ns0Named = "NS0303", Error, "the base namespace is named for Rust, which async-opcua provides",
         Some("the base namespace is not generated: generated code uses async-opcua's, as when its file is only in --models");
-    // Verifying a live server against its nodesets (`nodeset-compiler verify`).
-    MissingMember = "NS0401", Error, "a mandatory member is missing on the server", VERIFY_RECOVERY;
+    // Instances against their types: the static instances of the files (`nodeset-compiler check`) and a live
+    // server's (`nodeset-compiler verify`), by one checker.
+    MissingMember = "NS0401", Error, "a mandatory member (or anything in a mandatory placeholder's place) is missing", VERIFY_RECOVERY;
     WrongNodeClass = "NS0402", Error, "a member has another NodeClass than its declaration", VERIFY_RECOVERY;
     WrongTypeDefinition = "NS0403", Error, "a TypeDefinition is neither the declared type nor a subtype of it", VERIFY_RECOVERY;
     WrongDataType = "NS0404", Error, "a DataType is neither the declared DataType nor a subtype of it", VERIFY_RECOVERY;

@@ -70,7 +70,8 @@ impl Common {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Parse, load and resolve NodeSet2 files; print diagnostics and a per-namespace summary.
+    /// Parse, load and resolve NodeSet2 files, check their static instances with the rules of `verify`
+    /// (NS0401...NS0408); print diagnostics and a per-namespace summary.
     Check {
         #[command(flatten)]
         common: Common,
@@ -257,7 +258,9 @@ fn modelica_command(common: &Common, out: &Path, externs: &[String], check: bool
 fn check_command(common: &Common, all_warnings: bool, show: &[String], depth: usize) -> Result<(), Error> {
     let (inputs, mut opts) = common.options()?;
     opts.all_warnings = all_warnings;
-    let out = compile(inputs, &opts);
+    let mut out = compile(inputs, &opts);
+    // The static instances meet the rules `verify` applies to a server, with the same codes.
+    nodeset_compiler::verify::instances::check_compiled(&mut out, &opts);
     eprint!("{}", out.render_diagnostics());
     print!("{}", summary::render(&out.model));
     for q in show {

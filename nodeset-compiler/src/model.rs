@@ -26,6 +26,8 @@ pub fn article(word: &str) -> &'static str {
 
 /// Well-known NodeIds of namespace 0.
 pub mod ids {
+    /// ObjectsFolder: where a server's instances start.
+    pub const OBJECTS_FOLDER: u32 = 85;
     /// The References ReferenceType, root of all ReferenceTypes.
     pub const REFERENCES: u32 = 31;
     /// The HierarchicalReferences ReferenceType.
@@ -745,6 +747,47 @@ impl Model {
             path.clear();
         }
         depth
+    }
+
+    /// For every node, whether it belongs to an instance of the files rather than to a type: a node outside
+    /// namespace 0 that is not a type and whose parent chain ([`Node::parent`]) reaches no type. These are
+    /// the nodes the instance rules check (`check` through [`crate::verify::instances`], as `verify` checks
+    /// a server's); types, their InstanceDeclarations and namespace 0 (the server stack's own) are not. A
+    /// parent cycle counts as reaching no type. One pass: each node's answer is remembered for the nodes
+    /// below it.
+    pub fn instance_nodes(&self) -> Vec<bool> {
+        #[derive(Clone, Copy, PartialEq)]
+        enum S {
+            Unknown,
+            InType,
+            Free,
+            Walking,
+        }
+        let mut state = vec![S::Unknown; self.nodes.len()];
+        let mut path: Vec<usize> = Vec::new();
+        for start in 0..self.nodes.len() {
+            let mut cur = Some(start);
+            // Up the parent chain to a node whose answer is known, a type, a root or a cycle.
+            let answer = loop {
+                let Some(i) = cur else { break S::Free };
+                match state[i] {
+                    S::Unknown => {}
+                    S::Walking => break S::Free,
+                    known => break known,
+                }
+                if self.nodes[i].class.is_type() {
+                    state[i] = S::InType;
+                    break S::InType;
+                }
+                state[i] = S::Walking;
+                path.push(i);
+                cur = self.nodes[i].parent.map(NodeIx::index);
+            };
+            for i in path.drain(..) {
+                state[i] = answer;
+            }
+        }
+        self.nodes.iter().zip(state).map(|(n, s)| s == S::Free && n.id.ns != 0 && !n.class.is_type()).collect()
     }
 
     /// Whether `reference_type` is HierarchicalReferences or a subtype, HasSubtype and its subtypes excepted.

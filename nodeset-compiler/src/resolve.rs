@@ -1121,8 +1121,13 @@ fn value_fits(model: &Model, data_types: &BTreeMap<NodeIx, DataTypeInfo>, dt: No
     }
 }
 
-/// Pass 8: every value against its node's DataType (given before they join the model) and ValueRank.
+/// Pass 8: every value in a type (an InstanceDeclaration's, a VariableType's, a DataType's EnumStrings) and in
+/// namespace 0 against its node's DataType (given before they join the model) and ValueRank: NS0209. The
+/// values of the files' instances ([`Model::instance_nodes`]) are not checked here: the instance rules,
+/// which `check` and `verify` share, check them (NS0406), so that one defect is one finding with one code.
+/// Every value is decoded here either way, so an undecodable one is NS0214 wherever it is.
 fn check_values(model: &Model, data_types: &BTreeMap<NodeIx, DataTypeInfo>, diags: &mut Diagnostics) {
+    let instance = model.instance_nodes();
     for (i, node) in model.nodes.iter().enumerate() {
         let ix = NodeIx(i as u32);
         // The check needs the type and shape of the value only, not copies of what it holds.
@@ -1139,6 +1144,9 @@ fn check_values(model: &Model, data_types: &BTreeMap<NodeIx, DataTypeInfo>, diag
             }
             None => continue,
         };
+        if instance[i] {
+            continue;
+        }
         let Some(dt) = node.attrs.data_type else { continue };
         let Some(have) = v.builtin() else { continue };
         if !value_fits(model, data_types, dt, have) {

@@ -104,6 +104,28 @@ fn the_codes_table_lists_the_verify_codes() {
     let output = run(&["codes", "NS0401", "NS0409"]);
     let stdout = String::from_utf8_lossy(&output.stdout);
     assert!(output.status.success(), "{stdout}");
-    assert!(stdout.contains("NS0401 error   a mandatory member is missing on the server"), "{stdout}");
+    assert!(stdout.contains("NS0401 error   a mandatory member (or anything in a mandatory placeholder's place) is missing"), "{stdout}");
     assert!(stdout.contains("demotable: with --warn NS0409 or --allow NS0409"), "{stdout}");
+}
+
+#[test]
+fn check_applies_the_instance_rules_of_verify_to_static_instances() {
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let fixture = format!("{root}/tests/fixtures/bad/static_instances.xml");
+    let vendor = format!("{root}/nodesets/vendor");
+    let output = run(&["check", &fixture, "--models", &vendor]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "the planted defects are errors, as in verify: {stderr}");
+    for code in ["NS0401", "NS0403", "NS0404", "NS0405", "NS0406", "NS0408"] {
+        assert!(stderr.contains(&format!("error[{code}]")), "no {code}: {stderr}");
+    }
+    assert!(stderr.contains("error[NS0406]: `1:Bad/1:Mode` holds a scalar UInt16, but its DataType is"), "{stderr}");
+    assert!(stderr.contains("7 error(s), 1 warning(s)"), "{stderr}");
+    // Demoted as in verify: `--warn` makes them warnings, and check passes.
+    let demoted = ["--warn", "NS0401", "--warn", "NS0403", "--warn", "NS0404", "--warn", "NS0405", "--warn", "NS0406", "--warn", "NS0408"];
+    let args: Vec<&str> = ["check", fixture.as_str(), "--models", vendor.as_str()].into_iter().chain(demoted).collect();
+    let output = run(&args);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(stderr.contains("0 error(s), 8 warning(s)"), "{stderr}");
 }

@@ -1,7 +1,8 @@
 //! The bad-input suite: one minimal NodeSet2 file per user mistake (or hostile input) under
 //! `tests/fixtures/bad/`, each compiled against the pinned base model and checked three ways:
 //!
-//! 1. the compiler returns (a panic is caught and reported with the case's name);
+//! 1. the compiler returns (a panic is caught and reported with the case's name); what is checked is what
+//!    `nodeset-compiler check` reports: the compiler's diagnostics and the instance rules' findings;
 //! 2. the expected code is present with its severity, and where the fix belongs is where the caret points
 //!    (the line of the fixture holding a given piece of text);
 //! 3. the rendered diagnostics match an insta snapshot (`tests/tests/snapshots/diagnostics__<case>.snap`).
@@ -48,7 +49,13 @@ fn run_with(case: &str, inputs: Vec<Input>, opts: Options) -> Run {
             Input::Text { name, .. } => name.clone(),
         })
         .collect();
-    let out = match catch_unwind(AssertUnwindSafe(|| compile(inputs, &opts))) {
+    // What `nodeset-compiler check` does: compile, then the instance rules over the static instances.
+    let check = |inputs: Vec<Input>| {
+        let mut out = compile(inputs, &opts);
+        nodeset_compiler::verify::instances::check_compiled(&mut out, &opts);
+        out
+    };
+    let out = match catch_unwind(AssertUnwindSafe(|| check(inputs))) {
         Ok(out) => out,
         Err(e) => {
             let msg = e
@@ -823,18 +830,59 @@ fn enum_duplicate_names() {
 
 #[test]
 fn value_contradicts_datatype() {
+    // The value of an instance: the instance rules' NS0406 (an error, as `verify` reports it on a server),
+    // and not the resolver's NS0209 as well.
     let r = file("value_contradicts_datatype");
-    let d = r.warning("NS0209");
-    r.here(d, "<String xmlns").has_help(d);
-    assert!(r.out.ok(), "a contradicting value is a warning:\n{}", r.rendered);
+    let d = r.error("NS0406");
+    r.here(d, "<String xmlns");
+    r.absent("NS0209");
     r.snapshot();
 }
 
 #[test]
 fn value_rank_mismatch() {
+    // The value of a type: the resolver's NS0209.
     let r = file("value_rank_mismatch");
     let d = r.warning("NS0209");
     r.here(d, "<Int32 xmlns").has_help(d);
+    r.snapshot();
+}
+
+#[test]
+fn static_instances() {
+    // Each defect of `Objects/Bad` once, with the code and severity `verify` gives it on a server, pointing
+    // at the instance in the file; `Objects/Good` has none.
+    let r = file("static_instances");
+    let found: Vec<(&str, &str, usize)> = r
+        .out
+        .diagnostics
+        .items
+        .iter()
+        .map(|d| (d.code.as_str(), d.severity.as_str(), r.position(d).1))
+        .collect();
+    let line = |text: &str| r.line_of("static_instances.xml", text);
+    let bad = line("<UAObject NodeId=\"ns=1;s=Bad\"");
+    let want = vec![
+        ("NS0401", "error", bad),
+        ("NS0401", "error", bad),
+        ("NS0403", "error", line("<UAObject NodeId=\"ns=1;s=Bad.Lid2\"")),
+        ("NS0404", "error", line("<UAVariable NodeId=\"ns=1;s=Bad.Speed\"")),
+        ("NS0405", "error", line("<UAVariable NodeId=\"ns=1;s=Bad.Speed\"")),
+        ("NS0406", "error", line("<UInt16 xmlns")),
+        ("NS0408", "error", bad),
+        ("NS0209", "warning", line("<String xmlns")),
+    ];
+    let mut sorted = found.clone();
+    sorted.sort();
+    let mut want_sorted = want.clone();
+    want_sorted.sort();
+    if sorted != want_sorted {
+        r.fail(&format!("expected {want:?}, found {found:?}"));
+    }
+    // The violated declaration is a label, the browse path a note.
+    let missing = r.with("NS0401");
+    assert!(missing.iter().any(|d| d.message.contains("`1:Bad` has no mandatory Object `1:Lid`")), "{}", r.rendered);
+    assert!(r.rendered.contains("the instance: `1:Bad/1:Mode`"), "{}", r.rendered);
     r.snapshot();
 }
 

@@ -5,7 +5,11 @@
 //! - the robot cell's three servers (with `--insecure`): no violation;
 //! - a node-opcua server (`tests/node-peer/server.js`, installed by `cargo xtask node-peer`) with ns0, DI, IA
 //!   and Robotics, one correct MotionDeviceSystem and one with three planted defects: exactly those three;
-//! - a server namespace no nodeset defines: NS0409, and the run fails.
+//! - a server namespace no nodeset defines: NS0409, and the run fails;
+//! - NodeSet2 files served as they are by node-opcua (`tests/node-peer/serve.js`): a fixture with planted
+//!   defects and files of the UA-Nodeset tree with static instances; `verify` of that server and `check` of
+//!   the files give the same findings (codes, severities, paths);
+//! - a server that does not trust verify's certificate: verify says so at once, and what to do.
 //!
 //! Bad input without a server (no server, a malformed URL, a file that is not a nodeset) is tested in
 //! `nodeset-compiler/tests/cli.rs`.
@@ -16,7 +20,10 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use nodeset_tests::{executable, root, vendor};
+use nodeset_compiler::diag::Severities;
+use nodeset_compiler::load::Input;
+use nodeset_compiler::{compile, Options};
+use nodeset_tests::{corpus, executable, root, vendor};
 use process_support::Process;
 
 /// The URLs of the next `n` lines that contain `listening on <url>`.
@@ -241,6 +248,135 @@ fn a_server_namespace_without_a_nodeset_is_reported() {
     assert!(json.contains("\"unknown_namespaces\":[") && json.contains("http://opcfoundation.org/UA/Robotics/"), "{json}");
     let found = findings(&json);
     assert!(!found.is_empty() && found.iter().all(|(code, _)| code == "NS0409"), "{json}");
+    drop(server);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// (code, severity, path) of every finding of a `--json` report, each namespace prefix of the path replaced
+/// by its URI from the report's `namespaces`, sorted: comparable across two numberings of the namespaces.
+fn findings_by_uri(json: &str) -> Vec<(String, String, String)> {
+    let at = json.find("\"namespaces\":[").unwrap_or_else(|| panic!("no namespaces in {json}")) + 14;
+    let list = &json[at..at + json[at..].find(']').unwrap()];
+    let namespaces: Vec<String> = list.split(',').map(|u| u.trim_matches('"').to_owned()).collect();
+    let mut out = Vec::new();
+    for part in json.split("{\"code\":").skip(1) {
+        let field = |key: &str| {
+            let at = part.find(&format!("\"{key}\":\"")).unwrap() + key.len() + 4;
+            part[at..at + part[at..].find('"').unwrap()].to_owned()
+        };
+        out.push((part[1..7].to_owned(), field("severity"), by_uri(&field("path"), &namespaces)));
+    }
+    out.sort();
+    out
+}
+
+/// A browse path (`2:DeviceSet/1:Robot`) with each namespace index replaced by `namespaces[index]`.
+fn by_uri(path: &str, namespaces: &[String]) -> String {
+    let segments: Vec<String> = path
+        .split('/')
+        .map(|seg| match seg.split_once(':').and_then(|(ns, name)| Some((namespaces.get(ns.parse::<usize>().ok()?)?, name))) {
+            Some((uri, name)) => format!("{uri}|{name}"),
+            None => seg.to_owned(),
+        })
+        .collect();
+    segments.join("/")
+}
+
+#[test]
+fn check_and_verify_agree_on_static_instances_served_by_node_opcua() {
+    let dir = node_peer();
+    let tree = corpus();
+    // A fixture with one planted defect of each kind, and files of the UA-Nodeset tree with static
+    // instances below the Objects folder that break the rules (GDS: a missing mandatory member; DEXPI:
+    // ModellingRules on instances; the laser system example: missing mandatory variables), with the models
+    // they require, from the same tree (DI and Machinery among them, with static instances of their own).
+    let named: Vec<PathBuf> = [
+        root().join("tests/fixtures/bad/static_instances.xml"),
+        tree.join("GDS/Opc.Ua.Gds.NodeSet2.xml"),
+        tree.join("DEXPI/Opc.Ua.DEXPI.NodeSet2.xml"),
+        tree.join("LaserSystems/LaserSystem-Example.NodeSet2.xml"),
+    ]
+    .into();
+    let opts = Options { model_dirs: vec![tree.clone()], ..Options::default() };
+    let loaded = compile(named.iter().cloned().map(Input::Path).collect(), &opts);
+    assert!(loaded.ok(), "{}", loaded.render_diagnostics());
+    // Every file loaded, dependencies first: what the server loads, and what both checks read.
+    let files: Vec<PathBuf> = loaded.model.sources.files().map(|(_, f)| f.path.clone()).collect();
+    // `check`: every file named, so that the instances of the required models are checked as well.
+    let opts = Options::default();
+    let compiled = compile(files.iter().cloned().map(Input::Path).collect(), &opts);
+    let mut report = nodeset_compiler::verify::instances::check(&compiled.model);
+    report.apply(&Severities::new(), &compiled.model.sources);
+    // A server's walk starts at the Objects folder's children outside namespace 0: the instances a file
+    // hangs below the Server object (NamespaceMetadata) are `check`'s alone.
+    report.findings.retain(|f| f.path.split('/').next().is_some_and(|top| top.contains(':')));
+    let mut checked: Vec<(String, String, String)> = report
+        .findings
+        .iter()
+        .map(|f| (f.diagnostic.code.as_str().to_owned(), f.diagnostic.severity.as_str().to_owned(), by_uri(&f.path, &report.namespaces)))
+        .collect();
+    checked.sort();
+    // The defects planted in the fixture are among them.
+    let fixture = "http://example.com/bad/static_instances/|Bad";
+    let planted: Vec<&str> = checked.iter().filter(|f| f.2.starts_with(fixture)).map(|f| f.0.as_str()).collect();
+    assert_eq!(planted, ["NS0401", "NS0401", "NS0403", "NS0404", "NS0405", "NS0406", "NS0408"], "{checked:#?}");
+    assert!(checked.len() > planted.len(), "the corpus files should add findings of their own: {checked:#?}");
+
+    let port = free_port().to_string();
+    let mut command = Command::new("node");
+    command.current_dir(&dir).arg("serve.js").arg(&port).args(&files);
+    let server = Process::spawn(&mut command).unwrap_or_else(|e| panic!("{e}"));
+    let url = urls(&server, 1).remove(0);
+    let args: Vec<String> = files.iter().map(|f| f.display().to_string()).chain(["--insecure".to_owned()]).collect();
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let (output, json) = verify(&url, &args, &[]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    let mut verified = findings_by_uri(&json);
+    // One defect node-opcua hides: its loader does not serve the enumeration's UInt16 as the file writes
+    // it (it reads back as UncertainInitialValue), so that server cannot show it; a server that serves the
+    // value as written (ours, issue 37) gives verify the same NS0406 that check gives.
+    let repaired = ("NS0406".to_owned(), "error".to_owned(), format!("{fixture}/http://example.com/bad/static_instances/|Mode"));
+    assert!(!verified.contains(&repaired), "{json}");
+    verified.push(repaired);
+    verified.sort();
+    assert_eq!(checked, verified, "check (left) and verify (right) disagree\n{json}\n{stderr}");
+    assert_eq!(output.status.code(), Some(1), "violations give exit status 1: {stderr}");
+    drop(server);
+}
+
+#[test]
+fn a_server_that_does_not_trust_verify_says_so_at_once() {
+    let dir = temp_dir("robot-untrusting");
+    let (server_pki, client_pki) = (dir.join("server-pki"), dir.join("client-pki"));
+    // No --trust-on-first-use: the robot refuses a client certificate it has not been told to trust.
+    let mut command = Command::new(executable("example", "robot"));
+    command.args(["--port", "0", "--pki", server_pki.to_str().unwrap()]);
+    let server = Process::spawn(&mut command).unwrap_or_else(|e| panic!("{e}"));
+    let url = urls(&server, 1).remove(0);
+    let models = models();
+    // Verify trusts the server (--trust-server-cert), so only the server's refusal is left.
+    let args: Vec<&str> =
+        models.iter().map(String::as_str).chain(["--pki", client_pki.to_str().unwrap(), "--trust-server-cert"]).collect();
+    let start = std::time::Instant::now();
+    let (output, _) = verify(&url, &args, &[]);
+    let took = start.elapsed();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(took < std::time::Duration::from_secs(5), "the refusal took {took:?}, not well under the 10 s timeout: {stderr}");
+    assert!(stderr.contains("the server rejected verify's application certificate (BadCertificateUntrusted)")
+        || stderr.contains("the server rejected verify's application certificate (BadSecurityChecksFailed)"), "{stderr}");
+    let own = client_pki.join("own/cert.der");
+    assert!(stderr.contains(&format!("verify's certificate is {}", own.display())), "{stderr}");
+    assert!(stderr.contains("move it from there to `trusted/`"), "{stderr}");
+    // The advice holds: the server has put verify's certificate in its `rejected/` folder ...
+    let rejected: Vec<PathBuf> = std::fs::read_dir(server_pki.join("rejected")).unwrap().map(|e| e.unwrap().path()).collect();
+    assert_eq!(rejected.len(), 1, "{rejected:?}");
+    assert_eq!(std::fs::read(&rejected[0]).unwrap(), std::fs::read(&own).unwrap(), "the server rejected another certificate");
+    // ... and once moved to `trusted/`, verify gets its session (a running server reads `trusted/` on each
+    // connection).
+    std::fs::rename(&rejected[0], server_pki.join("trusted").join(rejected[0].file_name().unwrap())).unwrap();
+    assert_clean(&url, &["--pki", client_pki.to_str().unwrap(), "--trust-server-cert"], &[]);
     drop(server);
     let _ = std::fs::remove_dir_all(&dir);
 }

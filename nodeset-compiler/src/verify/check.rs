@@ -1,4 +1,6 @@
-//! The rules of `verify`: a pure function of the resolved model and a [`Snapshot`] of a server.
+//! The instance rules: a pure function of the resolved model and a [`Snapshot`], read from a live server
+//! (`verify`, [`super::client`]) or made from the static instances of the files (`check`,
+//! [`super::instances`]), so that both apply the same rules with the same codes and severities.
 //!
 //! Every instance is checked against a *declaration*: the instance declaration it fills (a member of its
 //! parent's type, or of the parent's own declaration), or, for an instance that fills none (a top-level
@@ -27,6 +29,8 @@ pub struct Finding {
     pub path: String,
     /// The server node, as `ns=N;i=M` in the server's numbering (the parent's for a missing member).
     pub node: String,
+    /// The same node as a NodeId, in the snapshot's numbering.
+    pub id: NodeId,
 }
 
 /// What [`check`] found.
@@ -40,6 +44,8 @@ pub struct Report {
     pub instances: usize,
     /// Server namespaces no loaded nodeset defines (their nodes are not checked against types).
     pub unknown_namespaces: Vec<String>,
+    /// The snapshot's NamespaceArray: what the namespace prefixes of the paths (`2:DeviceSet`) number.
+    pub namespaces: Vec<String>,
     /// Round trips of the snapshot.
     pub round_trips: u32,
 }
@@ -90,8 +96,15 @@ impl Report {
     }
 }
 
-/// Checks every instance of the snapshot against the model.
+/// Checks every instance of the snapshot against the model, walking from the Objects folder.
 pub fn check(model: &Model, snap: &Snapshot) -> Report {
+    check_from(model, snap, &[])
+}
+
+/// [`check`], then every node of `more` the walk from the Objects folder did not reach, in that order, as an
+/// instance of its own type, below the browse path given with it (the nodes of a file that hang elsewhere,
+/// such as below the Server object, or nowhere).
+pub fn check_from(model: &Model, snap: &Snapshot, more: &[(NodeId, String)]) -> Report {
     let to_model: Vec<Option<u16>> =
         snap.namespaces.iter().map(|uri| model.namespaces.iter().position(|m| m == uri).map(|i| i as u16)).collect();
     let unknown_namespaces = snap
@@ -103,6 +116,7 @@ pub fn check(model: &Model, snap: &Snapshot) -> Report {
         .collect();
     let mut c = Checker { model, snap, to_model, seen: BTreeSet::new(), report: Report::default() };
     c.report.unknown_namespaces = unknown_namespaces;
+    c.report.namespaces = snap.namespaces.clone();
     c.report.round_trips = snap.round_trips;
     let root = Snapshot::objects_folder();
     if let Some(objects) = snap.nodes.get(&root) {
@@ -110,6 +124,11 @@ pub fn check(model: &Model, snap: &Snapshot) -> Report {
             if child.ns != 0 {
                 c.root(&child, "");
             }
+        }
+    }
+    for (id, parent_path) in more {
+        if !c.seen.contains(id) {
+            c.root(id, parent_path);
         }
     }
     c.report
@@ -207,7 +226,7 @@ impl<'a> Checker<'a> {
     }
 
     fn push(&mut self, d: Diagnostic, path: &str, node: &NodeId) {
-        self.report.findings.push(Finding { diagnostic: d, path: path.to_owned(), node: format_node_id(node) });
+        self.report.findings.push(Finding { diagnostic: d, path: path.to_owned(), node: format_node_id(node), id: node.clone() });
     }
 
     /// Checks a node that fills no declaration: against its own TypeDefinition.
@@ -256,7 +275,7 @@ impl<'a> Checker<'a> {
             self.check_against(node, path, d, actual_type);
         }
         if node.class == NodeClass::Variable {
-            self.check_variable(node, path, decl.or(actual_type), actual_type);
+            self.check_variable(node, path, decl.or(actual_type));
         }
         self.check_children(node, path, decl, actual_type);
     }
@@ -289,54 +308,56 @@ impl<'a> Checker<'a> {
         }
     }
 
-    /// DataType, ValueRank and the value against the declaration (or the VariableType).
-    fn check_variable(&mut self, node: &'a RemoteNode, path: &str, decl: Option<NodeIx>, actual_type: Option<NodeIx>) {
+    /// DataType, ValueRank and the value against the declaration (or the VariableType); without either (a
+    /// variable without a TypeDefinition), the value against the variable's own DataType and ValueRank.
+    fn check_variable(&mut self, node: &'a RemoteNode, path: &str, decl: Option<NodeIx>) {
         let model = self.model;
-        let Some(decl) = decl else { return };
-        let dn = model.node(decl);
+        let dn = decl.map(|d| model.node(d));
+        // The violated declaration, when there is one, is where a finding points.
+        let at = |d: Diagnostic, label: String| match dn {
+            Some(dn) => d.at(dn.span).with_span_label(label),
+            None => d,
+        };
         let base = model.ns0(ids::BASE_DATA_TYPE);
-        let declared_dt = dn.attrs.data_type.or(base);
+        let declared_dt = dn.and_then(|dn| dn.attrs.data_type).or(base);
         let actual_dt = match &node.data_type {
             Some(id) => match self.lookup(id) {
                 Some(ix) => Some(ix),
                 None => {
-                    let d = Diagnostic::new(
+                    let mut d = Diagnostic::new(
                         Code::UnknownRemoteType,
                         format!("`{path}` has the DataType {}, which no loaded nodeset defines", format_node_id(id)),
                     )
-                    .at(dn.span)
                     .help("name the nodeset of that namespace, or put it in a --models folder");
+                    if let Some(dn) = dn {
+                        d = d.at(dn.span);
+                    }
                     self.push(d, path, &node.id);
                     None
                 }
             },
             None => None,
         };
-        if let (Some(want), Some(have)) = (declared_dt, actual_dt) {
+        if let (Some(want), Some(have), true) = (declared_dt, actual_dt, dn.is_some()) {
             if !model.is_subtype_of(have, want) {
                 let d = Diagnostic::new(
                     Code::WrongDataType,
                     format!("`{path}` has the DataType {}, which is not {} or a subtype of it", model.qualified(have), model.qualified(want)),
-                )
-                .at(dn.span)
-                .with_span_label(format!("declared with the DataType {}", model.qualified(want)));
-                self.push(d, path, &node.id);
+                );
+                self.push(at(d, format!("declared with the DataType {}", model.qualified(want))), path, &node.id);
             }
         }
         // A VariableType's ValueRank constrains its instances as an instance declaration's does.
-        let declared_rank = dn.attrs.value_rank.unwrap_or(-1);
-        if let Some(rank) = node.value_rank {
+        let declared_rank = dn.and_then(|dn| dn.attrs.value_rank).unwrap_or(-1);
+        if let (Some(rank), true) = (node.value_rank, dn.is_some()) {
             if !rank_compatible(declared_rank, rank) {
                 let d = Diagnostic::new(
                     Code::WrongValueRank,
                     format!("`{path}` has the ValueRank {rank}, which the declared ValueRank {declared_rank} does not allow"),
-                )
-                .at(dn.span)
-                .with_span_label(format!("declared with the ValueRank {declared_rank}"));
-                self.push(d, path, &node.id);
+                );
+                self.push(at(d, format!("declared with the ValueRank {declared_rank}")), path, &node.id);
             }
         }
-        let _ = actual_type;
         let dt = actual_dt.or(declared_dt);
         let rank = node.value_rank.unwrap_or(declared_rank);
         if let (Some(dt), Some(value)) = (dt, node.value) {
@@ -362,9 +383,8 @@ impl<'a> Checker<'a> {
                     Code::WrongValueType,
                     format!("`{path}` holds {shape} {got:?}, but its DataType is {want} and its ValueRank {rank}"),
                 )
-                .at(dn.span)
-                .with_span_label(format!("declared with the DataType {}", model.qualified(dt)));
-                self.push(d, path, &node.id);
+                .help("a client decodes the value by its DataType: give it the DataType's encoding (an enumeration is an Int32)");
+                self.push(at(d, format!("declared with the DataType {}", model.qualified(dt))), path, &node.id);
             }
         }
     }

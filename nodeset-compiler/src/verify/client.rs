@@ -130,25 +130,50 @@ pub async fn snapshot_batched(connect: &Connect, max_batch: Option<usize>) -> Re
         .with_connector(NoDelay)
         .build(client.certificate_store().clone())
         .map_err(|e| fail("cannot open a session", e))?;
-    let event_loop = event_loop.spawn();
-    let connected = tokio::time::timeout(Duration::from_secs(10), session.wait_for_connection()).await;
-    if connected != Ok(true) {
+    let mut event_loop = event_loop.spawn();
+    // With no retries the event loop ends at the first failure, with its status: that is the answer, at
+    // once (waiting for the connection alone would last the whole timeout, since it never returns then).
+    let failed: Option<Option<StatusCode>> = tokio::select! {
+        connected = session.wait_for_connection() => (!connected).then_some(None),
+        ended = &mut event_loop => Some(Some(ended.unwrap_or(StatusCode::BadUnexpectedError))),
+        _ = tokio::time::sleep(Duration::from_secs(10)) => Some(None),
+    };
+    if let Some(status) = failed {
         event_loop.abort();
-        let mut message = format!("cannot connect to {} (no session within 10 s)", connect.url);
-        if let Some(path) = rejected_copy(&connect.pki_dir, &server_certificate) {
-            message.push_str(&format!(
-                "\n  = note: the server's certificate is not trusted; it was put in {}\n  = help: check it (its thumbprint, \
-                 with the server's operator) and move it to {}, then run again",
-                path.display(),
-                connect.pki_dir.join("trusted").display()
-            ));
-        }
-        return Err(ClientError(message));
+        return Err(ClientError(connect_failure(connect, status, &server_certificate)));
     }
     let result = read_all_batched(&session, max_batch).await;
     let _ = session.disconnect().await;
     let _ = tokio::time::timeout(Duration::from_secs(5), event_loop).await;
     result
+}
+
+/// Why no session was made, and what to do about it: `status` is what the connection ended with (`None`:
+/// no answer within 10 s). Verify's own refusal of the server's certificate (found in its `rejected/`
+/// folder) is told apart from the server's refusal of verify's certificate (BadCertificateUntrusted, or
+/// BadSecurityChecksFailed, which servers answer so as not to say more), and each says what to move where.
+fn connect_failure(connect: &Connect, status: Option<StatusCode>, server_certificate: &[u8]) -> String {
+    let url = &connect.url;
+    if let Some(path) = rejected_copy(&connect.pki_dir, server_certificate) {
+        return format!(
+            "cannot connect to {url}: verify does not trust the server's certificate\n  = note: the server's certificate is not \
+             trusted; it was put in {}\n  = help: check it (its thumbprint, with the server's operator) and move it to {}, then run again",
+            path.display(),
+            connect.pki_dir.join("trusted").display()
+        );
+    }
+    match status {
+        None => format!("cannot connect to {url} (no session within 10 s)"),
+        Some(s) if s == StatusCode::BadCertificateUntrusted || s == StatusCode::BadSecurityChecksFailed => format!(
+            "cannot connect to {url}: the server rejected verify's application certificate ({s})\n  = note: verify's certificate \
+             is {} (application URI urn:nodeset-compiler:verify)\n  = help: on the server, trust it: a nodeset-runtime server (the \
+             examples, `ServerConfig`) has put it in the `rejected/` folder of its PKI folder (`--pki DIR`, by default `pki/<name>` \
+             in its working directory): move it from there to `trusted/` beside it, or copy the file above into that `trusted/` \
+             folder (another server: into the folder of the client certificates it trusts); then run again",
+            connect.pki_dir.join("own").join("cert.der").display()
+        ),
+        Some(s) => format!("cannot connect to {url}: the connection ended with {s}"),
+    }
 }
 
 /// The file in the PKI's `rejected/` folder that holds `certificate` (DER), if the client refused it.

@@ -1,7 +1,8 @@
-//! `nodeset-compiler verify`: checks a live server's instances against the nodesets of the namespaces it
-//! serves.
+//! The instance rules: every instance against its type's instance declarations, on a live server
+//! (`nodeset-compiler verify`) or in the files themselves (`nodeset-compiler check`), by one checker.
 //!
-//! The work is split in two so that the rules can be tested without a network:
+//! The work is split so that the rules need no network (and no async-opcua: only `client` and `driver`
+//! need the feature `verify`; `check` applies the rules in every build):
 //!
 //! ```text
 //! client    (feature `verify`) a session to the server -> Snapshot: the NamespaceArray and every node
@@ -9,27 +10,32 @@
 //!           DataType, ValueRank and the built-in type of the value; read in batches (Browse, BrowseNext and
 //!           Read with many nodes per request), so the round trips grow with the depth of the address space
 //!           and the number of nodes divided by the server's per-request limits, not with the node count
+//! instances &Model -> Snapshot: the same, made from the static instances of the loaded files (what a
+//!           server serving them shows), for `check`
 //! check     (&Model, &Snapshot) -> Report: every instance against its type's instance declarations
 //! report    Report -> rustc-style text (the violated declaration's place in its NodeSet2 file) or JSON
+//! driver    (feature `verify`) verify from end to end: read the server, load its nodesets, check
 //! ```
 //!
 //! What [`check::check`] verifies, each with its own diagnostic code (`NS0401`...`NS0409`, see
 //! [`crate::diag::Code`]): mandatory members present with the declared BrowseName; NodeClass as declared;
 //! TypeDefinition the declared one or a subtype; DataType the declared one or a subtype; ValueRank
 //! compatible; the value's built-in type the one its DataType is encoded as, and its shape (scalar or array)
-//! the one its ValueRank allows; children in a placeholder's place of the placeholder's type; no
-//! ModellingRule on instances.
+//! the one its ValueRank allows; children in a placeholder's place of the placeholder's type; mandatory
+//! placeholders filled; no ModellingRule on instances.
 //!
-//! Limits: only nodes outside namespace 0 are checked (namespace 0 is the server stack's own), and only
-//! those reached by forward hierarchical references from the Objects folder. A node whose type is in a
-//! namespace no loaded nodeset defines is reported (`NS0409`, an error that `--warn NS0409` demotes) and
-//! its children are checked against their own types.
+//! Limits: only nodes outside namespace 0 are checked (namespace 0 is the server stack's own). On a
+//! server, only those reached by forward hierarchical references from the Objects folder; in the files,
+//! every static instance ([`instances`]). A node whose type is in a namespace no loaded nodeset defines is
+//! reported (`NS0409`, an error that `--warn NS0409` demotes) and its children are checked against their
+//! own types.
 
 pub mod check;
 #[cfg(feature = "verify")]
 pub mod client;
 #[cfg(feature = "verify")]
 pub mod driver;
+pub mod instances;
 pub mod report;
 
 use crate::nodeid::{NodeId, QualifiedName};

@@ -38,7 +38,8 @@ pub fn summary(report: &Report, url: &str, millis: u128) -> String {
 }
 
 /// The report as one JSON object: `url`, `checked`, `instances`, `violations`, `warnings`, `round_trips`,
-/// `millis`, `unknown_namespaces` and `findings` (each with `code`, `severity`, `message`, `path`, `node`
+/// `millis`, `unknown_namespaces`, `namespaces` (the server's NamespaceArray, which numbers the prefixes of the
+/// paths) and `findings` (each with `code`, `severity`, `message`, `path`, `node`
 /// and, when the declaration is known, `declaration` with `file`, `line` and `column`).
 pub fn render_json(report: &Report, sources: &SourceMap, url: &str, millis: u128) -> String {
     let mut out = String::from("{");
@@ -54,7 +55,8 @@ pub fn render_json(report: &Report, sources: &SourceMap, url: &str, millis: u128
         millis
     );
     let unknown: Vec<String> = report.unknown_namespaces.iter().map(|u| json_str(u)).collect();
-    let _ = write!(out, "\"unknown_namespaces\":[{}],\"findings\":[", unknown.join(","));
+    let namespaces: Vec<String> = report.namespaces.iter().map(|u| json_str(u)).collect();
+    let _ = write!(out, "\"unknown_namespaces\":[{}],\"namespaces\":[{}],\"findings\":[", unknown.join(","), namespaces.join(","));
     for (i, f) in report.findings.iter().enumerate() {
         if i > 0 {
             out.push(',');

@@ -1,0 +1,153 @@
+//! `check`'s side of the instance rules: the static instances of the loaded files as a [`Snapshot`], the
+//! same snapshot `verify` reads from a server serving them, checked by the same [`check`](super::check)
+//! function, so that a static instance in a NodeSet2 file and the same instance on a live server meet one
+//! set of rules with the same codes and severities.
+//!
+//! The snapshot holds what a server serving the files would show a client: every node of
+//! [`Model::instance_nodes`] (outside namespace 0, not a type, not below one) with its forward references,
+//! and, for variables, its DataType (BaseDataType when the file names none, as the XML schema says), its
+//! ValueRank (-1 when absent) and the built-in type and shape of its value; the Objects folder with its
+//! forward references. The walk starts where `verify`'s does, at the Objects folder; the nodes it does not
+//! reach (below the Server object, or below no node at all) are then checked as instances of their own
+//! types, under their browse path.
+
+use super::check::{self, Report};
+use super::{RemoteNode, RemoteReference, RemoteValue, Snapshot};
+use crate::diag::{Code, Diagnostics, Label, Severities};
+use crate::model::{ids, Model, NodeIx};
+use crate::nodeid::{NodeId, QualifiedName};
+use crate::raw::NodeClass;
+use crate::value::{Content, Variant};
+use crate::{Compiled, Options};
+
+/// The snapshot of the files' static instances a server serving them would give (see the module's
+/// documentation). NodeIds and BrowseNames carry the model's namespace indices.
+pub fn snapshot(model: &Model) -> Snapshot {
+    let instance = model.instance_nodes();
+    let mut snap = Snapshot { namespaces: model.namespaces.clone(), ..Snapshot::default() };
+    let objects = Snapshot::objects_folder();
+    let remote = |ix: NodeIx| {
+        let node = model.node(ix);
+        let references = node
+            .references
+            .iter()
+            .filter(|r| r.forward)
+            .map(|r| RemoteReference { reference_type: model.node(r.reference_type).id.clone(), target: model.node(r.target).id.clone() })
+            .collect();
+        let variable = node.class == NodeClass::Variable;
+        let base = NodeId::numeric(0, ids::BASE_DATA_TYPE);
+        RemoteNode {
+            id: node.id.clone(),
+            class: node.class,
+            browse_name: node.browse_name.clone(),
+            references,
+            data_type: variable.then(|| node.attrs.data_type.map(|d| model.node(d).id.clone()).unwrap_or(base)),
+            value_rank: variable.then(|| node.attrs.value_rank.unwrap_or(-1)),
+            value: if variable { value_shape(model, ix) } else { None },
+        }
+    };
+    for (i, _) in instance.iter().enumerate().filter(|(_, &is)| is) {
+        let ix = NodeIx(i as u32);
+        snap.nodes.insert(model.node(ix).id.clone(), remote(ix));
+    }
+    let folder = model.lookup(&objects).map(remote).unwrap_or_else(|| RemoteNode {
+        id: objects.clone(),
+        class: NodeClass::Object,
+        browse_name: QualifiedName { ns: 0, name: "Objects".into() },
+        references: Vec::new(),
+        data_type: None,
+        value_rank: None,
+        value: None,
+    });
+    snap.nodes.insert(objects, folder);
+    snap
+}
+
+/// What a server serves for the value of variable `ix`: `Empty` without a value, `None` when it cannot be
+/// decoded (NS0214 says so; a server would leave it out).
+fn value_shape(model: &Model, ix: NodeIx) -> Option<RemoteValue> {
+    match model.decode_value(ix, Content::Shape) {
+        None => Some(RemoteValue::Empty),
+        Some(Err(_)) => None,
+        Some(Ok(v)) => Some(match (v.builtin(), &v) {
+            (None, _) => RemoteValue::Empty,
+            (Some(b), Variant::Array(..)) => RemoteValue::Array(b),
+            (Some(b), _) => RemoteValue::Scalar(b),
+        }),
+    }
+}
+
+/// The browse path of `ix` from the Objects folder (or from the top of its parent chain), as the checker
+/// writes paths: `Server/Namespaces/2:Robotics`.
+fn browse_path(model: &Model, ix: NodeIx) -> String {
+    let objects = model.ns0(ids::OBJECTS_FOLDER);
+    let mut names: Vec<String> = Vec::new();
+    let mut cur = Some(ix);
+    while let Some(c) = cur {
+        if Some(c) == objects || names.len() > model.nodes.len() {
+            break;
+        }
+        let bn = &model.node(c).browse_name;
+        names.push(if bn.ns == 0 { bn.name.clone() } else { format!("{}:{}", bn.ns, bn.name) });
+        cur = model.node(c).parent;
+    }
+    names.reverse();
+    names.join("/")
+}
+
+/// Checks every static instance of the model with the instance rules: from the Objects folder as `verify`
+/// walks a server, then the instances the walk does not reach. The findings have the codes' default
+/// severities, in the order of the walk (see [`Report::apply`]).
+pub fn check(model: &Model) -> Report {
+    let snap = snapshot(model);
+    let instance = model.instance_nodes();
+    // First the tops of the instance trees that hang elsewhere (no parent among the instances), in node
+    // order; then anything still unreached (a parent that does not reference it).
+    let top = |i: usize| model.nodes[i].parent.is_none_or(|p| !instance[p.index()]);
+    let mut more: Vec<(NodeId, String)> = Vec::new();
+    for pass_tops in [true, false] {
+        for i in (0..model.nodes.len()).filter(|&i| instance[i] && top(i) == pass_tops) {
+            let ix = NodeIx(i as u32);
+            let parent = model.node(ix).parent.map(|p| browse_path(model, p)).unwrap_or_default();
+            more.push((model.node(ix).id.clone(), parent));
+        }
+    }
+    check::check_from(model, &snap, &more)
+}
+
+/// [`check`] as `check` reports it: the findings on instances of the files the user named (or of every
+/// file, with `all`), each pointing at the instance in its file (at its value for NS0406) with the violated
+/// declaration as a label and the instance's browse path in a note, after the severity settings.
+pub fn diagnostics(model: &Model, severities: &Severities, all: bool) -> Diagnostics {
+    let mut report = check(model);
+    report.apply(severities, &model.sources);
+    let mut out = Diagnostics::new();
+    for f in report.findings {
+        let Some(ix) = model.lookup(&f.id) else { continue };
+        let node = model.node(ix);
+        if !all && !model.sources.get(node.file).named {
+            continue;
+        }
+        let mut d = f.diagnostic;
+        let here = match (d.code, model.value_element(ix)) {
+            (Code::WrongValueType, Some(value)) => value.span(),
+            _ => node.span,
+        };
+        if let Some(declared) = d.span.replace(here) {
+            let label = d.span_label.take().unwrap_or_else(|| "the declaration".into());
+            d.labels.insert(0, Label { span: declared, message: label });
+        }
+        d.notes.insert(0, format!("the instance: `{}` ({})", f.path, model.display_id(&node.id)));
+        out.push(d);
+    }
+    out
+}
+
+/// What `nodeset-compiler check` does after compiling: the findings of [`diagnostics`] on the static
+/// instances of the files the user named (of every loaded file with [`Options::all_warnings`]) join the
+/// compiler's diagnostics, with `opts`' severity settings, and the diagnostics are sorted again.
+pub fn check_compiled(compiled: &mut Compiled, opts: &Options) {
+    let found = diagnostics(&compiled.model, &opts.severities, opts.all_warnings);
+    compiled.diagnostics.extend(found);
+    compiled.diagnostics.sort(&compiled.model.sources);
+}
