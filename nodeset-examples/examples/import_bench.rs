@@ -101,7 +101,7 @@ fn run() -> Result<(), String> {
             tree.namespaces_mut().add_namespace(table.namespace_uri);
         }
         for table in TABLES {
-            space.import_node_set(&TableImport(table), tree.namespaces_mut());
+            space.import_node_set(&TableImport::new(table), tree.namespaces_mut());
         }
         import_ms.push(ms_since(t));
         import_cpu.push(thread_cpu_ms() - cpu);

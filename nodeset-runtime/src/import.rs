@@ -9,15 +9,21 @@
 //! filtered out here with a `tracing` warning instead: a reference from a node to itself, and a NodeId
 //! whose namespace was not registered. Rows whose NodeId is not in the table's own namespace are skipped
 //! too, because the address space only accepts nodes of namespaces the import owns.
+//!
+//! Structure values ([`Val::Structure`]) are written in OPC UA binary with the server's namespace indices and
+//! decoded by the type loaders the import is given ([`TableImport::with_type_loaders`]; see `structure`).
+
+mod structure;
 
 use opcua::nodes::{
     Base, DataType, EventNotifier, ImportedItem, ImportedReference, Method, NodeSetImport, NodeSetNamespaceMapper,
     NodeType, Object, ObjectType, ReferenceType, Variable, VariableType, View,
 };
 use opcua::types::{
-    Argument, Array, ByteString, DataTypeDefinition, DataValue, DateTime, EnumDefinition, EnumField, EnumValueType,
-    ExpandedNodeId, ExtensionObject, Guid, LocalizedText, NodeClass, NodeId, QualifiedName, StatusCode,
-    StructureDefinition, StructureField, StructureType, UAString, Variant, VariantScalarTypeId,
+    Argument, Array, ByteString, Context, DataTypeDefinition, DataValue, DateTime, DecodingOptions, EnumDefinition,
+    EnumField, EnumValueType, ExpandedNodeId, ExtensionObject, Guid, LocalizedText, NodeClass, NodeId, QualifiedName,
+    StatusCode, StructureDefinition, StructureField, StructureType, TypeLoaderCollection, UAString, Variant,
+    VariantScalarTypeId,
 };
 use tracing::{error, warn};
 
@@ -33,13 +39,41 @@ const HAS_ENCODING: u32 = 38;
 /// A generated table as an async-opcua [`NodeSetImport`].
 ///
 /// Pass it to `AddressSpace::import_node_set` (the node manager of [`crate::server`] does this for
-/// every table it serves).
-#[derive(Clone, Copy, Debug)]
-pub struct TableImport(pub &'static NodeSetTable);
+/// every table it serves, with the server's type loaders).
+#[derive(Clone)]
+pub struct TableImport {
+    table: &'static NodeSetTable,
+    loaders: TypeLoaderCollection,
+}
+
+impl std::fmt::Debug for TableImport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TableImport").field("table", &self.table.namespace_uri).finish_non_exhaustive()
+    }
+}
+
+impl TableImport {
+    /// The import of a table whose structure values are decoded with async-opcua's own type loaders: ns0's
+    /// structures arrive typed, the others as their encoded bytes (which clients read all the same).
+    pub fn new(table: &'static NodeSetTable) -> TableImport {
+        TableImport { table, loaders: TypeLoaderCollection::new() }
+    }
+
+    /// The import of a table whose structure values are decoded with `loaders` (a server's: ns0's, the
+    /// generated namespaces' `TypeLoader`s and async-opcua's fallback).
+    pub fn with_type_loaders(table: &'static NodeSetTable, loaders: TypeLoaderCollection) -> TableImport {
+        TableImport { table, loaders }
+    }
+
+    /// The table imported.
+    pub fn table(&self) -> &'static NodeSetTable {
+        self.table
+    }
+}
 
 impl NodeSetImport for TableImport {
     fn register_namespaces(&self, namespaces: &mut NodeSetNamespaceMapper) {
-        let table = self.0;
+        let table = self.table;
         for (i, uri) in table.namespaces.iter().enumerate() {
             let Ok(local) = u16::try_from(i) else {
                 warn!("table {}: more than 65535 namespaces; the rest are ignored", table.namespace_uri);
@@ -67,16 +101,16 @@ impl NodeSetImport for TableImport {
     }
 
     fn get_own_namespaces(&self) -> Vec<String> {
-        if self.0.own == 0 {
+        if self.table.own == 0 {
             // Importing into ns0 would clash with the core node manager; `load` yields nothing then.
-            warn!("table {}: own namespace index is 0; nothing is imported", self.0.namespace_uri);
+            warn!("table {}: own namespace index is 0; nothing is imported", self.table.namespace_uri);
             return Vec::new();
         }
-        vec![self.0.namespace_uri.to_owned()]
+        vec![self.table.namespace_uri.to_owned()]
     }
 
     fn load<'a>(&'a self, namespaces: &'a NodeSetNamespaceMapper) -> Box<dyn Iterator<Item = ImportedItem> + 'a> {
-        let table = self.0;
+        let table = self.table;
         let map = namespace_map(table, namespaces);
         if table.own == 0 {
             return Box::new(std::iter::empty());
@@ -90,7 +124,9 @@ impl NodeSetImport for TableImport {
         };
         // One timestamp for every value of the import: the values are as of the moment the table is loaded.
         let now = DateTime::now();
-        Box::new(rows.iter().filter_map(move |row| build_item(table, row, &map, now)))
+        // Structure values are decoded against the server's namespaces, with the import's type loaders.
+        let types = Context::new(namespaces.namespaces(), &self.loaders, DecodingOptions::default());
+        Box::new(rows.iter().filter_map(move |row| build_item(table, row, &map, now, &types)))
     }
 }
 
@@ -125,8 +161,8 @@ pub(crate) fn build_map(table: &NodeSetTable, server_index: impl Fn(u16, &str) -
 pub(crate) const UNMAPPED: u16 = u16::MAX;
 
 /// Builds one node with its references, or `None` (with a warning) if the row cannot be imported.
-fn build_item(table: &NodeSetTable, row: &NodeRow, map: &NamespaceMap, now: DateTime) -> Option<ImportedItem> {
-    let ctx = Ctx { table, map, now };
+fn build_item(table: &NodeSetTable, row: &NodeRow, map: &NamespaceMap, now: DateTime, types: &Context<'_>) -> Option<ImportedItem> {
+    let ctx = Ctx { table, map, now, types };
     if row.id.ns != table.own {
         warn!(
             "table {}: node {:?} is not in the table's own namespace (index {}); skipped",
@@ -238,6 +274,8 @@ struct Ctx<'a> {
     map: &'a NamespaceMap,
     /// The source and server timestamp of every value.
     now: DateTime,
+    /// The server's namespaces and the type loaders structure values are decoded with.
+    types: &'a Context<'a>,
 }
 
 impl Ctx<'_> {
@@ -437,6 +475,18 @@ impl Ctx<'_> {
                 typed_array(VariantScalarTypeId::ExtensionObject, values.iter().map(Self::enum_value).collect())?
             }
             Val::Struct(f) => f(self.map),
+            Val::Structure(encoding, items) => match self.structure(*encoding, items, node) {
+                Ok(eo) => Variant::from(eo),
+                Err(e) => {
+                    warn!("table {}: node {node}: its structure value cannot be built ({e}); the node has no value", self.table.namespace_uri);
+                    return None;
+                }
+            },
+            Val::Variant(inner) => return self.value(inner, node),
+            Val::Fields(_) | Val::Null(_) | Val::NullArray(_) => {
+                warn!("table {}: node {node}: {v:?} is only an item of a structure's body; the node has no value", self.table.namespace_uri);
+                return None;
+            }
         })
     }
 

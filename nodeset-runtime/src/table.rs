@@ -40,6 +40,14 @@
 //!   `LocalizedText:locale:"text"` (the locale `~` or a string), `Array:type { Val* }` (`type` the ns0
 //!   DataType number), `Arguments:{ ArgRow* }` with an `ArgRow` `name data_type value_rank
 //!   array_dimensions description`, and `EnumValues:{ EnumRow* }`. [`Val::Struct`] has no text form.
+//! - A structure value (an ExtensionObject) is `Structure:Id { Val* }`: the NodeId of its DataType's Default
+//!   Binary encoding, then its body as the items of its OPC UA binary encoding, in order (the compiler, which
+//!   knows every field's DataType, lays them out; see [`Val::Structure`]). Inside a body, an item is written
+//!   as Part 6 encodes it: a scalar as its built-in type (`UInt32:5` is also how an encoding mask or a union's
+//!   switch field is written), `Array:type { Val* }` as a length and its items, `Structure:` as an
+//!   ExtensionObject, `Fields:{ Val* }` as a structure encoded in place (a field of a concrete structure
+//!   DataType), `Variant:Val` as a Variant (a field of DataType BaseDataType), `Null:type` as the null value
+//!   of a built-in type and `NullArray:type` as a null array (fields a value leaves out).
 //! - A reference is `ReferenceTypeId>TargetId` (forward) or `ReferenceTypeId<TargetId` (inverse), in the
 //!   nodeset's order.
 //! - A node with RolePermissions or AccessRestrictions in its nodeset has a second line after its row,
@@ -257,6 +265,18 @@ pub enum Val {
     /// Any other ExtensionObject value (scalar, or an array when it returns several), built at import time
     /// because it contains NodeIds whose namespace indices are only known then.
     Struct(fn(&crate::NamespaceMap) -> opcua::types::Variant),
+    /// A structure value: the Default Binary encoding of its DataType and the items of its body, in the
+    /// order of its binary encoding. The import writes the body's bytes with the server's namespace indices
+    /// and decodes them with the server's type loaders (or keeps the bytes, for a type no loader knows).
+    Structure(Id, &'static [Val]),
+    /// Inside a structure's body: a nested structure encoded in place, its items in order.
+    Fields(&'static [Val]),
+    /// Inside a structure's body: a value encoded as a Variant.
+    Variant(&'static Val),
+    /// Inside a structure's body: the null value of a built-in type (by its ns0 DataType number).
+    Null(u32),
+    /// Inside a structure's body: a null array of a built-in type (by its ns0 DataType number).
+    NullArray(u32),
 }
 
 /// What kind of node a row is, with the attributes of that node class.

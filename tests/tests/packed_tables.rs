@@ -229,7 +229,7 @@ impl Check<'_> {
     }
 
     /// The decoded value against the model's: equal where the table can hold it, `None` where the model has
-    /// none or one the generator leaves out (structures other than Argument and EnumValueType).
+    /// none or one the generator leaves out (a structure it cannot lay out, with a warning).
     fn value(&self, val: &Val, ix: NodeIx) -> Result<(), String> {
         match (self.model.value(ix), val) {
             (None, Val::None) | (Some(Err(_)), Val::None) => Ok(()),
@@ -264,18 +264,27 @@ impl Check<'_> {
             (Variant::LocalizedText(a), Val::LocalizedText(locale, text)) => a.locale.as_deref() == *locale && a.text == *text,
             (Variant::Array(BuiltinType::ExtensionObject, items), Val::Arguments(rows)) => items.len() == rows.len(),
             (Variant::Array(BuiltinType::ExtensionObject, items), Val::EnumValues(rows)) => items.len() == rows.len(),
-            (Variant::ExtensionObject(_), Val::Arguments(rows)) => rows.len() == 1,
-            (Variant::ExtensionObject(_), Val::EnumValues(rows)) => rows.len() == 1,
+            (Variant::ExtensionObject(eo), Val::Structure(encoding, _)) => self.is_binary_encoding(encoding, eo),
+            (Variant::Array(BuiltinType::ExtensionObject, items), Val::Array(22, vals)) => {
+                items.len() == vals.len() && items.iter().zip(vals.iter()).all(|(i, v)| self.same_value(v, i))
+            }
             (Variant::Array(b, items), Val::Array(ty, vals)) => {
                 b.id() == *ty && items.len() == vals.len() && items.iter().zip(vals.iter()).all(|(i, v)| self.same_value(v, i))
             }
             _ => false,
         }
     }
+
+    /// Whether a structure value's table encoding is the Default Binary encoding of the value's DataType.
+    fn is_binary_encoding(&self, encoding: &Id, eo: &nodeset_compiler::value::ExtensionObject) -> bool {
+        let Some(dt) = eo.structure().and_then(|s| self.model.lookup(&s.data_type)) else { return false };
+        let info = &self.model.data_types[&dt];
+        info.encodings.iter().any(|(n, e)| n == "Default Binary" && self.same_id(encoding, &self.model.node(*e).id))
+    }
 }
 
-/// Whether the table can hold a value: everything but structures (other than Argument and EnumValueType
-/// arrays, which `same_value` checks), XML elements and null.
+/// Whether the table must hold a value: everything but structures (a structure the generator cannot lay out
+/// is left out with a warning; those it lays out `same_value` checks), XML elements and null.
 fn representable(v: &Variant) -> bool {
     match v {
         Variant::ExtensionObject(_) | Variant::XmlElement(_) | Variant::Null => false,

@@ -198,13 +198,15 @@ impl ModelNodes {
             .collect();
         let mut served = Vec::new();
         let instance_ns;
+        // Structure values are decoded with the server's type loaders (ns0's and the generated namespaces').
+        let loaders = context.info.type_loaders.read().clone();
         {
             let mut tree = context.type_tree.write();
             for t in &tables {
                 tree.namespaces_mut().add_namespace(t.namespace_uri);
             }
             for t in &tables {
-                space.import_node_set(&TableImport(t), tree.namespaces_mut());
+                space.import_node_set(&TableImport::with_type_loaders(t, loaders.clone()), tree.namespaces_mut());
                 let known = tree.namespaces();
                 served.push(ServedTable { table: t, map: build_map(t, |_, uri| known.get_index(uri)) });
             }

@@ -465,6 +465,15 @@ impl Cursor {
                 self.sp()?;
                 Val::Array(ty, self.list(Self::value)?)
             }
+            "Structure" => {
+                let encoding = self.id()?;
+                self.sp()?;
+                Val::Structure(encoding, self.list(Self::value)?)
+            }
+            "Fields" => Val::Fields(self.list(Self::value)?),
+            "Variant" => Val::Variant(Box::leak(Box::new(self.value()?))),
+            "Null" => Val::Null(self.num("a DataType number")?),
+            "NullArray" => Val::NullArray(self.num("a DataType number")?),
             "Arguments" => Val::Arguments(self.list(Self::arg_row)?),
             "EnumValues" => Val::EnumValues(self.list(Self::enum_row)?),
             t => return Err(format!("unknown value tag `{t}`")),

@@ -118,3 +118,96 @@ fn every_fixture_structure_round_trips() {
     rt::<enum_gaps::types::OperatingMode>();
     rt::<option_set::types::AxisStatusFlags>();
 }
+
+/// The `structure_values` fixture's tables imported with the type loaders of its namespaces, as a server
+/// imports them: each structure value the compiler laid out decodes into the generated type (or ns0's), which
+/// holds only if the layout is the binary encoding async-opcua's derive reads, field for field.
+#[test]
+fn structure_values_of_a_table_decode_into_the_generated_types() {
+    use nodeset_fixture_code::{parts, structure_values};
+    use nodeset_models::runtime::import::TableImport;
+    use opcua::nodes::NodeType;
+    use opcua::server::address_space::AddressSpace;
+    use opcua::types::{EUInformation, NodeId, QualifiedName, Range};
+    use structure_values::types::{Tool, ToolChoice, ToolMode, ToolOptions, Toolset};
+
+    let mut ns = NamespaceMap::new();
+    let mut loaders = TypeLoaderCollection::new();
+    loaders.add_type_loader(parts::TypeLoader);
+    loaders.add_type_loader(structure_values::TypeLoader);
+    let mut space = AddressSpace::new();
+    for table in [&parts::TABLE, &structure_values::TABLE] {
+        ns.add_namespace(table.namespace_uri);
+    }
+    for table in [&parts::TABLE, &structure_values::TABLE] {
+        space.import_node_set(&TableImport::with_type_loaders(table, loaders.clone()), &mut ns);
+    }
+    let own = ns.get_index(structure_values::NAMESPACE_URI).unwrap();
+    let other = ns.get_index(parts::NAMESPACE_URI).unwrap();
+    let value = |id: u32| -> Variant {
+        match space.find(&NodeId::new(own, id)) {
+            Some(NodeType::Variable(v)) => v.value(opcua::types::TimestampsToReturn::Neither, &opcua::types::NumericRange::None, &opcua::types::DataEncoding::Binary, 0.0).value.unwrap_or_default(),
+            other => panic!("i={id} is not a variable: {other:?}"),
+        }
+    };
+    let structure = |id: u32| -> ExtensionObject {
+        match value(id) {
+            Variant::ExtensionObject(eo) => eo,
+            other => panic!("i={id}: {other:?}"),
+        }
+    };
+    let unit = structure(6010);
+    let unit = unit.inner_as::<EUInformation>().expect("ns0's EUInformation");
+    assert_eq!((unit.unit_id, unit.display_name.text.as_ref()), (4408652, "°C"));
+    assert_eq!(structure(6011).inner_as::<Range>(), Some(&Range { low: -5.5, high: 120.0 }));
+
+    let main = structure(6013);
+    let main = main.inner_as::<Tool>().expect("the generated Tool");
+    assert_eq!(main.name.as_ref(), "Drill 6 mm");
+    assert_eq!(main.mode, ToolMode::Drilling);
+    assert_eq!((main.offset.x, main.offset.y, main.offset.z), (1.5, -2.0, 0.25));
+    assert_eq!(main.weights, Some(vec![1.5, 2.25, -0.5]));
+    assert_eq!(main.holder, NodeId::new(own, 6001), "the file's ns=1 is the server's index of the fixture");
+    assert_eq!(main.tag, QualifiedName::new(other, "Spindle"), "the file's ns=2 is the server's index of parts");
+    assert_eq!(main.setting, Variant::Int32(42));
+    assert_eq!(main.label, LocalizedText::new("en", "Six millimetre drill"));
+
+    let lean = structure(6014);
+    let lean = lean.inner_as::<Tool>().expect("the generated Tool");
+    assert_eq!(lean, &Tool { name: "Blank".into(), ..Tool::default() }, "fields left out are null");
+
+    let options = structure(6016);
+    let options = options.inner_as::<ToolOptions>().expect("the generated ToolOptions");
+    assert_eq!((options.required, options.comment.clone()), (7, None));
+    assert_eq!(options.limit, Some(Range { low: 0.5, high: 9.5 }));
+    assert_eq!(options.position.as_ref().map(|p| (p.x, p.y, p.z)), Some((10.0, 20.0, 30.0)));
+
+    let choice = structure(6018);
+    assert_eq!(choice.inner_as::<ToolChoice>(), Some(&ToolChoice::Label("two".into())));
+    let place = structure(6019);
+    assert!(matches!(place.inner_as::<ToolChoice>(), Some(ToolChoice::Where(w)) if (w.x, w.y, w.z) == (0.5, 0.25, 0.125)));
+
+    let kit = structure(6020);
+    let kit = kit.inner_as::<Toolset>().expect("the generated Toolset");
+    let tools = kit.tools.as_ref().expect("two tools");
+    assert_eq!(tools.iter().map(|t| t.name.as_ref()).collect::<Vec<_>>(), ["Mill", "Tap"]);
+    assert_eq!(tools[1].weights, Some(vec![]), "an empty array stays empty");
+    let extra = kit.extra.inner_as::<parts::types::Marker>().expect("the Extra field, an ExtensionObject of parts");
+    assert_eq!((extra.target.clone(), extra.name.clone()), (NodeId::new(other, 6001), QualifiedName::new(other, "RackSlot")));
+    assert_eq!(kit.marks.as_ref().map(Vec::len), Some(2));
+    assert_eq!(kit.unit.unit_id, 5066068);
+
+    match value(6015) {
+        Variant::Array(a) => {
+            let names: Vec<String> = a.values.iter().map(|v| match v {
+                Variant::ExtensionObject(eo) => eo.inner_as::<Tool>().expect("a Tool").name.to_string(),
+                other => panic!("{other:?}"),
+            }).collect();
+            assert_eq!(names, ["Mill", "Tap"]);
+        }
+        other => panic!("Tools: {other:?}"),
+    }
+    let direction = structure(6021);
+    let direction = direction.inner_as::<parts::types::Vector>().expect("a structure of the other namespace");
+    assert_eq!((direction.x, direction.y, direction.z), (0.0, -1.0, 0.5));
+}

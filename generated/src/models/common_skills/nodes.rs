@@ -55,30 +55,30 @@ Object 1:1601 1:"InputParameterSet" = "The inputs of the joint motion: TargetJoi
 Overrides 1:1601 1:1501
 Variable 1:1602 1:"Speed" = "Maximum joint speed of the leading joint, in degrees per second." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1603
 Overrides 1:1602 1:1502
-Variable 1:1603 0:"EngineeringUnits" = "Unit of Speed: degree per second." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 1:1603 0:"EngineeringUnits" = "Unit of Speed: degree per second." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4536630 LocalizedText:"en":"°/s" LocalizedText:"en":"degree per second" } 0:40>0:68 0:37>0:78
 Overrides 1:1603 1:1503
 Variable 1:1604 1:"Acceleration" = "Maximum joint acceleration of the leading joint, in degrees per second squared." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1605
 Overrides 1:1604 1:1504
-Variable 1:1605 0:"EngineeringUnits" = "Unit of Acceleration: degree per second squared." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 1:1605 0:"EngineeringUnits" = "Unit of Acceleration: degree per second squared." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5059637 LocalizedText:"en":"°/s²" LocalizedText:"en":"degree [unit of angle] per second squared" } 0:40>0:68 0:37>0:78
 Overrides 1:1605 1:1505
 Variable 1:1606 1:"TargetJointPositions" = "Target angle of every joint, in degrees, in the order of the joints from the base to the flange. The array has one element per joint of the robot." 0 0 0:11 1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1607
-Variable 1:1607 0:"EngineeringUnits" = "Unit of TargetJointPositions: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 1:1607 0:"EngineeringUnits" = "Unit of TargetJointPositions: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 1:1607 0:17502
 ObjectType 1:1700 1:"RelativeCartesianLinearMoveSkillType" = "Linear Cartesian motion relative to where the tool is: the tool centre point moves on a straight line by PoseOffset, expressed in the tool frame (the frame of the tool centre point when the motion starts). Used for short approach and retreat motions, such as moving a drill nose into a drill bush along tool Z." 0 0 0 0:45<1:1500 0:47>1:1701
 Object 1:1701 1:"InputParameterSet" = "The inputs of the relative motion: PoseOffset, Speed and Acceleration." 0 0 0 0:40>0:58 0:37>0:78 0:47>1:1702 0:47>1:1704 0:47>1:1706
 Overrides 1:1701 1:1501
 Variable 1:1702 1:"Speed" = "Maximum speed of the tool centre point along the path, in millimetres per second." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1703
 Overrides 1:1702 1:1502
-Variable 1:1703 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 1:1703 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4403510 LocalizedText:"en":"mm/s" LocalizedText:"en":"millimetre per second" } 0:40>0:68 0:37>0:78
 Overrides 1:1703 1:1503
 Variable 1:1704 1:"Acceleration" = "Maximum acceleration of the tool centre point along the path, in millimetres per second squared." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1705
 Overrides 1:1704 1:1504
-Variable 1:1705 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 1:1705 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5059633 LocalizedText:"en":"mm/s²" LocalizedText:"en":"millimetre per second squared" } 0:40>0:68 0:37>0:78
 Overrides 1:1705 1:1505
 Variable 1:1706 1:"PoseOffset" = "Displacement and rotation of the tool centre point, in the tool frame at the start of the motion; millimetres and degrees." 0 0 0:18814 -1 [] 3 3 0 ~ ~ 0:40>0:18791 0:37>0:78 0:47>1:1707 0:47>1:1712
 Variable 1:1707 0:"CartesianCoordinates" = "Position part of PoseOffset: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 3 3 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>1:1708 0:47>1:1709 0:47>1:1710 0:47>1:1711
 Overrides 1:1707 0:18796
-Variable 1:1708 0:"LengthUnit" = "Unit of X, Y and Z of PoseOffset: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 1:1708 0:"LengthUnit" = "Unit of X, Y and Z of PoseOffset: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 1:1708 0:18773
 Variable 1:1709 0:"X" = "X coordinate of PoseOffset." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 1:1709 0:18798
@@ -88,7 +88,7 @@ Variable 1:1711 0:"Z" = "Z coordinate of PoseOffset." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0
 Overrides 1:1711 0:18800
 Variable 1:1712 0:"Orientation" = "Orientation part of PoseOffset: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 3 3 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>1:1713 0:47>1:1714 0:47>1:1715 0:47>1:1716
 Overrides 1:1712 0:18792
-Variable 1:1713 0:"AngleUnit" = "Unit of A, B and C of PoseOffset: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 1:1713 0:"AngleUnit" = "Unit of A, B and C of PoseOffset: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 1:1713 0:18780
 Variable 1:1714 0:"A" = "Rotation of PoseOffset about the X axis (roll)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 1:1714 0:19074
@@ -101,16 +101,16 @@ Object 1:1801 1:"InputParameterSet" = "The inputs of the absolute motion: Target
 Overrides 1:1801 1:1501
 Variable 1:1802 1:"Speed" = "Maximum speed of the tool centre point along the path, in millimetres per second." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1803
 Overrides 1:1802 1:1502
-Variable 1:1803 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 1:1803 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4403510 LocalizedText:"en":"mm/s" LocalizedText:"en":"millimetre per second" } 0:40>0:68 0:37>0:78
 Overrides 1:1803 1:1503
 Variable 1:1804 1:"Acceleration" = "Maximum acceleration of the tool centre point along the path, in millimetres per second squared." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1805
 Overrides 1:1804 1:1504
-Variable 1:1805 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 1:1805 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5059633 LocalizedText:"en":"mm/s²" LocalizedText:"en":"millimetre per second squared" } 0:40>0:68 0:37>0:78
 Overrides 1:1805 1:1505
 Variable 1:1806 1:"TargetPose" = "Pose the tool centre point moves to, in the base frame of the robot; millimetres and degrees." 0 0 0:18814 -1 [] 3 3 0 ~ ~ 0:40>0:18791 0:37>0:78 0:47>1:1807 0:47>1:1812
 Variable 1:1807 0:"CartesianCoordinates" = "Position part of TargetPose: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 3 3 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>1:1808 0:47>1:1809 0:47>1:1810 0:47>1:1811
 Overrides 1:1807 0:18796
-Variable 1:1808 0:"LengthUnit" = "Unit of X, Y and Z of TargetPose: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 1:1808 0:"LengthUnit" = "Unit of X, Y and Z of TargetPose: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 1:1808 0:18773
 Variable 1:1809 0:"X" = "X coordinate of TargetPose." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 1:1809 0:18798
@@ -120,7 +120,7 @@ Variable 1:1811 0:"Z" = "Z coordinate of TargetPose." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0
 Overrides 1:1811 0:18800
 Variable 1:1812 0:"Orientation" = "Orientation part of TargetPose: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 3 3 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>1:1813 0:47>1:1814 0:47>1:1815 0:47>1:1816
 Overrides 1:1812 0:18792
-Variable 1:1813 0:"AngleUnit" = "Unit of A, B and C of TargetPose: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 1:1813 0:"AngleUnit" = "Unit of A, B and C of TargetPose: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 1:1813 0:18780
 Variable 1:1814 0:"A" = "Rotation of TargetPose about the X axis (roll)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 1:1814 0:19074
@@ -133,7 +133,7 @@ Object 1:1901 1:"InputParameterSet" = "The inputs of the gripping: Action and Gr
 Overrides 1:1901 1:1301
 Variable 1:1902 1:"Action" = "Whether the run opens or closes the gripper." 0 0 1:1000 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
 Variable 1:1903 1:"GripForce" = "Force the jaws hold the part with when closing, in newtons; ignored when opening." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>1:1904
-Variable 1:1904 0:"EngineeringUnits" = "Unit of GripForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 1:1904 0:"EngineeringUnits" = "Unit of GripForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5129559 LocalizedText:"en":"N" LocalizedText:"en":"newton" } 0:40>0:68 0:37>0:78
 Overrides 1:1904 0:17502
 "#)),
 };

@@ -26,7 +26,7 @@ Overrides 5:1001 1:1301
 Variable 5:1002 5:"HolePosition" = "Rough pose of the drill bush in the base frame of the robot, from the template referencing camera: position of the bush face centre, Z along the bush axis into the part; millimetres and degrees." 0 0 0:18814 -1 [] 3 3 0 ~ ~ 0:40>0:18791 0:37>0:78 0:47>5:1003 0:47>5:1008
 Variable 5:1003 0:"CartesianCoordinates" = "Position part of HolePosition: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 3 3 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>5:1004 0:47>5:1005 0:47>5:1006 0:47>5:1007
 Overrides 5:1003 0:18796
-Variable 5:1004 0:"LengthUnit" = "Unit of X, Y and Z of HolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:1004 0:"LengthUnit" = "Unit of X, Y and Z of HolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 5:1004 0:18773
 Variable 5:1005 0:"X" = "X coordinate of HolePosition." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 5:1005 0:18798
@@ -36,7 +36,7 @@ Variable 5:1007 0:"Z" = "Z coordinate of HolePosition." 0 0 0:11 -1 [] 3 3 0 ~ ~
 Overrides 5:1007 0:18800
 Variable 5:1008 0:"Orientation" = "Orientation part of HolePosition: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 3 3 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>5:1009 0:47>5:1010 0:47>5:1011 0:47>5:1012
 Overrides 5:1008 0:18792
-Variable 5:1009 0:"AngleUnit" = "Unit of A, B and C of HolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:1009 0:"AngleUnit" = "Unit of A, B and C of HolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 5:1009 0:18780
 Variable 5:1010 0:"A" = "Rotation of HolePosition about the X axis (roll)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 5:1010 0:19074
@@ -45,7 +45,7 @@ Overrides 5:1011 0:19075
 Variable 5:1012 0:"C" = "Rotation of HolePosition about the Z axis (yaw)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 5:1012 0:19076
 Variable 5:1013 5:"ApproachDistance" = "Distance in front of the bush face at which the end effector stops, in millimetres." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:1014
-Variable 5:1014 0:"EngineeringUnits" = "Unit of ApproachDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:1014 0:"EngineeringUnits" = "Unit of ApproachDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 5:1014 0:17502
 Object 5:1015 1:"OutputParameterSet" = "The results: Result and ReferencedHolePosition." 0 0 0 0:40>0:58 0:37>0:78 0:47>5:1016 0:47>5:1017
 Overrides 5:1015 1:1302
@@ -54,7 +54,7 @@ Overrides 5:1016 1:1303
 Variable 5:1017 5:"ReferencedHolePosition" = "Pose of the drill bush as the hole referencing unit measured it, in the base frame of the robot; millimetres and degrees. Valid after a run that ended in Ready." 0 0 0:18814 -1 [] 1 1 0 ~ ~ 0:40>0:18791 0:37>0:78 0:47>5:1018 0:47>5:1023
 Variable 5:1018 0:"CartesianCoordinates" = "Position part of ReferencedHolePosition: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 1 1 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>5:1019 0:47>5:1020 0:47>5:1021 0:47>5:1022
 Overrides 5:1018 0:18796
-Variable 5:1019 0:"LengthUnit" = "Unit of X, Y and Z of ReferencedHolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:1019 0:"LengthUnit" = "Unit of X, Y and Z of ReferencedHolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 5:1019 0:18773
 Variable 5:1020 0:"X" = "X coordinate of ReferencedHolePosition." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 5:1020 0:18798
@@ -64,7 +64,7 @@ Variable 5:1022 0:"Z" = "Z coordinate of ReferencedHolePosition." 0 0 0:11 -1 []
 Overrides 5:1022 0:18800
 Variable 5:1023 0:"Orientation" = "Orientation part of ReferencedHolePosition: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 1 1 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>5:1024 0:47>5:1025 0:47>5:1026 0:47>5:1027
 Overrides 5:1023 0:18792
-Variable 5:1024 0:"AngleUnit" = "Unit of A, B and C of ReferencedHolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:1024 0:"AngleUnit" = "Unit of A, B and C of ReferencedHolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 5:1024 0:18780
 Variable 5:1025 0:"A" = "Rotation of ReferencedHolePosition about the X axis (roll)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 5:1025 0:19074
@@ -76,22 +76,22 @@ ObjectType 5:2000 5:"DrillHoleSkillType" = "Drills one hole through the drill bu
 Object 5:2001 1:"InputParameterSet" = "The inputs: InsertionDistance and the drilling parameters passed to TemplateDrilling." 0 0 0 0:40>0:58 0:37>0:78 0:47>5:2002 0:47>5:2004 0:47>5:2006 0:47>5:2008 0:47>5:2010 0:47>5:2012
 Overrides 5:2001 1:1301
 Variable 5:2002 5:"InsertionDistance" = "Distance the nose moves along tool Z into the drill bush before drilling and back out after, in millimetres." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:2003
-Variable 5:2003 0:"EngineeringUnits" = "Unit of InsertionDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:2003 0:"EngineeringUnits" = "Unit of InsertionDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 5:2003 0:17502
 Variable 5:2004 5:"HoleDiameter" = "Nominal diameter of the hole, in millimetres; selects and checks the drill." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:2005
-Variable 5:2005 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:2005 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 5:2005 0:17502
 Variable 5:2006 5:"Depth" = "Depth to drill, in millimetres, measured from the face of the drill bush." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:2007
-Variable 5:2007 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:2007 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 5:2007 0:17502
 Variable 5:2008 5:"FeedRate" = "Feed of the drill along its axis, in millimetres per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:2009
-Variable 5:2009 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:2009 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4732977 LocalizedText:"en":"mm/min" LocalizedText:"en":"millimetre per minute" } 0:40>0:68 0:37>0:78
 Overrides 5:2009 0:17502
 Variable 5:2010 5:"SpindleSpeed" = "Rotational speed of the spindle, in revolutions per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:2011
-Variable 5:2011 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:2011 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5394509 LocalizedText:"en":"r/min" LocalizedText:"en":"revolutions per minute" } 0:40>0:68 0:37>0:78
 Overrides 5:2011 0:17502
 Variable 5:2012 5:"ClampForce" = "Force the nose clamps the stack against the template with, in newtons." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:2013
-Variable 5:2013 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:2013 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5129559 LocalizedText:"en":"N" LocalizedText:"en":"newton" } 0:40>0:68 0:37>0:78
 Overrides 5:2013 0:17502
 ObjectType 5:3000 5:"DrillingCellType" = "A template drilling work cell: offers the process skills ReferenceDrillBush and DrillHole, which a process controller runs once per hole, using the skills of the robot system and its end effector." 0 0 0 0:45<0:58 0:17603>1:1200 0:47>5:3001
 Object 5:3001 1:"SkillSet" = "The process skills of the cell (ISkillSetType)." 0 0 0 0:40>0:61 0:37>0:78 0:47>5:3002 0:47>5:3045
@@ -132,7 +132,7 @@ Variable 5:3019 5:"HolePosition" = "Rough pose of the drill bush in the base fra
 Overrides 5:3019 5:1002
 Variable 5:3020 0:"CartesianCoordinates" = "Position part of HolePosition: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 3 3 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>5:3021 0:47>5:3022 0:47>5:3023 0:47>5:3024
 Overrides 5:3020 5:1003
-Variable 5:3021 0:"LengthUnit" = "Unit of X, Y and Z of HolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:3021 0:"LengthUnit" = "Unit of X, Y and Z of HolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 5:3021 5:1004
 Variable 5:3022 0:"X" = "X coordinate of HolePosition." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 5:3022 5:1005
@@ -142,7 +142,7 @@ Variable 5:3024 0:"Z" = "Z coordinate of HolePosition." 0 0 0:11 -1 [] 3 3 0 ~ ~
 Overrides 5:3024 5:1007
 Variable 5:3025 0:"Orientation" = "Orientation part of HolePosition: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 3 3 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>5:3026 0:47>5:3027 0:47>5:3028 0:47>5:3029
 Overrides 5:3025 5:1008
-Variable 5:3026 0:"AngleUnit" = "Unit of A, B and C of HolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:3026 0:"AngleUnit" = "Unit of A, B and C of HolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 5:3026 5:1009
 Variable 5:3027 0:"A" = "Rotation of HolePosition about the X axis (roll)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 5:3027 5:1010
@@ -152,7 +152,7 @@ Variable 5:3029 0:"C" = "Rotation of HolePosition about the Z axis (yaw)." 0 0 0
 Overrides 5:3029 5:1012
 Variable 5:3030 5:"ApproachDistance" = "Distance in front of the bush face at which the end effector stops, in millimetres." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:3031
 Overrides 5:3030 5:1013
-Variable 5:3031 0:"EngineeringUnits" = "Unit of ApproachDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:3031 0:"EngineeringUnits" = "Unit of ApproachDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 5:3031 5:1014
 Object 5:3032 1:"OutputParameterSet" = "The results: Result and ReferencedHolePosition." 0 0 0 0:40>0:58 0:37>0:78 0:47>5:3033 0:47>5:3034
 Overrides 5:3032 5:1015
@@ -162,7 +162,7 @@ Variable 5:3034 5:"ReferencedHolePosition" = "Pose of the drill bush as the hole
 Overrides 5:3034 5:1017
 Variable 5:3035 0:"CartesianCoordinates" = "Position part of ReferencedHolePosition: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 1 1 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>5:3036 0:47>5:3037 0:47>5:3038 0:47>5:3039
 Overrides 5:3035 5:1018
-Variable 5:3036 0:"LengthUnit" = "Unit of X, Y and Z of ReferencedHolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:3036 0:"LengthUnit" = "Unit of X, Y and Z of ReferencedHolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 5:3036 5:1019
 Variable 5:3037 0:"X" = "X coordinate of ReferencedHolePosition." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 5:3037 5:1020
@@ -172,7 +172,7 @@ Variable 5:3039 0:"Z" = "Z coordinate of ReferencedHolePosition." 0 0 0:11 -1 []
 Overrides 5:3039 5:1022
 Variable 5:3040 0:"Orientation" = "Orientation part of ReferencedHolePosition: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 1 1 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>5:3041 0:47>5:3042 0:47>5:3043 0:47>5:3044
 Overrides 5:3040 5:1023
-Variable 5:3041 0:"AngleUnit" = "Unit of A, B and C of ReferencedHolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:3041 0:"AngleUnit" = "Unit of A, B and C of ReferencedHolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 5:3041 5:1024
 Variable 5:3042 0:"A" = "Rotation of ReferencedHolePosition about the X axis (roll)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 5:3042 5:1025
@@ -215,27 +215,27 @@ Object 5:3061 1:"InputParameterSet" = "The inputs: InsertionDistance and the dri
 Overrides 5:3061 5:2001
 Variable 5:3062 5:"InsertionDistance" = "Distance the nose moves along tool Z into the drill bush before drilling and back out after, in millimetres." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:3063
 Overrides 5:3062 5:2002
-Variable 5:3063 0:"EngineeringUnits" = "Unit of InsertionDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:3063 0:"EngineeringUnits" = "Unit of InsertionDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 5:3063 5:2003
 Variable 5:3064 5:"HoleDiameter" = "Nominal diameter of the hole, in millimetres; selects and checks the drill." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:3065
 Overrides 5:3064 5:2004
-Variable 5:3065 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:3065 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 5:3065 5:2005
 Variable 5:3066 5:"Depth" = "Depth to drill, in millimetres, measured from the face of the drill bush." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:3067
 Overrides 5:3066 5:2006
-Variable 5:3067 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:3067 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 5:3067 5:2007
 Variable 5:3068 5:"FeedRate" = "Feed of the drill along its axis, in millimetres per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:3069
 Overrides 5:3068 5:2008
-Variable 5:3069 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:3069 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4732977 LocalizedText:"en":"mm/min" LocalizedText:"en":"millimetre per minute" } 0:40>0:68 0:37>0:78
 Overrides 5:3069 5:2009
 Variable 5:3070 5:"SpindleSpeed" = "Rotational speed of the spindle, in revolutions per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:3071
 Overrides 5:3070 5:2010
-Variable 5:3071 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:3071 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5394509 LocalizedText:"en":"r/min" LocalizedText:"en":"revolutions per minute" } 0:40>0:68 0:37>0:78
 Overrides 5:3071 5:2011
 Variable 5:3072 5:"ClampForce" = "Force the nose clamps the stack against the template with, in newtons." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>5:3073
 Overrides 5:3072 5:2012
-Variable 5:3073 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 5:3073 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5129559 LocalizedText:"en":"N" LocalizedText:"en":"newton" } 0:40>0:68 0:37>0:78
 Overrides 5:3073 5:2013
 Object 5:3074 1:"OutputParameterSet" = "The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here)." 0 0 0 0:40>0:58 0:37>0:78 0:47>5:3075
 Overrides 5:3074 1:1302
@@ -262,27 +262,27 @@ Method 5:4017 0:"Reset" = "Brings the halted skill back to Ready so that it can 
 Object 5:4018 1:"InputParameterSet" = "The inputs: HolePosition and ApproachDistance." 0 0 0 0:40>0:58 0:47>5:4019 0:47>5:4030
 Variable 5:4019 5:"HolePosition" = "Rough pose of the drill bush in the base frame of the robot, from the template referencing camera: position of the bush face centre, Z along the bush axis into the part; millimetres and degrees." 0 0 0:18814 -1 [] 3 3 0 ~ ~ 0:40>0:18791 0:47>5:4020 0:47>5:4025
 Variable 5:4020 0:"CartesianCoordinates" = "Position part of HolePosition: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 3 3 0 ~ ~ 0:40>0:18774 0:46>5:4021 0:47>5:4022 0:47>5:4023 0:47>5:4024
-Variable 5:4021 0:"LengthUnit" = "Unit of X, Y and Z of HolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:4021 0:"LengthUnit" = "Unit of X, Y and Z of HolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68
 Variable 5:4022 0:"X" = "X coordinate of HolePosition." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:4023 0:"Y" = "Y coordinate of HolePosition." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:4024 0:"Z" = "Z coordinate of HolePosition." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:4025 0:"Orientation" = "Orientation part of HolePosition: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 3 3 0 ~ ~ 0:40>0:18781 0:46>5:4026 0:47>5:4027 0:47>5:4028 0:47>5:4029
-Variable 5:4026 0:"AngleUnit" = "Unit of A, B and C of HolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:4026 0:"AngleUnit" = "Unit of A, B and C of HolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68
 Variable 5:4027 0:"A" = "Rotation of HolePosition about the X axis (roll)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:4028 0:"B" = "Rotation of HolePosition about the Y axis (pitch)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:4029 0:"C" = "Rotation of HolePosition about the Z axis (yaw)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:4030 5:"ApproachDistance" = "Distance in front of the bush face at which the end effector stops, in millimetres." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:4031
-Variable 5:4031 0:"EngineeringUnits" = "Unit of ApproachDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:4031 0:"EngineeringUnits" = "Unit of ApproachDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68
 Object 5:4032 1:"OutputParameterSet" = "The results: Result and ReferencedHolePosition." 0 0 0 0:40>0:58 0:47>5:4033 0:47>5:4034
 Variable 5:4033 1:"Result" = "Outcome of the last run: Good when it ended in Ready, the Bad code of the cause when it ended in Halted. Uncertain_InitialValue before the first run." 0 0 0:19 -1 [] 1 1 0 ~ ~ 0:40>0:63
 Variable 5:4034 5:"ReferencedHolePosition" = "Pose of the drill bush as the hole referencing unit measured it, in the base frame of the robot; millimetres and degrees. Valid after a run that ended in Ready." 0 0 0:18814 -1 [] 1 1 0 ~ ~ 0:40>0:18791 0:47>5:4035 0:47>5:4040
 Variable 5:4035 0:"CartesianCoordinates" = "Position part of ReferencedHolePosition: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 1 1 0 ~ ~ 0:40>0:18774 0:46>5:4036 0:47>5:4037 0:47>5:4038 0:47>5:4039
-Variable 5:4036 0:"LengthUnit" = "Unit of X, Y and Z of ReferencedHolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:4036 0:"LengthUnit" = "Unit of X, Y and Z of ReferencedHolePosition: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68
 Variable 5:4037 0:"X" = "X coordinate of ReferencedHolePosition." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63
 Variable 5:4038 0:"Y" = "Y coordinate of ReferencedHolePosition." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63
 Variable 5:4039 0:"Z" = "Z coordinate of ReferencedHolePosition." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63
 Variable 5:4040 0:"Orientation" = "Orientation part of ReferencedHolePosition: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 1 1 0 ~ ~ 0:40>0:18781 0:46>5:4041 0:47>5:4042 0:47>5:4043 0:47>5:4044
-Variable 5:4041 0:"AngleUnit" = "Unit of A, B and C of ReferencedHolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:4041 0:"AngleUnit" = "Unit of A, B and C of ReferencedHolePosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68
 Variable 5:4042 0:"A" = "Rotation of ReferencedHolePosition about the X axis (roll)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63
 Variable 5:4043 0:"B" = "Rotation of ReferencedHolePosition about the Y axis (pitch)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63
 Variable 5:4044 0:"C" = "Rotation of ReferencedHolePosition about the Z axis (yaw)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63
@@ -304,17 +304,17 @@ Method 5:4059 0:"Halt" = "Aborts the skill (Ready, Running or Suspended to Halte
 Method 5:4060 0:"Reset" = "Brings the halted skill back to Ready so that it can be started again." 0 0 1 1
 Object 5:4061 1:"InputParameterSet" = "The inputs: InsertionDistance and the drilling parameters passed to TemplateDrilling." 0 0 0 0:40>0:58 0:47>5:4062 0:47>5:4064 0:47>5:4066 0:47>5:4068 0:47>5:4070 0:47>5:4072
 Variable 5:4062 5:"InsertionDistance" = "Distance the nose moves along tool Z into the drill bush before drilling and back out after, in millimetres." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:4063
-Variable 5:4063 0:"EngineeringUnits" = "Unit of InsertionDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:4063 0:"EngineeringUnits" = "Unit of InsertionDistance: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68
 Variable 5:4064 5:"HoleDiameter" = "Nominal diameter of the hole, in millimetres; selects and checks the drill." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:4065
-Variable 5:4065 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:4065 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68
 Variable 5:4066 5:"Depth" = "Depth to drill, in millimetres, measured from the face of the drill bush." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:4067
-Variable 5:4067 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:4067 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68
 Variable 5:4068 5:"FeedRate" = "Feed of the drill along its axis, in millimetres per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:4069
-Variable 5:4069 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:4069 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4732977 LocalizedText:"en":"mm/min" LocalizedText:"en":"millimetre per minute" } 0:40>0:68
 Variable 5:4070 5:"SpindleSpeed" = "Rotational speed of the spindle, in revolutions per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:4071
-Variable 5:4071 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:4071 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5394509 LocalizedText:"en":"r/min" LocalizedText:"en":"revolutions per minute" } 0:40>0:68
 Variable 5:4072 5:"ClampForce" = "Force the nose clamps the stack against the template with, in newtons." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:4073
-Variable 5:4073 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:4073 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5129559 LocalizedText:"en":"N" LocalizedText:"en":"newton" } 0:40>0:68
 Object 5:4074 1:"OutputParameterSet" = "The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here)." 0 0 0 0:40>0:58 0:47>5:4075
 Variable 5:4075 1:"Result" = "Outcome of the last run: Good when it ended in Ready, the Bad code of the cause when it ended in Halted. Uncertain_InitialValue before the first run." 0 0 0:19 -1 [] 1 1 0 ~ ~ 0:40>0:63
 Object 5:5000 5:"TemplateDrillingLwrSystem" = "The mobile lightweight robot system of the cell: a UR10e carrying the drilling end effector." 0 0 0 0:47<2:5001 0:40>4:5000 0:47>5:5001 0:47>5:5210 0:47>5:5211
@@ -355,11 +355,11 @@ Method 5:5034 0:"Halt" = "Aborts the skill (Ready, Running or Suspended to Halte
 Method 5:5035 0:"Reset" = "Brings the halted skill back to Ready so that it can be started again." 0 0 1 1
 Object 5:5036 1:"InputParameterSet" = "The inputs of the joint motion: TargetJointPositions (six angles), Speed and Acceleration." 0 0 0 0:40>0:58 0:47>5:5037 0:47>5:5039 0:47>5:5041
 Variable 5:5037 1:"Speed" = "Maximum joint speed of the leading joint, in degrees per second." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:5038
-Variable 5:5038 0:"EngineeringUnits" = "Unit of Speed: degree per second." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5038 0:"EngineeringUnits" = "Unit of Speed: degree per second." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4536630 LocalizedText:"en":"°/s" LocalizedText:"en":"degree per second" } 0:40>0:68
 Variable 5:5039 1:"Acceleration" = "Maximum joint acceleration of the leading joint, in degrees per second squared." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:5040
-Variable 5:5040 0:"EngineeringUnits" = "Unit of Acceleration: degree per second squared." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5040 0:"EngineeringUnits" = "Unit of Acceleration: degree per second squared." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5059637 LocalizedText:"en":"°/s²" LocalizedText:"en":"degree [unit of angle] per second squared" } 0:40>0:68
 Variable 5:5041 1:"TargetJointPositions" = "Target angles of the six joints from Base to Wrist3, in degrees." 0 0 0:11 1 [6] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:5042
-Variable 5:5042 0:"EngineeringUnits" = "Unit of TargetJointPositions: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5042 0:"EngineeringUnits" = "Unit of TargetJointPositions: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68
 Object 5:5043 1:"OutputParameterSet" = "The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here)." 0 0 0 0:40>0:58 0:47>5:5044
 Variable 5:5044 1:"Result" = "Outcome of the last run: Good when it ended in Ready, the Bad code of the cause when it ended in Halted. Uncertain_InitialValue before the first run." 0 0 0:19 -1 [] 1 1 0 ~ ~ 0:40>0:63
 Object 5:5045 4:"RelativeCartesianLinearMove" = "Moves the tool centre point on a straight line by PoseOffset in the tool frame." 0 0 1 0:40>1:1700 0:47>5:5046 0:47>5:5049 0:46>5:5053 0:46>5:5054 0:46>5:5055 0:47>5:5056 0:47>5:5057 0:47>5:5058 0:47>5:5059 0:47>5:5075
@@ -378,17 +378,17 @@ Method 5:5057 0:"Halt" = "Aborts the skill (Ready, Running or Suspended to Halte
 Method 5:5058 0:"Reset" = "Brings the halted skill back to Ready so that it can be started again." 0 0 1 1
 Object 5:5059 1:"InputParameterSet" = "The inputs of the relative motion: PoseOffset, Speed and Acceleration." 0 0 0 0:40>0:58 0:47>5:5060 0:47>5:5062 0:47>5:5064
 Variable 5:5060 1:"Speed" = "Maximum speed of the tool centre point along the path, in millimetres per second." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:5061
-Variable 5:5061 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5061 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4403510 LocalizedText:"en":"mm/s" LocalizedText:"en":"millimetre per second" } 0:40>0:68
 Variable 5:5062 1:"Acceleration" = "Maximum acceleration of the tool centre point along the path, in millimetres per second squared." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:5063
-Variable 5:5063 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5063 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5059633 LocalizedText:"en":"mm/s²" LocalizedText:"en":"millimetre per second squared" } 0:40>0:68
 Variable 5:5064 1:"PoseOffset" = "Displacement and rotation of the tool centre point, in the tool frame at the start of the motion; millimetres and degrees." 0 0 0:18814 -1 [] 3 3 0 ~ ~ 0:40>0:18791 0:47>5:5065 0:47>5:5070
 Variable 5:5065 0:"CartesianCoordinates" = "Position part of PoseOffset: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 3 3 0 ~ ~ 0:40>0:18774 0:46>5:5066 0:47>5:5067 0:47>5:5068 0:47>5:5069
-Variable 5:5066 0:"LengthUnit" = "Unit of X, Y and Z of PoseOffset: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5066 0:"LengthUnit" = "Unit of X, Y and Z of PoseOffset: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68
 Variable 5:5067 0:"X" = "X coordinate of PoseOffset." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:5068 0:"Y" = "Y coordinate of PoseOffset." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:5069 0:"Z" = "Z coordinate of PoseOffset." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:5070 0:"Orientation" = "Orientation part of PoseOffset: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 3 3 0 ~ ~ 0:40>0:18781 0:46>5:5071 0:47>5:5072 0:47>5:5073 0:47>5:5074
-Variable 5:5071 0:"AngleUnit" = "Unit of A, B and C of PoseOffset: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5071 0:"AngleUnit" = "Unit of A, B and C of PoseOffset: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68
 Variable 5:5072 0:"A" = "Rotation of PoseOffset about the X axis (roll)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:5073 0:"B" = "Rotation of PoseOffset about the Y axis (pitch)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:5074 0:"C" = "Rotation of PoseOffset about the Z axis (yaw)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
@@ -410,17 +410,17 @@ Method 5:5089 0:"Halt" = "Aborts the skill (Ready, Running or Suspended to Halte
 Method 5:5090 0:"Reset" = "Brings the halted skill back to Ready so that it can be started again." 0 0 1 1
 Object 5:5091 1:"InputParameterSet" = "The inputs of the absolute motion: TargetPose, Speed and Acceleration." 0 0 0 0:40>0:58 0:47>5:5092 0:47>5:5094 0:47>5:5096
 Variable 5:5092 1:"Speed" = "Maximum speed of the tool centre point along the path, in millimetres per second." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:5093
-Variable 5:5093 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5093 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4403510 LocalizedText:"en":"mm/s" LocalizedText:"en":"millimetre per second" } 0:40>0:68
 Variable 5:5094 1:"Acceleration" = "Maximum acceleration of the tool centre point along the path, in millimetres per second squared." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:5095
-Variable 5:5095 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5095 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5059633 LocalizedText:"en":"mm/s²" LocalizedText:"en":"millimetre per second squared" } 0:40>0:68
 Variable 5:5096 1:"TargetPose" = "Pose the tool centre point moves to, in the base frame of the robot; millimetres and degrees." 0 0 0:18814 -1 [] 3 3 0 ~ ~ 0:40>0:18791 0:47>5:5097 0:47>5:5102
 Variable 5:5097 0:"CartesianCoordinates" = "Position part of TargetPose: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 3 3 0 ~ ~ 0:40>0:18774 0:46>5:5098 0:47>5:5099 0:47>5:5100 0:47>5:5101
-Variable 5:5098 0:"LengthUnit" = "Unit of X, Y and Z of TargetPose: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5098 0:"LengthUnit" = "Unit of X, Y and Z of TargetPose: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68
 Variable 5:5099 0:"X" = "X coordinate of TargetPose." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:5100 0:"Y" = "Y coordinate of TargetPose." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:5101 0:"Z" = "Z coordinate of TargetPose." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:5102 0:"Orientation" = "Orientation part of TargetPose: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 3 3 0 ~ ~ 0:40>0:18781 0:46>5:5103 0:47>5:5104 0:47>5:5105 0:47>5:5106
-Variable 5:5103 0:"AngleUnit" = "Unit of A, B and C of TargetPose: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5103 0:"AngleUnit" = "Unit of A, B and C of TargetPose: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68
 Variable 5:5104 0:"A" = "Rotation of TargetPose about the X axis (roll)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:5105 0:"B" = "Rotation of TargetPose about the Y axis (pitch)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
 Variable 5:5106 0:"C" = "Rotation of TargetPose about the Z axis (yaw)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63
@@ -438,32 +438,32 @@ Object 5:5117 3:"Axes" = "The six joints of the arm." 0 0 0 0:40>0:61 0:47>5:511
 Object 5:5118 4:"Base" = "Joint 1 of the UR10e (base), rotary, limited to ±360°." 0 0 0 0:40>3:16601 0:47>5:5119 0:46>5:5122
 Object 5:5119 2:"ParameterSet" = "Runtime values of the Base joint." 0 0 0 0:40>0:58 0:47>5:5120
 Variable 5:5120 3:"ActualPosition" = "Actual angle of the Base joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:46>5:5121
-Variable 5:5121 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5121 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68
 Variable 5:5122 3:"MotionProfile" = "Motion profile of the Base joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68
 Object 5:5123 4:"Shoulder" = "Joint 2 of the UR10e (shoulder), rotary, limited to ±360°." 0 0 0 0:40>3:16601 0:47>5:5124 0:46>5:5127
 Object 5:5124 2:"ParameterSet" = "Runtime values of the Shoulder joint." 0 0 0 0:40>0:58 0:47>5:5125
 Variable 5:5125 3:"ActualPosition" = "Actual angle of the Shoulder joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:46>5:5126
-Variable 5:5126 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5126 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68
 Variable 5:5127 3:"MotionProfile" = "Motion profile of the Shoulder joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68
 Object 5:5128 4:"Elbow" = "Joint 3 of the UR10e (elbow), rotary, limited to ±360°." 0 0 0 0:40>3:16601 0:47>5:5129 0:46>5:5132
 Object 5:5129 2:"ParameterSet" = "Runtime values of the Elbow joint." 0 0 0 0:40>0:58 0:47>5:5130
 Variable 5:5130 3:"ActualPosition" = "Actual angle of the Elbow joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:46>5:5131
-Variable 5:5131 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5131 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68
 Variable 5:5132 3:"MotionProfile" = "Motion profile of the Elbow joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68
 Object 5:5133 4:"Wrist1" = "Joint 4 of the UR10e (wrist 1), rotary, limited to ±360°." 0 0 0 0:40>3:16601 0:47>5:5134 0:46>5:5137
 Object 5:5134 2:"ParameterSet" = "Runtime values of the Wrist1 joint." 0 0 0 0:40>0:58 0:47>5:5135
 Variable 5:5135 3:"ActualPosition" = "Actual angle of the Wrist1 joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:46>5:5136
-Variable 5:5136 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5136 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68
 Variable 5:5137 3:"MotionProfile" = "Motion profile of the Wrist1 joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68
 Object 5:5138 4:"Wrist2" = "Joint 5 of the UR10e (wrist 2), rotary, limited to ±360°." 0 0 0 0:40>3:16601 0:47>5:5139 0:46>5:5142
 Object 5:5139 2:"ParameterSet" = "Runtime values of the Wrist2 joint." 0 0 0 0:40>0:58 0:47>5:5140
 Variable 5:5140 3:"ActualPosition" = "Actual angle of the Wrist2 joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:46>5:5141
-Variable 5:5141 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5141 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68
 Variable 5:5142 3:"MotionProfile" = "Motion profile of the Wrist2 joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68
 Object 5:5143 4:"Wrist3" = "Joint 6 of the UR10e (wrist 3), rotary, limited to ±360°." 0 0 0 0:40>3:16601 0:47>5:5144 0:46>5:5147
 Object 5:5144 2:"ParameterSet" = "Runtime values of the Wrist3 joint." 0 0 0 0:40>0:58 0:47>5:5145
 Variable 5:5145 3:"ActualPosition" = "Actual angle of the Wrist3 joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:46>5:5146
-Variable 5:5146 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5146 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68
 Variable 5:5147 3:"MotionProfile" = "Motion profile of the Wrist3 joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68
 Variable 5:5148 3:"MotionDeviceCategory" = "Kinematic category of the arm: an articulated robot." 0 0 3:18193 -1 [] 1 1 0 ~ Int32:1 0:40>0:68
 Object 5:5149 3:"PowerTrains" = "The six drive trains of the arm, one per joint." 0 0 0 0:40>0:61 0:47>5:5150 0:47>5:5159 0:47>5:5168 0:47>5:5177 0:47>5:5186 0:47>5:5195
@@ -471,7 +471,7 @@ Object 5:5150 4:"BaseDrive" = "Drive train of the Base joint: its motor and gear
 Object 5:5151 4:"Motor" = "Motor of the Base joint." 0 0 0 0:40>3:1019 0:47>5:5152 0:46>5:5155 0:46>5:5156 0:46>5:5157 0:46>5:5158
 Object 5:5152 2:"ParameterSet" = "Runtime values of the Base motor." 0 0 0 0:40>0:58 0:47>5:5153
 Variable 5:5153 3:"MotorTemperature" = "Temperature of the Base motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:46>5:5154
-Variable 5:5154 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5154 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4408652 LocalizedText:"en":"°C" LocalizedText:"en":"degree Celsius" } 0:40>0:68
 Variable 5:5155 2:"Manufacturer" = "Manufacturer of the Base motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68
 Variable 5:5156 2:"Model" = "Model name of the Base motor." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68
 Variable 5:5157 2:"ProductCode" = "Product code of the Base motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68
@@ -480,7 +480,7 @@ Object 5:5159 4:"ShoulderDrive" = "Drive train of the Shoulder joint: its motor 
 Object 5:5160 4:"Motor" = "Motor of the Shoulder joint." 0 0 0 0:40>3:1019 0:47>5:5161 0:46>5:5164 0:46>5:5165 0:46>5:5166 0:46>5:5167
 Object 5:5161 2:"ParameterSet" = "Runtime values of the Shoulder motor." 0 0 0 0:40>0:58 0:47>5:5162
 Variable 5:5162 3:"MotorTemperature" = "Temperature of the Shoulder motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:46>5:5163
-Variable 5:5163 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5163 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4408652 LocalizedText:"en":"°C" LocalizedText:"en":"degree Celsius" } 0:40>0:68
 Variable 5:5164 2:"Manufacturer" = "Manufacturer of the Shoulder motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68
 Variable 5:5165 2:"Model" = "Model name of the Shoulder motor." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68
 Variable 5:5166 2:"ProductCode" = "Product code of the Shoulder motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68
@@ -489,7 +489,7 @@ Object 5:5168 4:"ElbowDrive" = "Drive train of the Elbow joint: its motor and ge
 Object 5:5169 4:"Motor" = "Motor of the Elbow joint." 0 0 0 0:40>3:1019 0:47>5:5170 0:46>5:5173 0:46>5:5174 0:46>5:5175 0:46>5:5176
 Object 5:5170 2:"ParameterSet" = "Runtime values of the Elbow motor." 0 0 0 0:40>0:58 0:47>5:5171
 Variable 5:5171 3:"MotorTemperature" = "Temperature of the Elbow motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:46>5:5172
-Variable 5:5172 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5172 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4408652 LocalizedText:"en":"°C" LocalizedText:"en":"degree Celsius" } 0:40>0:68
 Variable 5:5173 2:"Manufacturer" = "Manufacturer of the Elbow motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68
 Variable 5:5174 2:"Model" = "Model name of the Elbow motor." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68
 Variable 5:5175 2:"ProductCode" = "Product code of the Elbow motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68
@@ -498,7 +498,7 @@ Object 5:5177 4:"Wrist1Drive" = "Drive train of the Wrist1 joint: its motor and 
 Object 5:5178 4:"Motor" = "Motor of the Wrist1 joint." 0 0 0 0:40>3:1019 0:47>5:5179 0:46>5:5182 0:46>5:5183 0:46>5:5184 0:46>5:5185
 Object 5:5179 2:"ParameterSet" = "Runtime values of the Wrist1 motor." 0 0 0 0:40>0:58 0:47>5:5180
 Variable 5:5180 3:"MotorTemperature" = "Temperature of the Wrist1 motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:46>5:5181
-Variable 5:5181 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5181 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4408652 LocalizedText:"en":"°C" LocalizedText:"en":"degree Celsius" } 0:40>0:68
 Variable 5:5182 2:"Manufacturer" = "Manufacturer of the Wrist1 motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68
 Variable 5:5183 2:"Model" = "Model name of the Wrist1 motor." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68
 Variable 5:5184 2:"ProductCode" = "Product code of the Wrist1 motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68
@@ -507,7 +507,7 @@ Object 5:5186 4:"Wrist2Drive" = "Drive train of the Wrist2 joint: its motor and 
 Object 5:5187 4:"Motor" = "Motor of the Wrist2 joint." 0 0 0 0:40>3:1019 0:47>5:5188 0:46>5:5191 0:46>5:5192 0:46>5:5193 0:46>5:5194
 Object 5:5188 2:"ParameterSet" = "Runtime values of the Wrist2 motor." 0 0 0 0:40>0:58 0:47>5:5189
 Variable 5:5189 3:"MotorTemperature" = "Temperature of the Wrist2 motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:46>5:5190
-Variable 5:5190 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5190 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4408652 LocalizedText:"en":"°C" LocalizedText:"en":"degree Celsius" } 0:40>0:68
 Variable 5:5191 2:"Manufacturer" = "Manufacturer of the Wrist2 motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68
 Variable 5:5192 2:"Model" = "Model name of the Wrist2 motor." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68
 Variable 5:5193 2:"ProductCode" = "Product code of the Wrist2 motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68
@@ -516,7 +516,7 @@ Object 5:5195 4:"Wrist3Drive" = "Drive train of the Wrist3 joint: its motor and 
 Object 5:5196 4:"Motor" = "Motor of the Wrist3 joint." 0 0 0 0:40>3:1019 0:47>5:5197 0:46>5:5200 0:46>5:5201 0:46>5:5202 0:46>5:5203
 Object 5:5197 2:"ParameterSet" = "Runtime values of the Wrist3 motor." 0 0 0 0:40>0:58 0:47>5:5198
 Variable 5:5198 3:"MotorTemperature" = "Temperature of the Wrist3 motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:46>5:5199
-Variable 5:5199 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5199 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4408652 LocalizedText:"en":"°C" LocalizedText:"en":"degree Celsius" } 0:40>0:68
 Variable 5:5200 2:"Manufacturer" = "Manufacturer of the Wrist3 motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68
 Variable 5:5201 2:"Model" = "Model name of the Wrist3 motor." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68
 Variable 5:5202 2:"ProductCode" = "Product code of the Wrist3 motor." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68
@@ -549,15 +549,15 @@ Method 5:5228 0:"Halt" = "Aborts the skill (Ready, Running or Suspended to Halte
 Method 5:5229 0:"Reset" = "Brings the halted skill back to Ready so that it can be started again." 0 0 1 1
 Object 5:5230 1:"InputParameterSet" = "The drilling parameters: HoleDiameter, Depth, FeedRate, SpindleSpeed and ClampForce." 0 0 0 0:40>0:58 0:47>5:5231 0:47>5:5233 0:47>5:5235 0:47>5:5237 0:47>5:5239
 Variable 5:5231 4:"HoleDiameter" = "Nominal diameter of the hole, in millimetres; selects and checks the drill." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:5232
-Variable 5:5232 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5232 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68
 Variable 5:5233 4:"Depth" = "Depth to drill, in millimetres, measured from the face of the drill bush." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:5234
-Variable 5:5234 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5234 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68
 Variable 5:5235 4:"FeedRate" = "Feed of the drill along its axis, in millimetres per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:5236
-Variable 5:5236 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5236 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4732977 LocalizedText:"en":"mm/min" LocalizedText:"en":"millimetre per minute" } 0:40>0:68
 Variable 5:5237 4:"SpindleSpeed" = "Rotational speed of the spindle, in revolutions per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:5238
-Variable 5:5238 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5238 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5394509 LocalizedText:"en":"r/min" LocalizedText:"en":"revolutions per minute" } 0:40>0:68
 Variable 5:5239 4:"ClampForce" = "Force the nose clamps the stack against the template with, in newtons." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:46>5:5240
-Variable 5:5240 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68
+Variable 5:5240 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5129559 LocalizedText:"en":"N" LocalizedText:"en":"newton" } 0:40>0:68
 Object 5:5241 1:"OutputParameterSet" = "The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here)." 0 0 0 0:40>0:58 0:47>5:5242
 Variable 5:5242 1:"Result" = "Outcome of the last run: Good when it ended in Ready, the Bad code of the cause when it ended in Halted. Uncertain_InitialValue before the first run." 0 0 0:19 -1 [] 1 1 0 ~ ~ 0:40>0:63
 "#)),

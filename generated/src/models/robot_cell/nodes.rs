@@ -23,19 +23,19 @@ ObjectType 4:1000 4:"TemplateDrillingSkillType" = "Drilling one hole through a d
 Object 4:1001 1:"InputParameterSet" = "The drilling parameters: HoleDiameter, Depth, FeedRate, SpindleSpeed and ClampForce." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:1002 0:47>4:1004 0:47>4:1006 0:47>4:1008 0:47>4:1010
 Overrides 4:1001 1:1301
 Variable 4:1002 4:"HoleDiameter" = "Nominal diameter of the hole, in millimetres; selects and checks the drill." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:1003
-Variable 4:1003 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:1003 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 4:1003 0:17502
 Variable 4:1004 4:"Depth" = "Depth to drill, in millimetres, measured from the face of the drill bush." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:1005
-Variable 4:1005 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:1005 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 4:1005 0:17502
 Variable 4:1006 4:"FeedRate" = "Feed of the drill along its axis, in millimetres per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:1007
-Variable 4:1007 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:1007 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4732977 LocalizedText:"en":"mm/min" LocalizedText:"en":"millimetre per minute" } 0:40>0:68 0:37>0:78
 Overrides 4:1007 0:17502
 Variable 4:1008 4:"SpindleSpeed" = "Rotational speed of the spindle, in revolutions per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:1009
-Variable 4:1009 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:1009 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5394509 LocalizedText:"en":"r/min" LocalizedText:"en":"revolutions per minute" } 0:40>0:68 0:37>0:78
 Overrides 4:1009 0:17502
 Variable 4:1010 4:"ClampForce" = "Force the nose clamps the stack against the template with, in newtons." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:1011
-Variable 4:1011 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:1011 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5129559 LocalizedText:"en":"N" LocalizedText:"en":"newton" } 0:40>0:68 0:37>0:78
 Overrides 4:1011 0:17502
 ObjectType 4:2000 4:"DrillingEndEffectorType" = "A drilling end effector for template drilling, carried by a robot: a drilling unit with a concentric collet nose and an expanding mandrel that locks into the drill bushes of a drilling template. Its skill TemplateDrilling drills one hole." 0 0 0 0:45<2:15063 0:17603>1:1200 0:46>4:2001 0:46>4:2002 0:46>4:2003 0:47>4:2004
 Variable 4:2001 2:"Manufacturer" = "Manufacturer of the end effector." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
@@ -76,23 +76,23 @@ Object 4:2019 1:"InputParameterSet" = "The drilling parameters: HoleDiameter, De
 Overrides 4:2019 4:1001
 Variable 4:2020 4:"HoleDiameter" = "Nominal diameter of the hole, in millimetres; selects and checks the drill." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:2021
 Overrides 4:2020 4:1002
-Variable 4:2021 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:2021 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 4:2021 4:1003
 Variable 4:2022 4:"Depth" = "Depth to drill, in millimetres, measured from the face of the drill bush." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:2023
 Overrides 4:2022 4:1004
-Variable 4:2023 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:2023 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 4:2023 4:1005
 Variable 4:2024 4:"FeedRate" = "Feed of the drill along its axis, in millimetres per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:2025
 Overrides 4:2024 4:1006
-Variable 4:2025 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:2025 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4732977 LocalizedText:"en":"mm/min" LocalizedText:"en":"millimetre per minute" } 0:40>0:68 0:37>0:78
 Overrides 4:2025 4:1007
 Variable 4:2026 4:"SpindleSpeed" = "Rotational speed of the spindle, in revolutions per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:2027
 Overrides 4:2026 4:1008
-Variable 4:2027 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:2027 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5394509 LocalizedText:"en":"r/min" LocalizedText:"en":"revolutions per minute" } 0:40>0:68 0:37>0:78
 Overrides 4:2027 4:1009
 Variable 4:2028 4:"ClampForce" = "Force the nose clamps the stack against the template with, in newtons." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:2029
 Overrides 4:2028 4:1010
-Variable 4:2029 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:2029 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5129559 LocalizedText:"en":"N" LocalizedText:"en":"newton" } 0:40>0:68 0:37>0:78
 Overrides 4:2029 4:1011
 Object 4:2030 1:"OutputParameterSet" = "The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here)." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:2031
 Overrides 4:2030 1:1302
@@ -175,15 +175,15 @@ Object 4:4035 1:"InputParameterSet" = "The inputs of the joint motion: TargetJoi
 Overrides 4:4035 1:1601
 Variable 4:4036 1:"Speed" = "Maximum joint speed of the leading joint, in degrees per second." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4037
 Overrides 4:4036 1:1602
-Variable 4:4037 0:"EngineeringUnits" = "Unit of Speed: degree per second." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4037 0:"EngineeringUnits" = "Unit of Speed: degree per second." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4536630 LocalizedText:"en":"°/s" LocalizedText:"en":"degree per second" } 0:40>0:68 0:37>0:78
 Overrides 4:4037 1:1603
 Variable 4:4038 1:"Acceleration" = "Maximum joint acceleration of the leading joint, in degrees per second squared." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4039
 Overrides 4:4038 1:1604
-Variable 4:4039 0:"EngineeringUnits" = "Unit of Acceleration: degree per second squared." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4039 0:"EngineeringUnits" = "Unit of Acceleration: degree per second squared." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5059637 LocalizedText:"en":"°/s²" LocalizedText:"en":"degree [unit of angle] per second squared" } 0:40>0:68 0:37>0:78
 Overrides 4:4039 1:1605
 Variable 4:4040 1:"TargetJointPositions" = "Target angles of the six joints from Base to Wrist3, in degrees." 0 0 0:11 1 [6] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4041
 Overrides 4:4040 1:1606
-Variable 4:4041 0:"EngineeringUnits" = "Unit of TargetJointPositions: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4041 0:"EngineeringUnits" = "Unit of TargetJointPositions: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 4:4041 1:1607
 Object 4:4042 1:"OutputParameterSet" = "The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here)." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:4043
 Overrides 4:4042 1:1302
@@ -220,17 +220,17 @@ Object 4:4058 1:"InputParameterSet" = "The inputs of the relative motion: PoseOf
 Overrides 4:4058 1:1701
 Variable 4:4059 1:"Speed" = "Maximum speed of the tool centre point along the path, in millimetres per second." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4060
 Overrides 4:4059 1:1702
-Variable 4:4060 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4060 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4403510 LocalizedText:"en":"mm/s" LocalizedText:"en":"millimetre per second" } 0:40>0:68 0:37>0:78
 Overrides 4:4060 1:1703
 Variable 4:4061 1:"Acceleration" = "Maximum acceleration of the tool centre point along the path, in millimetres per second squared." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4062
 Overrides 4:4061 1:1704
-Variable 4:4062 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4062 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5059633 LocalizedText:"en":"mm/s²" LocalizedText:"en":"millimetre per second squared" } 0:40>0:68 0:37>0:78
 Overrides 4:4062 1:1705
 Variable 4:4063 1:"PoseOffset" = "Displacement and rotation of the tool centre point, in the tool frame at the start of the motion; millimetres and degrees." 0 0 0:18814 -1 [] 3 3 0 ~ ~ 0:40>0:18791 0:37>0:78 0:47>4:4064 0:47>4:4069
 Overrides 4:4063 1:1706
 Variable 4:4064 0:"CartesianCoordinates" = "Position part of PoseOffset: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 3 3 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>4:4065 0:47>4:4066 0:47>4:4067 0:47>4:4068
 Overrides 4:4064 1:1707
-Variable 4:4065 0:"LengthUnit" = "Unit of X, Y and Z of PoseOffset: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4065 0:"LengthUnit" = "Unit of X, Y and Z of PoseOffset: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 4:4065 1:1708
 Variable 4:4066 0:"X" = "X coordinate of PoseOffset." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 4:4066 1:1709
@@ -240,7 +240,7 @@ Variable 4:4068 0:"Z" = "Z coordinate of PoseOffset." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0
 Overrides 4:4068 1:1711
 Variable 4:4069 0:"Orientation" = "Orientation part of PoseOffset: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 3 3 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>4:4070 0:47>4:4071 0:47>4:4072 0:47>4:4073
 Overrides 4:4069 1:1712
-Variable 4:4070 0:"AngleUnit" = "Unit of A, B and C of PoseOffset: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4070 0:"AngleUnit" = "Unit of A, B and C of PoseOffset: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 4:4070 1:1713
 Variable 4:4071 0:"A" = "Rotation of PoseOffset about the X axis (roll)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 4:4071 1:1714
@@ -283,17 +283,17 @@ Object 4:4090 1:"InputParameterSet" = "The inputs of the absolute motion: Target
 Overrides 4:4090 1:1801
 Variable 4:4091 1:"Speed" = "Maximum speed of the tool centre point along the path, in millimetres per second." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4092
 Overrides 4:4091 1:1802
-Variable 4:4092 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4092 0:"EngineeringUnits" = "Unit of Speed: millimetre per second." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4403510 LocalizedText:"en":"mm/s" LocalizedText:"en":"millimetre per second" } 0:40>0:68 0:37>0:78
 Overrides 4:4092 1:1803
 Variable 4:4093 1:"Acceleration" = "Maximum acceleration of the tool centre point along the path, in millimetres per second squared." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4094
 Overrides 4:4093 1:1804
-Variable 4:4094 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4094 0:"EngineeringUnits" = "Unit of Acceleration: millimetre per second squared." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5059633 LocalizedText:"en":"mm/s²" LocalizedText:"en":"millimetre per second squared" } 0:40>0:68 0:37>0:78
 Overrides 4:4094 1:1805
 Variable 4:4095 1:"TargetPose" = "Pose the tool centre point moves to, in the base frame of the robot; millimetres and degrees." 0 0 0:18814 -1 [] 3 3 0 ~ ~ 0:40>0:18791 0:37>0:78 0:47>4:4096 0:47>4:4101
 Overrides 4:4095 1:1806
 Variable 4:4096 0:"CartesianCoordinates" = "Position part of TargetPose: X, Y and Z in millimetres." 0 0 0:18810 -1 [] 3 3 0 ~ ~ 0:40>0:18774 0:37>0:78 0:46>4:4097 0:47>4:4098 0:47>4:4099 0:47>4:4100
 Overrides 4:4096 1:1807
-Variable 4:4097 0:"LengthUnit" = "Unit of X, Y and Z of TargetPose: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4097 0:"LengthUnit" = "Unit of X, Y and Z of TargetPose: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 4:4097 1:1808
 Variable 4:4098 0:"X" = "X coordinate of TargetPose." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 4:4098 1:1809
@@ -303,7 +303,7 @@ Variable 4:4100 0:"Z" = "Z coordinate of TargetPose." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0
 Overrides 4:4100 1:1811
 Variable 4:4101 0:"Orientation" = "Orientation part of TargetPose: rotations A, B and C in degrees." 0 0 0:18812 -1 [] 3 3 0 ~ ~ 0:40>0:18781 0:37>0:78 0:46>4:4102 0:47>4:4103 0:47>4:4104 0:47>4:4105
 Overrides 4:4101 1:1812
-Variable 4:4102 0:"AngleUnit" = "Unit of A, B and C of TargetPose: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4102 0:"AngleUnit" = "Unit of A, B and C of TargetPose: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 4:4102 1:1813
 Variable 4:4103 0:"A" = "Rotation of TargetPose about the X axis (roll)." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:63 0:37>0:78
 Overrides 4:4103 1:1814
@@ -337,7 +337,7 @@ Object 4:4118 2:"ParameterSet" = "Runtime values of the Base joint." 0 0 0 0:40>
 Overrides 4:4118 3:16602
 Variable 4:4119 3:"ActualPosition" = "Actual angle of the Base joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4120
 Overrides 4:4119 3:16662
-Variable 4:4120 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4120 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 4:4120 3:16667
 Variable 4:4121 3:"MotionProfile" = "Motion profile of the Base joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68 0:37>0:78
 Overrides 4:4121 3:16637
@@ -346,7 +346,7 @@ Object 4:4123 2:"ParameterSet" = "Runtime values of the Shoulder joint." 0 0 0 0
 Overrides 4:4123 3:16602
 Variable 4:4124 3:"ActualPosition" = "Actual angle of the Shoulder joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4125
 Overrides 4:4124 3:16662
-Variable 4:4125 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4125 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 4:4125 3:16667
 Variable 4:4126 3:"MotionProfile" = "Motion profile of the Shoulder joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68 0:37>0:78
 Overrides 4:4126 3:16637
@@ -355,7 +355,7 @@ Object 4:4128 2:"ParameterSet" = "Runtime values of the Elbow joint." 0 0 0 0:40
 Overrides 4:4128 3:16602
 Variable 4:4129 3:"ActualPosition" = "Actual angle of the Elbow joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4130
 Overrides 4:4129 3:16662
-Variable 4:4130 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4130 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 4:4130 3:16667
 Variable 4:4131 3:"MotionProfile" = "Motion profile of the Elbow joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68 0:37>0:78
 Overrides 4:4131 3:16637
@@ -364,7 +364,7 @@ Object 4:4133 2:"ParameterSet" = "Runtime values of the Wrist1 joint." 0 0 0 0:4
 Overrides 4:4133 3:16602
 Variable 4:4134 3:"ActualPosition" = "Actual angle of the Wrist1 joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4135
 Overrides 4:4134 3:16662
-Variable 4:4135 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4135 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 4:4135 3:16667
 Variable 4:4136 3:"MotionProfile" = "Motion profile of the Wrist1 joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68 0:37>0:78
 Overrides 4:4136 3:16637
@@ -373,7 +373,7 @@ Object 4:4138 2:"ParameterSet" = "Runtime values of the Wrist2 joint." 0 0 0 0:4
 Overrides 4:4138 3:16602
 Variable 4:4139 3:"ActualPosition" = "Actual angle of the Wrist2 joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4140
 Overrides 4:4139 3:16662
-Variable 4:4140 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4140 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 4:4140 3:16667
 Variable 4:4141 3:"MotionProfile" = "Motion profile of the Wrist2 joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68 0:37>0:78
 Overrides 4:4141 3:16637
@@ -382,7 +382,7 @@ Object 4:4143 2:"ParameterSet" = "Runtime values of the Wrist3 joint." 0 0 0 0:4
 Overrides 4:4143 3:16602
 Variable 4:4144 3:"ActualPosition" = "Actual angle of the Wrist3 joint, in degrees." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4145
 Overrides 4:4144 3:16662
-Variable 4:4145 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4145 0:"EngineeringUnits" = "Unit of ActualPosition: degree." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:17476 LocalizedText:"en":"°" LocalizedText:"en":"degree [unit of angle]" } 0:40>0:68 0:37>0:78
 Overrides 4:4145 3:16667
 Variable 4:4146 3:"MotionProfile" = "Motion profile of the Wrist3 joint: rotary with limited range." 0 0 3:3008 -1 [] 1 1 0 ~ Int32:1 0:40>0:68 0:37>0:78
 Overrides 4:4146 3:16637
@@ -396,7 +396,7 @@ Object 4:4151 2:"ParameterSet" = "Runtime values of the Base motor." 0 0 0 0:40>
 Overrides 4:4151 3:5105
 Variable 4:4152 3:"MotorTemperature" = "Temperature of the Base motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4153
 Overrides 4:4152 3:6757
-Variable 4:4153 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4153 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4408652 LocalizedText:"en":"°C" LocalizedText:"en":"degree Celsius" } 0:40>0:68 0:37>0:78
 Overrides 4:4153 3:6762
 Variable 4:4154 2:"Manufacturer" = "Manufacturer of the Base motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68 0:37>0:78
 Overrides 4:4154 3:17101
@@ -412,7 +412,7 @@ Object 4:4160 2:"ParameterSet" = "Runtime values of the Shoulder motor." 0 0 0 0
 Overrides 4:4160 3:5105
 Variable 4:4161 3:"MotorTemperature" = "Temperature of the Shoulder motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4162
 Overrides 4:4161 3:6757
-Variable 4:4162 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4162 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4408652 LocalizedText:"en":"°C" LocalizedText:"en":"degree Celsius" } 0:40>0:68 0:37>0:78
 Overrides 4:4162 3:6762
 Variable 4:4163 2:"Manufacturer" = "Manufacturer of the Shoulder motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68 0:37>0:78
 Overrides 4:4163 3:17101
@@ -428,7 +428,7 @@ Object 4:4169 2:"ParameterSet" = "Runtime values of the Elbow motor." 0 0 0 0:40
 Overrides 4:4169 3:5105
 Variable 4:4170 3:"MotorTemperature" = "Temperature of the Elbow motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4171
 Overrides 4:4170 3:6757
-Variable 4:4171 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4171 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4408652 LocalizedText:"en":"°C" LocalizedText:"en":"degree Celsius" } 0:40>0:68 0:37>0:78
 Overrides 4:4171 3:6762
 Variable 4:4172 2:"Manufacturer" = "Manufacturer of the Elbow motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68 0:37>0:78
 Overrides 4:4172 3:17101
@@ -444,7 +444,7 @@ Object 4:4178 2:"ParameterSet" = "Runtime values of the Wrist1 motor." 0 0 0 0:4
 Overrides 4:4178 3:5105
 Variable 4:4179 3:"MotorTemperature" = "Temperature of the Wrist1 motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4180
 Overrides 4:4179 3:6757
-Variable 4:4180 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4180 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4408652 LocalizedText:"en":"°C" LocalizedText:"en":"degree Celsius" } 0:40>0:68 0:37>0:78
 Overrides 4:4180 3:6762
 Variable 4:4181 2:"Manufacturer" = "Manufacturer of the Wrist1 motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68 0:37>0:78
 Overrides 4:4181 3:17101
@@ -460,7 +460,7 @@ Object 4:4187 2:"ParameterSet" = "Runtime values of the Wrist2 motor." 0 0 0 0:4
 Overrides 4:4187 3:5105
 Variable 4:4188 3:"MotorTemperature" = "Temperature of the Wrist2 motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4189
 Overrides 4:4188 3:6757
-Variable 4:4189 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4189 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4408652 LocalizedText:"en":"°C" LocalizedText:"en":"degree Celsius" } 0:40>0:68 0:37>0:78
 Overrides 4:4189 3:6762
 Variable 4:4190 2:"Manufacturer" = "Manufacturer of the Wrist2 motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68 0:37>0:78
 Overrides 4:4190 3:17101
@@ -476,7 +476,7 @@ Object 4:4196 2:"ParameterSet" = "Runtime values of the Wrist3 motor." 0 0 0 0:4
 Overrides 4:4196 3:5105
 Variable 4:4197 3:"MotorTemperature" = "Temperature of the Wrist3 motor, in degrees Celsius." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:4198
 Overrides 4:4197 3:6757
-Variable 4:4198 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:4198 0:"EngineeringUnits" = "Unit of MotorTemperature: degree Celsius." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4408652 LocalizedText:"en":"°C" LocalizedText:"en":"degree Celsius" } 0:40>0:68 0:37>0:78
 Overrides 4:4198 3:6762
 Variable 4:4199 2:"Manufacturer" = "Manufacturer of the Wrist3 motor." 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:"en":"Universal Robots A/S" 0:40>0:68 0:37>0:78
 Overrides 4:4199 3:17101
@@ -539,23 +539,23 @@ Object 4:5020 1:"InputParameterSet" = "The drilling parameters: HoleDiameter, De
 Overrides 4:5020 4:2019
 Variable 4:5021 4:"HoleDiameter" = "Nominal diameter of the hole, in millimetres; selects and checks the drill." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:5022
 Overrides 4:5021 4:2020
-Variable 4:5022 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:5022 0:"EngineeringUnits" = "Unit of HoleDiameter: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 4:5022 4:2021
 Variable 4:5023 4:"Depth" = "Depth to drill, in millimetres, measured from the face of the drill bush." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:5024
 Overrides 4:5023 4:2022
-Variable 4:5024 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:5024 0:"EngineeringUnits" = "Unit of Depth: millimetre." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5066068 LocalizedText:"en":"mm" LocalizedText:"en":"millimetre" } 0:40>0:68 0:37>0:78
 Overrides 4:5024 4:2023
 Variable 4:5025 4:"FeedRate" = "Feed of the drill along its axis, in millimetres per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:5026
 Overrides 4:5025 4:2024
-Variable 4:5026 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:5026 0:"EngineeringUnits" = "Unit of FeedRate: millimetre per minute." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:4732977 LocalizedText:"en":"mm/min" LocalizedText:"en":"millimetre per minute" } 0:40>0:68 0:37>0:78
 Overrides 4:5026 4:2025
 Variable 4:5027 4:"SpindleSpeed" = "Rotational speed of the spindle, in revolutions per minute." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:5028
 Overrides 4:5027 4:2026
-Variable 4:5028 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:5028 0:"EngineeringUnits" = "Unit of SpindleSpeed: revolutions per minute." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5394509 LocalizedText:"en":"r/min" LocalizedText:"en":"revolutions per minute" } 0:40>0:68 0:37>0:78
 Overrides 4:5028 4:2027
 Variable 4:5029 4:"ClampForce" = "Force the nose clamps the stack against the template with, in newtons." 0 0 0:11 -1 [] 3 3 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>4:5030
 Overrides 4:5029 4:2028
-Variable 4:5030 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 4:5030 0:"EngineeringUnits" = "Unit of ClampForce: newton." 0 0 0:887 -1 [] 1 1 0 ~ Structure:0:889 { String:"http://www.opcfoundation.org/UA/units/un/cefact" Int32:5129559 LocalizedText:"en":"N" LocalizedText:"en":"newton" } 0:40>0:68 0:37>0:78
 Overrides 4:5030 4:2029
 Object 4:5031 1:"OutputParameterSet" = "The results of the skill: read-only variables set when a run ends and kept until the next Start (what ProgramStateMachineType leaves to its Optional FinalResultData, always present here)." 0 0 0 0:40>0:58 0:37>0:78 0:47>4:5032
 Overrides 4:5031 4:2030

@@ -13,865 +13,866 @@ pub static TABLE: rt::table::NodeSetTable = rt::table::NodeSetTable {
     namespaces: &[
         "http://opcfoundation.org/UA/",
         "http://opcfoundation.org/UA/DI/",
+        "http://opcfoundation.org/UA/IA/",
         "http://opcfoundation.org/UA/Robotics/",
     ],
-    own: 2u16,
+    own: 3u16,
     nodes: rt::table::Nodes::Packed(rt::table::Packed::new(r#"
-DataType 2:3008 2:"AxisMotionProfileEnumeration" = ~ 0 0 0 Enum { 0 "OTHER" = "Any motion-profile which is not defined by the AxisMotionProfileEnumeration." 1 "ROTARY" = "Rotary motion is a rotation along a circular path with defined limits. Motion movement is not going always in the same direction. Control unit is mainly degree." 2 "ROTARY_ENDLESS" = "Rotary motion is a rotation along a circular path with no limits. Motion movement is going endless in the same direction. Control unit is mainly degree." 3 "LINEAR" = "Linear motion is a one dimensional motion along a straight line with defined limits. Motion movement is not going always in the same direction. Control unit is mainly mm." 4 "LINEAR_ENDLESS" = "Linear motion is a one dimensional motion along a straight line with no limits. Motion movement is going endless in the same direction. Control unit is mainly mm." } 0:45<0:29
-Variable 2:6027 0:"EnumStrings" = ~ 0 0 0:21 1 [0] 1 1 0 ~ Array:21 { LocalizedText:~:"OTHER" LocalizedText:~:"ROTARY" LocalizedText:~:"ROTARY_ENDLESS" LocalizedText:~:"LINEAR" LocalizedText:~:"LINEAR_ENDLESS" } 0:46<2:3008 0:40>0:68
-DataType 2:18191 2:"ExecutionModeEnumeration" = ~ 0 0 0 Enum { 0 "CYCLE" = "Single execution of a task program according to ISO 8373." 1 "CONTINUOUS" = "Task program is executed continuously and starts again automatically." 2 "STEP" = "Task program is executed in steps." } 0:45<0:29
-Variable 2:18192 0:"EnumStrings" = ~ 0 0 0:21 1 [0] 1 1 0 ~ Array:21 { LocalizedText:~:"CYCLE" LocalizedText:~:"CONTINUOUS" LocalizedText:~:"STEP" } 0:46<2:18191 0:40>0:68
-DataType 2:18193 2:"MotionDeviceCategoryEnumeration" = ~ 0 0 0 Enum { 0 "OTHER" = "Any MotionDevice which is not defined by the MotionDeviceCategoryEnumeration." 1 "ARTICULATED_ROBOT" = "This robot design features rotary joints and can range from simple two joint structures to 10 or more joints. The arm is connected to the base with a twisting joint. The links in the arm are connected by rotary joints." 2 "SCARA_ROBOT" = "The robot has two parallel rotary joints that ensure compliance in a specified plane." 3 "CARTESIAN_ROBOT" = "Cartesian robots have three linear joints that use the Cartesian coordinate system (X, Y, and Z). They also may have an attached wrist to allow for rotational movement. The three prismatic joints provide linear movement along the axis." 4 "SPHERICAL_ROBOT" = "The arm is connected to the base with a twisting joint and a combination of two rotary joints and one linear joint. The axes form a polar coordinate system and create a spherical shaped work envelope." 5 "PARALLEL_ROBOT" = "These spider like robots are built from jointed parallelograms connected to a common base. The parallelograms move a single EOAT in a dome-shaped work area." 6 "CYLINDRICAL_ROBOT" = "The robot has at least one rotary joint at the base and at least one prismatic joint to connect the links. The rotary joint uses a rotational motion along the joint axis, while the prismatic joint moves in a linear motion. Cylindrical robots operate within a cylindrical-shaped work envelope." } 0:45<0:29
-Variable 2:18194 0:"EnumStrings" = ~ 0 0 0:21 1 [0] 1 1 0 ~ Array:21 { LocalizedText:~:"OTHER" LocalizedText:~:"ARTICULATED_ROBOT" LocalizedText:~:"SCARA_ROBOT" LocalizedText:~:"CARTESIAN_ROBOT" LocalizedText:~:"SPHERICAL_ROBOT" LocalizedText:~:"PARALLEL_ROBOT" LocalizedText:~:"CYLINDRICAL_ROBOT" } 0:46<2:18193 0:40>0:68
-DataType 2:3006 2:"OperationalModeEnumeration" = ~ 0 0 0 Enum { 0 "OTHER" = "Other for when there is a system-boot (unknown) or a failure of the safety, there is no valid operational mode." 1 "MANUAL_REDUCED_SPEED" = "\"Manual reduced speed\" - name according to ISO 10218-1:2011." 2 "MANUAL_HIGH_SPEED" = "\"Manual high speed\" - name according to ISO 10218-1:2011." 3 "AUTOMATIC" = "\"Automatic\" - name according to ISO 10218-1:2011." 4 "AUTOMATIC_EXTERNAL" = "\"Automatic external\" - Same as \"Automatic\" but with external control, e.g. by a PLC." } 0:45<0:29
-Variable 2:6022 0:"EnumStrings" = ~ 0 0 0:21 1 [0] 1 1 0 ~ Array:21 { LocalizedText:~:"OTHER" LocalizedText:~:"MANUAL_REDUCED_SPEED" LocalizedText:~:"MANUAL_HIGH_SPEED" LocalizedText:~:"AUTOMATIC" LocalizedText:~:"AUTOMATIC_EXTERNAL" } 0:46<2:3006 0:40>0:68
-ReferenceType 2:4002 2:"Controls" = "Reference: Describe dependencies between objects which have a controlling character." 0 0 0 0 "IsControlledBy" 0:45<0:33
-ReferenceType 2:18182 2:"HasSafetyStates" = "Reference: Describe dependencies between objects to show which (controller) object is responsible for the execution of the safety-functionality. The BrowseName HasSafetyStates and the InverseName SafetyStatesOf describe semantically the hierarchical dependency." 0 0 0 0 "SafetyStatesOf" 0:45<0:33
-ReferenceType 2:18183 2:"HasSlave" = "Reference: Provide the master-slave relationship of powertrains which provide torque for a common axis. The InverseName is IsSlaveOf." 0 0 0 0 "IsSlaveOf" 0:45<0:33
-ReferenceType 2:18180 2:"IsDrivenBy" = "Reference: Describe dependencies between objects which have a driving or powering character. The BrowseName IsDrivenBy and the InverseName Drives describe semantically the hierarchical dependency." 0 0 0 0 "Drives" 0:45<0:33
-ReferenceType 2:18178 2:"Moves" = "Reference: Describe the coupling between a powertrain and the axes from the powertrain point of view." 0 0 0 0 "IsMovedBy" 0:45<0:33
-ReferenceType 2:18179 2:"Requires" = "Reference: Describe the coupling between a powertrain and axes from the axis point of view. An axis has a Requires reference to all powertrains that need to move such that only this single axis moves." 0 0 0 0 "IsRequiredBy" 0:45<0:33
-ReferenceType 2:18181 2:"IsConnectedTo" = "Reference: Describe dependencies between objects which are mounted or mechanically linked or connected to each other. The IsConnectedTo reference is symmetric and has no InverseName." 0 0 1 0 "IsConnectedTo" 0:45<0:32
-ObjectType 2:1015 2:"MultiAcknowledgeableConditionType" = ~ 0 0 0 0:45<0:2881 0:46>2:6140
-Variable 2:6140 2:"ConditionDescriptions" = ~ 0 0 0:21 1 [0] 3 3 0 ~ ~ 0:37>0:78 0:40>0:68
-ObjectType 2:17230 2:"EmergencyStopFunctionType" = "According to ISO 10218-1:2011 Ch.5.5.2 Emergency stop the robot shall have one or more emergency stop functions." 0 0 0 0:45<0:58 0:47>2:17232 0:46>2:17231
-Variable 2:17232 2:"Active" = "The Active variable is TRUE if this particular emergency stop function is active, e.g. that the emergency stop button is pressed, FALSE otherwise." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Variable 2:17231 2:"Name" = "The Name of the EmergencyStopFunctionType provides a manufacturer-specific emergency stop function identifier within the safety system." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-ObjectType 2:1018 2:"LoadType" = "The LoadType is for describing loads mounted on the motion device typically by an integrator or a customer." 0 0 0 0:45<0:58 0:47>2:6013 0:47>2:18170 0:47>2:6723
-Variable 2:6013 2:"CenterOfMass" = "The position and orientation of the center of the mass related to the mounting point using a FrameType. X, Y, Z define the position of the center of gravity relative to the mounting point coordinate system. A, B, C define the orientation of the principal axes of inertia relative to the mounting point coordinate system. Orientation A, B, C can be \"0\" for systems which do not need these  values." 0 0 0:18814 -1 [] 1 1 0 ~ ~ 0:40>0:18791 0:37>0:80 0:47>2:16130 0:47>2:16132
-Variable 2:16130 0:"CartesianCoordinates" = ~ 0 0 0:18810 -1 [] 1 1 0 ~ ~ 0:40>0:18774 0:37>0:78 0:47>2:16134 0:47>2:16135 0:47>2:16136
-Overrides 2:16130 0:18796
-Variable 2:16134 0:"X" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:16134 0:18798
-Variable 2:16135 0:"Y" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:16135 0:18799
-Variable 2:16136 0:"Z" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:16136 0:18800
-Variable 2:16132 0:"Orientation" = ~ 0 0 0:18812 -1 [] 1 1 0 ~ ~ 0:40>0:18781 0:37>0:78 0:47>2:16137 0:47>2:16138 0:47>2:16139
-Overrides 2:16132 0:18792
-Variable 2:16137 0:"A" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:16137 0:19074
-Variable 2:16138 0:"B" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:16138 0:19075
-Variable 2:16139 0:"C" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:16139 0:19076
-Variable 2:18170 2:"Inertia" = "The Inertia uses the VectorType to describe the three values of the principal moments of inertia with respect to the mounting point coordinate system. If inertia values are provided for rotary axis the CenterOfMass shall be completely filled as well." 0 0 0:18808 -1 [] 1 1 0 ~ ~ 0:40>0:17716 0:37>0:80 0:47>2:18171 0:47>2:18172 0:47>2:18173
-Variable 2:18171 0:"X" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:18171 0:18769
-Variable 2:18172 0:"Y" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:18172 0:18770
-Variable 2:18173 0:"Z" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:18173 0:18771
-Variable 2:6723 2:"Mass" = "The weight of the load mounted on one mounting point." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>2:6728
-Variable 2:6728 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:6728 0:17502
-ObjectType 2:17233 2:"ProtectiveStopFunctionType" = "According to ISO 10218-1:2011 Ch.5.5.3 the robot shall have one or more protective stop functions designed for the connection of external protective devices." 0 0 0 0:45<0:58 0:47>2:17236 0:47>2:17235 0:46>2:17234
-Variable 2:17236 2:"Active" = "–\tThe Active variable is TRUE if this particular protective stop function is active, i.e. that a stop is initiated, FALSE otherwise. If Enabled is FALSE then Active shall be FALSE." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Variable 2:17235 2:"Enabled" = "–\tThe Enabled variable is TRUE if this protective stop function is currently supervising the system, FALSE otherwise. A protective stop function may or may not be enabled at all times, e.g. the protective stop function of the safety doors are typically enabled in automatic operational mode and disabled in manual mode. On the other hand for example, the protective stop function of the teach pendant enabling device is enabled in manual modes and disabled in automatic modes." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Variable 2:17234 2:"Name" = "The Name of the ProtectiveStopFunctionType provides a manufacturer-specific protective stop function identifier within the safety system." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-ObjectType 2:1007 2:"ExecutingSubstateMachineType" = ~ 0 0 0 0:45<0:2771 0:41>0:2311 0:47>2:6036 0:47>2:6038 0:47>2:5020 0:47>2:5022 0:47>2:5021
-Variable 2:6036 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>2:6037
-Overrides 2:6036 0:2773
-Variable 2:6037 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6037 0:3732
-Variable 2:6038 2:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>2:6039 0:46>2:6040
-Variable 2:6039 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
-Overrides 2:6039 0:11241
-Variable 2:6040 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
-Overrides 2:6040 0:11461
-Object 2:5020 2:"Running" = ~ 0 0 0 0:40>0:2309 0:46>2:6041
-Variable 2:6041 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
-Overrides 2:6041 0:2308
-Object 2:5022 2:"RunningToStopping" = ~ 0 0 0 0:40>0:2310 0:51>2:5020 0:52>2:5021 0:54>0:2311 0:46>2:6043
-Variable 2:6043 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
-Overrides 2:6043 0:2312
-Object 2:5021 2:"Stopping" = ~ 0 0 0 0:40>0:2307 0:46>2:6042
-Variable 2:6042 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
-Overrides 2:6042 0:2308
-ObjectType 2:1009 2:"IdleSubstateMachineType" = ~ 0 0 0 0:45<0:2771 0:41>0:2311 0:47>2:5017 0:47>2:5018 0:47>2:6026 0:47>2:6029 0:47>2:5015 0:47>2:5019
-Object 2:5017 2:"GettingReady" = ~ 0 0 0 0:40>0:2307 0:46>2:6031
-Variable 2:6031 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
-Overrides 2:6031 0:2308
-Object 2:5018 2:"GettingReadyToStandBy" = ~ 0 0 0 0:40>0:2310 0:51>2:5017 0:52>2:5015 0:54>0:2311 0:46>2:6032
-Variable 2:6032 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
-Overrides 2:6032 0:2312
-Variable 2:6026 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>2:6028
-Overrides 2:6026 0:2773
-Variable 2:6028 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6028 0:3732
-Variable 2:6029 2:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>2:6034 0:46>2:6035
-Variable 2:6034 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:40>0:68 0:37>0:78
-Overrides 2:6034 0:11241
-Variable 2:6035 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
-Overrides 2:6035 0:11461
-Object 2:5015 2:"StandBy" = ~ 0 0 0 0:40>0:2309 0:46>2:6030
-Variable 2:6030 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
-Overrides 2:6030 0:2308
-Object 2:5019 2:"StandByToGettingReady" = ~ 0 0 0 0:40>0:2310 0:52>2:5017 0:51>2:5015 0:54>0:2311 0:46>2:6033
-Variable 2:6033 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
-Overrides 2:6033 0:2312
-ObjectType 2:1006 2:"OperationStateMachineType" = ~ 0 0 1 0:45<0:2771 0:41>0:2311 0:47>2:6009 0:47>2:5007 0:47>2:5013 0:47>2:5011 0:47>2:5005 0:47>2:5014 0:47>2:5009 0:47>2:6005 0:47>2:6007 0:47>2:6008 0:47>2:5006 0:47>2:5012 0:47>2:5008 0:47>2:7001 0:47>2:7002
-Variable 2:6009 2:"ConfiguredDefaultStopMode" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:63
-Object 2:5007 2:"Executing" = "Entity is in a condition of execution." 0 0 0 0:40>0:2307 0:46>2:6012
-Variable 2:6012 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:3 0:37>0:78 0:40>0:68
-Overrides 2:6012 0:2308
-Object 2:5013 2:"ExecutingToIdle" = "Changes from Executing to Idle" 0 0 0 0:40>0:2310 0:51>2:5007 0:52>2:5005 0:54>0:2311 0:46>2:6018
-Variable 2:6018 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:6 0:37>0:78 0:40>0:68
-Overrides 2:6018 0:2312
-Object 2:5011 2:"ExecutingToReady" = "Changes from Executing to Ready" 0 0 0 0:40>0:2310 0:51>2:5007 0:52>2:5006 0:53>2:7002 0:54>0:2311 0:46>2:6016
-Variable 2:6016 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:5 0:37>0:78 0:40>0:68
-Overrides 2:6016 0:2312
-Object 2:5005 2:"Idle" = "Entity is not in a condition to start execution." 0 0 0 0:40>0:2307 0:46>2:6010
-Variable 2:6010 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
-Overrides 2:6010 0:2308
-Object 2:5014 2:"IdleToIdle" = "Changes from Idle to Idle." 0 0 0 0:40>0:2310 0:51>2:5005 0:52>2:5005 0:54>0:2311 0:46>2:6019
-Variable 2:6019 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
-Overrides 2:6019 0:2312
-Object 2:5009 2:"IdleToReady" = "Changes from Idle to Ready" 0 0 0 0:40>0:2310 0:51>2:5005 0:52>2:5006 0:54>0:2311 0:46>2:6015
-Variable 2:6015 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
-Overrides 2:6015 0:2312
-Variable 2:6005 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>2:6006
-Overrides 2:6005 0:2773
-Variable 2:6006 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6006 0:3732
-Variable 2:6007 2:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>2:6020 0:46>2:6021
-Variable 2:6020 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
-Overrides 2:6020 0:11241
-Variable 2:6021 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
-Overrides 2:6021 0:11461
-Variable 2:6008 2:"PossibleStopModes" = ~ 0 0 0:7594 1 [0] 3 3 0 ~ EnumValues:{ 1 "OnPath" = "Stop program execution in a controlled manner along the programmed path" 2 "EndOfCycle" = "Stop program execution when the current production cycle has been finished" 3 "ProcessStop" = "Application dependent stop instruction that stops program execution at a favourable point for the application, e.g. at the end of a paint stroke or sealing bead" 4 "QuickStop" = "This stop is performed by ramping down motion as fast as possible using optimum motor performance. The robot may not stay on the path" 5 "EndOfInstruction" = "This stop can be used to stop the program execution when the current instruction is completed" } 0:37>0:80 0:40>0:63
-Object 2:5006 2:"Ready" = "Entity is in a condition to start execution." 0 0 0 0:40>0:2307 0:46>2:6011
-Variable 2:6011 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
-Overrides 2:6011 0:2308
-Object 2:5012 2:"ReadyToExecuting" = "Changes from Ready to Executing" 0 0 0 0:40>0:2310 0:52>2:5007 0:51>2:5006 0:53>2:7001 0:54>0:2311 0:46>2:6017
-Variable 2:6017 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:4 0:37>0:78 0:40>0:68
-Overrides 2:6017 0:2312
-Object 2:5008 2:"ReadyToIdle" = "Changes from Ready to Idle" 0 0 0 0:40>0:2310 0:52>2:5005 0:51>2:5006 0:54>0:2311 0:46>2:6014
-Variable 2:6014 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:3 0:37>0:78 0:40>0:68
-Overrides 2:6014 0:2312
-Method 2:7001 2:"Start" = ~ 0 0 1 1 0:37>0:80 0:46>2:6023
-Variable 2:6023 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
-Method 2:7002 2:"Stop" = ~ 0 0 1 1 0:37>0:80 0:46>2:6024 0:46>2:6025
-Variable 2:6024 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "StopMode" 0:8 -1 [] "provides a way to differentiate between different stop modes. This parameter should correspond to one of the values in the PossibleStopModes array" } 0:37>0:78 0:40>0:68
-Variable 2:6025 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
-ObjectType 2:1021 2:"SystemOperationStateMachineType" = ~ 0 0 0 0:45<2:1006 0:41>0:2311 0:47>2:6057 0:47>2:5032 0:47>2:5028 0:47>2:5038 0:47>2:5037 0:47>2:7006 0:47>2:5030 0:47>2:5027 0:47>2:5033 0:47>2:5034 0:47>2:6058 0:47>2:6060 0:47>2:6063 0:47>2:5031 0:47>2:5036 0:47>2:5035 0:47>2:7007 0:47>2:7004 0:47>2:7005
-Variable 2:6057 2:"ConfiguredDefaultStopMode" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:63
-Overrides 2:6057 2:6009
-Object 2:5032 2:"Executing" = ~ 0 0 0 0:40>0:2307 0:117>2:5028 0:46>2:6087
-Overrides 2:5032 2:5007
-Variable 2:6087 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:3 0:37>0:78 0:40>0:68
-Overrides 2:6087 2:6012
-Object 2:5028 2:"ExecutingSubstateMachine" = ~ 0 0 0 0:37>0:80 0:40>2:1007 0:47>2:6083 0:47>2:6078 0:47>2:6080
-Variable 2:6083 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2760 0:46>2:6084
-Overrides 2:6083 0:2772
-Variable 2:6084 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6084 0:3728
-Variable 2:6078 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>2:6079
-Overrides 2:6078 2:6036
-Variable 2:6079 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6079 2:6037
-Variable 2:6080 2:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>2:6081 0:46>2:6082
-Overrides 2:6080 2:6038
-Variable 2:6081 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
-Overrides 2:6081 2:6039
-Variable 2:6082 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
-Overrides 2:6082 2:6040
-Object 2:5038 2:"ExecutingToIdle" = ~ 0 0 0 0:40>0:2310 0:51>2:5032 0:52>2:5030 0:54>0:2311 0:46>2:6093
-Overrides 2:5038 2:5013
-Variable 2:6093 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:6 0:37>0:78 0:40>0:68
-Overrides 2:6093 2:6018
-Object 2:5037 2:"ExecutingToReady" = ~ 0 0 0 0:40>0:2310 0:51>2:5032 0:52>2:5031 0:53>2:7005 0:54>0:2311 0:46>2:6092
-Overrides 2:5037 2:5011
-Variable 2:6092 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:5 0:37>0:78 0:40>0:68
-Overrides 2:6092 2:6016
-Method 2:7006 2:"GetReady" = ~ 0 0 1 1 0:37>0:80 0:46>2:6068
-Variable 2:6068 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
-Object 2:5030 2:"Idle" = ~ 0 0 0 0:40>0:2307 0:117>2:5027 0:46>2:6085
-Overrides 2:5030 2:5005
-Variable 2:6085 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
-Overrides 2:6085 2:6010
-Object 2:5027 2:"IdleSubstateMachine" = ~ 0 0 0 0:37>0:80 0:40>2:1009 0:47>2:6076 0:47>2:6071 0:47>2:6073
-Variable 2:6076 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2760 0:46>2:6077
-Overrides 2:6076 0:2772
-Variable 2:6077 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6077 0:3728
-Variable 2:6071 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>2:6072
-Overrides 2:6071 2:6026
-Variable 2:6072 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6072 2:6028
-Variable 2:6073 2:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>2:6074 0:46>2:6075
-Overrides 2:6073 2:6029
-Variable 2:6074 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "" = ~ } 0:37>0:78 0:40>0:68
-Overrides 2:6074 2:6034
-Variable 2:6075 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
-Overrides 2:6075 2:6035
-Object 2:5033 2:"IdleToIdle" = ~ 0 0 0 0:40>0:2310 0:52>2:5030 0:51>2:5030 0:53>2:7007 0:54>0:2311 0:46>2:6088
-Overrides 2:5033 2:5014
-Variable 2:6088 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
-Overrides 2:6088 2:6019
-Object 2:5034 2:"IdleToReady" = ~ 0 0 0 0:40>0:2310 0:53>2:7006 0:51>2:5030 0:52>2:5031 0:54>0:2311 0:46>2:6089
-Overrides 2:5034 2:5009
-Variable 2:6089 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
-Overrides 2:6089 2:6015
-Variable 2:6058 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>2:6059
-Overrides 2:6058 2:6005
-Variable 2:6059 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6059 2:6006
-Variable 2:6060 2:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>2:6061 0:46>2:6062
-Overrides 2:6060 2:6007
-Variable 2:6061 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
-Overrides 2:6061 2:6020
-Variable 2:6062 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
-Overrides 2:6062 2:6021
-Variable 2:6063 2:"PossibleStopModes" = ~ 0 0 0:7594 1 [0] 3 3 0 ~ EnumValues:{ 1 "OnPath" = "Stop program execution in a controlled manner along the programmed path" 2 "EndOfCycle" = "Stop program execution when the current production cycle has been finished" 3 "ProcessStop" = "Application dependent stop instruction that stops program execution at a favourable point for the application, e.g. at the end of a paint stroke or sealing bead" 4 "QuickStop" = "This stop is performed by ramping down motion as fast as possible using optimum motor performance. The robot may not stay on the path" 5 "EndOfInstruction" = "This stop can be used to stop the program execution when the current instruction is completed" } 0:37>0:80 0:40>0:63
-Overrides 2:6063 2:6008
-Object 2:5031 2:"Ready" = ~ 0 0 0 0:40>0:2307 0:46>2:6086
-Overrides 2:5031 2:5006
-Variable 2:6086 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
-Overrides 2:6086 2:6011
-Object 2:5036 2:"ReadyToExecuting" = ~ 0 0 0 0:40>0:2310 0:52>2:5032 0:51>2:5031 0:53>2:7004 0:54>0:2311 0:46>2:6091
-Overrides 2:5036 2:5012
-Variable 2:6091 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:4 0:37>0:78 0:40>0:68
-Overrides 2:6091 2:6017
-Object 2:5035 2:"ReadyToIdle" = ~ 0 0 0 0:40>0:2310 0:52>2:5030 0:51>2:5031 0:53>2:7007 0:54>0:2311 0:46>2:6090
-Overrides 2:5035 2:5008
-Variable 2:6090 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:3 0:37>0:78 0:40>0:68
-Overrides 2:6090 2:6014
-Method 2:7007 2:"StandDown" = ~ 0 0 1 1 0:37>0:80 0:46>2:6070
-Variable 2:6070 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
-Method 2:7004 2:"Start" = ~ 0 0 1 1 0:37>0:80 0:46>2:6064
-Overrides 2:7004 2:7001
-Variable 2:6064 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
-Method 2:7005 2:"Stop" = ~ 0 0 1 1 0:37>0:80 0:46>2:6065 0:46>2:6066
-Overrides 2:7005 2:7002
-Variable 2:6065 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "StopMode" 0:8 -1 [] "provides a way to differentiate between different stop modes. This parameter should correspond to one of the values in the PossibleStopModes array" } 0:37>0:78 0:40>0:68
-Variable 2:6066 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
-ObjectType 2:1025 2:"TaskControlStateMachineType" = ~ 0 0 0 0:45<2:1006 0:41>0:2311 0:47>2:6094 0:47>2:5042 0:47>2:5048 0:47>2:5047 0:47>2:5040 0:47>2:5043 0:47>2:5044 0:47>2:6095 0:47>2:6097 0:47>2:7011 0:47>2:7010 0:47>2:6100 0:47>2:5041 0:47>2:5039 0:47>2:5046 0:47>2:5045 0:47>2:7008 0:47>2:7009 0:47>2:7014 0:47>2:7013 0:47>2:7012
-Variable 2:6094 2:"ConfiguredDefaultStopMode" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:63
-Overrides 2:6094 2:6009
-Object 2:5042 2:"Executing" = ~ 0 0 0 0:40>0:2307 0:46>2:6114
-Overrides 2:5042 2:5007
-Variable 2:6114 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:3 0:37>0:78 0:40>0:68
-Overrides 2:6114 2:6012
-Object 2:5048 2:"ExecutingToIdle" = ~ 0 0 0 0:40>0:2310 0:51>2:5042 0:52>2:5040 0:54>0:2311 0:46>2:6122
-Overrides 2:5048 2:5013
-Variable 2:6122 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:6 0:37>0:78 0:40>0:68
-Overrides 2:6122 2:6018
-Object 2:5047 2:"ExecutingToReady" = ~ 0 0 0 0:40>0:2310 0:51>2:5042 0:52>2:5041 0:53>2:7009 0:54>0:2311 0:46>2:6121
-Overrides 2:5047 2:5011
-Variable 2:6121 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:5 0:37>0:78 0:40>0:68
-Overrides 2:6121 2:6016
-Object 2:5040 2:"Idle" = ~ 0 0 0 0:40>0:2307 0:46>2:6112
-Overrides 2:5040 2:5005
-Variable 2:6112 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
-Overrides 2:6112 2:6010
-Object 2:5043 2:"IdleToIdle" = ~ 0 0 0 0:40>0:2310 0:51>2:5040 0:52>2:5040 0:54>0:2311 0:46>2:6115
-Overrides 2:5043 2:5014
-Variable 2:6115 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
-Overrides 2:6115 2:6019
-Object 2:5044 2:"IdleToReady" = ~ 0 0 0 0:40>0:2310 0:51>2:5040 0:53>2:7011 0:53>2:7010 0:52>2:5041 0:54>0:2311 0:46>2:6116
-Overrides 2:5044 2:5009
-Variable 2:6116 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
-Overrides 2:6116 2:6015
-Variable 2:6095 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>2:6096
-Overrides 2:6095 2:6005
-Variable 2:6096 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6096 2:6006
-Variable 2:6097 2:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>2:6098 0:46>2:6099
-Overrides 2:6097 2:6007
-Variable 2:6098 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
-Overrides 2:6098 2:6020
-Variable 2:6099 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
-Overrides 2:6099 2:6021
-Method 2:7011 2:"LoadByName" = ~ 0 0 1 1 0:37>0:80 0:46>2:6143 0:46>2:6144
-Variable 2:6143 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Name" 0:12 -1 [] "Name to identify a task control program or module" } 0:37>0:78 0:40>0:68
-Variable 2:6144 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK – Everything is OK\n1 – E_SystemState – The system is not in correct state for this operation\n2 – E_UnexpectedError – Unexpected Error during the method call\n3 – E_ActiveAlarm – An Active Alarm prevents the system start\n4 – E_AcknowledgeRequired – Condition needs to be acknowledged\n<0 – shall be used for vendor-specific errors\n>0 – are reserved for errors defined by this and future standards" } 0:37>0:78 0:40>0:68
-Method 2:7010 2:"LoadByNodeId" = ~ 0 0 1 1 0:37>0:80 0:46>2:6141 0:46>2:6142
-Variable 2:6141 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Id" 0:18 -1 [] "ExpandedNodeId pointing to an instance of FileType representing a task control program or module" } 0:37>0:78 0:40>0:68
-Variable 2:6142 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK – Everything is OK\n1 – E_SystemState – The system is not in correct state for this operation\n2 – E_UnexpectedError – Unexpected Error during the method call\n3 – E_ActiveAlarm – An Active Alarm prevents the system start\n4 – E_AcknowledgeRequired – Condition needs to be acknowledged\n<0 – shall be used for vendor-specific errors\n>0 – are reserved for errors defined by this and future standards" } 0:37>0:78 0:40>0:68
-Variable 2:6100 2:"PossibleStopModes" = ~ 0 0 0:7594 1 [0] 3 3 0 ~ EnumValues:{ 1 "OnPath" = "Stop program execution in a controlled manner along the programmed path" 2 "EndOfCycle" = "Stop program execution when the current production cycle has been finished" 3 "ProcessStop" = "Application dependent stop instruction that stops program execution at a favourable point for the application, e.g. at the end of a paint stroke or sealing bead" 4 "QuickStop" = "This stop is performed by ramping down motion as fast as possible using optimum motor performance. The robot may not stay on the path" 5 "EndOfInstruction" = "This stop can be used to stop the program execution when the current instruction is completed" } 0:37>0:80 0:40>0:63
-Overrides 2:6100 2:6008
-Object 2:5041 2:"Ready" = ~ 0 0 0 0:40>0:2307 0:117>2:5039 0:46>2:6113
-Overrides 2:5041 2:5006
-Variable 2:6113 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
-Overrides 2:6113 2:6011
-Object 2:5039 2:"ReadySubstateMachine" = ~ 0 0 0 0:37>0:80 0:40>2:1012 0:47>2:6109 0:47>2:6104 0:47>2:6106
-Variable 2:6109 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2760 0:46>2:6111
-Overrides 2:6109 0:2772
-Variable 2:6111 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6111 0:3728
-Variable 2:6104 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>2:6105
-Overrides 2:6104 2:6044
-Variable 2:6105 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6105 2:6045
-Variable 2:6106 2:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>2:6107 0:46>2:6108
-Overrides 2:6106 2:6046
-Variable 2:6107 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
-Overrides 2:6107 2:6047
-Variable 2:6108 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
-Overrides 2:6108 2:6048
-Object 2:5046 2:"ReadyToExecuting" = ~ 0 0 0 0:40>0:2310 0:52>2:5042 0:51>2:5041 0:53>2:7008 0:54>0:2311 0:46>2:6120
-Overrides 2:5046 2:5012
-Variable 2:6120 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:4 0:37>0:78 0:40>0:68
-Overrides 2:6120 2:6017
-Object 2:5045 2:"ReadyToIdle" = ~ 0 0 0 0:40>0:2310 0:52>2:5040 0:51>2:5041 0:54>0:2311 0:53>2:7014 0:53>2:7013 0:53>2:7012 0:46>2:6119
-Overrides 2:5045 2:5008
-Variable 2:6119 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:3 0:37>0:78 0:40>0:68
-Overrides 2:6119 2:6014
-Method 2:7008 2:"Start" = ~ 0 0 1 1 0:37>0:80 0:46>2:6101
-Overrides 2:7008 2:7001
-Variable 2:6101 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
-Method 2:7009 2:"Stop" = ~ 0 0 1 1 0:37>0:80 0:46>2:6102 0:46>2:6103
-Overrides 2:7009 2:7002
-Variable 2:6102 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "StopMode" 0:8 -1 [] "provides a way to differentiate between different stop modes. This parameter should correspond to one of the values in the PossibleStopModes array" } 0:37>0:78 0:40>0:68
-Variable 2:6103 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
-Method 2:7014 2:"UnloadByName" = ~ 0 0 1 1 0:37>0:80 0:46>2:6067 0:46>2:6069
-Variable 2:6067 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Name" 0:12 -1 [] ~ } 0:37>0:78 0:40>0:68
-Variable 2:6069 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] ~ } 0:37>0:78 0:40>0:68
-Method 2:7013 2:"UnloadByNodeId" = ~ 0 0 1 1 0:37>0:80 0:46>2:6146 0:46>2:6147
-Variable 2:6146 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Id" 0:18 -1 [] "Expanded NodeId of the module to be unloaded" } 0:37>0:78 0:40>0:68
-Variable 2:6147 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK – Everything is OK\n1 – E_SystemState – The system is not in correct state for this operation\n2 – E_UnexpectedError – Unexpected Error during the method call\n3 – E_ActiveAlarm – An Active Alarm prevents the system start\n4 – E_AcknowledgeRequired – Condition needs to be acknowledged\n<0 – shall be used for vendor-specific errors\n>0 – are reserved for errors defined by this and future standards" } 0:37>0:78 0:40>0:68
-Method 2:7012 2:"UnloadProgram" = ~ 0 0 1 1 0:37>0:80 0:46>2:6145
-Variable 2:6145 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK – Everything is OK\n1 – E_SystemState – The system is not in correct state for this operation\n2 – E_UnexpectedError – Unexpected Error during the method call\n3 – E_ActiveAlarm – An Active Alarm prevents the system start\n4 – E_AcknowledgeRequired – Condition needs to be acknowledged\n<0 – shall be used for vendor-specific errors\n>0 – are reserved for errors defined by this and future standards" } 0:37>0:78 0:40>0:68
-ObjectType 2:1012 2:"ReadySubstateMachineType" = ~ 0 0 0 0:45<0:2771 0:41>0:2311 0:47>2:5023 0:47>2:6044 0:47>2:6046 0:47>2:5025 0:47>2:7003 0:47>2:5024 0:47>2:5026
-Object 2:5023 2:"AtProgramStart" = ~ 0 0 0 0:40>0:2307 0:46>2:6049
-Variable 2:6049 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
-Overrides 2:6049 0:2308
-Variable 2:6044 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>2:6045
-Overrides 2:6044 0:2773
-Variable 2:6045 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6045 0:3732
-Variable 2:6046 2:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>2:6047 0:46>2:6048
-Variable 2:6047 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
-Overrides 2:6047 0:11241
-Variable 2:6048 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
-Overrides 2:6048 0:11461
-Object 2:5025 2:"ProgramStartToSuspended" = ~ 0 0 0 0:40>0:2310 0:51>2:5023 0:52>2:5024 0:54>0:2311 0:46>2:6051
-Variable 2:6051 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
-Overrides 2:6051 0:2312
-Method 2:7003 2:"ResetToProgramStart" = ~ 0 0 1 1 0:37>0:80 0:46>2:6053
-Variable 2:6053 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK – Everything is OK\n1 – E_SystemState – The system is not in correct state for this operation\n2 – E_UnexpectedError – Unexpected Error during the method call\n3 – E_ActiveAlarm – An Active Alarm prevents the system start\n4 – E_AcknowledgeRequired – Condition needs to be acknowledged\n<0 – shall be used for vendor-specific errors\n>0 – are reserved for errors defined by this and future standards" } 0:37>0:78 0:40>0:68
-Object 2:5024 2:"Suspended" = ~ 0 0 0 0:40>0:2307 0:46>2:6050
-Variable 2:6050 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
-Overrides 2:6050 0:2308
-Object 2:5026 2:"SuspendedToProgramStart" = ~ 0 0 0 0:40>0:2310 0:52>2:5023 0:53>2:7003 0:51>2:5024 0:54>0:2311 0:46>2:6052
-Variable 2:6052 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
-Overrides 2:6052 0:2312
-ObjectType 2:1028 2:"SystemOperationType" = ~ 0 0 0 0:45<0:58 0:47>2:5050 0:46>2:6130 0:47>2:5049
-Object 2:5050 2:"Conditions" = ~ 0 0 0 0:37>0:80 0:40>0:61 0:35>2:5059
-Object 2:5059 2:"<AcknowledgeableCondition>" = ~ 0 0 0 0:37>0:11510 0:40>0:2881 0:47>2:6185 0:47>2:7019 0:47>2:7020 0:46>2:6191 0:46>2:6192 0:47>2:6193 0:46>2:6195 0:46>2:6196 0:46>2:6197 0:46>2:6198 0:46>2:6199 0:47>2:7021 0:47>2:7022 0:47>2:6188 0:46>2:6205 0:46>2:6206 0:47>2:6200 0:46>2:6207 0:47>2:6202 0:46>2:6208 0:46>2:6204 0:46>2:6209 0:46>2:6210 0:46>2:6211 0:46>2:6212
-Variable 2:6185 0:"AckedState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:8995 0:46>2:6186
-Overrides 2:6185 0:9093
-Variable 2:6186 0:"Id" = ~ 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6186 0:9094
-Method 2:7019 0:"Acknowledge" = ~ 0 0 1 1 0:37>0:78 0:46>2:6187
-Overrides 2:7019 0:9111
-Variable 2:6187 0:"InputArguments" = ~ 0 0 0:296 1 [2] 1 1 0 ~ Arguments:{ "EventId" 0:15 -1 [] "The identifier for the event to comment." "Comment" 0:21 -1 [] "The comment to add to the condition." } 0:37>0:78 0:40>0:68
-Method 2:7020 0:"AddComment" = ~ 0 0 1 1 0:37>0:78 0:46>2:6190
-Overrides 2:7020 0:9029
-Variable 2:6190 0:"InputArguments" = ~ 0 0 0:296 1 [2] 1 1 0 ~ Arguments:{ "EventId" 0:15 -1 [] "The identifier for the event to comment." "Comment" 0:21 -1 [] "The comment to add to the condition." } 0:37>0:78 0:40>0:68
-Variable 2:6191 0:"BranchId" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6191 0:9010
-Variable 2:6192 0:"ClientUserId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6192 0:9026
-Variable 2:6193 0:"Comment" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:9002 0:46>2:6194
-Overrides 2:6193 0:9024
-Variable 2:6194 0:"SourceTimestamp" = ~ 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6194 0:9025
-Variable 2:6195 0:"ConditionClassId" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6195 0:11112
-Variable 2:6196 0:"ConditionClassName" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6196 0:11113
-Variable 2:6197 0:"ConditionName" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6197 0:9009
-Variable 2:6198 0:"ConditionSubClassId" = ~ 0 0 0:17 1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6198 0:16363
-Variable 2:6199 0:"ConditionSubClassName" = ~ 0 0 0:21 1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6199 0:16364
-Method 2:7021 0:"Disable" = ~ 0 0 1 1 0:37>0:78
-Overrides 2:7021 0:9028
-Method 2:7022 0:"Enable" = ~ 0 0 1 1 0:37>0:78
-Overrides 2:7022 0:9027
-Variable 2:6188 0:"EnabledState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:8995 0:9004>2:6185 0:46>2:6189
-Overrides 2:6188 0:9073
-Variable 2:6189 0:"Id" = ~ 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6189 0:9074
-Variable 2:6205 0:"EventId" = ~ 0 0 0:15 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6205 0:2042
-Variable 2:6206 0:"EventType" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6206 0:2043
-Variable 2:6200 0:"LastSeverity" = ~ 0 0 0:5 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:9002 0:46>2:6201
-Overrides 2:6200 0:9022
-Variable 2:6201 0:"SourceTimestamp" = ~ 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6201 0:9023
-Variable 2:6207 0:"Message" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6207 0:2050
-Variable 2:6202 0:"Quality" = ~ 0 0 0:19 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:9002 0:46>2:6203
-Overrides 2:6202 0:9020
-Variable 2:6203 0:"SourceTimestamp" = ~ 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6203 0:9021
-Variable 2:6208 0:"ReceiveTime" = ~ 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6208 0:2047
-Variable 2:6204 0:"Retain" = ~ 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6204 0:3874
-Variable 2:6209 0:"Severity" = ~ 0 0 0:5 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6209 0:2051
-Variable 2:6210 0:"SourceName" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6210 0:2045
-Variable 2:6211 0:"SourceNode" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6211 0:2044
-Variable 2:6212 0:"Time" = ~ 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6212 0:2046
-Variable 2:6130 0:"DefaultInstanceBrowseName" = ~ 0 0 0:20 -1 [] 3 3 0 ~ QualifiedName:0:"SystemOperation" 0:40>0:68
-Object 2:5049 2:"SystemOperationStateMachine" = ~ 0 0 0 0:37>0:78 0:40>2:1021 0:47>2:6128 0:47>2:6123 0:47>2:6125
-Variable 2:6128 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2760 0:46>2:6129
-Overrides 2:6128 0:2772
-Variable 2:6129 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6129 0:3728
-Variable 2:6123 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>2:6124
-Overrides 2:6123 2:6058
-Variable 2:6124 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6124 2:6059
-Variable 2:6125 2:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>2:6126 0:46>2:6127
-Overrides 2:6125 2:6060
-Variable 2:6126 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
-Overrides 2:6126 2:6061
-Variable 2:6127 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
-Overrides 2:6127 2:6062
-ObjectType 2:1008 2:"TaskControlOperationType" = ~ 0 0 0 0:45<0:58 0:46>2:6132 0:46>2:6131 0:47>2:5051
-Variable 2:6132 0:"DefaultInstanceBrowseName" = ~ 0 0 0:20 -1 [] 3 3 0 ~ QualifiedName:2:"TaskControlOperation" 0:40>0:68
-Variable 2:6131 2:"MotionDevicesUnderControl" = ~ 0 0 0:17 1 [0] 1 1 0 ~ ~ 0:37>0:80 0:40>0:68
-Object 2:5051 2:"TaskControlStateMachine" = ~ 0 0 0 0:37>0:78 0:40>2:1025 0:47>2:6138 0:47>2:6133 0:47>2:6135
-Variable 2:6138 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2760 0:46>2:6139
-Overrides 2:6138 0:2772
-Variable 2:6139 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6139 0:3728
-Variable 2:6133 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>2:6134
-Overrides 2:6133 2:6095
-Variable 2:6134 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6134 2:6096
-Variable 2:6135 2:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>2:6136 0:46>2:6137
-Overrides 2:6135 2:6097
-Variable 2:6136 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
-Overrides 2:6136 2:6098
-Variable 2:6137 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
-Overrides 2:6137 2:6099
-ObjectType 2:1016 2:"TaskModuleType" = ~ 0 0 0 0:45<0:58 0:46>2:6056 0:46>2:6054 0:46>2:6055
-Variable 2:6056 2:"IsReferenced" = ~ 0 0 0:1 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:68
-Variable 2:6054 2:"Name" = ~ 0 0 0:12 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:68
-Variable 2:6055 2:"Version" = ~ 0 0 0:12 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:68
-ObjectType 2:17725 2:"AuxiliaryComponentType" = "Components mounted in a controller cabinet or a motion device e.g. an IO-board or a power supply." 0 0 0 0:45<1:15063 0:46>2:6183 0:46>2:17756
-Variable 2:6183 1:"AssetId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
-Overrides 2:6183 1:15098
-Variable 2:17756 1:"ProductCode" = "The ProductCode property provides a unique combination of numbers and letters used to identify the product. It may be the order information displayed on type shields or in ERP systems." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17756 1:15092
-ObjectType 2:16601 2:"AxisType" = "The AxisType describes an axis of a motion device." 0 0 0 0:45<1:15063 2:18179>2:18344 0:47>2:16638 0:46>2:6175 0:46>2:16637 0:47>2:16602
-Object 2:18344 2:"<PowerTrainIdentifier>" = "The Requires reference provides the relationship of axes to powertrains. For complex kinematics this does not need to be a one to one relationship, because more than one power train might influence the motion of one axis. This reference connects all power trains to an axis that must be actively driven when only this axis should move and all other axes should stand still. Virtual axes that are not actively driven by a power train do not have this reference." 0 0 0 0:40>2:16794 0:37>0:11508 0:47>2:15998
-Object 2:16638 2:"AdditionalLoad" = "The additional load which is mounted on this axis. E.g. for process-need a transformer for welding." 0 0 0 0:40>2:1018 0:37>0:80 0:47>2:16639
-Variable 2:16639 2:"Mass" = "The weight of the load mounted on one mounting point." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>2:16644
-Overrides 2:16639 2:6723
-Variable 2:16644 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16644 2:6728
-Variable 2:6175 1:"AssetId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
-Overrides 2:6175 1:15098
-Variable 2:16637 2:"MotionProfile" = "The kind of axis motion as defined with the AxisMotionProfileEnumeration." 0 0 2:3008 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Object 2:16602 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>2:16674 0:47>2:16662 0:47>2:16668
-Overrides 2:16602 1:5002
-Variable 2:16674 2:"ActualAcceleration" = ": The ActualAcceleration variable provides the axis acceleration. Applicable acceleration limits of the axis shall be provided by the EURange property of the AnalogUnitType." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:80 0:46>2:16679
-Variable 2:16679 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16679 0:17502
-Variable 2:16662 2:"ActualPosition" = "The axis position inclusive Unit and RangeOfMotion." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>2:16667
-Variable 2:16667 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16667 0:17502
-Variable 2:16668 2:"ActualSpeed" = "The axis speed on load side (after gear/spindle) inclusive Unit." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:80 0:46>2:16673
-Variable 2:16673 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16673 0:17502
-ObjectType 2:1003 2:"ControllerType" = "The ControllerType describes the control unit of motion devices. One motion device system can have one or more instances of the ControllerType." 0 0 0 0:45<1:15063 2:4002>2:18964 2:18182>2:18918 0:46>2:6180 0:46>2:6181 0:47>2:17252 0:47>2:17249 0:46>2:6182 0:46>2:17237 0:46>2:17239 0:47>2:5004 0:46>2:17245 0:47>2:5054 0:46>2:17240 0:47>2:15800 0:17604>2:5055 0:47>2:15826
-Object 2:18964 2:"<MotionDeviceIdentifier>" = "The relationship of a motion device and controller." 0 0 0 0:40>2:1004 0:37>0:11508 0:47>2:19002 0:46>2:18985 0:46>2:18987 0:46>2:18998 0:47>2:18965 0:47>2:19080 0:46>2:18993 0:46>2:18988 0:47>2:6003
-Object 2:19002 2:"Axes" = "Axes is a container for one or more instances of the AxisType." 0 0 0 0:40>0:61 0:37>0:78 0:47>2:15743
-Overrides 2:19002 2:15305
-Variable 2:18985 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:18985 2:16351
-Variable 2:18987 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:18987 2:16353
-Variable 2:18998 2:"MotionDeviceCategory" = "The variable MotionDeviceCategory provides the kind of motion device defined by MotionDeviceCategoryEnumeration based on ISO 8373." 0 0 2:18193 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:18998 2:16362
-Object 2:18965 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>2:19001
-Overrides 2:18965 2:5029
-Variable 2:19001 2:"SpeedOverride" = "SpeedOverride provides the current speed setting in percent of programmed speed (0 - 100%)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:19001 2:16365
-Object 2:19080 2:"PowerTrains" = "PowerTrains is a container for one or more instances of the PowerTrainType." 0 0 0 0:40>0:61 0:37>0:78 0:47>2:15905
-Overrides 2:19080 2:16443
-Variable 2:18993 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:18993 2:16359
-Variable 2:18988 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:18988 2:16354
-Variable 2:6003 2:"TaskControlReference" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:80 0:40>0:63
-Overrides 2:6003 2:6001
-Object 2:18918 2:"<SafetyStatesIdentifier>" = "The relationship of safety states to a controller." 0 0 0 0:40>2:1013 0:37>0:11508 0:47>2:18919
-Object 2:18919 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>2:18962 0:47>2:18961 0:47>2:18963
-Overrides 2:18919 2:5016
-Variable 2:18962 2:"EmergencyStop" = "The EmergencyStop variable is TRUE if one or more of the emergency stop functions in the robot system are active, FALSE otherwise. If the EmergencyStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed emergency stop functions are active." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:18962 2:15882
-Variable 2:18961 2:"OperationalMode" = "The OperationalMode variable provides information about the current operational mode. Allowed values are described in OperationalModeEnumeration, see ISO 10218-1:2011 Ch.5.7 Operational Modes." 0 0 2:3006 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:18961 2:15912
-Variable 2:18963 2:"ProtectiveStop" = "The ProtectiveStop variable is TRUE if one or more of the enabled protective stop functions in the system are active, FALSE otherwise. If the ProtectiveStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed protective stop functions are enabled and active." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:18963 2:15913
-Variable 2:6180 1:"AssetId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
-Overrides 2:6180 1:15098
-Variable 2:6181 1:"ComponentName" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
-Overrides 2:6181 1:15099
-Object 2:17252 2:"Components" = "Components is a container for one or more instances of subtypes of ComponentType defined in OPC UA DI. The listed components are installed in the motion device system, e.g. a processing-unit, a power-supply, an IO-board or a drive, and have an electrical interface to the controller." 0 0 0 0:40>0:61 0:37>0:80 0:47>2:18813
-Object 2:18813 2:"<ComponentIdentifier>" = "The intention is to integrate inside this container devices which are defined in other companion specifications using DI." 0 0 0 0:37>0:11510 0:40>1:15063 0:17603>1:15048 0:17603>1:15035
-Object 2:17249 2:"CurrentUser" = "The current user of the system." 0 0 0 0:40>2:18175 0:37>0:78 0:46>2:17250
-Variable 2:17250 2:"Level" = "The weight of the load mounted on one mounting point." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17250 2:18176
-Variable 2:6182 1:"DeviceManual" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
-Overrides 2:6182 1:15093
-Variable 2:17237 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17237 1:15086
-Variable 2:17239 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17239 1:15088
-Object 2:5004 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:80 0:47>2:17365 0:47>2:17371 0:47>2:17377 0:47>2:15366 0:47>2:17383 0:47>2:17359 0:47>2:17358 0:47>2:15365
-Overrides 2:5004 1:5002
-Variable 2:17365 2:"CabinetFanSpeed" = "The speed of the cabinet fan." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:80 0:46>2:17370
-Variable 2:17370 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17370 0:17502
-Variable 2:17371 2:"CPUFanSpeed" = "The speed of the CPU fan." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:80 0:46>2:17376
-Variable 2:17376 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17376 0:17502
-Variable 2:17377 2:"InputVoltage" = "The input voltage of the controller which can be a configured value. To distinguish between an AC or DC supply the optional property Definition of the base type DataItemType shall be used." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:80 0:46>2:17382
-Variable 2:17382 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17382 0:17502
-Variable 2:15366 2:"StartUpTime" = "The date and time of the last start-up of the controller." 0 0 0:13 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
-Variable 2:17383 2:"Temperature" = "The controller temperature given by a temperature sensor inside of the controller." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:80 0:46>2:17388
-Variable 2:17388 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17388 0:17502
-Variable 2:17359 2:"TotalEnergyConsumption" = "The total accumulated energy consumed by the motion devices related with this controller instance." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:80 0:46>2:17364
-Variable 2:17364 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17364 0:17502
-Variable 2:17358 2:"TotalPowerOnTime" = "The total accumulated time the controller was powered on." 0 0 0:12879 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
-Variable 2:15365 2:"UpsState" = "The vendor specific status of an integrated UPS or accumulator system." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
-Variable 2:17245 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17245 1:15092
-Object 2:5054 2:"Programs" = ~ 0 0 0 0:37>0:80 0:40>0:13353 0:47>2:7015 0:47>2:7016 0:47>2:7017 0:47>2:7018
-Method 2:7015 0:"CreateDirectory" = ~ 0 0 1 1 0:37>0:78 0:46>2:6155 0:46>2:6156
-Overrides 2:7015 0:13387
-Variable 2:6155 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "DirectoryName" 0:12 -1 [] ~ } 0:37>0:78 0:40>0:68
-Variable 2:6156 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "DirectoryNodeId" 0:17 -1 [] ~ } 0:37>0:78 0:40>0:68
-Method 2:7016 0:"CreateFile" = ~ 0 0 1 1 0:37>0:78 0:46>2:6157 0:46>2:6158
-Overrides 2:7016 0:13390
-Variable 2:6157 0:"InputArguments" = ~ 0 0 0:296 1 [2] 1 1 0 ~ Arguments:{ "FileName" 0:12 -1 [] ~ "RequestFileOpen" 0:1 -1 [] ~ } 0:37>0:78 0:40>0:68
-Variable 2:6158 0:"OutputArguments" = ~ 0 0 0:296 1 [2] 1 1 0 ~ Arguments:{ "FileNodeId" 0:17 -1 [] ~ "FileHandle" 0:7 -1 [] ~ } 0:37>0:78 0:40>0:68
-Method 2:7017 0:"Delete" = ~ 0 0 1 1 0:37>0:78 0:46>2:6159
-Overrides 2:7017 0:13393
-Variable 2:6159 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "ObjectToDelete" 0:17 -1 [] ~ } 0:37>0:78 0:40>0:68
-Method 2:7018 0:"MoveOrCopy" = ~ 0 0 1 1 0:37>0:78 0:46>2:6160 0:46>2:6161
-Overrides 2:7018 0:13395
-Variable 2:6160 0:"InputArguments" = ~ 0 0 0:296 1 [4] 1 1 0 ~ Arguments:{ "ObjectToMoveOrCopy" 0:17 -1 [] ~ "TargetDirectory" 0:17 -1 [] ~ "CreateCopy" 0:1 -1 [] ~ "NewName" 0:12 -1 [] ~ } 0:37>0:78 0:40>0:68
-Variable 2:6161 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "NewNodeId" 0:17 -1 [] ~ } 0:37>0:78 0:40>0:68
-Variable 2:17240 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17240 1:15095
-Object 2:15800 2:"Software" = "Software is a container for one or more instances of SoftwareType defined in OPC UA DI." 0 0 0 0:40>0:61 0:37>0:78 0:47>2:18847
-Object 2:18847 2:"<SoftwareIdentifier>" = ~ 0 0 0 0:37>0:11510 0:40>1:15106 0:46>2:18868 0:46>2:18870 0:46>2:18873
-Variable 2:18868 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:18868 1:15129
-Variable 2:18870 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:18870 1:15131
-Variable 2:18873 1:"SoftwareRevision" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:18873 1:15133
-Object 2:5055 2:"SystemOperation" = ~ 0 0 0 0:37>0:80 0:40>2:1028 0:47>2:5056
-Object 2:5056 2:"SystemOperationStateMachine" = ~ 0 0 0 0:37>0:78 0:40>2:1021 0:47>2:6162 0:47>2:6164 0:47>2:6166
-Overrides 2:5056 2:5049
-Variable 2:6162 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2760 0:46>2:6163
-Overrides 2:6162 2:6128
-Variable 2:6163 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6163 2:6129
-Variable 2:6164 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>2:6165
-Overrides 2:6164 2:6123
-Variable 2:6165 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6165 2:6124
-Variable 2:6166 2:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>2:6167 0:46>2:6168
-Overrides 2:6166 2:6125
-Variable 2:6167 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
-Overrides 2:6167 2:6126
-Variable 2:6168 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
-Overrides 2:6168 2:6127
-Object 2:15826 2:"TaskControls" = "TaskControls is a container for one or more instances of TaskControlType." 0 0 0 0:40>0:61 0:37>0:78 0:47>2:18881
-Object 2:18881 2:"<TaskControlIdentifier>" = ~ 0 0 0 0:40>2:1011 0:37>0:11510 0:46>2:18914 0:47>2:18882
-Variable 2:18914 1:"ComponentName" = "A user writable name provided by the vendor, integrator or user of the device." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:18914 2:17873
-Object 2:18882 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>2:18916 0:47>2:18915
-Overrides 2:18882 2:15883
-Variable 2:18916 2:"TaskProgramLoaded" = "The TaskProgramLoaded variable is TRUE if a task program is loaded in the task control, FALSE otherwise." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:18916 2:17875
-Variable 2:18915 2:"TaskProgramName" = "A customer given identifier for the task program." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:18915 2:17874
-ObjectType 2:17793 2:"DriveType" = "Drives (multi-slot or single-slot axis amplifier) mounted in a controller cabinet or a motion device." 0 0 0 0:45<1:15063 0:46>2:6184 0:46>2:17824
-Variable 2:6184 1:"AssetId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
-Overrides 2:6184 1:15098
-Variable 2:17824 1:"ProductCode" = "The ProductCode property provides a unique combination of numbers and letters used to identify the product. It may be the order information displayed on type shields or in ERP systems." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17824 1:15092
-ObjectType 2:1022 2:"GearType" = "The GearType describes a gear in a powertrain, e.g. a gear box or a spindle." 0 0 0 0:45<1:15063 0:46>2:6178 0:47>2:15941 0:46>2:17152 0:46>2:17154 0:47>2:17165 0:46>2:17160 0:46>2:17155
-Variable 2:6178 1:"AssetId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
-Overrides 2:6178 1:15098
-Variable 2:15941 2:"GearRatio" = "The transmission ratio of the gear expressed as a fraction as input velocity (motor side) by output velocity (load side)." 0 0 0:18806 -1 [] 1 1 0 ~ ~ 0:40>0:17709 0:37>0:78 0:47>2:15616 0:47>2:15615
-Variable 2:15616 0:"Denominator" = ~ 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:15616 0:17713
-Variable 2:15615 0:"Numerator" = ~ 0 0 0:6 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:15615 0:17712
-Variable 2:17152 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17152 1:15086
-Variable 2:17154 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17154 1:15088
-Variable 2:17165 2:"Pitch" = "Pitch describes the distance covered in millimeters (mm) for linear motion per one revolution of the output side of the driving unit. Pitch is used in combination with GearRatio to describe the overall transmission from input to output of the gear." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
-Variable 2:17160 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17160 1:15092
-Variable 2:17155 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17155 1:15095
-ObjectType 2:1002 2:"MotionDeviceSystemType" = "Contains the set of controllers and motion devices in a closely-coupled motion device system." 0 0 0 0:45<1:15063 0:46>2:6171 0:47>2:5001 0:47>2:5002 0:47>2:5010
-Variable 2:6171 1:"ComponentName" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
-Overrides 2:6171 1:15099
-Object 2:5001 2:"Controllers" = "Contains the set of controllers in the motion device system." 0 0 0 0:40>0:61 0:37>0:78 0:47>2:15405
-Object 2:15405 2:"<ControllerIdentifier>" = ~ 0 0 0 0:40>2:1003 0:37>0:11510 0:47>2:15440 0:46>2:15426 0:46>2:15428 0:46>2:15434 0:46>2:15429 0:47>2:15483 0:47>2:15518
-Object 2:15440 2:"CurrentUser" = "The given name of the device." 0 0 0 0:40>2:18175 0:37>0:78 0:46>2:15441
-Overrides 2:15440 2:17249
-Variable 2:15441 2:"Level" = "The weight of the load mounted on one mounting point." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:15441 2:17250
-Variable 2:15426 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:15426 2:17237
-Variable 2:15428 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:15428 2:17239
-Variable 2:15434 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:15434 2:17245
-Variable 2:15429 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:15429 2:17240
-Object 2:15483 2:"Software" = "Software is a container for one or more instances of SoftwareType defined in OPC UA DI." 0 0 0 0:40>0:61 0:37>0:78 0:47>2:18847
-Overrides 2:15483 2:15800
-Object 2:15518 2:"TaskControls" = "TaskControls is a container for one or more instances of TaskControlType." 0 0 0 0:40>0:61 0:37>0:78 0:47>2:18881
-Overrides 2:15518 2:15826
-Object 2:5002 2:"MotionDevices" = "Contains any kinematic or motion device which is part of the motion device system." 0 0 0 0:40>0:61 0:37>0:78 0:47>2:15008
-Object 2:15008 2:"<MotionDeviceIdentifier>" = ~ 0 0 0 0:40>2:1004 0:37>0:11510 0:47>2:15062 0:46>2:15045 0:46>2:15047 0:46>2:15058 0:47>2:15024 0:47>2:15208 0:46>2:15053 0:46>2:15048 0:47>2:6002
-Object 2:15062 2:"Axes" = "Axes is a container for one or more instances of the AxisType." 0 0 0 0:40>0:61 0:37>0:78 0:47>2:15743
-Overrides 2:15062 2:15305
-Variable 2:15045 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:15045 2:16351
-Variable 2:15047 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:15047 2:16353
-Variable 2:15058 2:"MotionDeviceCategory" = "The variable MotionDeviceCategory provides the kind of motion device defined by MotionDeviceCategoryEnumeration based on ISO 8373." 0 0 2:18193 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:15058 2:16362
-Object 2:15024 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>2:15061
-Overrides 2:15024 2:5029
-Variable 2:15061 2:"SpeedOverride" = "SpeedOverride provides the current speed setting in percent of programmed speed (0 - 100%)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:15061 2:16365
-Object 2:15208 2:"PowerTrains" = "PowerTrains is a container for one or more instances of the PowerTrainType." 0 0 0 0:40>0:61 0:37>0:78 0:47>2:15905
-Overrides 2:15208 2:16443
-Variable 2:15053 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:15053 2:16359
-Variable 2:15048 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:15048 2:16354
-Variable 2:6002 2:"TaskControlReference" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:80 0:40>0:63
-Overrides 2:6002 2:6001
-Object 2:5010 2:"SafetyStates" = "Contains safety-related data from motion device system." 0 0 0 0:40>0:61 0:37>0:78 0:47>2:15697
-Object 2:15697 2:"<SafetyStateIdentifier>" = ~ 0 0 0 0:40>2:1013 0:37>0:11510 0:47>2:15698
-Object 2:15698 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>2:15741 0:47>2:15740 0:47>2:15742
-Overrides 2:15698 2:5016
-Variable 2:15741 2:"EmergencyStop" = "The EmergencyStop variable is TRUE if one or more of the emergency stop functions in the robot system are active, FALSE otherwise. If the EmergencyStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed emergency stop functions are active." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:15741 2:15882
-Variable 2:15740 2:"OperationalMode" = "The OperationalMode variable provides information about the current operational mode. Allowed values are described in OperationalModeEnumeration, see ISO 10218-1:2011 Ch.5.7 Operational Modes." 0 0 2:3006 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:15740 2:15912
-Variable 2:15742 2:"ProtectiveStop" = "The ProtectiveStop variable is TRUE if one or more of the enabled protective stop functions in the system are active, FALSE otherwise. If the ProtectiveStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed protective stop functions are enabled and active." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:15742 2:15913
-ObjectType 2:1004 2:"MotionDeviceType" = "Represents a specific motion device in the motion device system like a robot, a linear unit or a positioner. A MotionDevice should have at least one axis." 0 0 0 0:45<1:15063 0:47>2:16566 0:46>2:6172 0:47>2:15305 0:46>2:6173 0:46>2:6174 0:47>2:5091 0:46>2:16351 0:46>2:16353 0:46>2:16362 0:47>2:5029 0:47>2:16443 0:46>2:16359 0:46>2:16354 0:47>2:6001
-Object 2:16566 2:"AdditionalComponents" = "AdditionalComponents is a container for one or more instances of subtypes of ComponentType defined in OPC UA DI. The listed components are installed at the motion device, e.g. an IO-board." 0 0 0 0:40>0:61 0:37>0:80 0:47>2:5003
-Object 2:5003 2:"<AdditionalComponentIdentifier>" = ~ 0 0 0 0:37>0:11510 0:40>0:58
-Variable 2:6172 1:"AssetId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
-Overrides 2:6172 1:15098
-Object 2:15305 2:"Axes" = "Axes is a container for one or more instances of the AxisType." 0 0 0 0:40>0:61 0:37>0:78 0:47>2:15743
-Object 2:15743 2:"<AxisIdentifier>" = ~ 0 0 0 0:40>2:16601 0:37>0:11510 0:46>2:15808 0:47>2:15744
-Variable 2:15808 2:"MotionProfile" = "The kind of axis motion as defined with the AxisMotionProfileEnumeration." 0 0 2:3008 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:15808 2:16637
-Object 2:15744 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>2:15863
-Overrides 2:15744 2:16602
-Variable 2:15863 2:"ActualPosition" = "The axis position inclusive Unit and RangeOfMotion." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>2:15869
-Overrides 2:15863 2:16662
-Variable 2:15869 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:15869 2:16667
-Variable 2:6173 1:"ComponentName" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
-Overrides 2:6173 1:15099
-Variable 2:6174 1:"DeviceManual" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
-Overrides 2:6174 1:15093
-Object 2:5091 2:"FlangeLoad" = "The FlangeLoad is the load on the flange or at the mounting point of the MotionDevice. This can be the maximum load of the MotionDevice." 0 0 0 0:40>2:1018 0:37>0:80 0:47>2:6624
-Variable 2:6624 2:"Mass" = "The weight of the load mounted on one mounting point." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>2:15659
-Overrides 2:6624 2:6723
-Variable 2:15659 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:15659 2:6728
-Variable 2:16351 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16351 1:15086
-Variable 2:16353 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16353 1:15088
-Variable 2:16362 2:"MotionDeviceCategory" = "The variable MotionDeviceCategory provides the kind of motion device defined by MotionDeviceCategoryEnumeration based on ISO 8373." 0 0 2:18193 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Object 2:5029 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>2:16364 0:47>2:16363 0:47>2:16365
-Overrides 2:5029 1:5002
-Variable 2:16364 2:"InControl" = "InControl provides the information if the actuators (in most cases a motor) of the motion device are powered up and in control: \"true\". The motion device might be in a standstill." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
-Variable 2:16363 2:"OnPath" = "OnPath is true if the motion device is on or near enough the planned program path such that program execution can continue. If the MotionDevice deviates too much from this path in case of errors or an emergency stop, this value becomes false. If OnPath is false, the motion device needs repositioning to continue program execution." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
-Variable 2:16365 2:"SpeedOverride" = "SpeedOverride provides the current speed setting in percent of programmed speed (0 - 100%)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Object 2:16443 2:"PowerTrains" = "PowerTrains is a container for one or more instances of the PowerTrainType." 0 0 0 0:40>0:61 0:37>0:78 0:47>2:15905
-Object 2:15905 2:"<PowerTrainIdentifier>" = ~ 0 0 0 0:40>2:16794 0:37>0:11510 0:47>2:15998
-Variable 2:16359 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16359 1:15092
-Variable 2:16354 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16354 1:15095
-Variable 2:6001 2:"TaskControlReference" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:80 0:40>0:63
-ObjectType 2:1019 2:"MotorType" = "The MotorType is for representing instances of electric motors." 0 0 0 0:45<1:15063 2:18180>2:5060 0:46>2:6177 0:46>2:17101 0:46>2:17103 0:47>2:5105 0:46>2:17109 0:46>2:17104
-Object 2:5060 2:"<DriveIdentifier>" = ~ 0 0 0 0:37>0:11508 0:40>0:58
-Variable 2:6177 1:"AssetId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
-Overrides 2:6177 1:15098
-Variable 2:17101 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17101 1:15086
-Variable 2:17103 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17103 1:15088
-Object 2:5105 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>2:17150 0:47>2:6776 0:47>2:6757
-Overrides 2:5105 1:5002
-Variable 2:17150 2:"BrakeReleased" = "Indicates an optional variable used only for motors with brakes. If BrakeReleased is TRUE the motor is free to run. FALSE means that the motor shaft is locked by the brake." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
-Variable 2:6776 2:"EffectiveLoadRate" = "EffectiveLoadRate is expressed as a percentage of maximum continuous load. The Joule integral is typically used to calculate the current load. Duration should be defined and documented by the vendor." 0 0 0:5 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
-Variable 2:6757 2:"MotorTemperature" = "The motor temperature provides the temperature of the motor. If there is no temperature sensor the value is set to \\\"null\\\"." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>2:6762
-Variable 2:6762 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:6762 0:17502
-Variable 2:17109 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17109 1:15092
-Variable 2:17104 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17104 1:15095
-ObjectType 2:16794 2:"PowerTrainType" = "The PowerTrainType represents instances of powertrains of a motion device." 0 0 0 0:45<1:15063 2:18178>2:18536 0:47>2:16041 0:47>2:15998 2:18183>2:18613 0:46>2:6176
-Object 2:18536 2:"<AxisIdentifier>" = "Moves is a reference to provide the relationship of powertrains to axes. For complex kinematics this does not need to be a one to one relationship, because a powertrain might influence the motion of more than one axis. This reference connects all axis to a powertrain that that move when only this powertrain moves and all other powertrains stand still." 0 0 0 0:40>2:16601 0:37>0:11508 0:46>2:18570 0:47>2:18537
-Variable 2:18570 2:"MotionProfile" = "The kind of axis motion as defined with the AxisMotionProfileEnumeration." 0 0 2:3008 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:18570 2:16637
-Object 2:18537 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>2:18595
-Overrides 2:18537 2:16602
-Variable 2:18595 2:"ActualPosition" = "The axis position inclusive Unit and RangeOfMotion." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>2:18600
-Overrides 2:18595 2:16662
-Variable 2:18600 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:18600 2:16667
-Object 2:16041 2:"<GearIdentifier>" = ~ 0 0 0 0:40>2:1022 0:37>0:11508 0:47>2:16076 0:46>2:16062 0:46>2:16064 0:46>2:16068 0:46>2:16071
-Variable 2:16076 2:"GearRatio" = "The transmission ratio of the gear expressed as a fraction as input velocity (motor side) by output velocity (load side)." 0 0 0:18806 -1 [] 1 1 0 ~ ~ 0:40>0:17709 0:37>0:78 0:47>2:16078 0:47>2:16077
-Overrides 2:16076 2:15941
-Variable 2:16078 0:"Denominator" = ~ 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:16078 2:15616
-Variable 2:16077 0:"Numerator" = ~ 0 0 0:6 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:16077 2:15615
-Variable 2:16062 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16062 2:17152
-Variable 2:16064 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16064 2:17154
-Variable 2:16068 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16068 2:17160
-Variable 2:16071 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16071 2:17155
-Object 2:15998 2:"<MotorIdentifier>" = ~ 0 0 0 0:40>2:1019 0:37>0:11510 0:46>2:16019 0:46>2:16021 0:47>2:15999 0:46>2:16025 0:46>2:16028
-Variable 2:16019 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16019 2:17101
-Variable 2:16021 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16021 2:17103
-Object 2:15999 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>2:16034
-Overrides 2:15999 2:5105
-Variable 2:16034 2:"MotorTemperature" = "The motor temperature provides the temperature of the motor. If there is no temperature sensor the value is set to \\\"null\\\"." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>2:16039
-Overrides 2:16034 2:6757
-Variable 2:16039 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16039 2:6762
-Variable 2:16025 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16025 2:17109
-Variable 2:16028 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:16028 2:17104
-Object 2:18613 2:"<PowerTrainIdentifier>" = "HasSlave is a reference to provide the master-slave relationship of powertrains which provide torque for a common axis. The InverseName is IsSlaveOf." 0 0 0 0:40>2:16794 0:37>0:11508 0:47>2:15998
-Variable 2:6176 1:"ComponentName" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
-Overrides 2:6176 1:15099
-ObjectType 2:1013 2:"SafetyStateType" = "SafetyStateType describes the safety states of the motion devices and controllers. One motion device system is associated with one or more instances of the SafetyStateType." 0 0 0 0:45<1:15063 0:46>2:6179 0:47>2:17221 0:47>2:5016 0:47>2:17225
-Variable 2:6179 1:"ComponentName" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
-Overrides 2:6179 1:15099
-Object 2:17221 2:"EmergencyStopFunctions" = "EmergencyStopFunctions is a container for one or more instances of the EmergencyStopFunctionType." 0 0 0 0:40>0:61 0:37>0:80 0:47>2:18806
-Object 2:18806 2:"<EmergencyStopFunctionIdentifier>" = ~ 0 0 0 0:40>2:17230 0:37>0:11510 0:47>2:18808 0:46>2:18807
-Variable 2:18808 2:"Active" = "The Active variable is TRUE if this particular emergency stop function is active, e.g. that the emergency stop button is pressed, FALSE otherwise." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:18808 2:17232
-Variable 2:18807 2:"Name" = "The Name of the EmergencyStopFunctionType provides a manufacturer-specific emergency stop function identifier within the safety system." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:18807 2:17231
-Object 2:5016 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>2:15882 0:47>2:15912 0:47>2:15913
-Overrides 2:5016 1:5002
-Variable 2:15882 2:"EmergencyStop" = "The EmergencyStop variable is TRUE if one or more of the emergency stop functions in the robot system are active, FALSE otherwise. If the EmergencyStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed emergency stop functions are active." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Variable 2:15912 2:"OperationalMode" = "The OperationalMode variable provides information about the current operational mode. Allowed values are described in OperationalModeEnumeration, see ISO 10218-1:2011 Ch.5.7 Operational Modes." 0 0 2:3006 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Variable 2:15913 2:"ProtectiveStop" = "The ProtectiveStop variable is TRUE if one or more of the enabled protective stop functions in the system are active, FALSE otherwise. If the ProtectiveStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed protective stop functions are enabled and active." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Object 2:17225 2:"ProtectiveStopFunctions" = "ProtectiveStopFunctions is a container for one or more instances of the ProtectiveStopFunctionType." 0 0 0 0:40>0:61 0:37>0:80 0:47>2:18809
-Object 2:18809 2:"<ProtectiveStopFunctionIdentifier>" = ~ 0 0 0 0:40>2:17233 0:37>0:11510 0:47>2:18812 0:47>2:18811 0:46>2:18810
-Variable 2:18812 2:"Active" = "–\tThe Active variable is TRUE if this particular protective stop function is active, i.e. that a stop is initiated, FALSE otherwise. If Enabled is FALSE then Active shall be FALSE." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:18812 2:17236
-Variable 2:18811 2:"Enabled" = "–\tThe Enabled variable is TRUE if this protective stop function is currently supervising the system, FALSE otherwise. A protective stop function may or may not be enabled at all times, e.g. the protective stop function of the safety doors are typically enabled in automatic operational mode and disabled in manual mode. On the other hand for example, the protective stop function of the teach pendant enabling device is enabled in manual modes and disabled in automatic modes." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:18811 2:17235
-Variable 2:18810 2:"Name" = "The Name of the ProtectiveStopFunctionType provides a manufacturer-specific protective stop function identifier within the safety system." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:18810 2:17234
-ObjectType 2:1011 2:"TaskControlType" = "Represents a specific task control active on the controller." 0 0 0 0:45<1:15063 2:4002>2:19254 0:46>2:17873 0:47>2:15883 0:17604>2:5052 0:47>2:5057
-Object 2:19254 2:"<MotionDeviceIdentifier>" = "Controls is a reference to provide the relationship between a task control and a motion device." 0 0 0 0:40>2:1004 0:37>0:11508 0:47>2:19292 0:46>2:19275 0:46>2:19277 0:46>2:19288 0:47>2:19255 0:47>2:19370 0:46>2:19283 0:46>2:19278 0:47>2:6004
-Object 2:19292 2:"Axes" = "Axes is a container for one or more instances of the AxisType." 0 0 0 0:40>0:61 0:37>0:78 0:47>2:15743
-Overrides 2:19292 2:15305
-Variable 2:19275 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:19275 2:16351
-Variable 2:19277 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:19277 2:16353
-Variable 2:19288 2:"MotionDeviceCategory" = "The variable MotionDeviceCategory provides the kind of motion device defined by MotionDeviceCategoryEnumeration based on ISO 8373." 0 0 2:18193 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:19288 2:16362
-Object 2:19255 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>2:19291
-Overrides 2:19255 2:5029
-Variable 2:19291 2:"SpeedOverride" = "SpeedOverride provides the current speed setting in percent of programmed speed (0 - 100%)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Overrides 2:19291 2:16365
-Object 2:19370 2:"PowerTrains" = "PowerTrains is a container for one or more instances of the PowerTrainType." 0 0 0 0:40>0:61 0:37>0:78 0:47>2:15905
-Overrides 2:19370 2:16443
-Variable 2:19283 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:19283 2:16359
-Variable 2:19278 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:19278 2:16354
-Variable 2:6004 2:"TaskControlReference" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:80 0:40>0:63
-Overrides 2:6004 2:6001
-Variable 2:17873 1:"ComponentName" = "A user writable name provided by the vendor, integrator or user of the device." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:17873 1:15099
-Object 2:15883 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>2:17876 0:47>2:17875 0:47>2:17874
-Overrides 2:15883 1:5002
-Variable 2:17876 2:"ExecutionMode" = "Execution mode of the task control (continuous or step-wise)." 0 0 2:18191 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
-Variable 2:17875 2:"TaskProgramLoaded" = "The TaskProgramLoaded variable is TRUE if a task program is loaded in the task control, FALSE otherwise." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Variable 2:17874 2:"TaskProgramName" = "A customer given identifier for the task program." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
-Object 2:5052 2:"TaskControlOperation" = ~ 0 0 0 0:37>0:80 0:40>2:1008 0:47>2:5053
-Object 2:5053 2:"TaskControlStateMachine" = ~ 0 0 0 0:37>0:78 0:40>2:1025 0:47>2:6148 0:47>2:6150 0:47>2:6152
-Overrides 2:5053 2:5051
-Variable 2:6148 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2760 0:46>2:6149
-Overrides 2:6148 2:6138
-Variable 2:6149 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6149 2:6139
-Variable 2:6150 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>2:6151
-Overrides 2:6150 2:6133
-Variable 2:6151 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
-Overrides 2:6151 2:6134
-Variable 2:6152 2:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>2:6153 0:46>2:6154
-Overrides 2:6152 2:6135
-Variable 2:6153 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
-Overrides 2:6153 2:6136
-Variable 2:6154 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
-Overrides 2:6154 2:6137
-Object 2:5057 2:"TaskModules" = ~ 0 0 0 0:37>0:80 0:40>0:61 0:35>2:5058
-Object 2:5058 2:"<TaskModule>" = ~ 0 0 0 0:40>2:1016 0:37>0:11508 0:46>2:6169
-Variable 2:6169 2:"Name" = ~ 0 0 0:12 -1 [] 3 3 0 ~ ~ 0:40>0:68 0:37>0:78
-Overrides 2:6169 2:6054
-ObjectType 2:18175 2:"UserType" = "The UserType ObjectType describes information of the registered user groups within the control system." 0 0 0 0:45<0:58 0:46>2:18176 0:46>2:18177
-Variable 2:18176 2:"Level" = "Provides information about the access rights and determines what can be viewed, updated, or deleted by a user" 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
-Variable 2:18177 2:"Name" = "The name for the current user within the control system." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
-Object 2:15011 2:"http://opcfoundation.org/UA/Robotics/" = ~ 0 0 0 0:47<0:11715 0:40>0:11616
-Variable 2:15585 0:"DefaultAccessRestrictions" = ~ 0 0 0:95 -1 [] 1 1 0 ~ ~ 0:46<2:15011 0:40>0:68
-Access 2:15585 ~ 0:15704=98 0:15644=1
-Variable 2:15583 0:"DefaultRolePermissions" = ~ 0 0 0:96 1 [] 1 1 0 ~ ~ 0:46<2:15011 0:40>0:68
-Access 2:15583 ~ 0:15704=98 0:15644=1
-Variable 2:15584 0:"DefaultUserRolePermissions" = ~ 0 0 0:96 1 [] 1 1 0 ~ ~ 0:46<2:15011 0:40>0:68
-Variable 2:15114 0:"IsNamespaceSubset" = ~ 0 0 0:1 -1 [] 1 1 0 ~ Boolean:0 0:46<2:15011 0:40>0:68
-Variable 2:15091 0:"NamespacePublicationDate" = ~ 0 0 0:13 -1 [] 1 1 0 ~ DateTime:"2025-09-08T00:00:00Z" 0:46<2:15011 0:40>0:68
-Variable 2:15034 0:"NamespaceUri" = ~ 0 0 0:12 -1 [] 1 1 0 ~ String:"http://opcfoundation.org/UA/Robotics/" 0:46<2:15011 0:40>0:68
-Variable 2:15064 0:"NamespaceVersion" = ~ 0 0 0:12 -1 [] 1 1 0 ~ String:"1.02" 0:46<2:15011 0:40>0:68
-Variable 2:15145 0:"StaticNodeIdTypes" = ~ 0 0 0:256 1 [0] 1 1 0 ~ Array:6 { Int32:0 } 0:46<2:15011 0:40>0:68
-Variable 2:15173 0:"StaticNumericNodeIdRange" = ~ 0 0 0:291 1 [0] 1 1 0 ~ ~ 0:46<2:15011 0:40>0:68
-Variable 2:15209 0:"StaticStringNodeIdPattern" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:46<2:15011 0:40>0:68
+DataType 3:3008 3:"AxisMotionProfileEnumeration" = ~ 0 0 0 Enum { 0 "OTHER" = "Any motion-profile which is not defined by the AxisMotionProfileEnumeration." 1 "ROTARY" = "Rotary motion is a rotation along a circular path with defined limits. Motion movement is not going always in the same direction. Control unit is mainly degree." 2 "ROTARY_ENDLESS" = "Rotary motion is a rotation along a circular path with no limits. Motion movement is going endless in the same direction. Control unit is mainly degree." 3 "LINEAR" = "Linear motion is a one dimensional motion along a straight line with defined limits. Motion movement is not going always in the same direction. Control unit is mainly mm." 4 "LINEAR_ENDLESS" = "Linear motion is a one dimensional motion along a straight line with no limits. Motion movement is going endless in the same direction. Control unit is mainly mm." } 0:45<0:29
+Variable 3:6027 0:"EnumStrings" = ~ 0 0 0:21 1 [0] 1 1 0 ~ Array:21 { LocalizedText:~:"OTHER" LocalizedText:~:"ROTARY" LocalizedText:~:"ROTARY_ENDLESS" LocalizedText:~:"LINEAR" LocalizedText:~:"LINEAR_ENDLESS" } 0:46<3:3008 0:40>0:68
+DataType 3:18191 3:"ExecutionModeEnumeration" = ~ 0 0 0 Enum { 0 "CYCLE" = "Single execution of a task program according to ISO 8373." 1 "CONTINUOUS" = "Task program is executed continuously and starts again automatically." 2 "STEP" = "Task program is executed in steps." } 0:45<0:29
+Variable 3:18192 0:"EnumStrings" = ~ 0 0 0:21 1 [0] 1 1 0 ~ Array:21 { LocalizedText:~:"CYCLE" LocalizedText:~:"CONTINUOUS" LocalizedText:~:"STEP" } 0:46<3:18191 0:40>0:68
+DataType 3:18193 3:"MotionDeviceCategoryEnumeration" = ~ 0 0 0 Enum { 0 "OTHER" = "Any MotionDevice which is not defined by the MotionDeviceCategoryEnumeration." 1 "ARTICULATED_ROBOT" = "This robot design features rotary joints and can range from simple two joint structures to 10 or more joints. The arm is connected to the base with a twisting joint. The links in the arm are connected by rotary joints." 2 "SCARA_ROBOT" = "The robot has two parallel rotary joints that ensure compliance in a specified plane." 3 "CARTESIAN_ROBOT" = "Cartesian robots have three linear joints that use the Cartesian coordinate system (X, Y, and Z). They also may have an attached wrist to allow for rotational movement. The three prismatic joints provide linear movement along the axis." 4 "SPHERICAL_ROBOT" = "The arm is connected to the base with a twisting joint and a combination of two rotary joints and one linear joint. The axes form a polar coordinate system and create a spherical shaped work envelope." 5 "PARALLEL_ROBOT" = "These spider like robots are built from jointed parallelograms connected to a common base. The parallelograms move a single EOAT in a dome-shaped work area." 6 "CYLINDRICAL_ROBOT" = "The robot has at least one rotary joint at the base and at least one prismatic joint to connect the links. The rotary joint uses a rotational motion along the joint axis, while the prismatic joint moves in a linear motion. Cylindrical robots operate within a cylindrical-shaped work envelope." } 0:45<0:29
+Variable 3:18194 0:"EnumStrings" = ~ 0 0 0:21 1 [0] 1 1 0 ~ Array:21 { LocalizedText:~:"OTHER" LocalizedText:~:"ARTICULATED_ROBOT" LocalizedText:~:"SCARA_ROBOT" LocalizedText:~:"CARTESIAN_ROBOT" LocalizedText:~:"SPHERICAL_ROBOT" LocalizedText:~:"PARALLEL_ROBOT" LocalizedText:~:"CYLINDRICAL_ROBOT" } 0:46<3:18193 0:40>0:68
+DataType 3:3006 3:"OperationalModeEnumeration" = ~ 0 0 0 Enum { 0 "OTHER" = "Other for when there is a system-boot (unknown) or a failure of the safety, there is no valid operational mode." 1 "MANUAL_REDUCED_SPEED" = "\"Manual reduced speed\" - name according to ISO 10218-1:2011." 2 "MANUAL_HIGH_SPEED" = "\"Manual high speed\" - name according to ISO 10218-1:2011." 3 "AUTOMATIC" = "\"Automatic\" - name according to ISO 10218-1:2011." 4 "AUTOMATIC_EXTERNAL" = "\"Automatic external\" - Same as \"Automatic\" but with external control, e.g. by a PLC." } 0:45<0:29
+Variable 3:6022 0:"EnumStrings" = ~ 0 0 0:21 1 [0] 1 1 0 ~ Array:21 { LocalizedText:~:"OTHER" LocalizedText:~:"MANUAL_REDUCED_SPEED" LocalizedText:~:"MANUAL_HIGH_SPEED" LocalizedText:~:"AUTOMATIC" LocalizedText:~:"AUTOMATIC_EXTERNAL" } 0:46<3:3006 0:40>0:68
+ReferenceType 3:4002 3:"Controls" = "Reference: Describe dependencies between objects which have a controlling character." 0 0 0 0 "IsControlledBy" 0:45<0:33
+ReferenceType 3:18182 3:"HasSafetyStates" = "Reference: Describe dependencies between objects to show which (controller) object is responsible for the execution of the safety-functionality. The BrowseName HasSafetyStates and the InverseName SafetyStatesOf describe semantically the hierarchical dependency." 0 0 0 0 "SafetyStatesOf" 0:45<0:33
+ReferenceType 3:18183 3:"HasSlave" = "Reference: Provide the master-slave relationship of powertrains which provide torque for a common axis. The InverseName is IsSlaveOf." 0 0 0 0 "IsSlaveOf" 0:45<0:33
+ReferenceType 3:18180 3:"IsDrivenBy" = "Reference: Describe dependencies between objects which have a driving or powering character. The BrowseName IsDrivenBy and the InverseName Drives describe semantically the hierarchical dependency." 0 0 0 0 "Drives" 0:45<0:33
+ReferenceType 3:18178 3:"Moves" = "Reference: Describe the coupling between a powertrain and the axes from the powertrain point of view." 0 0 0 0 "IsMovedBy" 0:45<0:33
+ReferenceType 3:18179 3:"Requires" = "Reference: Describe the coupling between a powertrain and axes from the axis point of view. An axis has a Requires reference to all powertrains that need to move such that only this single axis moves." 0 0 0 0 "IsRequiredBy" 0:45<0:33
+ReferenceType 3:18181 3:"IsConnectedTo" = "Reference: Describe dependencies between objects which are mounted or mechanically linked or connected to each other. The IsConnectedTo reference is symmetric and has no InverseName." 0 0 1 0 "IsConnectedTo" 0:45<0:32
+ObjectType 3:1015 3:"MultiAcknowledgeableConditionType" = ~ 0 0 0 0:45<0:2881 0:46>3:6140
+Variable 3:6140 3:"ConditionDescriptions" = ~ 0 0 0:21 1 [0] 3 3 0 ~ ~ 0:37>0:78 0:40>0:68
+ObjectType 3:17230 3:"EmergencyStopFunctionType" = "According to ISO 10218-1:2011 Ch.5.5.2 Emergency stop the robot shall have one or more emergency stop functions." 0 0 0 0:45<0:58 0:47>3:17232 0:46>3:17231
+Variable 3:17232 3:"Active" = "The Active variable is TRUE if this particular emergency stop function is active, e.g. that the emergency stop button is pressed, FALSE otherwise." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Variable 3:17231 3:"Name" = "The Name of the EmergencyStopFunctionType provides a manufacturer-specific emergency stop function identifier within the safety system." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+ObjectType 3:1018 3:"LoadType" = "The LoadType is for describing loads mounted on the motion device typically by an integrator or a customer." 0 0 0 0:45<0:58 0:47>3:6013 0:47>3:18170 0:47>3:6723
+Variable 3:6013 3:"CenterOfMass" = "The position and orientation of the center of the mass related to the mounting point using a FrameType. X, Y, Z define the position of the center of gravity relative to the mounting point coordinate system. A, B, C define the orientation of the principal axes of inertia relative to the mounting point coordinate system. Orientation A, B, C can be \"0\" for systems which do not need these  values." 0 0 0:18814 -1 [] 1 1 0 ~ ~ 0:40>0:18791 0:37>0:80 0:47>3:16130 0:47>3:16132
+Variable 3:16130 0:"CartesianCoordinates" = ~ 0 0 0:18810 -1 [] 1 1 0 ~ ~ 0:40>0:18774 0:37>0:78 0:47>3:16134 0:47>3:16135 0:47>3:16136
+Overrides 3:16130 0:18796
+Variable 3:16134 0:"X" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:16134 0:18798
+Variable 3:16135 0:"Y" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:16135 0:18799
+Variable 3:16136 0:"Z" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:16136 0:18800
+Variable 3:16132 0:"Orientation" = ~ 0 0 0:18812 -1 [] 1 1 0 ~ ~ 0:40>0:18781 0:37>0:78 0:47>3:16137 0:47>3:16138 0:47>3:16139
+Overrides 3:16132 0:18792
+Variable 3:16137 0:"A" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:16137 0:19074
+Variable 3:16138 0:"B" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:16138 0:19075
+Variable 3:16139 0:"C" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:16139 0:19076
+Variable 3:18170 3:"Inertia" = "The Inertia uses the VectorType to describe the three values of the principal moments of inertia with respect to the mounting point coordinate system. If inertia values are provided for rotary axis the CenterOfMass shall be completely filled as well." 0 0 0:18808 -1 [] 1 1 0 ~ ~ 0:40>0:17716 0:37>0:80 0:47>3:18171 0:47>3:18172 0:47>3:18173
+Variable 3:18171 0:"X" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:18171 0:18769
+Variable 3:18172 0:"Y" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:18172 0:18770
+Variable 3:18173 0:"Z" = ~ 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:18173 0:18771
+Variable 3:6723 3:"Mass" = "The weight of the load mounted on one mounting point." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>3:6728
+Variable 3:6728 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:6728 0:17502
+ObjectType 3:17233 3:"ProtectiveStopFunctionType" = "According to ISO 10218-1:2011 Ch.5.5.3 the robot shall have one or more protective stop functions designed for the connection of external protective devices." 0 0 0 0:45<0:58 0:47>3:17236 0:47>3:17235 0:46>3:17234
+Variable 3:17236 3:"Active" = "–\tThe Active variable is TRUE if this particular protective stop function is active, i.e. that a stop is initiated, FALSE otherwise. If Enabled is FALSE then Active shall be FALSE." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Variable 3:17235 3:"Enabled" = "–\tThe Enabled variable is TRUE if this protective stop function is currently supervising the system, FALSE otherwise. A protective stop function may or may not be enabled at all times, e.g. the protective stop function of the safety doors are typically enabled in automatic operational mode and disabled in manual mode. On the other hand for example, the protective stop function of the teach pendant enabling device is enabled in manual modes and disabled in automatic modes." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Variable 3:17234 3:"Name" = "The Name of the ProtectiveStopFunctionType provides a manufacturer-specific protective stop function identifier within the safety system." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+ObjectType 3:1007 3:"ExecutingSubstateMachineType" = ~ 0 0 0 0:45<0:2771 0:41>0:2311 0:47>3:6036 0:47>3:6038 0:47>3:5020 0:47>3:5022 0:47>3:5021
+Variable 3:6036 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>3:6037
+Overrides 3:6036 0:2773
+Variable 3:6037 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6037 0:3732
+Variable 3:6038 3:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>3:6039 0:46>3:6040
+Variable 3:6039 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
+Overrides 3:6039 0:11241
+Variable 3:6040 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
+Overrides 3:6040 0:11461
+Object 3:5020 3:"Running" = ~ 0 0 0 0:40>0:2309 0:46>3:6041
+Variable 3:6041 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
+Overrides 3:6041 0:2308
+Object 3:5022 3:"RunningToStopping" = ~ 0 0 0 0:40>0:2310 0:51>3:5020 0:52>3:5021 0:54>0:2311 0:46>3:6043
+Variable 3:6043 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
+Overrides 3:6043 0:2312
+Object 3:5021 3:"Stopping" = ~ 0 0 0 0:40>0:2307 0:46>3:6042
+Variable 3:6042 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
+Overrides 3:6042 0:2308
+ObjectType 3:1009 3:"IdleSubstateMachineType" = ~ 0 0 0 0:45<0:2771 0:41>0:2311 0:47>3:5017 0:47>3:5018 0:47>3:6026 0:47>3:6029 0:47>3:5015 0:47>3:5019
+Object 3:5017 3:"GettingReady" = ~ 0 0 0 0:40>0:2307 0:46>3:6031
+Variable 3:6031 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
+Overrides 3:6031 0:2308
+Object 3:5018 3:"GettingReadyToStandBy" = ~ 0 0 0 0:40>0:2310 0:51>3:5017 0:52>3:5015 0:54>0:2311 0:46>3:6032
+Variable 3:6032 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
+Overrides 3:6032 0:2312
+Variable 3:6026 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>3:6028
+Overrides 3:6026 0:2773
+Variable 3:6028 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6028 0:3732
+Variable 3:6029 3:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>3:6034 0:46>3:6035
+Variable 3:6034 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:40>0:68 0:37>0:78
+Overrides 3:6034 0:11241
+Variable 3:6035 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
+Overrides 3:6035 0:11461
+Object 3:5015 3:"StandBy" = ~ 0 0 0 0:40>0:2309 0:46>3:6030
+Variable 3:6030 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
+Overrides 3:6030 0:2308
+Object 3:5019 3:"StandByToGettingReady" = ~ 0 0 0 0:40>0:2310 0:52>3:5017 0:51>3:5015 0:54>0:2311 0:46>3:6033
+Variable 3:6033 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
+Overrides 3:6033 0:2312
+ObjectType 3:1006 3:"OperationStateMachineType" = ~ 0 0 1 0:45<0:2771 0:41>0:2311 0:47>3:6009 0:47>3:5007 0:47>3:5013 0:47>3:5011 0:47>3:5005 0:47>3:5014 0:47>3:5009 0:47>3:6005 0:47>3:6007 0:47>3:6008 0:47>3:5006 0:47>3:5012 0:47>3:5008 0:47>3:7001 0:47>3:7002
+Variable 3:6009 3:"ConfiguredDefaultStopMode" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:63
+Object 3:5007 3:"Executing" = "Entity is in a condition of execution." 0 0 0 0:40>0:2307 0:46>3:6012
+Variable 3:6012 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:3 0:37>0:78 0:40>0:68
+Overrides 3:6012 0:2308
+Object 3:5013 3:"ExecutingToIdle" = "Changes from Executing to Idle" 0 0 0 0:40>0:2310 0:51>3:5007 0:52>3:5005 0:54>0:2311 0:46>3:6018
+Variable 3:6018 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:6 0:37>0:78 0:40>0:68
+Overrides 3:6018 0:2312
+Object 3:5011 3:"ExecutingToReady" = "Changes from Executing to Ready" 0 0 0 0:40>0:2310 0:51>3:5007 0:52>3:5006 0:53>3:7002 0:54>0:2311 0:46>3:6016
+Variable 3:6016 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:5 0:37>0:78 0:40>0:68
+Overrides 3:6016 0:2312
+Object 3:5005 3:"Idle" = "Entity is not in a condition to start execution." 0 0 0 0:40>0:2307 0:46>3:6010
+Variable 3:6010 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
+Overrides 3:6010 0:2308
+Object 3:5014 3:"IdleToIdle" = "Changes from Idle to Idle." 0 0 0 0:40>0:2310 0:51>3:5005 0:52>3:5005 0:54>0:2311 0:46>3:6019
+Variable 3:6019 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
+Overrides 3:6019 0:2312
+Object 3:5009 3:"IdleToReady" = "Changes from Idle to Ready" 0 0 0 0:40>0:2310 0:51>3:5005 0:52>3:5006 0:54>0:2311 0:46>3:6015
+Variable 3:6015 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
+Overrides 3:6015 0:2312
+Variable 3:6005 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>3:6006
+Overrides 3:6005 0:2773
+Variable 3:6006 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6006 0:3732
+Variable 3:6007 3:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>3:6020 0:46>3:6021
+Variable 3:6020 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
+Overrides 3:6020 0:11241
+Variable 3:6021 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
+Overrides 3:6021 0:11461
+Variable 3:6008 3:"PossibleStopModes" = ~ 0 0 0:7594 1 [0] 3 3 0 ~ EnumValues:{ 1 "OnPath" = "Stop program execution in a controlled manner along the programmed path" 2 "EndOfCycle" = "Stop program execution when the current production cycle has been finished" 3 "ProcessStop" = "Application dependent stop instruction that stops program execution at a favourable point for the application, e.g. at the end of a paint stroke or sealing bead" 4 "QuickStop" = "This stop is performed by ramping down motion as fast as possible using optimum motor performance. The robot may not stay on the path" 5 "EndOfInstruction" = "This stop can be used to stop the program execution when the current instruction is completed" } 0:37>0:80 0:40>0:63
+Object 3:5006 3:"Ready" = "Entity is in a condition to start execution." 0 0 0 0:40>0:2307 0:46>3:6011
+Variable 3:6011 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
+Overrides 3:6011 0:2308
+Object 3:5012 3:"ReadyToExecuting" = "Changes from Ready to Executing" 0 0 0 0:40>0:2310 0:52>3:5007 0:51>3:5006 0:53>3:7001 0:54>0:2311 0:46>3:6017
+Variable 3:6017 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:4 0:37>0:78 0:40>0:68
+Overrides 3:6017 0:2312
+Object 3:5008 3:"ReadyToIdle" = "Changes from Ready to Idle" 0 0 0 0:40>0:2310 0:52>3:5005 0:51>3:5006 0:54>0:2311 0:46>3:6014
+Variable 3:6014 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:3 0:37>0:78 0:40>0:68
+Overrides 3:6014 0:2312
+Method 3:7001 3:"Start" = ~ 0 0 1 1 0:37>0:80 0:46>3:6023
+Variable 3:6023 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
+Method 3:7002 3:"Stop" = ~ 0 0 1 1 0:37>0:80 0:46>3:6024 0:46>3:6025
+Variable 3:6024 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "StopMode" 0:8 -1 [] "provides a way to differentiate between different stop modes. This parameter should correspond to one of the values in the PossibleStopModes array" } 0:37>0:78 0:40>0:68
+Variable 3:6025 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
+ObjectType 3:1021 3:"SystemOperationStateMachineType" = ~ 0 0 0 0:45<3:1006 0:41>0:2311 0:47>3:6057 0:47>3:5032 0:47>3:5028 0:47>3:5038 0:47>3:5037 0:47>3:7006 0:47>3:5030 0:47>3:5027 0:47>3:5033 0:47>3:5034 0:47>3:6058 0:47>3:6060 0:47>3:6063 0:47>3:5031 0:47>3:5036 0:47>3:5035 0:47>3:7007 0:47>3:7004 0:47>3:7005
+Variable 3:6057 3:"ConfiguredDefaultStopMode" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:63
+Overrides 3:6057 3:6009
+Object 3:5032 3:"Executing" = ~ 0 0 0 0:40>0:2307 0:117>3:5028 0:46>3:6087
+Overrides 3:5032 3:5007
+Variable 3:6087 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:3 0:37>0:78 0:40>0:68
+Overrides 3:6087 3:6012
+Object 3:5028 3:"ExecutingSubstateMachine" = ~ 0 0 0 0:37>0:80 0:40>3:1007 0:47>3:6083 0:47>3:6078 0:47>3:6080
+Variable 3:6083 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2760 0:46>3:6084
+Overrides 3:6083 0:2772
+Variable 3:6084 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6084 0:3728
+Variable 3:6078 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>3:6079
+Overrides 3:6078 3:6036
+Variable 3:6079 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6079 3:6037
+Variable 3:6080 3:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>3:6081 0:46>3:6082
+Overrides 3:6080 3:6038
+Variable 3:6081 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
+Overrides 3:6081 3:6039
+Variable 3:6082 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
+Overrides 3:6082 3:6040
+Object 3:5038 3:"ExecutingToIdle" = ~ 0 0 0 0:40>0:2310 0:51>3:5032 0:52>3:5030 0:54>0:2311 0:46>3:6093
+Overrides 3:5038 3:5013
+Variable 3:6093 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:6 0:37>0:78 0:40>0:68
+Overrides 3:6093 3:6018
+Object 3:5037 3:"ExecutingToReady" = ~ 0 0 0 0:40>0:2310 0:51>3:5032 0:52>3:5031 0:53>3:7005 0:54>0:2311 0:46>3:6092
+Overrides 3:5037 3:5011
+Variable 3:6092 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:5 0:37>0:78 0:40>0:68
+Overrides 3:6092 3:6016
+Method 3:7006 3:"GetReady" = ~ 0 0 1 1 0:37>0:80 0:46>3:6068
+Variable 3:6068 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
+Object 3:5030 3:"Idle" = ~ 0 0 0 0:40>0:2307 0:117>3:5027 0:46>3:6085
+Overrides 3:5030 3:5005
+Variable 3:6085 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
+Overrides 3:6085 3:6010
+Object 3:5027 3:"IdleSubstateMachine" = ~ 0 0 0 0:37>0:80 0:40>3:1009 0:47>3:6076 0:47>3:6071 0:47>3:6073
+Variable 3:6076 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2760 0:46>3:6077
+Overrides 3:6076 0:2772
+Variable 3:6077 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6077 0:3728
+Variable 3:6071 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>3:6072
+Overrides 3:6071 3:6026
+Variable 3:6072 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6072 3:6028
+Variable 3:6073 3:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>3:6074 0:46>3:6075
+Overrides 3:6073 3:6029
+Variable 3:6074 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "" = ~ } 0:37>0:78 0:40>0:68
+Overrides 3:6074 3:6034
+Variable 3:6075 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
+Overrides 3:6075 3:6035
+Object 3:5033 3:"IdleToIdle" = ~ 0 0 0 0:40>0:2310 0:52>3:5030 0:51>3:5030 0:53>3:7007 0:54>0:2311 0:46>3:6088
+Overrides 3:5033 3:5014
+Variable 3:6088 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
+Overrides 3:6088 3:6019
+Object 3:5034 3:"IdleToReady" = ~ 0 0 0 0:40>0:2310 0:53>3:7006 0:51>3:5030 0:52>3:5031 0:54>0:2311 0:46>3:6089
+Overrides 3:5034 3:5009
+Variable 3:6089 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
+Overrides 3:6089 3:6015
+Variable 3:6058 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>3:6059
+Overrides 3:6058 3:6005
+Variable 3:6059 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6059 3:6006
+Variable 3:6060 3:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>3:6061 0:46>3:6062
+Overrides 3:6060 3:6007
+Variable 3:6061 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
+Overrides 3:6061 3:6020
+Variable 3:6062 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
+Overrides 3:6062 3:6021
+Variable 3:6063 3:"PossibleStopModes" = ~ 0 0 0:7594 1 [0] 3 3 0 ~ EnumValues:{ 1 "OnPath" = "Stop program execution in a controlled manner along the programmed path" 2 "EndOfCycle" = "Stop program execution when the current production cycle has been finished" 3 "ProcessStop" = "Application dependent stop instruction that stops program execution at a favourable point for the application, e.g. at the end of a paint stroke or sealing bead" 4 "QuickStop" = "This stop is performed by ramping down motion as fast as possible using optimum motor performance. The robot may not stay on the path" 5 "EndOfInstruction" = "This stop can be used to stop the program execution when the current instruction is completed" } 0:37>0:80 0:40>0:63
+Overrides 3:6063 3:6008
+Object 3:5031 3:"Ready" = ~ 0 0 0 0:40>0:2307 0:46>3:6086
+Overrides 3:5031 3:5006
+Variable 3:6086 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
+Overrides 3:6086 3:6011
+Object 3:5036 3:"ReadyToExecuting" = ~ 0 0 0 0:40>0:2310 0:52>3:5032 0:51>3:5031 0:53>3:7004 0:54>0:2311 0:46>3:6091
+Overrides 3:5036 3:5012
+Variable 3:6091 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:4 0:37>0:78 0:40>0:68
+Overrides 3:6091 3:6017
+Object 3:5035 3:"ReadyToIdle" = ~ 0 0 0 0:40>0:2310 0:52>3:5030 0:51>3:5031 0:53>3:7007 0:54>0:2311 0:46>3:6090
+Overrides 3:5035 3:5008
+Variable 3:6090 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:3 0:37>0:78 0:40>0:68
+Overrides 3:6090 3:6014
+Method 3:7007 3:"StandDown" = ~ 0 0 1 1 0:37>0:80 0:46>3:6070
+Variable 3:6070 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
+Method 3:7004 3:"Start" = ~ 0 0 1 1 0:37>0:80 0:46>3:6064
+Overrides 3:7004 3:7001
+Variable 3:6064 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
+Method 3:7005 3:"Stop" = ~ 0 0 1 1 0:37>0:80 0:46>3:6065 0:46>3:6066
+Overrides 3:7005 3:7002
+Variable 3:6065 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "StopMode" 0:8 -1 [] "provides a way to differentiate between different stop modes. This parameter should correspond to one of the values in the PossibleStopModes array" } 0:37>0:78 0:40>0:68
+Variable 3:6066 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
+ObjectType 3:1025 3:"TaskControlStateMachineType" = ~ 0 0 0 0:45<3:1006 0:41>0:2311 0:47>3:6094 0:47>3:5042 0:47>3:5048 0:47>3:5047 0:47>3:5040 0:47>3:5043 0:47>3:5044 0:47>3:6095 0:47>3:6097 0:47>3:7011 0:47>3:7010 0:47>3:6100 0:47>3:5041 0:47>3:5039 0:47>3:5046 0:47>3:5045 0:47>3:7008 0:47>3:7009 0:47>3:7014 0:47>3:7013 0:47>3:7012
+Variable 3:6094 3:"ConfiguredDefaultStopMode" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:63
+Overrides 3:6094 3:6009
+Object 3:5042 3:"Executing" = ~ 0 0 0 0:40>0:2307 0:46>3:6114
+Overrides 3:5042 3:5007
+Variable 3:6114 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:3 0:37>0:78 0:40>0:68
+Overrides 3:6114 3:6012
+Object 3:5048 3:"ExecutingToIdle" = ~ 0 0 0 0:40>0:2310 0:51>3:5042 0:52>3:5040 0:54>0:2311 0:46>3:6122
+Overrides 3:5048 3:5013
+Variable 3:6122 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:6 0:37>0:78 0:40>0:68
+Overrides 3:6122 3:6018
+Object 3:5047 3:"ExecutingToReady" = ~ 0 0 0 0:40>0:2310 0:51>3:5042 0:52>3:5041 0:53>3:7009 0:54>0:2311 0:46>3:6121
+Overrides 3:5047 3:5011
+Variable 3:6121 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:5 0:37>0:78 0:40>0:68
+Overrides 3:6121 3:6016
+Object 3:5040 3:"Idle" = ~ 0 0 0 0:40>0:2307 0:46>3:6112
+Overrides 3:5040 3:5005
+Variable 3:6112 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
+Overrides 3:6112 3:6010
+Object 3:5043 3:"IdleToIdle" = ~ 0 0 0 0:40>0:2310 0:51>3:5040 0:52>3:5040 0:54>0:2311 0:46>3:6115
+Overrides 3:5043 3:5014
+Variable 3:6115 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
+Overrides 3:6115 3:6019
+Object 3:5044 3:"IdleToReady" = ~ 0 0 0 0:40>0:2310 0:51>3:5040 0:53>3:7011 0:53>3:7010 0:52>3:5041 0:54>0:2311 0:46>3:6116
+Overrides 3:5044 3:5009
+Variable 3:6116 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
+Overrides 3:6116 3:6015
+Variable 3:6095 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>3:6096
+Overrides 3:6095 3:6005
+Variable 3:6096 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6096 3:6006
+Variable 3:6097 3:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>3:6098 0:46>3:6099
+Overrides 3:6097 3:6007
+Variable 3:6098 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
+Overrides 3:6098 3:6020
+Variable 3:6099 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
+Overrides 3:6099 3:6021
+Method 3:7011 3:"LoadByName" = ~ 0 0 1 1 0:37>0:80 0:46>3:6143 0:46>3:6144
+Variable 3:6143 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Name" 0:12 -1 [] "Name to identify a task control program or module" } 0:37>0:78 0:40>0:68
+Variable 3:6144 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK – Everything is OK\n1 – E_SystemState – The system is not in correct state for this operation\n2 – E_UnexpectedError – Unexpected Error during the method call\n3 – E_ActiveAlarm – An Active Alarm prevents the system start\n4 – E_AcknowledgeRequired – Condition needs to be acknowledged\n<0 – shall be used for vendor-specific errors\n>0 – are reserved for errors defined by this and future standards" } 0:37>0:78 0:40>0:68
+Method 3:7010 3:"LoadByNodeId" = ~ 0 0 1 1 0:37>0:80 0:46>3:6141 0:46>3:6142
+Variable 3:6141 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Id" 0:18 -1 [] "ExpandedNodeId pointing to an instance of FileType representing a task control program or module" } 0:37>0:78 0:40>0:68
+Variable 3:6142 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK – Everything is OK\n1 – E_SystemState – The system is not in correct state for this operation\n2 – E_UnexpectedError – Unexpected Error during the method call\n3 – E_ActiveAlarm – An Active Alarm prevents the system start\n4 – E_AcknowledgeRequired – Condition needs to be acknowledged\n<0 – shall be used for vendor-specific errors\n>0 – are reserved for errors defined by this and future standards" } 0:37>0:78 0:40>0:68
+Variable 3:6100 3:"PossibleStopModes" = ~ 0 0 0:7594 1 [0] 3 3 0 ~ EnumValues:{ 1 "OnPath" = "Stop program execution in a controlled manner along the programmed path" 2 "EndOfCycle" = "Stop program execution when the current production cycle has been finished" 3 "ProcessStop" = "Application dependent stop instruction that stops program execution at a favourable point for the application, e.g. at the end of a paint stroke or sealing bead" 4 "QuickStop" = "This stop is performed by ramping down motion as fast as possible using optimum motor performance. The robot may not stay on the path" 5 "EndOfInstruction" = "This stop can be used to stop the program execution when the current instruction is completed" } 0:37>0:80 0:40>0:63
+Overrides 3:6100 3:6008
+Object 3:5041 3:"Ready" = ~ 0 0 0 0:40>0:2307 0:117>3:5039 0:46>3:6113
+Overrides 3:5041 3:5006
+Variable 3:6113 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
+Overrides 3:6113 3:6011
+Object 3:5039 3:"ReadySubstateMachine" = ~ 0 0 0 0:37>0:80 0:40>3:1012 0:47>3:6109 0:47>3:6104 0:47>3:6106
+Variable 3:6109 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2760 0:46>3:6111
+Overrides 3:6109 0:2772
+Variable 3:6111 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6111 0:3728
+Variable 3:6104 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>3:6105
+Overrides 3:6104 3:6044
+Variable 3:6105 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6105 3:6045
+Variable 3:6106 3:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>3:6107 0:46>3:6108
+Overrides 3:6106 3:6046
+Variable 3:6107 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
+Overrides 3:6107 3:6047
+Variable 3:6108 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
+Overrides 3:6108 3:6048
+Object 3:5046 3:"ReadyToExecuting" = ~ 0 0 0 0:40>0:2310 0:52>3:5042 0:51>3:5041 0:53>3:7008 0:54>0:2311 0:46>3:6120
+Overrides 3:5046 3:5012
+Variable 3:6120 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:4 0:37>0:78 0:40>0:68
+Overrides 3:6120 3:6017
+Object 3:5045 3:"ReadyToIdle" = ~ 0 0 0 0:40>0:2310 0:52>3:5040 0:51>3:5041 0:54>0:2311 0:53>3:7014 0:53>3:7013 0:53>3:7012 0:46>3:6119
+Overrides 3:5045 3:5008
+Variable 3:6119 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:3 0:37>0:78 0:40>0:68
+Overrides 3:6119 3:6014
+Method 3:7008 3:"Start" = ~ 0 0 1 1 0:37>0:80 0:46>3:6101
+Overrides 3:7008 3:7001
+Variable 3:6101 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
+Method 3:7009 3:"Stop" = ~ 0 0 1 1 0:37>0:80 0:46>3:6102 0:46>3:6103
+Overrides 3:7009 3:7002
+Variable 3:6102 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "StopMode" 0:8 -1 [] "provides a way to differentiate between different stop modes. This parameter should correspond to one of the values in the PossibleStopModes array" } 0:37>0:78 0:40>0:68
+Variable 3:6103 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK\nValues > 0 are reserved for errors defined by this and future standards.\nValues < 0 shall be used for application-specific errors" } 0:37>0:78 0:40>0:68
+Method 3:7014 3:"UnloadByName" = ~ 0 0 1 1 0:37>0:80 0:46>3:6067 0:46>3:6069
+Variable 3:6067 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Name" 0:12 -1 [] ~ } 0:37>0:78 0:40>0:68
+Variable 3:6069 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] ~ } 0:37>0:78 0:40>0:68
+Method 3:7013 3:"UnloadByNodeId" = ~ 0 0 1 1 0:37>0:80 0:46>3:6146 0:46>3:6147
+Variable 3:6146 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Id" 0:18 -1 [] "Expanded NodeId of the module to be unloaded" } 0:37>0:78 0:40>0:68
+Variable 3:6147 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK – Everything is OK\n1 – E_SystemState – The system is not in correct state for this operation\n2 – E_UnexpectedError – Unexpected Error during the method call\n3 – E_ActiveAlarm – An Active Alarm prevents the system start\n4 – E_AcknowledgeRequired – Condition needs to be acknowledged\n<0 – shall be used for vendor-specific errors\n>0 – are reserved for errors defined by this and future standards" } 0:37>0:78 0:40>0:68
+Method 3:7012 3:"UnloadProgram" = ~ 0 0 1 1 0:37>0:80 0:46>3:6145
+Variable 3:6145 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK – Everything is OK\n1 – E_SystemState – The system is not in correct state for this operation\n2 – E_UnexpectedError – Unexpected Error during the method call\n3 – E_ActiveAlarm – An Active Alarm prevents the system start\n4 – E_AcknowledgeRequired – Condition needs to be acknowledged\n<0 – shall be used for vendor-specific errors\n>0 – are reserved for errors defined by this and future standards" } 0:37>0:78 0:40>0:68
+ObjectType 3:1012 3:"ReadySubstateMachineType" = ~ 0 0 0 0:45<0:2771 0:41>0:2311 0:47>3:5023 0:47>3:6044 0:47>3:6046 0:47>3:5025 0:47>3:7003 0:47>3:5024 0:47>3:5026
+Object 3:5023 3:"AtProgramStart" = ~ 0 0 0 0:40>0:2307 0:46>3:6049
+Variable 3:6049 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
+Overrides 3:6049 0:2308
+Variable 3:6044 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>3:6045
+Overrides 3:6044 0:2773
+Variable 3:6045 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6045 0:3732
+Variable 3:6046 3:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>3:6047 0:46>3:6048
+Variable 3:6047 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
+Overrides 3:6047 0:11241
+Variable 3:6048 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
+Overrides 3:6048 0:11461
+Object 3:5025 3:"ProgramStartToSuspended" = ~ 0 0 0 0:40>0:2310 0:51>3:5023 0:52>3:5024 0:54>0:2311 0:46>3:6051
+Variable 3:6051 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:1 0:37>0:78 0:40>0:68
+Overrides 3:6051 0:2312
+Method 3:7003 3:"ResetToProgramStart" = ~ 0 0 1 1 0:37>0:80 0:46>3:6053
+Variable 3:6053 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "Status" 0:6 -1 [] "0 – OK – Everything is OK\n1 – E_SystemState – The system is not in correct state for this operation\n2 – E_UnexpectedError – Unexpected Error during the method call\n3 – E_ActiveAlarm – An Active Alarm prevents the system start\n4 – E_AcknowledgeRequired – Condition needs to be acknowledged\n<0 – shall be used for vendor-specific errors\n>0 – are reserved for errors defined by this and future standards" } 0:37>0:78 0:40>0:68
+Object 3:5024 3:"Suspended" = ~ 0 0 0 0:40>0:2307 0:46>3:6050
+Variable 3:6050 0:"StateNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
+Overrides 3:6050 0:2308
+Object 3:5026 3:"SuspendedToProgramStart" = ~ 0 0 0 0:40>0:2310 0:52>3:5023 0:53>3:7003 0:51>3:5024 0:54>0:2311 0:46>3:6052
+Variable 3:6052 0:"TransitionNumber" = ~ 0 0 0:7 -1 [] 1 1 0 ~ UInt32:2 0:37>0:78 0:40>0:68
+Overrides 3:6052 0:2312
+ObjectType 3:1028 3:"SystemOperationType" = ~ 0 0 0 0:45<0:58 0:47>3:5050 0:46>3:6130 0:47>3:5049
+Object 3:5050 3:"Conditions" = ~ 0 0 0 0:37>0:80 0:40>0:61 0:35>3:5059
+Object 3:5059 3:"<AcknowledgeableCondition>" = ~ 0 0 0 0:37>0:11510 0:40>0:2881 0:47>3:6185 0:47>3:7019 0:47>3:7020 0:46>3:6191 0:46>3:6192 0:47>3:6193 0:46>3:6195 0:46>3:6196 0:46>3:6197 0:46>3:6198 0:46>3:6199 0:47>3:7021 0:47>3:7022 0:47>3:6188 0:46>3:6205 0:46>3:6206 0:47>3:6200 0:46>3:6207 0:47>3:6202 0:46>3:6208 0:46>3:6204 0:46>3:6209 0:46>3:6210 0:46>3:6211 0:46>3:6212
+Variable 3:6185 0:"AckedState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:8995 0:46>3:6186
+Overrides 3:6185 0:9093
+Variable 3:6186 0:"Id" = ~ 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6186 0:9094
+Method 3:7019 0:"Acknowledge" = ~ 0 0 1 1 0:37>0:78 0:46>3:6187
+Overrides 3:7019 0:9111
+Variable 3:6187 0:"InputArguments" = ~ 0 0 0:296 1 [2] 1 1 0 ~ Arguments:{ "EventId" 0:15 -1 [] "The identifier for the event to comment." "Comment" 0:21 -1 [] "The comment to add to the condition." } 0:37>0:78 0:40>0:68
+Method 3:7020 0:"AddComment" = ~ 0 0 1 1 0:37>0:78 0:46>3:6190
+Overrides 3:7020 0:9029
+Variable 3:6190 0:"InputArguments" = ~ 0 0 0:296 1 [2] 1 1 0 ~ Arguments:{ "EventId" 0:15 -1 [] "The identifier for the event to comment." "Comment" 0:21 -1 [] "The comment to add to the condition." } 0:37>0:78 0:40>0:68
+Variable 3:6191 0:"BranchId" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6191 0:9010
+Variable 3:6192 0:"ClientUserId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6192 0:9026
+Variable 3:6193 0:"Comment" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:9002 0:46>3:6194
+Overrides 3:6193 0:9024
+Variable 3:6194 0:"SourceTimestamp" = ~ 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6194 0:9025
+Variable 3:6195 0:"ConditionClassId" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6195 0:11112
+Variable 3:6196 0:"ConditionClassName" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6196 0:11113
+Variable 3:6197 0:"ConditionName" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6197 0:9009
+Variable 3:6198 0:"ConditionSubClassId" = ~ 0 0 0:17 1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6198 0:16363
+Variable 3:6199 0:"ConditionSubClassName" = ~ 0 0 0:21 1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6199 0:16364
+Method 3:7021 0:"Disable" = ~ 0 0 1 1 0:37>0:78
+Overrides 3:7021 0:9028
+Method 3:7022 0:"Enable" = ~ 0 0 1 1 0:37>0:78
+Overrides 3:7022 0:9027
+Variable 3:6188 0:"EnabledState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:8995 0:9004>3:6185 0:46>3:6189
+Overrides 3:6188 0:9073
+Variable 3:6189 0:"Id" = ~ 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6189 0:9074
+Variable 3:6205 0:"EventId" = ~ 0 0 0:15 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6205 0:2042
+Variable 3:6206 0:"EventType" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6206 0:2043
+Variable 3:6200 0:"LastSeverity" = ~ 0 0 0:5 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:9002 0:46>3:6201
+Overrides 3:6200 0:9022
+Variable 3:6201 0:"SourceTimestamp" = ~ 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6201 0:9023
+Variable 3:6207 0:"Message" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6207 0:2050
+Variable 3:6202 0:"Quality" = ~ 0 0 0:19 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:9002 0:46>3:6203
+Overrides 3:6202 0:9020
+Variable 3:6203 0:"SourceTimestamp" = ~ 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6203 0:9021
+Variable 3:6208 0:"ReceiveTime" = ~ 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6208 0:2047
+Variable 3:6204 0:"Retain" = ~ 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6204 0:3874
+Variable 3:6209 0:"Severity" = ~ 0 0 0:5 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6209 0:2051
+Variable 3:6210 0:"SourceName" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6210 0:2045
+Variable 3:6211 0:"SourceNode" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6211 0:2044
+Variable 3:6212 0:"Time" = ~ 0 0 0:294 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6212 0:2046
+Variable 3:6130 0:"DefaultInstanceBrowseName" = ~ 0 0 0:20 -1 [] 3 3 0 ~ QualifiedName:2:"SystemOperation" 0:40>0:68
+Object 3:5049 3:"SystemOperationStateMachine" = ~ 0 0 0 0:37>0:78 0:40>3:1021 0:47>3:6128 0:47>3:6123 0:47>3:6125
+Variable 3:6128 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2760 0:46>3:6129
+Overrides 3:6128 0:2772
+Variable 3:6129 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6129 0:3728
+Variable 3:6123 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>3:6124
+Overrides 3:6123 3:6058
+Variable 3:6124 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6124 3:6059
+Variable 3:6125 3:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>3:6126 0:46>3:6127
+Overrides 3:6125 3:6060
+Variable 3:6126 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
+Overrides 3:6126 3:6061
+Variable 3:6127 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
+Overrides 3:6127 3:6062
+ObjectType 3:1008 3:"TaskControlOperationType" = ~ 0 0 0 0:45<0:58 0:46>3:6132 0:46>3:6131 0:47>3:5051
+Variable 3:6132 0:"DefaultInstanceBrowseName" = ~ 0 0 0:20 -1 [] 3 3 0 ~ QualifiedName:3:"TaskControlOperation" 0:40>0:68
+Variable 3:6131 3:"MotionDevicesUnderControl" = ~ 0 0 0:17 1 [0] 1 1 0 ~ ~ 0:37>0:80 0:40>0:68
+Object 3:5051 3:"TaskControlStateMachine" = ~ 0 0 0 0:37>0:78 0:40>3:1025 0:47>3:6138 0:47>3:6133 0:47>3:6135
+Variable 3:6138 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2760 0:46>3:6139
+Overrides 3:6138 0:2772
+Variable 3:6139 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6139 0:3728
+Variable 3:6133 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>3:6134
+Overrides 3:6133 3:6095
+Variable 3:6134 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6134 3:6096
+Variable 3:6135 3:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>3:6136 0:46>3:6137
+Overrides 3:6135 3:6097
+Variable 3:6136 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
+Overrides 3:6136 3:6098
+Variable 3:6137 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
+Overrides 3:6137 3:6099
+ObjectType 3:1016 3:"TaskModuleType" = ~ 0 0 0 0:45<0:58 0:46>3:6056 0:46>3:6054 0:46>3:6055
+Variable 3:6056 3:"IsReferenced" = ~ 0 0 0:1 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:68
+Variable 3:6054 3:"Name" = ~ 0 0 0:12 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:68
+Variable 3:6055 3:"Version" = ~ 0 0 0:12 -1 [] 3 3 0 ~ ~ 0:37>0:80 0:40>0:68
+ObjectType 3:17725 3:"AuxiliaryComponentType" = "Components mounted in a controller cabinet or a motion device e.g. an IO-board or a power supply." 0 0 0 0:45<1:15063 0:46>3:6183 0:46>3:17756
+Variable 3:6183 1:"AssetId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 3:6183 1:15098
+Variable 3:17756 1:"ProductCode" = "The ProductCode property provides a unique combination of numbers and letters used to identify the product. It may be the order information displayed on type shields or in ERP systems." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17756 1:15092
+ObjectType 3:16601 3:"AxisType" = "The AxisType describes an axis of a motion device." 0 0 0 0:45<1:15063 3:18179>3:18344 0:47>3:16638 0:46>3:6175 0:46>3:16637 0:47>3:16602
+Object 3:18344 3:"<PowerTrainIdentifier>" = "The Requires reference provides the relationship of axes to powertrains. For complex kinematics this does not need to be a one to one relationship, because more than one power train might influence the motion of one axis. This reference connects all power trains to an axis that must be actively driven when only this axis should move and all other axes should stand still. Virtual axes that are not actively driven by a power train do not have this reference." 0 0 0 0:40>3:16794 0:37>0:11508 0:47>3:15998
+Object 3:16638 3:"AdditionalLoad" = "The additional load which is mounted on this axis. E.g. for process-need a transformer for welding." 0 0 0 0:40>3:1018 0:37>0:80 0:47>3:16639
+Variable 3:16639 3:"Mass" = "The weight of the load mounted on one mounting point." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>3:16644
+Overrides 3:16639 3:6723
+Variable 3:16644 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16644 3:6728
+Variable 3:6175 1:"AssetId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 3:6175 1:15098
+Variable 3:16637 3:"MotionProfile" = "The kind of axis motion as defined with the AxisMotionProfileEnumeration." 0 0 3:3008 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Object 3:16602 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>3:16674 0:47>3:16662 0:47>3:16668
+Overrides 3:16602 1:5002
+Variable 3:16674 3:"ActualAcceleration" = ": The ActualAcceleration variable provides the axis acceleration. Applicable acceleration limits of the axis shall be provided by the EURange property of the AnalogUnitType." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:80 0:46>3:16679
+Variable 3:16679 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16679 0:17502
+Variable 3:16662 3:"ActualPosition" = "The axis position inclusive Unit and RangeOfMotion." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>3:16667
+Variable 3:16667 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16667 0:17502
+Variable 3:16668 3:"ActualSpeed" = "The axis speed on load side (after gear/spindle) inclusive Unit." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:80 0:46>3:16673
+Variable 3:16673 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16673 0:17502
+ObjectType 3:1003 3:"ControllerType" = "The ControllerType describes the control unit of motion devices. One motion device system can have one or more instances of the ControllerType." 0 0 0 0:45<1:15063 3:4002>3:18964 3:18182>3:18918 0:46>3:6180 0:46>3:6181 0:47>3:17252 0:47>3:17249 0:46>3:6182 0:46>3:17237 0:46>3:17239 0:47>3:5004 0:46>3:17245 0:47>3:5054 0:46>3:17240 0:47>3:15800 0:17604>3:5055 0:47>3:15826
+Object 3:18964 3:"<MotionDeviceIdentifier>" = "The relationship of a motion device and controller." 0 0 0 0:40>3:1004 0:37>0:11508 0:47>3:19002 0:46>3:18985 0:46>3:18987 0:46>3:18998 0:47>3:18965 0:47>3:19080 0:46>3:18993 0:46>3:18988 0:47>3:6003
+Object 3:19002 3:"Axes" = "Axes is a container for one or more instances of the AxisType." 0 0 0 0:40>0:61 0:37>0:78 0:47>3:15743
+Overrides 3:19002 3:15305
+Variable 3:18985 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:18985 3:16351
+Variable 3:18987 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:18987 3:16353
+Variable 3:18998 3:"MotionDeviceCategory" = "The variable MotionDeviceCategory provides the kind of motion device defined by MotionDeviceCategoryEnumeration based on ISO 8373." 0 0 3:18193 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:18998 3:16362
+Object 3:18965 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>3:19001
+Overrides 3:18965 3:5029
+Variable 3:19001 3:"SpeedOverride" = "SpeedOverride provides the current speed setting in percent of programmed speed (0 - 100%)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:19001 3:16365
+Object 3:19080 3:"PowerTrains" = "PowerTrains is a container for one or more instances of the PowerTrainType." 0 0 0 0:40>0:61 0:37>0:78 0:47>3:15905
+Overrides 3:19080 3:16443
+Variable 3:18993 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:18993 3:16359
+Variable 3:18988 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:18988 3:16354
+Variable 3:6003 3:"TaskControlReference" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:80 0:40>0:63
+Overrides 3:6003 3:6001
+Object 3:18918 3:"<SafetyStatesIdentifier>" = "The relationship of safety states to a controller." 0 0 0 0:40>3:1013 0:37>0:11508 0:47>3:18919
+Object 3:18919 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>3:18962 0:47>3:18961 0:47>3:18963
+Overrides 3:18919 3:5016
+Variable 3:18962 3:"EmergencyStop" = "The EmergencyStop variable is TRUE if one or more of the emergency stop functions in the robot system are active, FALSE otherwise. If the EmergencyStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed emergency stop functions are active." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:18962 3:15882
+Variable 3:18961 3:"OperationalMode" = "The OperationalMode variable provides information about the current operational mode. Allowed values are described in OperationalModeEnumeration, see ISO 10218-1:2011 Ch.5.7 Operational Modes." 0 0 3:3006 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:18961 3:15912
+Variable 3:18963 3:"ProtectiveStop" = "The ProtectiveStop variable is TRUE if one or more of the enabled protective stop functions in the system are active, FALSE otherwise. If the ProtectiveStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed protective stop functions are enabled and active." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:18963 3:15913
+Variable 3:6180 1:"AssetId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 3:6180 1:15098
+Variable 3:6181 1:"ComponentName" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 3:6181 1:15099
+Object 3:17252 3:"Components" = "Components is a container for one or more instances of subtypes of ComponentType defined in OPC UA DI. The listed components are installed in the motion device system, e.g. a processing-unit, a power-supply, an IO-board or a drive, and have an electrical interface to the controller." 0 0 0 0:40>0:61 0:37>0:80 0:47>3:18813
+Object 3:18813 3:"<ComponentIdentifier>" = "The intention is to integrate inside this container devices which are defined in other companion specifications using DI." 0 0 0 0:37>0:11510 0:40>1:15063 0:17603>1:15048 0:17603>1:15035
+Object 3:17249 3:"CurrentUser" = "The current user of the system." 0 0 0 0:40>3:18175 0:37>0:78 0:46>3:17250
+Variable 3:17250 3:"Level" = "The weight of the load mounted on one mounting point." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17250 3:18176
+Variable 3:6182 1:"DeviceManual" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 3:6182 1:15093
+Variable 3:17237 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17237 1:15086
+Variable 3:17239 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17239 1:15088
+Object 3:5004 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:80 0:47>3:17365 0:47>3:17371 0:47>3:17377 0:47>3:15366 0:47>3:17383 0:47>3:17359 0:47>3:17358 0:47>3:15365
+Overrides 3:5004 1:5002
+Variable 3:17365 3:"CabinetFanSpeed" = "The speed of the cabinet fan." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:80 0:46>3:17370
+Variable 3:17370 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17370 0:17502
+Variable 3:17371 3:"CPUFanSpeed" = "The speed of the CPU fan." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:80 0:46>3:17376
+Variable 3:17376 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17376 0:17502
+Variable 3:17377 3:"InputVoltage" = "The input voltage of the controller which can be a configured value. To distinguish between an AC or DC supply the optional property Definition of the base type DataItemType shall be used." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:80 0:46>3:17382
+Variable 3:17382 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17382 0:17502
+Variable 3:15366 3:"StartUpTime" = "The date and time of the last start-up of the controller." 0 0 0:13 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
+Variable 3:17383 3:"Temperature" = "The controller temperature given by a temperature sensor inside of the controller." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:80 0:46>3:17388
+Variable 3:17388 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17388 0:17502
+Variable 3:17359 3:"TotalEnergyConsumption" = "The total accumulated energy consumed by the motion devices related with this controller instance." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:80 0:46>3:17364
+Variable 3:17364 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17364 0:17502
+Variable 3:17358 3:"TotalPowerOnTime" = "The total accumulated time the controller was powered on." 0 0 0:12879 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
+Variable 3:15365 3:"UpsState" = "The vendor specific status of an integrated UPS or accumulator system." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
+Variable 3:17245 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17245 1:15092
+Object 3:5054 3:"Programs" = ~ 0 0 0 0:37>0:80 0:40>0:13353 0:47>3:7015 0:47>3:7016 0:47>3:7017 0:47>3:7018
+Method 3:7015 0:"CreateDirectory" = ~ 0 0 1 1 0:37>0:78 0:46>3:6155 0:46>3:6156
+Overrides 3:7015 0:13387
+Variable 3:6155 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "DirectoryName" 0:12 -1 [] ~ } 0:37>0:78 0:40>0:68
+Variable 3:6156 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "DirectoryNodeId" 0:17 -1 [] ~ } 0:37>0:78 0:40>0:68
+Method 3:7016 0:"CreateFile" = ~ 0 0 1 1 0:37>0:78 0:46>3:6157 0:46>3:6158
+Overrides 3:7016 0:13390
+Variable 3:6157 0:"InputArguments" = ~ 0 0 0:296 1 [2] 1 1 0 ~ Arguments:{ "FileName" 0:12 -1 [] ~ "RequestFileOpen" 0:1 -1 [] ~ } 0:37>0:78 0:40>0:68
+Variable 3:6158 0:"OutputArguments" = ~ 0 0 0:296 1 [2] 1 1 0 ~ Arguments:{ "FileNodeId" 0:17 -1 [] ~ "FileHandle" 0:7 -1 [] ~ } 0:37>0:78 0:40>0:68
+Method 3:7017 0:"Delete" = ~ 0 0 1 1 0:37>0:78 0:46>3:6159
+Overrides 3:7017 0:13393
+Variable 3:6159 0:"InputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "ObjectToDelete" 0:17 -1 [] ~ } 0:37>0:78 0:40>0:68
+Method 3:7018 0:"MoveOrCopy" = ~ 0 0 1 1 0:37>0:78 0:46>3:6160 0:46>3:6161
+Overrides 3:7018 0:13395
+Variable 3:6160 0:"InputArguments" = ~ 0 0 0:296 1 [4] 1 1 0 ~ Arguments:{ "ObjectToMoveOrCopy" 0:17 -1 [] ~ "TargetDirectory" 0:17 -1 [] ~ "CreateCopy" 0:1 -1 [] ~ "NewName" 0:12 -1 [] ~ } 0:37>0:78 0:40>0:68
+Variable 3:6161 0:"OutputArguments" = ~ 0 0 0:296 1 [1] 1 1 0 ~ Arguments:{ "NewNodeId" 0:17 -1 [] ~ } 0:37>0:78 0:40>0:68
+Variable 3:17240 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17240 1:15095
+Object 3:15800 3:"Software" = "Software is a container for one or more instances of SoftwareType defined in OPC UA DI." 0 0 0 0:40>0:61 0:37>0:78 0:47>3:18847
+Object 3:18847 3:"<SoftwareIdentifier>" = ~ 0 0 0 0:37>0:11510 0:40>1:15106 0:46>3:18868 0:46>3:18870 0:46>3:18873
+Variable 3:18868 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:18868 1:15129
+Variable 3:18870 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:18870 1:15131
+Variable 3:18873 1:"SoftwareRevision" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:18873 1:15133
+Object 3:5055 3:"SystemOperation" = ~ 0 0 0 0:37>0:80 0:40>3:1028 0:47>3:5056
+Object 3:5056 3:"SystemOperationStateMachine" = ~ 0 0 0 0:37>0:78 0:40>3:1021 0:47>3:6162 0:47>3:6164 0:47>3:6166
+Overrides 3:5056 3:5049
+Variable 3:6162 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2760 0:46>3:6163
+Overrides 3:6162 3:6128
+Variable 3:6163 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6163 3:6129
+Variable 3:6164 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>3:6165
+Overrides 3:6164 3:6123
+Variable 3:6165 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6165 3:6124
+Variable 3:6166 3:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>3:6167 0:46>3:6168
+Overrides 3:6166 3:6125
+Variable 3:6167 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
+Overrides 3:6167 3:6126
+Variable 3:6168 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
+Overrides 3:6168 3:6127
+Object 3:15826 3:"TaskControls" = "TaskControls is a container for one or more instances of TaskControlType." 0 0 0 0:40>0:61 0:37>0:78 0:47>3:18881
+Object 3:18881 3:"<TaskControlIdentifier>" = ~ 0 0 0 0:40>3:1011 0:37>0:11510 0:46>3:18914 0:47>3:18882
+Variable 3:18914 1:"ComponentName" = "A user writable name provided by the vendor, integrator or user of the device." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:18914 3:17873
+Object 3:18882 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>3:18916 0:47>3:18915
+Overrides 3:18882 3:15883
+Variable 3:18916 3:"TaskProgramLoaded" = "The TaskProgramLoaded variable is TRUE if a task program is loaded in the task control, FALSE otherwise." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:18916 3:17875
+Variable 3:18915 3:"TaskProgramName" = "A customer given identifier for the task program." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:18915 3:17874
+ObjectType 3:17793 3:"DriveType" = "Drives (multi-slot or single-slot axis amplifier) mounted in a controller cabinet or a motion device." 0 0 0 0:45<1:15063 0:46>3:6184 0:46>3:17824
+Variable 3:6184 1:"AssetId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 3:6184 1:15098
+Variable 3:17824 1:"ProductCode" = "The ProductCode property provides a unique combination of numbers and letters used to identify the product. It may be the order information displayed on type shields or in ERP systems." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17824 1:15092
+ObjectType 3:1022 3:"GearType" = "The GearType describes a gear in a powertrain, e.g. a gear box or a spindle." 0 0 0 0:45<1:15063 0:46>3:6178 0:47>3:15941 0:46>3:17152 0:46>3:17154 0:47>3:17165 0:46>3:17160 0:46>3:17155
+Variable 3:6178 1:"AssetId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 3:6178 1:15098
+Variable 3:15941 3:"GearRatio" = "The transmission ratio of the gear expressed as a fraction as input velocity (motor side) by output velocity (load side)." 0 0 0:18806 -1 [] 1 1 0 ~ ~ 0:40>0:17709 0:37>0:78 0:47>3:15616 0:47>3:15615
+Variable 3:15616 0:"Denominator" = ~ 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:15616 0:17713
+Variable 3:15615 0:"Numerator" = ~ 0 0 0:6 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:15615 0:17712
+Variable 3:17152 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17152 1:15086
+Variable 3:17154 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17154 1:15088
+Variable 3:17165 3:"Pitch" = "Pitch describes the distance covered in millimeters (mm) for linear motion per one revolution of the output side of the driving unit. Pitch is used in combination with GearRatio to describe the overall transmission from input to output of the gear." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
+Variable 3:17160 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17160 1:15092
+Variable 3:17155 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17155 1:15095
+ObjectType 3:1002 3:"MotionDeviceSystemType" = "Contains the set of controllers and motion devices in a closely-coupled motion device system." 0 0 0 0:45<1:15063 0:46>3:6171 0:47>3:5001 0:47>3:5002 0:47>3:5010
+Variable 3:6171 1:"ComponentName" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 3:6171 1:15099
+Object 3:5001 3:"Controllers" = "Contains the set of controllers in the motion device system." 0 0 0 0:40>0:61 0:37>0:78 0:47>3:15405
+Object 3:15405 3:"<ControllerIdentifier>" = ~ 0 0 0 0:40>3:1003 0:37>0:11510 0:47>3:15440 0:46>3:15426 0:46>3:15428 0:46>3:15434 0:46>3:15429 0:47>3:15483 0:47>3:15518
+Object 3:15440 3:"CurrentUser" = "The given name of the device." 0 0 0 0:40>3:18175 0:37>0:78 0:46>3:15441
+Overrides 3:15440 3:17249
+Variable 3:15441 3:"Level" = "The weight of the load mounted on one mounting point." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:15441 3:17250
+Variable 3:15426 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:15426 3:17237
+Variable 3:15428 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:15428 3:17239
+Variable 3:15434 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:15434 3:17245
+Variable 3:15429 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:15429 3:17240
+Object 3:15483 3:"Software" = "Software is a container for one or more instances of SoftwareType defined in OPC UA DI." 0 0 0 0:40>0:61 0:37>0:78 0:47>3:18847
+Overrides 3:15483 3:15800
+Object 3:15518 3:"TaskControls" = "TaskControls is a container for one or more instances of TaskControlType." 0 0 0 0:40>0:61 0:37>0:78 0:47>3:18881
+Overrides 3:15518 3:15826
+Object 3:5002 3:"MotionDevices" = "Contains any kinematic or motion device which is part of the motion device system." 0 0 0 0:40>0:61 0:37>0:78 0:47>3:15008
+Object 3:15008 3:"<MotionDeviceIdentifier>" = ~ 0 0 0 0:40>3:1004 0:37>0:11510 0:47>3:15062 0:46>3:15045 0:46>3:15047 0:46>3:15058 0:47>3:15024 0:47>3:15208 0:46>3:15053 0:46>3:15048 0:47>3:6002
+Object 3:15062 3:"Axes" = "Axes is a container for one or more instances of the AxisType." 0 0 0 0:40>0:61 0:37>0:78 0:47>3:15743
+Overrides 3:15062 3:15305
+Variable 3:15045 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:15045 3:16351
+Variable 3:15047 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:15047 3:16353
+Variable 3:15058 3:"MotionDeviceCategory" = "The variable MotionDeviceCategory provides the kind of motion device defined by MotionDeviceCategoryEnumeration based on ISO 8373." 0 0 3:18193 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:15058 3:16362
+Object 3:15024 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>3:15061
+Overrides 3:15024 3:5029
+Variable 3:15061 3:"SpeedOverride" = "SpeedOverride provides the current speed setting in percent of programmed speed (0 - 100%)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:15061 3:16365
+Object 3:15208 3:"PowerTrains" = "PowerTrains is a container for one or more instances of the PowerTrainType." 0 0 0 0:40>0:61 0:37>0:78 0:47>3:15905
+Overrides 3:15208 3:16443
+Variable 3:15053 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:15053 3:16359
+Variable 3:15048 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:15048 3:16354
+Variable 3:6002 3:"TaskControlReference" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:80 0:40>0:63
+Overrides 3:6002 3:6001
+Object 3:5010 3:"SafetyStates" = "Contains safety-related data from motion device system." 0 0 0 0:40>0:61 0:37>0:78 0:47>3:15697
+Object 3:15697 3:"<SafetyStateIdentifier>" = ~ 0 0 0 0:40>3:1013 0:37>0:11510 0:47>3:15698
+Object 3:15698 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>3:15741 0:47>3:15740 0:47>3:15742
+Overrides 3:15698 3:5016
+Variable 3:15741 3:"EmergencyStop" = "The EmergencyStop variable is TRUE if one or more of the emergency stop functions in the robot system are active, FALSE otherwise. If the EmergencyStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed emergency stop functions are active." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:15741 3:15882
+Variable 3:15740 3:"OperationalMode" = "The OperationalMode variable provides information about the current operational mode. Allowed values are described in OperationalModeEnumeration, see ISO 10218-1:2011 Ch.5.7 Operational Modes." 0 0 3:3006 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:15740 3:15912
+Variable 3:15742 3:"ProtectiveStop" = "The ProtectiveStop variable is TRUE if one or more of the enabled protective stop functions in the system are active, FALSE otherwise. If the ProtectiveStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed protective stop functions are enabled and active." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:15742 3:15913
+ObjectType 3:1004 3:"MotionDeviceType" = "Represents a specific motion device in the motion device system like a robot, a linear unit or a positioner. A MotionDevice should have at least one axis." 0 0 0 0:45<1:15063 0:47>3:16566 0:46>3:6172 0:47>3:15305 0:46>3:6173 0:46>3:6174 0:47>3:5091 0:46>3:16351 0:46>3:16353 0:46>3:16362 0:47>3:5029 0:47>3:16443 0:46>3:16359 0:46>3:16354 0:47>3:6001
+Object 3:16566 3:"AdditionalComponents" = "AdditionalComponents is a container for one or more instances of subtypes of ComponentType defined in OPC UA DI. The listed components are installed at the motion device, e.g. an IO-board." 0 0 0 0:40>0:61 0:37>0:80 0:47>3:5003
+Object 3:5003 3:"<AdditionalComponentIdentifier>" = ~ 0 0 0 0:37>0:11510 0:40>0:58
+Variable 3:6172 1:"AssetId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 3:6172 1:15098
+Object 3:15305 3:"Axes" = "Axes is a container for one or more instances of the AxisType." 0 0 0 0:40>0:61 0:37>0:78 0:47>3:15743
+Object 3:15743 3:"<AxisIdentifier>" = ~ 0 0 0 0:40>3:16601 0:37>0:11510 0:46>3:15808 0:47>3:15744
+Variable 3:15808 3:"MotionProfile" = "The kind of axis motion as defined with the AxisMotionProfileEnumeration." 0 0 3:3008 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:15808 3:16637
+Object 3:15744 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>3:15863
+Overrides 3:15744 3:16602
+Variable 3:15863 3:"ActualPosition" = "The axis position inclusive Unit and RangeOfMotion." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>3:15869
+Overrides 3:15863 3:16662
+Variable 3:15869 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:15869 3:16667
+Variable 3:6173 1:"ComponentName" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 3:6173 1:15099
+Variable 3:6174 1:"DeviceManual" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 3:6174 1:15093
+Object 3:5091 3:"FlangeLoad" = "The FlangeLoad is the load on the flange or at the mounting point of the MotionDevice. This can be the maximum load of the MotionDevice." 0 0 0 0:40>3:1018 0:37>0:80 0:47>3:6624
+Variable 3:6624 3:"Mass" = "The weight of the load mounted on one mounting point." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>3:15659
+Overrides 3:6624 3:6723
+Variable 3:15659 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:15659 3:6728
+Variable 3:16351 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16351 1:15086
+Variable 3:16353 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16353 1:15088
+Variable 3:16362 3:"MotionDeviceCategory" = "The variable MotionDeviceCategory provides the kind of motion device defined by MotionDeviceCategoryEnumeration based on ISO 8373." 0 0 3:18193 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Object 3:5029 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>3:16364 0:47>3:16363 0:47>3:16365
+Overrides 3:5029 1:5002
+Variable 3:16364 3:"InControl" = "InControl provides the information if the actuators (in most cases a motor) of the motion device are powered up and in control: \"true\". The motion device might be in a standstill." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
+Variable 3:16363 3:"OnPath" = "OnPath is true if the motion device is on or near enough the planned program path such that program execution can continue. If the MotionDevice deviates too much from this path in case of errors or an emergency stop, this value becomes false. If OnPath is false, the motion device needs repositioning to continue program execution." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
+Variable 3:16365 3:"SpeedOverride" = "SpeedOverride provides the current speed setting in percent of programmed speed (0 - 100%)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Object 3:16443 3:"PowerTrains" = "PowerTrains is a container for one or more instances of the PowerTrainType." 0 0 0 0:40>0:61 0:37>0:78 0:47>3:15905
+Object 3:15905 3:"<PowerTrainIdentifier>" = ~ 0 0 0 0:40>3:16794 0:37>0:11510 0:47>3:15998
+Variable 3:16359 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16359 1:15092
+Variable 3:16354 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16354 1:15095
+Variable 3:6001 3:"TaskControlReference" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:80 0:40>0:63
+ObjectType 3:1019 3:"MotorType" = "The MotorType is for representing instances of electric motors." 0 0 0 0:45<1:15063 3:18180>3:5060 0:46>3:6177 0:46>3:17101 0:46>3:17103 0:47>3:5105 0:46>3:17109 0:46>3:17104
+Object 3:5060 3:"<DriveIdentifier>" = ~ 0 0 0 0:37>0:11508 0:40>0:58
+Variable 3:6177 1:"AssetId" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 3:6177 1:15098
+Variable 3:17101 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17101 1:15086
+Variable 3:17103 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17103 1:15088
+Object 3:5105 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>3:17150 0:47>3:6776 0:47>3:6757
+Overrides 3:5105 1:5002
+Variable 3:17150 3:"BrakeReleased" = "Indicates an optional variable used only for motors with brakes. If BrakeReleased is TRUE the motor is free to run. FALSE means that the motor shaft is locked by the brake." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
+Variable 3:6776 3:"EffectiveLoadRate" = "EffectiveLoadRate is expressed as a percentage of maximum continuous load. The Joule integral is typically used to calculate the current load. Duration should be defined and documented by the vendor." 0 0 0:5 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
+Variable 3:6757 3:"MotorTemperature" = "The motor temperature provides the temperature of the motor. If there is no temperature sensor the value is set to \\\"null\\\"." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>3:6762
+Variable 3:6762 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:6762 0:17502
+Variable 3:17109 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17109 1:15092
+Variable 3:17104 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17104 1:15095
+ObjectType 3:16794 3:"PowerTrainType" = "The PowerTrainType represents instances of powertrains of a motion device." 0 0 0 0:45<1:15063 3:18178>3:18536 0:47>3:16041 0:47>3:15998 3:18183>3:18613 0:46>3:6176
+Object 3:18536 3:"<AxisIdentifier>" = "Moves is a reference to provide the relationship of powertrains to axes. For complex kinematics this does not need to be a one to one relationship, because a powertrain might influence the motion of more than one axis. This reference connects all axis to a powertrain that that move when only this powertrain moves and all other powertrains stand still." 0 0 0 0:40>3:16601 0:37>0:11508 0:46>3:18570 0:47>3:18537
+Variable 3:18570 3:"MotionProfile" = "The kind of axis motion as defined with the AxisMotionProfileEnumeration." 0 0 3:3008 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:18570 3:16637
+Object 3:18537 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>3:18595
+Overrides 3:18537 3:16602
+Variable 3:18595 3:"ActualPosition" = "The axis position inclusive Unit and RangeOfMotion." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>3:18600
+Overrides 3:18595 3:16662
+Variable 3:18600 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:18600 3:16667
+Object 3:16041 3:"<GearIdentifier>" = ~ 0 0 0 0:40>3:1022 0:37>0:11508 0:47>3:16076 0:46>3:16062 0:46>3:16064 0:46>3:16068 0:46>3:16071
+Variable 3:16076 3:"GearRatio" = "The transmission ratio of the gear expressed as a fraction as input velocity (motor side) by output velocity (load side)." 0 0 0:18806 -1 [] 1 1 0 ~ ~ 0:40>0:17709 0:37>0:78 0:47>3:16078 0:47>3:16077
+Overrides 3:16076 3:15941
+Variable 3:16078 0:"Denominator" = ~ 0 0 0:7 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:16078 3:15616
+Variable 3:16077 0:"Numerator" = ~ 0 0 0:6 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:16077 3:15615
+Variable 3:16062 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16062 3:17152
+Variable 3:16064 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16064 3:17154
+Variable 3:16068 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16068 3:17160
+Variable 3:16071 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16071 3:17155
+Object 3:15998 3:"<MotorIdentifier>" = ~ 0 0 0 0:40>3:1019 0:37>0:11510 0:46>3:16019 0:46>3:16021 0:47>3:15999 0:46>3:16025 0:46>3:16028
+Variable 3:16019 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16019 3:17101
+Variable 3:16021 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16021 3:17103
+Object 3:15999 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>3:16034
+Overrides 3:15999 3:5105
+Variable 3:16034 3:"MotorTemperature" = "The motor temperature provides the temperature of the motor. If there is no temperature sensor the value is set to \\\"null\\\"." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:17497 0:37>0:78 0:46>3:16039
+Overrides 3:16034 3:6757
+Variable 3:16039 0:"EngineeringUnits" = ~ 0 0 0:887 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16039 3:6762
+Variable 3:16025 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16025 3:17109
+Variable 3:16028 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:16028 3:17104
+Object 3:18613 3:"<PowerTrainIdentifier>" = "HasSlave is a reference to provide the master-slave relationship of powertrains which provide torque for a common axis. The InverseName is IsSlaveOf." 0 0 0 0:40>3:16794 0:37>0:11508 0:47>3:15998
+Variable 3:6176 1:"ComponentName" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 3:6176 1:15099
+ObjectType 3:1013 3:"SafetyStateType" = "SafetyStateType describes the safety states of the motion devices and controllers. One motion device system is associated with one or more instances of the SafetyStateType." 0 0 0 0:45<1:15063 0:46>3:6179 0:47>3:17221 0:47>3:5016 0:47>3:17225
+Variable 3:6179 1:"ComponentName" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Overrides 3:6179 1:15099
+Object 3:17221 3:"EmergencyStopFunctions" = "EmergencyStopFunctions is a container for one or more instances of the EmergencyStopFunctionType." 0 0 0 0:40>0:61 0:37>0:80 0:47>3:18806
+Object 3:18806 3:"<EmergencyStopFunctionIdentifier>" = ~ 0 0 0 0:40>3:17230 0:37>0:11510 0:47>3:18808 0:46>3:18807
+Variable 3:18808 3:"Active" = "The Active variable is TRUE if this particular emergency stop function is active, e.g. that the emergency stop button is pressed, FALSE otherwise." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:18808 3:17232
+Variable 3:18807 3:"Name" = "The Name of the EmergencyStopFunctionType provides a manufacturer-specific emergency stop function identifier within the safety system." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:18807 3:17231
+Object 3:5016 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>3:15882 0:47>3:15912 0:47>3:15913
+Overrides 3:5016 1:5002
+Variable 3:15882 3:"EmergencyStop" = "The EmergencyStop variable is TRUE if one or more of the emergency stop functions in the robot system are active, FALSE otherwise. If the EmergencyStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed emergency stop functions are active." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Variable 3:15912 3:"OperationalMode" = "The OperationalMode variable provides information about the current operational mode. Allowed values are described in OperationalModeEnumeration, see ISO 10218-1:2011 Ch.5.7 Operational Modes." 0 0 3:3006 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Variable 3:15913 3:"ProtectiveStop" = "The ProtectiveStop variable is TRUE if one or more of the enabled protective stop functions in the system are active, FALSE otherwise. If the ProtectiveStopFunctions object is provided, then the value of this variable is TRUE if one or more of the listed protective stop functions are enabled and active." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Object 3:17225 3:"ProtectiveStopFunctions" = "ProtectiveStopFunctions is a container for one or more instances of the ProtectiveStopFunctionType." 0 0 0 0:40>0:61 0:37>0:80 0:47>3:18809
+Object 3:18809 3:"<ProtectiveStopFunctionIdentifier>" = ~ 0 0 0 0:40>3:17233 0:37>0:11510 0:47>3:18812 0:47>3:18811 0:46>3:18810
+Variable 3:18812 3:"Active" = "–\tThe Active variable is TRUE if this particular protective stop function is active, i.e. that a stop is initiated, FALSE otherwise. If Enabled is FALSE then Active shall be FALSE." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:18812 3:17236
+Variable 3:18811 3:"Enabled" = "–\tThe Enabled variable is TRUE if this protective stop function is currently supervising the system, FALSE otherwise. A protective stop function may or may not be enabled at all times, e.g. the protective stop function of the safety doors are typically enabled in automatic operational mode and disabled in manual mode. On the other hand for example, the protective stop function of the teach pendant enabling device is enabled in manual modes and disabled in automatic modes." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:18811 3:17235
+Variable 3:18810 3:"Name" = "The Name of the ProtectiveStopFunctionType provides a manufacturer-specific protective stop function identifier within the safety system." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:18810 3:17234
+ObjectType 3:1011 3:"TaskControlType" = "Represents a specific task control active on the controller." 0 0 0 0:45<1:15063 3:4002>3:19254 0:46>3:17873 0:47>3:15883 0:17604>3:5052 0:47>3:5057
+Object 3:19254 3:"<MotionDeviceIdentifier>" = "Controls is a reference to provide the relationship between a task control and a motion device." 0 0 0 0:40>3:1004 0:37>0:11508 0:47>3:19292 0:46>3:19275 0:46>3:19277 0:46>3:19288 0:47>3:19255 0:47>3:19370 0:46>3:19283 0:46>3:19278 0:47>3:6004
+Object 3:19292 3:"Axes" = "Axes is a container for one or more instances of the AxisType." 0 0 0 0:40>0:61 0:37>0:78 0:47>3:15743
+Overrides 3:19292 3:15305
+Variable 3:19275 1:"Manufacturer" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:19275 3:16351
+Variable 3:19277 1:"Model" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:19277 3:16353
+Variable 3:19288 3:"MotionDeviceCategory" = "The variable MotionDeviceCategory provides the kind of motion device defined by MotionDeviceCategoryEnumeration based on ISO 8373." 0 0 3:18193 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:19288 3:16362
+Object 3:19255 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>3:19291
+Overrides 3:19255 3:5029
+Variable 3:19291 3:"SpeedOverride" = "SpeedOverride provides the current speed setting in percent of programmed speed (0 - 100%)." 0 0 0:11 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Overrides 3:19291 3:16365
+Object 3:19370 3:"PowerTrains" = "PowerTrains is a container for one or more instances of the PowerTrainType." 0 0 0 0:40>0:61 0:37>0:78 0:47>3:15905
+Overrides 3:19370 3:16443
+Variable 3:19283 1:"ProductCode" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:19283 3:16359
+Variable 3:19278 1:"SerialNumber" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:19278 3:16354
+Variable 3:6004 3:"TaskControlReference" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:80 0:40>0:63
+Overrides 3:6004 3:6001
+Variable 3:17873 1:"ComponentName" = "A user writable name provided by the vendor, integrator or user of the device." 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:17873 1:15099
+Object 3:15883 1:"ParameterSet" = "Flat list of Parameters" 0 0 0 0:40>0:58 0:37>0:78 0:47>3:17876 0:47>3:17875 0:47>3:17874
+Overrides 3:15883 1:5002
+Variable 3:17876 3:"ExecutionMode" = "Execution mode of the task control (continuous or step-wise)." 0 0 3:18191 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:80
+Variable 3:17875 3:"TaskProgramLoaded" = "The TaskProgramLoaded variable is TRUE if a task program is loaded in the task control, FALSE otherwise." 0 0 0:1 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Variable 3:17874 3:"TaskProgramName" = "A customer given identifier for the task program." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:63 0:37>0:78
+Object 3:5052 3:"TaskControlOperation" = ~ 0 0 0 0:37>0:80 0:40>3:1008 0:47>3:5053
+Object 3:5053 3:"TaskControlStateMachine" = ~ 0 0 0 0:37>0:78 0:40>3:1025 0:47>3:6148 0:47>3:6150 0:47>3:6152
+Overrides 3:5053 3:5051
+Variable 3:6148 0:"CurrentState" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2760 0:46>3:6149
+Overrides 3:6148 3:6138
+Variable 3:6149 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6149 3:6139
+Variable 3:6150 0:"LastTransition" = ~ 0 0 0:21 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:2767 0:46>3:6151
+Overrides 3:6150 3:6133
+Variable 3:6151 0:"Id" = ~ 0 0 0:17 -1 [] 1 1 0 ~ ~ 0:37>0:78 0:40>0:68
+Overrides 3:6151 3:6134
+Variable 3:6152 3:"LastTransitionReason" = ~ 0 0 0:4 -1 [] 3 3 0 ~ ~ 0:37>0:78 0:40>0:11238 0:46>3:6153 0:46>3:6154
+Overrides 3:6152 3:6135
+Variable 3:6153 0:"EnumValues" = ~ 0 0 0:7594 1 [] 1 1 0 ~ EnumValues:{ 0 "Unknown" = "Caused by an unknown reason" 1 "External" = "Caused by external operation" 2 "Direct" = "Caused by direct operation" 3 "System" = "Caused by system specific behavior" 4 "Error" = "Caused by an error" 5 "Application" = "Caused explicitly by end user program logic" } 0:37>0:78 0:40>0:68
+Overrides 3:6153 3:6136
+Variable 3:6154 0:"ValueAsText" = ~ 0 0 0:21 -1 [] 1 1 0 ~ LocalizedText:~:"Invalid" 0:37>0:78 0:40>0:68
+Overrides 3:6154 3:6137
+Object 3:5057 3:"TaskModules" = ~ 0 0 0 0:37>0:80 0:40>0:61 0:35>3:5058
+Object 3:5058 3:"<TaskModule>" = ~ 0 0 0 0:40>3:1016 0:37>0:11508 0:46>3:6169
+Variable 3:6169 3:"Name" = ~ 0 0 0:12 -1 [] 3 3 0 ~ ~ 0:40>0:68 0:37>0:78
+Overrides 3:6169 3:6054
+ObjectType 3:18175 3:"UserType" = "The UserType ObjectType describes information of the registered user groups within the control system." 0 0 0 0:45<0:58 0:46>3:18176 0:46>3:18177
+Variable 3:18176 3:"Level" = "Provides information about the access rights and determines what can be viewed, updated, or deleted by a user" 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:78
+Variable 3:18177 3:"Name" = "The name for the current user within the control system." 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:40>0:68 0:37>0:80
+Object 3:15011 3:"http://opcfoundation.org/UA/Robotics/" = ~ 0 0 0 0:47<0:11715 0:40>0:11616
+Variable 3:15585 0:"DefaultAccessRestrictions" = ~ 0 0 0:95 -1 [] 1 1 0 ~ ~ 0:46<3:15011 0:40>0:68
+Access 3:15585 ~ 0:15704=98 0:15644=1
+Variable 3:15583 0:"DefaultRolePermissions" = ~ 0 0 0:96 1 [] 1 1 0 ~ ~ 0:46<3:15011 0:40>0:68
+Access 3:15583 ~ 0:15704=98 0:15644=1
+Variable 3:15584 0:"DefaultUserRolePermissions" = ~ 0 0 0:96 1 [] 1 1 0 ~ ~ 0:46<3:15011 0:40>0:68
+Variable 3:15114 0:"IsNamespaceSubset" = ~ 0 0 0:1 -1 [] 1 1 0 ~ Boolean:0 0:46<3:15011 0:40>0:68
+Variable 3:15091 0:"NamespacePublicationDate" = ~ 0 0 0:13 -1 [] 1 1 0 ~ DateTime:"2025-09-08T00:00:00Z" 0:46<3:15011 0:40>0:68
+Variable 3:15034 0:"NamespaceUri" = ~ 0 0 0:12 -1 [] 1 1 0 ~ String:"http://opcfoundation.org/UA/Robotics/" 0:46<3:15011 0:40>0:68
+Variable 3:15064 0:"NamespaceVersion" = ~ 0 0 0:12 -1 [] 1 1 0 ~ String:"1.02" 0:46<3:15011 0:40>0:68
+Variable 3:15145 0:"StaticNodeIdTypes" = ~ 0 0 0:256 1 [0] 1 1 0 ~ Array:6 { Int32:0 } 0:46<3:15011 0:40>0:68
+Variable 3:15173 0:"StaticNumericNodeIdRange" = ~ 0 0 0:291 1 [0] 1 1 0 ~ ~ 0:46<3:15011 0:40>0:68
+Variable 3:15209 0:"StaticStringNodeIdPattern" = ~ 0 0 0:12 -1 [] 1 1 0 ~ ~ 0:46<3:15011 0:40>0:68
 "#)),
 };

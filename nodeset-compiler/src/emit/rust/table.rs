@@ -12,13 +12,15 @@
 //! quoted with `"`, `\`, line breaks and control characters escaped; floats are printed the way Rust parses
 //! them back to the same value.
 
+mod values;
+
 use super::{lit, Gen};
 use crate::diag::{Code, Diagnostic};
-use crate::model::{ids, Argument, DataTypeKind, EnumValue, NodeIx, StructureKind};
-use crate::nodeid::{Identifier, NodeId};
+use crate::model::{DataTypeKind, Model, NodeIx, StructureKind};
+use crate::nodeid::Identifier;
 use crate::raw::NodeClass;
-use crate::value::{BuiltinType, Structure, Variant};
 use crate::write::OutFile;
+use values::{item_text, Item, Layout};
 use proc_macro2::Literal;
 use quote::quote;
 use std::collections::BTreeSet;
@@ -209,14 +211,36 @@ impl Gen<'_> {
                 used.insert(model.node(role).id.ns);
             }
         }
+        // Values, laid out once: the namespaces of the NodeIds in them are the table's too.
+        let layout = Layout { model };
+        let mut values: Vec<Option<Item>> = Vec::with_capacity(mine.len());
+        for &ix in &mine {
+            let n = model.node(ix);
+            if !matches!(n.class, NodeClass::Variable | NodeClass::VariableType) {
+                values.push(None);
+                continue;
+            }
+            let item = match model.value(ix) {
+                None => None,
+                Some(decoded) => match decoded.and_then(|v| layout.node_value(v)) {
+                    Ok(item) => item,
+                    Err(why) => {
+                        self.diags.push(unserved_value(model, ix, &why));
+                        None
+                    }
+                },
+            };
+            if let Some(item) = &item {
+                item.namespaces(model, &mut used);
+            }
+            values.push(item);
+        }
         used.remove(&0);
         let locals: Vec<u16> = std::iter::once(0).chain(used.iter().copied()).collect();
         let local = |g: u16| locals.iter().position(|&l| l == g).unwrap_or(0) as u16;
 
         let mut rows = String::with_capacity(mine.len() * 160);
-        let mut dropped_values = 0usize;
-        let mut value = String::new();
-        for &ix in &mine {
+        for (&ix, value) in mine.iter().zip(&values) {
             let n = model.node(ix);
             let out = &mut rows;
             let id_of = |out: &mut String, ix: NodeIx| {
@@ -247,12 +271,6 @@ impl Gen<'_> {
                 }
                 NodeClass::ObjectType => flag(out, n.is_abstract()),
                 NodeClass::Variable | NodeClass::VariableType => {
-                    value.clear();
-                    if !self.value_text(&mut value, ix, &local) {
-                        dropped_values += 1;
-                        value.clear();
-                        value.push('~');
-                    }
                     match n.attrs.data_type {
                         Some(dt) => id_of(out, dt),
                         None => out.push_str("0:24"),
@@ -275,7 +293,10 @@ impl Gen<'_> {
                         flag(out, n.is_abstract());
                     }
                     out.push(' ');
-                    out.push_str(&value);
+                    match value {
+                        Some(item) => item_text(model, out, item, &local),
+                        None => out.push('~'),
+                    }
                 }
                 NodeClass::Method => {
                     let e = n.attrs.executable.unwrap_or(true);
@@ -337,15 +358,6 @@ impl Gen<'_> {
                 out.push('\n');
             }
         }
-        if dropped_values > 0 {
-            self.diags.push(
-                Diagnostic::new(
-                    Code::UnsupportedFeature,
-                    format!("{dropped_values} value(s) of `{}` are structures the generator cannot build yet; those variables start without a value", self.uri()),
-                )
-                .help("Argument and EnumValueType values are supported; other ExtensionObject values are not yet"),
-            );
-        }
         let m = model.model_of_namespace(self.ns);
         NodeTable {
             namespace_uri: self.uri().to_owned(),
@@ -402,163 +414,6 @@ impl Gen<'_> {
             _ => out.push('~'),
         }
     }
-
-    /// Appends the table value of a variable or variable type; false if it cannot be expressed (then the
-    /// caller discards what was appended).
-    fn value_text(&self, out: &mut String, ix: NodeIx, local: &dyn Fn(u16) -> u16) -> bool {
-        match self.model.value(ix) {
-            None => {
-                out.push('~');
-                true
-            }
-            Some(Ok(v)) => self.val_text(out, &v, local),
-            Some(Err(_)) => false,
-        }
-    }
-
-    fn val_text(&self, out: &mut String, v: &Variant, local: &dyn Fn(u16) -> u16) -> bool {
-        let nid = |out: &mut String, id: &NodeId| table_id(out, local(id.ns), &id.id);
-        match v {
-            Variant::Boolean(b) => {
-                out.push_str("Boolean:");
-                flag(out, *b);
-            }
-            Variant::SByte(x) => {
-                let _ = write!(out, "SByte:{x}");
-            }
-            Variant::Byte(x) => {
-                let _ = write!(out, "Byte:{x}");
-            }
-            Variant::Int16(x) => {
-                let _ = write!(out, "Int16:{x}");
-            }
-            Variant::UInt16(x) => {
-                let _ = write!(out, "UInt16:{x}");
-            }
-            Variant::Int32(x) => {
-                let _ = write!(out, "Int32:{x}");
-            }
-            Variant::UInt32(x) => {
-                let _ = write!(out, "UInt32:{x}");
-            }
-            Variant::Int64(x) => {
-                let _ = write!(out, "Int64:{x}");
-            }
-            Variant::UInt64(x) => {
-                let _ = write!(out, "UInt64:{x}");
-            }
-            // Rust prints floats so that they parse back to the same value (`NaN`, `inf` and `-0` included).
-            Variant::Float(x) => {
-                let _ = write!(out, "Float:{x}");
-            }
-            Variant::Double(x) => {
-                let _ = write!(out, "Double:{x}");
-            }
-            Variant::String(s) => {
-                out.push_str("String:");
-                str_lit(out, s);
-            }
-            Variant::DateTime(s) => {
-                out.push_str("DateTime:");
-                str_lit(out, s);
-            }
-            Variant::Guid(g) => {
-                out.push_str("Guid:");
-                hex(out, g);
-            }
-            Variant::ByteString(b) => {
-                out.push_str("ByteString:");
-                hex(out, b);
-            }
-            Variant::NodeId(id) => {
-                out.push_str("NodeId:");
-                nid(out, id);
-            }
-            Variant::ExpandedNodeId(id) => {
-                out.push_str("ExpandedNodeId:");
-                nid(out, id);
-            }
-            Variant::StatusCode(c) => {
-                let _ = write!(out, "StatusCode:{c}");
-            }
-            Variant::QualifiedName(q) => {
-                let _ = write!(out, "QualifiedName:{}:", local(q.ns));
-                str_lit(out, &q.name);
-            }
-            Variant::LocalizedText(t) => {
-                out.push_str("LocalizedText:");
-                opt_str(out, t.locale.as_deref());
-                out.push(':');
-                str_lit(out, &t.text);
-            }
-            Variant::Array(b, items) => {
-                if *b == BuiltinType::ExtensionObject {
-                    return self.struct_array_text(out, items, local);
-                }
-                let _ = write!(out, "Array:{} {{", b.id());
-                for item in items {
-                    out.push(' ');
-                    if !self.val_text(out, item, local) {
-                        return false;
-                    }
-                }
-                out.push_str(" }");
-            }
-            Variant::ExtensionObject(_) => return self.struct_array_text(out, std::slice::from_ref(v), local),
-            Variant::Variant(inner) => return self.val_text(out, inner, local),
-            Variant::XmlElement(_) | Variant::Null => return false,
-        }
-        true
-    }
-
-    /// Arrays of Argument or EnumValueType structures (the ExtensionObject values every nodeset has).
-    fn struct_array_text(&self, out: &mut String, items: &[Variant], local: &dyn Fn(u16) -> u16) -> bool {
-        let structures: Option<Vec<&Structure>> = items
-            .iter()
-            .map(|i| match i {
-                Variant::ExtensionObject(eo) => eo.structure(),
-                _ => None,
-            })
-            .collect();
-        let Some(structures) = structures else { return false };
-        let Some(kind) = structures.first().and_then(|s| s.data_type.ns0()) else { return false };
-        if !structures.iter().all(|s| s.data_type.ns0() == Some(kind)) {
-            return false;
-        }
-        match kind {
-            ids::ARGUMENT => {
-                // On failure the caller discards what was written.
-                out.push_str("Arguments:{");
-                for s in &structures {
-                    let Ok(a) = Argument::from_structure(self.model, s) else { return false };
-                    let dt = match a.data_type {
-                        Some(dt) => self.model.node(dt).id.clone(),
-                        None => NodeId::numeric(0, ids::BASE_DATA_TYPE),
-                    };
-                    out.push(' ');
-                    str_lit(out, &a.name);
-                    out.push(' ');
-                    table_id(out, local(dt.ns), &dt.id);
-                    let _ = write!(out, " {} ", a.value_rank);
-                    dims(out, &a.array_dimensions);
-                    out.push(' ');
-                    opt_str(out, a.description.as_deref());
-                }
-                out.push_str(" }");
-                true
-            }
-            ids::ENUM_VALUE_TYPE => {
-                out.push_str("EnumValues:");
-                list(out, &structures, |out, s| {
-                    let v = EnumValue::from_enum_value_type(s, 0);
-                    let dn = v.display_name.as_deref().unwrap_or("");
-                    enum_row(out, v.value, dn, dn, v.description.as_deref());
-                });
-                true
-            }
-            _ => false,
-        }
-    }
 }
 
 /// Appends an enumeration row: `value name display_name description`.
@@ -569,4 +424,37 @@ fn enum_row(out: &mut String, value: i64, name: &str, display_name: &str, descri
     str_or_same(out, display_name, name);
     out.push(' ');
     opt_str(out, description);
+}
+
+/// The warning for a value the table cannot hold: the variable by browse path and NodeId, at its `<Value>`.
+fn unserved_value(model: &Model, ix: NodeIx, why: &str) -> Diagnostic {
+    let n = model.node(ix);
+    let span = model.value_element(ix).map_or(n.span, |v| v.span());
+    Diagnostic::new(
+        Code::UnsupportedFeature,
+        format!(
+            "the value of `{}` ({}) is not served: {why}; the variable starts without a value",
+            browse_path(model, ix),
+            model.display_id(&n.id)
+        ),
+    )
+    .at(span)
+    .help("a structure value is served when its TypeId names the encoding of a structure DataType with a definition and every field decodes")
+}
+
+/// The browse path of a node from its type or top object (`MotorType/Speed/EngineeringUnits`), for messages.
+fn browse_path(model: &Model, ix: NodeIx) -> String {
+    let mut parts = Vec::new();
+    let mut cur = Some(ix);
+    while let Some(c) = cur.filter(|_| parts.len() < 16) {
+        let n = model.node(c);
+        parts.push(n.browse_name.name.as_str());
+        if n.class.is_type() {
+            break;
+        }
+        // Up to the type, or to the object below a folder of the base namespace (Objects).
+        cur = n.parent.filter(|&p| n.id.ns == 0 || model.node(p).id.ns != 0);
+    }
+    parts.reverse();
+    parts.join("/")
 }
