@@ -124,6 +124,7 @@ codes! {
         Some("the feature is left out of the generated code");
     Ns0Named = "NS0303", Error, "the base namespace is named for Rust, which async-opcua provides",
         Some("the base namespace is not generated: generated code uses async-opcua's, as when its file is only in --models");
+    MappedNeedsGenerated = "NS0304", Error, "a namespace mapped to existing code requires a namespace this run generates", NO;
     // Verifying a live server against its nodesets (`nodeset-compiler verify`).
     MissingMember = "NS0401", Error, "a mandatory member is missing on the server", VERIFY_RECOVERY;
     WrongNodeClass = "NS0402", Error, "a member has another NodeClass than its declaration", VERIFY_RECOVERY;
