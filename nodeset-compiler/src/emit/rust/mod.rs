@@ -795,13 +795,12 @@ impl<'m> Gen<'m> {
             }
         }
         // async-opcua's `ua_encodable` and `impl_encoded_as!` derive the JSON and XML encodings under
-        // `cfg(feature = "json")` and `cfg(feature = "xml")`, tested in the crate that holds this code. A crate
-        // without those features (a user's crate, whose build script generated this) gets no JSON or XML
-        // encodings, which is right while async-opcua's `json` and `xml` are off, and must not get a warning
-        // about features it never declared (README, "Your own crate").
+        // `cfg(feature = "json")` and `cfg(feature = "xml")`, tested in the crate that holds this code: that
+        // crate declares both features, forwarded to async-opcua (README, "Your own crate"). An
+        // `allow(unexpected_cfgs)` here would not help: rustc reports cfgs that come out of an attribute macro
+        // at the crate's level, not the module's.
         let tokens = quote! {
             //! Data types of this namespace, encodable with async-opcua.
-            #![allow(unexpected_cfgs)]
             #(#items)*
 
             static TYPES: std::sync::LazyLock<opcua::types::TypeLoaderInstance> = std::sync::LazyLock::new(|| {
