@@ -13,9 +13,17 @@
 //!         .unwrap_or_else(|e| panic!("{e}"));
 //! }
 //!
-//! // src/lib.rs
-//! // include!(concat!(env!("OUT_DIR"), "/nodesets.rs"));
+//! // src/main.rs
+//! // mod cell { include!(concat!(env!("OUT_DIR"), "/nodesets.rs")); }
+//! // ... nodeset_models::models::register(config) then cell::register(config) ...
 //! ```
+//!
+//! It generates what `nodeset-compiler rust` generates ([`crate::run_rust`], one code path): the models of the
+//! files, and every model they require that is not mapped with [`Builder::extern_namespace`], plus
+//! `register`, which adds the generated namespaces to a server configuration, dependencies first. The mapped
+//! namespaces are registered by the code they are mapped to (for nodeset-models,
+//! `nodeset_models::models::register`), before. A mapped namespace whose own requirements would be generated
+//! here is an error (`NS0304`) that names both models: map the required one too.
 //!
 //! Every file the compiler reads is printed as `cargo:rerun-if-changed`, warnings as `cargo:warning`. The
 //! output file is replaced atomically (written as `.<file>.tmp-<pid>` beside it, then renamed over it); on
@@ -46,7 +54,8 @@ impl Builder {
         Builder { cargo_output: true, rust, ..Builder::default() }
     }
 
-    /// A NodeSet2 file whose models are generated.
+    /// A NodeSet2 file whose models are generated, with every model they require that is not mapped
+    /// ([`Builder::extern_namespace`]): as `nodeset-compiler rust` does, the output compiles on its own.
     pub fn file(mut self, path: impl Into<PathBuf>) -> Self {
         self.files.push(path.into());
         self
@@ -64,7 +73,9 @@ impl Builder {
         self
     }
 
-    /// A namespace generated elsewhere: its module's Rust path. Its types are used, not generated again.
+    /// A namespace generated elsewhere: its module's Rust path. Its types are used, not generated again. The
+    /// models it requires must be mapped too (`NS0304` otherwise); the last segment of the path is reserved, so
+    /// that no generated namespace gets that module name.
     pub fn extern_namespace(mut self, uri: &str, rust_path: &str) -> Self {
         self.rust.extern_paths.insert(uri.into(), rust_path.into());
         self
@@ -148,17 +159,20 @@ impl Builder {
         }
         out.checked(&opts.severities)?;
         let model = &out.model;
-        let cfg = self.rust.config(model)?;
-        let mut gen = crate::emit::rust::generate(model, &cfg);
-        gen.diagnostics.finalize(&opts.severities, &model.sources, "Rust generation failed")?;
+        // The `rust` command's run: every model the files require is generated too unless it is mapped, and
+        // the top `mod.rs` with `register` comes with it; inlined here for `include!`.
+        let run = crate::run_rust(model, &self.rust, &opts.severities)?;
         if self.cargo_output {
-            for d in out.diagnostics.items.iter().chain(&gen.diagnostics.items) {
+            for d in out.diagnostics.items.iter().chain(&run.diagnostics.items) {
                 let first = d.render(&model.sources).lines().next().unwrap_or_default().to_string();
                 let at = d.span.map(|s| model.sources.location(s)).unwrap_or_default();
                 println!("cargo:warning={first} ({at})");
             }
+            for (uri, path) in &run.plan.unused {
+                println!("cargo:warning=extern_namespace(\"{uri}\", \"{path}\") names no loaded model");
+            }
         }
-        let text = crate::emit::rust::inline(&gen.files, &cfg.namespaces);
+        let text = crate::emit::rust::inline(&run.files);
         let name = self.out_file.clone().unwrap_or_else(|| "nodesets.rs".into());
         let path = out_dir.join(&name);
         std::fs::create_dir_all(&out_dir).map_err(|e| Error::Write(format!("cannot create {}: {e}", out_dir.display())))?;

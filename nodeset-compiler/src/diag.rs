@@ -127,6 +127,7 @@ codes! {
         Some("the feature is left out of the generated code");
     Ns0Named = "NS0303", Error, "the base namespace is named for Rust, which async-opcua provides",
         Some("the base namespace is not generated: generated code uses async-opcua's, as when its file is only in --models");
+    MappedNeedsGenerated = "NS0304", Error, "a namespace mapped to existing code requires a namespace this run generates", NO;
     // Instances against their types: the static instances of the files (`nodeset-compiler check`) and a live
     // server's (`nodeset-compiler verify`), by one checker.
     MissingMember = "NS0401", Error, "a mandatory member (or anything in a mandatory placeholder's place) is missing", VERIFY_RECOVERY;

@@ -28,8 +28,9 @@
 //! }
 //! ```
 //!
-//! and in `src/lib.rs`, `include!(concat!(env!("OUT_DIR"), "/nodesets.rs"));`: one module per namespace, named
-//! by the URI's last segment (`my_cell`).
+//! and in `src/main.rs`, `mod my_cell_models { include!(concat!(env!("OUT_DIR"), "/nodesets.rs")); }`: one module
+//! per namespace, named by the URI's last segment (`my_cell`), for the file's models and every model they
+//! require that is not mapped, and `register`, as `nodeset-compiler rust` writes them ([`run_rust`]).
 //!
 //! Each namespace module holds NodeId constants that carry the namespace URI (`ids`), the data types with
 //! their encodings (`types`, and `TypeLoader`), the address space as a static table (`TABLE`) and typed
@@ -39,16 +40,20 @@
 //!
 //! ```rust,no_run
 //! # // Your crate, from step 2; here a namespace of nodeset-models stands in for it.
-//! # mod my_cell_models { pub use nodeset_models::models::drilling_process as my_cell; }
+//! # mod my_cell_models {
+//! #     use nodeset_models::runtime::server::ServerConfig;
+//! #     pub fn register(config: ServerConfig) -> ServerConfig {
+//! #         use nodeset_models::models::drilling_process as my_cell;
+//! #         config.table(&my_cell::TABLE).type_loader(my_cell::TypeLoader)
+//! #     }
+//! # }
 //! use nodeset_models::runtime::server::ServerConfig;
 //!
 //! #[tokio::main]
 //! async fn main() -> Result<(), String> {
-//!     // The namespaces of nodeset-models (DI, IA, Robotics, ...), dependencies first, then yours.
-//!     let config = nodeset_models::models::register(ServerConfig::new("My cell"))
-//!         .table(&my_cell_models::my_cell::TABLE)
-//!         .type_loader(my_cell_models::my_cell::TypeLoader)
-//!         .port(4840);
+//!     // The namespaces of nodeset-models (DI, IA, Robotics, ...), then yours, dependencies first.
+//!     let config = nodeset_models::models::register(ServerConfig::new("My cell"));
+//!     let config = my_cell_models::register(config).port(4840);
 //!     config.build()?.run().await
 //! }
 //! ```
@@ -165,7 +170,8 @@ pub fn compile(inputs: Vec<Input>, opts: &Options) -> Compiled {
 }
 
 /// How the Rust back end is configured by a front door: module names, namespaces generated elsewhere, the
-/// runtime's path. [`RustOptions::config`] turns it into the emitter's [`emit::rust::RustConfig`] for a model.
+/// runtime's path. [`run_rust`] plans a run with it and [`RustOptions::config_of`] turns it into the emitter's
+/// [`emit::rust::RustConfig`].
 #[derive(Clone, Debug)]
 pub struct RustOptions {
     /// Module names by namespace URI (default: the rule of [`emit::plan::Plan::module_names`]).
@@ -190,22 +196,21 @@ impl Default for RustOptions {
 }
 
 impl RustOptions {
-    /// The emitter's configuration for `model`: one module for each model of a file the user named, named by
-    /// [`emit::plan::Plan::module_names`] (so two URIs that end alike get two modules).
-    pub fn config(&self, model: &model::Model) -> Result<emit::rust::RustConfig, Error> {
-        let named: Vec<String> =
-            model.models.iter().filter(|m| model.sources.get(m.file).named).map(|m| m.uri.clone()).collect();
-        self.config_of(&named)
-    }
-
     /// The emitter's configuration for the namespaces `uris`, generated in this order (the order in which
-    /// `mod.rs` registers them, [`generate_rust`]), each module named by [`emit::plan::Plan::module_names`].
+    /// `mod.rs` registers them, [`generate_rust`]), each module named by [`emit::plan::Plan::module_names_beside`]
+    /// with the names of the mapped namespaces' modules (the last segment of each extern path) reserved.
     /// [`Error::Config`] when a path is not a Rust path ([`RustOptions::paths`]).
     pub fn config_of(&self, uris: &[String]) -> Result<emit::rust::RustConfig, Error> {
         self.check_modules()?;
         let (extern_paths, runtime_path) = self.paths()?;
         let plan = emit::plan::Plan { generated: uris.to_vec(), ..emit::plan::Plan::default() };
-        let modules = plan.module_names(&self.modules);
+        let reserved: Vec<String> = self
+            .extern_paths
+            .values()
+            .filter_map(|p| p.rsplit("::").next())
+            .map(|s| s.trim().to_string())
+            .collect();
+        let modules = plan.module_names_beside(&self.modules, &reserved);
         let namespaces =
             uris.iter().map(|u| emit::rust::RustNamespace { uri: u.clone(), module: modules[u].clone() }).collect();
         Ok(emit::rust::RustConfig { namespaces, extern_paths, runtime_path, command: self.command.clone() })
@@ -272,12 +277,22 @@ pub fn generate_rust(
     earlier: diag::Diagnostics,
     severities: &Severities,
 ) -> Result<(Vec<write::OutFile>, String), Error> {
+    generate_rust_tree(model, cfg, earlier, severities).map(|(files, rendered, _)| (files, rendered))
+}
+
+/// [`generate_rust`], with the warnings that remain also as items.
+fn generate_rust_tree(
+    model: &model::Model,
+    cfg: &emit::rust::RustConfig,
+    earlier: diag::Diagnostics,
+    severities: &Severities,
+) -> Result<(Vec<write::OutFile>, String, Diagnostics), Error> {
     let mut gen = emit::rust::generate(model, cfg);
     gen.diagnostics.extend(earlier);
     let rendered = gen.diagnostics.finalize(severities, &model.sources, "Rust generation failed")?;
     let mut files = gen.files;
     files.extend(emit::rust::top_files(cfg));
-    Ok((files, rendered))
+    Ok((files, rendered, gen.diagnostics))
 }
 
 /// Generates Modelica for `model` and finalises the emitter's diagnostics, like [`generate_rust`].
@@ -304,6 +319,8 @@ pub struct RustRun {
     pub files: Vec<write::OutFile>,
     /// The warnings of planning and generation, rendered.
     pub warnings: String,
+    /// The same warnings, one item each (a build script prints each as a `cargo:warning`).
+    pub diagnostics: diag::Diagnostics,
 }
 
 /// The `rust` command's complete run over `model`: every loaded model that `rust` does not map
@@ -313,12 +330,13 @@ pub struct RustRun {
 pub fn run_rust(model: &model::Model, rust: &RustOptions, severities: &Severities) -> Result<RustRun, Error> {
     const STAGE: &str = "Rust generation failed";
     let (plan, mut planning) = emit::plan::plan(model, &rust.extern_paths, true);
-    // A refused plan (NS0303 not demoted) stops before anything is generated.
+    planning.extend(emit::plan::mapped_requirements(model, &plan));
+    // A refused plan (NS0303, NS0304) stops before anything is generated.
     planning.finalize(severities, &model.sources, STAGE)?;
     let cfg = rust.config_of(&plan.generated)?;
     let modules = cfg.namespaces.iter().map(|n| (n.uri.clone(), n.module.clone())).collect();
-    let (files, warnings) = generate_rust(model, &cfg, planning, severities)?;
-    Ok(RustRun { plan, modules, files, warnings })
+    let (files, warnings, diagnostics) = generate_rust_tree(model, &cfg, planning, severities)?;
+    Ok(RustRun { plan, modules, files, warnings, diagnostics })
 }
 
 /// One complete run of the `modelica` command: the plan, the files and the rendered warnings.

@@ -317,7 +317,7 @@ fn check_file(file: &PathBuf, opts: &Options) -> Result<(usize, usize), String> 
     let (mut tables, mut rows) = (0, 0);
     for ns_cfg in &namespaces {
         let Some(ns) = model.namespaces.iter().position(|u| *u == ns_cfg.uri).map(|i| i as u16) else { continue };
-        let path = PathBuf::from(&ns_cfg.module).join("nodes.rs");
+        let path = nodeset_compiler::emit::rust::module_dir(&ns_cfg.module).join("nodes.rs");
         let nodes = generated.files.iter().find(|f| f.path == path).ok_or(format!("no {}", path.display()))?;
         let t = parse_table(&nodes.contents).map_err(|e| format!("{}: {e}", path.display()))?;
         if t.namespaces.get(t.own as usize) != Some(&ns_cfg.uri) {

@@ -256,3 +256,65 @@ fn generated_code_is_in_prettyplease_layout() {
     }
     assert!(checked >= 24, "only {checked} generated files found under {}", models.display());
 }
+
+/// The build.rs front door generates what the `rust` command generates (one run, `run_rust`): the vendor
+/// Robotics model of `tests/user-crate` with the vendor Device model it requires (not named, found in the
+/// model folder), and the same `register`; the OPC Foundation's namespaces mapped to nodeset-models are not
+/// generated, and the vendor's `.../Robotics/` does not take the mapped Robotics' module name. Mapping Robotics
+/// without the DI and IA it requires is NS0304, naming the models and the fix.
+#[test]
+fn the_builder_generates_what_the_command_line_generates() {
+    use nodeset_compiler::load::Input;
+    use nodeset_compiler::{compile, run_rust, Options, RustOptions};
+    let dir = root().join("tests/user-crate/nodesets");
+    let file = dir.join("Example.VendorRobotics.NodeSet2.xml");
+    let externs = [
+        ("http://opcfoundation.org/UA/DI/", "nodeset_models::models::di"),
+        ("http://opcfoundation.org/UA/IA/", "nodeset_models::models::ia"),
+        ("http://opcfoundation.org/UA/Robotics/", "nodeset_models::models::robotics"),
+    ];
+    let out = std::env::temp_dir().join(format!("nodeset-builder-cli-{}", std::process::id()));
+    let builder = |externs: &[(&str, &str)]| {
+        externs
+            .iter()
+            .fold(Builder::new().cargo_output(false).models_dir(&dir).models_dir(vendor()).out_dir(&out).file(&file), |b, (u, p)| {
+                b.extern_namespace(u, p)
+            })
+    };
+    let path = builder(&externs).generate().unwrap_or_else(|e| panic!("{e}"));
+    let text = std::fs::read_to_string(&path).expect("generated file");
+    for expected in ["pub mod device {", "pub mod ua_robotics {", "pub fn register(", ".table(&device::TABLE)", ".type_loader(ua_robotics::TypeLoader)"] {
+        assert!(text.contains(expected), "the Builder's output lacks `{expected}`");
+    }
+    for unexpected in ["pub mod robotics {", "pub mod di {"] {
+        assert!(!text.contains(unexpected), "the Builder's output generates a mapped namespace: `{unexpected}`");
+    }
+    // The command's run over the same input, inlined, is the same text.
+    let opts = Options { model_dirs: vec![dir.clone(), vendor()], ..Options::default() };
+    let compiled = compile(vec![Input::Path(file.clone())], &opts);
+    assert!(compiled.ok(), "{}", compiled.render_diagnostics());
+    let rust = RustOptions {
+        extern_paths: externs.iter().map(|(u, p)| (u.to_string(), p.to_string())).collect(),
+        command: "cargo build (build.rs)".into(),
+        ..RustOptions::default()
+    };
+    let run = run_rust(&compiled.model, &rust, &opts.severities).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(text, nodeset_compiler::emit::rust::inline(&run.files), "the Builder's output is not the command's");
+    // Robotics mapped, DI and IA (which the mapped Robotics requires) not: refused, nothing written.
+    let err = builder(&externs[2..]).out_file("refused.rs").generate().expect_err("a mapped model's requirement generated here is refused");
+    let rendered = err.diagnostics().replace(&root().display().to_string(), "<root>");
+    assert!(rendered.contains("error[NS0304]"), "{rendered}");
+    assert!(rendered.contains("`http://opcfoundation.org/UA/Robotics/` is mapped to `nodeset_models::models::robotics`, but the model it requires, `http://opcfoundation.org/UA/DI/`"), "{rendered}");
+    assert!(rendered.contains(".extern_namespace(\"http://opcfoundation.org/UA/DI/\", PATH)"), "{rendered}");
+    assert!(!out.join("refused.rs").exists());
+    // Nothing mapped: every required model is generated, as the command does.
+    let path = builder(&[]).out_file("all.rs").generate().unwrap_or_else(|e| panic!("{e}"));
+    let all = std::fs::read_to_string(&path).expect("generated file");
+    for expected in ["pub mod di {", "pub mod ia {", "pub mod device {"] {
+        assert!(all.contains(expected), "with nothing mapped, the Builder's output lacks `{expected}`");
+    }
+    // The two Robotics models (the OPC Foundation's and the vendor's) take their URIs' segments until they differ.
+    let robotics: Vec<&str> = all.lines().filter(|l| l.starts_with("pub mod ") && l.ends_with("_robotics {")).collect();
+    assert_eq!(robotics.len(), 2, "{robotics:?}");
+    let _ = std::fs::remove_dir_all(&out);
+}

@@ -20,6 +20,7 @@ mod one_at_a_time;
 mod registry;
 mod soak;
 mod test;
+mod user_crate;
 mod util;
 mod venv;
 mod node_peer;
@@ -62,6 +63,8 @@ enum Command {
     Soak(soak::Args),
     /// Everything a fresh machine needs (pinned nodesets, Python test peers), then every test.
     Test(test::Args),
+    /// Build the user crate of README.md (`tests/user-crate`) outside the workspace, start it and connect.
+    UserCrate(user_crate::Args),
     /// Create or update the Python venv `.venv` with the test peers of `tests/requirements.txt`.
     Venv(venv::Args),
     /// Install the node-opcua test peer of `tests/node-peer` (npm ci from its pinned package-lock.json).
@@ -81,6 +84,7 @@ fn main() -> ExitCode {
         Command::Load(args) => load::run(args),
         Command::Soak(args) => soak::run(args),
         Command::Test(args) => test::run(args),
+        Command::UserCrate(args) => user_crate::run(args),
         Command::Venv(args) => venv::run(args),
         Command::NodePeer(args) => node_peer::run(args),
     };

@@ -3,7 +3,8 @@
 //! 1. The pinned companion specs (`fetch-nodesets`, a no-op when they are present and verified).
 //! 2. The Python venv with the test peers (`.venv`, from `tests/requirements.txt`) and the node-opcua peer
 //!    (`tests/node-peer`, `cargo xtask node-peer`).
-//! 3. `cargo test --workspace --locked`, whose summary lines CI reads.
+//! 3. `cargo test --workspace --locked`, whose summary lines CI reads; then `cargo xtask user-crate`: the
+//!    README's user crate (`tests/user-crate`, not a workspace member) built, started and connected to.
 //! 4. `cargo xtask corpus`: Rust for every resolvable ua-nodeset file, compiled; `cargo xtask registry`: every
 //!    file of the pinned registry package through check, Rust (compiled) and Modelica (rumoca and the structural checks).
 //! 5. `cargo xtask load --seconds 20`: the robot example under 50 subscribed client sessions and a writer.
@@ -41,6 +42,8 @@ pub fn run(args: Args) -> Result<(), String> {
     if !status.success() {
         return Err(format!("cargo test failed ({status})"));
     }
+    // The user crate of README.md, outside the workspace: built (in the same target folder), run, connected.
+    crate::user_crate::run(crate::user_crate::Args::default())?;
     // The whole corpus as Rust, compiled: too long for a #[test] among others, so it runs after them.
     crate::corpus::run(crate::corpus::Args::default())?;
     // The registry package's 38 files, each as a user names it: resolved, as Rust compiled, as Modelica

@@ -52,6 +52,32 @@ pub fn plan(model: &Model, mapped: &BTreeMap<String, String>, base_is_external: 
     (plan, diags)
 }
 
+/// The mapped namespaces of `plan` that require a namespace `plan` generates (`NS0304`). The existing code of
+/// a mapped namespace was generated against its own copy of what it requires: generating that namespace again
+/// here would give the user's crate two copies of it (two sets of types, two node tables for one URI). The
+/// diagnostic names both models and says to map the required one too.
+pub fn mapped_requirements(model: &Model, plan: &Plan) -> Diagnostics {
+    let mut diags = Diagnostics::new();
+    for (uri, path) in &plan.mapped {
+        let Some(m) = model.models.iter().find(|m| m.uri == *uri) else { continue };
+        for r in m.required.iter().filter(|r| plan.generated.contains(&r.uri)) {
+            diags.push(
+                Diagnostic::new(
+                    Code::MappedNeedsGenerated,
+                    format!("`{uri}` is mapped to `{path}`, but the model it requires, `{}`, is generated in this run", r.uri),
+                )
+                .at(r.span)
+                .with_span_label("the required model")
+                .help(format!(
+                    "map `{}` to the code `{path}` was generated with too (`.extern_namespace(\"{}\", PATH)` in a build script, `--extern {}=PATH` on the command line), or map neither and generate both",
+                    r.uri, r.uri, r.uri
+                )),
+            );
+        }
+    }
+    diags
+}
+
 impl Plan {
     /// Rust module names of the generated namespaces: as `overrides` (`--module`) gives them, else the URI's
     /// last segment in snake case. URIs whose names would be equal, or would take an override's name, join the
@@ -60,9 +86,18 @@ impl Plan {
     /// that collide in full are numbered in URI order. Neither the order of `generated` nor the order the
     /// files were named in changes a name.
     pub fn module_names(&self, overrides: &BTreeMap<String, String>) -> BTreeMap<String, String> {
+        self.module_names_beside(overrides, &[])
+    }
+
+    /// [`Plan::module_names`], with `reserved` names no namespace takes by default (as if an override had
+    /// taken them): the last segments of the paths the mapped namespaces are reached by, so that a vendor
+    /// namespace `.../Robotics/` generated beside a mapping to `nodeset_models::models::robotics` is not named
+    /// `robotics` too (it gets its URI's segments before, `vendor_com_robotics`), and a user crate that uses both
+    /// never reads one name for two namespaces.
+    pub fn module_names_beside(&self, overrides: &BTreeMap<String, String>, reserved: &[String]) -> BTreeMap<String, String> {
         use crate::names::{sanitize, Case, Target};
         let mut out: BTreeMap<String, String> = BTreeMap::new();
-        let mut taken: std::collections::BTreeSet<String> = overrides.values().cloned().collect();
+        let mut taken: std::collections::BTreeSet<String> = overrides.values().cloned().chain(reserved.iter().cloned()).collect();
         let mut pending: std::collections::BTreeSet<&str> = std::collections::BTreeSet::new();
         for u in &self.generated {
             match overrides.get(u) {
@@ -155,5 +190,26 @@ mod tests {
         let same = Plan { generated: vec!["http://a.org/x-y/".into(), "http://a.org/x_y/".into()], ..Plan::default() };
         let names = same.module_names(&BTreeMap::new());
         assert_eq!((names["http://a.org/x-y/"].as_str(), names["http://a.org/x_y/"].as_str()), ("http_a_org_x_y", "http_a_org_x_y_2"));
+    }
+
+    /// A vendor namespace whose URI ends like a mapped one (`.../Robotics/` beside a mapping of the OPC
+    /// Foundation's Robotics to `nodeset_models::models::robotics`) does not take the mapped module's name: the
+    /// name is reserved, so it takes its URI's segment before (`ua_robotics`). An override may still use it.
+    #[test]
+    fn names_of_mapped_modules_are_reserved() {
+        let plan = Plan { generated: vec!["http://vendor.example.com/UA/Robotics/".into(), "http://vendor.example.com/UA/Device/".into()], ..Plan::default() };
+        let free = plan.module_names(&BTreeMap::new());
+        assert_eq!(free["http://vendor.example.com/UA/Robotics/"], "robotics");
+        let names = plan.module_names_beside(&BTreeMap::new(), &["robotics".to_string(), "di".to_string()]);
+        assert_eq!(names["http://vendor.example.com/UA/Robotics/"], "ua_robotics");
+        assert_eq!(names["http://vendor.example.com/UA/Device/"], "device");
+        let overridden: BTreeMap<String, String> = [("http://vendor.example.com/UA/Robotics/".to_string(), "robotics".to_string())].into_iter().collect();
+        assert_eq!(plan.module_names_beside(&overridden, &["robotics".to_string()])["http://vendor.example.com/UA/Robotics/"], "robotics");
+        // Through the front doors' options: the extern path's last segment is what is reserved.
+        let mut rust = crate::RustOptions::default();
+        rust.extern_paths.insert("http://opcfoundation.org/UA/Robotics/".into(), "nodeset_models::models::robotics".into());
+        let cfg = rust.config_of(&plan.generated).unwrap();
+        let got: Vec<&str> = cfg.namespaces.iter().map(|n| n.module.as_str()).collect();
+        assert_eq!(got, ["ua_robotics", "device"]);
     }
 }

@@ -17,3 +17,9 @@ pub mod recovered {
 pub mod name_collision_alone {
     include!(concat!(env!("OUT_DIR"), "/name_collision_alone.rs"));
 }
+
+/// The keyword fixture (tests/rust-fixtures/keyword) as the `rust` command writes it: a folder per namespace,
+/// one of them the module `r#struct` in the folder `struct/`.
+pub mod keyword {
+    include!(concat!(env!("OUT_DIR"), "/keyword_tree.rs"));
+}

@@ -25,7 +25,6 @@ use proc_macro2::Literal;
 use quote::quote;
 use std::collections::BTreeSet;
 use std::fmt::Write as _;
-use std::path::PathBuf;
 
 /// Appends a string in the packed format: quoted, with `"`, `\`, line breaks, tabs and other control
 /// characters escaped (so a row stays on one line and the Rust raw string around the text stays valid).
@@ -185,7 +184,7 @@ impl Gen<'_> {
              /// first use).\n",
         );
         text.push_str(&table_text);
-        OutFile { path: PathBuf::from(&self.module).join("nodes.rs"), contents: format!("{}{text}", self.header("Address space")) }
+        OutFile { path: super::module_dir(&self.module).join("nodes.rs"), contents: format!("{}{text}", self.header("Address space")) }
     }
 
     /// The node table of the namespace as data: what `nodes.rs` holds, for a server built in memory.
