@@ -53,6 +53,7 @@ const CASES: &[&str] = &[
     "two_namespaces",
     "union",
     "variable_type",
+    "vendor_robot",
 ];
 
 fn python() -> PathBuf {
@@ -141,6 +142,7 @@ snapshots!(
     two_namespaces,
     union,
     variable_type,
+    vendor_robot,
 );
 
 #[test]
