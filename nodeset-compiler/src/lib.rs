@@ -377,3 +377,18 @@ fn finish(model: model::Model, mut diags: Diagnostics, opts: &Options) -> Compil
     diags.sort(&model.sources);
     Compiled { model, diagnostics: diags }
 }
+
+#[cfg(test)]
+mod tests {
+    /// Through the front doors' options, the last segment of each extern path is a reserved module name: a
+    /// vendor `.../Robotics/` beside a mapping of the OPC Foundation's Robotics takes `ua_robotics`.
+    #[test]
+    fn extern_paths_reserve_their_module_names() {
+        let generated = vec!["http://vendor.example.com/UA/Robotics/".to_string(), "http://vendor.example.com/UA/Device/".to_string()];
+        let mut rust = crate::RustOptions::default();
+        rust.extern_paths.insert("http://opcfoundation.org/UA/Robotics/".into(), "nodeset_models::models::robotics".into());
+        let cfg = rust.config_of(&generated).unwrap();
+        let got: Vec<&str> = cfg.namespaces.iter().map(|n| n.module.as_str()).collect();
+        assert_eq!(got, ["ua_robotics", "device"]);
+    }
+}

@@ -205,11 +205,5 @@ mod tests {
         assert_eq!(names["http://vendor.example.com/UA/Device/"], "device");
         let overridden: BTreeMap<String, String> = [("http://vendor.example.com/UA/Robotics/".to_string(), "robotics".to_string())].into_iter().collect();
         assert_eq!(plan.module_names_beside(&overridden, &["robotics".to_string()])["http://vendor.example.com/UA/Robotics/"], "robotics");
-        // Through the front doors' options: the extern path's last segment is what is reserved.
-        let mut rust = crate::RustOptions::default();
-        rust.extern_paths.insert("http://opcfoundation.org/UA/Robotics/".into(), "nodeset_models::models::robotics".into());
-        let cfg = rust.config_of(&plan.generated).unwrap();
-        let got: Vec<&str> = cfg.namespaces.iter().map(|n| n.module.as_str()).collect();
-        assert_eq!(got, ["ua_robotics", "device"]);
     }
 }
