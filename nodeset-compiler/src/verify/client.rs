@@ -216,18 +216,7 @@ pub async fn read_all_batched(session: &Arc<Session>, max_batch: Option<usize>) 
 
     // Breadth first from the Objects folder, one level per batch of Browse requests.
     let objects = Snapshot::objects_folder();
-    snap.nodes.insert(
-        objects.clone(),
-        RemoteNode {
-            id: objects.clone(),
-            class: NodeClass::Object,
-            browse_name: QualifiedName { ns: 0, name: "Objects".into() },
-            references: Vec::new(),
-            data_type: None,
-            value_rank: None,
-            value: None,
-        },
-    );
+    snap.nodes.insert(objects.clone(), RemoteNode::empty_objects_folder());
     let mut level = vec![objects];
     while !level.is_empty() {
         let mut next: Vec<NodeId> = Vec::new();

@@ -15,7 +15,7 @@ use super::check::{self, Report};
 use super::{RemoteNode, RemoteReference, RemoteValue, Snapshot};
 use crate::diag::{Code, Diagnostics, Label, Severities};
 use crate::model::{ids, Model, NodeIx};
-use crate::nodeid::{NodeId, QualifiedName};
+use crate::nodeid::NodeId;
 use crate::raw::NodeClass;
 use crate::value::{Content, Variant};
 use crate::{Compiled, Options};
@@ -50,15 +50,7 @@ pub fn snapshot(model: &Model) -> Snapshot {
         let ix = NodeIx(i as u32);
         snap.nodes.insert(model.node(ix).id.clone(), remote(ix));
     }
-    let folder = model.lookup(&objects).map(remote).unwrap_or_else(|| RemoteNode {
-        id: objects.clone(),
-        class: NodeClass::Object,
-        browse_name: QualifiedName { ns: 0, name: "Objects".into() },
-        references: Vec::new(),
-        data_type: None,
-        value_rank: None,
-        value: None,
-    });
+    let folder = model.lookup(&objects).map(remote).unwrap_or_else(RemoteNode::empty_objects_folder);
     snap.nodes.insert(objects, folder);
     snap
 }

@@ -100,3 +100,19 @@ impl Snapshot {
         NodeId::numeric(0, 85)
     }
 }
+
+impl RemoteNode {
+    /// The Objects folder with no references yet: where a snapshot's walk starts when nothing else
+    /// describes the folder.
+    pub fn empty_objects_folder() -> RemoteNode {
+        RemoteNode {
+            id: Snapshot::objects_folder(),
+            class: NodeClass::Object,
+            browse_name: QualifiedName { ns: 0, name: "Objects".into() },
+            references: Vec::new(),
+            data_type: None,
+            value_rank: None,
+            value: None,
+        }
+    }
+}
