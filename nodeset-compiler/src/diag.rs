@@ -88,6 +88,9 @@ codes! {
     UnknownNamespaceUri = "NS0112", Error, "a namespace URI names no loaded model", NO;
     AliasByBrowseName = "NS0113", Warning, "an undeclared alias was resolved by the BrowseName of a base type",
         Some("the base DataType or ReferenceType of that BrowseName is used");
+    AmbiguousModel = "NS0114", Error, "different files of the model folders define one model in the same version and publication date", NO;
+    ModelFilesDiffer = "NS0115", Warning, "different files of the model folders define one model in the same version and publication date, one holding every node of the others",
+        Some("the file holding every node of the others is used");
     // Resolving one model of all files.
     DuplicateNodeId = "NS0201", Error, "a NodeId is defined twice", Some("the first definition is kept and the second is ignored");
     DanglingReference = "NS0202", Error, "a reference points to a node that does not exist", Some("the reference is dropped");
