@@ -14,7 +14,8 @@ pub enum Severity {
     Error,
     /// Reported; the stage goes on (with the code's recovery).
     Warning,
-    /// Information only; no code has it as its default severity.
+    /// Information only: printed, counted neither as an error nor as a warning. NS0115 (a superset file of
+    /// a model chosen over its subset, a safe choice the user may want to know about) is one by default.
     Note,
 }
 
@@ -89,6 +90,9 @@ codes! {
     UnknownNamespaceUri = "NS0112", Error, "a namespace URI names no loaded model", NO;
     AliasByBrowseName = "NS0113", Warning, "an undeclared alias was resolved by the BrowseName of a base type",
         Some("the base DataType or ReferenceType of that BrowseName is used");
+    AmbiguousModel = "NS0114", Error, "different files of the model folders define one model in the same version and publication date", NO;
+    ModelFilesDiffer = "NS0115", Note, "different files of the model folders define one model in the same version and publication date, one holding every node of the others",
+        Some("the file holding every node of the others is used");
     // Resolving one model of all files.
     DuplicateNodeId = "NS0201", Error, "a NodeId is defined twice", Some("the first definition is kept and the second is ignored");
     DanglingReference = "NS0202", Error, "a reference points to a node that does not exist", Some("the reference is dropped");

@@ -1,10 +1,14 @@
 //! The loader: from files and model folders to an ordered set of parsed files with one namespace table.
 //!
 //! The user names files; the models they require are taken from among them or found in model folders
-//! (searched recursively, indexed by ModelUri from a cheap scan of each file's `<Models>` header). Of several
-//! versions of one model, the newest that satisfies the requirement wins. Files are then ordered so that a
-//! model comes after everything it requires (ties broken by ModelUri, so input order never matters), and
-//! every file's namespace indices are mapped onto the global table.
+//! (searched recursively, indexed by ModelUri from a cheap scan of each file's `<Models>` header, see
+//! `folders`). A named file always provides its models, even when it also lies in a folder. Of several
+//! versions of one model in the folders, the newest that satisfies the requirement wins (then the newest
+//! publication date, the shorter path, the path); files that tie on version and date are one model if their
+//! content is the same, and are otherwise reported (`duplicates`). Each file is read at most once, which is
+//! what bounds the work (see the termination argument in [`load`]). Files are then ordered so that a model
+//! comes after everything it requires (ties broken by ModelUri, so input order never matters), and every
+//! file's namespace indices are mapped onto the global table.
 
 use crate::fxhash::FxHashMap;
 use crate::diag::{Code, Diagnostic, Diagnostics};
@@ -15,6 +19,12 @@ use crate::source::{FileId, SourceFile, SourceMap, Span, Spanned};
 use std::cmp::Ordering;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::{Path, PathBuf};
+
+mod duplicates;
+mod folders;
+
+pub use folders::{cmp_version, declared_models, find_model_files, models_of_file};
+use folders::{canonical, Candidate, Seen};
 
 /// The URI of the OPC UA base namespace, always namespace index 0.
 pub const NS0_URI: &str = "http://opcfoundation.org/UA/";
@@ -185,24 +195,6 @@ impl Loaded {
     }
 }
 
-/// A file offered by a models folder, known from its header only.
-#[derive(Clone, Debug)]
-struct Candidate {
-    path: PathBuf,
-    models: Vec<(String, Option<String>, Option<String>)>,
-    /// For a file without `<Models>`: the first of its NamespaceUris, the namespace such files (the older
-    /// specifications) define their nodes in.
-    own_namespace: Option<String>,
-}
-
-/// What [`scan_header`] reads of a NodeSet2 file: its declared models (URI, version, publication date)
-/// and, when it declares none, the first of its NamespaceUris.
-#[derive(Debug, PartialEq)]
-struct Header {
-    models: Vec<(String, Option<String>, Option<String>)>,
-    own_namespace: Option<String>,
-}
-
 /// A source of input: a file on disk or text held in memory (tests, fuzzing, build scripts).
 pub enum Input {
     /// A file to read.
@@ -223,11 +215,16 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
     // about each goes into the diagnostics in the order the files were named.
     let mut said: Vec<Diagnostics> = Vec::new();
     let mut texts: Vec<(usize, FileId)> = Vec::new();
+    // Every file read, so that none is read twice (see the termination argument below).
+    let mut seen = Seen::default();
     for input in inputs {
         let mut d = Diagnostics::new();
         let (path, display, bytes) = match input {
             Input::Path(p) => match std::fs::read(&p) {
-                Ok(b) => (p.clone(), p.display().to_string(), b),
+                Ok(b) => {
+                    seen.add_path(canonical(&p));
+                    (p.clone(), p.display().to_string(), b)
+                }
                 Err(e) => {
                     d.push(
                         Diagnostic::new(Code::Io, format!("cannot read {}: {}", p.display(), io_reason(&e)))
@@ -240,6 +237,7 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
             Input::Text { name, text } => (PathBuf::from(&name), name, text.into_bytes()),
         };
         if let Some(id) = add_source(&mut sources, path, display, bytes, true, &mut d) {
+            seen.add_source(id, &sources);
             texts.push((said.len(), id));
         }
         said.push(d);
@@ -295,6 +293,17 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
     }
 
     // Resolve requirements transitively, from the named files and from the models folders.
+    //
+    // Why this loop ends: the queue holds indices of `parsed`, and an index is pushed once, when its file
+    // joins `parsed`: a named file at the start, or a file of the model folders just read. A folder file is
+    // read only if `seen` holds neither its canonical path nor its content, and its path goes into `seen`
+    // before it is parsed (`read_new`, and `duplicates::choose` for the files it reads). The folders hold
+    // finitely many files (`index`, scanned once), so there are at most (named files + folder files) passes,
+    // each over the finitely many requirements of one file; a requirement costs at most one read of each
+    // folder file. Requirements that form cycles, files named and also found in a folder, and copies of a
+    // file under other paths all end at `seen`. (Before `seen`, a named file without <Models> whose first
+    // NamespaceUri it only refers to found itself in the folder as that namespace's file, read itself again,
+    // and so on without end.)
     let mut index: Option<Vec<Candidate>> = None;
     let mut queue: Vec<usize> = (0..parsed.len()).collect();
     let mut checked: BTreeSet<(String, FileId)> = BTreeSet::new();
@@ -324,21 +333,13 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
             if let Some(&fid) = provided.get(&req.uri) {
                 // An implied model has no version to check.
                 if let Some(m) = parsed.iter().find(|s| s.file == fid).and_then(|set| set.models.iter().find(|m| m.uri == req.uri)) {
-                    check_version(&req, m.version.as_deref(), m.publication_date.as_deref(), &sources.get(fid).display, diags);
+                    let requirer = &sources.get(set_file).display;
+                    check_version(&req, requirer, m.version.as_deref(), m.publication_date.as_deref(), &sources.get(fid).display, diags);
                 }
                 continue;
             }
-            let idx = index.get_or_insert_with(|| scan_dirs(&opts.model_dirs));
-            let mut options: Vec<&Candidate> = idx.iter().filter(|c| c.models.iter().any(|m| m.0 == req.uri)).collect();
-            let version_of = |c: &Candidate| c.models.iter().find(|m| m.0 == req.uri).map(|m| (m.1.clone(), m.2.clone())).unwrap_or_default();
-            options.sort_by(|a, b| {
-                let (va, da) = version_of(a);
-                let (vb, db) = version_of(b);
-                cmp_version(vb.as_deref(), va.as_deref())
-                    .then_with(|| db.cmp(&da))
-                    .then_with(|| a.path.as_os_str().len().cmp(&b.path.as_os_str().len()))
-                    .then_with(|| a.path.cmp(&b.path))
-            });
+            let idx = index.get_or_insert_with(|| folders::scan_dirs(&opts.model_dirs));
+            let options = folders::ranked(idx, &req.uri);
             // A file without <Models> (an older specification) that refers to a namespace takes, first, a file
             // of the same kind whose own namespace that is, from its own folder if there is one there: the
             // release it was written against, not the newest model of that URI.
@@ -349,62 +350,46 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
                 idx.iter().filter(|c| c.models.is_empty() && c.own_namespace.as_deref() == Some(req.uri.as_str())).collect()
             };
             same_kind.sort_by_key(|c| (c.path.parent() != requirer_dir.as_deref(), c.path.as_os_str().len(), c.path.clone()));
-            let satisfying = same_kind.first().copied().or_else(|| {
-                options.iter().copied().find(|c| {
-                    let (v, _) = version_of(c);
-                    req.version.is_none() || cmp_version(v.as_deref(), req.version.as_deref()) != Ordering::Less
-                })
-            });
+            let mut older: Option<(&Candidate, Vec<u8>)> = None;
+            for c in same_kind {
+                if let Some(bytes) = read_new(c, &mut seen, &sources, req.span, diags) {
+                    older = Some((c, bytes));
+                    break;
+                }
+            }
+            let satisfies = |c: &Candidate| {
+                req.version.is_none() || cmp_version(c.version_of(&req.uri).0.as_deref(), req.version.as_deref()) != Ordering::Less
+            };
             let requirer = sources.get(set_file).display.clone();
-            match satisfying {
-                Some(c) => {
-                    let path = c.path.clone();
-                    let (v, d) = version_of(c);
-                    check_version(&req, v.as_deref(), d.as_deref(), &path.display().to_string(), diags);
-                    let bytes = match std::fs::read(&path) {
-                        Ok(b) => b,
-                        Err(e) => {
-                            diags.push(Diagnostic::new(Code::Io, format!("cannot read {}: {e}", path.display())).at(req.span));
-                            continue;
+            let loaded: Option<RawNodeSet> = match (older, options.first().copied().filter(|c| satisfies(c))) {
+                (Some((c, bytes)), _) => {
+                    let display = c.path.display().to_string();
+                    read_and_parse(&mut sources, c.path.clone(), display, bytes, false, &opts.limits, diags)
+                }
+                (None, Some(c)) => {
+                    let (v, d) = c.version_of(&req.uri);
+                    check_version(&req, &requirer, v.as_deref(), d.as_deref(), &c.path.display().to_string(), diags);
+                    match duplicates::choose(&req.uri, &options, req.span, &mut sources, &mut seen, &opts.limits, diags) {
+                        Some(pick) => pick.set,
+                        None => {
+                            // A file read before provides its models, so the folder's best file for a model not
+                            // provided is new unless it failed to parse (then nothing is read again).
+                            let Some(bytes) = read_new(c, &mut seen, &sources, req.span, diags) else { continue };
+                            let display = c.path.display().to_string();
+                            read_and_parse(&mut sources, c.path.clone(), display, bytes, false, &opts.limits, diags)
                         }
-                    };
-                    let display = path.display().to_string();
-                    if let Some(set) = read_and_parse(&mut sources, path, display, bytes, false, &opts.limits, diags) {
-                        for m in &set.models {
-                            provided.entry(m.uri.clone()).or_insert(set.file);
-                        }
-                        if set.models.is_empty() {
-                            imply_models(&set, sources.get(set.file).text.as_str(), &mut provided, &mut implied, &mut implied_requires);
-                        }
-                        parsed.push(set);
-                        queue.push(parsed.len() - 1);
-                    } else {
-                        // Do not try this model again for every file that requires it.
-                        provided.insert(req.uri.clone(), FileId(u32::MAX));
                     }
                 }
-                None if !options.is_empty() => {
+                (None, None) if !options.is_empty() => {
+                    // The newest file of that model is too old: said as when a file already read is (whether a
+                    // file was read first depends on the order requirements are met, which must not show).
                     let best = options[0];
-                    let (v, _) = version_of(best);
-                    diags.push(
-                        Diagnostic::new(
-                            Code::ModelTooOld,
-                            format!(
-                                "`{}` requires model `{}` version {}, but only version {} is available",
-                                requirer,
-                                req.uri,
-                                req.version.as_deref().unwrap_or("?"),
-                                v.as_deref().unwrap_or("(none)")
-                            ),
-                        )
-                        .at(req.span)
-                        .with_span_label(format!("requires version {}", req.version.as_deref().unwrap_or("?")))
-                        .note(format!("newest available: {} in {}", v.as_deref().unwrap_or("(no version)"), best.path.display()))
-                        .help("get a newer release of that model (for the companion specs: `cargo xtask fetch-nodesets`), or correct the RequiredModel Version"),
-                    );
+                    let (v, d) = best.version_of(&req.uri);
+                    check_version(&req, &requirer, v.as_deref(), d.as_deref(), &best.path.display().to_string(), diags);
+                    continue;
                 }
-                None => {
-                    if provided.get(&req.uri) == Some(&FileId(u32::MAX)) || (!explicit && req.uri != NS0_URI) {
+                (None, None) => {
+                    if !explicit && req.uri != NS0_URI {
                         // An implied requirement not found: the file's references into that namespace are
                         // reported where they are written.
                         continue;
@@ -430,6 +415,24 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
                             .note(looked)
                             .help("name the file that defines this model, or add the folder holding it with --models DIR"),
                     );
+                    continue;
+                }
+            };
+            match loaded {
+                Some(set) => {
+                    seen.add_source(set.file, &sources);
+                    for m in &set.models {
+                        provided.entry(m.uri.clone()).or_insert(set.file);
+                    }
+                    if set.models.is_empty() {
+                        imply_models(&set, sources.get(set.file).text.as_str(), &mut provided, &mut implied, &mut implied_requires);
+                    }
+                    parsed.push(set);
+                    queue.push(parsed.len() - 1);
+                }
+                // Do not try this model again for every file that requires it.
+                None => {
+                    provided.insert(req.uri.clone(), FileId(u32::MAX));
                 }
             }
         }
@@ -591,6 +594,22 @@ fn read_and_parse(
     set
 }
 
+/// Reads a file of the model folders unless it was read before, under any path or with the same content
+/// (then `None`): what bounds the loader's work. The file counts as read from here on, whatever comes of it.
+fn read_new(c: &Candidate, seen: &mut Seen, sources: &SourceMap, at: Span, diags: &mut Diagnostics) -> Option<Vec<u8>> {
+    if seen.has_path(&c.id) {
+        return None;
+    }
+    seen.add_path(c.id.clone());
+    match std::fs::read(&c.path) {
+        Ok(bytes) => seen.same_as(&bytes, sources).is_none().then_some(bytes),
+        Err(e) => {
+            diags.push(Diagnostic::new(Code::Io, format!("cannot read {}: {}", c.path.display(), io_reason(&e))).at(at));
+            None
+        }
+    }
+}
+
 /// Adds a file to the sources: its text if it is UTF-8 (and returns its id), or else a lossy copy for
 /// showing its lines, with the diagnostic.
 fn add_source(sources: &mut SourceMap, path: PathBuf, display: String, bytes: Vec<u8>, named: bool, diags: &mut Diagnostics) -> Option<FileId> {
@@ -628,17 +647,19 @@ fn displayable(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).replace('\0', "\u{2400}")
 }
 
-fn check_version(req: &RequiredInfo, have: Option<&str>, have_date: Option<&str>, where_: &str, diags: &mut Diagnostics) {
+/// Checks the version (and, for an equal version, the publication date) that `where_` holds against a
+/// requirement of `requirer`.
+fn check_version(req: &RequiredInfo, requirer: &str, have: Option<&str>, have_date: Option<&str>, where_: &str, diags: &mut Diagnostics) {
     let Some(want) = req.version.as_deref() else { return };
     match cmp_version(have, Some(want)) {
         Ordering::Less => diags.push(
             Diagnostic::new(
                 Code::ModelTooOld,
-                format!("model `{}` is required in version {want}, but {where_} holds version {}", req.uri, have.unwrap_or("(none)")),
+                format!("`{requirer}` requires model `{}` version {want}, but {where_} holds version {}", req.uri, have.unwrap_or("(none)")),
             )
             .at(req.span)
             .with_span_label(format!("requires version {want}"))
-            .help("use a newer release of the required model"),
+            .help("get a newer release of that model (for the companion specs: `cargo xtask fetch-nodesets`), or correct the RequiredModel Version"),
         ),
         Ordering::Equal => {
             if let (Some(want_d), Some(have_d)) = (req.publication_date.as_deref(), have_date) {
@@ -663,175 +684,6 @@ fn check_version(req: &RequiredInfo, have: Option<&str>, have_date: Option<&str>
 
 fn date_key(d: &str) -> &str {
     d.get(..10).unwrap_or(d)
-}
-
-/// Compares dotted versions numerically (`1.05.03` > `1.5.2`, `1.04` == `1.4.0`); absent is lowest.
-pub fn cmp_version(a: Option<&str>, b: Option<&str>) -> Ordering {
-    match (a, b) {
-        (None, None) => Ordering::Equal,
-        (None, Some(_)) => Ordering::Less,
-        (Some(_), None) => Ordering::Greater,
-        (Some(a), Some(b)) => {
-            let pa: Vec<&str> = a.trim().split(['.', '-']).collect();
-            let pb: Vec<&str> = b.trim().split(['.', '-']).collect();
-            for i in 0..pa.len().max(pb.len()) {
-                let x = pa.get(i).copied().unwrap_or("0");
-                let y = pb.get(i).copied().unwrap_or("0");
-                let o = match (x.parse::<u64>(), y.parse::<u64>()) {
-                    (Ok(x), Ok(y)) => x.cmp(&y),
-                    _ => x.cmp(y),
-                };
-                if o != Ordering::Equal {
-                    return o;
-                }
-            }
-            Ordering::Equal
-        }
-    }
-}
-
-/// For each of `uris`, the NodeSet2 file under `dirs` that defines that model in its newest version (the
-/// choice the loader makes for a required model without a version); URIs no file defines are left out.
-pub fn find_model_files(dirs: &[PathBuf], uris: &[String]) -> BTreeMap<String, PathBuf> {
-    let index = scan_dirs(dirs);
-    let mut out = BTreeMap::new();
-    for uri in uris {
-        let version_of = |c: &Candidate| c.models.iter().find(|m| m.0 == *uri).map(|m| (m.1.clone(), m.2.clone())).unwrap_or_default();
-        let mut options: Vec<&Candidate> = index.iter().filter(|c| c.models.iter().any(|m| m.0 == *uri)).collect();
-        options.sort_by(|a, b| {
-            let (va, da) = version_of(a);
-            let (vb, db) = version_of(b);
-            cmp_version(vb.as_deref(), va.as_deref())
-                .then_with(|| db.cmp(&da))
-                .then_with(|| a.path.as_os_str().len().cmp(&b.path.as_os_str().len()))
-                .then_with(|| a.path.cmp(&b.path))
-        });
-        if let Some(c) = options.first() {
-            out.insert(uri.clone(), c.path.clone());
-        }
-    }
-    out
-}
-
-/// The models the header of a NodeSet2 file declares (URIs), without parsing the rest; `None` if the file
-/// cannot be read or is not a NodeSet2 file.
-pub fn models_of_file(path: &Path) -> Option<Vec<String>> {
-    declared_models(path).map(|models| models.into_iter().map(|(uri, _, _)| uri).collect())
-}
-
-/// The models the header of a NodeSet2 file declares, each as its ModelUri, Version and PublicationDate, read
-/// as the loader reads them when it looks for required models; `None` as for [`models_of_file`].
-pub fn declared_models(path: &Path) -> Option<Vec<(String, Option<String>, Option<String>)>> {
-    scan_header(path).map(|h| h.models)
-}
-
-/// Lists every NodeSet2 file under the folders with the models its header declares.
-fn scan_dirs(dirs: &[PathBuf]) -> Vec<Candidate> {
-    let mut paths = Vec::new();
-    for d in dirs {
-        walk(d, &mut paths);
-    }
-    paths.sort();
-    paths.dedup();
-    paths
-        .into_iter()
-        .filter_map(|p| scan_header(&p).map(|h| Candidate { path: p, models: h.models, own_namespace: h.own_namespace }))
-        .collect()
-}
-
-fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else { return };
-    for e in entries.flatten() {
-        let p = e.path();
-        let Ok(ft) = e.file_type() else { continue };
-        if ft.is_dir() {
-            walk(&p, out);
-        } else if p.extension().and_then(|x| x.to_str()).is_some_and(|x| x.eq_ignore_ascii_case("xml")) {
-            out.push(p);
-        }
-    }
-}
-
-/// How much of a file [`scan_header`] looks at, at most. Real NodeSet2 files close `<Models>` within the
-/// first few KiB.
-const HEADER_LIMIT: usize = 256 * 1024;
-
-/// Reads the `<Models>` element of a file without parsing the rest (and, for a file that declares no
-/// models within [`HEADER_LIMIT`], its first NamespaceUri).
-///
-/// A models folder is scanned once per compile and may hold hundreds of files, so the file is read in
-/// growing chunks and reading stops as soon as `</Models>` has been seen. The answer is the one the first
-/// [`HEADER_LIMIT`] bytes give: reading stops early only when the bytes read so far already contain
-/// everything the tests below look for (the first `<Models>` and the `</Models>` after it, and
-/// `UANodeSet`), and reading more cannot change where those are first found.
-fn scan_header(path: &Path) -> Option<Header> {
-    use std::io::Read;
-    let mut f = std::fs::File::open(path).ok()?;
-    let mut buf: Vec<u8> = Vec::new();
-    let mut chunk = 16 * 1024;
-    loop {
-        let want = (buf.len() + chunk).min(HEADER_LIMIT);
-        let mut n = buf.len();
-        buf.resize(want, 0);
-        while n < want {
-            let k = f.read(&mut buf[n..]).ok()?;
-            if k == 0 {
-                break;
-            }
-            n += k;
-        }
-        let at_end = n < want || n == HEADER_LIMIT;
-        buf.truncate(n);
-        if at_end || header_complete(&String::from_utf8_lossy(&buf)) {
-            break;
-        }
-        chunk *= 2;
-    }
-    let text = String::from_utf8_lossy(&buf);
-    if !text.contains("UANodeSet") {
-        return None;
-    }
-    let Some(start) = text.find("<Models>") else {
-        return Some(Header { models: Vec::new(), own_namespace: first_namespace_uri(&text) });
-    };
-    let end = text[start..].find("</Models>")? + start + "</Models>".len();
-    let mut reader = quick_xml::Reader::from_str(&text[start..end]);
-    let mut out = Vec::new();
-    loop {
-        match reader.read_event() {
-            Ok(quick_xml::events::Event::Start(e)) | Ok(quick_xml::events::Event::Empty(e)) => {
-                if e.local_name().as_ref() == b"Model" {
-                    let get = |k: &[u8]| {
-                        e.attributes()
-                            .flatten()
-                            .find(|a| a.key.local_name().as_ref() == k)
-                            .and_then(|a| a.unescape_value().ok().map(|v| v.into_owned()))
-                    };
-                    if let Some(uri) = get(b"ModelUri") {
-                        out.push((uri, get(b"Version"), get(b"PublicationDate")));
-                    }
-                }
-            }
-            Ok(quick_xml::events::Event::Eof) | Err(_) => break,
-            _ => {}
-        }
-    }
-    Some(Header { models: out, own_namespace: None })
-}
-
-/// The first `<Uri>` of the `<NamespaceUris>` in a header's text.
-fn first_namespace_uri(text: &str) -> Option<String> {
-    let start = text.find("<NamespaceUris>")?;
-    let end = text[start..].find("</NamespaceUris>")? + start;
-    let from = text[start..end].find("<Uri>")? + start + "<Uri>".len();
-    let to = text[from..end].find("</Uri>")? + from;
-    let uri = quick_xml::escape::unescape(text[from..to].trim()).ok()?.into_owned();
-    (!uri.is_empty()).then_some(uri)
-}
-
-/// Whether a prefix of a file already decides [`scan_header`]'s answer (see there).
-fn header_complete(text: &str) -> bool {
-    text.contains("UANodeSet") && text.find("<Models>").is_some_and(|start| text[start..].contains("</Models>"))
 }
 
 fn topo_order(
@@ -899,11 +751,13 @@ fn topo_order(
     if !rest.is_empty() {
         let mut rest_sorted = rest.clone();
         rest_sorted.sort_by_key(|&i| key(i));
-        // Walk the requirements from the first file until a file repeats: that is the cycle.
+        // Walk the requirements from the first file until a file repeats: that is the cycle. Of several
+        // requirements, the walk follows the first by the same key (not the order files were read in, which
+        // depends on the order they were named).
         let mut path: Vec<usize> = vec![rest_sorted[0]];
         loop {
             let cur = *path.last().expect("path is never empty");
-            let Some(&next) = deps[cur].iter().find(|d| rest.contains(d)) else { break };
+            let Some(next) = deps[cur].iter().copied().filter(|d| rest.contains(d)).min_by_key(|&d| key(d)) else { break };
             if let Some(pos) = path.iter().position(|&p| p == next) {
                 path.drain(..pos);
                 path.push(next);
@@ -1002,108 +856,4 @@ pub fn edit_distance_within(a: &str, b: &str, limit: usize) -> Option<usize> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn versions_compare_numerically() {
-        assert_eq!(cmp_version(Some("1.05.03"), Some("1.5.2")), Ordering::Greater);
-        assert_eq!(cmp_version(Some("1.04"), Some("1.4.0")), Ordering::Equal);
-        assert_eq!(cmp_version(Some("1.02"), Some("1.04.0")), Ordering::Less);
-        assert_eq!(cmp_version(None, Some("1.0")), Ordering::Less);
-        assert_eq!(cmp_version(Some("9.99.99"), Some("1.05")), Ordering::Greater);
-    }
-
-    #[test]
-    fn header_scan_stops_at_models_but_answers_as_the_full_prefix_would() {
-        let dir = std::env::temp_dir().join(format!("nodeset-header-scan-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let model = "<Model ModelUri=\"http://x/\" Version=\"1.0\" PublicationDate=\"2020-01-01\"/>";
-        // A header past the first chunk, one that straddles chunks, one past the limit, and no UANodeSet.
-        let pad = "<!--".to_string() + &"x".repeat(40_000) + "-->";
-        // A file without <Models> answers with its first NamespaceUri (none when it has none).
-        let uris = "<NamespaceUris><Uri>http://old/</Uri><Uri>http://other/</Uri></NamespaceUris>";
-        let x = || vec![("http://x/".to_string(), Some("1.0".to_string()), Some("2020-01-01".to_string()))];
-        let none = |own: Option<&str>| Some(Header { models: Vec::new(), own_namespace: own.map(str::to_string) });
-        let cases = [
-            (format!("<UANodeSet>{pad}<Models>{model}</Models></UANodeSet>"), Some(Header { models: x(), own_namespace: None })),
-            (format!("<UANodeSet><Models>{pad}{model}</Models></UANodeSet>"), Some(Header { models: x(), own_namespace: None })),
-            (format!("<UANodeSet>{}<Models>{model}</Models></UANodeSet>", "x".repeat(HEADER_LIMIT)), none(None)),
-            (format!("<Other><Models>{model}</Models></Other>"), None),
-            (format!("<UANodeSet>{uris}{pad}<UAObject NodeId=\"ns=1;i=1\"/></UANodeSet>"), none(Some("http://old/"))),
-        ];
-        for (i, (text, want)) in cases.iter().enumerate() {
-            let path = dir.join(format!("{i}.xml"));
-            std::fs::write(&path, text).unwrap();
-            assert_eq!(&scan_header(&path), want, "case {i}");
-        }
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    /// A named file without `<Models>` implies one model per namespace it defines nodes in (numeric and
-    /// string NodeIds), in the order of its NamespaceUris; a namespace it only refers to implies none.
-    #[test]
-    fn a_file_without_models_implies_one_per_namespace_it_defines_nodes_in() {
-        let text = r#"<UANodeSet xmlns="http://opcfoundation.org/UA/2011/03/UANodeSet.xsd">
-  <NamespaceUris><Uri>http://a/</Uri><Uri>http://only-referenced/</Uri><Uri>http://b/</Uri></NamespaceUris>
-  <UAObject NodeId="ns=3;s=Pump" BrowseName="3:Pump">
-    <References><Reference ReferenceType="HasTypeDefinition">i=58</Reference>
-      <Reference ReferenceType="Organizes">ns=2;i=7</Reference></References>
-  </UAObject>
-  <UAObjectType NodeId="ns=1;i=1" BrowseName="1:ValveType">
-    <References><Reference ReferenceType="HasSubtype" IsForward="false">i=58</Reference></References>
-  </UAObjectType>
-</UANodeSet>"#;
-        let mut diags = Diagnostics::new();
-        let input = Input::Text { name: "implied.xml".into(), text: text.into() };
-        let loaded = load(vec![input], &LoadOptions::default(), &mut diags);
-        let implied: Vec<(&str, bool, bool)> =
-            loaded.models.iter().map(|m| (m.uri.as_str(), m.version.is_none(), m.required.is_empty())).collect();
-        assert_eq!(implied, vec![("http://a/", true, true), ("http://b/", true, true)]);
-        let said = format!("{diags:?}");
-        assert!(!said.contains("only-referenced"), "a namespace only referred to is looked for, not required: {said}");
-    }
-
-    /// A file without `<Models>` found in a models folder: an older file that refers to its namespace takes
-    /// it (from its own folder), not the newest model of that URI, and the namespace is its implied model.
-    #[test]
-    fn an_older_file_takes_the_older_file_of_its_folder_for_a_namespace_it_refers_to() {
-        let dir = std::env::temp_dir().join(format!("nodeset-older-{}", std::process::id()));
-        let file = |rel: &str, text: &str| {
-            let p = dir.join(rel);
-            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
-            std::fs::write(&p, text).unwrap();
-            p
-        };
-        let head = r#"<UANodeSet xmlns="http://opcfoundation.org/UA/2011/03/UANodeSet.xsd">"#;
-        let object = r#"<UAObject NodeId="ns=1;i=1" BrowseName="1:X"><References><Reference ReferenceType="HasTypeDefinition">i=58</Reference></References></UAObject>"#;
-        file(
-            "current/A.xml",
-            &format!(r#"{head}<NamespaceUris><Uri>http://a/</Uri></NamespaceUris><Models><Model ModelUri="http://a/" Version="2.0"/></Models>{object}</UANodeSet>"#),
-        );
-        let old_a = file("old/A.xml", &format!("{head}<NamespaceUris><Uri>http://a/</Uri></NamespaceUris>{object}</UANodeSet>"));
-        let old_b = file(
-            "old/B.xml",
-            &format!("{head}<NamespaceUris><Uri>http://b/</Uri><Uri>http://a/</Uri></NamespaceUris>{object}</UANodeSet>"),
-        );
-        let mut diags = Diagnostics::new();
-        let loaded = load(vec![Input::Path(old_b.clone())], &LoadOptions { model_dirs: vec![dir.clone()], ..Default::default() }, &mut diags);
-        let mut paths: Vec<&Path> = loaded.files.iter().map(|f| loaded.sources.get(f.raw.file).path.as_path()).collect();
-        paths.sort();
-        assert_eq!(paths, vec![old_a.as_path(), old_b.as_path()]);
-        let a = loaded.models.iter().find(|m| m.uri == "http://a/").expect("http://a/ is a model");
-        assert_eq!((a.version.as_deref(), loaded.sources.get(a.file).path.as_path()), (None, old_a.as_path()));
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-
-    #[test]
-    fn nearest_finds_typos_only() {
-        let c = ["HasComponent", "HasProperty", "Organizes"];
-        assert_eq!(nearest("HasComponnet", c.iter().copied()), Some("HasComponent"));
-        assert_eq!(nearest("Zebra", c.iter().copied()), None);
-        assert_eq!(edit_distance("kitten", "sitting"), 3);
-        assert_eq!(edit_distance_within("kitten", "sitting", 2), None);
-        assert_eq!(edit_distance_within("kitten", "sitting", 3), Some(3));
-        assert_eq!(nearest(&"x".repeat(101), ["x".repeat(101).as_str()].into_iter()), None, "long names get no suggestion");
-    }
-}
+mod tests;

@@ -900,15 +900,42 @@ impl Model {
         self.namespace_uri(ns) == NS0_URI
     }
 
-    /// `Name` for ns0 types, `prefix:Name` otherwise, for messages.
+    /// `Name` for ns0 types, `prefix:Name` otherwise, for messages (see [`Model::namespace_prefix`]).
     pub fn qualified(&self, ix: NodeIx) -> String {
         let n = self.node(ix);
         if n.browse_name.ns == 0 {
             n.browse_name.name.clone()
         } else {
-            let uri = self.namespace_uri(n.browse_name.ns);
-            let short = uri.trim_end_matches('/').rsplit('/').next().unwrap_or(uri);
-            format!("{short}:{}", n.browse_name.name)
+            format!("{}:{}", self.namespace_prefix(n.browse_name.ns), n.browse_name.name)
+        }
+    }
+
+    /// The short name of a namespace in messages: the last segment of its URI (`Robotics` for
+    /// `http://opcfoundation.org/UA/Robotics/`), or as many trailing segments as it takes to tell it from every
+    /// other loaded namespace (`UA/Robotics` beside a vendor's `vendor.example/Robotics`).
+    pub fn namespace_prefix(&self, ns: u16) -> String {
+        fn body(uri: &str) -> &str {
+            let trimmed = uri.trim_end_matches('/');
+            trimmed.split_once("://").map_or(trimmed, |(_, rest)| rest)
+        }
+        fn tail(uri: &str, k: usize) -> &str {
+            let body = body(uri);
+            body.rmatch_indices('/').nth(k - 1).map_or(body, |(i, _)| &body[i + 1..])
+        }
+        let uri = self.namespace_uri(ns);
+        let mut k = 1;
+        loop {
+            let mine = tail(uri, k);
+            let clash = self
+                .namespaces
+                .iter()
+                .enumerate()
+                .any(|(i, other)| i != ns as usize && i != 0 && tail(other, k) == mine);
+            // The whole URI (without its scheme) is the longest prefix there is.
+            if !clash || mine.len() == body(uri).len() {
+                return mine.to_string();
+            }
+            k += 1;
         }
     }
 }

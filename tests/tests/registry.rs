@@ -40,3 +40,36 @@ fn every_registry_file_resolves() {
     assert!(nodes > 200_000, "too few nodes resolved: {nodes} in {} runs", units.len());
     eprintln!("{} runs, {nodes} nodes resolved", units.len());
 }
+
+/// `nodeset-compiler check FILE --models nodesets/vendor` for each file of `1.02/` alone (issue 37): a file
+/// without `<Models>` named on the command line and also lying in the models folder once made the loader
+/// read itself again without end. Each returns within a minute, loads the file once, and finds the files of
+/// its own folder it refers to (errors are allowed: alone, FTNIR's references into ADI may not all resolve).
+#[test]
+fn each_file_without_models_named_alone_returns() {
+    let dir = vendor();
+    let old: Vec<PathBuf> = nodeset_files(&dir).into_iter().filter(|f| f.parent() == Some(&dir.join("1.02"))).collect();
+    assert_eq!(old.len(), 3, "{old:?}");
+    for f in old {
+        let (tx, rx) = std::sync::mpsc::channel();
+        let (file, models) = (f.clone(), dir.clone());
+        std::thread::spawn(move || {
+            let opts = Options { model_dirs: vec![models], ..Options::default() };
+            let _ = tx.send(compile(vec![Input::Path(file)], &opts));
+        });
+        let compiled = match rx.recv_timeout(std::time::Duration::from_secs(60)) {
+            Ok(c) => c,
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                use std::io::Write as _;
+                let _ = writeln!(std::io::stderr(), "check {} --models {} did not return within 60 s", f.display(), dir.display());
+                std::process::exit(101);
+            }
+            Err(_) => panic!("the compiler panicked on {}", f.display()),
+        };
+        let read: Vec<&std::path::Path> =
+            compiled.model.sources.files().filter(|(_, s)| s.path == f).map(|(_, s)| s.path.as_path()).collect();
+        assert_eq!(read.len(), 1, "{} read {} times", f.display(), read.len());
+        let own = compiled.model.nodes.iter().filter(|n| compiled.model.sources.get(n.file).path == f).count();
+        assert!(own > 0, "no node of {} resolved:\n{}", f.display(), compiled.render_diagnostics());
+    }
+}
