@@ -21,6 +21,7 @@ mod registry;
 mod soak;
 mod test;
 mod util;
+mod timing;
 mod venv;
 mod node_peer;
 
