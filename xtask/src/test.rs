@@ -120,13 +120,13 @@ fn steps(table: &mut Table, args: &Args) -> Vec<String> {
 /// that the three targets with cargo-fuzz's installation and the instrumented build add a few minutes.
 pub const FUZZ_SECS: u64 = 25;
 
-/// The row of xtask's own build, which `.ci/run` times before it starts xtask and passes on in
+/// The row of the build `.ci/run` does before it starts xtask (the workspace's tests and xtask), passed on in
 /// `NODESET_XTASK_BUILD` as `WALL CPU` (seconds).
 fn xtask_build_row() -> Option<Row> {
     let value = std::env::var("NODESET_XTASK_BUILD").ok()?;
     let mut parts = value.split_whitespace().map(|p| p.parse::<f64>());
     let (Some(Ok(wall)), Some(Ok(cpu))) = (parts.next(), parts.next()) else { return None };
-    Some(Row { name: "cargo build (xtask, by .ci/run)".into(), wall, cpu, outcome: Outcome::Passed })
+    Some(Row { name: "cargo build (workspace + xtask, by .ci/run)".into(), wall, cpu, outcome: Outcome::Passed })
 }
 
 /// `cargo test` arguments split into what cargo takes, the test name filters (cargo's `TESTNAME`, passed on
