@@ -1,7 +1,6 @@
 //! Shared helpers of the integration tests: where the workspace, the pinned nodesets and the corpus are.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 
 pub mod synth;
 
@@ -64,24 +63,10 @@ fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// Builds the `nodeset-compiler` command (this workspace's build of it, with the profile and target folder of
-/// the calling `cargo test`) and returns the path of its executable.
+/// The `nodeset-compiler` command's executable: the one `cargo test --workspace` has built (see [`executable`]).
+/// A `cargo build -p nodeset-compiler --bin nodeset-compiler` of its own resolved the dependencies' features
+/// for that package alone, and so compiled async-opcua and 27 other crates a second time (about 200 s of a cold
+/// CI run).
 pub fn command_binary() -> PathBuf {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-    let output = Command::new(cargo)
-        .current_dir(root())
-        .args(["build", "-p", "nodeset-compiler", "--bin", "nodeset-compiler", "--message-format=json-render-diagnostics"])
-        .stderr(Stdio::inherit())
-        .output()
-        .expect("cargo runs");
-    assert!(output.status.success(), "cargo build -p nodeset-compiler --bin nodeset-compiler failed");
-    let stdout = String::from_utf8_lossy(&output.stdout);
-    let line = stdout
-        .lines()
-        .filter(|l| l.contains("\"reason\":\"compiler-artifact\"") && l.contains("\"executable\":\""))
-        .find(|l| l.contains("\"name\":\"nodeset-compiler\""))
-        .expect("cargo reports the command's executable");
-    let start = line.find("\"executable\":\"").unwrap() + "\"executable\":\"".len();
-    let end = start + line[start..].find('"').unwrap();
-    PathBuf::from(&line[start..end])
+    executable("bin", "nodeset-compiler")
 }

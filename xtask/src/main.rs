@@ -22,6 +22,7 @@ mod soak;
 mod test;
 mod user_crate;
 mod util;
+mod timing;
 mod venv;
 mod node_peer;
 

@@ -1,5 +1,5 @@
-//! An example server started as a user starts it: its binary, built by the test (`cargo build -p
-//! nodeset-examples --example ...`, a no-op when it is up to date), run as a child process
+//! An example server started as a user starts it: its binary, from the build of `cargo test --workspace`
+//! (`cargo test --workspace --no-run`, a no-op when it is up to date), run as a child process
 //! ([`process_support::Process`]); and the user file such a server is started with. Included with
 //! `#[path = "common/example.rs"] mod example;`.
 
@@ -23,7 +23,10 @@ pub fn executable(name: &str) -> PathBuf {
     if let Some((_, path)) = built.iter().find(|(n, _)| n == name) {
         return path.clone();
     }
-    let artifacts = process_support::cargo_artifacts(env!("CARGO_MANIFEST_DIR").as_ref(), &["build", "-p", "nodeset-examples", "--example", name])
+    // The build `cargo test --workspace` has done (a no-op here when it is up to date): `cargo build -p
+    // nodeset-examples --example NAME` resolves the dependencies' features for this package alone and compiled
+    // async-opcua, the runtime and the models a second time (about three minutes of a cold CI run).
+    let artifacts = process_support::cargo_artifacts(env!("CARGO_MANIFEST_DIR").as_ref(), &["test", "--workspace", "--no-run"])
         .unwrap_or_else(|e| panic!("{e}"));
     let path = artifacts
         .into_iter()
