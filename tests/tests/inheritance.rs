@@ -102,9 +102,18 @@ fn check_show_lists_the_inherited_members_of_an_override() {
     let shown = summary::show_type(m, ty(m, VENDOR, "ArmXType"), 3);
     let block: Vec<&str> =
         shown.lines().skip_while(|l| !l.contains("Object DI:ParameterSet")).skip(1).take_while(|l| l.starts_with("    ")).collect();
-    for want in ["Robotics:SpeedOverride : BaseDataVariableType [Mandatory]", "Robotics:Payload", "vendor_robot:ToolWeight", "vendor_robot:Reach"] {
+    // Two loaded namespaces end in `Robotics`: each is named by as many URI segments as tell it apart.
+    for want in [
+        "Variable UA/Robotics:SpeedOverride : BaseDataVariableType [Mandatory]",
+        "Variable vendor_robot/Robotics:Payload",
+        "Variable vendor_robot:ToolWeight",
+        "Variable vendor_robot:Reach",
+    ] {
         assert!(block.iter().any(|l| l.contains(want)), "`check --show ArmXType` lists {want} under ParameterSet:\n{shown}");
     }
+    let prefixes: BTreeSet<String> = (1..m.namespaces.len() as u16).map(|ns| m.namespace_prefix(ns)).collect();
+    assert_eq!(prefixes.len(), m.namespaces.len() - 1, "two namespaces share a prefix: {prefixes:?}");
+    assert!(prefixes.contains("DI") && prefixes.contains("vendor_robot"), "a prefix is one segment where that is unique: {prefixes:?}");
 }
 
 /// Every mandatory path of an instance of `t` in the model's hierarchy, as the runtime names the nodes it
