@@ -144,7 +144,7 @@ fn generate_cmd(mut args: impl Iterator<Item = String>) -> Result<(), String> {
         }
         let cfg = options.config_of(&uris).map_err(|e| e.to_string())?;
         let mut rust = rust_emit::generate(model, &cfg);
-        rust.files.extend(rust_emit::top_files(&cfg));
+        rust.files.extend(rust_emit::top_files(model, &cfg));
         let t_emit = ms_since(t1);
         let c2 = process_cpu_ms();
         compile_ms.push(t_compile);

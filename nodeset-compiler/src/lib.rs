@@ -291,7 +291,7 @@ fn generate_rust_tree(
     gen.diagnostics.extend(earlier);
     let rendered = gen.diagnostics.finalize(severities, &model.sources, "Rust generation failed")?;
     let mut files = gen.files;
-    files.extend(emit::rust::top_files(cfg));
+    files.extend(emit::rust::top_files(model, cfg));
     Ok((files, rendered, gen.diagnostics))
 }
 

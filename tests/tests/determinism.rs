@@ -59,7 +59,7 @@ fn in_process(files: &[PathBuf]) -> Output {
     };
     let mut rust = rust_emit::generate(model, &cfg);
     assert!(!rust.diagnostics.has_errors(), "{}", rust.diagnostics.render(&model.sources));
-    rust.files.extend(rust_emit::top_files(&cfg));
+    rust.files.extend(rust_emit::top_files(model, &cfg));
     let modelica = generate_with_diagnostics(model, &ModelicaConfig::new());
     assert!(!modelica.diagnostics.has_errors(), "{}", modelica.diagnostics.render(&model.sources));
     let mut files = Output::new();

@@ -69,11 +69,14 @@ pub struct ServerConfig {
     /// The ApplicationUri of the server, which becomes namespace 1. Defaults to `urn:nodeset-models:<name>`.
     pub application_uri: String,
     /// The generated namespaces to serve, in the order their namespace indices are assigned. A table's
-    /// dependencies should come before it (DI, then IA, then Robotics).
+    /// dependencies should come before it (DI, then IA, then Robotics). [`ServerConfig::table`] adds each
+    /// table once, however often it is given (a generated `register` adds the namespaces it requires).
     pub tables: Vec<&'static NodeSetTable>,
     /// Type loaders of the generated data types, so that structures written by clients or passed to
     /// methods arrive decoded.
     pub type_loaders: Vec<Arc<dyn TypeLoader>>,
+    /// The Rust types of the loaders [`ServerConfig::type_loader`] added, so that each is added once.
+    loader_types: Vec<std::any::TypeId>,
     /// The namespace URI of instances created at run time ([`ModelManager::instantiate`]). Defaults to
     /// `<application URI>:instances`.
     pub instance_namespace: Option<String>,
@@ -124,6 +127,7 @@ impl ServerConfig {
             application_name,
             tables: Vec::new(),
             type_loaders: Vec::new(),
+            loader_types: Vec::new(),
             instance_namespace: None,
             min_sampling_interval_ms: 0.0,
             min_publishing_interval_ms: 100,
@@ -193,9 +197,11 @@ impl ServerConfig {
         self
     }
 
-    /// Adds a table to serve.
+    /// Adds a table to serve (once: a table already added is not added again).
     pub fn table(mut self, table: &'static NodeSetTable) -> ServerConfig {
-        self.tables.push(table);
+        if !self.tables.iter().any(|t| std::ptr::eq(*t, table)) {
+            self.tables.push(table);
+        }
         self
     }
 
@@ -217,9 +223,13 @@ impl ServerConfig {
         self
     }
 
-    /// Adds a type loader.
-    pub fn type_loader(mut self, loader: impl TypeLoader + 'static) -> ServerConfig {
-        self.type_loaders.push(Arc::new(loader));
+    /// Adds a type loader (once: a loader of a Rust type already added is not added again).
+    pub fn type_loader<L: TypeLoader + 'static>(mut self, loader: L) -> ServerConfig {
+        let id = std::any::TypeId::of::<L>();
+        if !self.loader_types.contains(&id) {
+            self.loader_types.push(id);
+            self.type_loaders.push(Arc::new(loader));
+        }
         self
     }
 

@@ -932,15 +932,25 @@ fn builtin_type(b: BuiltinType) -> TokenStream {
 }
 
 /// The files at the top of a folder that holds the namespaces of `cfg`, one module each: `mod.rs`, which declares
-/// them and registers all of them with a server in `cfg`'s order (dependencies first), and `rustfmt.toml`.
-pub fn top_files(cfg: &RustConfig) -> [OutFile; 2] {
+/// them and registers them with a server in `cfg`'s order (dependencies first), and `rustfmt.toml`. The models of
+/// `model` that `cfg` maps to modules generated elsewhere are registered first, in the model's order, so that
+/// `register` alone serves everything the generated namespaces need (a server adds each table once).
+pub fn top_files(model: &Model, cfg: &RustConfig) -> [OutFile; 2] {
     let modules: Vec<(String, String)> = cfg.namespaces.iter().map(|n| (n.module.clone(), n.uri.clone())).collect();
-    [models_mod(&modules, &cfg.runtime_path, &cfg.command), rustfmt_toml()]
+    let mapped: Vec<(&str, &RustPath)> = model
+        .namespaces
+        .iter()
+        .filter_map(|uri| cfg.extern_paths.get_key_value(uri.as_str()))
+        .filter(|(uri, _)| !modules.iter().any(|(_, u)| u == *uri))
+        .map(|(uri, path)| (uri.as_str(), path))
+        .collect();
+    [models_mod(&modules, &mapped, &cfg.runtime_path, &cfg.command), rustfmt_toml()]
 }
 
 /// The `mod.rs` of a folder holding several generated namespaces (`modules`: module name and namespace URI,
-/// dependencies first), with `register`, which adds all of them to a server configuration in that order.
-fn models_mod(modules: &[(String, String)], runtime: &RustPath, command: &str) -> OutFile {
+/// dependencies first), with `register`, which adds the `mapped` namespaces (URI and module path) and then all
+/// of the folder's to a server configuration in that order.
+fn models_mod(modules: &[(String, String)], mapped: &[(&str, &RustPath)], runtime: &RustPath, command: &str) -> OutFile {
     let items: Vec<TokenStream> = modules
         .iter()
         .map(|(m, uri)| {
@@ -949,15 +959,26 @@ fn models_mod(modules: &[(String, String)], runtime: &RustPath, command: &str) -
             quote! { #[doc = #d] pub mod #m; }
         })
         .collect();
+    let externs = mapped.iter().map(|(_, path)| quote! { .table(&#path::TABLE).type_loader(#path::TypeLoader) });
     let adds = modules.iter().map(|(m, _)| {
         let m = ident(m);
         quote! { .table(&#m::TABLE).type_loader(#m::TypeLoader) }
     });
+    let doc = if mapped.is_empty() {
+        " Adds the address space and the type loader of every namespace above to a server, dependencies\n first.".to_string()
+    } else {
+        let names: Vec<String> = mapped.iter().map(|(uri, path)| format!("`{}` ({uri})", path.as_str())).collect();
+        format!(
+            " Adds the address space and the type loader of every namespace above to a server, dependencies\n first, after those of the namespaces they require from elsewhere: {}. A server adds each table\n once, so registering those again (say with their crate's own `register`) changes nothing.",
+            names.join(", ")
+        )
+    };
+    // One `///` line each, as written by hand.
+    let doc_lines = doc.split('\n');
     let register = quote! {
-        /// Adds the address space and the type loader of every namespace above to a server, dependencies
-        /// first.
+        #(#[doc = #doc_lines])*
         pub fn register(config: #runtime::server::ServerConfig) -> #runtime::server::ServerConfig {
-            config #(#adds)*
+            config #(#externs)* #(#adds)*
         }
     };
     let file: syn::File = syn::parse2(quote! { #(#items)* #register }).expect("internal error: models mod.rs");
