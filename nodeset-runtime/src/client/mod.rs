@@ -60,7 +60,7 @@ pub use program::{RemoteMachine, RemoteProgram};
 
 use crate::remote::{RemoteError, RemoteServer};
 use crate::typed::{Arguments, Holds, MemberPath, MethodMember, TypeHandle, UaValue, VariableMember, VariableType};
-use crate::NsNodeId;
+use crate::table::NsNodeId;
 
 /// How a client connects: the security policy and mode, the user, the client's PKI folder and its
 /// application name and URI. Every client of the runtime (typed handles and composite skills) connects
@@ -627,7 +627,7 @@ fn sample<T: UaValue>(value: DataValue, what: &str) -> Result<Sample<T>, ClientE
 /// The NodeId of a generated NsNodeId on the session's server.
 pub(crate) fn resolve_id(session: &Session, id: NsNodeId) -> Result<NodeId, ClientError> {
     let ns = session.get_namespace_index_from_cache(id.namespace_uri).ok_or(ClientError::UnknownNamespace(id.namespace_uri.to_owned()))?;
-    Ok(crate::make_node_id(ns, id.id))
+    Ok(crate::table::make_node_id(ns, id.id))
 }
 
 /// One Read of the Value attribute of `nodes`.

@@ -25,11 +25,10 @@ use tracing::{error, warn};
 
 use super::check::Types;
 use super::fields::field_children;
-use crate::import::{build_map, parse_date_time, TableImport, OPC_UA_NAMESPACE, UNMAPPED};
-use crate::table::NodeSetTable;
+use crate::import::{build_map, parse_date_time, TableImport, OPC_UA_NAMESPACE};
+use crate::table::{NamespaceMap, NodeSetTable, NsNodeId, UNMAPPED};
 use crate::typed::instance::{Planner, Spaces};
 use crate::typed::{BindError, Binder, Handle, Instantiate, InstantiateError};
-use crate::{NamespaceMap, NsNodeId};
 
 /// ns0 HasProperty.
 const HAS_PROPERTY: u32 = 46;

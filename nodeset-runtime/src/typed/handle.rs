@@ -14,7 +14,7 @@ use opcua::types::{
 
 use super::value::{rank_fits, UaValue};
 use crate::server::{MethodError, MethodInvocation, ModelManager};
-use crate::NsNodeId;
+use crate::table::NsNodeId;
 
 /// Why a handle could not be bound to a node.
 #[derive(Clone, Debug, PartialEq)]
