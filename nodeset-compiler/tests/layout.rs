@@ -1,11 +1,13 @@
-//! The compiler's module structure: no modules import each other in a loop, among the crate's top-level
-//! modules (`resolve` and `datatypes` among them) or inside the Modelica back end.
+//! The module structure of the workspace's crates: no modules import each other in a loop, among a crate's
+//! top-level modules (the compiler's `resolve` and `datatypes`, the runtime's `server` and `typed`, ...) or
+//! inside the compiler's Modelica back end; and the runtime's modules keep the layer order its crate
+//! documentation writes down.
 //! A loop means two files are one concern split in two; the test names the modules of each loop and the
 //! paths that tie them.
 //!
 //! It reads the source as text: `crate::`, `super::` and `self::` paths (with `use` groups), and the names of
 //! a module's own children (`plan::ClassKey` in `mod.rs`). Doc comments and comments are left out; test
-//! modules (`tests.rs`, `*_tests.rs`) are not part of the structure.
+//! modules (`tests.rs`, `*_tests.rs`) and binaries (`main.rs`, `bin/`) are not part of the structure.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -24,6 +26,8 @@ fn modules(src: &Path) -> BTreeMap<String, PathBuf> {
     }
     let mut files = Vec::new();
     walk(src, &mut files);
+    // The binaries beside a library are crates of their own.
+    files.retain(|f| !f.strip_prefix(src).is_ok_and(|rel| rel.starts_with("bin")));
     let mut out = BTreeMap::new();
     for file in files {
         let rel = file.strip_prefix(src).unwrap().with_extension("");
@@ -159,6 +163,98 @@ fn without_quoted(code: &str) -> String {
     out
 }
 
+/// Code with the body of each `macro_rules!` reduced to its `$crate::` paths: a macro's other paths
+/// (`super::super::NS`) are relative to the module that invokes it, not imports of the module that defines it.
+fn without_macro_bodies(code: &str) -> String {
+    let c: Vec<char> = code.chars().collect();
+    let mut out = String::with_capacity(code.len());
+    let mut i = 0;
+    while i < c.len() {
+        if word_at(&c, i, "macro_rules!") {
+            let mut j = i + "macro_rules!".len();
+            while j < c.len() && c[j] != '{' && c[j] != '(' && c[j] != '[' {
+                j += 1;
+            }
+            let end = closing(&c, j);
+            let body: String = c[(j + 1).min(c.len())..end.min(c.len())].iter().collect();
+            let absolute: Vec<String> = paths(&body).into_iter().filter(|p| p.len() > 1 && p[0] == "crate").map(|p| p.join("::")).collect();
+            out.extend(&c[i..j]);
+            out.push_str(&format!("{{ {} }}", absolute.join("; ")));
+            i = end + 1;
+        } else {
+            out.push(c[i]);
+            i += 1;
+        }
+    }
+    out
+}
+
+/// Code split by inline module (`mod tests { ... }`): each piece with the path of its module below the
+/// file's (empty for the file's own code), so that `super::` in an inline module is resolved from it.
+fn inline_modules(code: &str) -> Vec<(Vec<String>, String)> {
+    fn split(c: &[char], at: Vec<String>, out: &mut Vec<(Vec<String>, String)>) {
+        let mut own = String::new();
+        let mut i = 0;
+        while i < c.len() {
+            if word_at(c, i, "mod") && c.get(i + 3).is_some_and(|c| c.is_whitespace()) {
+                let mut j = i + 3;
+                while j < c.len() && c[j].is_whitespace() {
+                    j += 1;
+                }
+                let start = j;
+                while j < c.len() && is_ident_char(c[j]) {
+                    j += 1;
+                }
+                let name: String = c[start..j].iter().collect();
+                while j < c.len() && c[j].is_whitespace() {
+                    j += 1;
+                }
+                if !name.is_empty() && c.get(j) == Some(&'{') {
+                    let end = closing(c, j);
+                    let mut inner = at.clone();
+                    inner.push(name);
+                    split(&c[j + 1..end.min(c.len())], inner, out);
+                    i = end + 1;
+                    continue;
+                }
+            }
+            own.push(c[i]);
+            i += 1;
+        }
+        out.push((at, own));
+    }
+    let c: Vec<char> = code.chars().collect();
+    let mut out = Vec::new();
+    split(&c, Vec::new(), &mut out);
+    out
+}
+
+/// Whether `word` starts at `i`, not inside a longer identifier.
+fn word_at(c: &[char], i: usize, word: &str) -> bool {
+    (i == 0 || !is_ident_char(c[i - 1])) && word.chars().enumerate().all(|(k, w)| c.get(i + k) == Some(&w))
+}
+
+/// Where the bracket opened at `open` closes (the end of the code if it does not).
+fn closing(c: &[char], open: usize) -> usize {
+    let (o, e) = match c.get(open) {
+        Some('(') => ('(', ')'),
+        Some('[') => ('[', ']'),
+        _ => ('{', '}'),
+    };
+    let mut depth = 0;
+    for (k, &ch) in c.iter().enumerate().skip(open) {
+        if ch == o {
+            depth += 1;
+        } else if ch == e {
+            depth -= 1;
+            if depth == 0 {
+                return k;
+            }
+        }
+    }
+    c.len()
+}
+
 fn is_ident_char(c: char) -> bool {
     c.is_alphanumeric() || c == '_'
 }
@@ -257,6 +353,16 @@ fn split_top(s: &str) -> Vec<String> {
     out
 }
 
+/// The names of the `macro_rules!` macros some code defines.
+fn macro_names(code: &str) -> Vec<String> {
+    code.match_indices("macro_rules!")
+        .filter_map(|(i, m)| {
+            let name: String = code[i + m.len()..].trim_start().chars().take_while(|c| is_ident_char(*c)).collect();
+            (!name.is_empty()).then_some(name)
+        })
+        .collect()
+}
+
 /// Which modules each module names: the longest module path that a path it writes starts with.
 fn imports(modules: &BTreeMap<String, PathBuf>) -> BTreeMap<String, BTreeMap<String, BTreeSet<String>>> {
     let split = |m: &str| -> Vec<String> {
@@ -266,11 +372,20 @@ fn imports(modules: &BTreeMap<String, PathBuf>) -> BTreeMap<String, BTreeMap<Str
             m.split("::").map(str::to_string).collect()
         }
     };
+    let texts: BTreeMap<&String, String> = modules
+        .iter()
+        .map(|(m, file)| (m, without_macro_bodies(&without_quoted(&code(&std::fs::read_to_string(file).unwrap())))))
+        .collect();
+    // `#[macro_export]` puts a macro at the crate root whatever module defines it: `crate::__x` names the
+    // module of `macro_rules! __x`.
+    let macros: BTreeMap<String, &String> = texts.iter().flat_map(|(m, text)| macro_names(text).into_iter().map(move |n| (n, *m))).collect();
     let mut out = BTreeMap::new();
-    for (module, file) in modules {
-        let here = split(module);
+    for (module, text) in &texts {
+        let module = *module;
         let mut named: BTreeMap<String, BTreeSet<String>> = BTreeMap::new();
-        for path in paths(&without_quoted(&code(&std::fs::read_to_string(file).unwrap()))) {
+        let pieces = inline_modules(text);
+        for (inline, path) in pieces.iter().flat_map(|(inline, text)| paths(text).into_iter().map(move |p| (inline, p))) {
+            let here: Vec<String> = split(module).into_iter().chain(inline.iter().cloned()).collect();
             // One segment is no import: a visibility (`pub(crate)`, `pub(super)`), a `mod x;` declaration, a
             // local name.
             if path.len() < 2 {
@@ -298,6 +413,14 @@ fn imports(modules: &BTreeMap<String, PathBuf>) -> BTreeMap<String, BTreeMap<Str
                     if !modules.contains_key(&child.join("::")) {
                         continue;
                     }
+                }
+            }
+            if path[0] == "crate" {
+                if let Some(defined) = macros.get(&path[1]) {
+                    if *defined != module {
+                        named.entry((*defined).clone()).or_default().insert(path.join("::"));
+                    }
+                    continue;
                 }
             }
             abs.extend(rest.iter().cloned());
@@ -331,7 +454,7 @@ fn loops(all: &BTreeMap<String, BTreeMap<String, BTreeSet<String>>>, scope: &str
         for (to, how) in named {
             let Some(b) = member(to) else { continue };
             if a != b {
-                edges.entry(a.clone()).or_default().entry(b).or_default().extend(how.iter().map(|h| format!("{from}: {h}")));
+                edges.entry(a.clone()).or_default().entry(b).or_default().extend(how.iter().map(|h| format!("{}: {h}", shown(from))));
             }
         }
     }
@@ -365,26 +488,128 @@ fn loops(all: &BTreeMap<String, BTreeMap<String, BTreeSet<String>>>, scope: &str
     out
 }
 
-fn compiler_imports() -> BTreeMap<String, BTreeMap<String, BTreeSet<String>>> {
-    imports(&modules(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src")))
+/// The workspace's folder (the compiler's parent).
+fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap().to_path_buf()
 }
 
-fn assert_no_loops(scope: &str) {
-    let all = compiler_imports();
-    assert!(all.keys().any(|m| m.starts_with(scope)), "no module {scope}");
+/// The library crates of the workspace: the members of its `Cargo.toml` with a `src/lib.rs`, by folder.
+fn libraries() -> Vec<String> {
+    let manifest = std::fs::read_to_string(workspace().join("Cargo.toml")).unwrap();
+    let start = manifest.find("members = [").expect("the workspace's members") + "members = [".len();
+    let list = &manifest[start..start + manifest[start..].find(']').unwrap()];
+    let mut out: Vec<String> = list
+        .split(',')
+        .map(|m| m.split('#').next().unwrap().trim().trim_matches('"').to_string())
+        .filter(|m| !m.is_empty() && workspace().join(m).join("src/lib.rs").is_file())
+        .collect();
+    out.sort();
+    out
+}
+
+fn imports_of(krate: &str) -> BTreeMap<String, BTreeMap<String, BTreeSet<String>>> {
+    imports(&modules(&workspace().join(krate).join("src")))
+}
+
+/// A module as messages name it: the crate root as `(crate root)`.
+fn shown(module: &str) -> &str {
+    if module.is_empty() {
+        "(crate root)"
+    } else {
+        module
+    }
+}
+
+fn loop_text(found: &[(Vec<String>, Vec<String>)]) -> String {
+    let text: Vec<String> =
+        found.iter().map(|(ms, ties)| format!("{}\n    {}", ms.iter().map(|m| shown(m)).collect::<Vec<_>>().join(" <-> "), ties.join("\n    "))).collect();
+    text.join("\n")
+}
+
+fn assert_no_loops(krate: &str, scope: &str) {
+    let all = imports_of(krate);
+    assert!(all.keys().any(|m| m.starts_with(scope)), "no module {scope} in {krate}");
     let found = loops(&all, scope);
-    let text: Vec<String> = found.iter().map(|(ms, ties)| format!("{}\n    {}", ms.join(" <-> "), ties.join("\n    "))).collect();
-    assert!(found.is_empty(), "modules of `{scope}` that import each other:\n{}", text.join("\n"));
+    let which = if scope.is_empty() { format!("top-level modules of {krate}") } else { format!("modules of `{scope}` in {krate}") };
+    assert!(found.is_empty(), "{which} that import each other:\n{}", loop_text(&found));
 }
 
 #[test]
 fn no_loop_among_the_top_level_modules() {
-    assert_no_loops("");
+    assert_no_loops("nodeset-compiler", "");
 }
 
 #[test]
 fn no_loop_inside_the_modelica_back_end() {
-    assert_no_loops("emit::modelica");
+    assert_no_loops("nodeset-compiler", "emit::modelica");
+}
+
+#[test]
+fn no_loop_among_the_runtimes_layers() {
+    assert_no_loops("nodeset-runtime", "");
+}
+
+#[test]
+fn no_loop_in_any_library_of_the_workspace() {
+    let libraries = libraries();
+    for known in ["nodeset-compiler", "nodeset-runtime", "generated", "process-support"] {
+        assert!(libraries.iter().any(|l| l == known), "{known} not among the workspace's libraries {libraries:?}");
+    }
+    let mut failures = Vec::new();
+    for krate in &libraries {
+        let found = loops(&imports_of(krate), "");
+        if !found.is_empty() {
+            failures.push(format!("{krate}:\n{}", loop_text(&found)));
+        }
+    }
+    assert!(failures.is_empty(), "top-level modules that import each other:\n{}", failures.join("\n"));
+}
+
+/// A crate's layers as its `lib.rs` documents them, from the bottom: the rows of the table under `# Layers`,
+/// each starting with its module as ``[`name`]``.
+fn documented_layers(lib_rs: &str) -> Vec<String> {
+    let Some((_, section)) = lib_rs.split_once("//! # Layers") else { return Vec::new() };
+    section
+        .lines()
+        .skip(1)
+        .take_while(|l| l.starts_with("//!"))
+        .filter_map(|l| Some(l.strip_prefix("//! | [`")?.split_once("`]")?.0.to_string()))
+        .collect()
+}
+
+/// The imports that break the layers: a module naming one of a layer above its own, or naming the crate root
+/// (which only re-exports). `layers` lists the top-level modules from the bottom.
+fn upward(all: &BTreeMap<String, BTreeMap<String, BTreeSet<String>>>, layers: &[String]) -> Vec<String> {
+    let rank = |m: &str| layers.iter().position(|l| l == m.split("::").next().unwrap());
+    let mut out = Vec::new();
+    for (from, named) in all {
+        for (to, how) in named {
+            let how: Vec<&str> = how.iter().map(String::as_str).take(3).collect();
+            match (from.is_empty(), to.is_empty(), rank(from), rank(to)) {
+                (false, true, _, _) => out.push(format!("{from} names the crate root: {}", how.join(", "))),
+                (false, false, Some(a), Some(b)) if b > a => {
+                    out.push(format!("{from} (layer `{}`) names {to} (layer `{}`, above it): {}", layers[a], layers[b], how.join(", ")))
+                }
+                _ => {}
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn the_runtimes_modules_use_only_the_layers_below_them() {
+    let lib = std::fs::read_to_string(workspace().join("nodeset-runtime/src/lib.rs")).unwrap();
+    let layers = documented_layers(&lib);
+    let all = imports_of("nodeset-runtime");
+    let top: BTreeSet<&str> = all.keys().filter(|m| !m.is_empty()).map(|m| m.split("::").next().unwrap()).collect();
+    let listed: BTreeSet<&str> = layers.iter().map(String::as_str).collect();
+    assert!(
+        listed == top && listed.len() == layers.len(),
+        "the table under `# Layers` in nodeset-runtime/src/lib.rs lists {layers:?}; it must name each of the modules {top:?} once"
+    );
+    let wrong = upward(&all, &layers);
+    assert!(wrong.is_empty(), "imports against the runtime's layers ({}):\n{}", layers.join(" < "), wrong.join("\n"));
 }
 
 #[test]
@@ -407,4 +632,26 @@ fn the_reader_sees_what_a_loop_is_made_of() {
     assert_eq!(found.len(), 1, "{found:?}");
     assert_eq!(found[0].0, vec!["a::x".to_string(), "a::y".to_string()]);
     assert!(loops(&all, "b").is_empty());
+    assert_eq!(macro_names("#[macro_export]\nmacro_rules! __x { () => {} }"), ["__x"]);
+    // A macro's body keeps only its absolute paths; an inline module resolves `super::` from itself.
+    let text = "macro_rules! m { ($t:ty) => { impl $crate::typed::T for $t { const N: u16 = super::super::NS; } }; }\n\
+                fn f() {} mod tests { use super::f; mod deeper { use super::super::g; } }";
+    let pieces = inline_modules(&without_macro_bodies(&code(text)));
+    let found: BTreeSet<(String, String)> =
+        pieces.iter().flat_map(|(at, t)| paths(t).into_iter().map(move |p| (at.join("::"), p.join("::")))).collect();
+    let want: BTreeSet<(String, String)> = [("", "crate::typed::T"), ("tests", "super::f"), ("tests::deeper", "super::super::g")]
+        .into_iter()
+        .map(|(a, b)| (a.to_string(), b.to_string()))
+        .collect();
+    assert_eq!(found.into_iter().filter(|(_, p)| p.contains("::")).collect::<BTreeSet<_>>(), want);
+    let doc = "//! # Layers\n//!\n//! | layer | what |\n//! |---|---|\n//! | [`low`] | a |\n//! | [`high`] | b |\n\npub mod low;";
+    assert_eq!(documented_layers(doc), ["low", "high"]);
+    let mut all: BTreeMap<String, BTreeMap<String, BTreeSet<String>>> = BTreeMap::new();
+    all.entry("high::x".into()).or_default().entry("low".into()).or_default().insert("crate::low::A".into());
+    all.entry("".into()).or_default().entry("high".into()).or_default().insert("high::B".into());
+    assert!(upward(&all, &documented_layers(doc)).is_empty());
+    all.entry("low".into()).or_default().entry("high::x".into()).or_default().insert("crate::high::x::C".into());
+    all.entry("low".into()).or_default().entry("".into()).or_default().insert("crate::D".into());
+    let wrong = upward(&all, &documented_layers(doc));
+    assert_eq!(wrong.len(), 2, "{wrong:?}");
 }

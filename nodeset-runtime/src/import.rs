@@ -27,8 +27,9 @@ use opcua::types::{
 };
 use tracing::{error, warn};
 
-use super::table::{ArgRow, Def, EnumRow, FieldRow, Id, Kind, NodeRow, NodeSetTable, NumRef, Ref, StructureKind, Val};
-use super::NamespaceMap;
+use crate::table::{
+    ArgRow, Def, EnumRow, FieldRow, Id, Kind, NamespaceMap, NodeRow, NodeSetTable, NumRef, Ref, StructureKind, Val, UNMAPPED,
+};
 
 /// The OPC UA namespace, always index 0.
 pub const OPC_UA_NAMESPACE: &str = "http://opcfoundation.org/UA/";
@@ -156,9 +157,6 @@ pub(crate) fn build_map(table: &NodeSetTable, server_index: impl Fn(u16, &str) -
         .collect();
     NamespaceMap { indices }
 }
-
-/// The server index of a table-local namespace that has none.
-pub(crate) const UNMAPPED: u16 = u16::MAX;
 
 /// Builds one node with its references, or `None` (with a warning) if the row cannot be imported.
 fn build_item(table: &NodeSetTable, row: &NodeRow, map: &NamespaceMap, now: DateTime, types: &Context<'_>) -> Option<ImportedItem> {

@@ -38,6 +38,7 @@
 //!   by the same read.
 
 use std::future::Future;
+use std::path::PathBuf;
 use std::pin::Pin;
 use std::sync::Arc;
 use std::time::Duration;
@@ -54,12 +55,121 @@ use tokio_util::codec::FramedRead;
 use opcua::client::{ClientBuilder, IdentityToken, Session, SessionPollResult};
 use opcua::crypto::SecurityPolicy;
 use opcua::types::{
-    BrowseDescription, BrowseDirection, BrowsePath, BrowseResultMask, NodeClassMask, NodeId, ObjectId, QualifiedName,
-    ReferenceTypeId, RelativePath, RelativePathElement, StatusCode,
+    BrowseDescription, BrowseDirection, BrowsePath, BrowseResultMask, MessageSecurityMode, NodeClassMask, NodeId, ObjectId,
+    QualifiedName, ReferenceTypeId, RelativePath, RelativePathElement, StatusCode,
 };
 use tokio::task::JoinHandle;
 
-use crate::client::ClientConfig;
+
+/// How a client connects: the security policy and mode, the user, the client's PKI folder and its
+/// application name and URI. Every client of the runtime (typed handles and composite skills) connects
+/// through it ([`ClientConfig::connect`]); one configuration serves any number of servers.
+///
+/// Secure by default: [`ClientConfig::new`] is Basic256Sha256 with SignAndEncrypt, and the server's
+/// certificate must be in the PKI folder's `trusted/` (an unknown one is refused and written to
+/// `rejected/`, for an administrator to move). [`ClientConfig::insecure`] (SecurityPolicy None, anonymous)
+/// is for servers started with `--insecure` on loopback.
+#[derive(Clone)]
+pub struct ClientConfig {
+    /// The application name the session shows (and the client's certificate carries).
+    pub application_name: String,
+    /// The application URI of the client, which its certificate carries.
+    pub application_uri: String,
+    /// The security policy of the endpoint to use.
+    pub policy: SecurityPolicy,
+    /// The message security mode of the endpoint to use.
+    pub mode: MessageSecurityMode,
+    /// User name and password; `None` connects anonymously.
+    pub user: Option<(String, String)>,
+    /// The client's PKI folder: its certificate (`own/cert.der`, `private/private.pem`, created on first
+    /// use) and the server certificates it trusts (`trusted/`) or refused (`rejected/`).
+    pub pki_dir: PathBuf,
+    /// Trusts an unknown server certificate (development only).
+    pub trust_server_on_first_use: bool,
+    /// How long the session may take to open.
+    pub connect_timeout: Duration,
+}
+
+impl std::fmt::Debug for ClientConfig {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ClientConfig")
+            .field("application_name", &self.application_name)
+            .field("application_uri", &self.application_uri)
+            .field("policy", &self.policy)
+            .field("mode", &self.mode)
+            .field("user", &self.user.as_ref().map(|(name, _)| (name, "<password>")))
+            .field("pki_dir", &self.pki_dir)
+            .field("trust_server_on_first_use", &self.trust_server_on_first_use)
+            .field("connect_timeout", &self.connect_timeout)
+            .finish()
+    }
+}
+
+impl ClientConfig {
+    /// Basic256Sha256, SignAndEncrypt, anonymous, with the client's PKI folder at `pki_dir`.
+    pub fn new(pki_dir: impl Into<PathBuf>) -> ClientConfig {
+        ClientConfig {
+            application_name: "nodeset-models client".into(),
+            application_uri: "urn:nodeset-models:client".into(),
+            policy: SecurityPolicy::Basic256Sha256,
+            mode: MessageSecurityMode::SignAndEncrypt,
+            user: None,
+            pki_dir: pki_dir.into(),
+            trust_server_on_first_use: false,
+            connect_timeout: Duration::from_secs(10),
+        }
+    }
+
+    /// SecurityPolicy None, anonymous: only for servers started with `insecure`, on loopback. No
+    /// certificate is made or checked.
+    pub fn insecure() -> ClientConfig {
+        ClientConfig {
+            policy: SecurityPolicy::None,
+            mode: MessageSecurityMode::None,
+            ..ClientConfig::new(std::env::temp_dir().join("nodeset-models-pki-remote"))
+        }
+    }
+
+    /// Sets the user name and password.
+    pub fn user(mut self, name: impl Into<String>, password: impl Into<String>) -> ClientConfig {
+        self.user = Some((name.into(), password.into()));
+        self
+    }
+
+    /// Sets the security policy and mode.
+    pub fn policy(mut self, policy: SecurityPolicy, mode: MessageSecurityMode) -> ClientConfig {
+        self.policy = policy;
+        self.mode = mode;
+        self
+    }
+
+    /// Sets the application name and URI (a PKI folder holds the certificate of one application URI).
+    pub fn application(mut self, name: &str, uri: &str) -> ClientConfig {
+        self.application_name = name.to_owned();
+        self.application_uri = uri.to_owned();
+        self
+    }
+
+    /// Trusts unknown server certificates: development only.
+    pub fn trust_server_on_first_use(mut self) -> ClientConfig {
+        self.trust_server_on_first_use = true;
+        self
+    }
+
+    /// Sets how long the session may take to open.
+    pub fn connect_timeout(mut self, timeout: Duration) -> ClientConfig {
+        self.connect_timeout = timeout;
+        self
+    }
+
+    /// Opens a session to the server at `url` (`opc.tcp://host:port/`) and reads its namespaces. A refusal
+    /// that retrying cannot change (the user, or a certificate: `BadIdentityTokenRejected`,
+    /// `BadCertificateUntrusted`, ...) fails at once with its status; a server that does not answer fails
+    /// after `connect_timeout` with the status of the last attempt.
+    pub async fn connect(&self, url: &str) -> Result<RemoteServer, RemoteError> {
+        RemoteServer::open(url, self).await
+    }
+}
 
 /// Why a remote skill could not be reached or found.
 #[derive(Clone, Debug, PartialEq)]
@@ -509,5 +619,17 @@ mod tests {
         assert_eq!(segments("DeviceSet/Robot/SkillSet/Move"), ["DeviceSet", "Robot", "SkillSet", "Move"]);
         assert_eq!(segments("{http://x/A/}Cell//SkillSet/"), ["{http://x/A/}Cell", "SkillSet"]);
         assert!(segments("").is_empty());
+    }
+
+    #[test]
+    fn a_client_config_is_secure_by_default_and_does_not_show_the_password() {
+        let config = ClientConfig::new("pki/client").user("op", "s3cret-pass");
+        assert_eq!((config.policy, config.mode), (SecurityPolicy::Basic256Sha256, MessageSecurityMode::SignAndEncrypt));
+        assert!(!config.trust_server_on_first_use);
+        assert_eq!(config.pki_dir, PathBuf::from("pki/client"));
+        let shown = format!("{config:?}");
+        assert!(shown.contains("\"op\"") && !shown.contains("s3cret-pass"), "{shown}");
+        let none = ClientConfig::insecure();
+        assert_eq!((none.policy, none.mode, none.user), (SecurityPolicy::None, MessageSecurityMode::None, None));
     }
 }

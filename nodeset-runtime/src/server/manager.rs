@@ -25,11 +25,8 @@ use tracing::{error, warn};
 
 use super::check::Types;
 use super::fields::field_children;
-use crate::import::{build_map, parse_date_time, TableImport, OPC_UA_NAMESPACE, UNMAPPED};
-use crate::table::NodeSetTable;
-use crate::typed::instance::{Planner, Spaces};
-use crate::typed::{BindError, Binder, Handle, Instantiate, InstantiateError};
-use crate::{NamespaceMap, NsNodeId};
+use crate::import::{build_map, parse_date_time, TableImport, OPC_UA_NAMESPACE};
+use crate::table::{NamespaceMap, NodeSetTable, NsNodeId, UNMAPPED};
 
 /// ns0 HasProperty.
 const HAS_PROPERTY: u32 = 46;
@@ -607,6 +604,17 @@ impl ModelManager {
         self.node_manager.inner()
     }
 
+    /// The declaration each InstanceDeclaration of the served tables overrides, by server NodeId (for
+    /// `instantiate` in [`crate::typed::instance`]).
+    pub(crate) fn overrides(&self) -> &HashMap<NodeId, NodeId> {
+        &self.nodes().overrides
+    }
+
+    /// The server's node manager of ns0, if it has one.
+    pub(crate) fn core_node_manager(&self) -> Option<Arc<CoreNodeManager>> {
+        self.nodes().node_managers.get_of_type::<CoreNodeManager>()
+    }
+
     /// The server's index of a namespace URI, if the server knows it.
     pub fn namespace_index(&self, namespace_uri: &str) -> Option<u16> {
         self.nodes().type_tree.read().namespaces().get_index(namespace_uri)
@@ -674,81 +682,6 @@ impl ModelManager {
     /// The server's type tree (types of ns0 and of every table).
     pub fn type_tree(&self) -> &Arc<RwLock<DefaultTypeTree>> {
         &self.nodes().type_tree
-    }
-
-    /// Binds a typed handle (a generated ObjectType handle, `Variable<T>`, ...) to an existing node.
-    pub fn bind<H: Handle>(&self, node: &NodeId) -> Result<H, BindError> {
-        Binder::bind(self, node)
-    }
-
-    /// Binds a typed handle to the node at `path` below the Objects folder: BrowseNames (their name part)
-    /// separated by `/`, such as `DrillingCell/SkillSet/DrillHole`. A segment that matches no child, or
-    /// several, is a `MissingChild` error naming the node where the path stopped.
-    pub fn bind_path<H: Handle>(&self, path: &str) -> Result<H, BindError> {
-        self.bind_with(|b| {
-            let mut node: NodeId = opcua::types::ObjectId::ObjectsFolder.into();
-            for segment in path.split('/').filter(|s| !s.is_empty()) {
-                let hits: Vec<NodeId> = b
-                    .children(&node)
-                    .into_iter()
-                    .filter(|c| b.browse_name(c).is_some_and(|q| q.name.as_ref() == segment))
-                    .collect();
-                match <[NodeId; 1]>::try_from(hits) {
-                    Ok([one]) => node = one,
-                    Err(_) => return Err(BindError::MissingChild { parent: node, browse_name: segment.to_owned() }),
-                }
-            }
-            H::bind(b, &node)
-        })
-    }
-
-    /// Runs `f` with a [`Binder`] (one read lock for a whole tree of handles).
-    pub fn bind_with<H>(&self, f: impl FnOnce(&Binder<'_>) -> Result<H, BindError>) -> Result<H, BindError> {
-        // The type tree first, then the address space: async-opcua initialises node managers holding the
-        // type tree and then taking the address space, so the other order deadlocks a bind that runs while a
-        // server on another thread starts.
-        let tree = self.nodes().type_tree.read();
-        let space = self.node_manager.address_space().read();
-        f(&Binder::new(self, &space, &tree))
-    }
-
-    /// Creates an instance of an ObjectType or VariableType under `parent` as the type prescribes (see
-    /// [`crate::typed::instance`]) and returns its NodeId. Nothing is created if anything fails.
-    pub fn instantiate(
-        &self,
-        type_id: &NodeId,
-        parent: &NodeId,
-        browse_name: QualifiedName,
-        options: &Instantiate,
-    ) -> Result<NodeId, InstantiateError> {
-        let core = self.nodes().node_managers.get_of_type::<CoreNodeManager>();
-        let planned = {
-            // The type tree first (see `bind_with`).
-            let tree = self.nodes().type_tree.read();
-            let core_space = core.as_ref().map(|c| c.address_space().read());
-            let space = self.node_manager.address_space().read();
-            let overrides = &self.nodes().overrides;
-            let spaces = Spaces { core: core_space.as_deref(), model: &space, tree: &tree, overrides };
-            let id = options.node_id_or(self.instance_namespace(), browse_name.name.as_ref());
-            let mut planner = Planner { spaces, options, used: Default::default(), out: Vec::new() };
-            planner.root(type_id, parent, browse_name, id)?;
-            if let Some(path) = planner.unused() {
-                return Err(InstantiateError::UnknownPath(path));
-            }
-            planner.out
-        };
-        let mut space = self.node_manager.address_space().write();
-        if let Some(p) = planned.iter().find(|p| space.node_exists(p.node.as_node().node_id())) {
-            return Err(InstantiateError::NodeExists(p.node.as_node().node_id().clone()));
-        }
-        let root = planned.first().map(|p| p.node.as_node().node_id().clone()).unwrap_or_else(NodeId::null);
-        for p in planned {
-            space.insert::<NodeType, NodeId>(p.node, None);
-            for (source, target, rt) in p.references {
-                space.insert_reference(&source, &target, rt);
-            }
-        }
-        Ok(root)
     }
 
     /// Reports an event to the clients that monitor any of `notifiers` for events (the event's source, the

@@ -14,7 +14,7 @@ use opcua::types::{
 
 use super::value::{rank_fits, UaValue};
 use crate::server::{MethodError, MethodInvocation, ModelManager};
-use crate::NsNodeId;
+use crate::table::NsNodeId;
 
 /// Why a handle could not be bound to a node.
 #[derive(Clone, Debug, PartialEq)]
@@ -93,6 +93,47 @@ pub trait Handle: Sized {
     fn bind(binder: &Binder<'_>, node: &NodeId) -> Result<Self, BindError> {
         binder.finish(Self::build(binder, node))
     }
+}
+
+/// The typed layer's side of the server's [`ModelManager`]: typed handles bound to its nodes. It is defined
+/// here, above the server, so that `server` never names the typed layer.
+impl ModelManager {
+    /// Binds a typed handle (a generated ObjectType handle, `Variable<T>`, ...) to an existing node.
+    pub fn bind<H: Handle>(&self, node: &NodeId) -> Result<H, BindError> {
+        Binder::bind(self, node)
+    }
+
+    /// Binds a typed handle to the node at `path` below the Objects folder: BrowseNames (their name part)
+    /// separated by `/`, such as `DrillingCell/SkillSet/DrillHole`. A segment that matches no child, or
+    /// several, is a `MissingChild` error naming the node where the path stopped.
+    pub fn bind_path<H: Handle>(&self, path: &str) -> Result<H, BindError> {
+        self.bind_with(|b| {
+            let mut node: NodeId = opcua::types::ObjectId::ObjectsFolder.into();
+            for segment in path.split('/').filter(|s| !s.is_empty()) {
+                let hits: Vec<NodeId> = b
+                    .children(&node)
+                    .into_iter()
+                    .filter(|c| b.browse_name(c).is_some_and(|q| q.name.as_ref() == segment))
+                    .collect();
+                match <[NodeId; 1]>::try_from(hits) {
+                    Ok([one]) => node = one,
+                    Err(_) => return Err(BindError::MissingChild { parent: node, browse_name: segment.to_owned() }),
+                }
+            }
+            H::bind(b, &node)
+        })
+    }
+
+    /// Runs `f` with a [`Binder`] (one read lock for a whole tree of handles).
+    pub fn bind_with<H>(&self, f: impl FnOnce(&Binder<'_>) -> Result<H, BindError>) -> Result<H, BindError> {
+        // The type tree first, then the address space: async-opcua initialises node managers holding the
+        // type tree and then taking the address space, so the other order deadlocks a bind that runs while a
+        // server on another thread starts.
+        let tree = self.type_tree().read();
+        let space = self.node_manager().address_space().read();
+        f(&Binder::new(self, &space, &tree))
+    }
+
 }
 
 /// Finds the children of instances for [`Handle::build`] while holding one read lock on the address space.

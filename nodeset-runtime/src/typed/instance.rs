@@ -22,6 +22,7 @@ use opcua::types::{
 };
 
 use super::handle::BindError;
+use crate::server::ModelManager;
 
 /// How deep instance declarations may nest (a guard against types that contain themselves).
 const MAX_DEPTH: usize = 32;
@@ -142,6 +143,50 @@ impl From<BindError> for InstantiateError {
     fn from(e: BindError) -> Self {
         InstantiateError::Bind(e)
     }
+}
+
+/// The typed layer's side of the server's [`ModelManager`]: instances created as their type prescribes. It is
+/// defined here, above the server, so that `server` never names the typed layer.
+impl ModelManager {
+    /// Creates an instance of an ObjectType or VariableType under `parent` as the type prescribes (see
+    /// [`crate::typed::instance`]) and returns its NodeId. Nothing is created if anything fails.
+    pub fn instantiate(
+        &self,
+        type_id: &NodeId,
+        parent: &NodeId,
+        browse_name: QualifiedName,
+        options: &Instantiate,
+    ) -> Result<NodeId, InstantiateError> {
+        let core = self.core_node_manager();
+        let planned = {
+            // The type tree first (see `ModelManager::bind_with`).
+            let tree = self.type_tree().read();
+            let core_space = core.as_ref().map(|c| c.address_space().read());
+            let space = self.node_manager().address_space().read();
+            let overrides = self.overrides();
+            let spaces = Spaces { core: core_space.as_deref(), model: &space, tree: &tree, overrides };
+            let id = options.node_id_or(self.instance_namespace(), browse_name.name.as_ref());
+            let mut planner = Planner { spaces, options, used: Default::default(), out: Vec::new() };
+            planner.root(type_id, parent, browse_name, id)?;
+            if let Some(path) = planner.unused() {
+                return Err(InstantiateError::UnknownPath(path));
+            }
+            planner.out
+        };
+        let mut space = self.node_manager().address_space().write();
+        if let Some(p) = planned.iter().find(|p| space.node_exists(p.node.as_node().node_id())) {
+            return Err(InstantiateError::NodeExists(p.node.as_node().node_id().clone()));
+        }
+        let root = planned.first().map(|p| p.node.as_node().node_id().clone()).unwrap_or_else(NodeId::null);
+        for p in planned {
+            space.insert::<NodeType, NodeId>(p.node, None);
+            for (source, target, rt) in p.references {
+                space.insert_reference(&source, &target, rt);
+            }
+        }
+        Ok(root)
+    }
+
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

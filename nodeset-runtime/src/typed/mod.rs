@@ -27,7 +27,7 @@ use std::marker::PhantomData;
 use opcua::types::{NodeId, QualifiedName};
 
 use crate::server::ModelManager;
-use crate::NsNodeId;
+use crate::table::NsNodeId;
 
 /// What the handles of ObjectTypes and VariableTypes have in common: the type whose instances they stand
 /// for. A typed client binds a remote instance as `H` (`client::Remote<H>`) when its TypeDefinition is
@@ -421,11 +421,11 @@ pub use crate::__nodeset_deref_base as deref_base;
 macro_rules! __nodeset_object_type {
     ($t:ident, $id:expr, $name:literal) => {
         impl $crate::typed::TypeHandle for $t {
-            const TYPE_NODE_ID: $crate::NsNodeId = $id;
+            const TYPE_NODE_ID: $crate::table::NsNodeId = $id;
             const TYPE_NAME: &'static str = $name;
         }
         impl $crate::typed::ObjectType for $t {
-            const TYPE_ID: $crate::NsNodeId = $id;
+            const TYPE_ID: $crate::table::NsNodeId = $id;
             const BROWSE_NAME: &'static str = $name;
         }
     };
@@ -438,11 +438,11 @@ pub use crate::__nodeset_object_type as object_type;
 macro_rules! __nodeset_variable_type {
     ($t:ident, $id:expr, $name:literal, $value:ty) => {
         impl $crate::typed::TypeHandle for $t {
-            const TYPE_NODE_ID: $crate::NsNodeId = $id;
+            const TYPE_NODE_ID: $crate::table::NsNodeId = $id;
             const TYPE_NAME: &'static str = $name;
         }
         impl $crate::typed::VariableType for $t {
-            const TYPE_ID: $crate::NsNodeId = $id;
+            const TYPE_ID: $crate::table::NsNodeId = $id;
             const BROWSE_NAME: &'static str = $name;
             type Value = $value;
         }

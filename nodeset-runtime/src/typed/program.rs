@@ -52,7 +52,7 @@ use super::handle::{BindError, Binder, ObjectNode};
 use super::value::UaValue;
 use super::ObjectType;
 use crate::server::{MethodError, MethodInvocation, ModelManager};
-use crate::NsNodeId;
+use crate::table::NsNodeId;
 
 /// The ns0 namespace URI, for the BrowseNames of the state machine's variables.
 const UA: &str = "http://opcfoundation.org/UA/";
@@ -535,8 +535,8 @@ fn supertypes(manager: &ModelManager, event_type: &NodeId) -> Vec<NodeId> {
 /// than taken from the generated `models::common_skills`, so that the runtime builds without the generated
 /// models (a build script's output uses it on its own); the test
 /// `skill_transition_event_type_matches_the_generated_id` keeps the two equal.
-pub const SKILL_TRANSITION_EVENT_TYPE: crate::NsNodeId =
-    crate::NsNodeId::numeric("http://nodeset-compiler.dev/CommonSkills/", 1100);
+pub const SKILL_TRANSITION_EVENT_TYPE: NsNodeId =
+    NsNodeId::numeric("http://nodeset-compiler.dev/CommonSkills/", 1100);
 
 /// The states of a program (Part 10), which the driver treats specially.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
