@@ -273,7 +273,9 @@ impl<'a> Spaces<'a> {
                 }
             }
             depth += 1;
-            current = if depth < MAX_DEPTH { self.tree.get_supertype(&t).cloned() } else { None };
+            // By the address spaces' HasSubtype references, not the type tree: the tree holds ns0's types only
+            // once the server runs, and a type's ns0 supertypes (BaseEventType's EventId, ...) count before.
+            current = if depth < MAX_DEPTH { self.supertype(&t) } else { None };
         }
         out
     }
