@@ -713,10 +713,15 @@ pub fn find_model_files(dirs: &[PathBuf], uris: &[String]) -> BTreeMap<String, P
     out
 }
 
-/// The models the header of a NodeSet2 file declares (URIs), without parsing the rest; `None` if the file
-/// cannot be read or is not a NodeSet2 file.
+/// The models the header of a NodeSet2 file declares (URIs), without parsing the rest; for a file without
+/// `<Models>`, the model it implies for its first namespace (as the loader implies one, and prefers it to a
+/// file of a models folder); `None` if the file cannot be read or is not a NodeSet2 file.
 pub fn models_of_file(path: &Path) -> Option<Vec<String>> {
-    declared_models(path).map(|models| models.into_iter().map(|(uri, _, _)| uri).collect())
+    let header = scan_header(path)?;
+    if header.models.is_empty() {
+        return Some(header.own_namespace.into_iter().collect());
+    }
+    Some(header.models.into_iter().map(|(uri, _, _)| uri).collect())
 }
 
 /// The models the header of a NodeSet2 file declares, each as its ModelUri, Version and PublicationDate, read
@@ -1037,6 +1042,11 @@ mod tests {
             std::fs::write(&path, text).unwrap();
             assert_eq!(&scan_header(&path), want, "case {i}");
         }
+        // What a named file provides, for `verify`: the models it declares, or the one its first namespace
+        // implies (an old ADI named beside the current one in a models folder must keep its namespace).
+        assert_eq!(models_of_file(&dir.join("0.xml")), Some(vec!["http://x/".to_string()]));
+        assert_eq!(models_of_file(&dir.join("4.xml")), Some(vec!["http://old/".to_string()]));
+        assert_eq!(models_of_file(&dir.join("3.xml")), None);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
