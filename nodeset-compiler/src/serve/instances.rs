@@ -142,9 +142,21 @@ pub fn instantiate_all(manager: &ModelManager, m: &Model) -> Instantiated {
     }
     done.nodes += 1;
     let machines = StateTables::new(manager, m);
+    // Two types of one namespace may share a BrowseName (AML's libraries): their instances are told apart
+    // by the type's NodeId.
+    let mut names: BTreeMap<(u16, &str), usize> = BTreeMap::new();
+    for &t in &types {
+        let n = m.node(t);
+        *names.entry((n.id.ns, n.browse_name.name.as_str())).or_default() += 1;
+    }
     for t in types {
+        let n = m.node(t);
+        let name = match names[&(n.id.ns, n.browse_name.name.as_str())] {
+            1 => n.browse_name.name.clone(),
+            _ => format!("{} ({})", n.browse_name.name, m.display_id(&n.id)),
+        };
         let what = format!("{} ({})", m.qualified(t), m.display_id(&m.node(t).id));
-        match instantiate_one(manager, m, t, &folder_id) {
+        match instantiate_one(manager, m, t, &name, &folder_id) {
             Ok(root) => {
                 done.instantiated += 1;
                 let created = subtree(manager, &root);
@@ -170,17 +182,16 @@ pub fn instantiate_all(manager: &ModelManager, m: &Model) -> Instantiated {
     done
 }
 
-fn instantiate_one(manager: &ModelManager, m: &Model, t: NodeIx, folder: &NodeId) -> Result<NodeId, String> {
+fn instantiate_one(manager: &ModelManager, m: &Model, t: NodeIx, name: &str, folder: &NodeId) -> Result<NodeId, String> {
     let type_id = server_id(manager, m, t).ok_or("its namespace is not served")?;
     let (_, placeholders) = mandatory_paths(m, t, &element_name)?;
     let options = placeholders
         .iter()
         .fold(Instantiate::new().data_type_defaults(), |o, p| o.placeholder(p.clone(), [element_name(p.rsplit('/').next().unwrap_or(p))]));
-    let name = &m.node(t).browse_name.name;
     let ns = type_id.namespace;
     let id = NodeId::new(manager.instance_namespace(), format!("Instances/{ns}:{name}"));
     manager
-        .instantiate(&type_id, folder, QualifiedName::new(ns, name.as_str()), &options.node_id(id))
+        .instantiate(&type_id, folder, QualifiedName::new(ns, name), &options.node_id(id))
         .map_err(|e| e.to_string())
 }
 

@@ -125,6 +125,10 @@ pub async fn serve(model: &Model, opts: &ServeOptions) -> Result<(), String> {
     let url = server.endpoint_url().to_owned();
     let mut task = tokio::spawn(server.run());
     if opts.instantiate_all {
+        // Instances are made once async-opcua has loaded ns0's types into the type tree (when the server
+        // starts running): before, a reference type of the files that derives from ns0's HasComponent is
+        // not known to be hierarchical, and which members an instance gets would depend on timing.
+        wait_for_ns0_types(&handle).await?;
         let done = instances::instantiate_all(&manager, model);
         for (what, why) in &done.failures {
             eprintln!("warning: {what} is not instantiated: {why}");
@@ -164,4 +168,20 @@ pub async fn serve(model: &Model, opts: &ServeOptions) -> Result<(), String> {
         Ok(Err(e)) => Err(format!("the server task failed: {e}")),
         Err(_) => Err("the server did not stop within 10 s".to_owned()),
     }
+}
+
+/// Waits (at most 30 s) until the running server's type tree holds ns0's reference types. async-opcua loads
+/// them under one write lock when the server starts, so once HasComponent is known to be hierarchical, all
+/// of ns0 is there.
+async fn wait_for_ns0_types(handle: &opcua::server::ServerHandle) -> Result<(), String> {
+    use opcua::nodes::TypeTree;
+    use opcua::types::ReferenceTypeId;
+    let (component, hierarchical) = (ReferenceTypeId::HasComponent.into(), ReferenceTypeId::HierarchicalReferences.into());
+    for _ in 0..3000 {
+        if handle.type_tree().read().is_subtype_of(&component, &hierarchical) {
+            return Ok(());
+        }
+        tokio::time::sleep(Duration::from_millis(10)).await;
+    }
+    Err("the server did not load the OPC UA namespace's types within 30 s".into())
 }
