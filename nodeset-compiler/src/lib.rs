@@ -107,6 +107,8 @@ mod par;
 pub mod parse;
 pub mod raw;
 pub mod resolve;
+#[cfg(feature = "serve")]
+pub mod serve;
 pub mod source;
 pub mod summary;
 pub mod value;

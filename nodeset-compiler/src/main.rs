@@ -145,6 +145,48 @@ yet is put in PKI/rejected/ and the run stops: check it, move it to PKI/trusted/
 Example: nodeset-compiler verify opc.tcp://localhost:4855/ --models nodesets --pki verify-pki \
 --user operator --password-env OPERATOR_PASSWORD")]
     Verify(VerifyArgs),
+    /// Serve NodeSet2 files on an OPC UA server: their address space and their required models' (ns0 from
+    /// async-opcua), from tables built in memory; no Rust is generated or compiled.
+    #[cfg(feature = "serve")]
+    #[command(after_help = "Secure by default: Basic256Sha256, Aes128_Sha256_RsaOaep and Aes256_Sha256_RsaPss in Sign and \
+SignAndEncrypt, the server's certificate created in the PKI folder on first start (own/, private/, trusted/, rejected/, \
+issuers/); anonymous sessions may read, the users of --users FILE (`nodeset-users add FILE NAME ROLES`) write and call \
+as their roles and the nodesets' RolePermissions allow. A client certificate is refused and put in PKI/rejected/ \
+until moved to PKI/trusted/ (or --trust-on-first-use). --insecure adds a SecurityPolicy None endpoint.\n\n\
+It prints `listening on URL` once clients may connect, and stops on Ctrl-C, SIGTERM or after --seconds.\n\n\
+Example: nodeset-compiler serve nodesets/vendor/Opc.Ua.Robotics.NodeSet2.xml --models nodesets/vendor --instantiate-all")]
+    Serve(ServeArgs),
+}
+
+/// The arguments of `nodeset-compiler serve`.
+#[cfg(feature = "serve")]
+#[derive(Args)]
+struct ServeArgs {
+    #[command(flatten)]
+    common: Common,
+    /// Create one instance of every concrete ObjectType of the named files, at Objects/Instances/<TypeName>
+    /// (mandatory members, one element per MandatoryPlaceholder, state machines in their initial state).
+    #[arg(long)]
+    instantiate_all: bool,
+    /// The TCP port (0 picks a free one).
+    #[arg(long, default_value_t = 4840)]
+    port: u16,
+    /// The PKI folder (default: pki/nodeset-compiler-serve); the certificate is created there on first start.
+    #[arg(long, value_name = "DIR")]
+    pki: Option<PathBuf>,
+    /// The user file (users, password hashes, roles).
+    #[arg(long, value_name = "FILE")]
+    users: Option<PathBuf>,
+    /// Trust every client certificate on first use (development only).
+    #[arg(long)]
+    trust_on_first_use: bool,
+    /// Also open a SecurityPolicy None endpoint, on which anonymous sessions act as Operator (loopback
+    /// testing only).
+    #[arg(long)]
+    insecure: bool,
+    /// Stop after N seconds.
+    #[arg(long, value_name = "N")]
+    seconds: Option<u64>,
 }
 
 /// The arguments of `nodeset-compiler verify`.
@@ -369,6 +411,27 @@ fn verify_command(args: &VerifyArgs) -> ExitCode {
     }
 }
 
+#[cfg(feature = "serve")]
+fn serve_command(args: &ServeArgs) -> Result<(), Error> {
+    use nodeset_compiler::serve::{serve, ServeOptions};
+    let (compiled, _) = compile_checked(&args.common)?;
+    let opts = ServeOptions {
+        port: args.port,
+        host: None,
+        pki: args.pki.clone(),
+        users: args.users.clone(),
+        trust_on_first_use: args.trust_on_first_use,
+        insecure: args.insecure,
+        instantiate_all: args.instantiate_all,
+        seconds: args.seconds,
+    };
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .enable_all()
+        .build()
+        .map_err(|e| Error::Config(format!("cannot start the async runtime: {e}")))?;
+    runtime.block_on(serve(&compiled.model, &opts)).map_err(Error::Config)
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
@@ -378,6 +441,8 @@ fn main() -> ExitCode {
         Command::Codes { codes } => codes_command(codes),
         #[cfg(feature = "verify")]
         Command::Verify(args) => return verify_command(args),
+        #[cfg(feature = "serve")]
+        Command::Serve(args) => serve_command(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -513,6 +513,18 @@ pub struct StateMachineInfo {
     pub event_type: Option<NodeIx>,
 }
 
+impl StateMachineInfo {
+    /// The index in [`StateMachineInfo::states`] of a transition's FromState or ToState target: the state
+    /// itself, or the state of the same BrowseName (a subtype may override a state, while a transition it
+    /// inherits still names the supertype's state object, which is the same state).
+    pub fn state_index(&self, model: &Model, s: NodeIx) -> Option<usize> {
+        self.states
+            .iter()
+            .position(|x| x.node == s)
+            .or_else(|| self.states.iter().position(|x| model.node(x.node).browse_name == model.node(s).browse_name))
+    }
+}
+
 /// How a loaded file maps its local namespace indices and aliases (needed to decode its values).
 #[derive(Clone, Debug)]
 pub struct FileContext {

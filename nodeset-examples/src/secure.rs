@@ -50,15 +50,13 @@ impl SecureArgs {
             config = config.users(Users::load(file).map_err(|e| e.to_string())?);
         }
         if self.trust_on_first_use {
-            eprintln!("WARNING: {}: --trust-on-first-use: every client certificate is trusted on first use (development only)", config.application_name);
             config = config.trust_on_first_use();
         }
         if self.insecure {
-            eprintln!(
-                "WARNING: {}: --insecure: a SecurityPolicy None endpoint is open, and anonymous sessions may write and call methods (loopback testing only)",
-                config.application_name
-            );
             config = config.insecure();
+        }
+        for warning in config.warnings() {
+            eprintln!("{warning}");
         }
         Ok(config)
     }

@@ -265,6 +265,21 @@ fn dims(d: &[u32]) -> Option<Vec<u32>> {
     }
 }
 
+/// The ArrayDimensions of an Argument: as written, padded with 0 (a dimension of unknown length) to the
+/// ValueRank of an array argument. Nodesets often leave them empty (`<ArrayDimensions/>`) where Part 3 wants
+/// one entry per dimension, and async-opcua refuses to encode such an Argument: the whole Read of the
+/// InputArguments would fail with `BadEncodingError` (IOLink's ReadISDU). async-opcua's decoder pads the
+/// same way.
+fn argument_dims(value_rank: i32, d: &[u32]) -> Option<Vec<u32>> {
+    let rank = usize::try_from(value_rank).unwrap_or(0);
+    if rank > d.len() {
+        let mut padded = d.to_vec();
+        padded.resize(rank, 0);
+        return Some(padded);
+    }
+    dims(d)
+}
+
 /// Everything a row needs to be turned into async-opcua values: the table (for lookups and messages) and
 /// its namespace map.
 struct Ctx<'a> {
@@ -417,7 +432,7 @@ impl Ctx<'_> {
             name: a.name.into(),
             data_type: self.node_id(a.data_type, node, "argument DataType"),
             value_rank: a.value_rank,
-            array_dimensions: dims(a.array_dimensions),
+            array_dimensions: argument_dims(a.value_rank, a.array_dimensions),
             description: Self::text(a.description),
         })
         .into()
@@ -550,6 +565,15 @@ mod tests {
         assert_eq!(parse_date_time("2021-05-20T02:00:00+02:00").unwrap(), utc);
         assert!(parse_date_time("2021-05-20T00:00:00.125Z").is_some());
         assert!(parse_date_time("yesterday").is_none());
+    }
+
+    #[test]
+    fn array_arguments_get_one_dimension_per_rank() {
+        assert_eq!(argument_dims(1, &[]), Some(vec![0]));
+        assert_eq!(argument_dims(2, &[3]), Some(vec![3, 0]));
+        assert_eq!(argument_dims(1, &[4]), Some(vec![4]));
+        assert_eq!(argument_dims(-1, &[]), None);
+        assert_eq!(argument_dims(0, &[]), None);
     }
 
     #[test]

@@ -10,13 +10,12 @@
 //! mandatory paths of the model's hierarchy.
 
 use nodeset_compiler::diag::Code;
-use nodeset_compiler::emit::rust::{default_module_name, node_tables, NodeTable, RustConfig, RustNamespace, RustPath};
 use nodeset_compiler::load::Input;
 use nodeset_compiler::model::{Member, Model, ModellingRule, NodeIx};
+use nodeset_compiler::serve::{self, instances::mandatory_paths};
 use nodeset_compiler::raw::NodeClass;
 use nodeset_compiler::{compile, summary, Compiled, Options};
 use nodeset_runtime::server::ServerConfig;
-use nodeset_runtime::table::{NodeSetTable, Nodes, Packed};
 use nodeset_runtime::typed::{Instantiate, InstantiateError};
 use nodeset_tests::{root, vendor};
 use opcua::types::{BrowseDirection, NodeId, QualifiedName, ReferenceTypeId};
@@ -116,75 +115,17 @@ fn check_show_lists_the_inherited_members_of_an_override() {
     assert!(prefixes.contains("DI") && prefixes.contains("vendor_robot"), "a prefix is one segment where that is unique: {prefixes:?}");
 }
 
-/// Every mandatory path of an instance of `t` in the model's hierarchy, as the runtime names the nodes it
-/// creates (`ParameterSet/SpeedOverride`; one element `P1` in each MandatoryPlaceholder), and the paths of
-/// the MandatoryPlaceholders, to name their element when instantiating.
-fn model_paths(m: &Model, t: NodeIx) -> (BTreeSet<String>, Vec<String>) {
-    fn walk(m: &Model, members: Vec<Member>, prefix: &str, depth: usize, out: &mut (BTreeSet<String>, Vec<String>)) {
-        assert!(depth < 16, "the hierarchy below {prefix} nests too deep for a test type");
-        for x in members {
-            let n = m.node(x.node);
-            let name = &x.browse_name.name;
-            let path = match n.modelling_rule {
-                Some(ModellingRule::Mandatory) => format!("{prefix}{name}"),
-                Some(ModellingRule::MandatoryPlaceholder) => {
-                    out.1.push(format!("{prefix}{name}"));
-                    format!("{prefix}P1")
-                }
-                _ => continue,
-            };
-            out.0.insert(path.clone());
-            if n.class == NodeClass::Method {
-                // A method is copied with its argument properties.
-                for (_, c) in m.children(x.node) {
-                    out.0.insert(format!("{path}/{}", m.node(c).browse_name.name));
-                }
-            } else {
-                walk(m, m.instance_members(x.node), &format!("{path}/"), depth + 1, out);
-            }
-        }
-    }
-    let mut out = (BTreeSet::new(), Vec::new());
-    let root: Vec<Member> = m.members[&t].iter().filter(|x| m.node(x.node).modelling_rule.is_some()).cloned().collect();
-    walk(m, root, "", 0, &mut out);
-    out
-}
-
-/// A node table built in memory, as `'static` as the generated ones.
-fn leak(t: NodeTable) -> &'static NodeSetTable {
-    let namespaces: Vec<&'static str> = t.namespaces.into_iter().map(|u| &*Box::leak(u.into_boxed_str())).collect();
-    Box::leak(Box::new(NodeSetTable {
-        namespace_uri: Box::leak(t.namespace_uri.into_boxed_str()),
-        version: Box::leak(t.version.into_boxed_str()),
-        publication_date: Box::leak(t.publication_date.into_boxed_str()),
-        namespaces: Box::leak(namespaces.into_boxed_slice()),
-        own: t.own,
-        nodes: Nodes::Packed(Packed::new(Box::leak(t.rows.into_boxed_str()))),
-    }))
-}
-
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn instantiate_creates_exactly_the_model_hierarchy() {
     let out = vendor_model();
     let m = &out.model;
-    // Every model but ns0 as a table, dependencies first (the model's order).
-    let namespaces: Vec<RustNamespace> = m
-        .models
-        .iter()
-        .filter(|x| x.ns != 0)
-        .map(|x| RustNamespace { uri: x.uri.clone(), module: format!("{}_{}", default_module_name(&x.uri), x.ns) })
-        .collect();
-    let cfg = RustConfig {
-        namespaces,
-        extern_paths: Default::default(),
-        runtime_path: RustPath::new("crate::runtime").unwrap(),
-        command: "test".into(),
-    };
-    let (tables, diags) = node_tables(m, &cfg);
+    // Every model but ns0 as a table, dependencies first (the model's order), built in memory as `serve`
+    // builds them.
+    let (tables, diags) = serve::tables(m);
     assert!(diags.items.is_empty(), "the tables build without diagnostics");
     let mut config = ServerConfig::new("inheritance").port(0).insecure_only();
     for t in tables {
-        config = config.table(leak(t));
+        config = config.table(t);
     }
     let server = config.build().expect("the server builds");
     let manager = server.manager().clone();
@@ -210,7 +151,7 @@ async fn instantiate_creates_exactly_the_model_hierarchy() {
         .collect();
     for (uri, t) in types {
         let name = &m.node(t).browse_name.name;
-        let (want, placeholders) = model_paths(m, t);
+        let (want, placeholders) = mandatory_paths(m, t, &|_| "P1".to_owned()).expect("no type of the fixture contains itself");
         let options = placeholders.iter().fold(Instantiate::new(), |o, p| o.placeholder(p.clone(), ["P1"]));
         let type_id = NodeId::new(manager.namespace_index(&uri).expect("namespace served"), node_number(m, t));
         let id = manager

@@ -17,13 +17,14 @@
 //! The command and the examples come from `cargo test --workspace --no-run`, as in `interop.rs`. The test
 //! fails, never skips, when node or the node-opcua packages are missing, saying how to install them.
 
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use nodeset_compiler::diag::Severities;
 use nodeset_compiler::load::Input;
 use nodeset_compiler::{compile, Options};
-use nodeset_tests::{corpus, executable, root, vendor};
+use nodeset_tests::{command_binary, corpus, executable, root, vendor};
 use process_support::Process;
 
 /// The URLs of the next `n` lines that contain `listening on <url>`.
@@ -382,5 +383,119 @@ fn a_server_that_does_not_trust_verify_says_so_at_once() {
     std::fs::rename(&rejected[0], server_pki.join("trusted").join(rejected[0].file_name().unwrap())).unwrap();
     assert_clean(&url, &["--pki", client_pki.to_str().unwrap(), "--trust-server-cert"], &[]);
     drop(server);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `nodeset-compiler serve FILES --models ... ARGS --port 0 --pki PKI`, its stderr in `stderr`; the server
+/// and its URL once it listens.
+fn serve(files: &[PathBuf], args: &[&str], pki: &Path, stderr: &Path) -> (Process, String) {
+    let mut command = Command::new(command_binary());
+    command.current_dir(root()).arg("serve").args(files).args(models()).args(args);
+    command.args(["--port", "0", "--pki", pki.to_str().unwrap()]);
+    command.stderr(std::fs::File::create(stderr).unwrap());
+    let server = Process::spawn(&mut command).unwrap_or_else(|e| panic!("{e}"));
+    let url = server.wait_for("listening on ", process_support::STARTUP).unwrap_or_else(|e| {
+        panic!("{e}; serve said:\n{}", std::fs::read_to_string(stderr).unwrap_or_default())
+    });
+    (server, url)
+}
+
+/// The vendor fixture and Robotics as `serve` names them (Robotics as a named file, so its types are
+/// instantiated too).
+fn robotics_and_vendor() -> Vec<PathBuf> {
+    let fixture = root().join("tests/fixtures/vendor_robot");
+    vec![vendor().join("Opc.Ua.Robotics.NodeSet2.xml"), fixture.join("Example.VendorRobot.NodeSet2.xml")]
+}
+
+/// `--models` for `serve` and `verify` of the vendor fixture.
+fn vendor_models() -> [String; 2] {
+    ["--models".into(), root().join("tests/fixtures/vendor_robot").display().to_string()]
+}
+
+#[test]
+fn serve_instantiates_every_type_and_verify_and_node_opcua_find_them_sound() {
+    let dir = temp_dir("serve-all");
+    let (pki, client_pki, node_pki, log) = (dir.join("server-pki"), dir.join("verify-pki"), dir.join("node-pki"), dir.join("serve.log"));
+    let extra = vendor_models();
+    // Secure only (no --insecure): the clients come in over SignAndEncrypt, their certificates trusted on
+    // first use.
+    let args: Vec<&str> = extra.iter().map(String::as_str).chain(["--instantiate-all", "--trust-on-first-use"]).collect();
+    let (server, url) = serve(&robotics_and_vendor(), &args, &pki, &log);
+    let said = std::fs::read_to_string(&log).unwrap();
+    // Robotics' 24 concrete ObjectTypes and the fixture's ArmType and ArmXType, each instantiated.
+    assert!(said.contains("instantiated 26 of 26 concrete ObjectType(s) below Objects/Instances"), "{said}");
+    assert!(!said.contains("is not instantiated"), "{said}");
+    assert!(said.contains("WARNING: nodeset-compiler serve: --trust-on-first-use"), "{said}");
+    assert!(!said.contains("--insecure"), "no None endpoint was asked for: {said}");
+
+    let mut command = Command::new(command_binary());
+    command.current_dir(root()).arg("verify").arg(&url).args(models()).args(&extra);
+    command.args(["--pki", client_pki.to_str().unwrap(), "--trust-server-cert", "--json"]);
+    let output = command.output().expect("verify runs");
+    let json = String::from_utf8_lossy(&output.stdout);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    // Every instance below Objects/Instances (and every static instance of the files) conforms to its type.
+    assert_eq!(findings(&json), Vec::<(String, String)>::new(), "{json}\n{stderr}");
+    assert!(output.status.success(), "{json}\n{stderr}");
+    assert!(number(&json, "checked") > 300, "{json}");
+
+    // node-opcua browses Objects/Instances and reads every variable there, over SignAndEncrypt.
+    let peer = node_peer();
+    let output = Command::new("node").current_dir(&peer).arg("browse.js").arg(&url).arg("Instances").arg(&node_pki).output().expect("node runs");
+    let out = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{out}\n{}", String::from_utf8_lossy(&output.stderr));
+    let summary = out.lines().last().unwrap_or_default();
+    let count = |key: &str| -> u64 {
+        let words: Vec<&str> = summary.split(' ').collect();
+        let at = words.iter().position(|w| *w == key).unwrap_or_else(|| panic!("no {key} in {summary}"));
+        words[at + 1].parse().unwrap()
+    };
+    assert!(count("variables") > 200 && count("objects") > 80 && count("methods") > 0, "{out}");
+    assert_eq!((count("bad"), count("good") + count("uncertain")), (0, count("variables")), "{out}");
+    // Values come from the nodeset or the DataType's default; only structures (EUInformation, RationalNumber)
+    // and BaseDataType (a ParameterSet's placeholder element) have none.
+    let empty: Vec<&str> = out.lines().filter(|l| l.starts_with("empty ")).collect();
+    assert_eq!(empty.len() as u64, count("empty"), "{out}");
+    let empty_types: BTreeSet<&str> = empty.iter().filter_map(|l| l.rsplit(' ').next()).collect();
+    assert_eq!(empty_types, BTreeSet::from(["ns=0;i=18806", "ns=0;i=24", "ns=0;i=887"]), "{out}");
+    // The state machines start in their initial state (Robotics marks one in its substate machines only).
+    assert!(out.lines().any(|l| l == "state Instances/IdleSubstateMachineType/CurrentState StandBy"), "{out}");
+    assert!(said.contains("2 state machine(s) served"), "{said}");
+    // SIGTERM stops it cleanly.
+    server.stop().unwrap_or_else(|e| panic!("{e}"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn serve_is_secure_by_default() {
+    let dir = temp_dir("serve-secure");
+    let files = [root().join("tests/fixtures/vendor_robot/Example.VendorRobot.NodeSet2.xml")];
+    let extra = vendor_models();
+    let args: Vec<&str> = extra.iter().map(String::as_str).collect();
+    let (server, url) = serve(&files, &args, &dir.join("pki"), &dir.join("secure.log"));
+    // The PKI folder has the runtime's layout, the certificate created on first start.
+    for sub in ["own/cert.der", "private/private.pem", "trusted", "rejected", "issuers"] {
+        assert!(dir.join("pki").join(sub).exists(), "{sub}");
+    }
+    // No None endpoint: a client that asks for one gets no session.
+    let verify_insecure = |url: &str| {
+        let mut command = Command::new(command_binary());
+        command.current_dir(root()).arg("verify").arg(url).args(models()).args(&extra).args(["--insecure", "--json"]);
+        command.output().expect("verify runs")
+    };
+    let output = verify_insecure(&url);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("None"), "{stderr}");
+    assert!(!std::fs::read_to_string(dir.join("secure.log")).unwrap().contains("WARNING"), "the secure defaults warn of nothing");
+    server.stop().unwrap_or_else(|e| panic!("{e}"));
+    // --insecure adds it, with the runtime's warning; --seconds ends the server by itself, cleanly.
+    let (server, url) = serve(&files, &[&args[..], &["--insecure", "--seconds", "10"]].concat(), &dir.join("pki"), &dir.join("insecure.log"));
+    let said = std::fs::read_to_string(dir.join("insecure.log")).unwrap();
+    assert!(said.contains("WARNING: nodeset-compiler serve: --insecure: a SecurityPolicy None endpoint is open"), "{said}");
+    let output = verify_insecure(&url);
+    let json = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{json}\n{}", String::from_utf8_lossy(&output.stderr));
+    server.wait_for("server stopped cleanly", std::time::Duration::from_secs(40)).unwrap_or_else(|e| panic!("{e}"));
     let _ = std::fs::remove_dir_all(&dir);
 }

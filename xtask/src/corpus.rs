@@ -29,7 +29,7 @@ pub(crate) fn module_for(tree: &Path, file: &Path) -> String {
     format!("m_{}", sanitize(&rel, Case::Snake, Target::Rust).trim_start_matches("r#"))
 }
 
-fn nodeset_files(dir: &Path, out: &mut Vec<PathBuf>) {
+pub(crate) fn nodeset_files(dir: &Path, out: &mut Vec<PathBuf>) {
     let Ok(entries) = std::fs::read_dir(dir) else { return };
     for e in entries.flatten() {
         let p = e.path();

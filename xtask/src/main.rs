@@ -18,6 +18,7 @@ mod generate;
 mod load;
 mod one_at_a_time;
 mod registry;
+mod serve_corpus;
 mod soak;
 mod test;
 mod user_crate;
@@ -54,6 +55,9 @@ enum Command {
     /// Every NodeSet2 file of the pinned registry package through check, Rust (compiled) and Modelica (rumoca and
     /// the structural checks; `--pymoca` adds pymoca).
     Registry(registry::Args),
+    /// Every file of the UA-Nodeset tree and of the registry package served with `nodeset-compiler serve
+    /// --instantiate-all`, then checked with `nodeset-compiler verify`; figures and failures at the end.
+    ServeCorpus(serve_corpus::Args),
     /// Run one cargo-fuzz target of fuzz/ for a number of seconds (installs cargo-fuzz, builds the seeds).
     Fuzz(fuzz::Args),
     /// Regenerate generated/ from the pinned companion specifications (`--check`: fail if stale).
@@ -80,6 +84,7 @@ fn main() -> ExitCode {
         Command::Corpus(args) => corpus::run(args),
         Command::OneAtATime(args) => one_at_a_time::run(args),
         Command::Registry(args) => registry::run(args),
+        Command::ServeCorpus(args) => serve_corpus::run(args),
         Command::Fuzz(args) => fuzz::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Load(args) => load::run(args),

@@ -32,6 +32,19 @@ pub struct Args {
     pymoca: bool,
 }
 
+/// The runs the registry package's files are named in: every current file alone; the older files of `1.02/`,
+/// which declare no <Model> (so none of them can require another), together (DI, ADI, FTNIR), as a user of
+/// that set must.
+pub(crate) fn units(vendor: &Path) -> Vec<Vec<PathBuf>> {
+    let files: Vec<PathBuf> = crate::fetch::SELECTION.iter().map(|w| vendor.join(w.name)).collect();
+    let old_order = ["Opc.Ua.Di.NodeSet2.xml", "Opc.Ua.Adi.NodeSet2.xml", "FTNIR.NodeSet2.xml"];
+    let mut old: Vec<PathBuf> = files.iter().filter(|f| rel(vendor, f).starts_with("1.02/")).cloned().collect();
+    old.sort_by_key(|f| old_order.iter().position(|n| f.ends_with(n)).unwrap_or(old_order.len()));
+    let mut units: Vec<Vec<PathBuf>> = files.iter().filter(|f| !old.contains(f)).map(|f| vec![f.clone()]).collect();
+    units.push(old);
+    units
+}
+
 pub fn run(args: Args) -> Result<(), String> {
     let start = Instant::now();
     crate::fetch::ensure_fetched()?;
@@ -40,13 +53,7 @@ pub fn run(args: Args) -> Result<(), String> {
     let vendor = root.join(crate::fetch::VENDOR_DIR).canonicalize().map_err(|e| format!("{}: {e}", crate::fetch::VENDOR_DIR))?;
     let out = args.out.unwrap_or_else(|| root.join("target/registry"));
     let files: Vec<PathBuf> = crate::fetch::SELECTION.iter().map(|w| vendor.join(w.name)).collect();
-    // The older files of `1.02/` declare no <Model>, so none of them can require another: they are named
-    // together (DI, ADI, FTNIR), as a user of that set must. Every current file is named alone.
-    let old_order = ["Opc.Ua.Di.NodeSet2.xml", "Opc.Ua.Adi.NodeSet2.xml", "FTNIR.NodeSet2.xml"];
-    let mut old: Vec<PathBuf> = files.iter().filter(|f| rel(&vendor, f).starts_with("1.02/")).cloned().collect();
-    old.sort_by_key(|f| old_order.iter().position(|n| f.ends_with(n)).unwrap_or(old_order.len()));
-    let mut units: Vec<Vec<PathBuf>> = files.iter().filter(|f| !old.contains(f)).map(|f| vec![f.clone()]).collect();
-    units.push(old);
+    let units = units(&vendor);
     let unit_name = |u: &[PathBuf]| u.iter().map(|f| rel(&vendor, f)).collect::<Vec<_>>().join(" + ");
 
     // 1. check.

@@ -189,10 +189,15 @@ pub fn find_model_files(dirs: &[PathBuf], uris: &[String]) -> BTreeMap<String, P
     uris.iter().filter_map(|uri| ranked(&index, uri).first().map(|c| (uri.clone(), c.path.clone()))).collect()
 }
 
-/// The models the header of a NodeSet2 file declares (URIs), without parsing the rest; `None` if the file
-/// cannot be read or is not a NodeSet2 file.
+/// The models the header of a NodeSet2 file declares (URIs), without parsing the rest; for a file without
+/// `<Models>`, the model it implies for its first namespace (as the loader implies one, and prefers it to a
+/// file of a models folder); `None` if the file cannot be read or is not a NodeSet2 file.
 pub fn models_of_file(path: &Path) -> Option<Vec<String>> {
-    declared_models(path).map(|models| models.into_iter().map(|(uri, _, _)| uri).collect())
+    let header = scan_header(path)?;
+    if header.models.is_empty() {
+        return Some(header.own_namespace.into_iter().collect());
+    }
+    Some(header.models.into_iter().map(|(uri, _, _)| uri).collect())
 }
 
 /// The models the header of a NodeSet2 file declares, each as its ModelUri, Version and PublicationDate, read

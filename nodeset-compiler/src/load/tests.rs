@@ -36,6 +36,11 @@ fn header_scan_stops_at_models_but_answers_as_the_full_prefix_would() {
         std::fs::write(&path, text).unwrap();
         assert_eq!(&scan_header(&path), want, "case {i}");
     }
+    // What a named file provides, for `verify`: the models it declares, or the one its first namespace
+    // implies (an old ADI named beside the current one in a models folder must keep its namespace).
+    assert_eq!(models_of_file(&dir.join("0.xml")), Some(vec!["http://x/".to_string()]));
+    assert_eq!(models_of_file(&dir.join("4.xml")), Some(vec!["http://old/".to_string()]));
+    assert_eq!(models_of_file(&dir.join("3.xml")), None);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

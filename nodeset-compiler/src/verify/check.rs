@@ -481,10 +481,18 @@ impl<'a> Checker<'a> {
                 continue;
             }
             let child_type = self.target_of(child, ids::HAS_TYPE_DEFINITION).and_then(|t| self.lookup(t));
-            let fits = places.iter().find(|m| match (model.node(m.node).type_definition, child_type) {
+            let type_fits = |m: &&&Member| match (model.node(m.node).type_definition, child_type) {
                 (Some(want), Some(have)) => model.is_subtype_of(have, want),
                 _ => true,
-            });
+            };
+            // Of the placeholders of its type, a variable stands in the place of one whose DataType it has
+            // (Safety's SafetyPDUsType: `<RequestSPDU>` and `<ResponseSPDU>` are both BaseDataVariables).
+            let child_dt = child.data_type.as_ref().and_then(|d| self.lookup(d));
+            let data_type_fits = |m: &&&Member| match (model.node(m.node).attrs.data_type, child_dt) {
+                (Some(want), Some(have)) => model.is_subtype_of(have, want),
+                _ => true,
+            };
+            let fits = places.iter().find(|m| type_fits(m) && data_type_fits(m)).or_else(|| places.iter().find(|m| type_fits(m)));
             let child_path = join(path, &child.browse_name);
             match fits {
                 Some(m) => {

@@ -233,6 +233,25 @@ impl ServerConfig {
         self
     }
 
+    /// What this configuration weakens, one line each, for a server to print when it starts: the None
+    /// endpoint ([`ServerConfig::insecure`]) and trust on first use. Empty for the secure defaults.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.security.trust_on_first_use {
+            out.push(format!(
+                "WARNING: {}: --trust-on-first-use: every client certificate is trusted on first use (development only)",
+                self.application_name
+            ));
+        }
+        if self.security.insecure {
+            out.push(format!(
+                "WARNING: {}: --insecure: a SecurityPolicy None endpoint is open, and anonymous sessions may write and call methods (loopback testing only)",
+                self.application_name
+            ));
+        }
+        out
+    }
+
     /// Binds the port and builds the server, importing every table.
     ///
     /// Fails if the PKI folder cannot be used (see [`security::prepare_pki`]), the port cannot be bound or

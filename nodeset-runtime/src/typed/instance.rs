@@ -25,7 +25,7 @@ use super::handle::BindError;
 use crate::server::ModelManager;
 
 /// How deep instance declarations may nest (a guard against types that contain themselves).
-const MAX_DEPTH: usize = 32;
+pub(crate) const MAX_DEPTH: usize = 32;
 
 /// What to create besides the mandatory members, and where.
 ///
@@ -40,6 +40,7 @@ pub struct Instantiate {
     placeholders: BTreeMap<String, Vec<(String, Option<NodeId>)>>,
     reference_type: Option<NodeId>,
     node_id: Option<NodeId>,
+    data_type_defaults: bool,
 }
 
 impl Instantiate {
@@ -78,6 +79,15 @@ impl Instantiate {
     /// TypeDefinition).
     pub fn placeholder_of_type(mut self, path: impl Into<String>, name: impl Into<String>, type_id: NodeId) -> Instantiate {
         self.placeholders.entry(path.into()).or_default().push((name.into(), Some(type_id)));
+        self
+    }
+
+    /// Give every new variable whose declaration has no value the default of its DataType (zero, the empty
+    /// string, an enumeration's first value, an empty array; structures get none), so that clients read a
+    /// value of the declared type rather than an empty one. Off by default: the typed API binds such
+    /// variables to fields.
+    pub fn data_type_defaults(mut self) -> Instantiate {
+        self.data_type_defaults = true;
         self
     }
 
@@ -238,13 +248,13 @@ impl<'a> Spaces<'a> {
         Some(self.model).filter(|m| m.node_exists(id)).or(self.core.filter(|c| c.node_exists(id)))
     }
 
-    fn find(&self, id: &NodeId) -> Option<&'a NodeType> {
+    pub(super) fn find(&self, id: &NodeId) -> Option<&'a NodeType> {
         self.space_of(id)?.find(id)
     }
 
     /// Forward references of `node` of type `rt` (or, for HierarchicalReferences, any hierarchical type),
     /// as (reference type, target).
-    fn refs(&self, node: &NodeId, rt: ReferenceTypeId) -> Vec<(NodeId, NodeId)> {
+    pub(super) fn refs(&self, node: &NodeId, rt: ReferenceTypeId) -> Vec<(NodeId, NodeId)> {
         let wanted = NodeId::from(rt);
         let hierarchical = rt == ReferenceTypeId::HierarchicalReferences;
         let mut out: Vec<(NodeId, NodeId)> = Vec::new();
@@ -308,7 +318,9 @@ impl<'a> Spaces<'a> {
                 }
             }
             depth += 1;
-            current = if depth < MAX_DEPTH { self.tree.get_supertype(&t).cloned() } else { None };
+            // By the address spaces' HasSubtype references, not the type tree: the tree holds ns0's types only
+            // once the server runs, and a type's ns0 supertypes (BaseEventType's EventId, ...) count before.
+            current = if depth < MAX_DEPTH { self.supertype(&t) } else { None };
         }
         out
     }
@@ -367,14 +379,19 @@ impl<'a> Spaces<'a> {
             if c == *of {
                 return true;
             }
-            cur = [Some(self.model), self.core].into_iter().flatten().find_map(|space| {
-                space
-                    .find_references(&c, Some((ReferenceTypeId::HasSubtype, false)), self.tree, BrowseDirection::Inverse)
-                    .next()
-                    .map(|r| r.target_node.clone())
-            });
+            cur = self.supertype(&c);
         }
         false
+    }
+
+    /// The supertype of a type, by the inverse HasSubtype reference in either address space.
+    pub(super) fn supertype(&self, t: &NodeId) -> Option<NodeId> {
+        [Some(self.model), self.core].into_iter().flatten().find_map(|space| {
+            space
+                .find_references(t, Some((ReferenceTypeId::HasSubtype, false)), self.tree, BrowseDirection::Inverse)
+                .next()
+                .map(|r| r.target_node.clone())
+        })
     }
 }
 
@@ -442,7 +459,10 @@ impl<'a> Planner<'a> {
         let base = Base::new_full(id.clone(), class, browse_name, display_name, description, None, None);
         let node: NodeType = match (class, source.template) {
             (NodeClass::Variable, Some(NodeType::Variable(v))) => {
-                let value = v.value(TimestampsToReturn::Neither, &NumericRange::None, &DataEncoding::Binary, 0.0);
+                let mut value = v.value(TimestampsToReturn::Neither, &NumericRange::None, &DataEncoding::Binary, 0.0);
+                if value.value.is_none() && self.options.data_type_defaults {
+                    value.value = self.spaces.default_value(&v.data_type(), v.value_rank());
+                }
                 let now = DateTime::now();
                 let value = DataValue { source_timestamp: Some(now), server_timestamp: Some(now), ..value };
                 VariableNode::new_full(
@@ -459,7 +479,10 @@ impl<'a> Planner<'a> {
                 .into()
             }
             (NodeClass::Variable, Some(NodeType::VariableType(vt))) => {
-                let value = vt.value().cloned().unwrap_or_default();
+                let mut value = vt.value().cloned().unwrap_or_default();
+                if value.value.is_none() && self.options.data_type_defaults {
+                    value.value = self.spaces.default_value(vt.data_type(), vt.value_rank());
+                }
                 VariableNode::new_full(base, vt.data_type().clone(), false, vt.value_rank(), value, 1, 1, vt.array_dimensions(), None)
                     .into()
             }

@@ -5,6 +5,7 @@
 //! [`TypeHandle`]s, and the member markers that `nodeset-derive` checks bindings against and typed clients
 //! read ([`VariableMember`], [`MethodMember`]).
 
+mod defaults;
 pub mod handle;
 pub mod instance;
 pub mod model;

@@ -935,6 +935,14 @@ impl Machine {
         Machine::serve_table(&M::TABLE, machine.state_machine_node(), initial)
     }
 
+    /// Serves the state machine instance `instance` by a table built at run time rather than generated
+    /// (`nodeset-compiler serve` builds one per state machine type of the model), starting in the table's
+    /// initial state (`NoInitialState` if it has none).
+    pub fn serve_by_table(table: &'static StateTable, instance: &ObjectNode) -> Result<Machine, ProgramError> {
+        let initial = table.states.iter().position(|s| s.initial).ok_or(ProgramError::NoInitialState)?;
+        Machine::serve_table(table, instance, initial)
+    }
+
     fn serve_table(table: &'static StateTable, instance: &ObjectNode, initial: usize) -> Result<Machine, ProgramError> {
         let core = Core::new(table, instance)?;
         core.show_state(initial);

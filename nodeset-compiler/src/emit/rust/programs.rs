@@ -293,14 +293,7 @@ impl Gen<'_> {
 
     fn table_tokens(&self, info: &StateMachineInfo, uris: &mut BTreeMap<String, usize>) -> TokenStream {
         let model = self.model;
-        let index = |s: NodeIx| -> Option<usize> {
-            // A subtype may override a state; a transition inherited from the supertype still names the
-            // supertype's state object, which is the same state by BrowseName.
-            info.states
-                .iter()
-                .position(|x| x.node == s)
-                .or_else(|| info.states.iter().position(|x| model.node(x.node).browse_name == model.node(s).browse_name))
-        };
+        let index = |s: NodeIx| info.state_index(model, s);
         let opt = |n: Option<u32>| match n {
             Some(n) => {
                 let n = Literal::u32_unsuffixed(n);

@@ -14,13 +14,13 @@ const BOX_MODEL: &str = r#"<?xml version="1.0" encoding="utf-8"?>
   <NamespaceUris><Uri>urn:test:verify</Uri></NamespaceUris>
   <Models><Model ModelUri="urn:test:verify" Version="1.0.0" PublicationDate="2024-01-01T00:00:00Z">
     <RequiredModel ModelUri="http://opcfoundation.org/UA/" Version="1.05.00"/></Model></Models>
-  <Aliases><Alias Alias="Double">i=11</Alias><Alias Alias="HasProperty">i=46</Alias><Alias Alias="HasComponent">i=47</Alias>
+  <Aliases><Alias Alias="Double">i=11</Alias><Alias Alias="String">i=12</Alias><Alias Alias="HasProperty">i=46</Alias><Alias Alias="HasComponent">i=47</Alias>
     <Alias Alias="HasSubtype">i=45</Alias><Alias Alias="HasTypeDefinition">i=40</Alias><Alias Alias="HasModellingRule">i=37</Alias></Aliases>
   <UAObjectType NodeId="ns=1;i=1000" BrowseName="1:BoxType">
     <References><Reference ReferenceType="HasSubtype" IsForward="false">i=61</Reference>
       <Reference ReferenceType="HasProperty">ns=1;i=1001</Reference>
       <Reference ReferenceType="HasComponent">ns=1;i=1002</Reference>
-      <Reference ReferenceType="HasComponent">ns=1;i=1003</Reference></References>
+      <Reference ReferenceType="HasComponent">ns=1;i=1003</Reference><Reference ReferenceType="HasComponent">ns=1;i=1004</Reference><Reference ReferenceType="HasComponent">ns=1;i=1005</Reference></References>
   </UAObjectType>
   <UAVariable NodeId="ns=1;i=1001" BrowseName="1:Size" DataType="Double" ParentNodeId="ns=1;i=1000">
     <References><Reference ReferenceType="HasTypeDefinition">i=68</Reference><Reference ReferenceType="HasModellingRule">i=78</Reference></References>
@@ -40,6 +40,12 @@ const BOX_MODEL: &str = r#"<?xml version="1.0" encoding="utf-8"?>
   <UAObjectType NodeId="ns=1;i=3000" BrowseName="1:OtherType">
     <References><Reference ReferenceType="HasSubtype" IsForward="false">i=58</Reference></References>
   </UAObjectType>
+  <UAVariable NodeId="ns=1;i=1004" BrowseName="1:&lt;Request&gt;" DataType="Double" ParentNodeId="ns=1;i=1000">
+    <References><Reference ReferenceType="HasTypeDefinition">i=63</Reference><Reference ReferenceType="HasModellingRule">i=11508</Reference></References>
+  </UAVariable>
+  <UAVariable NodeId="ns=1;i=1005" BrowseName="1:&lt;Response&gt;" DataType="String" ParentNodeId="ns=1;i=1000">
+    <References><Reference ReferenceType="HasTypeDefinition">i=63</Reference><Reference ReferenceType="HasModellingRule">i=11508</Reference></References>
+  </UAVariable>
 </UANodeSet>
 "#;
 
@@ -191,4 +197,29 @@ fn wrong_class_type_data_type_and_rank() {
     // Good is now an OtherType: it fills no declaration, so its own type (no members) is all it must match;
     // its children are then checked against their own types.
     assert_eq!(codes(&check(&model, &snap), "2:Good"), Vec::<(String, String)>::new());
+}
+
+#[test]
+fn a_variable_takes_the_place_of_the_placeholder_of_its_data_type() {
+    // `<Request>` (Double) and `<Response>` (String) are both BaseDataVariables: a String variable stands
+    // in the place of `<Response>`, not of the first placeholder of its TypeDefinition (Safety's
+    // SafetyPDUsType has this shape).
+    let model = model();
+    let mut snap = snapshot();
+    let good = snap.nodes.get_mut(&s("Good")).unwrap();
+    good.references.push(reference(ids::HAS_COMPONENT, s("Good.Response1")));
+    snap.nodes.insert(
+        s("Good.Response1"),
+        RemoteNode {
+            id: s("Good.Response1"),
+            class: NodeClass::Variable,
+            browse_name: QualifiedName { ns: 2, name: "Response1".into() },
+            references: vec![reference(ids::HAS_TYPE_DEFINITION, NodeId::numeric(0, 63))],
+            data_type: Some(NodeId::numeric(0, 12)),
+            value_rank: Some(-1),
+            value: Some(RemoteValue::Scalar(BuiltinType::String)),
+        },
+    );
+    let report = check(&model, &snap);
+    assert_eq!(codes(&report, "2:Good"), Vec::<(String, String)>::new(), "{:#?}", report.findings);
 }

@@ -1,0 +1,187 @@
+//! `nodeset-compiler serve`: the address space of NodeSet2 files on a secure OPC UA server, straight from the
+//! resolved model, with no Rust generated or compiled (feature `serve`).
+//!
+//! ```text
+//! Model ──emit::rust::node_tables──▶ node tables in memory ──leak──▶ &'static NodeSetTable
+//!       ──nodeset_runtime::server::ServerConfig──▶ the server the generated code would run (ns0 from async-opcua)
+//!       ──instances::instantiate_all (--instantiate-all)──▶ Objects/Instances/<ns>:<TypeName>, one per concrete ObjectType
+//! ```
+//!
+//! The tables are the ones `nodeset-compiler rust` writes into `nodes.rs`, decoded by the same runtime import,
+//! so a served file shows what a generated server of it would show. The server is the runtime's
+//! [`ServerConfig`]: encrypted endpoints, the PKI folder layout, the user file, roles and the nodesets'
+//! RolePermissions; `--insecure` adds the None endpoint with the runtime's warning. Variables keep what
+//! clients write (the runtime's write rules); methods answer `BadNotImplemented` unless the runtime
+//! implements them (the cause methods of the state machines [`instances`] serves).
+
+pub mod instances;
+
+use crate::diag::Diagnostics;
+use crate::emit::rust::{default_module_name, node_tables, NodeTable, RustConfig, RustNamespace, RustPath};
+use crate::model::Model;
+use nodeset_runtime::server::{ServerConfig, Users};
+use nodeset_runtime::table::{NodeSetTable, Nodes, Packed};
+use std::io::Write;
+use std::path::PathBuf;
+use std::time::Duration;
+
+/// The options of `nodeset-compiler serve` besides the files.
+#[derive(Clone, Debug, Default)]
+pub struct ServeOptions {
+    /// The TCP port (0 picks a free one).
+    pub port: u16,
+    /// The host to listen on and to name in the endpoint URL (default `127.0.0.1`).
+    pub host: Option<String>,
+    /// The PKI folder (default `pki/nodeset-compiler-serve` below the working directory).
+    pub pki: Option<PathBuf>,
+    /// The user file (`nodeset_runtime::server::users`).
+    pub users: Option<PathBuf>,
+    /// Trust unknown client certificates on first use (development only).
+    pub trust_on_first_use: bool,
+    /// Add the SecurityPolicy None endpoint (loopback testing only).
+    pub insecure: bool,
+    /// One instance of every concrete ObjectType of the named files below `Objects/Instances`.
+    pub instantiate_all: bool,
+    /// Stop after this many seconds (else on SIGINT or SIGTERM).
+    pub seconds: Option<u64>,
+}
+
+/// The ApplicationName of the server.
+pub const APPLICATION_NAME: &str = "nodeset-compiler serve";
+
+/// The node tables of every namespace of the model but ns0 (async-opcua serves its own), dependencies
+/// first, built in memory exactly as `nodeset-compiler rust` writes them, and leaked: a server holds its
+/// tables for as long as the process runs, as it holds the generated ones.
+pub fn tables(model: &Model) -> (Vec<&'static NodeSetTable>, Diagnostics) {
+    let namespaces: Vec<RustNamespace> = model
+        .models
+        .iter()
+        .filter(|x| x.ns != 0)
+        .map(|x| RustNamespace { uri: x.uri.clone(), module: format!("{}_{}", default_module_name(&x.uri), x.ns) })
+        .collect();
+    let cfg = RustConfig {
+        namespaces,
+        extern_paths: Default::default(),
+        runtime_path: RustPath::new("crate::runtime").expect("a valid Rust path"),
+        command: "nodeset-compiler serve".into(),
+    };
+    let (tables, diags) = node_tables(model, &cfg);
+    (tables.into_iter().map(leak).collect(), diags)
+}
+
+/// A node table built in memory, made as `'static` as a generated one.
+pub fn leak(t: NodeTable) -> &'static NodeSetTable {
+    let namespaces: Vec<&'static str> = t.namespaces.into_iter().map(|u| &*Box::leak(u.into_boxed_str())).collect();
+    Box::leak(Box::new(NodeSetTable {
+        namespace_uri: Box::leak(t.namespace_uri.into_boxed_str()),
+        version: Box::leak(t.version.into_boxed_str()),
+        publication_date: Box::leak(t.publication_date.into_boxed_str()),
+        namespaces: Box::leak(namespaces.into_boxed_slice()),
+        own: t.own,
+        nodes: Nodes::Packed(Packed::new(Box::leak(t.rows.into_boxed_str()))),
+    }))
+}
+
+/// The server's configuration for `tables` with `opts`: the runtime's secure defaults, then what the
+/// options weaken (each with the runtime's warning, printed by [`serve`]).
+pub fn config(tables: &[&'static NodeSetTable], opts: &ServeOptions) -> Result<ServerConfig, String> {
+    let mut config = ServerConfig::new(APPLICATION_NAME).port(opts.port);
+    if let Some(host) = &opts.host {
+        config = config.host(host.clone());
+    }
+    if let Some(pki) = &opts.pki {
+        config = config.pki_dir(pki.clone());
+    }
+    if let Some(file) = &opts.users {
+        config = config.users(Users::load(file).map_err(|e| e.to_string())?);
+    }
+    if opts.trust_on_first_use {
+        config = config.trust_on_first_use();
+    }
+    if opts.insecure {
+        config = config.insecure();
+    }
+    for &t in tables {
+        config = config.table(t);
+    }
+    Ok(config)
+}
+
+/// Serves `model` until SIGINT, SIGTERM or `opts.seconds`: prints the warnings of the configuration and
+/// the instances that could not be created on stderr, `listening on <url>` on stdout once clients may
+/// connect, and `server stopped cleanly` at the end. Must run inside a multi-threaded tokio runtime.
+pub async fn serve(model: &Model, opts: &ServeOptions) -> Result<(), String> {
+    let (tables, diags) = tables(model);
+    if diags.has_errors() {
+        return Err(format!("the node tables cannot be built:\n{}", diags.render(&model.sources)));
+    }
+    let config = config(&tables, opts)?;
+    for warning in config.warnings() {
+        eprintln!("{warning}");
+    }
+    let server = config.build()?;
+    let manager = server.manager().clone();
+    let handle = server.handle().clone();
+    let url = server.endpoint_url().to_owned();
+    let mut task = tokio::spawn(server.run());
+    if opts.instantiate_all {
+        // Instances are made once async-opcua has loaded ns0's types into the type tree (when the server
+        // starts running): before, a reference type of the files that derives from ns0's HasComponent is
+        // not known to be hierarchical, and which members an instance gets would depend on timing.
+        wait_for_ns0_types(&handle).await?;
+        let done = instances::instantiate_all(&manager, model);
+        for (what, why) in &done.failures {
+            eprintln!("warning: {what} is not instantiated: {why}");
+        }
+        eprintln!(
+            "instantiated {} of {} concrete ObjectType(s) below Objects/Instances ({} nodes, {} state machine(s) served, {} without an initial state)",
+            done.instantiated,
+            done.types,
+            done.nodes,
+            done.machines,
+            done.without_initial_state
+        );
+    }
+    println!("listening on {url}");
+    let _ = std::io::stdout().flush();
+    let mut terminate = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
+        .map_err(|e| format!("cannot listen for SIGTERM: {e}"))?;
+    let deadline = async {
+        match opts.seconds {
+            Some(s) => tokio::time::sleep(Duration::from_secs(s)).await,
+            None => std::future::pending().await,
+        }
+    };
+    tokio::select! {
+        _ = tokio::signal::ctrl_c() => {}
+        _ = terminate.recv() => {}
+        _ = deadline => {}
+        result = &mut task => return Err(format!("the server stopped by itself: {result:?}")),
+    }
+    handle.cancel();
+    match tokio::time::timeout(Duration::from_secs(10), task).await {
+        Ok(Ok(Ok(()))) => {
+            println!("server stopped cleanly");
+            Ok(())
+        }
+        Ok(Ok(Err(e))) => Err(format!("the server failed: {e}")),
+        Ok(Err(e)) => Err(format!("the server task failed: {e}")),
+        Err(_) => Err("the server did not stop within 10 s".to_owned()),
+    }
+}
+
+/// Waits (at most 30 s) until the running server's type tree holds ns0's reference types. async-opcua loads
+/// them under one write lock when the server starts, so once HasComponent is known to be hierarchical, all
+/// of ns0 is there.
+async fn wait_for_ns0_types(handle: &opcua::server::ServerHandle) -> Result<(), String> {
+    use opcua::nodes::TypeTree;
+    use opcua::types::ReferenceTypeId;
+    let (component, hierarchical) = (ReferenceTypeId::HasComponent.into(), ReferenceTypeId::HierarchicalReferences.into());
+    for _ in 0..3000 {
+        if handle.type_tree().read().is_subtype_of(&component, &hierarchical) {
+            return Ok(());
+        }
+        tokio::time::sleep(Duration::from_millis(10)).await;
+    }
+    Err("the server did not load the OPC UA namespace's types within 30 s".into())
+}
