@@ -3,7 +3,7 @@
 //! writing any Modelica. `tests.rs` checks what rendering makes of the same decisions.
 
 use super::plan::{ClassInfo, ClassKey, ClassPlan, ElemKind, Element, Item, Mod, Owner, Value};
-use super::tests::robotics;
+use super::tests::{robotics, vendor_robot_with, VENDOR_ROBOT};
 use super::{plan, ModelicaConfig, Planned};
 use crate::model::{Model, NodeIx};
 
@@ -144,4 +144,49 @@ fn a_declared_value_is_bound_to_the_node_that_gives_it() {
         }
     }
     assert!(bound > 100, "only {bound} declarations take their value from the nodeset");
+}
+
+/// The `final` modifiers of `ident` in a modification list, at any depth.
+fn finals(mods: &[Mod], ident: &str) -> usize {
+    mods.iter()
+        .map(|m| match m {
+            Mod::Value { ident: i, is_final: true, .. } if i == ident => 1,
+            Mod::Nested { mods, .. } => finals(mods, ident),
+            _ => 0,
+        })
+        .sum()
+}
+
+#[test]
+fn a_member_a_final_flag_made_present_higher_up_is_present_to_subtypes_at_any_depth() {
+    // ArmXType makes Tuning/Limits/MaxAccel (Optional in VendorMotionDeviceType, two levels down) Mandatory, and
+    // ArmYType declares it again: `final use_maxAccel = true` is written once along the chain (Modelica refuses
+    // a modifier of a final element). ArmXType modifies the members of its Tuning component without a class of
+    // its own, whatever their values.
+    let same = |text: &str| text.replace(">4</Double>", ">3</Double>").replace(">5</Double>", ">3</Double>");
+    for (out, modifies) in [(vendor_robot_with(same), true), (vendor_robot_with(str::to_string), true)] {
+        let m = &out.model;
+        let cfg = VENDOR_ROBOT.iter().fold(ModelicaConfig::new(), |c, u| c.namespace(*u));
+        let p = plan(m, &cfg).unwrap_or_else(|d| panic!("{d:?}"));
+        let uri = VENDOR_ROBOT[2];
+        let mut written = 0;
+        for name in ["ArmXType", "ArmYType"] {
+            let plans = &p.ctx.plans[&Owner::Type(object_type(m, uri, name))];
+            for class in plans.main.iter().chain(plans.decls.iter().map(|(_, c)| c)) {
+                written += class.extends.as_ref().map_or(0, |(_, mods)| finals(mods, "use_maxAccel"));
+            }
+        }
+        assert_eq!(written, 1, "modifiers on the component: {modifies}");
+        // What ArmXType's modifiers (or class) made present is recorded where a subtype looks for it.
+        let t = object_type(m, uri, "ArmXType");
+        let tuning = element(info(&p, &ClassKey::Type(t)), "Tuning");
+        let limits = match (&tuning.modified, &tuning.kind) {
+            (Some(members), _) => members.iter().find(|e| e.bn.name == "Limits").expect("Limits").clone(),
+            (None, ElemKind::Object { class }) => element(info(&p, class), "Limits").clone(),
+            (None, k) => panic!("{k:?}"),
+        };
+        assert_eq!(tuning.modified.is_some(), modifies);
+        let members = limits.modified.as_deref().expect("Limits is modified without a class of its own");
+        assert!(members.iter().any(|e| e.bn.name == "MaxAccel" && e.present), "{members:?}");
+    }
 }

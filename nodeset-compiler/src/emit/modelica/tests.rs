@@ -43,6 +43,31 @@ fn fixture(case: &str) -> crate::Compiled {
     load(&files, vec![dir, workspace().join("nodesets/vendor")])
 }
 
+/// The fixture `vendor_robot`, the text of its vendor file (`Example.VendorRobot.NodeSet2.xml`, which ArmType,
+/// ArmXType and ArmYType come from) changed by `patch`.
+pub(super) fn vendor_robot_with(patch: impl Fn(&str) -> String) -> crate::Compiled {
+    let dir = workspace().join("tests/fixtures/vendor_robot");
+    let mut inputs = Vec::new();
+    for name in ["Example.VendorRobot.Device", "Example.VendorRobot.Robotics", "Example.VendorRobot"] {
+        let path = dir.join(format!("{name}.NodeSet2.xml"));
+        let mut text = std::fs::read_to_string(&path).unwrap();
+        if name == "Example.VendorRobot" {
+            text = patch(&text);
+        }
+        inputs.push(Input::Text { name: path.display().to_string(), text });
+    }
+    let out = compile(inputs, &Options { model_dirs: vec![workspace().join("nodesets/vendor")], ..Options::default() });
+    assert!(out.ok(), "{}", out.render_diagnostics());
+    out
+}
+
+/// The namespaces of the fixture `vendor_robot`.
+pub(super) const VENDOR_ROBOT: [&str; 3] = [
+    "http://example.com/fixtures/vendor_robot/Device/",
+    "http://example.com/fixtures/vendor_robot/Robotics/",
+    "http://example.com/fixtures/vendor_robot/",
+];
+
 /// Plans every ObjectType and instance of every namespace of the model (ns0 included) and checks that the
 /// identifiers of each class are unique: elements, their `use_` flags, counts and class aliases.
 fn assert_unique_names(model: &crate::model::Model) {
