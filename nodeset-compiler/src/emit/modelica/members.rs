@@ -6,8 +6,8 @@ use super::complete::{bind_free, COMPLETE_NOTE};
 use super::ctx::{count_name, node_id_text, Ctx};
 use super::objects::{join_path, starting_in};
 use super::plan::{
-    pin_alias, Base, Body, ClassInfo, ClassKey, ClassPlan, Deferred, ElemKind, Element, Item, MType, Mod, Mode, Own,
-    Owner, Pinned, TypeRef, Value,
+    pin_alias, Base, Body, ClassInfo, ClassKey, ClassPlan, Deferred, ElemKind, Element, Free, Item, MType, Mod, Mode,
+    Own, Owner, Pinned, TypeRef, Value,
 };
 use super::text::{self, string_literal};
 use super::types::dims_text;
@@ -683,7 +683,12 @@ impl Ctx<'_> {
                 let constraint_local = self.class_infos.get(class).map(|c| c.local_replaceable).unwrap_or(false);
                 let child_path = join_path(path, &n.browse_name.name);
                 let mut sub = self.plan_body(owner, &child_path, Some(&base_info), &children, mode, constraint_local);
-                if !sub.adds && !changed {
+                // A replaceable class whose components' inputs are free is the complete variant by default (see
+                // `plan_new`), which binds them to the inherited class's values; where this node gives them other
+                // values, it needs a class of its own, whose complete variant binds them.
+                let rebinds = e.alias.is_some()
+                    && old.as_ref().is_some_and(|c| c.is_partial_by_inputs() && self.rebinds(&c.free, &sub.elements));
+                if !sub.adds && !changed && !rebinds {
                     let free = self.free_of(&sub.elements);
                     if old.as_ref().is_some_and(|c| c.is_partial_by_inputs()) {
                         // The component is of the complete variant, which binds the free inputs to the values
@@ -752,6 +757,23 @@ impl Ctx<'_> {
                 Some(updated)
             }
         }
+    }
+
+    /// Whether the free inputs of `elements` (a class body's members) take values other than those of `free`,
+    /// the free inputs of the inherited class, which its complete variant binds. A declaration without a value
+    /// changes nothing: the inherited value stays.
+    fn rebinds(&mut self, free: &[Free], elements: &[Element]) -> bool {
+        for f in self.free_of(elements) {
+            let Some(g) = free.iter().find(|g| g.path == f.path) else { return true };
+            if g.node == f.node {
+                continue;
+            }
+            let given = self.explicit_value(f.node, &f.ty, None);
+            if given.is_some() && given != self.explicit_value(g.node, &g.ty, None) {
+                return true;
+            }
+        }
+        false
     }
 
     /// The members of a new class of a component (`elements`), each optional member that the component's
