@@ -189,4 +189,86 @@ fn a_member_a_final_flag_made_present_higher_up_is_present_to_subtypes_at_any_de
         let members = limits.modified.as_deref().expect("Limits is modified without a class of its own");
         assert!(members.iter().any(|e| e.bn.name == "MaxAccel" && e.present), "{members:?}");
     }
+
+    // The shape of the laboratory-device packages of the issue: a new component of a type's class whose
+    // declaration makes an optional member Mandatory (ArmType's Controller, FirmwareLevel of ControllerInfoType),
+    // declared Mandatory again by a subtype (ArmXType), with the same TypeDefinition or a subtype of it (then the
+    // component gets that type's class, and ArmType's modifiers still apply to it).
+    let firmware = |id: u32, parent: u32| {
+        format!(
+            r#"<UAVariable NodeId="ns=1;i={id}" BrowseName="5:FirmwareLevel" ParentNodeId="ns=1;i={parent}" DataType="UInt32">
+    <DisplayName>FirmwareLevel</DisplayName>
+    <References>
+      <Reference ReferenceType="HasTypeDefinition">i=68</Reference>
+      <Reference ReferenceType="HasModellingRule">i=78</Reference>
+    </References>
+  </UAVariable>
+  "#
+        )
+    };
+    let controller = |td: &str| {
+        format!(
+            r#"<UAObject NodeId="ns=1;i=5101" BrowseName="1:Controller" ParentNodeId="ns=1;i=1002">
+    <DisplayName>Controller</DisplayName>
+    <References>
+      <Reference ReferenceType="HasTypeDefinition">{td}</Reference>
+      <Reference ReferenceType="HasModellingRule">i=78</Reference>
+      <Reference ReferenceType="HasProperty">ns=1;i=6102</Reference>
+    </References>
+  </UAObject>
+  <UAObjectType NodeId="ns=1;i=1099" BrowseName="1:ControllerInfoXType">
+    <DisplayName>ControllerInfoXType</DisplayName>
+    <References>
+      <Reference ReferenceType="HasSubtype" IsForward="false">ns=5;i=1001</Reference>
+    </References>
+  </UAObjectType>
+  "#
+        )
+    };
+    for (td, redeclared) in [("ns=5;i=1001", false), ("ns=1;i=1099", true)] {
+        let out = vendor_robot_with(|text| {
+            let type_def = r#"<Reference ReferenceType="HasTypeDefinition">ns=5;i=1001</Reference>"#;
+            let firmware_ref = r#"<Reference ReferenceType="HasProperty">ns=1;i=6101</Reference>"#;
+            let arm_x = r#"<Reference ReferenceType="HasComponent">ns=1;i=5010</Reference>"#;
+            let text = text.replacen(type_def, &format!("{type_def}{firmware_ref}"), 1).replace(
+                arm_x,
+                &format!(r#"{arm_x}<Reference ReferenceType="HasComponent">ns=1;i=5101</Reference>"#),
+            );
+            let end = text.rfind("</UANodeSet>").expect("the end of the file");
+            let added = format!("{}{}{}", firmware(6101, 5004), controller(td), firmware(6102, 5101));
+            format!("{}{added}{}", &text[..end], &text[end..])
+        });
+        let m = &out.model;
+        let cfg = VENDOR_ROBOT.iter().fold(ModelicaConfig::new(), |c, u| c.namespace(*u));
+        let p = plan(m, &cfg).unwrap_or_else(|d| panic!("{d:?}"));
+        let extends = |name: &str| {
+            let plans = &p.ctx.plans[&Owner::Type(object_type(m, VENDOR_ROBOT[2], name))];
+            plans.main.as_ref().and_then(|c| c.extends.clone()).map(|(_, mods)| mods).unwrap_or_default()
+        };
+        // Not in ArmXType, nor in the class it may give its Controller.
+        let arm_x = &p.ctx.plans[&Owner::Type(object_type(m, VENDOR_ROBOT[2], "ArmXType"))];
+        for class in arm_x.main.iter().chain(arm_x.decls.iter().map(|(_, c)| c)) {
+            let mods = class.extends.as_ref().map(|(_, mods)| mods.as_slice()).unwrap_or_default();
+            assert_eq!(finals(mods, "use_firmwareLevel"), 0, "TypeDefinition {td}: {mods:?}");
+        }
+        let controller_redeclared =
+            extends("ArmXType").iter().any(|x| matches!(x, Mod::Redeclare { ident, .. } if ident == "Controller"));
+        assert_eq!(controller_redeclared, redeclared);
+        // ArmType sets the flag on its declaration of the component.
+        let t = object_type(m, VENDOR_ROBOT[2], "ArmType");
+        let mods = p.ctx.plans[&Owner::Type(t)]
+            .main
+            .as_ref()
+            .and_then(|c| {
+                c.items.iter().find_map(|i| match i {
+                    Item::Decl { ident, mods, .. } if ident == "controller" => Some(mods),
+                    _ => None,
+                })
+            })
+            .expect("ArmType declares controller");
+        assert_eq!(finals(mods, "use_firmwareLevel"), 1, "{mods:?}");
+        let controller = element(info(&p, &ClassKey::Type(t)), "Controller");
+        let members = controller.modified.as_deref().expect("the declaration modifies the members of its class");
+        assert!(members.iter().any(|e| e.bn.name == "FirmwareLevel" && e.present), "{members:?}");
+    }
 }
