@@ -6,8 +6,8 @@ use super::complete::{bind_free, COMPLETE_NOTE};
 use super::ctx::{count_name, node_id_text, Ctx};
 use super::objects::{join_path, starting_in};
 use super::plan::{
-    pin_alias, Base, Body, ClassInfo, ClassKey, ClassPlan, Deferred, ElemKind, Element, Item, MType, Mod, Mode, Own,
-    Owner, Pinned, TypeRef, Value,
+    pin_alias, Base, Body, ClassInfo, ClassKey, ClassPlan, Deferred, ElemKind, Element, Free, Item, MType, Mod, Mode,
+    Own, Owner, Pinned, TypeRef, Value,
 };
 use super::text::{self, string_literal};
 use super::types::dims_text;
@@ -201,6 +201,7 @@ impl Ctx<'_> {
             alias: None,
             pinned: None,
             nested_free: None,
+            modified: None,
         };
         if self.is_reference(o) {
             return self.plan_reference(ident, o, rule, body, element);
@@ -411,6 +412,12 @@ impl Ctx<'_> {
                                 } else {
                                     element.nested_free = Some(Rc::new(free));
                                 }
+                                // The members of the type's class, as these modifiers leave them (a new
+                                // child that declares nothing, a method or a variable without a Modelica type,
+                                // is not one).
+                                let mut members = sub.elements;
+                                members.truncate(td_info.elements.len());
+                                element.modified = Some(Rc::new(members));
                                 ClassKey::Type(td)
                             }
                         }
@@ -628,10 +635,22 @@ impl Ctx<'_> {
                 // The class of the override must be a subtype of the inherited class. When the inherited class
                 // is a type's class, the new type's class is one (OPC UA subtypes the TypeDefinition). When it
                 // is a declaration class, the new class extends it and declares again what the new type adds.
-                let old = self.class_infos.get(class).cloned();
+                // The inherited class as the component has it: with what modifiers of the base classes on the
+                // component changed in its members.
+                let old = self.class_infos.get(class).cloned().map(|info| match &e.modified {
+                    Some(elements) => Rc::new(ClassInfo { elements: elements.to_vec(), ..(*info).clone() }),
+                    None => info,
+                });
                 let mut children = children;
                 let base_info = match (changed, class) {
-                    (true, ClassKey::Type(_)) => td_c.and_then(|t| self.type_class(t)),
+                    // The modifiers on the component still apply to the new class: what they made present stays so.
+                    (true, ClassKey::Type(_)) => td_c.and_then(|t| self.type_class(t)).map(|info| match &e.modified {
+                        Some(elements) => Rc::new(ClassInfo {
+                            elements: self.present_as_in(&info.elements, elements),
+                            ..(*info).clone()
+                        }),
+                        None => info,
+                    }),
                     (true, _) => {
                         if let (Some(new_info), Some(old)) = (td_c.and_then(|t| self.type_class(t)), &old) {
                             let have: BTreeSet<QualifiedName> = old
@@ -663,9 +682,13 @@ impl Ctx<'_> {
                 };
                 let constraint_local = self.class_infos.get(class).map(|c| c.local_replaceable).unwrap_or(false);
                 let child_path = join_path(path, &n.browse_name.name);
-                let sub = self.plan_body(owner, &child_path, Some(&base_info), &children, mode, constraint_local);
-                if !sub.adds && !changed {
-                    let mut sub = sub;
+                let mut sub = self.plan_body(owner, &child_path, Some(&base_info), &children, mode, constraint_local);
+                // A replaceable class whose components' inputs are free is the complete variant by default (see
+                // `plan_new`), which binds them to the inherited class's values; where this node gives them other
+                // values, it needs a class of its own, whose complete variant binds them.
+                let rebinds = e.alias.is_some()
+                    && old.as_ref().is_some_and(|c| c.is_partial_by_inputs() && self.rebinds(&c.free, &sub.elements));
+                if !sub.adds && !changed && !rebinds {
                     let free = self.free_of(&sub.elements);
                     if old.as_ref().is_some_and(|c| c.is_partial_by_inputs()) {
                         // The component is of the complete variant, which binds the free inputs to the values
@@ -680,6 +703,10 @@ impl Ctx<'_> {
                     } else {
                         updated.nested_free = Some(Rc::new(free));
                     }
+                    // The members of the class, as these modifiers leave them (a new child that declares
+                    // nothing, a method or a variable without a Modelica type, is not one).
+                    sub.elements.truncate(base_info.elements.len());
+                    updated.modified = Some(Rc::new(sub.elements));
                     if !sub.mods.is_empty() {
                         body.mods.push(Mod::Nested { ident: e.ident.clone(), mods: sub.mods });
                     }
@@ -699,6 +726,9 @@ impl Ctx<'_> {
                         ),
                     );
                     if !sub.mods.is_empty() && !changed {
+                        // The members the class has, as these modifiers leave them (the additions are not there).
+                        sub.elements.truncate(base_info.elements.len());
+                        updated.modified = Some(Rc::new(sub.elements));
                         body.mods.push(Mod::Nested { ident: e.ident.clone(), mods: sub.mods });
                     }
                     return Some(updated);
@@ -722,9 +752,54 @@ impl Ctx<'_> {
                 body.adds = true;
                 updated.kind = ElemKind::Object { class: key };
                 updated.nested_free = None;
+                // The new class records its members (it was planned from the inherited ones as modified here).
+                updated.modified = None;
                 Some(updated)
             }
         }
+    }
+
+    /// Whether the free inputs of `elements` (a class body's members) take values other than those of `free`,
+    /// the free inputs of the inherited class, which its complete variant binds. A declaration without a value
+    /// changes nothing: the inherited value stays.
+    fn rebinds(&mut self, free: &[Free], elements: &[Element]) -> bool {
+        for f in self.free_of(elements) {
+            let Some(g) = free.iter().find(|g| g.path == f.path) else { return true };
+            if g.node == f.node {
+                continue;
+            }
+            let given = self.explicit_value(f.node, &f.ty, None);
+            if given.is_some() && given != self.explicit_value(g.node, &g.ty, None) {
+                return true;
+            }
+        }
+        false
+    }
+
+    /// The members of a new class of a component (`elements`), each optional member that the component's
+    /// modifiers made present in its former class (`modified`, its members as they left them) present here too,
+    /// at any depth: the modifiers apply to whatever class the component has.
+    fn present_as_in(&self, elements: &[Element], modified: &[Element]) -> Vec<Element> {
+        elements
+            .iter()
+            .map(|x| {
+                let mut x = x.clone();
+                let Some(was) = modified.iter().find(|w| w.bn == x.bn) else { return x };
+                if was.present && x.use_flag.is_some() && x.use_flag == was.use_flag {
+                    x.present = true;
+                }
+                if let (ElemKind::Object { class }, Some(inner)) = (&x.kind, &was.modified) {
+                    let members = match &x.modified {
+                        Some(m) => Some(m.to_vec()),
+                        None => self.class_infos.get(class).map(|i| i.elements.clone()),
+                    };
+                    if let Some(members) = members {
+                        x.modified = Some(Rc::new(self.present_as_in(&members, inner)));
+                    }
+                }
+                x
+            })
+            .collect()
     }
 
     /// A comment that documents a method: calls go through an OPC UA client, not through Modelica.

@@ -93,10 +93,15 @@
 //!   (`extends AxisType(parameterSet(actualPosition=0, ...))`). Modelica tools refuse components of partial
 //!   classes, so a component or a class alias whose class is partial uses the complete variant
 //!   (`replaceable model AxisIdentifier = ...Complete.AxisType constrainedby ...ObjectTypes.AxisType`). An
-//!   instance binds its unbound inputs itself, to the instance's values, and is complete. A Real with EngineeringUnits holds its SI value, as the Modelica Standard Library does
-//!   (`unit="m", displayUnit="mm", quantity="Length"`; a value from the nodeset is converted), and its
-//!   `__OPCUA` annotation keeps the UNECE code and the conversion from the OPC UA value (`engineeringUnit=
-//!   "MMT", siFactor=0.001`; see `units.rs`).
+//!   instance binds its unbound inputs itself, to the instance's values, and is complete. A subtype (or an
+//!   instance) that gives such an input of a replaceable component another value gives the component a
+//!   declaration class of its own, whose complete variant binds the new value and becomes the alias's class
+//!   (`redeclare model Tuning = ...Complete.ArmType_Tuning`): a modifier on the component would bind the inputs
+//!   of any model a user plugs in.
+//!   A Real with EngineeringUnits holds its SI value, as the Modelica Standard Library does (`unit="m",
+//!   displayUnit="mm", quantity="Length"`; a value from the nodeset is converted), and its `__OPCUA`
+//!   annotation keeps the UNECE code and the conversion from the OPC UA value (`engineeringUnit="MMT",
+//!   siFactor=0.001`; see `units.rs`).
 //! * An object becomes a component whose class is a replaceable alias (`replaceable model Axes =
 //!   OpcUaRobotics.Declarations.MotionDeviceType_Axes; Axes axes;`). An instance declaration that adds or
 //!   changes children gets a class of its own in `Declarations`; a subtype that overrides an inherited

@@ -205,6 +205,7 @@ impl Ctx<'_> {
                     alias: None,
                     pinned: None,
                     nested_free: None,
+                    modified: None,
                 });
                 continue;
             }
@@ -256,6 +257,7 @@ impl Ctx<'_> {
                 alias: None,
                 pinned: None,
                 nested_free: None,
+                modified: None,
             });
         }
         let mut doc = node.doc().map(text::html_paragraphs).unwrap_or_else(|| undescribed(m, t, "EventType"));

@@ -72,6 +72,11 @@ pub struct Element {
     /// The free inputs of an object whose members this class modifies without a class of its own (else those of
     /// its class).
     pub nested_free: Option<Rc<Vec<Free>>>,
+    /// The elements of an object's class as the modifiers on the component leave them, where a class modifies
+    /// the members of the component without a class of its own (an optional member made present by
+    /// `final use_x = true`, a value given), at any depth; else `None`, and those of its class hold. A class
+    /// derived from this one overrides the members as they are here: it never sets the `final` flag twice.
+    pub modified: Option<Rc<Vec<Element>>>,
 }
 
 /// A placeholder's array declared through an alias: its pins name aliases of the declaring class

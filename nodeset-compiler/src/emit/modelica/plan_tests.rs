@@ -3,7 +3,7 @@
 //! writing any Modelica. `tests.rs` checks what rendering makes of the same decisions.
 
 use super::plan::{ClassInfo, ClassKey, ClassPlan, ElemKind, Element, Item, Mod, Owner, Value};
-use super::tests::robotics;
+use super::tests::{robotics, vendor_robot_with, VENDOR_ROBOT};
 use super::{plan, ModelicaConfig, Planned};
 use crate::model::{Model, NodeIx};
 
@@ -144,4 +144,131 @@ fn a_declared_value_is_bound_to_the_node_that_gives_it() {
         }
     }
     assert!(bound > 100, "only {bound} declarations take their value from the nodeset");
+}
+
+/// The `final` modifiers of `ident` in a modification list, at any depth.
+fn finals(mods: &[Mod], ident: &str) -> usize {
+    mods.iter()
+        .map(|m| match m {
+            Mod::Value { ident: i, is_final: true, .. } if i == ident => 1,
+            Mod::Nested { mods, .. } => finals(mods, ident),
+            _ => 0,
+        })
+        .sum()
+}
+
+#[test]
+fn a_member_a_final_flag_made_present_higher_up_is_present_to_subtypes_at_any_depth() {
+    // ArmXType makes Tuning/Limits/MaxAccel (Optional in VendorMotionDeviceType, two levels down) Mandatory, and
+    // ArmYType declares it again: `final use_maxAccel = true` is written once along the chain (Modelica refuses
+    // a modifier of a final element). With MaxAccel's value left as inherited, ArmXType modifies the members of
+    // its Tuning component without a class of its own; with its own values, each type's Tuning has a class.
+    let same = |text: &str| text.replace(">4</Double>", ">3</Double>").replace(">5</Double>", ">3</Double>");
+    for (out, modifies) in [(vendor_robot_with(same), true), (vendor_robot_with(str::to_string), false)] {
+        let m = &out.model;
+        let cfg = VENDOR_ROBOT.iter().fold(ModelicaConfig::new(), |c, u| c.namespace(*u));
+        let p = plan(m, &cfg).unwrap_or_else(|d| panic!("{d:?}"));
+        let uri = VENDOR_ROBOT[2];
+        let mut written = 0;
+        for name in ["ArmXType", "ArmYType"] {
+            let plans = &p.ctx.plans[&Owner::Type(object_type(m, uri, name))];
+            for class in plans.main.iter().chain(plans.decls.iter().map(|(_, c)| c)) {
+                written += class.extends.as_ref().map_or(0, |(_, mods)| finals(mods, "use_maxAccel"));
+            }
+        }
+        assert_eq!(written, 1, "modifiers on the component: {modifies}");
+        // What ArmXType's modifiers (or class) made present is recorded where a subtype looks for it.
+        let t = object_type(m, uri, "ArmXType");
+        let tuning = element(info(&p, &ClassKey::Type(t)), "Tuning");
+        let limits = match (&tuning.modified, &tuning.kind) {
+            (Some(members), _) => members.iter().find(|e| e.bn.name == "Limits").expect("Limits").clone(),
+            (None, ElemKind::Object { class }) => element(info(&p, class), "Limits").clone(),
+            (None, k) => panic!("{k:?}"),
+        };
+        assert_eq!(tuning.modified.is_some(), modifies);
+        let members = limits.modified.as_deref().expect("Limits is modified without a class of its own");
+        assert!(members.iter().any(|e| e.bn.name == "MaxAccel" && e.present), "{members:?}");
+    }
+
+    // The shape of the laboratory-device packages of the issue: a new component of a type's class whose
+    // declaration makes an optional member Mandatory (ArmType's Controller, FirmwareLevel of ControllerInfoType),
+    // declared Mandatory again by a subtype (ArmXType), with the same TypeDefinition or a subtype of it (then the
+    // component gets that type's class, and ArmType's modifiers still apply to it).
+    let firmware = |id: u32, parent: u32| {
+        format!(
+            r#"<UAVariable NodeId="ns=1;i={id}" BrowseName="5:FirmwareLevel" ParentNodeId="ns=1;i={parent}" DataType="UInt32">
+    <DisplayName>FirmwareLevel</DisplayName>
+    <References>
+      <Reference ReferenceType="HasTypeDefinition">i=68</Reference>
+      <Reference ReferenceType="HasModellingRule">i=78</Reference>
+    </References>
+  </UAVariable>
+  "#
+        )
+    };
+    let controller = |td: &str| {
+        format!(
+            r#"<UAObject NodeId="ns=1;i=5101" BrowseName="1:Controller" ParentNodeId="ns=1;i=1002">
+    <DisplayName>Controller</DisplayName>
+    <References>
+      <Reference ReferenceType="HasTypeDefinition">{td}</Reference>
+      <Reference ReferenceType="HasModellingRule">i=78</Reference>
+      <Reference ReferenceType="HasProperty">ns=1;i=6102</Reference>
+    </References>
+  </UAObject>
+  <UAObjectType NodeId="ns=1;i=1099" BrowseName="1:ControllerInfoXType">
+    <DisplayName>ControllerInfoXType</DisplayName>
+    <References>
+      <Reference ReferenceType="HasSubtype" IsForward="false">ns=5;i=1001</Reference>
+    </References>
+  </UAObjectType>
+  "#
+        )
+    };
+    for (td, redeclared) in [("ns=5;i=1001", false), ("ns=1;i=1099", true)] {
+        let out = vendor_robot_with(|text| {
+            let type_def = r#"<Reference ReferenceType="HasTypeDefinition">ns=5;i=1001</Reference>"#;
+            let firmware_ref = r#"<Reference ReferenceType="HasProperty">ns=1;i=6101</Reference>"#;
+            let arm_x = r#"<Reference ReferenceType="HasComponent">ns=1;i=5010</Reference>"#;
+            let text = text.replacen(type_def, &format!("{type_def}{firmware_ref}"), 1).replace(
+                arm_x,
+                &format!(r#"{arm_x}<Reference ReferenceType="HasComponent">ns=1;i=5101</Reference>"#),
+            );
+            let end = text.rfind("</UANodeSet>").expect("the end of the file");
+            let added = format!("{}{}{}", firmware(6101, 5004), controller(td), firmware(6102, 5101));
+            format!("{}{added}{}", &text[..end], &text[end..])
+        });
+        let m = &out.model;
+        let cfg = VENDOR_ROBOT.iter().fold(ModelicaConfig::new(), |c, u| c.namespace(*u));
+        let p = plan(m, &cfg).unwrap_or_else(|d| panic!("{d:?}"));
+        let extends = |name: &str| {
+            let plans = &p.ctx.plans[&Owner::Type(object_type(m, VENDOR_ROBOT[2], name))];
+            plans.main.as_ref().and_then(|c| c.extends.clone()).map(|(_, mods)| mods).unwrap_or_default()
+        };
+        // Not in ArmXType, nor in the class it may give its Controller.
+        let arm_x = &p.ctx.plans[&Owner::Type(object_type(m, VENDOR_ROBOT[2], "ArmXType"))];
+        for class in arm_x.main.iter().chain(arm_x.decls.iter().map(|(_, c)| c)) {
+            let mods = class.extends.as_ref().map(|(_, mods)| mods.as_slice()).unwrap_or_default();
+            assert_eq!(finals(mods, "use_firmwareLevel"), 0, "TypeDefinition {td}: {mods:?}");
+        }
+        let controller_redeclared =
+            extends("ArmXType").iter().any(|x| matches!(x, Mod::Redeclare { ident, .. } if ident == "Controller"));
+        assert_eq!(controller_redeclared, redeclared);
+        // ArmType sets the flag on its declaration of the component.
+        let t = object_type(m, VENDOR_ROBOT[2], "ArmType");
+        let mods = p.ctx.plans[&Owner::Type(t)]
+            .main
+            .as_ref()
+            .and_then(|c| {
+                c.items.iter().find_map(|i| match i {
+                    Item::Decl { ident, mods, .. } if ident == "controller" => Some(mods),
+                    _ => None,
+                })
+            })
+            .expect("ArmType declares controller");
+        assert_eq!(finals(mods, "use_firmwareLevel"), 1, "{mods:?}");
+        let controller = element(info(&p, &ClassKey::Type(t)), "Controller");
+        let members = controller.modified.as_deref().expect("the declaration modifies the members of its class");
+        assert!(members.iter().any(|e| e.bn.name == "FirmwareLevel" && e.present), "{members:?}");
+    }
 }

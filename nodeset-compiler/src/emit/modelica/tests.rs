@@ -43,6 +43,31 @@ fn fixture(case: &str) -> crate::Compiled {
     load(&files, vec![dir, workspace().join("nodesets/vendor")])
 }
 
+/// The fixture `vendor_robot`, the text of its vendor file (`Example.VendorRobot.NodeSet2.xml`, which ArmType,
+/// ArmXType and ArmYType come from) changed by `patch`.
+pub(super) fn vendor_robot_with(patch: impl Fn(&str) -> String) -> crate::Compiled {
+    let dir = workspace().join("tests/fixtures/vendor_robot");
+    let mut inputs = Vec::new();
+    for name in ["Example.VendorRobot.Device", "Example.VendorRobot.Robotics", "Example.VendorRobot"] {
+        let path = dir.join(format!("{name}.NodeSet2.xml"));
+        let mut text = std::fs::read_to_string(&path).unwrap();
+        if name == "Example.VendorRobot" {
+            text = patch(&text);
+        }
+        inputs.push(Input::Text { name: path.display().to_string(), text });
+    }
+    let out = compile(inputs, &Options { model_dirs: vec![workspace().join("nodesets/vendor")], ..Options::default() });
+    assert!(out.ok(), "{}", out.render_diagnostics());
+    out
+}
+
+/// The namespaces of the fixture `vendor_robot`.
+pub(super) const VENDOR_ROBOT: [&str; 3] = [
+    "http://example.com/fixtures/vendor_robot/Device/",
+    "http://example.com/fixtures/vendor_robot/Robotics/",
+    "http://example.com/fixtures/vendor_robot/",
+];
+
 /// Plans every ObjectType and instance of every namespace of the model (ns0 included) and checks that the
 /// identifiers of each class are unique: elements, their `use_` flags, counts and class aliases.
 fn assert_unique_names(model: &crate::model::Model) {
@@ -575,4 +600,38 @@ fn a_placeholder_array_repeats_its_choices_through_aliases_that_derived_classes_
     assert!(products.contains("  Product product_[nProduct_](redeclare model Statistic = Product_2_Statistic)\n"), "{products}");
     let checkweigher = contents(&files, "OpcUaScalesV2/Declarations/CheckweigherType_ProductionPresetProducts.mo");
     assert!(checkweigher.contains("    redeclare model Product_2_Statistic = "), "{checkweigher}");
+}
+
+#[test]
+fn a_value_a_subtype_gives_a_free_input_of_a_replaceable_member_is_bound_by_the_class_it_uses() {
+    // VendorMotionDeviceType's Tuning (a replaceable class whose Limits publish MaxSpeed = 1.5 and MaxAccel = 3.0,
+    // inputs nothing binds) defaults to its complete variant. ArmType declares Tuning/Limits/MaxSpeed = 2, ArmXType
+    // MaxAccel = 4, ArmYType MaxAccel = 5: each type's Tuning gets a class of its own, whose complete variant
+    // (the default of the alias) binds the type's values; a model a user plugs in binds its own.
+    let out = vendor_robot_with(str::to_string);
+    let mut cfg = ModelicaConfig::new();
+    for uri in VENDOR_ROBOT {
+        cfg = cfg.namespace(uri);
+    }
+    let files = generate(&out.model, &cfg).unwrap();
+    let pkg = "ExampleFixturesVendorRobot";
+    for (ty, values) in [
+        ("ArmType", "maxSpeed=2.0, maxAccel=3.0"),
+        ("ArmXType", "maxSpeed=2.0, maxAccel=4.0"),
+        ("ArmYType", "maxSpeed=2.0, maxAccel=5.0"),
+    ] {
+        let class = contents(&files, &format!("{pkg}/ObjectTypes/{ty}.mo"));
+        assert!(class.contains(&format!("redeclare model Tuning = {pkg}.Complete.{ty}_Tuning")), "{class}");
+        let complete = contents(&files, &format!("{pkg}/Complete/{ty}_Tuning.mo"));
+        let extends = format!("  extends {pkg}.Declarations.{ty}_Tuning(limits({values}));\n");
+        assert!(complete.contains(&extends), "{complete}");
+    }
+    // The value stays where a subtype gives none (or the same): the inherited class binds it already.
+    let out = vendor_robot_with(|text| {
+        text.replace("<Value><Double xmlns=\"http://opcfoundation.org/UA/2008/02/Types.xsd\">5</Double></Value>", "")
+    });
+    let files = generate(&out.model, &cfg).unwrap();
+    let arm_y = contents(&files, "ExampleFixturesVendorRobot/ObjectTypes/ArmYType.mo");
+    assert!(!arm_y.contains("tuning(") && !arm_y.contains("model Tuning"), "{arm_y}");
+    assert!(!files.iter().any(|f| f.path.ends_with("ArmYType_Tuning.mo")));
 }
