@@ -184,3 +184,17 @@ fn the_check_sees_a_changed_prototype() {
         "a function missing from the header is seen"
     );
 }
+
+#[test]
+fn the_modelica_support_package_carries_the_same_header() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let here = std::fs::read_to_string(dir.join("include/nodeset_live.h")).unwrap();
+    let emitted =
+        dir.join("../nodeset-compiler/src/emit/modelica/support/Resources/Include/nodeset_live.h");
+    let there = std::fs::read_to_string(&emitted).unwrap();
+    assert!(
+        here == there,
+        "{} differs from include/nodeset_live.h: copy the header there",
+        emitted.display()
+    );
+}
