@@ -593,3 +593,143 @@ fn a_lost_connection_is_reported_and_the_client_connects_again() {
         opcua_live_server_free(again);
     }
 }
+
+/// The component-simulation scenario from C (`tests/c/drive.c`), compiled with the system's C compiler
+/// against `include/nodeset_live.h` and the shared library this build made, as a Modelica tool links it.
+#[test]
+fn a_c_program_integrates_a_drive_and_publishes_it_to_a_secure_client() {
+    let dir = tmp("drive");
+    let deps = shared_library().parent().unwrap().to_path_buf();
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let exe = dir.join("drive");
+    let cc = std::process::Command::new("cc")
+        .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-I"])
+        .arg(manifest.join("include"))
+        .arg(manifest.join("tests/c/drive.c"))
+        .arg("-L")
+        .arg(&deps)
+        .args(["-lnodeset_live", "-lm"])
+        .arg(format!("-Wl,-rpath,{}", deps.display()))
+        .arg("-o")
+        .arg(&exe)
+        .output()
+        .expect("cc runs (apt-get install gcc)");
+    assert!(
+        cc.status.success(),
+        "cc failed:\n{}",
+        String::from_utf8_lossy(&cc.stderr)
+    );
+    // The administrator's part: both PKI folders made and each certificate trusted by the other side, a user.
+    let (server_pki, client_pki, users) = (
+        dir.join("server-pki"),
+        dir.join("client-pki"),
+        dir.join("users.txt"),
+    );
+    let server_cert = prepare_pki(
+        &server_pki,
+        "Modelica simulation",
+        "urn:nodeset-models:modelica-simulation",
+        &["127.0.0.1".into()],
+    )
+    .unwrap()
+    .cert;
+    let client_cert = prepare_pki(
+        &client_pki,
+        "Modelica simulation client",
+        "urn:nodeset-live:client",
+        &[],
+    )
+    .unwrap()
+    .cert;
+    trust_certificate(&server_pki, &client_cert).unwrap();
+    trust_certificate(&client_pki, &server_cert).unwrap();
+    let mut list = Users::default();
+    list.set_password("operator", vec![Role::Operator], "dr1ve-Pa55")
+        .unwrap();
+    std::fs::write(&users, list.to_text()).unwrap();
+    let r = root();
+    let nodesets = format!(
+        "{};{};{};{}",
+        r.join("nodesets/RobotCell.NodeSet2.xml").display(),
+        r.join("nodesets/CommonSkills.NodeSet2.xml").display(),
+        manifest.join("tests/fixtures/Live.NodeSet2.xml").display(),
+        r.join("nodesets/vendor").display()
+    );
+    let t = Instant::now();
+    let run = std::process::Command::new(&exe)
+        .args([
+            nodesets.as_str(),
+            server_pki.to_str().unwrap(),
+            client_pki.to_str().unwrap(),
+            users.to_str().unwrap(),
+            "DRIVE_PASSWORD",
+        ])
+        .env("DRIVE_PASSWORD", "dr1ve-Pa55")
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&run.stdout);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        run.status.success(),
+        "drive failed ({}):\n{out}\n{err}",
+        run.status
+    );
+    let samples: Vec<&str> = out.lines().filter(|l| l.starts_with("sample ")).collect();
+    assert_eq!(samples.len(), 41, "a sample every 50 ms for 2 s:\n{out}");
+    assert!(
+        samples[0].contains("t=0.00 position=0.000000 speed=0.000000 read=0.000000,0.000000"),
+        "{}",
+        samples[0]
+    );
+    assert!(
+        samples[4].contains("t=0.20 position=0.641514"),
+        "after one time constant, 1 - 0.95^20: {}",
+        samples[4]
+    );
+    assert!(out.contains("drive: unknown NodeId: status -2144075776: reading `nsu=http://nodeset-compiler.dev/RobotCell/;i=999999`: BadNodeIdUnknown"), "{out}");
+    assert!(out.contains("drive: wrong type: status -2139881472: writing `nsu=http://nodeset-compiler.dev/RobotCell/;i=4119`: the variable is a Double"), "{out}");
+    assert!(
+        out.contains("drive: 41 samples, final position 0.999967, 0 failures"),
+        "{out}"
+    );
+    println!("nodeset-live: the C drive ran in {:?} (server start with DI, IA, Robotics, CommonSkills, RobotCell included)", t.elapsed());
+}
+
+/// The shared library as a Modelica tool would get it: `cargo build -p nodeset-live --lib`, asked for its
+/// artifacts. (The `cargo test` that runs this test builds the crate as an rlib for the tests, and does not
+/// always write the cdylib again: a library left from an earlier build would be tested instead.)
+fn shared_library() -> PathBuf {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+    let out = std::process::Command::new(cargo)
+        .current_dir(root())
+        .args([
+            "build",
+            "-p",
+            "nodeset-live",
+            "--lib",
+            "--message-format=json-render-diagnostics",
+        ])
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .expect("cargo runs");
+    assert!(
+        out.status.success(),
+        "cargo build -p nodeset-live --lib failed"
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line = stdout
+        .lines()
+        .find(|l| {
+            l.contains("\"reason\":\"compiler-artifact\"")
+                && l.contains("\"name\":\"nodeset_live\"")
+        })
+        .expect("cargo reports the library");
+    let files = &line[line
+        .find("\"filenames\":[")
+        .expect("the artifact names its files")..];
+    let so = files
+        .split('"')
+        .find(|f| f.ends_with(".so"))
+        .expect("the library is built as a cdylib");
+    PathBuf::from(so)
+}
