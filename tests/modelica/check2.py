@@ -35,6 +35,13 @@ import check  # noqa: E402  (the class list, the wrappers and the worker pool ar
 RECURSION_LIMIT = 20000
 
 
+# pymoca 0.12 has no built-in ExternalObject (MLS 12.9.7): a class that extends it (OpcUaSupport.Live's server
+# and client objects) fails name lookup. This stand-in, an empty partial class at the top level, lets pymoca
+# flatten the classes that hold external objects; the constructor calls are flattened as function calls, not
+# run (no Modelica tool here runs external C functions).
+EXTERNAL_OBJECT = 'partial class ExternalObject "stand-in for the built-in class of MLS 12.9.7"\nend ExternalObject;\n'
+
+
 def check_one(root, name, kind, partial, consts):
     from pymoca import ast, parser, tree
 
@@ -44,6 +51,7 @@ def check_one(root, name, kind, partial, consts):
     try:
         lib = parser.modelicapath_to_tree([root])
         lib.extend(parser.parse(src, bypass_cache=True))
+        lib.extend(parser.parse(EXTERNAL_OBJECT, bypass_cache=True))
         tree.flatten(lib, ast.ComponentRef(name="Check__"))
         return True, ""
     except RecursionError:

@@ -930,6 +930,11 @@ fn files_are_utf8_without_bom_with_header_and_within() {
             "{} does not say how to regenerate it",
             f.path.display()
         );
+        if f.path.starts_with("OpcUaSupport/Resources") {
+            // Files for the Modelica tool (the C header of OpcUaSupport.Live), not classes: no `within`.
+            assert_eq!(f.path.extension().and_then(|x| x.to_str()), Some("h"), "{}", f.path.display());
+            continue;
+        }
         let parent: Vec<String> =
             f.path.parent().unwrap().components().map(|c| c.as_os_str().to_string_lossy().into_owned()).collect();
         let class = name.strip_suffix(".mo").unwrap();

@@ -1,5 +1,5 @@
 within;
-package BindingExample "The drilling cell bound to OPC UA through the loopback blocks"
+package BindingExample "The drilling cell bound to OPC UA: through the loopback blocks, and live"
   annotation (
     version="1.0.0",
     uses(NodesetCompilerDrillingProcess(version="1.0.0"), OpcUaSupport(version="0.1.0")),

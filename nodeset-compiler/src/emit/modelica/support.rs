@@ -2,6 +2,8 @@
 //!
 //! Its sources are hand-written Modelica kept beside this module (`support/*.mo`) and compiled into the
 //! binary, so the generator needs no files at run time. Only the header and the version are added here.
+//! `Resources/Include` holds the C header of the `nodeset_live` library that `OpcUaSupport.Live` calls;
+//! the library itself is built from the `nodeset-live` crate and placed in `Resources/Library/<platform>`.
 
 use super::text;
 use crate::write::OutFile;
@@ -51,6 +53,29 @@ const SOURCES: &[(&str, &str)] = &[
     ("Loopback/WriteBoolean.mo", include_str!("support/Loopback/WriteBoolean.mo")),
     ("Loopback/ReadString.mo", include_str!("support/Loopback/ReadString.mo")),
     ("Loopback/WriteString.mo", include_str!("support/Loopback/WriteString.mo")),
+    ("Live/package.mo", include_str!("support/Live/package.mo")),
+    ("Live/package.order", include_str!("support/Live/package.order")),
+    ("Live/Server/package.mo", include_str!("support/Live/Server/package.mo")),
+    ("Live/Server/package.order", include_str!("support/Live/Server/package.order")),
+    ("Live/Server/Endpoint.mo", include_str!("support/Live/Server/Endpoint.mo")),
+    ("Live/Server/ReadReal.mo", include_str!("support/Live/Server/ReadReal.mo")),
+    ("Live/Server/WriteReal.mo", include_str!("support/Live/Server/WriteReal.mo")),
+    ("Live/Server/ReadInteger.mo", include_str!("support/Live/Server/ReadInteger.mo")),
+    ("Live/Server/WriteInteger.mo", include_str!("support/Live/Server/WriteInteger.mo")),
+    ("Live/Server/ReadBoolean.mo", include_str!("support/Live/Server/ReadBoolean.mo")),
+    ("Live/Server/WriteBoolean.mo", include_str!("support/Live/Server/WriteBoolean.mo")),
+    ("Live/Client/package.mo", include_str!("support/Live/Client/package.mo")),
+    ("Live/Client/package.order", include_str!("support/Live/Client/package.order")),
+    ("Live/Client/Endpoint.mo", include_str!("support/Live/Client/Endpoint.mo")),
+    ("Live/Client/ReadReal.mo", include_str!("support/Live/Client/ReadReal.mo")),
+    ("Live/Client/WriteReal.mo", include_str!("support/Live/Client/WriteReal.mo")),
+    ("Live/Client/ReadInteger.mo", include_str!("support/Live/Client/ReadInteger.mo")),
+    ("Live/Client/WriteInteger.mo", include_str!("support/Live/Client/WriteInteger.mo")),
+    ("Live/Client/ReadBoolean.mo", include_str!("support/Live/Client/ReadBoolean.mo")),
+    ("Live/Client/WriteBoolean.mo", include_str!("support/Live/Client/WriteBoolean.mo")),
+    // The C header of the nodeset_live library the `Include` annotations of `Live` name (a copy of
+    // nodeset-live/include/nodeset_live.h, which nodeset-live's tests keep identical).
+    ("Resources/Include/nodeset_live.h", include_str!("support/Resources/Include/nodeset_live.h")),
 ];
 
 /// The support package as files below the output root.
@@ -79,7 +104,10 @@ mod tests {
     #[test]
     fn every_class_is_listed_in_the_package_order_and_has_a_file_or_is_nested_in_the_package() {
         let files = files();
-        let folders: BTreeSet<PathBuf> = files.iter().map(|f| f.path.parent().unwrap().to_path_buf()).collect();
+        // Resources/ holds files for the Modelica tool (the C header), not classes.
+        let resources = PathBuf::from(PACKAGE).join("Resources");
+        let folders: BTreeSet<PathBuf> =
+            files.iter().map(|f| f.path.parent().unwrap().to_path_buf()).filter(|d| !d.starts_with(&resources)).collect();
         assert!(folders.len() >= 3, "{folders:?}");
         for folder in &folders {
             let in_folder = |name: &str| files.iter().find(|f| f.path == folder.join(name));

@@ -1,0 +1,735 @@
+//! The library through its C interface, called as a Modelica tool's generated code calls it: the
+//! constructors at initialisation, the sampled reads and writes at each step (the `previous` value held,
+//! the status checked), the destructors at the end. A server object serves the fixture, a client object
+//! connects to it over Basic256Sha256 SignAndEncrypt as a user whose password is in an environment
+//! variable; bad input gets a status and a message, never a crash.
+
+/// The header kept in step with the exported functions (in this binary: one test binary for the crate).
+mod header;
+
+use std::ffi::{c_int, c_void, CStr, CString};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use nodeset_live::*;
+use nodeset_runtime::server::security::{prepare_pki, trust_certificate};
+use nodeset_runtime::server::{Role, Users};
+use opcua::crypto::X509;
+use opcua::types::StatusCode;
+
+const NS: &str = "http://example.com/nodeset-live/";
+
+fn root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
+}
+
+/// The fixture and the folder of the OPC UA namespace it requires, as the `nodesets` parameter.
+fn nodesets() -> CString {
+    let vendor = root().join("nodesets/vendor");
+    assert!(
+        vendor.join("Opc.Ua.NodeSet2.xml").is_file(),
+        "run `cargo xtask fetch-nodesets` first"
+    );
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/Live.NodeSet2.xml");
+    c(&format!("{};{}", fixture.display(), vendor.display()))
+}
+
+fn c(s: &str) -> CString {
+    CString::new(s).unwrap()
+}
+
+fn node(i: u32) -> CString {
+    c(&format!("nsu={NS};i={i}"))
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("nodeset-live-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn status(code: StatusCode) -> c_int {
+    code.bits() as c_int
+}
+
+unsafe fn server_error(s: *mut c_void) -> String {
+    CStr::from_ptr(opcua_live_server_error(s))
+        .to_string_lossy()
+        .into_owned()
+}
+
+unsafe fn client_error(s: *mut c_void) -> String {
+    CStr::from_ptr(opcua_live_client_error(s))
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// A server with a user `operator` (role Operator) and a client trusted by it and trusting it, as an
+/// administrator sets them up; the client's password in the environment variable `password_env`.
+struct Secure {
+    server: *mut c_void,
+    server_pki: PathBuf,
+    client_pki: PathBuf,
+    users: PathBuf,
+    port: c_int,
+}
+
+unsafe fn secure_server(name: &str, password_env: &str, port: c_int) -> Secure {
+    let dir = tmp(name);
+    let (server_pki, client_pki, users) = (
+        dir.join("server-pki"),
+        dir.join("client-pki"),
+        dir.join("users.txt"),
+    );
+    let mut list = Users::default();
+    list.set_password("operator", vec![Role::Operator], "s3cret-Pa55")
+        .unwrap();
+    std::fs::write(&users, list.to_text()).unwrap();
+    std::env::set_var(password_env, "s3cret-Pa55");
+    let server = opcua_live_server_new(
+        port,
+        nodesets().as_ptr(),
+        c(server_pki.to_str().unwrap()).as_ptr(),
+        c(users.to_str().unwrap()).as_ptr(),
+        0,
+    );
+    assert_eq!(
+        opcua_live_server_status(server),
+        0,
+        "{}",
+        server_error(server)
+    );
+    let client_cert = prepare_pki(
+        &client_pki,
+        "Modelica simulation client",
+        "urn:nodeset-live:client",
+        &[],
+    )
+    .unwrap()
+    .cert;
+    trust_certificate(&server_pki, &client_cert).unwrap();
+    let server_cert =
+        X509::from_der(&std::fs::read(server_pki.join("own/cert.der")).unwrap()).unwrap();
+    trust_certificate(&client_pki, &server_cert).unwrap();
+    let port = opcua_live_server_port(server);
+    Secure {
+        server,
+        server_pki,
+        client_pki,
+        users,
+        port,
+    }
+}
+
+unsafe fn secure_client(s: &Secure, password_env: &str) -> *mut c_void {
+    opcua_live_client_new(
+        c(&format!("opc.tcp://127.0.0.1:{}/", s.port)).as_ptr(),
+        c("Basic256Sha256").as_ptr(),
+        c("SignAndEncrypt").as_ptr(),
+        c(s.client_pki.to_str().unwrap()).as_ptr(),
+        c("operator").as_ptr(),
+        c(password_env).as_ptr(),
+    )
+}
+
+#[test]
+fn a_simulation_serves_and_a_secure_client_reads_and_writes_through_the_c_interface() {
+    unsafe {
+        let s = secure_server("roundtrip", "NODESET_LIVE_TEST_PASSWORD_1", 0);
+        let client = secure_client(&s, "NODESET_LIVE_TEST_PASSWORD_1");
+        assert_eq!(
+            opcua_live_client_status(client),
+            0,
+            "{}",
+            client_error(client)
+        );
+        let (position, count, enabled, ratio, level) =
+            (node(6001), node(6003), node(6004), node(6006), node(6007));
+        let mut st: c_int = -1;
+        // Before any step: the nodeset's values.
+        assert_eq!(
+            opcua_live_client_read_real(client, position.as_ptr(), -1.0, &mut st),
+            0.5
+        );
+        assert_eq!(st, 0, "{}", client_error(client));
+        assert_eq!(
+            opcua_live_server_read_integer(s.server, count.as_ptr(), -1, &mut st),
+            7
+        );
+        // Steps: the simulation publishes a position, the client reads it; the client writes a count, a
+        // flag and a ratio, the simulation reads them.
+        for step in 0..20 {
+            let x = 0.1 * step as f64;
+            assert_eq!(
+                opcua_live_server_write_real(s.server, position.as_ptr(), x),
+                0,
+                "{}",
+                server_error(s.server)
+            );
+            assert_eq!(
+                opcua_live_client_read_real(client, position.as_ptr(), -1.0, &mut st),
+                x,
+                "step {step}"
+            );
+            assert_eq!(st, 0);
+            assert_eq!(
+                opcua_live_client_write_integer(client, count.as_ptr(), 100 + step),
+                0,
+                "{}",
+                client_error(client)
+            );
+            assert_eq!(
+                opcua_live_server_read_integer(s.server, count.as_ptr(), -1, &mut st),
+                100 + step
+            );
+            assert_eq!(
+                opcua_live_client_write_boolean(client, enabled.as_ptr(), step % 2),
+                0,
+                "{}",
+                client_error(client)
+            );
+            assert_eq!(
+                opcua_live_server_read_boolean(s.server, enabled.as_ptr(), -1, &mut st),
+                step % 2
+            );
+        }
+        // A Real to a Float variable, an Integer to a Byte variable: the variable's type is kept.
+        assert_eq!(
+            opcua_live_client_write_real(client, ratio.as_ptr(), 0.75),
+            0,
+            "{}",
+            client_error(client)
+        );
+        assert_eq!(
+            opcua_live_server_read_real(s.server, ratio.as_ptr(), -1.0, &mut st),
+            0.75
+        );
+        assert_eq!(
+            opcua_live_client_write_integer(client, level.as_ptr(), 200),
+            0,
+            "{}",
+            client_error(client)
+        );
+        assert_eq!(
+            opcua_live_client_read_integer(client, level.as_ptr(), -1, &mut st),
+            200
+        );
+        assert_eq!(
+            opcua_live_server_write_integer(s.server, level.as_ptr(), 300),
+            status(StatusCode::BadOutOfRange)
+        );
+        assert!(
+            server_error(s.server).contains("300 is out of the range of Byte"),
+            "{}",
+            server_error(s.server)
+        );
+        assert_eq!(
+            opcua_live_client_write_integer(client, level.as_ptr(), -1),
+            status(StatusCode::BadOutOfRange)
+        );
+        assert!(
+            client_error(client).contains("-1 is out of the range of Byte"),
+            "{}",
+            client_error(client)
+        );
+        assert_eq!(
+            opcua_live_server_read_integer(s.server, level.as_ptr(), -1, &mut st),
+            200,
+            "the refused writes changed nothing"
+        );
+        // Throughput of one block, sampled as fast as the calls return.
+        let n = 300;
+        let t = Instant::now();
+        for i in 0..n {
+            opcua_live_client_read_real(client, position.as_ptr(), 0.0, &mut st);
+            assert_eq!(st, 0, "read {i}: {}", client_error(client));
+        }
+        let client_reads = n as f64 / t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        for i in 0..n {
+            assert_eq!(
+                opcua_live_server_write_real(s.server, position.as_ptr(), i as f64),
+                0
+            );
+        }
+        let server_writes = n as f64 / t.elapsed().as_secs_f64();
+        println!("nodeset-live: {client_reads:.0} client reads/s, {server_writes:.0} server writes/s (one block, SignAndEncrypt, loopback)");
+        opcua_live_client_free(client);
+        opcua_live_server_free(s.server);
+        let _ = (s.server_pki, s.users);
+    }
+}
+
+#[test]
+fn bad_input_gets_a_status_and_a_message_never_a_crash() {
+    unsafe {
+        let pki = tmp("bad");
+        // An insecure server and an insecure client: anonymous sessions may write on the None endpoint.
+        let server = opcua_live_server_new(
+            0,
+            nodesets().as_ptr(),
+            c(pki.join("server").to_str().unwrap()).as_ptr(),
+            std::ptr::null(),
+            1,
+        );
+        assert_eq!(
+            opcua_live_server_status(server),
+            0,
+            "{}",
+            server_error(server)
+        );
+        let url = c(&format!(
+            "opc.tcp://127.0.0.1:{}/",
+            opcua_live_server_port(server)
+        ));
+        let client_pki = c(pki.join("client").to_str().unwrap());
+        let client = opcua_live_client_new(
+            url.as_ptr(),
+            c("None").as_ptr(),
+            c("None").as_ptr(),
+            client_pki.as_ptr(),
+            std::ptr::null(),
+            std::ptr::null(),
+        );
+        assert_eq!(
+            opcua_live_client_status(client),
+            0,
+            "{}",
+            client_error(client)
+        );
+        let mut st: c_int = 0;
+
+        // An unknown NodeId, an unknown namespace, text that is no NodeId: the previous value is held.
+        let unknown = node(9999);
+        assert_eq!(
+            opcua_live_server_read_real(server, unknown.as_ptr(), 4.5, &mut st),
+            4.5
+        );
+        assert_eq!(st, status(StatusCode::BadNodeIdUnknown));
+        assert!(
+            server_error(server).contains("the server has no such node"),
+            "{}",
+            server_error(server)
+        );
+        assert_eq!(
+            opcua_live_client_read_real(client, unknown.as_ptr(), 4.5, &mut st),
+            4.5
+        );
+        assert_eq!(
+            st,
+            status(StatusCode::BadNodeIdUnknown),
+            "{}",
+            client_error(client)
+        );
+        assert!(
+            client_error(client).contains(&format!("reading `nsu={NS};i=9999`: BadNodeIdUnknown")),
+            "{}",
+            client_error(client)
+        );
+        assert_eq!(
+            opcua_live_client_write_real(client, unknown.as_ptr(), 1.0),
+            status(StatusCode::BadNodeIdUnknown)
+        );
+        let elsewhere = c("nsu=urn:nowhere;i=1");
+        assert_eq!(
+            opcua_live_client_read_integer(client, elsewhere.as_ptr(), 3, &mut st),
+            3
+        );
+        assert_eq!(st, status(StatusCode::BadNodeIdUnknown));
+        assert!(
+            client_error(client).contains("has no namespace `urn:nowhere`")
+                && client_error(client).contains(NS),
+            "{}",
+            client_error(client)
+        );
+        let garbage = c("Drive.Position");
+        assert_eq!(
+            opcua_live_server_write_real(server, garbage.as_ptr(), 1.0),
+            status(StatusCode::BadNodeIdInvalid)
+        );
+        assert!(
+            server_error(server).contains("`Drive.Position` is not a NodeId"),
+            "{}",
+            server_error(server)
+        );
+        assert_eq!(
+            opcua_live_server_read_real(server, std::ptr::null(), 2.0, std::ptr::null_mut()),
+            2.0,
+            "NULL strings and outputs"
+        );
+
+        // Wrong types: a String read as a Real, a Double written as a Boolean, a Double read as a Boolean.
+        let (position, enabled, label) = (node(6001), node(6004), node(6005));
+        assert_eq!(
+            opcua_live_server_read_real(server, label.as_ptr(), 1.5, &mut st),
+            1.5
+        );
+        assert_eq!(st, status(StatusCode::BadTypeMismatch));
+        assert!(
+            server_error(server).contains("String \"axis\" is not a Modelica Real"),
+            "{}",
+            server_error(server)
+        );
+        assert_eq!(
+            opcua_live_server_write_boolean(server, position.as_ptr(), 1),
+            status(StatusCode::BadTypeMismatch)
+        );
+        assert!(
+            server_error(server)
+                .contains("the variable is a Double, which a Modelica Boolean cannot write"),
+            "{}",
+            server_error(server)
+        );
+        assert_eq!(
+            opcua_live_client_read_boolean(client, position.as_ptr(), 1, &mut st),
+            1
+        );
+        assert_eq!(st, status(StatusCode::BadTypeMismatch));
+        assert!(
+            client_error(client).contains("is not a Modelica Boolean"),
+            "{}",
+            client_error(client)
+        );
+        assert_eq!(
+            opcua_live_client_write_real(client, enabled.as_ptr(), 1.0),
+            status(StatusCode::BadTypeMismatch)
+        );
+        assert!(
+            client_error(client).contains("the variable is a Boolean"),
+            "{}",
+            client_error(client)
+        );
+        // A good call clears the message.
+        assert_eq!(
+            opcua_live_client_read_real(client, position.as_ptr(), 0.0, &mut st),
+            0.5
+        );
+        assert_eq!((st, client_error(client).as_str()), (0, ""));
+
+        // An unreachable URL: the constructor returns, the status and every call say why.
+        let closed = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+        let port = closed.local_addr().unwrap().port();
+        drop(closed);
+        let t = Instant::now();
+        let nowhere = opcua_live_client_new(
+            c(&format!("opc.tcp://127.0.0.1:{port}/")).as_ptr(),
+            c("None").as_ptr(),
+            c("None").as_ptr(),
+            client_pki.as_ptr(),
+            std::ptr::null(),
+            std::ptr::null(),
+        );
+        assert!(
+            t.elapsed() < Duration::from_secs(8),
+            "the constructor gives up within its connect timeout"
+        );
+        assert_eq!(
+            opcua_live_client_status(nowhere),
+            status(StatusCode::BadNotConnected)
+        );
+        let why = client_error(nowhere);
+        assert!(
+            why.contains(&format!("not connected to opc.tcp://127.0.0.1:{port}/"))
+                && why.contains("connecting again"),
+            "{why}"
+        );
+        assert_eq!(
+            opcua_live_client_read_real(nowhere, position.as_ptr(), 9.0, &mut st),
+            9.0
+        );
+        assert_eq!(st, status(StatusCode::BadNotConnected));
+        opcua_live_client_free(nowhere);
+
+        // Configurations that cannot start: an object all the same, whose calls say why.
+        let broken = opcua_live_server_new(
+            0,
+            c("no/such/Model.NodeSet2.xml").as_ptr(),
+            c(pki.join("s2").to_str().unwrap()).as_ptr(),
+            std::ptr::null(),
+            0,
+        );
+        assert_eq!(
+            opcua_live_server_status(broken),
+            status(StatusCode::BadConfigurationError)
+        );
+        assert!(
+            server_error(broken).contains("no/such/Model.NodeSet2.xml: no such file or folder"),
+            "{}",
+            server_error(broken)
+        );
+        assert_eq!(
+            opcua_live_server_write_real(broken, position.as_ptr(), 1.0),
+            status(StatusCode::BadConfigurationError)
+        );
+        assert!(
+            server_error(broken).starts_with("the object did not start: "),
+            "{}",
+            server_error(broken)
+        );
+        opcua_live_server_free(broken);
+        let no_password = opcua_live_client_new(
+            url.as_ptr(),
+            std::ptr::null(),
+            std::ptr::null(),
+            client_pki.as_ptr(),
+            c("operator").as_ptr(),
+            c("NODESET_LIVE_TEST_UNSET").as_ptr(),
+        );
+        assert_eq!(
+            opcua_live_client_status(no_password),
+            status(StatusCode::BadConfigurationError)
+        );
+        assert!(client_error(no_password).contains("`NODESET_LIVE_TEST_UNSET`, which should hold the password of user `operator`, is not set"), "{}", client_error(no_password));
+        opcua_live_client_free(no_password);
+        let bad_policy = opcua_live_client_new(
+            url.as_ptr(),
+            c("Basic512").as_ptr(),
+            std::ptr::null(),
+            client_pki.as_ptr(),
+            std::ptr::null(),
+            std::ptr::null(),
+        );
+        assert!(
+            client_error(bad_policy).contains("unknown security policy `Basic512`"),
+            "{}",
+            client_error(bad_policy)
+        );
+        opcua_live_client_free(bad_policy);
+
+        // No object at all.
+        assert_eq!(
+            opcua_live_client_read_integer(std::ptr::null_mut(), position.as_ptr(), 5, &mut st),
+            5
+        );
+        assert_eq!(st, status(StatusCode::BadInvalidArgument));
+        assert!(client_error(std::ptr::null_mut()).starts_with("no object"));
+        opcua_live_client_free(std::ptr::null_mut());
+
+        opcua_live_client_free(client);
+        opcua_live_server_free(server);
+    }
+}
+
+#[test]
+fn a_lost_connection_is_reported_and_the_client_connects_again() {
+    unsafe {
+        let s = secure_server("reconnect", "NODESET_LIVE_TEST_PASSWORD_3", 0);
+        let client = secure_client(&s, "NODESET_LIVE_TEST_PASSWORD_3");
+        assert_eq!(
+            opcua_live_client_status(client),
+            0,
+            "{}",
+            client_error(client)
+        );
+        let position = node(6001);
+        let mut st: c_int = -1;
+        assert_eq!(
+            opcua_live_server_write_real(s.server, position.as_ptr(), 1.25),
+            0
+        );
+        assert_eq!(
+            opcua_live_client_read_real(client, position.as_ptr(), 0.0, &mut st),
+            1.25
+        );
+        // The server goes away: the next read reports it and holds the value.
+        opcua_live_server_free(s.server);
+        let gone = Instant::now();
+        assert_eq!(
+            opcua_live_client_read_real(client, position.as_ptr(), 1.25, &mut st),
+            1.25
+        );
+        assert_ne!(st, 0, "a read without a server fails");
+        let why = client_error(client);
+        assert!(
+            why.contains("connection is lost") || why.contains("not connected"),
+            "{why}"
+        );
+        println!(
+            "nodeset-live: server gone, reported after {:?}: {why}",
+            gone.elapsed()
+        );
+        // It comes back on the same port with the same PKI folder: the client connects again by itself.
+        let again = opcua_live_server_new(
+            s.port,
+            nodesets().as_ptr(),
+            c(s.server_pki.to_str().unwrap()).as_ptr(),
+            c(s.users.to_str().unwrap()).as_ptr(),
+            0,
+        );
+        assert_eq!(
+            opcua_live_server_status(again),
+            0,
+            "{}",
+            server_error(again)
+        );
+        let back = Instant::now();
+        assert_eq!(
+            opcua_live_server_write_real(again, position.as_ptr(), 2.5),
+            0
+        );
+        let mut value = 0.0;
+        while back.elapsed() < Duration::from_secs(30) {
+            value = opcua_live_client_read_real(client, position.as_ptr(), 0.0, &mut st);
+            if st == 0 {
+                break;
+            }
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        assert_eq!(
+            (st, value),
+            (0, 2.5),
+            "the client reads from the new server: {}",
+            client_error(client)
+        );
+        println!(
+            "nodeset-live: connected again {:?} after the server came back",
+            back.elapsed()
+        );
+        opcua_live_client_free(client);
+        opcua_live_server_free(again);
+    }
+}
+
+/// The component-simulation scenario from C (`tests/c/drive.c`), compiled with the system's C compiler
+/// against `include/nodeset_live.h` and the shared library this build made, as a Modelica tool links it.
+#[test]
+fn a_c_program_integrates_a_drive_and_publishes_it_to_a_secure_client() {
+    let dir = tmp("drive");
+    let deps = shared_library().parent().unwrap().to_path_buf();
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let exe = dir.join("drive");
+    let cc = std::process::Command::new("cc")
+        .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-I"])
+        .arg(manifest.join("include"))
+        .arg(manifest.join("tests/c/drive.c"))
+        .arg("-L")
+        .arg(&deps)
+        .args(["-lnodeset_live", "-lm"])
+        .arg(format!("-Wl,-rpath,{}", deps.display()))
+        .arg("-o")
+        .arg(&exe)
+        .output()
+        .expect("cc runs (apt-get install gcc)");
+    assert!(
+        cc.status.success(),
+        "cc failed:\n{}",
+        String::from_utf8_lossy(&cc.stderr)
+    );
+    // The administrator's part: both PKI folders made and each certificate trusted by the other side, a user.
+    let (server_pki, client_pki, users) = (
+        dir.join("server-pki"),
+        dir.join("client-pki"),
+        dir.join("users.txt"),
+    );
+    let server_cert = prepare_pki(
+        &server_pki,
+        "Modelica simulation",
+        "urn:nodeset-models:modelica-simulation",
+        &["127.0.0.1".into()],
+    )
+    .unwrap()
+    .cert;
+    let client_cert = prepare_pki(
+        &client_pki,
+        "Modelica simulation client",
+        "urn:nodeset-live:client",
+        &[],
+    )
+    .unwrap()
+    .cert;
+    trust_certificate(&server_pki, &client_cert).unwrap();
+    trust_certificate(&client_pki, &server_cert).unwrap();
+    let mut list = Users::default();
+    list.set_password("operator", vec![Role::Operator], "dr1ve-Pa55")
+        .unwrap();
+    std::fs::write(&users, list.to_text()).unwrap();
+    let r = root();
+    let nodesets = format!(
+        "{};{};{};{}",
+        r.join("nodesets/RobotCell.NodeSet2.xml").display(),
+        r.join("nodesets/CommonSkills.NodeSet2.xml").display(),
+        manifest.join("tests/fixtures/Live.NodeSet2.xml").display(),
+        r.join("nodesets/vendor").display()
+    );
+    let t = Instant::now();
+    let run = std::process::Command::new(&exe)
+        .args([
+            nodesets.as_str(),
+            server_pki.to_str().unwrap(),
+            client_pki.to_str().unwrap(),
+            users.to_str().unwrap(),
+            "DRIVE_PASSWORD",
+        ])
+        .env("DRIVE_PASSWORD", "dr1ve-Pa55")
+        .output()
+        .unwrap();
+    let out = String::from_utf8_lossy(&run.stdout);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        run.status.success(),
+        "drive failed ({}):\n{out}\n{err}",
+        run.status
+    );
+    let samples: Vec<&str> = out.lines().filter(|l| l.starts_with("sample ")).collect();
+    assert_eq!(samples.len(), 41, "a sample every 50 ms for 2 s:\n{out}");
+    assert!(
+        samples[0].contains("t=0.00 position=0.000000 speed=0.000000 read=0.000000,0.000000"),
+        "{}",
+        samples[0]
+    );
+    assert!(
+        samples[4].contains("t=0.20 position=0.641514"),
+        "after one time constant, 1 - 0.95^20: {}",
+        samples[4]
+    );
+    assert!(out.contains("drive: unknown NodeId: status -2144075776: reading `nsu=http://nodeset-compiler.dev/RobotCell/;i=999999`: BadNodeIdUnknown"), "{out}");
+    assert!(out.contains("drive: wrong type: status -2139881472: writing `nsu=http://nodeset-compiler.dev/RobotCell/;i=4119`: the variable is a Double"), "{out}");
+    assert!(
+        out.contains("drive: 41 samples, final position 0.999967, 0 failures"),
+        "{out}"
+    );
+    println!("nodeset-live: the C drive ran in {:?} (server start with DI, IA, Robotics, CommonSkills, RobotCell included)", t.elapsed());
+}
+
+/// The shared library as a Modelica tool would get it: `cargo build -p nodeset-live --lib`, asked for its
+/// artifacts. (The `cargo test` that runs this test builds the crate as an rlib for the tests, and does not
+/// always write the cdylib again: a library left from an earlier build would be tested instead.)
+fn shared_library() -> PathBuf {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
+    let out = std::process::Command::new(cargo)
+        .current_dir(root())
+        .args([
+            "build",
+            "-p",
+            "nodeset-live",
+            "--lib",
+            "--message-format=json-render-diagnostics",
+        ])
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .expect("cargo runs");
+    assert!(
+        out.status.success(),
+        "cargo build -p nodeset-live --lib failed"
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line = stdout
+        .lines()
+        .find(|l| {
+            l.contains("\"reason\":\"compiler-artifact\"")
+                && l.contains("\"name\":\"nodeset_live\"")
+        })
+        .expect("cargo reports the library");
+    let files = &line[line
+        .find("\"filenames\":[")
+        .expect("the artifact names its files")..];
+    let so = files
+        .split('"')
+        .find(|f| f.ends_with(".so"))
+        .expect("the library is built as a cdylib");
+    PathBuf::from(so)
+}
