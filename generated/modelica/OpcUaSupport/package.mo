@@ -83,6 +83,12 @@ connection</code> at the top of the model:</p>
   NodesetCompilerDrillingProcess.Instances.Bindings.DrillingCell cell(
     redeclare block ReadReal = MyOpcUa.ReadReal);
 end Cell;</pre>
+<p><code>OpcUaSupport.Live</code> implements the blocks over OPC UA itself, with the shared library
+<code>nodeset_live</code> (built from the <code>nodeset-live</code> crate, placed in
+<code>OpcUaSupport/Resources/Library/&lt;platform&gt;</code>): <code>Live.Server</code> when the simulation is the
+server (component simulation: it serves the namespaces of the nodesets), <code>Live.Client</code> when it is a
+client of a real server. Declare its <code>inner</code> endpoint beside the connection and redeclare the block
+classes with <code>Live.Server.ReadReal</code>, ... (see <code>OpcUaSupport.Live</code>).</p>
 <p><code>Examples</code> holds each instance ready to simulate (its binding model with the loopback blocks,
 beside the <code>inner</code> connection), with an <code>experiment</code> annotation.
 <code>Instances.Objects.nodes</code> is the <code>Nodes</code> configuration record of the DLR library's
