@@ -695,18 +695,22 @@ fn a_c_program_integrates_a_drive_and_publishes_it_to_a_secure_client() {
     println!("nodeset-live: the C drive ran in {:?} (server start with DI, IA, Robotics, CommonSkills, RobotCell included)", t.elapsed());
 }
 
-/// The shared library as a Modelica tool would get it: `cargo build -p nodeset-live --lib`, asked for its
-/// artifacts. (The `cargo test` that runs this test builds the crate as an rlib for the tests, and does not
-/// always write the cdylib again: a library left from an earlier build would be tested instead.)
+/// The shared library as a Modelica tool would get it, from the workspace build `.ci/run` makes (`cargo build
+/// --workspace --bins --tests --examples`: in CI a no-op that reports its artifacts), asked for its files.
+/// (The `cargo test` that runs this test builds the crate as an rlib for the tests, and does not always write
+/// the cdylib again: a library left from an earlier build would be tested instead. And `cargo build -p
+/// nodeset-live` alone resolves the dependencies' features for this crate only, so it compiles async-opcua
+/// and its dependencies a second time.)
 fn shared_library() -> PathBuf {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
     let out = std::process::Command::new(cargo)
         .current_dir(root())
         .args([
             "build",
-            "-p",
-            "nodeset-live",
-            "--lib",
+            "--workspace",
+            "--bins",
+            "--tests",
+            "--examples",
             "--message-format=json-render-diagnostics",
         ])
         .stderr(std::process::Stdio::inherit())
@@ -714,7 +718,7 @@ fn shared_library() -> PathBuf {
         .expect("cargo runs");
     assert!(
         out.status.success(),
-        "cargo build -p nodeset-live --lib failed"
+        "cargo build --workspace --bins --tests --examples failed"
     );
     let stdout = String::from_utf8_lossy(&out.stdout);
     let line = stdout
