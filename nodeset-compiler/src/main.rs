@@ -211,6 +211,7 @@ fn compile_checked(common: &Common) -> Result<(Compiled, Options), Error> {
 
 /// Writes (or with `check` compares) the output folder and prints what changed.
 fn write_out(out: &Path, files: &[OutFile], check: bool) -> Result<(), Error> {
+    let _t = nodeset_compiler::timing::span("write");
     let report = write_tree(out, files, if check { Mode::Check } else { Mode::Write }).map_err(Error::Write)?;
     if check && !report.is_clean() {
         return Err(Error::Stale(format!("{} is stale:\n{}", out.display(), report.describe(out))));
@@ -235,6 +236,7 @@ fn rust_command(common: &Common, out: &Path, externs: &[String], modules: &[Stri
         command: "nodeset-compiler rust ...".into(),
     };
     rust.check()?;
+    let _t = nodeset_compiler::timing::span("rust command");
     let (compiled, opts) = compile_checked(common)?;
     // Every required model that is not mapped with --extern is generated too, so the output compiles alone.
     let run = nodeset_compiler::run_rust(&compiled.model, &rust, &opts.severities)?;
