@@ -243,6 +243,10 @@ fn rust_command(common: &Common, out: &Path, externs: &[String], modules: &[Stri
     eprint!("{}", run.warnings);
     write_out(out, &run.files, check)?;
     eprint!("{}", run.plan.describe(|u| run.modules.get(u).cloned().unwrap_or_default()));
+    // The process ends here: the model and the files (hundreds of thousands of allocations) are left to
+    // the operating system instead of being freed one by one (about 5% of the CPU of this command on DI + IA +
+    // Robotics).
+    std::mem::forget((compiled, run));
     Ok(())
 }
 
