@@ -13,6 +13,9 @@
 //!
 //! * `robotics`: ns0 + DI + IA + Robotics from `nodesets/vendor/` (fetched first if missing); with `tree`
 //!   and `sets` in module [`foundation`].
+//! * `generation`: `nodeset-compiler rust` on DI + IA + Robotics as a whole process, in rounds with
+//!   async-opcua-codegen on the same files and with a process that only reads them (the floor); the
+//!   ratios ours / peer (target 0.05) and ours / floor (module [`generation`]).
 //! * `tree`: every NodeSet2 file of the `UA-Nodeset` tree at `../shared/nodesets/ua-nodeset`, one compile
 //!   per file with its required models taken from the tree.
 //! * `sets`: the same tree as a few compiles of many files each (every file named once, no ModelUri twice in
@@ -57,6 +60,7 @@ use process_support::workspace::{cargo, display_path, target_dir, workspace_root
 
 mod builds;
 mod foundation;
+mod generation;
 mod modelica;
 mod peer;
 mod robots;
@@ -81,12 +85,16 @@ const DEFAULT_TREE: &str = "../shared/nodesets/ua-nodeset";
 #[command(name = "cargo xtask bench", bin_name = "cargo xtask bench", about = "Time the compiler and the runtime against their targets and async-opcua-codegen (a report, not a test)")]
 pub struct Args {
     /// Which scenario(s) to run.
-    #[arg(long, value_parser = ["all", "robotics", "tree", "sets", "rust", "modelica", "scale", "robots", "verify"], default_value = "all")]
+    #[arg(long, value_parser = ["all", "robotics", "generation", "tree", "sets", "rust", "modelica", "scale", "robots", "verify"], default_value = "all")]
     scenario: String,
 
     /// Runs of the robotics scenario (ns0 + DI + IA + Robotics).
     #[arg(long, value_name = "N", default_value_t = 20)]
     runs_robotics: usize,
+
+    /// Rounds of the generation scenario (one run each of the peer, our CLI and the floor per round).
+    #[arg(long, value_name = "N", default_value_t = 15)]
+    runs_generation: usize,
 
     /// Runs of the tree and sets scenarios (one run = one pass over the tree).
     #[arg(long, value_name = "N", default_value_t = 3)]
@@ -172,7 +180,7 @@ fn run(args: Args) -> Result<(), String> {
     let want = |s: &str| args.scenario == "all" || args.scenario == s;
     let tree = args.tree.clone().unwrap_or_else(|| root.join(DEFAULT_TREE));
 
-    if want("robotics") || want("rust") || want("modelica") || want("scale") {
+    if want("robotics") || want("generation") || want("rust") || want("modelica") || want("scale") {
         ensure_vendor(&root.join("nodesets/vendor"))?;
     }
     let tree_scenarios: Vec<&str> = ["tree", "sets"].into_iter().filter(|s| want(s)).collect();
@@ -193,6 +201,9 @@ fn run(args: Args) -> Result<(), String> {
     if want("robotics") || run_tree {
         let scenarios = tree_scenarios.into_iter().filter(|_| run_tree);
         foundation::run(&args, &root, &tree, want("robotics"), scenarios)?;
+    }
+    if want("generation") {
+        generation::run(&args, &root, &tree)?;
     }
     if want("rust") {
         rust::run(&args, &root, &tree)?;

@@ -139,6 +139,18 @@ pub(super) fn run_peer(
     peer
 }
 
+/// The peer ready to run on DI + IA + Robotics, types and nodes of all three (the inputs of our `rust`
+/// command in the `rust` and `generation` scenarios): its executable, the folder it runs in (with its
+/// config, `codegen.yml`, written under `target/bench-build/peer-generation`) and the config.
+pub(super) fn prepare_three(root: &Path, tree: &Path) -> Step<(PathBuf, PathBuf, PathBuf)> {
+    let exe = ensure_peer(root).0?;
+    let dir = root.join("target/bench-build/peer-generation");
+    let schemas = schemas(tree)?;
+    write_peer_config(&dir, &root.join("nodesets/vendor"), &schemas, &["di", "ia", "robotics"], "DI + IA + Robotics")?;
+    let config = dir.join("codegen.yml");
+    Ok((exe, dir, config))
+}
+
 /// async-opcua-codegen's executable in `target/bench-tools`, installed there first if it is missing, and
 /// how long the installation took.
 fn ensure_peer(root: &Path) -> (Step<PathBuf>, Option<f64>) {

@@ -116,6 +116,20 @@ fn import_rounds(yardsticks: &Yardsticks, exe: &Path) -> Option<Step<ImportRound
     })())
 }
 
+/// The arguments of `nodeset-compiler rust` on DI + IA + Robotics from `vendor` (ns0 found there as their
+/// dependency), written to `out`: the peer's inputs, as `cargo xtask generate` names their modules.
+pub(super) fn cli_args(vendor: &Path, out: &Path) -> Vec<String> {
+    let mut cli_args: Vec<String> = vec!["rust".into()];
+    cli_args.extend(NAMESPACES.iter().map(|n| vendor.join(n.1).display().to_string()));
+    cli_args.extend(["--models".into(), vendor.display().to_string()]);
+    cli_args.extend(["--out".into(), out.display().to_string()]);
+    cli_args.extend(["--runtime".into(), "crate::runtime".into()]);
+    for (module, _, uri, _) in NAMESPACES {
+        cli_args.extend(["--module".into(), format!("{uri}={module}")]);
+    }
+    cli_args
+}
+
 /// Runs the scenario and prints its table; an error means one of our own steps failed.
 pub(super) fn run(args: &Args, root: &Path, tree: &Path) -> Result<(), String> {
     let start = Instant::now();
@@ -146,18 +160,7 @@ pub(super) fn run(args: &Args, root: &Path, tree: &Path) -> Result<(), String> {
             args.runs_process.max(1)
         );
         let cli_out = bench_target.join("ours-cli/models");
-        let mut cli_args: Vec<String> = vec!["rust".into()];
-        cli_args.extend(
-            NAMESPACES
-                .iter()
-                .map(|n| vendor.join(n.1).display().to_string()),
-        );
-        cli_args.extend(["--models".into(), vendor.display().to_string()]);
-        cli_args.extend(["--out".into(), cli_out.display().to_string()]);
-        cli_args.extend(["--runtime".into(), "crate::runtime".into()]);
-        for (module, _, uri, _) in NAMESPACES {
-            cli_args.extend(["--module".into(), format!("{uri}={module}")]);
-        }
+        let cli_args = cli_args(&vendor, &cli_out);
         let _ = fs::remove_dir_all(&cli_out);
         let cli = fs::create_dir_all(&bench_target)
             .map_err(|e| format!("cannot create {}: {e}", bench_target.display()))

@@ -21,6 +21,12 @@
 //!   time and the peak resident memory and CPU time of its processes (`getrusage(RUSAGE_CHILDREN)`; this
 //!   program has no other children, so the figures belong to the command alone). It measures peers such as
 //!   async-opcua-codegen under the same rules.
+//! * `alternate`: runs several named commands in rounds, one run of each per round in the order given
+//!   (A B C A B C ...), after one untimed round, and reports each command's wall times per round and its
+//!   CPU time per run. Commands compared this way sample the same stretch of a shared host's time, so the
+//!   per-round ratios hold where the absolute times drift.
+//! * `read`: reads the files named into memory and does nothing else: as a process, the floor under any
+//!   program that has to read them.
 //!
 //! Output: progress on stderr, and on stdout one line `BENCH key=value ...` (times in ms, memory in KiB).
 
@@ -50,7 +56,9 @@ fn workspace_root() -> PathBuf {
 }
 
 fn usage() -> String {
-    "usage: rust_bench generate [--runs N] [--vendor DIR]\n       rust_bench exec [--runs N] -- PROGRAM [ARGS...]"
+    "usage: rust_bench generate [--runs N] [--vendor DIR]\n       rust_bench exec [--runs N] -- PROGRAM [ARGS...]\n       \
+     rust_bench alternate [--rounds N] [--dir DIR] [--env K=V] --cmd NAME PROGRAM [ARGS...] --cmd NAME ...\n       \
+     rust_bench read FILE..."
         .to_string()
 }
 
@@ -290,11 +298,101 @@ fn exec_cmd(mut args: impl Iterator<Item = String>) -> Result<(), String> {
     }
 }
 
+/// One command of `alternate`: its name, program and arguments.
+struct Named {
+    name: String,
+    program: String,
+    args: Vec<String>,
+}
+
+fn alternate_cmd(mut args: impl Iterator<Item = String>) -> Result<(), String> {
+    let mut rounds = 10usize;
+    let mut dir: Option<PathBuf> = None;
+    let mut envs: Vec<(String, String)> = Vec::new();
+    let mut cmds: Vec<Named> = Vec::new();
+    while let Some(a) = args.next() {
+        match (a.as_str(), cmds.last_mut()) {
+            ("--cmd", _) => {
+                let name = args.next().ok_or("--cmd needs NAME PROGRAM")?;
+                let program = args.next().ok_or("--cmd needs NAME PROGRAM")?;
+                cmds.push(Named { name, program, args: Vec::new() });
+            }
+            (_, Some(cmd)) => cmd.args.push(a),
+            ("--rounds", None) => {
+                rounds = args.next().ok_or("--rounds needs a value")?.parse().map_err(|e| format!("--rounds: {e}"))?
+            }
+            ("--dir", None) => dir = Some(PathBuf::from(args.next().ok_or("--dir needs a value")?)),
+            ("--env", None) => {
+                let kv = args.next().ok_or("--env needs KEY=VALUE")?;
+                let (k, v) = kv.split_once('=').ok_or("--env needs KEY=VALUE")?;
+                envs.push((k.into(), v.into()));
+            }
+            (s, None) => return Err(format!("unexpected argument `{s}`\n{}", usage())),
+        }
+    }
+    if cmds.is_empty() {
+        return Err(usage());
+    }
+    let run = |c: &Named| -> Result<f64, String> {
+        let mut cmd = Command::new(&c.program);
+        cmd.args(&c.args).stdin(Stdio::null()).stdout(Stdio::piped()).stderr(Stdio::piped());
+        if let Some(d) = &dir {
+            cmd.current_dir(d);
+        }
+        for (k, v) in &envs {
+            cmd.env(k, v);
+        }
+        let t = Instant::now();
+        let out = cmd.output().map_err(|e| format!("cannot run {}: {e}", c.program))?;
+        let wall = ms_since(t);
+        if !out.status.success() {
+            let text = String::from_utf8_lossy(&out.stderr);
+            let tail: Vec<&str> = text.lines().rev().take(15).collect::<Vec<_>>().into_iter().rev().collect();
+            return Err(format!("{} ({}) failed ({}):\n{}", c.name, c.program, out.status, tail.join("\n")));
+        }
+        Ok(wall)
+    };
+    eprintln!("rust_bench: alternate {} command(s), 1 untimed round and {rounds} timed", cmds.len());
+    for c in &cmds {
+        run(c)?;
+    }
+    let mut wall: Vec<Vec<f64>> = cmds.iter().map(|_| Vec::new()).collect();
+    let mut cpu: Vec<Vec<f64>> = cmds.iter().map(|_| Vec::new()).collect();
+    for _ in 0..rounds.max(1) {
+        for (i, c) in cmds.iter().enumerate() {
+            let before = children_usage().1;
+            wall[i].push(run(c)?);
+            cpu[i].push(children_usage().1 - before);
+        }
+    }
+    let mut line = Line::new();
+    line.kv("scenario", "alternate").kv("rounds", rounds.max(1));
+    for (i, c) in cmds.iter().enumerate() {
+        let list: Vec<String> = wall[i].iter().map(|w| format!("{w:.3}")).collect();
+        line.stats(&c.name, &wall[i], 3)
+            .num(format!("{}_cpu_median_ms", c.name), median(&cpu[i]), 3)
+            .kv(format!("{}_rounds_ms", c.name), list.join(","));
+    }
+    line.print();
+    Ok(())
+}
+
+fn read_cmd(args: impl Iterator<Item = String>) -> Result<(), String> {
+    let mut bytes = 0usize;
+    for path in args {
+        bytes += black_box(std::fs::read(&path).map_err(|e| format!("cannot read {path}: {e}"))?).len();
+    }
+    println!("{bytes} bytes");
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let mut args = std::env::args().skip(1);
     let result = match args.next().as_deref() {
         Some("generate") => generate_cmd(args),
         Some("exec") => exec_cmd(args),
+        Some("alternate") => alternate_cmd(args),
+        Some("read") => read_cmd(args),
         _ => Err(usage()),
     };
     match result {

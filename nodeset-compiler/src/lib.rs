@@ -111,6 +111,7 @@ pub mod resolve;
 pub mod serve;
 pub mod source;
 pub mod summary;
+pub mod timing;
 pub mod value;
 pub mod verify;
 pub mod write;
@@ -161,13 +162,20 @@ impl Compiled {
 pub fn compile(inputs: Vec<Input>, opts: &Options) -> Compiled {
     let mut diags = Diagnostics::new();
     let load_opts = LoadOptions { model_dirs: opts.model_dirs.clone(), limits: opts.limits.clone() };
-    let mut loaded = load::load(inputs, &load_opts, &mut diags);
+    let _t = timing::span("compile");
+    let mut loaded = {
+        let _t = timing::span("load");
+        load::load(inputs, &load_opts, &mut diags)
+    };
     // Demoted errors of loading (`--warn NS0110`) do not stop it.
     diags.apply(&opts.severities);
     if diags.has_errors() {
         loaded.files.clear();
     }
-    let model = resolve::resolve(loaded, &mut diags);
+    let model = {
+        let _t = timing::span("resolve");
+        resolve::resolve(loaded, &mut diags)
+    };
     finish(model, diags, opts)
 }
 
@@ -289,7 +297,10 @@ fn generate_rust_tree(
     earlier: diag::Diagnostics,
     severities: &Severities,
 ) -> Result<(Vec<write::OutFile>, String, Diagnostics), Error> {
-    let mut gen = emit::rust::generate(model, cfg);
+    let mut gen = {
+        let _t = timing::span("emit rust");
+        emit::rust::generate(model, cfg)
+    };
     gen.diagnostics.extend(earlier);
     let rendered = gen.diagnostics.finalize(severities, &model.sources, "Rust generation failed")?;
     let mut files = gen.files;

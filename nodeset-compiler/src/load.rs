@@ -217,6 +217,7 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
     let mut texts: Vec<(usize, FileId)> = Vec::new();
     // Every file read, so that none is read twice (see the termination argument below).
     let mut seen = Seen::default();
+    let t_read = crate::timing::span("read named files");
     for input in inputs {
         let mut d = Diagnostics::new();
         let (path, display, bytes) = match input {
@@ -242,12 +243,15 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
         }
         said.push(d);
     }
+    drop(t_read);
+    let t_parse = crate::timing::span("parse named files");
     let jobs: Vec<(FileId, &str)> = texts.iter().map(|&(_, id)| (id, sources.get(id).text.as_str())).collect();
     let mut parsed_at: Vec<Option<RawNodeSet>> = (0..said.len()).map(|_| None).collect();
     for (&(i, _), (set, d)) in texts.iter().zip(parse::parse_files(&jobs, &opts.limits)) {
         said[i].extend(d);
         parsed_at[i] = set;
     }
+    drop(t_parse);
     for d in said {
         diags.extend(d);
     }
@@ -338,7 +342,10 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
                 }
                 continue;
             }
-            let idx = index.get_or_insert_with(|| folders::scan_dirs(&opts.model_dirs));
+            let idx = index.get_or_insert_with(|| {
+                let _t = crate::timing::span("scan model folders");
+                folders::scan_dirs(&opts.model_dirs)
+            });
             let options = folders::ranked(idx, &req.uri);
             // A file without <Models> (an older specification) that refers to a namespace takes, first, a file
             // of the same kind whose own namespace that is, from its own folder if there is one there: the
@@ -438,6 +445,7 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
         }
     }
 
+    let _t = crate::timing::span("order and namespace table");
     // Order files by requirement, ties by model URI then file name, never by input order.
     let order = topo_order(&parsed, &sources, &implied, &implied_requires, diags);
     let mut files_sorted: Vec<RawNodeSet> = Vec::with_capacity(parsed.len());
@@ -588,7 +596,11 @@ fn read_and_parse(
     limits: &Limits,
     diags: &mut Diagnostics,
 ) -> Option<RawNodeSet> {
-    let id = add_source(sources, path, display, bytes, named, diags)?;
+    let id = {
+        let _t = crate::timing::span("decode required file");
+        add_source(sources, path, display, bytes, named, diags)?
+    };
+    let _t = crate::timing::span("parse required file");
     let (set, d) = parse::parse_files(&[(id, sources.get(id).text.as_str())], limits).pop().expect("one file, one result");
     diags.extend(d);
     set
@@ -601,6 +613,7 @@ fn read_new(c: &Candidate, seen: &mut Seen, sources: &SourceMap, at: Span, diags
         return None;
     }
     seen.add_path(c.id.clone());
+    let _t = crate::timing::span("read required file");
     match std::fs::read(&c.path) {
         Ok(bytes) => seen.same_as(&bytes, sources).is_none().then_some(bytes),
         Err(e) => {

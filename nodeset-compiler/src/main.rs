@@ -253,6 +253,7 @@ fn compile_checked(common: &Common) -> Result<(Compiled, Options), Error> {
 
 /// Writes (or with `check` compares) the output folder and prints what changed.
 fn write_out(out: &Path, files: &[OutFile], check: bool) -> Result<(), Error> {
+    let _t = nodeset_compiler::timing::span("write");
     let report = write_tree(out, files, if check { Mode::Check } else { Mode::Write }).map_err(Error::Write)?;
     if check && !report.is_clean() {
         return Err(Error::Stale(format!("{} is stale:\n{}", out.display(), report.describe(out))));
@@ -277,12 +278,17 @@ fn rust_command(common: &Common, out: &Path, externs: &[String], modules: &[Stri
         command: "nodeset-compiler rust ...".into(),
     };
     rust.check()?;
+    let _t = nodeset_compiler::timing::span("rust command");
     let (compiled, opts) = compile_checked(common)?;
     // Every required model that is not mapped with --extern is generated too, so the output compiles alone.
     let run = nodeset_compiler::run_rust(&compiled.model, &rust, &opts.severities)?;
     eprint!("{}", run.warnings);
     write_out(out, &run.files, check)?;
     eprint!("{}", run.plan.describe(|u| run.modules.get(u).cloned().unwrap_or_default()));
+    // The process ends here: the model and the files (hundreds of thousands of allocations) are left to
+    // the operating system instead of being freed one by one (about 5% of the CPU of this command on DI + IA +
+    // Robotics).
+    std::mem::forget((compiled, run));
     Ok(())
 }
 

@@ -44,6 +44,7 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
     model.nodes.reserve(total);
     model.index.reserve(total);
 
+    let t_pass1 = crate::timing::span("pass 1 (index)");
     // Pass 1: every node gets its index and what it owns of its raw node. Raw nodes stay where the loader
     // put them; `pending` says where.
     let mut files = files;
@@ -171,6 +172,8 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
         }
     }
 
+    drop(t_pass1);
+    let t_pass2 = crate::timing::span("pass 2 (references)");
     for r in &redefined {
         diags.push(redefinition(&model, &files, &contexts, &sources, &value_arenas, &pending, r));
     }
@@ -228,6 +231,8 @@ pub fn resolve(loaded: Loaded, diags: &mut Diagnostics) -> Model {
     model.sources = sources;
     model.value_arenas = value_arenas;
     drop(pending);
+    drop(t_pass2);
+    let _t = crate::timing::span("passes 3-8");
     // The raw files are not needed any more: another thread frees them while this one goes on.
     let own = OwnReferences { references: own, ends: own_end, found: found_all };
     crate::par::join(move || drop(files), || link(&mut model, own, incoming, &broken, diags));
@@ -281,7 +286,7 @@ fn link(model: &mut Model, own: OwnReferences, incoming: Vec<(NodeIx, Reference)
     }
     drop((own, ends, sorted, starts, next));
     model_defaults(model, diags);
-
+    let t3 = crate::timing::span("pass 3 (types)");
     // Pass 3: hierarchy flags, supertypes, type definitions, modelling rules, parents.
     link_types(model, broken, diags);
 
@@ -289,6 +294,8 @@ fn link(model: &mut Model, own: OwnReferences, incoming: Vec<(NodeIx, Reference)
     // the method arguments (Argument structures) and the value check need them. So two rounds of two threads:
     // instance declarations beside the data types, then method arguments beside the value check. Each pass
     // keeps its diagnostics, which are added in pass order.
+    drop(t3);
+    let t48 = crate::timing::span("passes 4-6, 8");
     let m = &*model;
     let ((members, members_said), (data_types, data_types_said)) = crate::par::join(
         || said(|d| build_members(m, d)),
@@ -304,6 +311,8 @@ fn link(model: &mut Model, own: OwnReferences, incoming: Vec<(NodeIx, Reference)
     model.overridden = inherit::overrides(model, diags);
     diags.extend(data_types_said);
     diags.extend(methods_said);
+    drop(t48);
+    let _t = crate::timing::span("pass 7 (state machines)");
     // Pass 7: state machines, from the instance declarations.
     state_machines(model, diags);
     diags.extend(values_said);

@@ -12,7 +12,6 @@ use crate::raw::RawNodeSet;
 use crate::source::{FileId, SourceMap};
 use std::cmp::Ordering;
 use std::collections::{BTreeMap, BTreeSet};
-use std::hash::Hasher;
 use std::path::{Path, PathBuf};
 
 /// A model a file's header declares: ModelUri, Version and PublicationDate.
@@ -102,22 +101,30 @@ pub fn cmp_version(a: Option<&str>, b: Option<&str>) -> Ordering {
 
 /// A file's content as the loader compares it: without a UTF-8 byte order mark, and with CRLF line ends read
 /// as LF (a copy saved on another system is the same file).
-fn normalized(bytes: &[u8]) -> impl Iterator<Item = u8> + '_ {
+pub(super) fn normalized(bytes: &[u8]) -> impl Iterator<Item = u8> + '_ {
     let bytes = bytes.strip_prefix(&[0xEF, 0xBB, 0xBF]).unwrap_or(bytes);
     bytes.iter().enumerate().filter(|&(i, &b)| !(b == b'\r' && bytes.get(i + 1) == Some(&b'\n'))).map(|(_, &b)| b)
 }
 
 /// Whether two files have the same content (see [`normalized`]): such files are one model, wherever they lie.
 pub(super) fn same_content(a: &[u8], b: &[u8]) -> bool {
+    fn strip(x: &[u8]) -> &[u8] {
+        x.strip_prefix(&[0xEF, 0xBB, 0xBF]).unwrap_or(x)
+    }
+    let (sa, sb) = (strip(a), strip(b));
+    // Without CRLF the normalised contents are the bytes themselves: compared at memcmp speed.
+    if memchr::memmem::find(sa, b"\r\n").is_none() && memchr::memmem::find(sb, b"\r\n").is_none() {
+        return sa == sb;
+    }
     normalized(a).eq(normalized(b))
 }
 
-fn digest(bytes: &[u8]) -> u64 {
-    let mut h = crate::fxhash::FxHasher::default();
-    for b in normalized(bytes) {
-        h.write_u8(b);
-    }
-    h.finish()
+/// The length of a file's content as [`same_content`] compares it (without a byte order mark, CRLF counted
+/// as one byte): files of different lengths differ, so only files of one length are compared. Counting the
+/// line ends is a vectorised search; a digest of every byte cost more than the rest of reading ns0.
+pub(super) fn normalized_len(bytes: &[u8]) -> usize {
+    let bytes = bytes.strip_prefix(&[0xEF, 0xBB, 0xBF]).unwrap_or(bytes);
+    bytes.len() - memchr::memmem::find_iter(bytes, b"\r\n").count()
 }
 
 /// The canonical form of a path, for telling whether two paths are one file (the path itself when it
@@ -133,8 +140,9 @@ pub(super) fn canonical(path: &Path) -> PathBuf {
 #[derive(Default)]
 pub(super) struct Seen {
     paths: BTreeSet<PathBuf>,
-    /// Content digest to the files read with that digest (confirmed byte by byte before it counts).
-    digests: BTreeMap<u64, Vec<FileId>>,
+    /// The files read, by the length of their content ([`normalized_len`]; equal content is confirmed byte by
+    /// byte before it counts).
+    lengths: BTreeMap<usize, Vec<FileId>>,
 }
 
 impl Seen {
@@ -145,7 +153,7 @@ impl Seen {
 
     /// Records the content of a file that is now a source.
     pub(super) fn add_source(&mut self, file: FileId, sources: &SourceMap) {
-        self.digests.entry(digest(sources.get(file).text.as_bytes())).or_default().push(file);
+        self.lengths.entry(normalized_len(sources.get(file).text.as_bytes())).or_default().push(file);
     }
 
     /// Whether the file at this canonical path was read.
@@ -155,7 +163,7 @@ impl Seen {
 
     /// A file read before whose content is `bytes`, if any.
     pub(super) fn same_as(&self, bytes: &[u8], sources: &SourceMap) -> Option<FileId> {
-        let ids = self.digests.get(&digest(bytes))?;
+        let ids = self.lengths.get(&normalized_len(bytes))?;
         ids.iter().copied().find(|&f| same_content(bytes, sources.get(f).text.as_bytes()))
     }
 }

@@ -549,3 +549,30 @@ fn the_loader_ends_and_answers_sensibly_on_generated_folder_layouts() {
         assert!(seen_codes.contains(code), "no layout gave {code}: widen the generator ({seen_codes:?})");
     }
 }
+
+/// The loader finds copies of a file by the length of their normalised content, then compares bytes: a copy
+/// with a byte order mark, CRLF line ends or both must have the same length as the original (else it would
+/// be read as a second model), and the fast comparison must agree with the byte-by-byte definition.
+#[test]
+fn copies_have_one_normalised_length() {
+    let bases = ["<a>\n<b/>\n</a>\n", "x\ry\r\n\r\nz", "\r", "\n\r\n\r", "", "<UANodeSet>\r\n\r</UANodeSet>"];
+    let variants = |t: &str| -> Vec<Vec<u8>> {
+        let crlf = t.replace("\r\n", "\n").replace('\n', "\r\n");
+        let lf = t.replace("\r\n", "\n");
+        [t.to_string(), crlf.clone(), lf.clone(), format!("\u{feff}{t}"), format!("\u{feff}{crlf}"), format!("\u{feff}\u{feff}{lf}")]
+            .into_iter()
+            .map(String::into_bytes)
+            .collect()
+    };
+    let all: Vec<Vec<u8>> = bases.iter().flat_map(|b| variants(b)).collect();
+    for a in &all {
+        assert_eq!(folders::normalized_len(a), folders::normalized(a).count(), "{:?}", String::from_utf8_lossy(a));
+        for b in &all {
+            let by_bytes = folders::normalized(a).eq(folders::normalized(b));
+            assert_eq!(folders::same_content(a, b), by_bytes, "{:?} vs {:?}", String::from_utf8_lossy(a), String::from_utf8_lossy(b));
+            if by_bytes {
+                assert_eq!(folders::normalized_len(a), folders::normalized_len(b));
+            }
+        }
+    }
+}
