@@ -724,8 +724,11 @@ fn shared_library() -> PathBuf {
     let line = stdout
         .lines()
         .find(|l| {
+            // The library, not the crate's unit-test harness (`"test":true`, also named nodeset_live).
             l.contains("\"reason\":\"compiler-artifact\"")
                 && l.contains("\"name\":\"nodeset_live\"")
+                && l.contains("\"cdylib\"")
+                && l.contains("\"test\":false")
         })
         .expect("cargo reports the library");
     let files = &line[line
