@@ -1,5 +1,6 @@
 //! Bindings the derive accepts: field names as browse names, explicit paths, skipped fields, arrays as
-//! `Vec<T>`, generated enumerations, and members a subtype inherits.
+//! `Vec<T>`, generated enumerations, and members a subtype inherits. An ordinary test, compiled with the
+//! workspace (the mistakes the derive refuses are the UI tests, `derive_ui.rs`).
 
 use nodeset_models::models::robotics::objects::{AxisType, ControllerType, PowerTrainType};
 use nodeset_models::models::robotics::types::AxisMotionProfileEnumeration;
@@ -41,7 +42,8 @@ struct Controller {
     available_states: Vec<NodeId>,
 }
 
-fn main() {
+#[test]
+fn bindings_compile_and_carry_their_paths() {
     let axis: Vec<&str> = Axis::FIELDS.iter().map(|f| f.path).collect();
     assert_eq!(axis, ["ParameterSet/ActualPosition", "MotionProfile"]);
     assert_eq!(PowerTrain::FIELDS.len(), 3);
