@@ -154,17 +154,17 @@ pub fn run_with_groups(args: Args, groups: &[Vec<PathBuf>]) -> Result<(), String
         println!("  not resolvable: {}", names.join(" + "));
     }
     let start = std::time::Instant::now();
-    cargo_check(&root, &out)?;
+    cargo_check(&out)?;
     println!("corpus: cargo check of {} generated modules ({generated} files) passed in {:.1} s ({warnings} model warnings)", modules.len(), start.elapsed().as_secs_f64());
     Ok(())
 }
 
-/// `cargo check` of a generated corpus crate in the workspace's target folder (its dependencies are
+/// `cargo check` of a generated corpus crate in the target folder of the workspace (its dependencies are
 /// shared with the workspace's build; the crate's own name is unique to `out`, see [`package_name`]).
-pub fn cargo_check(root: &Path, out: &Path) -> Result<(), String> {
+pub fn cargo_check(out: &Path) -> Result<(), String> {
     let status = crate::util::cargo()
         .current_dir(out)
-        .env("CARGO_TARGET_DIR", root.join("target"))
+        .env("CARGO_TARGET_DIR", crate::util::target_dir())
         .args(["check", "--quiet", "--message-format", "short"])
         .status()
         .map_err(|e| format!("cannot run cargo check: {e}"))?;
@@ -211,7 +211,7 @@ mod tests {
         let mut text = std::fs::read_to_string(&module).unwrap();
         text.push_str("\nconst PLANTED: u8 = \"not a number\";\n");
         std::fs::write(&module, text).unwrap();
-        let err = cargo_check(&workspace_root(), &bad).expect_err("a planted compile error fails the corpus check");
+        let err = cargo_check(&bad).expect_err("a planted compile error fails the corpus check");
         assert!(err.contains("does not compile"), "{err}");
         let _ = std::fs::remove_dir_all(&dir);
     }

@@ -83,7 +83,7 @@ pub fn run(args: Args) -> Result<(), String> {
         return Err(format!("one-at-a-time: no file of {} generated, nothing to compile", tree.display()));
     }
     let start = std::time::Instant::now();
-    cargo_check(&root, &out)?;
+    cargo_check(&out)?;
     println!("one-at-a-time: cargo check of {} outputs passed in {:.1} s", modules.len(), start.elapsed().as_secs_f64());
     if !unresolved.is_empty() {
         return Err(format!(
