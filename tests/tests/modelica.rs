@@ -178,10 +178,24 @@ fn copy_dir(from: &Path, to: &Path) {
     }
 }
 
-/// Runs the checker; returns (passed, failed) and the output.
+/// Runs the checker; returns (passed, failed) and the output. The support package, when it is
+/// `generated/modelica`'s byte for byte, is left out (`check.py --same-as`, see [`left_out`]): that tree's
+/// test checks it class by class, and it refers to nothing outside itself.
 fn check(dir: &Path, aggregate: bool) -> (usize, usize, String) {
-    let args: &[&str] = if aggregate { &["--aggregate", "--jobs", "1"] } else { &[] };
-    run_checker("check.py", dir, args)
+    let same_as = format!("OpcUaSupport={}", root().join("generated/modelica").display());
+    let mut args = vec!["--same-as", same_as.as_str()];
+    if aggregate {
+        args.extend(["--aggregate", "--jobs", "1"]);
+    }
+    run_checker("check.py", dir, &args)
+}
+
+/// How many classes `check.py --same-as` left out (checked in the reference tree), from its output.
+fn left_out(text: &str) -> usize {
+    text.lines()
+        .filter_map(|l| l.strip_prefix("left out: "))
+        .filter_map(|l| l.split_whitespace().next()?.parse::<usize>().ok())
+        .sum()
 }
 
 /// The checkers of `tests/modelica`: `check.py` (rumoca), `check2.py` (pymoca, the second front end) and
@@ -274,7 +288,11 @@ fn companion_specs_and_the_example_pass_rumoca_and_the_example_simulates() {
         t.elapsed().as_secs_f64()
     );
     assert_eq!(failed, 0, "{text}");
-    assert_eq!(passed, classes + example_classes, "every generated class and the example are checked\n{text}");
+    assert_eq!(
+        passed + left_out(&text),
+        classes + example_classes,
+        "every generated class and the example are checked (here or in generated/modelica)\n{text}"
+    );
     // The second checker flattens the example (and with it the Robotics classes it uses); the generated classes
     // one by one are `generated_tree_passes_pymoca_and_the_structural_checks`'s.
     println!("{}", second_checks("RoboticsExample", &target, &["RoboticsExample"], classes + example_classes));
@@ -425,6 +443,9 @@ fn a_skill_instance_runs_through_start_halt_and_reset() {
     let (passed, failed, text) = check(&target, true);
     assert_eq!(failed, 0, "{text}");
     assert!(passed > 100, "{text}");
+    // The classes below the tree, those the support package left out included (pymoca and the structural
+    // checks see all of them).
+    let passed = passed + left_out(&text);
     // pymoca flattens the examples, the binding models and OpcUaSupport. When the library beside the examples is
     // generated/modelica byte for byte (as it is when generated/ is up to date), the binding models and
     // OpcUaSupport are flattened class by class in that tree by `generated_tree_passes_pymoca_and_the_structural_checks`
@@ -591,19 +612,18 @@ fn check_tree(label: &str, tree: &Path, files: &[PathBuf], absent_ok: bool) {
         .collect();
     assert!(cycles.is_empty(), "classes that contain themselves:\n{}", cycles.join("\n"));
     let gen_elapsed = t0.elapsed().as_secs_f64();
-    // Two workers: the CI machine has two cores.
+    // Two workers (the CI machine has two cores), each taking the next tree when it is done with one.
     let t1 = Instant::now();
+    let next = std::sync::atomic::AtomicUsize::new(0);
     let results: Vec<(PathBuf, usize, usize, String, f64)> = std::thread::scope(|s| {
-        let chunks: Vec<Vec<&(PathBuf, PathBuf, usize)>> =
-            (0..2).map(|w| jobs.iter().skip(w).step_by(2).collect()).collect();
-        let handles: Vec<_> = chunks
-            .into_iter()
-            .map(|chunk| {
+        let handles: Vec<_> = (0..2)
+            .map(|_| {
+                let (jobs, next) = (&jobs, &next);
                 s.spawn(move || {
-                    chunk
-                        .into_iter()
+                    std::iter::from_fn(|| jobs.get(next.fetch_add(1, std::sync::atomic::Ordering::Relaxed)))
                         .map(|(f, dir, classes)| {
                             let (p, fl, mut text) = check(dir, true);
+                            let p = p + left_out(&text);
                             // The structural checks (modifier targets, conditional reads) too.
                             let t = Instant::now();
                             let (ps, fs, texts) = run_checker("structure.py", dir, &[]);
@@ -616,7 +636,9 @@ fn check_tree(label: &str, tree: &Path, files: &[PathBuf], absent_ok: bool) {
                 })
             })
             .collect();
-        handles.into_iter().flat_map(|h| h.join().expect("a checker thread panicked")).collect()
+        let mut all: Vec<_> = handles.into_iter().flat_map(|h| h.join().expect("a checker thread panicked")).collect();
+        all.sort_by(|a, b| a.0.cmp(&b.0));
+        all
     });
     let mut passed = 0;
     let mut failed = 0;
@@ -631,7 +653,7 @@ fn check_tree(label: &str, tree: &Path, files: &[PathBuf], absent_ok: bool) {
         }
     }
     println!(
-        "{label}: {} files, {} generated ({generated_classes} classes, generation {gen_time:.2} s, {gen_elapsed:.1} s with loading), {} unresolvable (missing models); rumoca: {passed} passed, {failed} failed (with the structural checks, {structure_s:.1} s of them) in {:.1} s",
+        "{label}: {} files, {} generated ({generated_classes} classes, generation {gen_time:.2} s, {gen_elapsed:.1} s with loading), {} unresolvable (missing models); rumoca: {passed} passed (the support package's where it is generated/modelica's: there), {failed} failed (with the structural checks, {structure_s:.1} s of them) in {:.1} s",
         files.len(),
         jobs.len(),
         unresolvable.len(),
@@ -673,7 +695,8 @@ fn generated_tree_passes_rumoca() {
         }
     }
     let t = Instant::now();
-    let (passed, failed, text) = check(&tree, false);
+    // Every class, the support package's included: the other trees' checks leave it out when theirs is this one.
+    let (passed, failed, text) = run_checker("check.py", &tree, &[]);
     println!("generated/modelica: {passed} passed, {failed} failed in {:.1} s", t.elapsed().as_secs_f64());
     assert_eq!(failed, 0, "{text}");
     assert_eq!(passed, classes, "every class of generated/modelica is checked\n{text}");
@@ -688,6 +711,27 @@ fn generated_tree_passes_pymoca_and_the_structural_checks() {
     let classes = class_graph(&tree).len();
     assert!(classes > 200, "expected the classes of generated/modelica, found {classes}");
     println!("{}", second_checks("generated/modelica", &tree, &[], classes));
+}
+
+/// `check.py --same-as` leaves out a package only when it is the reference's byte for byte: a copy of the support
+/// package is left out whole; the same copy with one file changed is checked, every class of it.
+#[test]
+fn only_an_identical_support_package_is_left_out() {
+    let reference = root().join("generated/modelica");
+    let dir = tmp("same-as");
+    let _ = std::fs::remove_dir_all(&dir);
+    copy_dir(&reference.join("OpcUaSupport"), &dir.join("OpcUaSupport"));
+    let classes = class_graph(&dir).len();
+    assert!(classes > 30, "expected the support package's classes, found {classes}");
+    let (passed, failed, text) = check(&dir, true);
+    assert_eq!((passed, failed, left_out(&text)), (0, 0, classes), "{text}");
+    // One changed byte: the package is checked here.
+    let package = dir.join("OpcUaSupport/package.mo");
+    let mut source = std::fs::read_to_string(&package).unwrap();
+    source.push('\n');
+    std::fs::write(&package, source).unwrap();
+    let (passed, failed, text) = check(&dir, true);
+    assert_eq!((passed, failed, left_out(&text)), (classes, 0, 0), "{text}");
 }
 
 /// Each check fails on its planted mistake (`tests/modelica/planted`, whose package documents each case) and
