@@ -384,7 +384,7 @@ impl LiveClient {
                 format!("writing `{text}`: the variable is a {builtin:?}, which a Modelica {} cannot write", value.kind().name()),
             ));
         }
-        let variant = builtin.variant(value).map_err(|m| {
+        let variant = builtin.variant(&value).map_err(|m| {
             Failure::new(StatusCode::BadOutOfRange, format!("writing `{text}`: {m}"))
         })?;
         self.nodes

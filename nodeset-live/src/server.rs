@@ -183,7 +183,7 @@ impl LiveServer {
         };
         let mut last = String::new();
         for b in tries {
-            let variant = match b.variant(value) {
+            let variant = match b.variant(&value) {
                 Ok(v) => v,
                 Err(m) if fixed.is_some() => {
                     return Err(Failure::new(

@@ -243,6 +243,97 @@ fn a_simulation_serves_and_a_secure_client_reads_and_writes_through_the_c_interf
             200,
             "the refused writes changed nothing"
         );
+        // Strings: published by the simulation, written by the client; a failed read returns a copy of
+        // `previous`.
+        let label = node(6005);
+        let text = |p: *const std::ffi::c_char| CStr::from_ptr(p).to_string_lossy().into_owned();
+        assert_eq!(
+            text(opcua_live_client_read_string(
+                client,
+                label.as_ptr(),
+                c("?").as_ptr(),
+                &mut st
+            )),
+            "axis"
+        );
+        assert_eq!(st, 0, "{}", client_error(client));
+        assert_eq!(
+            opcua_live_server_write_string(s.server, label.as_ptr(), c("axis 2 (ä)").as_ptr()),
+            0,
+            "{}",
+            server_error(s.server)
+        );
+        assert_eq!(
+            text(opcua_live_client_read_string(
+                client,
+                label.as_ptr(),
+                c("?").as_ptr(),
+                &mut st
+            )),
+            "axis 2 (ä)"
+        );
+        assert_eq!(
+            opcua_live_client_write_string(client, label.as_ptr(), c("from the client").as_ptr()),
+            0,
+            "{}",
+            client_error(client)
+        );
+        assert_eq!(
+            text(opcua_live_server_read_string(
+                s.server,
+                label.as_ptr(),
+                c("?").as_ptr(),
+                &mut st
+            )),
+            "from the client"
+        );
+        let previous = c("held");
+        let held =
+            opcua_live_server_read_string(s.server, position.as_ptr(), previous.as_ptr(), &mut st);
+        assert_eq!(
+            (text(held), st),
+            ("held".to_owned(), status(StatusCode::BadTypeMismatch))
+        );
+        assert_ne!(held, previous.as_ptr(), "a copy, not the caller's pointer");
+        assert_eq!(
+            opcua_live_client_write_string(client, position.as_ptr(), c("1.5").as_ptr()),
+            status(StatusCode::BadTypeMismatch)
+        );
+        assert!(
+            client_error(client)
+                .contains("the variable is a Double, which a Modelica String cannot write"),
+            "{}",
+            client_error(client)
+        );
+        // A message returned to this thread stays as it was while another thread calls on the object.
+        let mine = opcua_live_client_error(client);
+        let before = text(mine);
+        let other = client as usize;
+        std::thread::spawn(move || {
+            let client = other as *mut c_void;
+            let mut st = 0;
+            for _ in 0..3 {
+                opcua_live_client_read_real(
+                    client,
+                    c("nsu=urn:elsewhere;i=1").as_ptr(),
+                    0.0,
+                    &mut st,
+                );
+                let _ = opcua_live_client_error(client);
+            }
+        })
+        .join()
+        .unwrap();
+        assert_eq!(
+            text(mine),
+            before,
+            "the string this thread got is its own until its next string call"
+        );
+        assert!(
+            client_error(client).contains("urn:elsewhere"),
+            "the object's message is the other thread's last"
+        );
+
         // Throughput of one block, sampled as fast as the calls return.
         let n = 300;
         let t = Instant::now();

@@ -18,6 +18,7 @@
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
@@ -28,6 +29,24 @@
 #define SPEED AXIS "6002"
 
 static int failures = 0;
+
+/*
+ * The string allocator of a Modelica tool's runtime (ModelicaUtilities.h), which the library finds in the
+ * process (the program is linked with -rdynamic, as a tool's simulation exports its runtime): every string
+ * the library returns is allocated here, and the "tool" frees them all at the end, as a tool frees its
+ * string stack.
+ */
+static char* strings[4096];
+static int allocated = 0;
+
+char* ModelicaAllocateStringWithErrorReturn(size_t len);
+char* ModelicaAllocateStringWithErrorReturn(size_t len) {
+    if (allocated == (int)(sizeof strings / sizeof strings[0])) {
+        return NULL;
+    }
+    strings[allocated] = malloc(len + 1);
+    return strings[allocated++];
+}
 
 static void expect(int ok, const char* what, const char* message) {
     if (!ok) {
@@ -112,9 +131,16 @@ int main(int argc, char** argv) {
            opcua_live_server_error(server));
     printf("drive: wrong type: status %d: %s\n", st, opcua_live_server_error(server));
 
-    /* The end: the destructors. */
+    const char* message = opcua_live_server_error(server);
+    expect(allocated > 0 && message == strings[allocated - 1], "the messages are allocated by the tool", message);
+    printf("drive: %d strings allocated by the tool\n", allocated);
+
+    /* The end: the destructors; the tool's strings freed. */
     opcua_live_client_free(client);
     opcua_live_server_free(server);
+    for (int i = 0; i < allocated; i++) {
+        free(strings[i]);
+    }
     printf("drive: %d samples, final position %.6f, %d failures\n", samples, x, failures);
     return failures == 0 ? 0 : 1;
 }

@@ -178,13 +178,24 @@ fn compile(name: &str, dir: &Path) -> PathBuf {
     let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
     let exe = dir.join(name);
     let cc = Command::new("cc")
-        .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-g", "-I"])
+        // -rdynamic: the program's own symbols visible to dlsym, as a tool's runtime is to the library.
+        .args([
+            "-std=c99",
+            "-Wall",
+            "-Wextra",
+            "-Werror",
+            "-g",
+            "-rdynamic",
+            "-I",
+        ])
         .arg(manifest.join("include"))
         .arg(manifest.join(format!("tests/c/{name}.c")))
         .arg("-L")
         .arg(&lib)
         .args(["-lnodeset_live", "-lm"])
-        .arg(format!("-Wl,-rpath,{}", lib.display()))
+        // RPATH, not RUNPATH: searched before LD_LIBRARY_PATH, which `cargo test` sets to folders that hold
+        // an older copy of the library (target/debug/libnodeset_live.so, uplifted by an earlier build).
+        .arg(format!("-Wl,--disable-new-dtags,-rpath,{}", lib.display()))
         .arg("-o")
         .arg(&exe)
         .output()
@@ -461,6 +472,19 @@ fn scenario_a_a_c_drive_publishes_a_robotics_axis_and_node_opcua_subscribes_over
             "drive: wrong type: status -2139881472: writing `{AXIS}6001`: the variable is a Double"
         )),
         "{out}"
+    );
+    let allocated: usize = out
+        .lines()
+        .find_map(|l| {
+            l.strip_prefix("drive: ")?
+                .strip_suffix(" strings allocated by the tool")
+        })
+        .unwrap_or_else(|| panic!("{out}"))
+        .parse()
+        .unwrap();
+    assert!(
+        allocated >= 4,
+        "the messages the program printed came from its allocator: {out}"
     );
     assert!(
         out.contains("drive: 41 samples, final position 0.999967, 0 failures"),
