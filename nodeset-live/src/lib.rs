@@ -15,11 +15,12 @@
 //!
 //! The C types are those of MLS 12.9: `Real` is `double`, `Integer` and `Boolean` are `int`, `String` is
 //! `const char*`, an external object is a `void*` made by its constructor and released by its destructor.
-//! Each read and write takes a NodeId string (`nsu=<namespace URI>;i=<n>`, `ns=<index>;i=<n>` or `i=<n>`)
-//! and reports an `int` status: 0 for Good, else the OPC UA status code's 32 bits (negative for Bad). A
-//! failed read returns the `previous` value it was given, so the block holds its value. The message of the
-//! last call on an object is `opcua_live_*_error(object)`, for the Modelica side to pass to `ModelicaError`
-//! or `assert`: the library itself does not link against a Modelica runtime. Strings returned (messages,
+//! Each read and write takes a NodeId string (`nsu=<namespace URI>;i=<n>`, `ns=<index>;i=<n>` or `i=<n>`;
+//! a client's also a browse path from the ObjectsFolder, translated once per session) and reports an `int`
+//! status: 0 for Good, else the OPC UA status code's 32 bits (negative for Bad). A failed read returns the
+//! `previous` value it was given, so the block holds its value. The message of the last call on an object
+//! is `opcua_live_*_error(object)`, for the Modelica side to pass to `ModelicaError` or `assert`: the
+//! library itself does not link against a Modelica runtime. Strings returned (messages,
 //! String values) are allocated by the tool's `ModelicaAllocateStringWithErrorReturn` where the process has
 //! it, else kept in a buffer of the calling thread until its next call that returns a string ([`strings`]).
 //!

@@ -372,6 +372,7 @@ fn the_c_drive_runs_clean_under_valgrind() {
         "nodeset-live: the C drive ran clean under valgrind memcheck in {:?}",
         started.elapsed()
     );
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -570,6 +571,7 @@ fn scenario_a_a_c_drive_publishes_a_robotics_axis_and_node_opcua_subscribes_over
         latency.len(),
         started.elapsed()
     );
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The robot's joint `i` (0-based) at `t` seconds: `examples/robot.rs` moves it along a sine, in degrees.
@@ -730,5 +732,6 @@ fn scenario_b_a_c_controller_reads_the_robots_joints_in_si_and_writes_a_setting(
         .unwrap_or_default()
         .to_owned();
     robot.stop().unwrap_or_else(|e| panic!("{e}"));
+    let _ = std::fs::remove_dir_all(&dir);
     println!("nodeset-live: scenario (b) against the robot example: {rate}");
 }
