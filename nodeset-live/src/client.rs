@@ -1,5 +1,7 @@
 //! The client a simulation runs (interactive simulation and control): a session to a real server, secure
-//! by default, through which read blocks read and write blocks write by NodeId.
+//! by default, through which read blocks read and write blocks write by NodeId, or by browse path from the
+//! ObjectsFolder (`Robot/Controllers/Controller/...`, translated by the server at the first call of each
+//! session and kept: a server whose NodeIds differ from the nodesets' is still reached).
 //!
 //! A sampled call never waits for a connection: while there is none, calls fail at once with
 //! `BadNotConnected` and the reason, and a task of the client's own runtime connects again every
@@ -7,13 +9,13 @@
 //! [`CALL_TIMEOUT`]) reports it and starts that task.
 
 use std::collections::HashMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::str::FromStr;
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
+use std::time::{Duration, SystemTime};
 
 use nodeset_runtime::client::ClientConfig;
-use nodeset_runtime::remote::RemoteServer;
+use nodeset_runtime::remote::{RemoteError, RemoteServer};
 use opcua::crypto::SecurityPolicy;
 use opcua::types::{
     AttributeId, DataValue, MessageSecurityMode, NodeId, ReadValueId, StatusCode,
@@ -61,6 +63,10 @@ pub struct LiveClient {
     runtime: tokio::runtime::Runtime,
     url: String,
     config: ClientConfig,
+    /// The client's PKI folder, named in the messages about certificates.
+    pki_dir: PathBuf,
+    /// When the object was made: a certificate rejected since was rejected by this client.
+    created: SystemTime,
     shared: Arc<Shared>,
     /// Each block's NodeId, resolved against the namespaces of the current session (cleared on reconnect),
     /// with the built-in type of the variable's value once known.
@@ -130,11 +136,12 @@ impl LiveClient {
                     format!("cannot start the client's threads: {e}"),
                 )
             })?;
+        let created = SystemTime::now();
         let first = runtime.block_on(config.connect(&params.url));
         let link = match first {
             Ok(server) => Link::Up(Arc::new(server)),
             Err(e) => Link::Down {
-                why: e.to_string(),
+                why: explain(&e, &params.pki_dir, created),
                 retrying: false,
             },
         };
@@ -142,6 +149,8 @@ impl LiveClient {
             runtime,
             url: params.url.clone(),
             config,
+            pki_dir: params.pki_dir.clone(),
+            created,
             shared: Arc::new(Shared {
                 link: Mutex::new(link),
             }),
@@ -181,6 +190,8 @@ impl LiveClient {
                         self.shared.clone(),
                         self.config.clone(),
                         self.url.clone(),
+                        self.pki_dir.clone(),
+                        self.created,
                     ));
                 }
                 Err(Failure::new(StatusCode::BadNotConnected, message))
@@ -205,7 +216,7 @@ impl LiveClient {
 
     fn node(
         &self,
-        session: &RemoteServer,
+        session: &Arc<RemoteServer>,
         text: &str,
     ) -> Result<(NodeId, Option<Builtin>), Failure> {
         if let Some(hit) = self
@@ -216,12 +227,52 @@ impl LiveClient {
         {
             return Ok(hit.clone());
         }
+        if is_browse_path(text) {
+            let id = self.find(session, text)?;
+            self.nodes
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .insert(text.to_owned(), (id.clone(), None));
+            return Ok((id, None));
+        }
         let parsed = NodeRef::parse(text)?;
         let id = {
             let context = session.session().encoding_context().read();
             parsed.resolve(context.namespaces(), text)?
         };
         Ok((id, None))
+    }
+
+    /// The node at a browse path from the ObjectsFolder, translated by the server (once per session: the
+    /// caller keeps it with the block's text until the connection is lost).
+    fn find(&self, session: &Arc<RemoteServer>, path: &str) -> Result<NodeId, Failure> {
+        let s = session.clone();
+        let owned = path.to_owned();
+        let outcome = self.runtime.block_on(async move {
+            tokio::time::timeout(CALL_TIMEOUT, async move { s.find(&owned).await }).await
+        });
+        let status = match outcome {
+            Ok(Ok(id)) => return Ok(id),
+            Ok(Err(RemoteError::Service(_, status))) if !lost_connection(status) => status,
+            Ok(Err(RemoteError::Service(_, status))) => {
+                self.lost(session, format!("the connection was lost ({status})"));
+                return Err(Failure::new(status, format!("finding `{path}` on {}: {status}: the connection is lost; connecting again every {} ms", self.url, RETRY.as_millis())));
+            }
+            Ok(Err(e)) => {
+                return Err(Failure::new(
+                    StatusCode::BadNoMatch,
+                    format!("finding `{path}` on {}: {e}", self.url),
+                ))
+            }
+            Err(_) => {
+                self.lost(session, "the connection was lost (BadTimeout)".into());
+                return Err(Failure::new(StatusCode::BadTimeout, format!("finding `{path}` on {}: no answer within {} ms: the connection is lost; connecting again every {} ms", self.url, CALL_TIMEOUT.as_millis(), RETRY.as_millis())));
+            }
+        };
+        Err(Failure::new(
+            status,
+            format!("finding `{path}` on {}: {status}", self.url),
+        ))
     }
 
     /// One service call with the timeout; a communication failure marks the connection lost.
@@ -333,7 +384,7 @@ impl LiveClient {
                 format!("writing `{text}`: the variable is a {builtin:?}, which a Modelica {} cannot write", value.kind().name()),
             ));
         }
-        let variant = builtin.variant(value).map_err(|m| {
+        let variant = builtin.variant(&value).map_err(|m| {
             Failure::new(StatusCode::BadOutOfRange, format!("writing `{text}`: {m}"))
         })?;
         self.nodes
@@ -392,7 +443,13 @@ impl Drop for LiveClient {
 }
 
 /// Connects until it succeeds, keeping the reason of each failed attempt for the calls to report.
-async fn reconnect(shared: Arc<Shared>, config: ClientConfig, url: String) {
+async fn reconnect(
+    shared: Arc<Shared>,
+    config: ClientConfig,
+    url: String,
+    pki_dir: PathBuf,
+    since: SystemTime,
+) {
     loop {
         match config.connect(&url).await {
             Ok(server) => {
@@ -402,13 +459,73 @@ async fn reconnect(shared: Arc<Shared>, config: ClientConfig, url: String) {
             Err(e) => {
                 let mut link = shared.link.lock().unwrap_or_else(|p| p.into_inner());
                 match &mut *link {
-                    Link::Down { why, .. } => *why = e.to_string(),
+                    Link::Down { why, .. } => *why = explain(&e, &pki_dir, since),
                     Link::Up(_) => return,
                 }
             }
         }
         tokio::time::sleep(RETRY).await;
     }
+}
+
+/// Why a session could not be opened, with what to do where a certificate was refused.
+///
+/// Both sides answer a refused certificate with one of a few statuses (BadCertificateUntrusted,
+/// BadSecurityChecksFailed, ...), so the status does not say which side refused. This client puts a server
+/// certificate it does not trust into `rejected/` (async-opcua's certificate store): a file written there
+/// since the client object was made (`since`) says this client refused; otherwise the server did.
+fn explain(e: &RemoteError, pki_dir: &Path, since: SystemTime) -> String {
+    let RemoteError::Connect(_, status) = e else {
+        return e.to_string();
+    };
+    let certificate = status.to_string().starts_with("BadCertificate")
+        || *status == StatusCode::BadSecurityChecksFailed;
+    if !certificate {
+        return e.to_string();
+    }
+    let rejected = pki_dir.join("rejected");
+    let mut files: Vec<(PathBuf, bool)> = std::fs::read_dir(&rejected)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .filter(|f| f.path().extension().is_some_and(|x| x == "der"))
+        .map(|f| {
+            let fresh = f
+                .metadata()
+                .and_then(|m| m.modified())
+                .is_ok_and(|m| m + Duration::from_secs(2) >= since);
+            (f.path(), fresh)
+        })
+        .collect();
+    files.sort();
+    let trusted = pki_dir.join("trusted");
+    if let Some((file, _)) = files.iter().find(|(_, fresh)| *fresh) {
+        return format!(
+            "{e}: this client does not trust the server's certificate, which it put in {}: if it is the server's, an administrator moves it to {}",
+            file.display(),
+            trusted.display()
+        );
+    }
+    let mut message = format!(
+        "{e}: the server refused this client's certificate: its administrator trusts {} (or lets the server trust clients on first use)",
+        pki_dir.join("own/cert.der").display()
+    );
+    if !files.is_empty() {
+        let names: Vec<String> = files.iter().map(|(f, _)| f.display().to_string()).collect();
+        message.push_str(&format!(
+            "; or, if the server's certificate is one this client rejected before ({}), move it to {}",
+            names.join(", "),
+            trusted.display()
+        ));
+    }
+    message
+}
+
+/// Whether a block's text is a browse path (BrowseNames from the ObjectsFolder separated by `/`, as the
+/// generated blocks' `browsePath` parameter gives it) rather than a NodeId, every form of which has an `=`.
+pub fn is_browse_path(text: &str) -> bool {
+    let text = text.trim();
+    !text.is_empty() && !text.contains('=')
 }
 
 /// Whether a status says the session or its connection is gone (not that one request was refused).

@@ -15,11 +15,14 @@
 //!
 //! The C types are those of MLS 12.9: `Real` is `double`, `Integer` and `Boolean` are `int`, `String` is
 //! `const char*`, an external object is a `void*` made by its constructor and released by its destructor.
-//! Each read and write takes a NodeId string (`nsu=<namespace URI>;i=<n>`, `ns=<index>;i=<n>` or `i=<n>`)
-//! and reports an `int` status: 0 for Good, else the OPC UA status code's 32 bits (negative for Bad). A
-//! failed read returns the `previous` value it was given, so the block holds its value. The message of the
-//! last call on an object is `opcua_live_*_error(object)`, for the Modelica side to pass to `ModelicaError`
-//! or `assert`: the library itself does not link against a Modelica runtime.
+//! Each read and write takes a NodeId string (`nsu=<namespace URI>;i=<n>`, `ns=<index>;i=<n>` or `i=<n>`;
+//! a client's also a browse path from the ObjectsFolder, translated once per session) and reports an `int`
+//! status: 0 for Good, else the OPC UA status code's 32 bits (negative for Bad). A failed read returns the
+//! `previous` value it was given, so the block holds its value. The message of the last call on an object
+//! is `opcua_live_*_error(object)`, for the Modelica side to pass to `ModelicaError` or `assert`: the
+//! library itself does not link against a Modelica runtime. Strings returned (messages,
+//! String values) are allocated by the tool's `ModelicaAllocateStringWithErrorReturn` where the process has
+//! it, else kept in a buffer of the calling thread until its next call that returns a string ([`strings`]).
 //!
 //! No Rust panic crosses the boundary: each exported function runs under `catch_unwind`, and a panic
 //! becomes the status `BadInternalError` with its message. The header is `include/nodeset_live.h`, written
@@ -27,9 +30,10 @@
 
 pub mod client;
 pub mod server;
+pub mod strings;
 pub mod value;
 
-use std::ffi::{c_char, c_int, c_void, CStr, CString};
+use std::ffi::{c_char, c_int, c_void, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -43,9 +47,8 @@ use value::{status_int, Failure, Kind, Value};
 /// An external object: what it runs (or why it could not start), and the message of its last call.
 struct Object<T> {
     inner: Result<T, Failure>,
-    /// The message of the last call ("" when it succeeded); the pointer `*_error` returns stays valid until
-    /// the next call on the object.
-    error: Mutex<CString>,
+    /// The message of the last call ("" when it succeeded).
+    error: Mutex<String>,
 }
 
 impl<T> Object<T> {
@@ -56,13 +59,13 @@ impl<T> Object<T> {
         };
         Box::into_raw(Box::new(Object {
             inner,
-            error: Mutex::new(c_string(error)),
+            error: Mutex::new(error),
         }))
         .cast()
     }
 
     fn set_error(&self, message: &str) {
-        *self.error.lock().unwrap_or_else(|p| p.into_inner()) = c_string(message.to_owned());
+        *self.error.lock().unwrap_or_else(|p| p.into_inner()) = message.to_owned();
     }
 
     /// Runs `f` on the running object, recording its message; the status as an `int`.
@@ -85,10 +88,6 @@ impl<T> Object<T> {
             }
         }
     }
-}
-
-fn c_string(message: String) -> CString {
-    CString::new(message.replace('\0', " ")).unwrap_or_default()
 }
 
 fn panicked(payload: Box<dyn std::any::Any + Send>) -> Failure {
@@ -235,7 +234,8 @@ pub unsafe extern "C" fn opcua_live_server_port(server: *mut c_void) -> c_int {
     })
 }
 
-/// The message of the last call on the server ("" if it succeeded), valid until the next call on it.
+/// The message of the last call on the server ("" if it succeeded): the tool's copy, or one valid until
+/// the calling thread's next call that returns a string.
 ///
 /// # Safety
 /// `server` is NULL or a live server object.
@@ -248,7 +248,7 @@ unsafe fn error_of<T>(p: *mut c_void) -> *const c_char {
     guard(
         c"internal error of nodeset-live".as_ptr(),
         || match object::<T>(p) {
-            Some(o) => o.error.lock().unwrap_or_else(|p| p.into_inner()).as_ptr(),
+            Some(o) => strings::give(&o.error.lock().unwrap_or_else(|p| p.into_inner())),
             None => c"no object: the constructor was not called, or returned NULL".as_ptr(),
         },
     )
@@ -389,6 +389,46 @@ pub unsafe extern "C" fn opcua_live_server_write_boolean(
     })
 }
 
+/// The value of a String variable (or the text of a LocalizedText); a copy of `previous` when the read
+/// fails. The string is the tool's copy, or one valid until the calling thread's next call that returns a
+/// string.
+///
+/// # Safety
+/// As [`opcua_live_server_read_real`]; `previous` NULL or NUL-terminated.
+#[no_mangle]
+pub unsafe extern "C" fn opcua_live_server_read_string(
+    server: *mut c_void,
+    node_id: *const c_char,
+    previous: *const c_char,
+    status: *mut c_int,
+) -> *const c_char {
+    let held = || strings::give(&text(previous, "previous").unwrap_or_default());
+    guard(c"".as_ptr(), || {
+        match server_read(server, node_id, Kind::String, status) {
+            Some(Value::String(v)) => strings::give(&v),
+            _ => held(),
+        }
+    })
+}
+
+/// Publishes a String value (as the variable's String, or LocalizedText without a locale); the status.
+///
+/// # Safety
+/// As [`opcua_live_server_write_real`]; `value` NULL (empty) or NUL-terminated.
+#[no_mangle]
+pub unsafe extern "C" fn opcua_live_server_write_string(
+    server: *mut c_void,
+    node_id: *const c_char,
+    value: *const c_char,
+) -> c_int {
+    guard(status_int(StatusCode::BadInternalError), || {
+        match text(value, "value") {
+            Ok(v) => server_write(server, node_id, Value::String(v.to_owned())),
+            Err(f) => status_int(f.status),
+        }
+    })
+}
+
 // ---------------------------------------------------------------------------------------------------------
 // Client
 
@@ -474,7 +514,8 @@ pub unsafe extern "C" fn opcua_live_client_status(client: *mut c_void) -> c_int 
     })
 }
 
-/// The message of the last call on the client ("" if it succeeded), valid until the next call on it.
+/// The message of the last call on the client ("" if it succeeded): the tool's copy, or one valid until
+/// the calling thread's next call that returns a string.
 ///
 /// # Safety
 /// `client` is NULL or a live client object.
@@ -614,6 +655,45 @@ pub unsafe extern "C" fn opcua_live_client_write_boolean(
 ) -> c_int {
     guard(status_int(StatusCode::BadInternalError), || {
         client_write(client, node_id, Value::Boolean(value != 0))
+    })
+}
+
+/// Reads a String variable (or the text of a LocalizedText); a copy of `previous` when the read fails.
+/// The string is the tool's copy, or one valid until the calling thread's next call that returns a string.
+///
+/// # Safety
+/// As [`opcua_live_client_read_real`]; `previous` NULL or NUL-terminated.
+#[no_mangle]
+pub unsafe extern "C" fn opcua_live_client_read_string(
+    client: *mut c_void,
+    node_id: *const c_char,
+    previous: *const c_char,
+    status: *mut c_int,
+) -> *const c_char {
+    let held = || strings::give(&text(previous, "previous").unwrap_or_default());
+    guard(c"".as_ptr(), || {
+        match client_read(client, node_id, Kind::String, status) {
+            Some(Value::String(v)) => strings::give(&v),
+            _ => held(),
+        }
+    })
+}
+
+/// Writes a String value (as the variable's String, or LocalizedText without a locale); the status.
+///
+/// # Safety
+/// As [`opcua_live_client_write_real`]; `value` NULL (empty) or NUL-terminated.
+#[no_mangle]
+pub unsafe extern "C" fn opcua_live_client_write_string(
+    client: *mut c_void,
+    node_id: *const c_char,
+    value: *const c_char,
+) -> c_int {
+    guard(status_int(StatusCode::BadInternalError), || {
+        match text(value, "value") {
+            Ok(v) => client_write(client, node_id, Value::String(v.to_owned())),
+            Err(f) => status_int(f.status),
+        }
     })
 }
 

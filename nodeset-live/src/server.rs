@@ -34,6 +34,9 @@ pub struct ServerParams {
     pub insecure: bool,
 }
 
+/// The shortest publishing interval the server grants a subscription, in milliseconds.
+pub const MIN_PUBLISHING_INTERVAL_MS: u64 = 10;
+
 /// A running server.
 pub struct LiveServer {
     runtime: tokio::runtime::Runtime,
@@ -53,9 +56,12 @@ impl LiveServer {
             message: m,
             ..config()
         })?;
+        // A simulation publishes at its sample period (tens of milliseconds): subscribers may ask for a
+        // publishing interval that short (the runtime's default floor is 100 ms).
         let mut server = ServerConfig::new("Modelica simulation")
             .port(params.port)
-            .pki_dir(&params.pki_dir);
+            .pki_dir(&params.pki_dir)
+            .min_publishing_interval_ms(MIN_PUBLISHING_INTERVAL_MS);
         if !params.users_file.is_empty() {
             let users = Users::load(Path::new(&params.users_file)).map_err(|e| Failure {
                 message: e.to_string(),
@@ -177,7 +183,7 @@ impl LiveServer {
         };
         let mut last = String::new();
         for b in tries {
-            let variant = match b.variant(value) {
+            let variant = match b.variant(&value) {
                 Ok(v) => v,
                 Err(m) if fixed.is_some() => {
                     return Err(Failure::new(
@@ -281,7 +287,10 @@ fn load_tables(nodesets: &str) -> Result<Vec<&'static NodeSetTable>, String> {
     // The tables `nodeset-compiler serve` builds: one home for the rule.
     let (tables, diags) = nodeset_compiler::serve::tables(&out.model);
     if diags.has_errors() {
-        return Err(format!("the node tables cannot be built:\n{}", diags.render(&out.model.sources)));
+        return Err(format!(
+            "the node tables cannot be built:\n{}",
+            diags.render(&out.model.sources)
+        ));
     }
     Ok(tables)
 }

@@ -1,7 +1,7 @@
 //! What the server and the client share: NodeIds as the Modelica blocks write them, the three Modelica
 //! scalar types and their OPC UA variants, and failures as a status code with a message.
 
-use opcua::types::{Identifier, NamespaceMap, NodeId, StatusCode, Variant};
+use opcua::types::{Identifier, LocalizedText, NamespaceMap, NodeId, StatusCode, Variant};
 use std::str::FromStr;
 
 /// A failed call: the OPC UA status the Modelica block's `status` output gets, and the message its
@@ -114,6 +114,8 @@ pub enum Kind {
     Integer,
     /// `Boolean`: `int`, 0 or 1.
     Boolean,
+    /// `String`: `const char*`.
+    String,
 }
 
 impl Kind {
@@ -123,12 +125,13 @@ impl Kind {
             Kind::Real => "Real",
             Kind::Integer => "Integer",
             Kind::Boolean => "Boolean",
+            Kind::String => "String",
         }
     }
 }
 
 /// A value of a Modelica block, before it becomes an OPC UA variant.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Value {
     /// A `Real`.
     Real(f64),
@@ -136,15 +139,18 @@ pub enum Value {
     Integer(i32),
     /// A `Boolean`.
     Boolean(bool),
+    /// A `String`.
+    String(String),
 }
 
 impl Value {
     /// Its kind.
-    pub fn kind(self) -> Kind {
+    pub fn kind(&self) -> Kind {
         match self {
             Value::Real(_) => Kind::Real,
             Value::Integer(_) => Kind::Integer,
             Value::Boolean(_) => Kind::Boolean,
+            Value::String(_) => Kind::String,
         }
     }
 }
@@ -165,6 +171,7 @@ pub fn candidates(kind: Kind) -> &'static [Builtin] {
             Builtin::SByte,
         ],
         Kind::Boolean => &[Builtin::Boolean],
+        Kind::String => &[Builtin::String, Builtin::LocalizedText],
     }
 }
 
@@ -193,6 +200,10 @@ pub enum Builtin {
     UInt64,
     /// Boolean.
     Boolean,
+    /// String.
+    String,
+    /// LocalizedText (a String written with no locale; its text read).
+    LocalizedText,
 }
 
 impl Builtin {
@@ -210,6 +221,8 @@ impl Builtin {
             Variant::Int64(_) => Builtin::Int64,
             Variant::UInt64(_) => Builtin::UInt64,
             Variant::Boolean(_) => Builtin::Boolean,
+            Variant::String(_) => Builtin::String,
+            Variant::LocalizedText(_) => Builtin::LocalizedText,
             _ => return None,
         })
     }
@@ -229,6 +242,8 @@ impl Builtin {
                 9 => Builtin::UInt64,
                 10 => Builtin::Float,
                 11 | 290 => Builtin::Double,
+                12 => Builtin::String,
+                21 => Builtin::LocalizedText,
                 _ => return None,
             }),
             _ => None,
@@ -236,10 +251,10 @@ impl Builtin {
     }
 
     /// `value` as a variant of this type, or why it cannot be (a Boolean is not a number, 300 is no Byte).
-    pub fn variant(self, value: Value) -> Result<Variant, String> {
-        let int = |v: Value| -> Result<i64, String> {
+    pub fn variant(self, value: &Value) -> Result<Variant, String> {
+        let int = |v: &Value| -> Result<i64, String> {
             match v {
-                Value::Integer(i) => Ok(i64::from(i)),
+                Value::Integer(i) => Ok(i64::from(*i)),
                 other => Err(format!(
                     "a Modelica {} is not written as {self:?}",
                     other.kind().name()
@@ -256,9 +271,11 @@ impl Builtin {
             }
         };
         Ok(match (self, value) {
-            (Builtin::Double, Value::Real(r)) => Variant::Double(r),
-            (Builtin::Float, Value::Real(r)) => Variant::Float(r as f32),
-            (Builtin::Boolean, Value::Boolean(b)) => Variant::Boolean(b),
+            (Builtin::Double, Value::Real(r)) => Variant::Double(*r),
+            (Builtin::Float, Value::Real(r)) => Variant::Float(*r as f32),
+            (Builtin::Boolean, Value::Boolean(b)) => Variant::Boolean(*b),
+            (Builtin::String, Value::String(t)) => Variant::from(t.as_str()),
+            (Builtin::LocalizedText, Value::String(t)) => Variant::from(LocalizedText::new("", t)),
             (Builtin::SByte, v) => {
                 Variant::SByte(fits(int(v)?, i8::MIN.into(), i8::MAX.into())? as i8)
             }
@@ -325,6 +342,11 @@ pub fn from_variant(v: &Variant, kind: Kind) -> Result<Value, String> {
             Variant::Boolean(b) => Ok(Value::Boolean(*b)),
             _ => Err(wrong()),
         },
+        Kind::String => match v {
+            Variant::String(t) => Ok(Value::String(t.as_ref().to_owned())),
+            Variant::LocalizedText(t) => Ok(Value::String(t.text.as_ref().to_owned())),
+            _ => Err(wrong()),
+        },
     }
 }
 
@@ -385,15 +407,15 @@ mod tests {
     #[test]
     fn values_convert_within_range_only() {
         assert_eq!(
-            Builtin::Byte.variant(Value::Integer(255)),
+            Builtin::Byte.variant(&Value::Integer(255)),
             Ok(Variant::Byte(255))
         );
         assert!(Builtin::Byte
-            .variant(Value::Integer(256))
+            .variant(&Value::Integer(256))
             .unwrap_err()
             .contains("out of the range of Byte"));
-        assert!(Builtin::UInt32.variant(Value::Integer(-1)).is_err());
-        assert!(Builtin::Double.variant(Value::Boolean(true)).is_err());
+        assert!(Builtin::UInt32.variant(&Value::Integer(-1)).is_err());
+        assert!(Builtin::Double.variant(&Value::Boolean(true)).is_err());
         assert_eq!(
             from_variant(&Variant::Float(1.5), Kind::Real),
             Ok(Value::Real(1.5))

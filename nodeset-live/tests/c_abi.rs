@@ -6,6 +6,8 @@
 
 /// The header kept in step with the exported functions (in this binary: one test binary for the crate).
 mod header;
+/// The two scenarios of issue 39 from C programs, with node-opcua and the robot example as peers.
+mod programs;
 
 use std::ffi::{c_int, c_void, CStr, CString};
 use std::path::{Path, PathBuf};
@@ -241,6 +243,97 @@ fn a_simulation_serves_and_a_secure_client_reads_and_writes_through_the_c_interf
             200,
             "the refused writes changed nothing"
         );
+        // Strings: published by the simulation, written by the client; a failed read returns a copy of
+        // `previous`.
+        let label = node(6005);
+        let text = |p: *const std::ffi::c_char| CStr::from_ptr(p).to_string_lossy().into_owned();
+        assert_eq!(
+            text(opcua_live_client_read_string(
+                client,
+                label.as_ptr(),
+                c("?").as_ptr(),
+                &mut st
+            )),
+            "axis"
+        );
+        assert_eq!(st, 0, "{}", client_error(client));
+        assert_eq!(
+            opcua_live_server_write_string(s.server, label.as_ptr(), c("axis 2 (ä)").as_ptr()),
+            0,
+            "{}",
+            server_error(s.server)
+        );
+        assert_eq!(
+            text(opcua_live_client_read_string(
+                client,
+                label.as_ptr(),
+                c("?").as_ptr(),
+                &mut st
+            )),
+            "axis 2 (ä)"
+        );
+        assert_eq!(
+            opcua_live_client_write_string(client, label.as_ptr(), c("from the client").as_ptr()),
+            0,
+            "{}",
+            client_error(client)
+        );
+        assert_eq!(
+            text(opcua_live_server_read_string(
+                s.server,
+                label.as_ptr(),
+                c("?").as_ptr(),
+                &mut st
+            )),
+            "from the client"
+        );
+        let previous = c("held");
+        let held =
+            opcua_live_server_read_string(s.server, position.as_ptr(), previous.as_ptr(), &mut st);
+        assert_eq!(
+            (text(held), st),
+            ("held".to_owned(), status(StatusCode::BadTypeMismatch))
+        );
+        assert_ne!(held, previous.as_ptr(), "a copy, not the caller's pointer");
+        assert_eq!(
+            opcua_live_client_write_string(client, position.as_ptr(), c("1.5").as_ptr()),
+            status(StatusCode::BadTypeMismatch)
+        );
+        assert!(
+            client_error(client)
+                .contains("the variable is a Double, which a Modelica String cannot write"),
+            "{}",
+            client_error(client)
+        );
+        // A message returned to this thread stays as it was while another thread calls on the object.
+        let mine = opcua_live_client_error(client);
+        let before = text(mine);
+        let other = client as usize;
+        std::thread::spawn(move || {
+            let client = other as *mut c_void;
+            let mut st = 0;
+            for _ in 0..3 {
+                opcua_live_client_read_real(
+                    client,
+                    c("nsu=urn:elsewhere;i=1").as_ptr(),
+                    0.0,
+                    &mut st,
+                );
+                let _ = opcua_live_client_error(client);
+            }
+        })
+        .join()
+        .unwrap();
+        assert_eq!(
+            text(mine),
+            before,
+            "the string this thread got is its own until its next string call"
+        );
+        assert!(
+            client_error(client).contains("urn:elsewhere"),
+            "the object's message is the other thread's last"
+        );
+
         // Throughput of one block, sampled as fast as the calls return.
         let n = 300;
         let t = Instant::now();
@@ -594,149 +687,97 @@ fn a_lost_connection_is_reported_and_the_client_connects_again() {
     }
 }
 
-/// The component-simulation scenario from C (`tests/c/drive.c`), compiled with the system's C compiler
-/// against `include/nodeset_live.h` and the shared library this build made, as a Modelica tool links it.
 #[test]
-fn a_c_program_integrates_a_drive_and_publishes_it_to_a_secure_client() {
-    let dir = tmp("drive");
-    let deps = shared_library().parent().unwrap().to_path_buf();
-    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let exe = dir.join("drive");
-    let cc = std::process::Command::new("cc")
-        .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-I"])
-        .arg(manifest.join("include"))
-        .arg(manifest.join("tests/c/drive.c"))
-        .arg("-L")
-        .arg(&deps)
-        .args(["-lnodeset_live", "-lm"])
-        .arg(format!("-Wl,-rpath,{}", deps.display()))
-        .arg("-o")
-        .arg(&exe)
-        .output()
-        .expect("cc runs (apt-get install gcc)");
-    assert!(
-        cc.status.success(),
-        "cc failed:\n{}",
-        String::from_utf8_lossy(&cc.stderr)
-    );
-    // The administrator's part: both PKI folders made and each certificate trusted by the other side, a user.
-    let (server_pki, client_pki, users) = (
-        dir.join("server-pki"),
-        dir.join("client-pki"),
-        dir.join("users.txt"),
-    );
-    let server_cert = prepare_pki(
-        &server_pki,
-        "Modelica simulation",
-        "urn:nodeset-models:modelica-simulation",
-        &["127.0.0.1".into()],
-    )
-    .unwrap()
-    .cert;
-    let client_cert = prepare_pki(
-        &client_pki,
-        "Modelica simulation client",
-        "urn:nodeset-live:client",
-        &[],
-    )
-    .unwrap()
-    .cert;
-    trust_certificate(&server_pki, &client_cert).unwrap();
-    trust_certificate(&client_pki, &server_cert).unwrap();
-    let mut list = Users::default();
-    list.set_password("operator", vec![Role::Operator], "dr1ve-Pa55")
-        .unwrap();
-    std::fs::write(&users, list.to_text()).unwrap();
-    let r = root();
-    let nodesets = format!(
-        "{};{};{};{}",
-        r.join("nodesets/RobotCell.NodeSet2.xml").display(),
-        r.join("nodesets/CommonSkills.NodeSet2.xml").display(),
-        manifest.join("tests/fixtures/Live.NodeSet2.xml").display(),
-        r.join("nodesets/vendor").display()
-    );
-    let t = Instant::now();
-    let run = std::process::Command::new(&exe)
-        .args([
-            nodesets.as_str(),
-            server_pki.to_str().unwrap(),
-            client_pki.to_str().unwrap(),
-            users.to_str().unwrap(),
-            "DRIVE_PASSWORD",
-        ])
-        .env("DRIVE_PASSWORD", "dr1ve-Pa55")
-        .output()
-        .unwrap();
-    let out = String::from_utf8_lossy(&run.stdout);
-    let err = String::from_utf8_lossy(&run.stderr);
-    assert!(
-        run.status.success(),
-        "drive failed ({}):\n{out}\n{err}",
-        run.status
-    );
-    let samples: Vec<&str> = out.lines().filter(|l| l.starts_with("sample ")).collect();
-    assert_eq!(samples.len(), 41, "a sample every 50 ms for 2 s:\n{out}");
-    assert!(
-        samples[0].contains("t=0.00 position=0.000000 speed=0.000000 read=0.000000,0.000000"),
-        "{}",
-        samples[0]
-    );
-    assert!(
-        samples[4].contains("t=0.20 position=0.641514"),
-        "after one time constant, 1 - 0.95^20: {}",
-        samples[4]
-    );
-    assert!(out.contains("drive: unknown NodeId: status -2144075776: reading `nsu=http://nodeset-compiler.dev/RobotCell/;i=999999`: BadNodeIdUnknown"), "{out}");
-    assert!(out.contains("drive: wrong type: status -2139881472: writing `nsu=http://nodeset-compiler.dev/RobotCell/;i=4119`: the variable is a Double"), "{out}");
-    assert!(
-        out.contains("drive: 41 samples, final position 0.999967, 0 failures"),
-        "{out}"
-    );
-    println!("nodeset-live: the C drive ran in {:?} (server start with DI, IA, Robotics, CommonSkills, RobotCell included)", t.elapsed());
-}
+fn a_refused_certificate_is_a_clear_message_on_either_side() {
+    unsafe {
+        let s = secure_server("refused", "NODESET_LIVE_TEST_PASSWORD_4", 0);
+        let url = c(&format!("opc.tcp://127.0.0.1:{}/", s.port));
+        let server_cert =
+            X509::from_der(&std::fs::read(s.server_pki.join("own/cert.der")).unwrap()).unwrap();
+        let dir = tmp("refused-clients");
+        let connect = |pki: &Path| {
+            opcua_live_client_new(
+                url.as_ptr(),
+                std::ptr::null(),
+                std::ptr::null(),
+                c(pki.to_str().unwrap()).as_ptr(),
+                c("operator").as_ptr(),
+                c("NODESET_LIVE_TEST_PASSWORD_4").as_ptr(),
+            )
+        };
+        let position = node(6001);
+        let mut st: c_int = 0;
 
-/// The shared library as a Modelica tool would get it, from the workspace build `.ci/run` makes (`cargo build
-/// --workspace --bins --tests --examples`: in CI a no-op that reports its artifacts), asked for its files.
-/// (The `cargo test` that runs this test builds the crate as an rlib for the tests, and does not always write
-/// the cdylib again: a library left from an earlier build would be tested instead. And `cargo build -p
-/// nodeset-live` alone resolves the dependencies' features for this crate only, so it compiles async-opcua
-/// and its dependencies a second time.)
-fn shared_library() -> PathBuf {
-    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".to_owned());
-    let out = std::process::Command::new(cargo)
-        .current_dir(root())
-        .args([
-            "build",
-            "--workspace",
-            "--bins",
-            "--tests",
-            "--examples",
-            "--message-format=json-render-diagnostics",
-        ])
-        .stderr(std::process::Stdio::inherit())
-        .output()
-        .expect("cargo runs");
-    assert!(
-        out.status.success(),
-        "cargo build --workspace --bins --tests --examples failed"
-    );
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let line = stdout
-        .lines()
-        .find(|l| {
-            // The library, not the crate's unit-test harness (`"test":true`, also named nodeset_live).
-            l.contains("\"reason\":\"compiler-artifact\"")
-                && l.contains("\"name\":\"nodeset_live\"")
-                && l.contains("\"cdylib\"")
-                && l.contains("\"test\":false")
-        })
-        .expect("cargo reports the library");
-    let files = &line[line
-        .find("\"filenames\":[")
-        .expect("the artifact names its files")..];
-    let so = files
-        .split('"')
-        .find(|f| f.ends_with(".so"))
-        .expect("the library is built as a cdylib");
-    PathBuf::from(so)
+        // The server does not trust the client (the client trusts the server).
+        let stranger = dir.join("stranger");
+        prepare_pki(
+            &stranger,
+            "Modelica simulation client",
+            "urn:nodeset-live:client",
+            &[],
+        )
+        .unwrap();
+        trust_certificate(&stranger, &server_cert).unwrap();
+        let client = connect(&stranger);
+        assert_eq!(
+            opcua_live_client_status(client),
+            status(StatusCode::BadNotConnected)
+        );
+        let why = client_error(client);
+        println!("nodeset-live: the server refuses the client: {why}");
+        assert!(
+            why.contains("the server refused this client's certificate"),
+            "{why}"
+        );
+        assert!(
+            why.contains(&format!("{}", stranger.join("own/cert.der").display())),
+            "{why}"
+        );
+        assert_eq!(
+            opcua_live_client_read_real(client, position.as_ptr(), 7.5, &mut st),
+            7.5
+        );
+        assert_eq!(st, status(StatusCode::BadNotConnected));
+        assert!(
+            client_error(client).contains("the server refused this client's certificate"),
+            "{}",
+            client_error(client)
+        );
+        opcua_live_client_free(client);
+
+        // The client does not trust the server (the server trusts the client).
+        let doubter = dir.join("doubter");
+        let cert = prepare_pki(
+            &doubter,
+            "Modelica simulation client",
+            "urn:nodeset-live:client",
+            &[],
+        )
+        .unwrap()
+        .cert;
+        trust_certificate(&s.server_pki, &cert).unwrap();
+        let client = connect(&doubter);
+        assert_eq!(
+            opcua_live_client_status(client),
+            status(StatusCode::BadNotConnected)
+        );
+        let why = client_error(client);
+        println!("nodeset-live: the client refuses the server: {why}");
+        assert!(
+            why.contains("this client does not trust the server's certificate"),
+            "{why}"
+        );
+        assert!(
+            why.contains(&format!("{}", doubter.join("rejected").display()))
+                && why.contains("an administrator moves it to"),
+            "{why}"
+        );
+        assert_eq!(
+            opcua_live_client_write_real(client, position.as_ptr(), 1.0),
+            status(StatusCode::BadNotConnected)
+        );
+        opcua_live_client_free(client);
+
+        opcua_live_server_free(s.server);
+    }
 }

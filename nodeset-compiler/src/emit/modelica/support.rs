@@ -64,6 +64,8 @@ const SOURCES: &[(&str, &str)] = &[
     ("Live/Server/WriteInteger.mo", include_str!("support/Live/Server/WriteInteger.mo")),
     ("Live/Server/ReadBoolean.mo", include_str!("support/Live/Server/ReadBoolean.mo")),
     ("Live/Server/WriteBoolean.mo", include_str!("support/Live/Server/WriteBoolean.mo")),
+    ("Live/Server/ReadString.mo", include_str!("support/Live/Server/ReadString.mo")),
+    ("Live/Server/WriteString.mo", include_str!("support/Live/Server/WriteString.mo")),
     ("Live/Client/package.mo", include_str!("support/Live/Client/package.mo")),
     ("Live/Client/package.order", include_str!("support/Live/Client/package.order")),
     ("Live/Client/Endpoint.mo", include_str!("support/Live/Client/Endpoint.mo")),
@@ -73,6 +75,8 @@ const SOURCES: &[(&str, &str)] = &[
     ("Live/Client/WriteInteger.mo", include_str!("support/Live/Client/WriteInteger.mo")),
     ("Live/Client/ReadBoolean.mo", include_str!("support/Live/Client/ReadBoolean.mo")),
     ("Live/Client/WriteBoolean.mo", include_str!("support/Live/Client/WriteBoolean.mo")),
+    ("Live/Client/ReadString.mo", include_str!("support/Live/Client/ReadString.mo")),
+    ("Live/Client/WriteString.mo", include_str!("support/Live/Client/WriteString.mo")),
     // The C header of the nodeset_live library the `Include` annotations of `Live` name (a copy of
     // nodeset-live/include/nodeset_live.h, which nodeset-live's tests keep identical).
     ("Resources/Include/nodeset_live.h", include_str!("support/Resources/Include/nodeset_live.h")),
