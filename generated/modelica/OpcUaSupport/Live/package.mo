@@ -95,6 +95,23 @@ package Live "The read and write blocks bound live to OPC UA: the simulation as 
     external "C" status = opcua_live_server_write_boolean(server, nodeId, value)
       annotation (Library="nodeset_live", Include="#include \"nodeset_live.h\"", IncludeDirectory="modelica://OpcUaSupport/Resources/Include", LibraryDirectory="modelica://OpcUaSupport/Resources/Library");
     end serverWriteBoolean;
+    impure function serverReadString "Reads a String variable (or the text of a LocalizedText) through the server object"
+      input ServerObject server "The server";
+      input String nodeId "NodeId: nsu=<namespace URI>;i=<number>, ns=<index>;i=<number> or i=<number>";
+      input String previous "Returned when the read fails";
+      output String value "The value read, or previous";
+      output Integer status "0: Good; else the OPC UA status code (negative for Bad)";
+    external "C" value = opcua_live_server_read_string(server, nodeId, previous, status)
+      annotation (Library="nodeset_live", Include="#include \"nodeset_live.h\"", IncludeDirectory="modelica://OpcUaSupport/Resources/Include", LibraryDirectory="modelica://OpcUaSupport/Resources/Library");
+    end serverReadString;
+    impure function serverWriteString "Writes a String variable (or a LocalizedText, without locale) through the server object"
+      input ServerObject server "The server";
+      input String nodeId "NodeId: nsu=<namespace URI>;i=<number>, ns=<index>;i=<number> or i=<number>";
+      input String value "The value to write";
+      output Integer status "0: Good; else the OPC UA status code (negative for Bad)";
+    external "C" status = opcua_live_server_write_string(server, nodeId, value)
+      annotation (Library="nodeset_live", Include="#include \"nodeset_live.h\"", IncludeDirectory="modelica://OpcUaSupport/Resources/Include", LibraryDirectory="modelica://OpcUaSupport/Resources/Library");
+    end serverWriteString;
     impure function serverStatus "0 when the server runs; else the OPC UA status code saying why not"
       input ServerObject server "The server";
       output Integer status "0: Good";
@@ -158,6 +175,23 @@ package Live "The read and write blocks bound live to OPC UA: the simulation as 
     external "C" status = opcua_live_client_write_boolean(client, nodeId, value)
       annotation (Library="nodeset_live", Include="#include \"nodeset_live.h\"", IncludeDirectory="modelica://OpcUaSupport/Resources/Include", LibraryDirectory="modelica://OpcUaSupport/Resources/Library");
     end clientWriteBoolean;
+    impure function clientReadString "Reads a String variable (or the text of a LocalizedText) through the client object"
+      input ClientObject client "The client";
+      input String nodeId "NodeId: nsu=<namespace URI>;i=<number>, ns=<index>;i=<number> or i=<number>";
+      input String previous "Returned when the read fails";
+      output String value "The value read, or previous";
+      output Integer status "0: Good; else the OPC UA status code (negative for Bad)";
+    external "C" value = opcua_live_client_read_string(client, nodeId, previous, status)
+      annotation (Library="nodeset_live", Include="#include \"nodeset_live.h\"", IncludeDirectory="modelica://OpcUaSupport/Resources/Include", LibraryDirectory="modelica://OpcUaSupport/Resources/Library");
+    end clientReadString;
+    impure function clientWriteString "Writes a String variable (or a LocalizedText, without locale) through the client object"
+      input ClientObject client "The client";
+      input String nodeId "NodeId: nsu=<namespace URI>;i=<number>, ns=<index>;i=<number> or i=<number>";
+      input String value "The value to write";
+      output Integer status "0: Good; else the OPC UA status code (negative for Bad)";
+    external "C" status = opcua_live_client_write_string(client, nodeId, value)
+      annotation (Library="nodeset_live", Include="#include \"nodeset_live.h\"", IncludeDirectory="modelica://OpcUaSupport/Resources/Include", LibraryDirectory="modelica://OpcUaSupport/Resources/Library");
+    end clientWriteString;
     impure function clientStatus "0 when the client runs (a session is open); else the OPC UA status code saying why not"
       input ClientObject client "The client";
       output Integer status "0: Good";
@@ -216,6 +250,11 @@ message. Bind a generated instance by redeclaring the block classes of its <code
     redeclare block ReadReal = OpcUaSupport.Live.Server.ReadReal,
     redeclare block WriteReal = OpcUaSupport.Live.Server.WriteReal);
 end Cell;</pre>
-<p>String variables stay with <code>OpcUaSupport.Loopback</code>: the library reads and writes Real, Integer
-and Boolean values.</p></html>"));
+<p>The library reads and writes Real, Integer, Boolean and String values (a String also reads and writes a
+LocalizedText's text). A String it returns is allocated with the tool's
+<code>ModelicaAllocateStringWithErrorReturn</code> where the simulation exports it, else kept in a buffer of the
+calling thread until its next call that returns a string. A client's blocks find their variable by
+<code>nodeId</code>, or by <code>browsePath</code> when <code>opcuaClient.useBrowsePaths = true</code>: the
+server translates each path once per session, so a server whose NodeIds differ from the nodesets' is still
+reached.</p></html>"));
 end Live;

@@ -8,6 +8,7 @@ model Endpoint "The OPC UA server the simulation connects to: declare it inner a
   parameter String pkiDir = "pki/simulation-client" "The client's PKI folder: its certificate is created in own/ on first use; trusted/ holds the server certificates it accepts";
   parameter String user = "" "User name; empty: anonymous";
   parameter String passwordEnv = "OPCUA_PASSWORD" "Name of the environment variable that holds the user's password (never the password itself)";
+  parameter Boolean useBrowsePaths = false "Find each variable by its block's browsePath (translated by the server once per session) instead of its nodeId: for a server whose NodeIds differ from the nodesets'";
   final parameter OpcUaSupport.Live.Functions.ClientObject client = OpcUaSupport.Live.Functions.ClientObject(url, policy, mode, pkiDir, user, passwordEnv) "The client";
   annotation (defaultComponentName="opcuaClient", defaultComponentPrefixes="inner", Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}), Documentation(info="<html><p>Opens a session when the simulation
 starts and closes it when it ends. A server that cannot be reached does not end the simulation: the blocks'

@@ -5,13 +5,14 @@ block WriteInteger "Writes a Integer variable: to the server"
   extends OpcUaSupport.Interfaces.WriteInteger;
   outer OpcUaSupport.Live.Client.Endpoint opcuaClient "The client, declared inner at the top of the model";
   parameter Boolean stopOnError = false "End the simulation when a write fails (else a warning and the status output)";
+  final parameter String node = if opcuaClient.useBrowsePaths and browsePath <> "" then browsePath else nodeId "What the calls name: nodeId, or browsePath where the endpoint says so";
   OpcUaSupport.IntegerOutput status(start = 0, fixed = true) "0: Good; else the OPC UA status code of the last write (negative for Bad)"
     annotation (Placement(transformation(extent={{100,-50},{120,-30}})));
 algorithm
   when sample(0, connection.samplePeriod) then
-    status := OpcUaSupport.Live.Functions.clientWriteInteger(opcuaClient.client, nodeId, value);
+    status := OpcUaSupport.Live.Functions.clientWriteInteger(opcuaClient.client, node, value);
     if status <> 0 and status <> pre(status) then
-      OpcUaSupport.Live.Functions.report(stopOnError, "writing " + nodeId, OpcUaSupport.Live.Functions.clientError(opcuaClient.client));
+      OpcUaSupport.Live.Functions.report(stopOnError, "writing " + node, OpcUaSupport.Live.Functions.clientError(opcuaClient.client));
     end if;
   end when;
   annotation (Icon(graphics={Rectangle(extent={{-100,100},{100,-100}}, lineColor={0,0,127}, fillColor={255,255,255}, fillPattern=FillPattern.Solid), Text(extent={{-150,150},{150,110}}, textString="%name", textColor={0,0,255})}), Documentation(info="<html><p>Writes <code>value</code> to the variable
