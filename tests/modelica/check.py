@@ -351,6 +351,9 @@ def main(argv):
         return 2
     root = os.path.abspath(args[0])
     items = classes(root)
+    # Which classes hold an external object is found over every class, the ones left out included: a class
+    # holds one through a component of a left-out class (an endpoint of the support package) as well.
+    everything = items
     for package, reference in same_as:
         if same_files(os.path.join(root, package), os.path.join(reference, package)):
             left = [it for it in items if it[0] == package or it[0].startswith(package + ".")]
@@ -372,7 +375,7 @@ def main(argv):
         # Blocks are checked one by one: a partial block may lack equations (see check_one), and a block's
         # inputs (the write blocks' `u`) are unbound, both of which unbalance a model holding it as a component.
         # Classes that hold an external object are refused by rumoca's ToDae, which check_one accepts.
-        holders = external_object_holders(root, items)
+        holders = external_object_holders(root, [it for it in everything if it[1] != "unknown"])
         alone = [it for it in items if it[1] == "block" or it[0] in holders]
         items = [it for it in items if it[1] != "block" and it[0] not in holders]
         if alone:
