@@ -8,6 +8,11 @@ use nodeset_compiler::{compile, summary, Compiled, Error, Options, RustOptions};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
+/// The command's allocator (see the feature `mimalloc` in Cargo.toml).
+#[cfg(feature = "mimalloc")]
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 #[derive(Parser)]
 #[command(name = "nodeset-compiler", version, about = "Compiles OPC UA NodeSet2 information models")]
 struct Cli {

@@ -499,7 +499,7 @@ impl Gen<'_> {
             decls.push(quote! { #d pub #fname: #ty });
             binds.push(quote! { #fname: #bind });
         }
-        quote! {
+        let mut tokens = quote! {
             #docs
             #[derive(Clone)]
             #allow
@@ -512,8 +512,10 @@ impl Gen<'_> {
                 }
             }
             #deref
-            #(#nested)*
-        }
+        };
+        // Moved, not copied (see `objects_file`).
+        tokens.extend(nested);
+        tokens
     }
 
     /// Variables and methods reachable from an instance of `members`' owner, not crossing placeholders.
@@ -696,21 +698,20 @@ impl Gen<'_> {
                 let base_for_markers = base.clone();
                 let body = self.handle_struct(name, &text, None, base.map(|(_, p)| p.to_token_stream()), &own, &names, &mut uris, nested_prefix(name), 0);
                 let machine = self.state_machine_items(t, name, &names, &item_names, &mut uris);
-                items.push(quote! {
-                    #body
-                    t::object_type!(#sname, #tid, #bname);
-                    #machine
-                });
+                // Token streams are moved into each other with `extend`: `#body` in `quote!` would copy
+                // every token of it (proc-macro2 copies a stream it does not own).
+                let mut item = body;
+                item.extend(quote! { t::object_type!(#sname, #tid, #bname); });
+                item.extend(machine);
+                items.push(item);
                 markers.push(self.markers("object_members", name, &all, base_for_markers.as_ref().map(|(s, p)| (*s, p)), &mut uris));
             } else {
                 // The value itself: ValueRank -1 when the nodeset leaves it out (the schema's default, and
                 // what the node table gives the server).
                 let vt = self.value_type(n.attrs.data_type, n.attrs.value_rank.unwrap_or(-1));
-                let body = self.handle_struct(name, &text, Some(quote! { t::Variable<#vt> }), None, &all, &names, &mut uris, nested_prefix(name), 0);
-                items.push(quote! {
-                    #body
-                    t::variable_type!(#sname, #tid, #bname, #vt);
-                });
+                let mut item = self.handle_struct(name, &text, Some(quote! { t::Variable<#vt> }), None, &all, &names, &mut uris, nested_prefix(name), 0);
+                item.extend(quote! { t::variable_type!(#sname, #tid, #bname, #vt); });
+                items.push(item);
                 let base = model.supertypes(t).find_map(|s| Some((s, self.handle_path(s, &names)?)));
                 markers.push(self.markers("variable_members", name, &all, base.as_ref().map(|(s, p)| (*s, p)), &mut uris));
             }
@@ -719,7 +720,7 @@ impl Gen<'_> {
         let mut ns_list: Vec<(&String, &usize)> = uris.iter().collect();
         ns_list.sort_by_key(|(_, i)| **i);
         let ns_items = ns_list.iter().map(|(u, _)| lit(u));
-        let tokens = quote! {
+        let mut tokens = quote! {
             //! Typed handles of this namespace's ObjectTypes and VariableTypes (bind them to instances with
             //! `ModelManager::bind`, create instances with `ObjectType::instantiate`), and member markers for
             //! `nodeset-derive`.
@@ -732,8 +733,8 @@ impl Gen<'_> {
             /// Namespace URIs of the BrowseNames and types named below.
             #[allow(dead_code)]
             const NS: &[&str] = &[#(#ns_items),*];
-            #(#items)*
         };
+        tokens.extend(items);
         let mut file = self.file("objects.rs", "Typed handles", tokens);
         file.contents.push_str(
             "/// Member markers of each ObjectType and VariableType, named from browse paths (`ParameterSet__ActualPosition`).\n\
