@@ -174,7 +174,7 @@ impl ModelManager {
             let core_space = core.as_ref().map(|c| c.address_space().read());
             let space = self.node_manager().address_space().read();
             let overrides = self.overrides();
-            let spaces = Spaces { core: core_space.as_deref(), model: &space, tree: &tree, overrides };
+            let spaces = Spaces { core: core_space.as_deref(), model: &space, tree: &tree, overrides: &overrides };
             let id = options.node_id_or(self.instance_namespace(), browse_name.name.as_ref());
             let mut planner = Planner { spaces, options, used: Default::default(), out: Vec::new() };
             planner.root(type_id, parent, browse_name, id)?;
