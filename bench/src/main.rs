@@ -31,6 +31,9 @@
 //! * `verify`: `nodeset-compiler verify` against the robot cell (its three servers), several runs, next to a
 //!   naive client's walk of the same nodes in the same run (module [`verify`]). Not part of `all` (it
 //!   starts the robot cell).
+//! * `startup`: `nodeset-compiler serve` on ns0 + DI + IA + Robotics until the first Read answers, in rounds
+//!   with node-opcua's server loading the same four files; the ratio ours / peer (target 0.10) and the peak
+//!   memory of both (module [`startup`]). Not part of `all` (it starts servers, node-opcua among them).
 //! * `scale`: synthetic models of n and 4n nodes in several shapes, timed in this process, with the ratio
 //!   per stage (module [`scale`]); looks for quadratic behaviour.
 //!
@@ -67,6 +70,7 @@ mod robots;
 mod rust;
 mod scale;
 mod size;
+mod startup;
 mod verify;
 
 /// The files of the `robotics` scenario, in `nodesets/vendor/`.
@@ -85,7 +89,7 @@ const DEFAULT_TREE: &str = "../shared/nodesets/ua-nodeset";
 #[command(name = "cargo xtask bench", bin_name = "cargo xtask bench", about = "Time the compiler and the runtime against their targets and async-opcua-codegen (a report, not a test)")]
 pub struct Args {
     /// Which scenario(s) to run.
-    #[arg(long, value_parser = ["all", "robotics", "generation", "tree", "sets", "rust", "modelica", "scale", "robots", "verify"], default_value = "all")]
+    #[arg(long, value_parser = ["all", "robotics", "generation", "tree", "sets", "rust", "modelica", "scale", "robots", "verify", "startup"], default_value = "all")]
     scenario: String,
 
     /// Runs of the robotics scenario (ns0 + DI + IA + Robotics).
@@ -159,6 +163,10 @@ pub struct Args {
     #[arg(long, value_name = "N", default_value_t = 5)]
     runs_verify: usize,
 
+    /// Rounds of the startup scenario (one start of node-opcua's server and one of ours per round).
+    #[arg(long, value_name = "N", default_value_t = 5)]
+    runs_startup: usize,
+
     /// Skip the stage-split runs (halves the run time; the table then shows totals only).
     #[arg(long)]
     no_split: bool,
@@ -220,6 +228,10 @@ fn run(args: Args) -> Result<(), String> {
     if args.scenario == "verify" {
         ensure_vendor(&root.join("nodesets/vendor"))?;
         verify::run(&root, args.runs_verify, !args.no_release)?;
+    }
+    if args.scenario == "startup" {
+        ensure_vendor(&root.join("nodesets/vendor"))?;
+        startup::run(&root, args.runs_startup)?;
     }
     Ok(())
 }

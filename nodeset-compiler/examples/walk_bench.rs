@@ -36,6 +36,7 @@ fn main() -> ExitCode {
         user: None,
         pki_dir: std::env::temp_dir().join("nodeset-compiler-walk-bench-pki"),
         trust_server_cert: false,
+        verify_server_cert: true,
     };
     let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build().expect("a tokio runtime");
     let mut times = Vec::with_capacity(runs);

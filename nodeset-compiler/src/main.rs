@@ -393,6 +393,7 @@ fn verify_command(args: &VerifyArgs) -> ExitCode {
         user,
         pki_dir: args.pki.clone().unwrap_or_else(|| std::env::temp_dir().join("nodeset-compiler-verify-pki")),
         trust_server_cert: args.trust_server_cert,
+        verify_server_cert: true,
     };
     let runtime = match tokio::runtime::Builder::new_current_thread().enable_all().build() {
         Ok(r) => r,

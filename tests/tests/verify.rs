@@ -499,3 +499,40 @@ fn serve_is_secure_by_default() {
     server.wait_for("server stopped cleanly", std::time::Duration::from_secs(40)).unwrap_or_else(|e| panic!("{e}"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The ns0 a server serves is async-opcua's (1.05.04); the files were resolved against another (the tree's
+/// 1.05.03, the registry package's 1.05.07). Where the two differ, `serve --instantiate-all` follows the
+/// model, the rule `verify` checks: DI's alarm types get ConditionType's `ConditionSubClassId` and
+/// `ConditionSubClassName` (Mandatory in 1.05.03, Optional in async-opcua's), and ns0's PubSub diagnostics
+/// types get the counters their `Counters` inherits from PubSubDiagnosticsType's (async-opcua serves ns0
+/// without the compiler's override links; the model's are given to `instantiate`).
+#[test]
+fn serve_follows_the_model_where_the_served_ns0_differs() {
+    let dir = temp_dir("serve-ns0");
+    let tree = corpus();
+    // Before, verify found 8 missing members on DI's instances, and 24 on ns0's.
+    let cases = [
+        ("di", tree.join("DI/Opc.Ua.Di.NodeSet2.xml"), tree.clone()),
+        ("ns0", vendor().join("Opc.Ua.NodeSet2.xml"), vendor()),
+    ];
+    for (name, file, models) in cases {
+        let log = dir.join(format!("{name}.log"));
+        let mut command = Command::new(command_binary());
+        command.current_dir(root()).arg("serve").arg(&file).arg("--models").arg(&models);
+        command.args(["--instantiate-all", "--insecure", "--port", "0", "--pki"]).arg(dir.join("pki"));
+        command.stderr(std::fs::File::create(&log).unwrap());
+        let server = Process::spawn(&mut command).unwrap_or_else(|e| panic!("{e}"));
+        let url = server.wait_for("listening on ", process_support::STARTUP).unwrap_or_else(|e| {
+            panic!("{e}; serve said:\n{}", std::fs::read_to_string(&log).unwrap_or_default())
+        });
+        let models = models.display().to_string();
+        let (output, json) = verify(&url, &[file.to_str().unwrap(), "--models", &models, "--insecure"], &[]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(findings(&json), Vec::<(String, String)>::new(), "{name}: {json}\n{stderr}");
+        assert!(number(&json, "checked") > 250, "{name}: {json}");
+        let said = std::fs::read_to_string(&log).unwrap();
+        assert!(said.contains("instantiated "), "{name}: {said}");
+        drop(server);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -4,13 +4,23 @@
 //! for each of the two steps; a file that does not compile, does not start, or does not answer in time is
 //! reported and the run goes on.
 //!
+//! The static instances of the files (everything verify finds outside `Objects/Instances`) must give the
+//! same findings as `check` of the same files (codes, severities, browse paths with namespace URIs): `check`
+//! runs in this process on every file the server loaded (the named ones and their required models, as the
+//! server serves all of them), and each finding only one side has is a disagreement.
+//!
 //! At the end: the figures (files, files served, concrete ObjectTypes instantiated of those the files
 //! define, nodes created below `Objects/Instances`, nodes verify checked, violations below
-//! `Objects/Instances` and elsewhere), then each file with violations below `Objects/Instances` or types
-//! not instantiated, with the reasons. Fails when a violation below `Objects/Instances` remains.
+//! `Objects/Instances` and elsewhere, disagreements with `check`), then each file with violations below
+//! `Objects/Instances`, types not instantiated or disagreements, with the reasons. Fails when a violation
+//! below `Objects/Instances` or a disagreement with `check` remains.
 
 use crate::util::workspace_root;
+use nodeset_compiler::diag::Severities;
+use nodeset_compiler::load::Input;
+use nodeset_compiler::{compile, Options};
 use process_support::Process;
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -47,6 +57,9 @@ struct Outcome {
     below: Vec<(String, String, String)>,
     /// Findings elsewhere (static instances of the files).
     elsewhere: usize,
+    /// Findings on the static instances only one of verify and check has: `verify only: ...` or
+    /// `check only: ...`, with code, severity and path (namespace URIs for prefixes).
+    disagreements: Vec<String>,
     /// `serve`'s reasons for the types it did not instantiate.
     not_instantiated: Vec<String>,
 }
@@ -88,13 +101,14 @@ pub fn run(args: Args) -> Result<(), String> {
             match &o.failed {
                 Some(why) => format!("not verified: {}", why.lines().next().unwrap_or_default()),
                 None => format!(
-                    "{}/{} types, {} instance nodes, {} checked, {} below Instances, {} elsewhere",
+                    "{}/{} types, {} instance nodes, {} checked, {} below Instances, {} elsewhere, {} disagreement(s) with check",
                     o.instantiated,
                     o.types,
                     o.instance_nodes,
                     o.checked,
                     o.below.len(),
-                    o.elsewhere
+                    o.elsewhere,
+                    o.disagreements.len()
                 ),
             },
             t.elapsed().as_secs_f64()
@@ -108,6 +122,7 @@ fn report(outcomes: &[Outcome], took: Duration) -> Result<(), String> {
     let served: Vec<&Outcome> = outcomes.iter().filter(|o| o.failed.is_none()).collect();
     let sum = |f: fn(&Outcome) -> usize| served.iter().map(|o| f(o)).sum::<usize>();
     let below = sum(|o| o.below.len());
+    let disagreements = sum(|o| o.disagreements.len());
     println!("\nserve-corpus: {} run(s) in {:.0} s", outcomes.len(), took.as_secs_f64());
     println!("  served and verified: {} (not verified: {})", served.len(), outcomes.len() - served.len());
     println!("  concrete ObjectTypes instantiated: {} of {}", sum(|o| o.instantiated), sum(|o| o.types));
@@ -116,10 +131,11 @@ fn report(outcomes: &[Outcome], took: Duration) -> Result<(), String> {
     println!("  nodes verify checked: {}", served.iter().map(|o| o.checked).sum::<u64>());
     println!("  violations below Objects/Instances: {below}");
     println!("  findings elsewhere (static instances of the files): {}", sum(|o| o.elsewhere));
+    println!("  disagreements of verify and check on the static instances: {disagreements}");
     for o in outcomes.iter().filter(|o| o.failed.is_some()) {
         println!("\nnot verified: {}\n  {}", o.name, o.failed.as_deref().unwrap_or_default().replace('\n', "\n  "));
     }
-    for o in served.iter().filter(|o| !o.below.is_empty() || !o.not_instantiated.is_empty()) {
+    for o in served.iter().filter(|o| !o.below.is_empty() || !o.not_instantiated.is_empty() || !o.disagreements.is_empty()) {
         println!("\n{}:", o.name);
         for why in &o.not_instantiated {
             println!("  {why}");
@@ -127,9 +143,14 @@ fn report(outcomes: &[Outcome], took: Duration) -> Result<(), String> {
         for (code, path, message) in &o.below {
             println!("  {code} {path}: {message}");
         }
+        for d in &o.disagreements {
+            println!("  {d}");
+        }
     }
-    if below > 0 {
-        return Err(format!("serve-corpus: {below} violation(s) below Objects/Instances (listed above)"));
+    if below > 0 || disagreements > 0 {
+        return Err(format!(
+            "serve-corpus: {below} violation(s) below Objects/Instances, {disagreements} disagreement(s) of verify and check (listed above)"
+        ));
     }
     Ok(())
 }
@@ -200,12 +221,19 @@ fn serve_and_verify(exe: &Path, unit: &[PathBuf], models: &Path, work: &Path, i:
     match verified {
         Ok((_, stderr)) if json.contains("\"findings\":") => {
             o.checked = number(&json, "checked").unwrap_or(0);
-            for (code, path, message) in findings(&json) {
+            let namespaces = namespaces(&json);
+            let mut verified = Vec::new();
+            for (code, severity, path, message) in findings(&json) {
                 if path.split('/').next().is_some_and(|top| top.ends_with(":Instances")) {
                     o.below.push((code, path, message));
                 } else {
                     o.elsewhere += 1;
+                    verified.push((code, severity, by_uri(&path, &namespaces)));
                 }
+            }
+            match static_findings(unit, models) {
+                Ok(checked) => o.disagreements = disagreements(&checked, verified),
+                Err(e) => o.disagreements.push(format!("check could not run: {e}")),
             }
             let _ = stderr;
         }
@@ -268,9 +296,77 @@ fn string_field(part: &str, key: &str) -> String {
     out
 }
 
-/// (code, path, message) of every finding of a `verify --json` report.
-fn findings(json: &str) -> Vec<(String, String, String)> {
-    json.split("{\"code\":").skip(1).map(|part| (part[1..7].to_owned(), string_field(part, "path"), string_field(part, "message"))).collect()
+/// (code, severity, path, message) of every finding of a `verify --json` report.
+fn findings(json: &str) -> Vec<(String, String, String, String)> {
+    json.split("{\"code\":")
+        .skip(1)
+        .map(|part| (part[1..7].to_owned(), string_field(part, "severity"), string_field(part, "path"), string_field(part, "message")))
+        .collect()
+}
+
+/// The `"namespaces"` array of a `verify --json` report: what the prefixes of its paths number.
+fn namespaces(json: &str) -> Vec<String> {
+    let Some(at) = json.find("\"namespaces\":[") else { return Vec::new() };
+    let list = &json[at + 14..];
+    let list = &list[..list.find(']').unwrap_or(list.len())];
+    list.split(',').map(|u| u.trim().trim_matches('"').to_owned()).collect()
+}
+
+/// A browse path (`2:DeviceSet/1:Robot`) with each namespace index replaced by `namespaces[index]`, so that
+/// paths of two numberings (the server's, the model's) compare.
+fn by_uri(path: &str, namespaces: &[String]) -> String {
+    let segments: Vec<String> = path
+        .split('/')
+        .map(|seg| match seg.split_once(':').and_then(|(ns, name)| Some((namespaces.get(ns.parse::<usize>().ok()?)?, name))) {
+            Some((uri, name)) => format!("{uri}|{name}"),
+            None => seg.to_owned(),
+        })
+        .collect();
+    segments.join("/")
+}
+
+/// What `check` finds on the static instances a server of `unit` (with its required models from `models`)
+/// shows to a client: (code, severity, path by URI). Every file loaded is named, since the server serves the
+/// static instances of the required models too; findings below the Server object (a file's
+/// NamespaceMetadata, whose top has no namespace prefix) are left out, since a server's walk starts at the
+/// Objects folder's children outside namespace 0 (the test
+/// `check_and_verify_agree_on_static_instances_served_by_node_opcua` does the same on four files).
+fn static_findings(unit: &[PathBuf], models: &Path) -> Result<Vec<(String, String, String)>, String> {
+    let opts = Options { model_dirs: vec![models.to_path_buf()], ..Options::default() };
+    let loaded = compile(unit.iter().cloned().map(Input::Path).collect(), &opts);
+    if !loaded.ok() {
+        return Err(loaded.render_diagnostics().lines().next().unwrap_or_default().to_owned());
+    }
+    let defining: BTreeSet<_> = loaded.model.models.iter().map(|m| m.file).collect();
+    let files: Vec<PathBuf> = loaded.model.sources.files().filter(|(id, _)| defining.contains(id)).map(|(_, f)| f.path.clone()).collect();
+    let compiled = compile(files.into_iter().map(Input::Path).collect(), &Options::default());
+    let mut report = nodeset_compiler::verify::instances::check(&compiled.model);
+    report.apply(&Severities::new(), &compiled.model.sources);
+    Ok(report
+        .findings
+        .iter()
+        .filter(|f| f.path.split('/').next().is_some_and(|top| top.contains(':')))
+        .map(|f| (f.diagnostic.code.as_str().to_owned(), f.diagnostic.severity.as_str().to_owned(), by_uri(&f.path, &report.namespaces)))
+        .collect())
+}
+
+/// The findings only one side has, each side's list compared as a multiset.
+fn disagreements(checked: &[(String, String, String)], verified: Vec<(String, String, String)>) -> Vec<String> {
+    let mut rest = verified;
+    let mut out = Vec::new();
+    let mut checked = checked.to_vec();
+    checked.sort();
+    for c in checked {
+        match rest.iter().position(|v| *v == c) {
+            Some(i) => {
+                rest.remove(i);
+            }
+            None => out.push(format!("check only: {} {} {}", c.0, c.1, c.2)),
+        }
+    }
+    rest.sort();
+    out.extend(rest.into_iter().map(|v| format!("verify only: {} {} {}", v.0, v.1, v.2)));
+    out
 }
 
 fn rel(root: &Path, f: &Path) -> String {

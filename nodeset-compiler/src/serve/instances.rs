@@ -5,8 +5,13 @@
 //! MandatoryPlaceholder, values from the nodeset or else the DataType's default, and every state machine
 //! among them served from its initial state, by a state table built from the model.
 //!
-//! What to name for the placeholders is read from the model ([`mandatory_paths`]), which computes the
-//! hierarchy once (`resolve/inherit.rs`); the runtime follows the same links in the tables. A type the
+//! What to name for the placeholders, and which members are Mandatory, is read from the model
+//! ([`mandatory_paths`]), which computes the hierarchy once (`resolve/inherit.rs`); the runtime follows the
+//! same links in the tables, and for ns0, which async-opcua serves without them, the model's links are given
+//! to it ([`ModelManager::add_overrides`]). Where the served ns0 (async-opcua's, 1.05.04) and the ns0 the
+//! files were resolved against differ in a ModellingRule (ConditionType's `ConditionSubClassId`, Mandatory
+//! in 1.05.03), the model's rule is the one followed: every member the model holds Mandatory is created,
+//! which an Optional member of the served type also allows. A type the
 //! runtime refuses (a MandatoryPlaceholder the model does not see, a type that contains itself) is reported
 //! with the reason, and the others are still created.
 
@@ -141,6 +146,7 @@ pub fn instantiate_all(manager: &ModelManager, m: &Model) -> Instantiated {
         return done;
     }
     done.nodes += 1;
+    manager.add_overrides(ns0_overrides(manager, m));
     let machines = StateTables::new(manager, m);
     // Two types of one namespace may share a BrowseName (AML's libraries): their instances are told apart
     // by the type's NodeId.
@@ -182,12 +188,30 @@ pub fn instantiate_all(manager: &ModelManager, m: &Model) -> Instantiated {
     done
 }
 
+/// The model's links of ns0's InstanceDeclarations (each to the declaration it overrides at its browse
+/// path, `Model::overridden`), as server NodeIds. The node tables carry these links for the namespaces they
+/// serve; ns0 is async-opcua's, served without them, so `instantiate` gets them from here, and merges an ns0
+/// subtype's declaration with what it overrides as the model does (PubSubDiagnosticsDataSetReaderType's
+/// `Counters` keeps `StateError` and the other counters of PubSubDiagnosticsType's).
+fn ns0_overrides(manager: &ModelManager, m: &Model) -> Vec<(NodeId, NodeId)> {
+    m.overridden
+        .iter()
+        .filter(|(&decl, _)| m.node(decl).id.ns == 0)
+        .filter_map(|(&decl, &over)| Some((server_id(manager, m, decl)?, server_id(manager, m, over)?)))
+        .collect()
+}
+
 fn instantiate_one(manager: &ModelManager, m: &Model, t: NodeIx, name: &str, folder: &NodeId) -> Result<NodeId, String> {
     let type_id = server_id(manager, m, t).ok_or("its namespace is not served")?;
-    let (_, placeholders) = mandatory_paths(m, t, &element_name)?;
+    let (mandatory, placeholders) = mandatory_paths(m, t, &element_name)?;
+    // Every member the model holds Mandatory is created, also where the server's own type marks it Optional:
+    // ns0 is async-opcua's (1.05.04), and the files were written against another ns0 (1.05.03 in the
+    // UA-Nodeset tree, where ConditionType's ConditionSubClassId is still Mandatory). The rule is the
+    // model's, computed once; an Optional member created is no fault of the served type's either.
+    let options = mandatory.iter().fold(Instantiate::new().data_type_defaults(), |o, p| o.ensure(p.clone()));
     let options = placeholders
         .iter()
-        .fold(Instantiate::new().data_type_defaults(), |o, p| o.placeholder(p.clone(), [element_name(p.rsplit('/').next().unwrap_or(p))]));
+        .fold(options, |o, p| o.placeholder(p.clone(), [element_name(p.rsplit('/').next().unwrap_or(p))]));
     let ns = type_id.namespace;
     let id = NodeId::new(manager.instance_namespace(), format!("Instances/{ns}:{name}"));
     manager

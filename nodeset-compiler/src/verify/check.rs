@@ -206,7 +206,10 @@ impl<'a> Checker<'a> {
         node.references.iter().find(|r| r.reference_type == want).map(|r| &r.target)
     }
 
-    /// The forward hierarchical children of a server node, in browse order (each once).
+    /// The forward hierarchical children of a server node (each once), ordered by BrowseName (namespace URI,
+    /// then name), then NodeId (namespace URI, then identifier): not in the server's browse order, so that
+    /// a node with two hierarchical parents is reached first by the same path on every server and in
+    /// `check`'s snapshot of the files (AML's libraries hang below two folders).
     fn children(&self, node: &RemoteNode) -> Vec<NodeId> {
         let mut out: Vec<NodeId> = Vec::new();
         let has_subtype = self.model.ns0(ids::HAS_SUBTYPE);
@@ -217,6 +220,11 @@ impl<'a> Checker<'a> {
                 out.push(r.target.clone());
             }
         }
+        let uri = |ns: u16| self.snap.namespaces.get(ns as usize).cloned().unwrap_or_default();
+        out.sort_by_cached_key(|id| {
+            let name = self.snap.nodes.get(id).map(|n| (uri(n.browse_name.ns), n.browse_name.name.clone()));
+            (name, uri(id.ns), format_node_id(&NodeId { ns: 0, id: id.id.clone() }))
+        });
         out
     }
 

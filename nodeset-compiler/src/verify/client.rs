@@ -42,6 +42,11 @@ pub struct Connect {
     pub pki_dir: PathBuf,
     /// Trust the server's certificate without finding it in the trust list (explicitly insecure).
     pub trust_server_cert: bool,
+    /// Check the server certificate's host name, application URI and validity (async-opcua's checks; on for
+    /// `verify`). async-opcua 0.19 takes the first SubjectAltName for the application URI and skips it, so
+    /// it refuses node-opcua's certificates (DNS name first) over any secure channel: the start-up bench,
+    /// which reaches node-opcua's server and ours over SignAndEncrypt with the same client, turns it off.
+    pub verify_server_cert: bool,
 }
 
 /// Why a snapshot could not be read.
@@ -67,6 +72,30 @@ pub async fn snapshot(connect: &Connect) -> Result<Snapshot, ClientError> {
 /// limits): `Some(1)` is the same walk one node at a time, the baseline of `cargo xtask bench --scenario
 /// verify`.
 pub async fn snapshot_batched(connect: &Connect, max_batch: Option<usize>) -> Result<Snapshot, ClientError> {
+    let open = open(connect).await?;
+    let result = read_all_batched(&open.session, max_batch).await;
+    open.close().await;
+    result
+}
+
+/// A session to a server, with the event loop that carries it.
+pub struct Open {
+    /// The session, connected and activated.
+    pub session: Arc<Session>,
+    event_loop: tokio::task::JoinHandle<StatusCode>,
+}
+
+impl Open {
+    /// Closes the session and waits (at most 5 s) for its event loop to end.
+    pub async fn close(self) {
+        let _ = self.session.disconnect().await;
+        let _ = tokio::time::timeout(Duration::from_secs(5), self.event_loop).await;
+    }
+}
+
+/// Opens a session as `connect` says (the endpoint of its policy and mode, reached at its URL, TCP_NODELAY,
+/// no retries): the one client of `verify`, also the client of `cargo xtask bench --scenario startup`.
+pub async fn open(connect: &Connect) -> Result<Open, ClientError> {
     let url_ok = connect.url.starts_with("opc.tcp://")
         && hostname_port_from_url(&connect.url, opcua::core::constants::DEFAULT_OPC_UA_SERVER_PORT).is_ok_and(|(h, _)| !h.is_empty());
     if !url_ok {
@@ -89,6 +118,7 @@ pub async fn snapshot_batched(connect: &Connect, max_batch: Option<usize>) -> Re
         .pki_dir(&connect.pki_dir)
         .create_sample_keypair(secure)
         .trust_server_certs(connect.trust_server_cert)
+        .verify_server_certs(connect.verify_server_cert)
         .session_retry_limit(0)
         .client()
         .map_err(|e| ClientError(format!("the client configuration is invalid: {}", e.join("; "))))?;
@@ -142,10 +172,7 @@ pub async fn snapshot_batched(connect: &Connect, max_batch: Option<usize>) -> Re
         event_loop.abort();
         return Err(ClientError(connect_failure(connect, status, &server_certificate)));
     }
-    let result = read_all_batched(&session, max_batch).await;
-    let _ = session.disconnect().await;
-    let _ = tokio::time::timeout(Duration::from_secs(5), event_loop).await;
-    result
+    Ok(Open { session, event_loop })
 }
 
 /// Why no session was made, and what to do about it: `status` is what the connection ended with (`None`:

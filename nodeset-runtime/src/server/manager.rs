@@ -133,8 +133,9 @@ pub struct ModelNodes {
     /// The AccessRestrictions the tables give their nodes (the nodes without any are not listed).
     restrictions: HashMap<NodeId, AccessRestrictionType>,
     /// The declaration each InstanceDeclaration of the tables overrides (the compiler's `Overrides` rows),
-    /// which `instantiate` follows to merge members by browse path.
-    overrides: HashMap<NodeId, NodeId>,
+    /// which `instantiate` follows to merge members by browse path; with the links given by
+    /// [`ModelManager::add_overrides`] for declarations no table carries.
+    overrides: RwLock<HashMap<NodeId, NodeId>>,
 }
 
 /// The node manager type as async-opcua's `ServerHandle::node_managers()` holds it.
@@ -235,7 +236,7 @@ impl ModelNodes {
             write_handlers: Default::default(),
             method_handlers: Default::default(),
             restrictions,
-            overrides,
+            overrides: RwLock::new(overrides),
         }
     }
 
@@ -606,8 +607,21 @@ impl ModelManager {
 
     /// The declaration each InstanceDeclaration of the served tables overrides, by server NodeId (for
     /// `instantiate` in [`crate::typed::instance`]).
-    pub(crate) fn overrides(&self) -> &HashMap<NodeId, NodeId> {
-        &self.nodes().overrides
+    pub(crate) fn overrides(&self) -> impl std::ops::Deref<Target = HashMap<NodeId, NodeId>> + '_ {
+        self.nodes().overrides.read()
+    }
+
+    /// Adds links (declaration, the declaration it overrides at its browse path) that no served table
+    /// carries: those of ns0's InstanceDeclarations, which async-opcua serves without the compiler's
+    /// `Overrides` rows. `nodeset-compiler serve` gives the ones of its resolved model, so that
+    /// `instantiate` merges the members of an ns0 subtype's declaration (`Counters` of
+    /// PubSubDiagnosticsDataSetReaderType) with those of the declaration it overrides (`Counters` of
+    /// PubSubDiagnosticsType), as the model does. A link already known is kept.
+    pub fn add_overrides(&self, links: impl IntoIterator<Item = (NodeId, NodeId)>) {
+        let mut overrides = self.nodes().overrides.write();
+        for (decl, over) in links {
+            overrides.entry(decl).or_insert(over);
+        }
     }
 
     /// The server's node manager of ns0, if it has one.

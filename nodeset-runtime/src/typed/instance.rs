@@ -56,7 +56,9 @@ impl Instantiate {
     }
 
     /// Create the member at `path` if it is Optional; unlike [`Instantiate::optional`], a path that is
-    /// Mandatory or not a member is no error (the derive asks for every prefix of the paths it binds).
+    /// Mandatory or not a member is no error (the derive asks for every prefix of the paths it binds), nor is
+    /// an Optional member beside a Mandatory one of the same name in another namespace (which the path
+    /// names already).
     pub fn ensure(mut self, path: impl Into<String>) -> Instantiate {
         self.ensure.insert(path.into());
         self
@@ -174,7 +176,7 @@ impl ModelManager {
             let core_space = core.as_ref().map(|c| c.address_space().read());
             let space = self.node_manager().address_space().read();
             let overrides = self.overrides();
-            let spaces = Spaces { core: core_space.as_deref(), model: &space, tree: &tree, overrides };
+            let spaces = Spaces { core: core_space.as_deref(), model: &space, tree: &tree, overrides: &overrides };
             let id = options.node_id_or(self.instance_namespace(), browse_name.name.as_ref());
             let mut planner = Planner { spaces, options, used: Default::default(), out: Vec::new() };
             planner.root(type_id, parent, browse_name, id)?;
@@ -514,7 +516,11 @@ impl<'a> Planner<'a> {
                     if wanted {
                         self.used.insert(format!("o:{member_path}"));
                     }
-                    if wanted || self.options.all_optional || self.options.ensure.contains(&member_path) {
+                    // A path names one member: ensuring it asks for nothing where a Mandatory sibling of
+                    // the same name (in another namespace) is created anyway, and their NodeIds would collide.
+                    let ensured = self.options.ensure.contains(&member_path)
+                        && !siblings.iter().any(|m| m.rule == Rule::Mandatory && m.browse_name.name == decl.browse_name.name);
+                    if wanted || self.options.all_optional || ensured {
                         vec![(decl.browse_name.clone(), None, member_path.clone())]
                     } else {
                         continue;
