@@ -19,6 +19,12 @@ use nodeset_runtime::server::{Role, Users};
 use opcua::crypto::X509;
 use opcua::types::StatusCode;
 
+/// A client PKI folder at `dir` as the simulation's client makes it (its application name and URI, no host
+/// names); its certificate.
+fn client_certificate(dir: &Path) -> X509 {
+    prepare_pki(dir, "Modelica simulation client", "urn:nodeset-live:client", &[]).unwrap().cert
+}
+
 const NS: &str = "http://example.com/nodeset-live/";
 
 fn root() -> PathBuf {
@@ -105,14 +111,7 @@ unsafe fn secure_server(name: &str, password_env: &str, port: c_int) -> Secure {
         "{}",
         server_error(server)
     );
-    let client_cert = prepare_pki(
-        &client_pki,
-        "Modelica simulation client",
-        "urn:nodeset-live:client",
-        &[],
-    )
-    .unwrap()
-    .cert;
+    let client_cert = client_certificate(&client_pki);
     trust_certificate(&server_pki, &client_cert).unwrap();
     let server_cert =
         X509::from_der(&std::fs::read(server_pki.join("own/cert.der")).unwrap()).unwrap();
@@ -710,13 +709,7 @@ fn a_refused_certificate_is_a_clear_message_on_either_side() {
 
         // The server does not trust the client (the client trusts the server).
         let stranger = dir.join("stranger");
-        prepare_pki(
-            &stranger,
-            "Modelica simulation client",
-            "urn:nodeset-live:client",
-            &[],
-        )
-        .unwrap();
+        client_certificate(&stranger);
         trust_certificate(&stranger, &server_cert).unwrap();
         let client = connect(&stranger);
         assert_eq!(
@@ -747,14 +740,7 @@ fn a_refused_certificate_is_a_clear_message_on_either_side() {
 
         // The client does not trust the server (the server trusts the client).
         let doubter = dir.join("doubter");
-        let cert = prepare_pki(
-            &doubter,
-            "Modelica simulation client",
-            "urn:nodeset-live:client",
-            &[],
-        )
-        .unwrap()
-        .cert;
+        let cert = client_certificate(&doubter);
         trust_certificate(&s.server_pki, &cert).unwrap();
         let client = connect(&doubter);
         assert_eq!(

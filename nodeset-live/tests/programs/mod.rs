@@ -294,14 +294,7 @@ fn drive_files(dir: &Path) -> DriveFiles {
     )
     .unwrap()
     .cert;
-    let client_cert = prepare_pki(
-        &client_pki,
-        "Modelica simulation client",
-        "urn:nodeset-live:client",
-        &[],
-    )
-    .unwrap()
-    .cert;
+    let client_cert = super::client_certificate(&client_pki);
     trust_certificate(&server_pki, &client_cert).unwrap();
     trust_certificate(&client_pki, &server_cert).unwrap();
     operator(&users, DRIVE_PASSWORD);
