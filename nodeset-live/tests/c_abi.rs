@@ -22,7 +22,14 @@ use opcua::types::StatusCode;
 /// A client PKI folder at `dir` as the simulation's client makes it (its application name and URI, no host
 /// names); its certificate.
 fn client_certificate(dir: &Path) -> X509 {
-    prepare_pki(dir, "Modelica simulation client", "urn:nodeset-live:client", &[]).unwrap().cert
+    prepare_pki(
+        dir,
+        "Modelica simulation client",
+        "urn:nodeset-live:client",
+        &[],
+    )
+    .unwrap()
+    .cert
 }
 
 const NS: &str = "http://example.com/nodeset-live/";
