@@ -8,17 +8,13 @@
 // `objects <n> variables <n> methods <n> good <n> uncertain <n> bad <n> empty <n>`. Exit status 0 when it could browse
 // and read, 1 otherwise.
 "use strict";
-const path = require("path");
 const {
-    OPCUAClient,
-    OPCUACertificateManager,
-    MessageSecurityMode,
-    SecurityPolicy,
     BrowseDirection,
     NodeClass,
     AttributeIds,
     DataType,
 } = require("node-opcua");
+const { connectSecurely } = require("./secure");
 
 const [url, folder, pki] = process.argv.slice(2);
 if (!url || !folder || !pki) {
@@ -46,20 +42,11 @@ async function browseAll(session, nodeId) {
 }
 
 async function main() {
-    const clientCertificateManager = new OPCUACertificateManager({
-        rootFolder: path.resolve(pki),
-        automaticallyAcceptUnknownCertificate: true,
-    });
-    const client = OPCUAClient.create({
+    const { client, session } = await connectSecurely(url, {
+        pki,
+        acceptUnknownServer: true,
         applicationName: "nodeset-compiler node-opcua browse",
-        securityMode: MessageSecurityMode.SignAndEncrypt,
-        securityPolicy: SecurityPolicy.Basic256Sha256,
-        endpointMustExist: false,
-        clientCertificateManager,
-        connectionStrategy: { maxRetry: 2, initialDelay: 200, maxDelay: 1000 },
     });
-    await client.connect(url);
-    const session = await client.createSession();
     const top = (await browseAll(session, "ns=0;i=85")).filter((r) => r.browseName.name === folder);
     if (top.length !== 1) {
         throw new Error(`Objects has ${top.length} children named ${folder}`);

@@ -11,17 +11,13 @@
 // arrival time in milliseconds since the Unix epoch (performance.timeOrigin + performance.now(), sub-millisecond).
 // Ends when its stdin closes: closes the session and prints `closed`. Exit status 0 when it could subscribe.
 "use strict";
-const path = require("path");
 const {
-    OPCUAClient,
-    OPCUACertificateManager,
-    MessageSecurityMode,
-    SecurityPolicy,
     UserTokenType,
     AttributeIds,
     TimestampsToReturn,
     ClientMonitoredItem,
 } = require("node-opcua");
+const { connectSecurely } = require("./secure");
 
 const [url, cert, key, pki, user, passwordEnv, ...nodeIds] = process.argv.slice(2);
 if (!url || !cert || !key || !pki || !user || !passwordEnv || nodeIds.length === 0) {
@@ -39,23 +35,15 @@ function now() {
 }
 
 async function main() {
-    const clientCertificateManager = new OPCUACertificateManager({
-        rootFolder: path.resolve(pki),
-        automaticallyAcceptUnknownCertificate: false,
-    });
-    const client = OPCUAClient.create({
+    const { client, session } = await connectSecurely(url, {
+        pki,
+        acceptUnknownServer: false,
         applicationName: "nodeset-live node-opcua subscriber",
         applicationUri: "urn:nodeset-live:node-subscriber",
-        securityMode: MessageSecurityMode.SignAndEncrypt,
-        securityPolicy: SecurityPolicy.Basic256Sha256,
-        certificateFile: path.resolve(cert),
-        privateKeyFile: path.resolve(key),
-        endpointMustExist: false,
-        clientCertificateManager,
-        connectionStrategy: { maxRetry: 2, initialDelay: 200, maxDelay: 1000 },
+        cert,
+        key,
+        identity: { type: UserTokenType.UserName, userName: user, password },
     });
-    await client.connect(url);
-    const session = await client.createSession({ type: UserTokenType.UserName, userName: user, password });
     const subscription = await session.createSubscription2({
         requestedPublishingInterval: 10,
         requestedLifetimeCount: 6000,
