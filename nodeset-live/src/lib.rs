@@ -25,8 +25,9 @@
 //! it, else kept in a buffer of the calling thread until its next call that returns a string ([`strings`]).
 //!
 //! No Rust panic crosses the boundary: each exported function runs under `catch_unwind`, and a panic
-//! becomes the status `BadInternalError` with its message. The header is `include/nodeset_live.h`, written
-//! by hand and checked against these functions by `tests/header/mod.rs` (names, parameter and result types).
+//! becomes the status `BadInternalError` with its message. The header is `nodeset_live.h`, which the
+//! compiler writes into the Modelica support package (`OpcUaSupport/Resources/Include`); it is written by
+//! hand and checked against these functions by `tests/header/mod.rs` (names, parameter and result types).
 
 pub mod client;
 pub mod server;

@@ -19,6 +19,14 @@ use nodeset_runtime::server::{Role, Users};
 use opcua::crypto::X509;
 use opcua::types::StatusCode;
 
+/// The C header of the library, `nodeset_live.h`: it has one home, the Modelica support package the compiler
+/// writes (`OpcUaSupport/Resources/Include`, where a tool's `Include` annotation finds it), and these tests and
+/// their C programs read it there.
+fn header_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../nodeset-compiler/src/emit/modelica/support/Resources/Include")
+}
+
 /// A client PKI folder at `dir` as the simulation's client makes it (its application name and URI, no host
 /// names); its certificate.
 fn client_certificate(dir: &Path) -> X509 {

@@ -1,5 +1,5 @@
 //! The two scenarios of issue 39 from C programs (`tests/c/*.c`), compiled with the system's C compiler
-//! against `include/nodeset_live.h` and the shared library of the workspace build, as a Modelica tool links
+//! against the header `nodeset_live.h` and the shared library of the workspace build, as a Modelica tool links
 //! them, and run as child processes:
 //!
 //! - (a) component simulation (`drive.c`): the program integrates a drive and publishes ActualPosition and
@@ -188,7 +188,7 @@ fn compile(name: &str, dir: &Path) -> PathBuf {
             "-rdynamic",
             "-I",
         ])
-        .arg(manifest.join("include"))
+        .arg(super::header_dir())
         .arg(manifest.join(format!("tests/c/{name}.c")))
         .arg("-L")
         .arg(&lib)

@@ -77,8 +77,8 @@ const SOURCES: &[(&str, &str)] = &[
     ("Live/Client/WriteBoolean.mo", include_str!("support/Live/Client/WriteBoolean.mo")),
     ("Live/Client/ReadString.mo", include_str!("support/Live/Client/ReadString.mo")),
     ("Live/Client/WriteString.mo", include_str!("support/Live/Client/WriteString.mo")),
-    // The C header of the nodeset_live library the `Include` annotations of `Live` name (a copy of
-    // nodeset-live/include/nodeset_live.h, which nodeset-live's tests keep identical).
+    // The C header of the nodeset_live library the `Include` annotations of `Live` name: its one home
+    // (nodeset-live's tests check it against the library's exports and compile their C programs with it).
     ("Resources/Include/nodeset_live.h", include_str!("support/Resources/Include/nodeset_live.h")),
 ];
 
