@@ -207,56 +207,39 @@ async fn run(port: u16, seconds: Option<u64>, secure: SecureArgs) -> Result<(), 
 
     let lifetimes = gear_lifetimes(&manager, &robot)?;
     let axes: Vec<_> = arm.axes.axis_identifier.values().map(|a| a.parameter_set.actual_position.clone()).collect();
-    let handle = server.handle().clone();
-    println!("listening on {}", server.endpoint_url());
-    let _ = std::io::stdout().flush();
-    let task = tokio::spawn(server.run());
-
-    // Joint motion at 100 Hz.
+    // Joint motion at 100 Hz, beside the server.
     let started = Instant::now();
     let mut tick = tokio::time::interval(Duration::from_millis(10));
     tick.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
-    let stop = async {
-        match seconds {
-            Some(s) => tokio::time::sleep(Duration::from_secs(s)).await,
-            None => shutdown_signal().await,
-        }
-    };
-    tokio::pin!(stop);
     let mut last_asset = identity.read(|i| i.asset_id.clone());
     let mut last_stop_mode = settings.read(|s| s.default_stop_mode);
-    loop {
-        tokio::select! {
-            _ = &mut stop => break,
-            _ = tick.tick() => {
-                let t = started.elapsed().as_secs_f64();
-                for (i, position) in axes.iter().enumerate() {
-                    let amplitude = 90.0 - 10.0 * i as f64;
-                    let _ = position.set(amplitude * (t * (0.2 + 0.05 * i as f64)).sin());
-                }
-                for (i, lifetime) in lifetimes.iter().enumerate() {
-                    let _ = lifetime.set(Variant::Double(remaining_hours(i, t)));
-                }
-                let asset = identity.read(|i| i.asset_id.clone());
-                if asset != last_asset {
-                    identity.update(|i| i.writes_seen += 1);
-                    println!("AssetId written by a client: {asset:?}");
-                    let _ = std::io::stdout().flush();
-                    last_asset = asset;
-                }
-                let stop_mode = settings.read(|s| s.default_stop_mode);
-                if stop_mode != last_stop_mode {
-                    println!("ConfiguredDefaultStopMode written by a client: {stop_mode}");
-                    let _ = std::io::stdout().flush();
-                    last_stop_mode = stop_mode;
-                }
+    let motion = async {
+        loop {
+            tick.tick().await;
+            let t = started.elapsed().as_secs_f64();
+            for (i, position) in axes.iter().enumerate() {
+                let amplitude = 90.0 - 10.0 * i as f64;
+                let _ = position.set(amplitude * (t * (0.2 + 0.05 * i as f64)).sin());
+            }
+            for (i, lifetime) in lifetimes.iter().enumerate() {
+                let _ = lifetime.set(Variant::Double(remaining_hours(i, t)));
+            }
+            let asset = identity.read(|i| i.asset_id.clone());
+            if asset != last_asset {
+                identity.update(|i| i.writes_seen += 1);
+                println!("AssetId written by a client: {asset:?}");
+                let _ = std::io::stdout().flush();
+                last_asset = asset;
+            }
+            let stop_mode = settings.read(|s| s.default_stop_mode);
+            if stop_mode != last_stop_mode {
+                println!("ConfiguredDefaultStopMode written by a client: {stop_mode}");
+                let _ = std::io::stdout().flush();
+                last_stop_mode = stop_mode;
             }
         }
-    }
-    handle.cancel();
-    task.await.map_err(|e| e.to_string())??;
-    println!("server stopped cleanly");
-    Ok(())
+    };
+    server.run_until_stopped(seconds, motion).await
 }
 
 /// The gears' lifetime in hours (DI LifetimeVariableType's StartValue; its LimitValue is 0).
@@ -323,23 +306,6 @@ impl LockShown {
         self.remaining.set(0.0)?;
         self.locked.set(holder.is_some())
     }
-}
-
-async fn shutdown_signal() {
-    #[cfg(unix)]
-    {
-        use tokio::signal::unix::{signal, SignalKind};
-        match signal(SignalKind::terminate()) {
-            Ok(mut term) => {
-                tokio::select! { _ = tokio::signal::ctrl_c() => {}, _ = term.recv() => {} }
-            }
-            Err(_) => {
-                let _ = tokio::signal::ctrl_c().await;
-            }
-        }
-    }
-    #[cfg(not(unix))]
-    let _ = tokio::signal::ctrl_c().await;
 }
 
 fn main() -> ExitCode {

@@ -55,11 +55,9 @@ use nodeset_examples::describe::{describe, nameplate};
 use nodeset_examples::secure::{SecureArgs, USAGE};
 use nodeset_models::runtime::client::ClientConfig;
 use nodeset_models::runtime::server::users::random_password;
-use nodeset_models::runtime::server::{security, ModelServer as Server, Role, ServerConfig};
+use nodeset_models::runtime::server::{security, stop_requested, ModelServer as Server, Role, RunningServer, ServerConfig};
 use nodeset_models::runtime::typed::{Control, Program};
-use opcua::server::ServerHandle;
 use opcua::types::{StatusCode, ThreeDCartesianCoordinates, ThreeDFrame, ThreeDOrientation};
-use tokio::task::JoinHandle;
 
 const SYSTEM: &str = "DeviceSet/TemplateDrillingLwrSystem";
 const CONTROLLER_SKILLS: &str = "MotionDeviceSystem/Controllers/URController/SkillSet";
@@ -113,16 +111,11 @@ fn config(name: &str, port: u16, secure: &SecureArgs, sub: &str) -> Result<Serve
     own.apply(config, sub)
 }
 
-/// A server that runs.
-struct Running {
-    handle: ServerHandle,
-    task: JoinHandle<Result<(), String>>,
-}
-
-fn start(label: &str, server: Server) -> Running {
-    println!("{label} listening on {}", server.endpoint_url());
+fn start(label: &str, server: Server) -> RunningServer {
+    let running = server.start();
+    println!("{label} listening on {}", running.endpoint_url());
     let _ = std::io::stdout().flush();
-    Running { handle: server.handle().clone(), task: tokio::spawn(server.run()) }
+    running
 }
 
 /// Waits for `time`, in steps of at most 10 ms, calling `step` with the fraction done after each and
@@ -326,6 +319,7 @@ async fn cell(server: &Server, robot_url: &str, unit_url: &str, client: &ClientC
 }
 
 async fn run(o: Options) -> Result<(), String> {
+    let stop = stop_requested(o.seconds);
     let next = |k: u16| if o.port == 0 { 0 } else { o.port + k };
     // The composite skills reach the devices over SignAndEncrypt as user `cell` (Operator on the devices, with
     // a password drawn at each start and kept only hashed there), and verify the devices' certificates: the
@@ -364,19 +358,13 @@ async fn run(o: Options) -> Result<(), String> {
     println!("cell ready");
     let _ = std::io::stdout().flush();
 
-    match o.seconds {
-        Some(s) => tokio::time::sleep(Duration::from_secs(s)).await,
-        None => shutdown_signal().await,
-    }
+    stop.await;
     // The cell first: its skills hold sessions to the other two.
     drop(cell_skills);
     let mut failed = Vec::new();
     for s in servers.into_iter().rev() {
-        s.handle.cancel();
-        match s.task.await {
-            Ok(Ok(())) => {}
-            Ok(Err(e)) => failed.push(e),
-            Err(e) => failed.push(e.to_string()),
+        if let Err(e) = s.stop().await {
+            failed.push(e);
         }
     }
     drop((robot_skills, drilling));
@@ -385,23 +373,6 @@ async fn run(o: Options) -> Result<(), String> {
     }
     println!("server stopped cleanly");
     Ok(())
-}
-
-async fn shutdown_signal() {
-    #[cfg(unix)]
-    {
-        use tokio::signal::unix::{signal, SignalKind};
-        match signal(SignalKind::terminate()) {
-            Ok(mut term) => {
-                tokio::select! { _ = tokio::signal::ctrl_c() => {}, _ = term.recv() => {} }
-            }
-            Err(_) => {
-                let _ = tokio::signal::ctrl_c().await;
-            }
-        }
-    }
-    #[cfg(not(unix))]
-    let _ = tokio::signal::ctrl_c().await;
 }
 
 fn main() -> ExitCode {

@@ -17,7 +17,6 @@
 //! that the server has no certificate (which the unencrypted endpoint does not need) and its notes about
 //! instance declarations shared between types while it builds the type tree.
 
-use std::io::Write;
 use std::process::ExitCode;
 use std::time::Duration;
 
@@ -95,23 +94,9 @@ async fn run() -> Result<(), String> {
     }
     let server = config.build()?;
     let manager = server.manager().clone();
-    let handle = server.handle().clone();
     if demo {
         demo_handlers(&manager)?;
     }
-    let url = server.endpoint_url().to_owned();
-    let mut task = tokio::spawn(server.run());
-    println!("listening on {url}");
-    let _ = std::io::stdout().flush();
-
-    let mut terminate = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
-        .map_err(|e| format!("cannot listen for SIGTERM: {e}"))?;
-    let deadline = async {
-        match options.seconds {
-            Some(s) => tokio::time::sleep(Duration::from_secs(s)).await,
-            None => std::future::pending().await,
-        }
-    };
     let counter = async {
         match demo.then(|| manager.resolve(demo::node(demo::ids::PUMP1_COUNTER))).flatten() {
             Some(counter) => {
@@ -124,23 +109,7 @@ async fn run() -> Result<(), String> {
             None => std::future::pending().await,
         }
     };
-    tokio::select! {
-        _ = tokio::signal::ctrl_c() => {}
-        _ = terminate.recv() => {}
-        _ = deadline => {}
-        _ = counter => {}
-        result = &mut task => return Err(format!("the server stopped by itself: {result:?}")),
-    }
-    handle.cancel();
-    match tokio::time::timeout(Duration::from_secs(10), task).await {
-        Ok(Ok(Ok(()))) => {
-            println!("server stopped cleanly");
-            Ok(())
-        }
-        Ok(Ok(Err(e))) => Err(format!("the server failed: {e}")),
-        Ok(Err(e)) => Err(format!("the server task failed: {e}")),
-        Err(_) => Err("the server did not stop within 10 s".to_owned()),
-    }
+    server.run_until_stopped(options.seconds, counter).await
 }
 
 /// Handlers of the demo namespace.

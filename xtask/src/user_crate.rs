@@ -53,8 +53,8 @@ pub fn run(_: Args) -> Result<(), String> {
 /// Hello, and stops it; the endpoint URL and what it said it serves.
 fn serve(exe: &std::path::Path, compiler: &std::path::Path, pki: &std::path::Path) -> Result<(String, String), String> {
     let server = Process::spawn(Command::new(exe).args(["--port", "0", "--seconds", "120", "--trust-on-first-use", "--pki"]).arg(pki.join("server")))?;
-    let url = server.wait_for("listening on ", process_support::STARTUP)?;
     let instance = server.wait_for("serving ", process_support::STARTUP)?;
+    let url = server.wait_for("listening on ", process_support::STARTUP)?;
     if !instance.contains("VendorControllerType") || !instance.contains("VendorArmType") {
         return Err(format!("the server serves `{instance}`, not a VendorControllerType and a VendorArmType"));
     }

@@ -19,9 +19,8 @@ pub mod instances;
 use crate::diag::Diagnostics;
 use crate::emit::rust::{default_module_name, node_tables, NodeTable, RustConfig, RustNamespace, RustPath};
 use crate::model::Model;
-use nodeset_runtime::server::{ServerConfig, Users};
+use nodeset_runtime::server::{stop_requested, ServerConfig, Users};
 use nodeset_runtime::table::{NodeSetTable, Nodes, Packed};
-use std::io::Write;
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -122,8 +121,8 @@ pub async fn serve(model: &Model, opts: &ServeOptions) -> Result<(), String> {
     let server = config.build()?;
     let manager = server.manager().clone();
     let handle = server.handle().clone();
-    let url = server.endpoint_url().to_owned();
-    let mut task = tokio::spawn(server.run());
+    let stop = stop_requested(opts.seconds);
+    let running = server.start();
     if opts.instantiate_all {
         // Instances are made once async-opcua has loaded ns0's types into the type tree (when the server
         // starts running): before, a reference type of the files that derives from ns0's HasComponent is
@@ -142,32 +141,7 @@ pub async fn serve(model: &Model, opts: &ServeOptions) -> Result<(), String> {
             done.without_initial_state
         );
     }
-    println!("listening on {url}");
-    let _ = std::io::stdout().flush();
-    let mut terminate = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
-        .map_err(|e| format!("cannot listen for SIGTERM: {e}"))?;
-    let deadline = async {
-        match opts.seconds {
-            Some(s) => tokio::time::sleep(Duration::from_secs(s)).await,
-            None => std::future::pending().await,
-        }
-    };
-    tokio::select! {
-        _ = tokio::signal::ctrl_c() => {}
-        _ = terminate.recv() => {}
-        _ = deadline => {}
-        result = &mut task => return Err(format!("the server stopped by itself: {result:?}")),
-    }
-    handle.cancel();
-    match tokio::time::timeout(Duration::from_secs(10), task).await {
-        Ok(Ok(Ok(()))) => {
-            println!("server stopped cleanly");
-            Ok(())
-        }
-        Ok(Ok(Err(e))) => Err(format!("the server failed: {e}")),
-        Ok(Err(e)) => Err(format!("the server task failed: {e}")),
-        Err(_) => Err("the server did not stop within 10 s".to_owned()),
-    }
+    running.serve_until(stop, std::future::pending()).await
 }
 
 /// Waits (at most 30 s) until the running server's type tree holds ns0's reference types. async-opcua loads

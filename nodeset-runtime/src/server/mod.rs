@@ -27,6 +27,9 @@
 //! # }
 //! ```
 //!
+//! A program that only serves ends with [`ModelServer::run_until_stopped`]: it prints `listening on <url>`,
+//! serves until Ctrl-C, SIGTERM or a number of seconds, and stops the server cleanly ([`running`]).
+//!
 //! The node manager behind it ([`ModelNodes`], reached through [`ModelManager`]) can also be added to a
 //! server configured by hand, with [`model_node_manager`].
 
@@ -35,6 +38,7 @@ mod check;
 mod fields;
 mod manager;
 mod namespace_objects;
+pub mod running;
 pub mod security;
 pub mod users;
 
@@ -47,6 +51,7 @@ use opcua::server::{Server, ServerBuilder, ServerEndpoint, ServerHandle, ANONYMO
 use opcua::types::{MessageSecurityMode, TypeLoader};
 
 pub use access::{AccessPolicy, Permissions, Role};
+pub use running::{stop_requested, RunningServer};
 pub use security::{PkiError, Security};
 pub use users::{Caller, ModelAuth, Users};
 

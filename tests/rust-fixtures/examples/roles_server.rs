@@ -10,7 +10,6 @@
 
 use std::io::Write;
 use std::process::ExitCode;
-use std::time::Duration;
 
 use nodeset_examples::secure::{SecureArgs, USAGE};
 use nodeset_fixture_code::roles;
@@ -43,7 +42,6 @@ async fn run() -> Result<(), String> {
     let config = secure.apply(ServerConfig::new("roles fixture"), "roles")?.port(port).table(&roles::TABLE);
     let server = config.build()?;
     let manager = server.manager().clone();
-    let handle = server.handle().clone();
     for (name, id) in [("Start", roles::ids::methods::PRESS_START), ("Reset", roles::ids::methods::PRESS_RESET)] {
         let node = manager.resolve(id).ok_or("the roles namespace is not served")?;
         manager.on_call(&node, move |call: MethodInvocation| async move {
@@ -52,25 +50,5 @@ async fn run() -> Result<(), String> {
             Ok(Vec::new())
         });
     }
-    let url = server.endpoint_url().to_owned();
-    let mut task = tokio::spawn(server.run());
-    println!("listening on {url}");
-    let _ = std::io::stdout().flush();
-    let mut terminate = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
-        .map_err(|e| format!("cannot listen for SIGTERM: {e}"))?;
-    tokio::select! {
-        _ = tokio::signal::ctrl_c() => {}
-        _ = terminate.recv() => {}
-        result = &mut task => return Err(format!("the server stopped by itself: {result:?}")),
-    }
-    handle.cancel();
-    match tokio::time::timeout(Duration::from_secs(10), task).await {
-        Ok(Ok(Ok(()))) => {
-            println!("server stopped cleanly");
-            Ok(())
-        }
-        Ok(Ok(Err(e))) => Err(format!("the server failed: {e}")),
-        Ok(Err(e)) => Err(format!("the server task failed: {e}")),
-        Err(_) => Err("the server did not stop within 10 s".to_owned()),
-    }
+    server.run_until_stopped(None, std::future::pending()).await
 }

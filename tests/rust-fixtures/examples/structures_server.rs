@@ -7,9 +7,7 @@
 //!
 //! Prints `listening on URL`, and `server stopped cleanly` after SIGTERM.
 
-use std::io::Write;
 use std::process::ExitCode;
-use std::time::Duration;
 
 use nodeset_examples::secure::{SecureArgs, USAGE};
 use nodeset_fixture_code::{parts, structure_values};
@@ -47,26 +45,5 @@ async fn run() -> Result<(), String> {
         .table(&structure_values::TABLE)
         .type_loader(structure_values::TypeLoader);
     let server = config.build()?;
-    let handle = server.handle().clone();
-    let url = server.endpoint_url().to_owned();
-    let mut task = tokio::spawn(server.run());
-    println!("listening on {url}");
-    let _ = std::io::stdout().flush();
-    let mut terminate = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())
-        .map_err(|e| format!("cannot listen for SIGTERM: {e}"))?;
-    tokio::select! {
-        _ = tokio::signal::ctrl_c() => {}
-        _ = terminate.recv() => {}
-        result = &mut task => return Err(format!("the server stopped by itself: {result:?}")),
-    }
-    handle.cancel();
-    match tokio::time::timeout(Duration::from_secs(10), task).await {
-        Ok(Ok(Ok(()))) => {
-            println!("server stopped cleanly");
-            Ok(())
-        }
-        Ok(Ok(Err(e))) => Err(format!("the server failed: {e}")),
-        Ok(Err(e)) => Err(format!("the server task failed: {e}")),
-        Err(_) => Err("the server did not stop within 10 s".to_owned()),
-    }
+    server.run_until_stopped(None, std::future::pending()).await
 }

@@ -5,9 +5,9 @@
 //! cargo run -- [--port 4840] [--pki DIR] [--trust-on-first-use] [--seconds N]
 //! ```
 //!
-//! The first line on stdout is `listening on <url>`, then `serving <NodeId> ...` once the instances are
-//! created and their variables set. `--trust-on-first-use` trusts each client certificate the first time
-//! it is presented (for tests; an operator otherwise moves it from the PKI folder's `rejected/`). It stops on SIGTERM or after `--seconds N`, and prints
+//! It prints `serving <NodeId> ...` once the instances are created and their variables set, then
+//! `listening on <url>`. `--trust-on-first-use` trusts each client certificate the first time
+//! it is presented (for tests; an operator otherwise moves it from the PKI folder's `rejected/`). It stops on Ctrl-C, SIGTERM or after `--seconds N`, and prints
 //! `server stopped cleanly`.
 #![deny(warnings)]
 
@@ -22,8 +22,6 @@ mod vendor {
 use nodeset_models::runtime::server::ServerConfig;
 use nodeset_models::runtime::typed::{Instantiate, ObjectType};
 use opcua::types::{NodeId, ObjectId};
-use std::io::Write;
-use std::time::Duration;
 use vendor::device::types::VendorMode;
 use vendor::ua_robotics::objects::{VendorArmType, VendorControllerType};
 
@@ -77,9 +75,6 @@ async fn run() -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     arm.parameter_set.payload.set(7.5).map_err(|e| e.to_string())?; // the vendor's own parameter
     arm.parameter_set.speed_override.set(0.5).map_err(|e| e.to_string())?; // inherited from Robotics
-    let url = server.endpoint_url().to_owned();
-    let task = tokio::spawn(server.run());
-    println!("listening on {url}");
     println!(
         "serving {} (VendorControllerType), CycleTime {} s; {} (VendorArmType), Payload {} kg",
         controller.node.id(),
@@ -87,20 +82,5 @@ async fn run() -> Result<(), String> {
         arm.node.id(),
         arm.parameter_set.payload.get().ok_or("Payload has no value")?
     );
-    let _ = std::io::stdout().flush();
-    let mut terminate = tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate()).map_err(|e| e.to_string())?;
-    let deadline = async {
-        match seconds {
-            Some(s) => tokio::time::sleep(Duration::from_secs(s)).await,
-            None => std::future::pending().await,
-        }
-    };
-    tokio::select! {
-        _ = terminate.recv() => {}
-        _ = tokio::signal::ctrl_c() => {}
-        _ = deadline => {}
-        ended = task => return Err(format!("the server ended: {ended:?}")),
-    }
-    println!("server stopped cleanly");
-    Ok(())
+    server.run_until_stopped(seconds, std::future::pending()).await
 }
