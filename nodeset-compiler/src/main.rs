@@ -161,6 +161,21 @@ until moved to PKI/trusted/ (or --trust-on-first-use). --insecure adds a Securit
 It prints `listening on URL` once clients may connect, and stops on Ctrl-C, SIGTERM or after --seconds.\n\n\
 Example: nodeset-compiler serve nodesets/vendor/Opc.Ua.Robotics.NodeSet2.xml --models nodesets/vendor --instantiate-all")]
     Serve(ServeArgs),
+    /// Trust certificates in a PKI folder of `serve`, of a server built on the runtime (the examples,
+    /// `ServerConfig`) or of `verify`: each is put in DIR/trusted/ under the file name async-opcua looks
+    /// for, and its copy in DIR/rejected/ (where the refusing side put it) is removed.
+    #[cfg(feature = "serve")]
+    #[command(after_help = "Check a certificate before you trust it (its thumbprint, with its owner). A copy under another \
+file name, or a certificate left in rejected/, is not trusted by async-opcua.\n\n\
+Example (a server that refused verify): nodeset-compiler trust --pki pki/robot verify-pki/own/cert.der")]
+    Trust {
+        /// The PKI folder (the server's --pki, or verify's --pki).
+        #[arg(long, value_name = "DIR")]
+        pki: PathBuf,
+        /// Certificate files, DER or PEM.
+        #[arg(required = true, value_name = "CERT")]
+        certs: Vec<PathBuf>,
+    },
 }
 
 /// The arguments of `nodeset-compiler serve`.
@@ -423,6 +438,46 @@ fn verify_command(args: &VerifyArgs) -> ExitCode {
     }
 }
 
+/// `nodeset-compiler trust`: each certificate into `pki`'s `trusted/` folder, out of its `rejected/` folder.
+#[cfg(feature = "serve")]
+fn trust_command(pki: &Path, certs: &[PathBuf]) -> Result<(), Error> {
+    use nodeset_runtime::server::security::trust_certificate;
+    use opcua::crypto::X509;
+    if !pki.join("trusted").is_dir() && !pki.join("rejected").is_dir() {
+        return Err(Error::Config(format!(
+            "{} is not a PKI folder (it has neither trusted/ nor rejected/)\n  = help: give the folder the server or verify \
+             was started with (--pki); they create it on first start",
+            pki.display()
+        )));
+    }
+    // Every file is read before any is trusted: a bad one leaves the folder as it was.
+    let mut read = Vec::new();
+    for path in certs {
+        let bytes = std::fs::read(path).map_err(|e| Error::Config(format!("{}: cannot read: {e}", path.display())))?;
+        let cert = X509::from_der(&bytes).or_else(|_| X509::from_pem(&bytes)).map_err(|_| {
+            Error::Config(format!(
+                "{}: not an X.509 certificate in DER or PEM\n  = help: give the certificate file (own/cert.der of the other \
+                 side's PKI folder, or the file its refusal left in rejected/)",
+                path.display()
+            ))
+        })?;
+        read.push((path, cert));
+    }
+    for (path, cert) in read {
+        let rejected = pki.join("rejected").join(opcua::crypto::CertificateStore::cert_file_name(&cert));
+        let was_rejected = rejected.exists();
+        let trusted = trust_certificate(pki, &cert).map_err(|e| Error::Config(e.to_string()))?;
+        println!(
+            "trusted {} ({}) as {}{}",
+            path.display(),
+            cert.subject_name(),
+            trusted.display(),
+            if was_rejected { "; removed from rejected/" } else { "" }
+        );
+    }
+    Ok(())
+}
+
 #[cfg(feature = "serve")]
 fn serve_command(args: &ServeArgs) -> Result<(), Error> {
     use nodeset_compiler::serve::{serve, ServeOptions};
@@ -455,6 +510,8 @@ fn main() -> ExitCode {
         Command::Verify(args) => return verify_command(args),
         #[cfg(feature = "serve")]
         Command::Serve(args) => serve_command(args),
+        #[cfg(feature = "serve")]
+        Command::Trust { pki, certs } => trust_command(pki, certs),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -129,3 +129,24 @@ fn check_applies_the_instance_rules_of_verify_to_static_instances() {
     assert!(output.status.success(), "{stderr}");
     assert!(stderr.contains("0 error(s), 8 warning(s)"), "{stderr}");
 }
+
+#[test]
+fn trust_refuses_a_folder_that_is_no_pki_folder_and_a_file_that_is_no_certificate() {
+    let dir = std::env::temp_dir().join(format!("nodeset-compiler-trust-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("pki/rejected")).unwrap();
+    let not_a_cert = dir.join("notes.txt");
+    std::fs::write(&not_a_cert, "not a certificate").unwrap();
+
+    let output = run(&["trust", "--pki", dir.join("nowhere").to_str().unwrap(), not_a_cert.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("is not a PKI folder") && stderr.contains("help: give the folder"), "{stderr}");
+
+    let output = run(&["trust", "--pki", dir.join("pki").to_str().unwrap(), not_a_cert.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("notes.txt: not an X.509 certificate in DER or PEM"), "{stderr}");
+    assert!(!dir.join("pki/trusted").exists(), "nothing is written for a bad file");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -378,9 +378,16 @@ fn a_server_that_does_not_trust_verify_says_so_at_once() {
     let rejected: Vec<PathBuf> = std::fs::read_dir(server_pki.join("rejected")).unwrap().map(|e| e.unwrap().path()).collect();
     assert_eq!(rejected.len(), 1, "{rejected:?}");
     assert_eq!(std::fs::read(&rejected[0]).unwrap(), std::fs::read(&own).unwrap(), "the server rejected another certificate");
-    // ... and once moved to `trusted/`, verify gets its session (a running server reads `trusted/` on each
-    // connection).
-    std::fs::rename(&rejected[0], server_pki.join("trusted").join(rejected[0].file_name().unwrap())).unwrap();
+    // ... and once trusted with the command the advice names (it moves the certificate out of `rejected/`,
+    // where async-opcua would still refuse it), verify gets its session (a running server reads `trusted/` on
+    // each connection).
+    let command = format!("nodeset-compiler trust --pki <the server's PKI folder> {}", own.display());
+    assert!(stderr.contains(&command), "{stderr}");
+    let trust = Command::new(command_binary()).args(["trust", "--pki"]).arg(&server_pki).arg(&own).output().unwrap();
+    let said = String::from_utf8_lossy(&trust.stdout);
+    assert!(trust.status.success(), "{said}{}", String::from_utf8_lossy(&trust.stderr));
+    assert!(said.contains("; removed from rejected/"), "{said}");
+    assert!(!rejected[0].exists() && server_pki.join("trusted").join(rejected[0].file_name().unwrap()).exists());
     assert_clean(&url, &["--pki", client_pki.to_str().unwrap(), "--trust-server-cert"], &[]);
     drop(server);
     let _ = std::fs::remove_dir_all(&dir);

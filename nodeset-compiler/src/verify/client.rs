@@ -195,8 +195,10 @@ fn connect_failure(connect: &Connect, status: Option<StatusCode>, server_certifi
             "cannot connect to {url}: the server rejected verify's application certificate ({s})\n  = note: verify's certificate \
              is {} (application URI urn:nodeset-compiler:verify)\n  = help: on the server, trust it: a nodeset-runtime server (the \
              examples, `ServerConfig`) has put it in the `rejected/` folder of its PKI folder (`--pki DIR`, by default `pki/<name>` \
-             in its working directory): move it from there to `trusted/` beside it, or copy the file above into that `trusted/` \
-             folder (another server: into the folder of the client certificates it trusts); then run again",
+             in its working directory): move it from there to `trusted/` beside it, keeping its file name (the server looks it up \
+             by that name), or run `nodeset-compiler trust --pki <the server's PKI folder> {}` (another server: put the \
+             file above into the folder of the client certificates it trusts); then run again",
+            connect.pki_dir.join("own").join("cert.der").display(),
             connect.pki_dir.join("own").join("cert.der").display()
         ),
         Some(s) => format!("cannot connect to {url}: the connection ended with {s}"),

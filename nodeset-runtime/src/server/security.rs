@@ -211,10 +211,25 @@ pub fn endpoint_id(policy: SecurityPolicy, mode: MessageSecurityMode) -> String 
 }
 
 /// Puts `cert` into the `trusted/` folder of the PKI folder `dir`, under the file name async-opcua looks
-/// for (`<common name> [<thumbprint>].der`); returns its path. This is what an administrator does by
-/// moving a certificate from `rejected/` to `trusted/`.
+/// for (`<common name> [<thumbprint>].der`: a copy under another name is not found), and removes the copy a
+/// server put in `rejected/` when it refused the certificate (async-opcua refuses a certificate that is in
+/// `rejected/`, even when it is also in `trusted/`); returns its path in `trusted/`. This is what an
+/// administrator does by moving a certificate from `rejected/` to `trusted/`.
 pub fn trust_certificate(dir: &Path, cert: &X509) -> Result<PathBuf, PkiError> {
-    let path = dir.join("trusted").join(CertificateStore::cert_file_name(cert));
+    let name = CertificateStore::cert_file_name(cert);
+    let rejected = dir.join("rejected").join(&name);
+    match std::fs::remove_file(&rejected) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+            return Err(PkiError {
+                path: rejected,
+                message: format!("cannot remove the rejected copy: {e}"),
+                hint: "check the PKI folder's permissions; the server refuses the certificate while it is in rejected/"
+                    .into(),
+            })
+        }
+        _ => {}
+    }
+    let path = dir.join("trusted").join(name);
     let der = cert.to_der().map_err(|e| PkiError {
         path: path.clone(),
         message: format!("cannot encode the certificate: {e}"),
@@ -266,6 +281,24 @@ mod tests {
         let e = prepare_pki(&dir, "pki test", "urn:test:other", &[]).unwrap_err();
         assert!(e.message.contains("another application URI"), "{e}");
         let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    #[test]
+    fn a_trusted_certificate_leaves_rejected_and_gets_the_name_the_server_looks_for() {
+        let (dir, client) = (temp("trust"), temp("trust-client"));
+        prepare_pki(&dir, "pki test", URI, &[]).unwrap();
+        let cert = prepare_pki(&client, "pki client", "urn:test:client", &[]).unwrap().cert;
+        let name = CertificateStore::cert_file_name(&cert);
+        // As a server leaves a certificate it refused.
+        std::fs::write(dir.join("rejected").join(&name), cert.to_der().unwrap()).unwrap();
+        let path = trust_certificate(&dir, &cert).unwrap();
+        assert_eq!(path, dir.join("trusted").join(&name));
+        assert_eq!(std::fs::read(&path).unwrap(), cert.to_der().unwrap());
+        assert!(!dir.join("rejected").join(&name).exists(), "the rejected copy is left, and async-opcua refuses it");
+        // Trusting again (nothing in rejected/) is no error.
+        assert_eq!(trust_certificate(&dir, &cert).unwrap(), path);
+        let _ = std::fs::remove_dir_all(&dir);
+        let _ = std::fs::remove_dir_all(&client);
     }
 
     #[test]
