@@ -13,8 +13,10 @@
 //! `SystemOperation/SystemOperationStateMachine/ConfiguredDefaultStopMode`: a client's write lands in that
 //! struct and is printed (`ConfiguredDefaultStopMode written by a client: <value>`). Joint positions
 //! (`Axes/<axis>/ParameterSet/ActualPosition`) move along sine curves, updated at 100 Hz through the typed
-//! handles. The arm's `Lock` object (DI LockingServicesType) has typed methods: `InitLock(Context)` locks
-//! for a client (Locked, LockingClient and LockingUser show who holds it), `ExitLock` unlocks. The
+//! handles. The arm's `Lock` object (DI LockingServicesType) is served by the runtime
+//! (`ModelManager::serve_lock`): `InitLock(Context)` locks the arm for a client application (Locked,
+//! LockingClient and LockingUser show who holds it), other applications' writes and calls below the arm get
+//! BadLocked, `ExitLock` unlocks. The
 //! controller's SystemOperationStateMachine is served as a state machine: it comes up Idle and takes
 //! IdleToReady. Each gear has a `Lifetime` variable (DI LifetimeVariableType, an AnalogUnitType): its
 //! remaining life in hours, counting down while the robot runs, from StartValue 20000 h to LimitValue 0 h.
@@ -26,7 +28,7 @@
 
 use std::io::Write;
 use std::process::ExitCode;
-use std::sync::{Arc, Mutex};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use nodeset_models::models::robotics::objects::MotionDeviceSystemType;
@@ -34,12 +36,12 @@ use nodeset_models::models::robotics::types::MotionDeviceCategoryEnumeration;
 use nodeset_models::models::{di, ia, robotics};
 use nodeset_examples::describe::{describe, units, HOUR};
 use nodeset_examples::secure::{SecureArgs, USAGE};
-use nodeset_models::runtime::server::{MethodError, ModelManager, ServerConfig};
+use nodeset_models::runtime::server::{ModelManager, ServerConfig};
 use nodeset_models::runtime::typed::{Bound, Instantiate, Machine, ObjectType, Variable, VariableType};
 use nodeset_models::ObjectModel;
 use opcua::nodes::NodeType;
 use opcua::server::address_space::AccessLevel;
-use opcua::types::{Identifier, LocalizedText, NodeId, ObjectId, QualifiedName, StatusCode, Variant};
+use opcua::types::{Identifier, LocalizedText, NodeId, ObjectId, QualifiedName, Variant};
 
 /// The arm's identification, bound to the Robotics MotionDeviceType (and the DI members it inherits).
 #[derive(Clone, Debug, ObjectModel)]
@@ -171,38 +173,9 @@ async fn run(port: u16, seconds: Option<u64>, secure: SecureArgs) -> Result<(), 
     machine.last_transition_reason.set(LAST_TRANSITION_REASON_SYSTEM).map_err(|s| s.to_string())?;
     system.transition("Ready").map_err(|s| s.to_string())?;
 
-    // The Lock methods, typed: InitLock(Context: String) -> InitLockStatus: Int32.
+    // The arm's Lock: DI's locking, as the runtime serves it for any Lock object.
     if let Some(lock) = &arm.lock {
-        let holder = Arc::new(Mutex::new(None::<String>));
-        let (h, shown) = (holder.clone(), LockShown::of(lock));
-        lock.init_lock.implement(move |ctx, (context,): (String,)| {
-            let (h, shown) = (h.clone(), shown.clone());
-            async move {
-                if context.is_empty() {
-                    return Err(MethodError::Status(StatusCode::BadInvalidArgument));
-                }
-                let mut held = h.lock().unwrap_or_else(|e| e.into_inner());
-                if held.is_some() {
-                    // DI: -1 = E_AlreadyLocked.
-                    return Ok((-1,));
-                }
-                shown.show(Some((&ctx.client, ctx.user.as_deref().unwrap_or("")))).map_err(MethodError::Status)?;
-                *held = Some(context);
-                Ok((0,))
-            }
-        });
-        let (h, shown) = (holder.clone(), LockShown::of(lock));
-        lock.exit_lock.implement(move |_ctx, ()| {
-            let (h, shown) = (h.clone(), shown.clone());
-            async move {
-                if h.lock().unwrap_or_else(|e| e.into_inner()).take().is_none() {
-                    return Ok((-1,));
-                }
-                shown.show(None).map_err(MethodError::Status)?;
-                Ok((0,))
-            }
-        });
-        LockShown::of(lock).show(None).map_err(|s| s.to_string())?;
+        manager.serve_lock(lock.node.id())?;
     }
 
     let lifetimes = gear_lifetimes(&manager, &robot)?;
@@ -277,36 +250,6 @@ fn gear_lifetimes(manager: &ModelManager, robot: &MotionDeviceSystemType) -> Res
 
 /// Robotics' LastTransitionReason 3: "System", the system took the transition by itself.
 const LAST_TRANSITION_REASON_SYSTEM: i16 = 3;
-
-/// What DI's LockingServicesType shows of a lock: Locked, LockingClient, LockingUser, RemainingLockTime.
-#[derive(Clone)]
-struct LockShown {
-    locked: Variable<bool>,
-    client: Variable<String>,
-    user: Variable<String>,
-    remaining: Variable<f64>,
-}
-
-impl LockShown {
-    fn of(lock: &di::objects::LockingServicesType) -> LockShown {
-        LockShown {
-            locked: lock.locked.clone(),
-            client: lock.locking_client.clone(),
-            user: lock.locking_user.clone(),
-            remaining: lock.remaining_lock_time.clone(),
-        }
-    }
-
-    /// Shows the lock held by `(client ApplicationUri, user)`, or no lock. This lock does not expire: DI
-    /// gives RemainingLockTime 0 for a lock without timeout, and for no lock.
-    fn show(&self, holder: Option<(&str, &str)>) -> Result<(), StatusCode> {
-        let (client, user) = holder.unwrap_or(("", ""));
-        self.client.set(client.into())?;
-        self.user.set(user.into())?;
-        self.remaining.set(0.0)?;
-        self.locked.set(holder.is_some())
-    }
-}
 
 fn main() -> ExitCode {
     let filter = std::env::var("RUST_LOG").unwrap_or_else(|_| "warn,opcua_server=error,opcua_nodes=error,opcua_crypto=off,opcua_core=error,opcua_core::comms::secure_channel=off".into());

@@ -6,7 +6,8 @@ It browses the instance down to Robot/MotionDevices/Arm/Axes/<axis>/ParameterSet
 the instance with its types' instance declarations (every Mandatory declaration of the type and its
 supertypes present, recursively, with the same NodeClass and TypeDefinition), subscribes to joint
 positions, writes a read-only and a writable variable, reads the identification set through the derive,
-and calls the typed Lock methods with correct and wrong arguments.
+and calls the Lock methods (DI locking, with a second client application) with correct and wrong
+arguments.
 
 Every check prints PASS or FAIL; the last line is ``N passed, N failed``; the exit status is 1 if any
 check failed.
@@ -214,9 +215,36 @@ async def run(url: str) -> Report:
         report.equal("Locked is True after InitLock", await locked.read_value(), True)
         result = await lock.call_method(init_lock, ua.Variant("again", ua.VariantType.String))
         report.check("InitLock while locked returns -1", result == -1, str(result))
+        remaining = await (await lock.get_child([f"{di}:RemainingLockTime"])).read_value()
+        report.check("RemainingLockTime counts down from 60 s", 0 < remaining <= 60000, str(remaining))
+        # Another application (another ApplicationUri) may read the locked arm, not change it.
+        other = Client(url=url, timeout=30)
+        other.application_uri = "urn:nodeset-compiler:interop:other"
+        async with other:
+            other_lock = other.get_node(lock.nodeid)
+            other_asset = other.get_node((await arm.get_child([f"{di}:AssetId"])).nodeid)
+            report.equal("the other application reads the locked arm", await other_asset.read_value(), "cell-1/robot")
+            try:
+                await other_asset.write_value(ua.DataValue(ua.Variant("taken", ua.VariantType.String)))
+                report.check("the other application's write below the locked arm is refused", False, "accepted")
+            except ua.UaStatusCodeError as e:
+                report.check("the other application's write below the locked arm is BadLocked", e.code == ua.StatusCodes.BadLocked, str(e))
+            try:
+                await other_lock.call_method(exit_lock.nodeid)
+                report.check("the other application's ExitLock is refused", False, "accepted")
+            except ua.UaStatusCodeError as e:
+                report.check("the other application's ExitLock is BadLocked", e.code == ua.StatusCodes.BadLocked, str(e))
+            result = await other_lock.call_method(init_lock.nodeid, ua.Variant("other", ua.VariantType.String))
+            report.check("the other application's InitLock returns -1 (E_AlreadyLocked)", result == -1, str(result))
+            result = await lock.call_method(exit_lock)
+            report.check("ExitLock returns 0", result == 0, str(result))
+            report.equal("Locked is False after ExitLock", await locked.read_value(), False)
+            result = await other_lock.call_method(init_lock.nodeid, ua.Variant("other", ua.VariantType.String))
+            report.check("once free, the other application's InitLock returns 0", result == 0, str(result))
+            result = await other_lock.call_method(exit_lock.nodeid)
+            report.check("and its ExitLock returns 0", result == 0, str(result))
         result = await lock.call_method(exit_lock)
-        report.check("ExitLock returns 0", result == 0, str(result))
-        report.equal("Locked is False after ExitLock", await locked.read_value(), False)
+        report.check("ExitLock of no lock returns -1 (E_NotLocked)", result == -1, str(result))
         for name, args, expected in [
             ("no arguments", [], ua.StatusCodes.BadArgumentsMissing),
             ("too many arguments", [ua.Variant("a", ua.VariantType.String), ua.Variant("b", ua.VariantType.String)], ua.StatusCodes.BadTooManyArguments),

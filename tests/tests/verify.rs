@@ -539,6 +539,8 @@ fn serve_follows_the_model_where_the_served_ns0_differs() {
         assert!(number(&json, "checked") > 250, "{name}: {json}");
         let said = std::fs::read_to_string(&log).unwrap();
         assert!(said.contains("instantiated "), "{name}: {said}");
+        // DI's LockingServicesType instance gets DI's locking (the runtime's, as the robot example's Lock).
+        assert_eq!(said.contains("served DI locking on 1 Lock object(s)"), name == "di", "{name}: {said}");
         drop(server);
     }
     let _ = std::fs::remove_dir_all(&dir);

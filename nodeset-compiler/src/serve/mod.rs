@@ -12,7 +12,8 @@
 //! [`ServerConfig`]: encrypted endpoints, the PKI folder layout, the user file, roles and the nodesets'
 //! RolePermissions; `--insecure` adds the None endpoint with the runtime's warning. Variables keep what
 //! clients write (the runtime's write rules); methods answer `BadNotImplemented` unless the runtime
-//! implements them (the cause methods of the state machines [`instances`] serves).
+//! implements them: the cause methods of the state machines [`instances`] serves, and DI's locking on every
+//! Lock object (LockingServicesType, `ModelManager::serve_locks`).
 
 pub mod instances;
 
@@ -140,6 +141,10 @@ pub async fn serve(model: &Model, opts: &ServeOptions) -> Result<(), String> {
             done.machines,
             done.without_initial_state
         );
+    }
+    let locks = manager.serve_locks()?;
+    if locks > 0 {
+        eprintln!("served DI locking on {locks} Lock object(s)");
     }
     running.serve_until(stop, std::future::pending()).await
 }

@@ -25,6 +25,7 @@ use tracing::{error, warn};
 
 use super::check::Types;
 use super::fields::field_children;
+use super::locks::Locks;
 use crate::import::{build_map, parse_date_time, TableImport, OPC_UA_NAMESPACE};
 use crate::table::{NamespaceMap, NodeSetTable, NsNodeId, UNMAPPED};
 
@@ -136,6 +137,8 @@ pub struct ModelNodes {
     /// which `instantiate` follows to merge members by browse path; with the links given by
     /// [`ModelManager::add_overrides`] for declarations no table carries.
     overrides: RwLock<HashMap<NodeId, NodeId>>,
+    /// DI's locks served on this server ([`super::locks`]).
+    pub(super) locks: Locks,
 }
 
 /// The node manager type as async-opcua's `ServerHandle::node_managers()` holds it.
@@ -237,6 +240,7 @@ impl ModelNodes {
             method_handlers: Default::default(),
             restrictions,
             overrides: RwLock::new(overrides),
+            locks: Locks::default(),
         }
     }
 
@@ -273,6 +277,7 @@ impl ModelNodes {
             return Err(status);
         }
         let space = types.space.ok_or(StatusCode::BadInternalError)?;
+        self.locks.check(space, types.tree, &write.node_id, None, &client_of(context))?;
         let node = space.find(&write.node_id).ok_or(StatusCode::BadNodeIdUnknown)?;
         if write.attribute_id == AttributeId::Value {
             let NodeType::Variable(var) = node else {
@@ -533,6 +538,12 @@ impl InMemoryNodeManagerImpl for ModelNodes {
                     call.set_status(status);
                     continue;
                 }
+                if let Err(status) =
+                    self.locks.check(&space, &*tree, call.object_id(), Some(call.object_id()), &client_of(context))
+                {
+                    call.set_status(status);
+                    continue;
+                }
                 match self.validate_call(&types, call) {
                     Err(MethodError::Status(status)) => call.set_status(status),
                     Err(MethodError::Arguments(results)) => call.set_argument_error(results),
@@ -560,7 +571,7 @@ impl InMemoryNodeManagerImpl for ModelNodes {
                 arguments: call.arguments().to_vec(),
                 manager: manager.clone(),
                 user: Some(context.user_token().0.clone()).filter(|u| u != opcua::server::ANONYMOUS_USER_TOKEN_ID),
-                client: context.session().read().application_description().application_uri.as_ref().to_owned(),
+                client: client_of(context),
             };
             match handler.call(invocation).await {
                 Ok(outputs) => {
@@ -577,6 +588,11 @@ impl InMemoryNodeManagerImpl for ModelNodes {
         }
         Ok(())
     }
+}
+
+/// The ApplicationUri the client of `context` gave when it created its session (empty if it gave none).
+fn client_of(context: &RequestContext) -> String {
+    context.session().read().application_description().application_uri.as_ref().to_owned()
 }
 
 /// The handle user code holds to the generated namespaces of a running server: resolve NodeIds, register
@@ -601,7 +617,7 @@ impl ModelManager {
         &self.node_manager
     }
 
-    fn nodes(&self) -> &ModelNodes {
+    pub(super) fn nodes(&self) -> &ModelNodes {
         self.node_manager.inner()
     }
 

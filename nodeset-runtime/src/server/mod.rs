@@ -36,6 +36,7 @@
 pub mod access;
 mod check;
 mod fields;
+pub mod locks;
 mod manager;
 mod namespace_objects;
 pub mod running;
