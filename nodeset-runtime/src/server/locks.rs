@@ -214,6 +214,8 @@ impl ModelManager {
     /// with `BadLocked` (see [`super::locks`]). Members the object lacks are left out. Must run inside a
     /// tokio runtime (the lock's expiry is a task).
     pub fn serve_lock(&self, lock: &NodeId) -> Result<(), String> {
+        let runtime = tokio::runtime::Handle::try_current()
+            .map_err(|_| format!("serve_lock({lock}) must be called inside a tokio runtime (the lock's expiry is a task)"))?;
         let (owner, members) = {
             let space = self.node_manager().address_space().read();
             let tree = self.type_tree().read();
@@ -280,7 +282,7 @@ impl ModelManager {
                 async move { Ok(vec![Variant::Int32(status)]) }
             });
         }
-        tokio::spawn(shown.expire());
+        runtime.spawn(shown.expire());
         Ok(())
     }
 
