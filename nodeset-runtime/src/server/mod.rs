@@ -36,7 +36,8 @@
 pub mod access;
 mod check;
 mod fields;
-pub mod locks;
+pub mod locking;
+mod locks;
 mod manager;
 mod namespace_objects;
 pub mod running;
