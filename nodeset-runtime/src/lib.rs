@@ -16,7 +16,7 @@
 //! |---|---|
 //! | [`table`] | the static tables generated code fills, their NodeIds ([`Id`], [`NsNodeId`]) and the [`NamespaceMap`] of a table's namespaces to a server's |
 //! | [`import`] | a table imported into an async-opcua address space |
-//! | [`server`] | the node manager of the tables and its handle [`server::ModelManager`], method and write handlers, [`server::ServerConfig`], users, roles and the PKI folder |
+//! | [`server`] | the node manager of the tables and its handle [`server::ModelManager`], method and write handlers, [`server::ServerConfig`], users, roles and the PKI folder, how a server runs and stops ([`server::running`]), DI's locking ([`server::locking`]) |
 //! | [`typed`] | typed handles bound to a server's nodes, instantiation, programs and skills; it adds `bind` and `instantiate` to `ModelManager` (an `impl` block in the layer that owns the types) |
 //! | [`remote`] | sessions to other servers ([`remote::ClientConfig`], [`remote::RemoteServer`]) and browse paths resolved on them |
 //! | [`client`] | typed clients of instances on those servers, their programs, and the steps of composite skills |
