@@ -215,6 +215,9 @@ async def run(url: str) -> Report:
         report.equal("Locked is True after InitLock", await locked.read_value(), True)
         result = await lock.call_method(init_lock, ua.Variant("again", ua.VariantType.String))
         report.check("InitLock while locked returns -1", result == -1, str(result))
+        capabilities = client.get_node(ua.NodeId(2268, 0))
+        max_inactive = await (await capabilities.get_child([f"{di}:MaxInactiveLockTime"])).read_value()
+        report.equal("ServerCapabilities' MaxInactiveLockTime is the server's 60 s", max_inactive, 60000.0)
         remaining = await (await lock.get_child([f"{di}:RemainingLockTime"])).read_value()
         report.check("RemainingLockTime counts down from 60 s", 0 < remaining <= 60000, str(remaining))
         # Another application (another ApplicationUri) may read the locked arm, not change it.

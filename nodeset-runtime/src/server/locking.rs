@@ -15,7 +15,8 @@
 //!   with `BadLocked`; reads, browsing and subscriptions stay open (DI's default, non-exclusive lock);
 //! - `Locked`, `LockingClient` (the holder's ApplicationUri), `LockingUser` and `RemainingLockTime` show it;
 //! - the lock ends after [`MAX_INACTIVE_LOCK_TIME`] without a request of the holder on the element
-//!   (RenewLock, or a write or call below the owner, renews it).
+//!   (RenewLock, or a write or call below the owner, renews it); DI's MaxInactiveLockTime property of
+//!   ServerCapabilities shows that time.
 //!
 //! The application is the ApplicationUri a client gave when it created its session.
 
@@ -32,6 +33,8 @@ use super::manager::{MethodError, MethodInvocation, ModelManager};
 const DI: &str = "http://opcfoundation.org/UA/DI/";
 /// DI's LockingServicesType (`ns=DI;i=6388`).
 const LOCKING_SERVICES_TYPE: u32 = 6388;
+/// DI's MaxInactiveLockTime property of ServerCapabilities (`ns=DI;i=6387`).
+const MAX_INACTIVE_LOCK_TIME_PROPERTY: u32 = 6387;
 /// ns0's HasAddIn.
 const HAS_ADD_IN: u32 = 17604;
 
@@ -191,6 +194,11 @@ impl ModelManager {
             (owner, members)
         };
         self.nodes().locks.owners.write().insert(lock.clone(), owner.clone());
+        // DI 7.4: the server's MaxInactiveLockTime (ms) on ServerCapabilities, where DI's nodeset gives it.
+        if let Some(property) = self.resolve(crate::table::NsNodeId::numeric(DI, MAX_INACTIVE_LOCK_TIME_PROPERTY)) {
+            self.set_value(&property, MAX_INACTIVE_LOCK_TIME.as_secs_f64() * 1000.0)
+                .map_err(|s| format!("cannot set DI's MaxInactiveLockTime: {s}"))?;
+        }
         let shown = Shown {
             manager: self.clone(),
             owner,
