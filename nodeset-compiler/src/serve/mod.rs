@@ -173,7 +173,7 @@ pub async fn serve(model: &Model, opts: &ServeOptions) -> Result<(), String> {
 /// Waits (at most 30 s) until the running server's type tree holds ns0's reference types. async-opcua loads
 /// them under one write lock when the server starts, so once HasComponent is known to be hierarchical, all
 /// of ns0 is there.
-async fn wait_for_ns0_types(handle: &opcua::server::ServerHandle) -> Result<(), String> {
+pub async fn wait_for_ns0_types(handle: &opcua::server::ServerHandle) -> Result<(), String> {
     use opcua::nodes::TypeTree;
     use opcua::types::ReferenceTypeId;
     let (component, hierarchical) = (ReferenceTypeId::HasComponent.into(), ReferenceTypeId::HierarchicalReferences.into());
