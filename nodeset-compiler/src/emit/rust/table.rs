@@ -194,7 +194,10 @@ impl Gen<'_> {
         let mut used: BTreeSet<u16> = BTreeSet::new();
         used.insert(self.ns);
         let mine: Vec<NodeIx> =
-            (0..model.nodes.len() as u32).map(NodeIx).filter(|&ix| model.node(ix).id.ns == self.ns).collect();
+            (0..model.nodes.len() as u32)
+                .map(NodeIx)
+                .filter(|&ix| model.node(ix).id.ns == self.ns && self.only.is_none_or(|only| only.contains(&ix)))
+                .collect();
         for &ix in &mine {
             let n = model.node(ix);
             used.insert(n.browse_name.ns);
