@@ -34,7 +34,7 @@ mod recursion;
 mod table;
 
 pub use objects::marker_name;
-pub use table::NodeTable;
+pub use table::{layout_value, Item as ValueItem, NodeTable};
 
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::model::{ids, DataTypeKind, Model, NodeIx, StructureKind};
