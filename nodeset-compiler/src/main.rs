@@ -431,7 +431,7 @@ fn verify_command(args: &VerifyArgs) -> ExitCode {
     } else {
         eprint!("{}", report::render_text(&done.report, sources, &connect.url, done.millis));
     }
-    if done.report.violations() > 0 {
+    if done.report.violations() > 0 || !done.report.structure_mismatches.is_empty() {
         ExitCode::FAILURE
     } else {
         ExitCode::SUCCESS

@@ -45,6 +45,8 @@ const HAS_ENCODING: u32 = 38;
 pub struct TableImport {
     table: &'static NodeSetTable,
     loaders: TypeLoaderCollection,
+    /// Whether a table of namespace 0 is imported (see [`TableImport::ns0_supplement`]).
+    ns0: bool,
 }
 
 impl std::fmt::Debug for TableImport {
@@ -57,13 +59,20 @@ impl TableImport {
     /// The import of a table whose structure values are decoded with async-opcua's own type loaders: ns0's
     /// structures arrive typed, the others as their encoded bytes (which clients read all the same).
     pub fn new(table: &'static NodeSetTable) -> TableImport {
-        TableImport { table, loaders: TypeLoaderCollection::new() }
+        TableImport { table, loaders: TypeLoaderCollection::new(), ns0: false }
     }
 
     /// The import of a table whose structure values are decoded with `loaders` (a server's: ns0's, the
     /// generated namespaces' `TypeLoader`s and async-opcua's fallback).
     pub fn with_type_loaders(table: &'static NodeSetTable, loaders: TypeLoaderCollection) -> TableImport {
-        TableImport { table, loaders }
+        TableImport { table, loaders, ns0: false }
+    }
+
+    /// The import of a table of namespace 0 (`own` 0) holding nodes the server's ns0 lacks, into the address
+    /// space of async-opcua's core node manager ([`crate::server::ModelManager::add_ns0_nodes`]); any other
+    /// import of such a table yields nothing.
+    pub fn ns0_supplement(table: &'static NodeSetTable) -> TableImport {
+        TableImport { table, loaders: TypeLoaderCollection::new(), ns0: true }
     }
 
     /// The table imported.
@@ -102,6 +111,9 @@ impl NodeSetImport for TableImport {
     }
 
     fn get_own_namespaces(&self) -> Vec<String> {
+        if self.table.own == 0 && self.ns0 {
+            return vec![OPC_UA_NAMESPACE.to_owned()];
+        }
         if self.table.own == 0 {
             // Importing into ns0 would clash with the core node manager; `load` yields nothing then.
             warn!("table {}: own namespace index is 0; nothing is imported", self.table.namespace_uri);
@@ -113,7 +125,7 @@ impl NodeSetImport for TableImport {
     fn load<'a>(&'a self, namespaces: &'a NodeSetNamespaceMapper) -> Box<dyn Iterator<Item = ImportedItem> + 'a> {
         let table = self.table;
         let map = namespace_map(table, namespaces);
-        if table.own == 0 {
+        if table.own == 0 && !self.ns0 {
             return Box::new(std::iter::empty());
         }
         let rows = match table.rows() {

@@ -131,6 +131,9 @@ async fn instantiate_creates_exactly_the_model_hierarchy() {
     let manager = server.manager().clone();
     let handle = server.handle().clone();
     let task = tokio::spawn(server.run());
+    // async-opcua fills ns0 once the server runs: ns0's types (a Robotics alarm's ConditionType members)
+    // are there only then (without the wait, about one run in ten found none of them).
+    serve::wait_for_ns0_types(&handle).await.expect("ns0 loads");
     let objects = NodeId::from(opcua::types::ObjectId::ObjectsFolder);
     let mut checked = 0;
     let served: Vec<(String, u16)> = m
@@ -151,8 +154,8 @@ async fn instantiate_creates_exactly_the_model_hierarchy() {
         .collect();
     for (uri, t) in types {
         let name = &m.node(t).browse_name.name;
-        let (want, placeholders) = mandatory_paths(m, t, &|_| "P1".to_owned()).expect("no type of the fixture contains itself");
-        let options = placeholders.iter().fold(Instantiate::new(), |o, p| o.placeholder(p.clone(), ["P1"]));
+        let (want, placeholders) = mandatory_paths(m, t).expect("no type of the fixture contains itself");
+        let options = placeholders.iter().fold(Instantiate::new(), |o, (p, element)| o.placeholder(p.clone(), [element.clone()]));
         let type_id = NodeId::new(manager.namespace_index(&uri).expect("namespace served"), node_number(m, t));
         let id = manager
             .instantiate(&type_id, &objects, QualifiedName::new(0, format!("I{checked}")), &options)
@@ -181,6 +184,72 @@ async fn instantiate_creates_exactly_the_model_hierarchy() {
         Some(InstantiateError::MissingPlaceholder("ParameterSet/<ParameterIdentifier>".into()).to_string()),
         "an empty ParameterSet is refused"
     );
+    handle.cancel();
+    let _ = tokio::time::timeout(std::time::Duration::from_secs(10), task).await;
+}
+
+/// Two shapes of the UA-Nodeset tree that once gave two members of an instance one NodeId
+/// (`tests/fixtures/member_ids`): ns0's `EURange` beside a companion spec's (Mining's ShearerLoaderType), and a
+/// MandatoryPlaceholder `PwmSwitchingFrequency` beside `<PwmSwitchingFrequency>` (Powertrain's drive types).
+/// `serve --instantiate-all` creates both types; the members of two namespaces are told apart by namespace in
+/// their NodeIds, the two placeholders' elements by number, and a name no other member has keeps its plain
+/// NodeId.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn members_that_share_a_name_get_nodeids_of_their_own() {
+    let dir = root().join("tests/fixtures/member_ids");
+    let out = compile(vec![Input::Path(dir.join("Example.MemberIds.NodeSet2.xml"))], &Options { model_dirs: vec![vendor()], ..Options::default() });
+    assert!(out.ok(), "{}", out.render_diagnostics());
+    let m = &out.model;
+    let (tables, diags) = serve::tables(m);
+    assert!(diags.items.is_empty(), "the tables build without diagnostics");
+    let mut config = ServerConfig::new("member-ids").port(0).insecure_only();
+    for t in tables {
+        config = config.table(t);
+    }
+    let server = config.build().expect("the server builds");
+    let manager = server.manager().clone();
+    let handle = server.handle().clone();
+    let task = tokio::spawn(server.run());
+    serve::wait_for_ns0_types(&handle).await.expect("ns0 loads");
+    let done = serve::instances::instantiate_all(&manager, m);
+    assert_eq!(done.failures, Vec::<(String, String)>::new());
+    assert_eq!((done.instantiated, done.types), (3, 3));
+    let ns = manager.namespace_index("http://example.com/fixtures/member_ids/").expect("served");
+    let inst = manager.instance_namespace();
+    let space = manager.node_manager().address_space().read();
+    let name_of = |id: &str| space.find(&NodeId::new(inst, id.to_owned())).map(|n| n.as_node().browse_name().clone());
+    let roof = format!("Instances/{ns}:ShearerType/RoofOffset");
+    assert_eq!(name_of(&roof), Some(QualifiedName::new(ns, "RoofOffset")), "a name no sibling shares keeps its plain NodeId");
+    assert_eq!(name_of(&format!("{roof}/0:EURange")), Some(QualifiedName::new(0, "EURange")));
+    assert_eq!(name_of(&format!("{roof}/{ns}:EURange")), Some(QualifiedName::new(ns, "EURange")));
+    assert_eq!(name_of(&format!("{roof}/EURange")), None, "neither EURange takes the plain NodeId");
+    let attributes = format!("Instances/{ns}:DriveType/ConverterAttributes1");
+    for element in ["PwmSwitchingFrequency1", "PwmSwitchingFrequency2"] {
+        assert_eq!(name_of(&format!("{attributes}/{element}")), Some(QualifiedName::new(ns, element)));
+    }
+    drop(space);
+    // What the model names for the placeholders: one element each, numbered in the order of their BrowseNames.
+    let drive = ty(m, "http://example.com/fixtures/member_ids/", "DriveType");
+    let (_, placeholders) = mandatory_paths(m, drive).expect("no type of the fixture contains itself");
+    assert_eq!(
+        placeholders,
+        [
+            ("<ConverterAttributes>".to_owned(), "ConverterAttributes1".to_owned()),
+            ("ConverterAttributes1/<PwmSwitchingFrequency>".to_owned(), "PwmSwitchingFrequency1".to_owned()),
+            ("ConverterAttributes1/PwmSwitchingFrequency".to_owned(), "PwmSwitchingFrequency2".to_owned()),
+        ]
+    );
+    // The runtime refuses, with the path, two elements given one name rather than creating one of them twice.
+    let refused = manager.instantiate(
+        &NodeId::new(ns, node_number(m, drive)),
+        &NodeId::from(opcua::types::ObjectId::ObjectsFolder),
+        QualifiedName::new(ns, "Drive"),
+        &Instantiate::new()
+            .placeholder("<ConverterAttributes>", ["A"])
+            .placeholder("A/<PwmSwitchingFrequency>", ["F"])
+            .placeholder("A/PwmSwitchingFrequency", ["F"]),
+    );
+    assert_eq!(refused.err(), Some(InstantiateError::DuplicateName(format!("A/{ns}:F"))));
     handle.cancel();
     let _ = tokio::time::timeout(std::time::Duration::from_secs(10), task).await;
 }

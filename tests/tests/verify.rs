@@ -9,7 +9,9 @@
 //! - NodeSet2 files served as they are by node-opcua (`tests/node-peer/serve.js`): a fixture with planted
 //!   defects and files of the UA-Nodeset tree with static instances; `verify` of that server and `check` of
 //!   the files give the same findings (codes, severities, paths);
-//! - a server that does not trust verify's certificate: verify says so at once, and what to do.
+//! - a server that does not trust verify's certificate: verify says so at once, and what to do;
+//! - `nodeset-compiler serve` of files: every type instantiated and sound, secure by default, following the
+//!   model where async-opcua's ns0 differs, every structure value of the files read back with its content.
 //!
 //! Bad input without a server (no server, a malformed URL, a file that is not a nodeset) is tested in
 //! `nodeset-compiler/tests/cli.rs`.
@@ -21,8 +23,9 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-use nodeset_compiler::diag::Severities;
 use nodeset_compiler::load::Input;
+use nodeset_compiler::verify::instances::static_findings_by_uri;
+use nodeset_compiler::verify::report::json_findings_by_uri;
 use nodeset_compiler::{compile, Options};
 use nodeset_tests::{command_binary, corpus, executable, root, vendor};
 use process_support::Process;
@@ -253,36 +256,6 @@ fn a_server_namespace_without_a_nodeset_is_reported() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// (code, severity, path) of every finding of a `--json` report, each namespace prefix of the path replaced
-/// by its URI from the report's `namespaces`, sorted: comparable across two numberings of the namespaces.
-fn findings_by_uri(json: &str) -> Vec<(String, String, String)> {
-    let at = json.find("\"namespaces\":[").unwrap_or_else(|| panic!("no namespaces in {json}")) + 14;
-    let list = &json[at..at + json[at..].find(']').unwrap()];
-    let namespaces: Vec<String> = list.split(',').map(|u| u.trim_matches('"').to_owned()).collect();
-    let mut out = Vec::new();
-    for part in json.split("{\"code\":").skip(1) {
-        let field = |key: &str| {
-            let at = part.find(&format!("\"{key}\":\"")).unwrap() + key.len() + 4;
-            part[at..at + part[at..].find('"').unwrap()].to_owned()
-        };
-        out.push((part[1..7].to_owned(), field("severity"), by_uri(&field("path"), &namespaces)));
-    }
-    out.sort();
-    out
-}
-
-/// A browse path (`2:DeviceSet/1:Robot`) with each namespace index replaced by `namespaces[index]`.
-fn by_uri(path: &str, namespaces: &[String]) -> String {
-    let segments: Vec<String> = path
-        .split('/')
-        .map(|seg| match seg.split_once(':').and_then(|(ns, name)| Some((namespaces.get(ns.parse::<usize>().ok()?)?, name))) {
-            Some((uri, name)) => format!("{uri}|{name}"),
-            None => seg.to_owned(),
-        })
-        .collect();
-    segments.join("/")
-}
-
 #[test]
 fn check_and_verify_agree_on_static_instances_served_by_node_opcua() {
     let dir = node_peer();
@@ -298,29 +271,16 @@ fn check_and_verify_agree_on_static_instances_served_by_node_opcua() {
         tree.join("LaserSystems/LaserSystem-Example.NodeSet2.xml"),
     ]
     .into();
+    // `check` of every file the server loads (the named ones and the models they require), on what a
+    // server's walk from the Objects folder reaches; the same function `cargo xtask serve-corpus` compares with.
+    let checked = static_findings_by_uri(&named, std::slice::from_ref(&tree)).unwrap_or_else(|e| panic!("{e}"));
+    // What the server loads: every file loaded, dependencies first.
     let opts = Options { model_dirs: vec![tree.clone()], ..Options::default() };
     let loaded = compile(named.iter().cloned().map(Input::Path).collect(), &opts);
     assert!(loaded.ok(), "{}", loaded.render_diagnostics());
-    // Every file loaded, dependencies first: what the server loads, and what both checks read.
-    // (The sources also hold files the loader only compared: of the tree's two ns0 files it reads the one
-    // holding every node of the other.)
     let defining: std::collections::BTreeSet<_> = loaded.model.models.iter().map(|m| m.file).collect();
     let files: Vec<PathBuf> =
         loaded.model.sources.files().filter(|(id, _)| defining.contains(id)).map(|(_, f)| f.path.clone()).collect();
-    // `check`: every file named, so that the instances of the required models are checked as well.
-    let opts = Options::default();
-    let compiled = compile(files.iter().cloned().map(Input::Path).collect(), &opts);
-    let mut report = nodeset_compiler::verify::instances::check(&compiled.model);
-    report.apply(&Severities::new(), &compiled.model.sources);
-    // A server's walk starts at the Objects folder's children outside namespace 0: the instances a file
-    // hangs below the Server object (NamespaceMetadata) are `check`'s alone.
-    report.findings.retain(|f| f.path.split('/').next().is_some_and(|top| top.contains(':')));
-    let mut checked: Vec<(String, String, String)> = report
-        .findings
-        .iter()
-        .map(|f| (f.diagnostic.code.as_str().to_owned(), f.diagnostic.severity.as_str().to_owned(), by_uri(&f.path, &report.namespaces)))
-        .collect();
-    checked.sort();
     // The defects planted in the fixture are among them.
     let fixture = "http://example.com/bad/static_instances/|Bad";
     let planted: Vec<&str> = checked.iter().filter(|f| f.2.starts_with(fixture)).map(|f| f.0.as_str()).collect();
@@ -337,7 +297,7 @@ fn check_and_verify_agree_on_static_instances_served_by_node_opcua() {
     let (output, json) = verify(&url, &args, &[]);
     let stderr = String::from_utf8_lossy(&output.stderr);
     assert!(!stderr.contains("panicked"), "{stderr}");
-    let mut verified = findings_by_uri(&json);
+    let mut verified = json_findings_by_uri(&json);
     // One defect node-opcua hides: its loader does not serve the enumeration's UInt16 as the file writes
     // it (it reads back as UncertainInitialValue), so that server cannot show it; a server that serves the
     // value as written (ours, issue 37) gives verify the same NS0406 that check gives.
@@ -507,6 +467,50 @@ fn serve_is_secure_by_default() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Every structure value of the `structure_values` fixture (ns0's EUInformation and Range, scalar and array; a
+/// structure of another namespace; nested structures in place and as ExtensionObjects; optional fields; unions;
+/// a Variant field; NodeIds and QualifiedNames of two namespaces) reads back from `serve` with the content the
+/// file gives: `verify` reads each one and compares it field by field with the file. A server of a copy whose
+/// Range differs in one field (planted) is caught at that field.
+#[test]
+fn serve_gives_back_every_structure_value_of_the_files() {
+    let dir = temp_dir("serve-structures");
+    let fixture = root().join("tests/fixtures/structure_values");
+    let file = fixture.join("Example.StructureValues.NodeSet2.xml");
+    let text = std::fs::read_to_string(&file).unwrap();
+    let planted = dir.join("Example.StructureValues.NodeSet2.xml");
+    std::fs::write(&planted, text.replacen("<High>120</High>", "<High>121</High>", 1)).unwrap();
+    assert_ne!(std::fs::read_to_string(&planted).unwrap(), text, "the defect is planted");
+    let extra = ["--models".to_owned(), fixture.display().to_string()];
+    let args: Vec<&str> = extra.iter().map(String::as_str).chain(["--insecure"]).collect();
+    let models = models();
+    for (served, want) in [(&file, None), (&planted, Some(":Span: .1: the file gives Double(120.0), the server sent Double(121.0)"))] {
+        let (server, url) = serve(std::slice::from_ref(served), &args, &dir.join("pki"), &dir.join("serve.log"));
+        // verify holds the server to the fixture itself.
+        let verify_args: Vec<&str> =
+            [file.to_str().unwrap()].into_iter().chain(models.iter().map(String::as_str)).chain(args.iter().copied()).collect();
+        let (output, json) = verify(&url, &verify_args, &[]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        // The twelve variables of the fixture's Workshop whose values are structures, each compared.
+        assert_eq!(number(&json, "structures_compared"), 12, "{json}\n{stderr}");
+        match want {
+            None => {
+                assert!(json.contains("\"structure_mismatches\":[]"), "{json}\n{stderr}");
+                assert!(output.status.success(), "{json}\n{stderr}");
+            }
+            Some(want) => {
+                let at = json.find("\"structure_mismatches\":[").unwrap() + 24;
+                let list = &json[at..at + json[at..].find(']').unwrap()];
+                assert_eq!(list.matches("\",\"").count(), 0, "one difference: {list}");
+                assert!(list.contains(want), "{list}");
+                assert_eq!(output.status.code(), Some(1), "a difference fails verify: {stderr}");
+            }
+        }
+        drop(server);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// The ns0 a server serves is async-opcua's (1.05.04); the files were resolved against another (the tree's
 /// 1.05.03, the registry package's 1.05.07). Where the two differ, `serve --instantiate-all` follows the
 /// model, the rule `verify` checks: DI's alarm types get ConditionType's `ConditionSubClassId` and
@@ -521,6 +525,9 @@ fn serve_follows_the_model_where_the_served_ns0_differs() {
     let cases = [
         ("di", tree.join("DI/Opc.Ua.Di.NodeSet2.xml"), tree.clone()),
         ("ns0", vendor().join("Opc.Ua.NodeSet2.xml"), vendor()),
+        // 1.05.03's AuditClientUpdateMethodResultEventType has MethodId and ObjectId of DataType NodeId where
+        // async-opcua's has ExpandedNodeId: the served declarations take the model's (before, two NS0404).
+        ("ns0-1.05.03", tree.join("Schema/Opc.Ua.NodeSet2.xml"), tree.clone()),
     ];
     for (name, file, models) in cases {
         let log = dir.join(format!("{name}.log"));
@@ -539,6 +546,15 @@ fn serve_follows_the_model_where_the_served_ns0_differs() {
         assert!(number(&json, "checked") > 250, "{name}: {json}");
         let said = std::fs::read_to_string(&log).unwrap();
         assert!(said.contains("instantiated "), "{name}: {said}");
+        assert!(!said.contains("is not instantiated"), "{name}: {said}");
+        if name == "ns0" {
+            // The registry package's ns0 is 1.05.07: its nodes async-opcua's 1.05.04 lacks are served from the
+            // model, so that its ObjectTypes are instantiated (before, eight were not, LogObjectType among them).
+            assert!(said.contains("note: 363 node(s) of the model's OPC UA namespace (1.05.07) that async-opcua's ns0 lacks are served from the model, 14 ObjectType(s) among them: ApplicationConfigurationFileType,"), "{said}");
+        }
+        if name == "ns0-1.05.03" {
+            assert!(said.contains("note: 2 InstanceDeclaration(s) of the OPC UA namespace served with the DataType and ValueRank of the model's (1.05.03), where async-opcua's differ: AuditClientUpdateMethodResultEventType/MethodId, AuditClientUpdateMethodResultEventType/ObjectId"), "{said}");
+        }
         // DI's LockingServicesType instance gets DI's locking (the runtime's, as the robot example's Lock).
         assert_eq!(said.contains("served DI locking on 1 Lock object(s)"), name == "di", "{name}: {said}");
         drop(server);

@@ -11,16 +11,15 @@
 //!
 //! At the end: the figures (files, files served, concrete ObjectTypes instantiated of those the files
 //! define, nodes created below `Objects/Instances`, nodes verify checked, violations below
-//! `Objects/Instances` and elsewhere, disagreements with `check`), then each file with violations below
-//! `Objects/Instances`, types not instantiated or disagreements, with the reasons. Fails when a violation
-//! below `Objects/Instances` or a disagreement with `check` remains.
+//! `Objects/Instances` and elsewhere, disagreements with `check`, structure values read back and compared
+//! with the files), then each file with violations below `Objects/Instances`, types not instantiated,
+//! disagreements or structure values that differ, with the reasons. Fails when a violation below
+//! `Objects/Instances`, a disagreement with `check` or a structure value that differs remains.
 
 use crate::util::workspace_root;
-use nodeset_compiler::diag::Severities;
-use nodeset_compiler::load::Input;
-use nodeset_compiler::{compile, Options};
+use nodeset_compiler::verify::instances::static_findings_by_uri;
+use nodeset_compiler::verify::report as verify_report;
 use process_support::Process;
-use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
@@ -62,6 +61,10 @@ struct Outcome {
     disagreements: Vec<String>,
     /// `serve`'s reasons for the types it did not instantiate.
     not_instantiated: Vec<String>,
+    /// Structure values read back and compared with the files (`verify`'s `structures_compared`).
+    structures: usize,
+    /// Those whose content differs (path and first difference).
+    structure_mismatches: Vec<String>,
 }
 
 pub fn run(args: Args) -> Result<(), String> {
@@ -101,14 +104,16 @@ pub fn run(args: Args) -> Result<(), String> {
             match &o.failed {
                 Some(why) => format!("not verified: {}", why.lines().next().unwrap_or_default()),
                 None => format!(
-                    "{}/{} types, {} instance nodes, {} checked, {} below Instances, {} elsewhere, {} disagreement(s) with check",
+                    "{}/{} types, {} instance nodes, {} checked, {} below Instances, {} elsewhere, {} disagreement(s) with check, {} structure value(s) compared, {} differ",
                     o.instantiated,
                     o.types,
                     o.instance_nodes,
                     o.checked,
                     o.below.len(),
                     o.elsewhere,
-                    o.disagreements.len()
+                    o.disagreements.len(),
+                    o.structures,
+                    o.structure_mismatches.len()
                 ),
             },
             t.elapsed().as_secs_f64()
@@ -123,6 +128,7 @@ fn report(outcomes: &[Outcome], took: Duration) -> Result<(), String> {
     let sum = |f: fn(&Outcome) -> usize| served.iter().map(|o| f(o)).sum::<usize>();
     let below = sum(|o| o.below.len());
     let disagreements = sum(|o| o.disagreements.len());
+    let mismatches = sum(|o| o.structure_mismatches.len());
     println!("\nserve-corpus: {} run(s) in {:.0} s", outcomes.len(), took.as_secs_f64());
     println!("  served and verified: {} (not verified: {})", served.len(), outcomes.len() - served.len());
     println!("  concrete ObjectTypes instantiated: {} of {}", sum(|o| o.instantiated), sum(|o| o.types));
@@ -132,10 +138,13 @@ fn report(outcomes: &[Outcome], took: Duration) -> Result<(), String> {
     println!("  violations below Objects/Instances: {below}");
     println!("  findings elsewhere (static instances of the files): {}", sum(|o| o.elsewhere));
     println!("  disagreements of verify and check on the static instances: {disagreements}");
+    println!("  structure values read back and compared with the files: {} ({mismatches} differ)", sum(|o| o.structures));
     for o in outcomes.iter().filter(|o| o.failed.is_some()) {
         println!("\nnot verified: {}\n  {}", o.name, o.failed.as_deref().unwrap_or_default().replace('\n', "\n  "));
     }
-    for o in served.iter().filter(|o| !o.below.is_empty() || !o.not_instantiated.is_empty() || !o.disagreements.is_empty()) {
+    for o in served.iter().filter(|o| {
+        !o.below.is_empty() || !o.not_instantiated.is_empty() || !o.disagreements.is_empty() || !o.structure_mismatches.is_empty()
+    }) {
         println!("\n{}:", o.name);
         for why in &o.not_instantiated {
             println!("  {why}");
@@ -146,10 +155,13 @@ fn report(outcomes: &[Outcome], took: Duration) -> Result<(), String> {
         for d in &o.disagreements {
             println!("  {d}");
         }
+        for m in &o.structure_mismatches {
+            println!("  structure value differs: {m}");
+        }
     }
-    if below > 0 || disagreements > 0 {
+    if below > 0 || disagreements > 0 || mismatches > 0 {
         return Err(format!(
-            "serve-corpus: {below} violation(s) below Objects/Instances, {disagreements} disagreement(s) of verify and check (listed above)"
+            "serve-corpus: {below} violation(s) below Objects/Instances, {disagreements} disagreement(s) of verify and check, {mismatches} structure value(s) that differ from the files (listed above)"
         ));
     }
     Ok(())
@@ -221,18 +233,20 @@ fn serve_and_verify(exe: &Path, unit: &[PathBuf], models: &Path, work: &Path, i:
     match verified {
         Ok((_, stderr)) if json.contains("\"findings\":") => {
             o.checked = number(&json, "checked").unwrap_or(0);
-            let namespaces = namespaces(&json);
+            o.structures = number(&json, "structures_compared").unwrap_or(0) as usize;
+            o.structure_mismatches = strings(&json, "structure_mismatches");
+            let namespaces = verify_report::json_namespaces(&json);
             let mut verified = Vec::new();
-            for (code, severity, path, message) in findings(&json) {
+            for (code, severity, path, message) in verify_report::json_findings(&json) {
                 if path.split('/').next().is_some_and(|top| top.ends_with(":Instances")) {
-                    o.below.push((code, path, message));
+                    o.below.push((code, path, message.replace('\n', " ")));
                 } else {
                     o.elsewhere += 1;
-                    verified.push((code, severity, by_uri(&path, &namespaces)));
+                    verified.push((code, severity, verify_report::path_by_uri(&path, &namespaces)));
                 }
             }
-            match static_findings(unit, models) {
-                Ok(checked) => o.disagreements = disagreements(&checked, verified),
+            match static_findings_by_uri(unit, &[models.to_path_buf()]) {
+                Ok(checked) => o.disagreements = verify_report::disagreements(&checked, &verified),
                 Err(e) => o.disagreements.push(format!("check could not run: {e}")),
             }
             let _ = stderr;
@@ -275,98 +289,15 @@ fn number(json: &str, key: &str) -> Option<u64> {
     json[at..].chars().take_while(char::is_ascii_digit).collect::<String>().parse().ok()
 }
 
-/// The string value of `"key":"..."` at the start of `part`'s first occurrence of the key, unescaped
-/// enough for a report line.
-fn string_field(part: &str, key: &str) -> String {
-    let Some(at) = part.find(&format!("\"{key}\":\"")) else { return String::new() };
-    let rest = &part[at + key.len() + 4..];
-    let mut out = String::new();
-    let mut chars = rest.chars();
-    while let Some(c) = chars.next() {
-        match c {
-            '"' => break,
-            '\\' => {
-                if let Some(n) = chars.next() {
-                    out.push(if n == 'n' { ' ' } else { n });
-                }
-            }
-            c => out.push(c),
-        }
+/// The strings of the array `"key":[...]` of a `verify --json` report (none of them holds `"]`).
+fn strings(json: &str, key: &str) -> Vec<String> {
+    let Some(at) = json.find(&format!("\"{key}\":[")) else { return Vec::new() };
+    let list = &json[at + key.len() + 4..];
+    if list.starts_with(']') {
+        return Vec::new();
     }
-    out
-}
-
-/// (code, severity, path, message) of every finding of a `verify --json` report.
-fn findings(json: &str) -> Vec<(String, String, String, String)> {
-    json.split("{\"code\":")
-        .skip(1)
-        .map(|part| (part[1..7].to_owned(), string_field(part, "severity"), string_field(part, "path"), string_field(part, "message")))
-        .collect()
-}
-
-/// The `"namespaces"` array of a `verify --json` report: what the prefixes of its paths number.
-fn namespaces(json: &str) -> Vec<String> {
-    let Some(at) = json.find("\"namespaces\":[") else { return Vec::new() };
-    let list = &json[at + 14..];
-    let list = &list[..list.find(']').unwrap_or(list.len())];
-    list.split(',').map(|u| u.trim().trim_matches('"').to_owned()).collect()
-}
-
-/// A browse path (`2:DeviceSet/1:Robot`) with each namespace index replaced by `namespaces[index]`, so that
-/// paths of two numberings (the server's, the model's) compare.
-fn by_uri(path: &str, namespaces: &[String]) -> String {
-    let segments: Vec<String> = path
-        .split('/')
-        .map(|seg| match seg.split_once(':').and_then(|(ns, name)| Some((namespaces.get(ns.parse::<usize>().ok()?)?, name))) {
-            Some((uri, name)) => format!("{uri}|{name}"),
-            None => seg.to_owned(),
-        })
-        .collect();
-    segments.join("/")
-}
-
-/// What `check` finds on the static instances a server of `unit` (with its required models from `models`)
-/// shows to a client: (code, severity, path by URI). Every file loaded is named, since the server serves the
-/// static instances of the required models too; findings below the Server object (a file's
-/// NamespaceMetadata, whose top has no namespace prefix) are left out, since a server's walk starts at the
-/// Objects folder's children outside namespace 0 (the test
-/// `check_and_verify_agree_on_static_instances_served_by_node_opcua` does the same on four files).
-fn static_findings(unit: &[PathBuf], models: &Path) -> Result<Vec<(String, String, String)>, String> {
-    let opts = Options { model_dirs: vec![models.to_path_buf()], ..Options::default() };
-    let loaded = compile(unit.iter().cloned().map(Input::Path).collect(), &opts);
-    if !loaded.ok() {
-        return Err(loaded.render_diagnostics().lines().next().unwrap_or_default().to_owned());
-    }
-    let defining: BTreeSet<_> = loaded.model.models.iter().map(|m| m.file).collect();
-    let files: Vec<PathBuf> = loaded.model.sources.files().filter(|(id, _)| defining.contains(id)).map(|(_, f)| f.path.clone()).collect();
-    let compiled = compile(files.into_iter().map(Input::Path).collect(), &Options::default());
-    let mut report = nodeset_compiler::verify::instances::check(&compiled.model);
-    report.apply(&Severities::new(), &compiled.model.sources);
-    Ok(report
-        .findings
-        .iter()
-        .filter(|f| f.path.split('/').next().is_some_and(|top| top.contains(':')))
-        .map(|f| (f.diagnostic.code.as_str().to_owned(), f.diagnostic.severity.as_str().to_owned(), by_uri(&f.path, &report.namespaces)))
-        .collect())
-}
-
-/// The findings only one side has, each side's list compared as a multiset.
-fn disagreements(checked: &[(String, String, String)], verified: Vec<(String, String, String)>) -> Vec<String> {
-    let mut rest = verified;
-    let mut out = Vec::new();
-    let mut checked = checked.to_vec();
-    checked.sort();
-    for c in checked {
-        match rest.iter().position(|v| *v == c) {
-            Some(i) => {
-                rest.remove(i);
-            }
-            None => out.push(format!("check only: {} {} {}", c.0, c.1, c.2)),
-        }
-    }
-    rest.sort();
-    out.extend(rest.into_iter().map(|v| format!("verify only: {} {} {}", v.0, v.1, v.2)));
-    out
+    let list = &list[..list.find("\"]").map_or(0, |e| e + 1)];
+    list.split("\",\"").map(|m| m.trim_matches('"').replace("\\\"", "\"")).filter(|m| !m.is_empty()).collect()
 }
 
 fn rel(root: &Path, f: &Path) -> String {

@@ -1,9 +1,9 @@
 //! `serve --instantiate-all`: one instance of every concrete ObjectType of the named files, below
 //! `Objects/Instances`, each named by its type's BrowseName in the type's namespace (so two namespaces'
 //! `ControllerType`s do not collide), made by the runtime's `instantiate` (the one generated servers use):
-//! mandatory members of the fully-inherited hierarchy, one element (`<Name>` gives `Name1`) in each
-//! MandatoryPlaceholder, values from the nodeset or else the DataType's default, and every state machine
-//! among them served from its initial state, by a state table built from the model.
+//! mandatory members of the fully-inherited hierarchy, one element (`<Name>` gives `Name1`, see
+//! [`element_name`]) in each MandatoryPlaceholder, values from the nodeset or else the DataType's default,
+//! and every state machine among them served from its initial state, by a state table built from the model.
 //!
 //! What to name for the placeholders, and which members are Mandatory, is read from the model
 //! ([`mandatory_paths`]), which computes the hierarchy once (`resolve/inherit.rs`); the runtime follows the
@@ -46,37 +46,47 @@ pub struct Instantiated {
     pub failures: Vec<(String, String)>,
 }
 
-/// The element a MandatoryPlaceholder gets: its name without the angle brackets, and `1`
-/// (`<AxisIdentifier>` gives `AxisIdentifier1`).
-pub fn element_name(placeholder: &str) -> String {
-    format!("{}1", placeholder.trim_start_matches('<').trim_end_matches('>'))
+/// The element a MandatoryPlaceholder gets: its name without the angle brackets and the smallest number
+/// from 1 that gives a name no other member of the same node has (`<AxisIdentifier>` gives
+/// `AxisIdentifier1`). `taken` holds the names of the other members and of the elements named before.
+pub fn element_name(placeholder: &str, taken: &BTreeSet<String>) -> String {
+    let base = placeholder.trim_start_matches('<').trim_end_matches('>');
+    (1..).map(|k| format!("{base}{k}")).find(|n| !taken.contains(n)).expect("a free number")
 }
 
 /// Every mandatory path of an instance of `t` in the model's fully-inherited hierarchy, as the runtime
-/// names the nodes it creates (`ParameterSet/SpeedOverride`; `element(<placeholder>)` for the one element
-/// of each MandatoryPlaceholder; a method with its argument properties), and the paths of the
-/// MandatoryPlaceholders (`Axes/<AxisIdentifier>`), which `Instantiate::placeholder` names. `Err` names
-/// the path where the hierarchy nests deeper than an instance can.
-pub fn mandatory_paths(m: &Model, t: NodeIx, element: &dyn Fn(&str) -> String) -> Result<(BTreeSet<String>, Vec<String>), String> {
-    fn walk(
-        m: &Model,
-        members: Vec<Member>,
-        prefix: &str,
-        depth: usize,
-        element: &dyn Fn(&str) -> String,
-        out: &mut (BTreeSet<String>, Vec<String>),
-    ) -> Result<(), String> {
+/// names the nodes it creates (`ParameterSet/SpeedOverride`; the one element of each MandatoryPlaceholder;
+/// a method with its argument properties), and each MandatoryPlaceholder's path (`Axes/<AxisIdentifier>`,
+/// as `Instantiate::placeholder` names it) with the name of its element ([`element_name`]: the placeholders
+/// of one node are named in the order of their BrowseNames, so Powertrain's `<PwmSwitchingFrequency>` gets
+/// `PwmSwitchingFrequency1` and the MandatoryPlaceholder `PwmSwitchingFrequency` beside it
+/// `PwmSwitchingFrequency2`, whatever the order of the file). `Err` names the path where the hierarchy nests
+/// deeper than an instance can.
+pub fn mandatory_paths(m: &Model, t: NodeIx) -> Result<(BTreeSet<String>, Vec<(String, String)>), String> {
+    type Out = (BTreeSet<String>, Vec<(String, String)>);
+    fn walk(m: &Model, members: Vec<Member>, prefix: &str, depth: usize, out: &mut Out) -> Result<(), String> {
         if depth >= MAX_DEPTH {
             return Err(format!("instance declarations nest deeper than {MAX_DEPTH} levels at `{prefix}` (a type that contains itself)"));
         }
-        for x in members {
+        let is_placeholder = |x: &Member| m.node(x.node).modelling_rule == Some(ModellingRule::MandatoryPlaceholder);
+        let mut taken: BTreeSet<String> = members.iter().filter(|x| !is_placeholder(x)).map(|x| x.browse_name.name.clone()).collect();
+        let mut placeholders: Vec<&Member> = members.iter().filter(|x| is_placeholder(x)).collect();
+        placeholders.sort_by(|a, b| (&a.browse_name.name, a.browse_name.ns).cmp(&(&b.browse_name.name, b.browse_name.ns)));
+        let mut elements: BTreeMap<NodeIx, String> = BTreeMap::new();
+        for x in placeholders {
+            let e = element_name(&x.browse_name.name, &taken);
+            taken.insert(e.clone());
+            elements.insert(x.node, e);
+        }
+        for x in &members {
             let n = m.node(x.node);
             let name = &x.browse_name.name;
             let path = match n.modelling_rule {
                 Some(ModellingRule::Mandatory) => format!("{prefix}{name}"),
                 Some(ModellingRule::MandatoryPlaceholder) => {
-                    out.1.push(format!("{prefix}{name}"));
-                    format!("{prefix}{}", element(name))
+                    let e = &elements[&x.node];
+                    out.1.push((format!("{prefix}{name}"), e.clone()));
+                    format!("{prefix}{e}")
                 }
                 _ => continue,
             };
@@ -86,14 +96,14 @@ pub fn mandatory_paths(m: &Model, t: NodeIx, element: &dyn Fn(&str) -> String) -
                     out.0.insert(format!("{path}/{}", m.node(c).browse_name.name));
                 }
             } else {
-                walk(m, m.instance_members(x.node), &format!("{path}/"), depth + 1, element, out)?;
+                walk(m, m.instance_members(x.node), &format!("{path}/"), depth + 1, out)?;
             }
         }
         Ok(())
     }
     let mut out = (BTreeSet::new(), Vec::new());
     let root: Vec<Member> = m.members.get(&t).into_iter().flatten().filter(|x| m.node(x.node).modelling_rule.is_some()).cloned().collect();
-    walk(m, root, "", 0, element, &mut out)?;
+    walk(m, root, "", 0, &mut out)?;
     Ok(out)
 }
 
@@ -203,15 +213,13 @@ fn ns0_overrides(manager: &ModelManager, m: &Model) -> Vec<(NodeId, NodeId)> {
 
 fn instantiate_one(manager: &ModelManager, m: &Model, t: NodeIx, name: &str, folder: &NodeId) -> Result<NodeId, String> {
     let type_id = server_id(manager, m, t).ok_or("its namespace is not served")?;
-    let (mandatory, placeholders) = mandatory_paths(m, t, &element_name)?;
+    let (mandatory, placeholders) = mandatory_paths(m, t)?;
     // Every member the model holds Mandatory is created, also where the server's own type marks it Optional:
     // ns0 is async-opcua's (1.05.04), and the files were written against another ns0 (1.05.03 in the
     // UA-Nodeset tree, where ConditionType's ConditionSubClassId is still Mandatory). The rule is the
     // model's, computed once; an Optional member created is no fault of the served type's either.
     let options = mandatory.iter().fold(Instantiate::new().data_type_defaults(), |o, p| o.ensure(p.clone()));
-    let options = placeholders
-        .iter()
-        .fold(options, |o, p| o.placeholder(p.clone(), [element_name(p.rsplit('/').next().unwrap_or(p))]));
+    let options = placeholders.iter().fold(options, |o, (p, element)| o.placeholder(p.clone(), [element.clone()]));
     let ns = type_id.namespace;
     let id = NodeId::new(manager.instance_namespace(), format!("Instances/{ns}:{name}"));
     manager

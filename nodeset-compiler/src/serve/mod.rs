@@ -20,6 +20,7 @@ pub mod instances;
 use crate::diag::Diagnostics;
 use crate::emit::rust::{default_module_name, node_tables, NodeTable, RustConfig, RustNamespace, RustPath};
 use crate::model::Model;
+use crate::raw::NodeClass;
 use nodeset_runtime::server::{stop_requested, ServerConfig, Users};
 use nodeset_runtime::table::{NodeSetTable, Nodes, Packed};
 use std::path::PathBuf;
@@ -53,20 +54,87 @@ pub const APPLICATION_NAME: &str = "nodeset-compiler serve";
 /// first, built in memory exactly as `nodeset-compiler rust` writes them, and leaked: a server holds its
 /// tables for as long as the process runs, as it holds the generated ones.
 pub fn tables(model: &Model) -> (Vec<&'static NodeSetTable>, Diagnostics) {
+    let (tables, diags) = node_tables(model, &rust_config(model));
+    (tables.into_iter().map(leak).collect(), diags)
+}
+
+fn rust_config(model: &Model) -> RustConfig {
     let namespaces: Vec<RustNamespace> = model
         .models
         .iter()
         .filter(|x| x.ns != 0)
         .map(|x| RustNamespace { uri: x.uri.clone(), module: format!("{}_{}", default_module_name(&x.uri), x.ns) })
         .collect();
-    let cfg = RustConfig {
+    RustConfig {
         namespaces,
         extern_paths: Default::default(),
         runtime_path: RustPath::new("crate::runtime").expect("a valid Rust path"),
         command: "nodeset-compiler serve".into(),
+    }
+}
+
+/// What [`add_missing_ns0`] added to the served ns0.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Ns0Added {
+    /// Nodes added.
+    pub nodes: usize,
+    /// The ObjectTypes among them, by BrowseName, sorted.
+    pub types: Vec<String>,
+    /// The version of the model's ns0 they come from.
+    pub version: String,
+    /// The InstanceDeclarations of ns0's types given the model's DataType or ValueRank (async-opcua's differ).
+    pub aligned: Vec<String>,
+}
+
+/// Adds to the running server's ns0 (async-opcua's, 1.05.04) every node of the model's ns0 that it lacks: the
+/// files were resolved against their own ns0 (the registry package's 1.05.07, whose
+/// ApplicationConfigurationFileType, LogObjectType, ... async-opcua does not have), and a server of the
+/// resolved model serves those nodes too, so that clients find them and their types can be instantiated.
+/// The nodes go through the node table the other namespaces use, made for these nodes alone
+/// ([`crate::emit::rust::ns0_table`]). Call it once ns0 is loaded ([`wait_for_ns0_types`]).
+pub fn add_missing_ns0(manager: &nodeset_runtime::server::ModelManager, model: &Model) -> Result<Ns0Added, String> {
+    let missing: std::collections::BTreeSet<_> = (0..model.nodes.len() as u32)
+        .map(crate::model::NodeIx)
+        .filter(|&ix| model.node(ix).id.ns == 0)
+        .filter(|&ix| instances::server_id(manager, model, ix).is_some_and(|id| !manager.ns0_has(&id)))
+        .collect();
+    let version = model.model_of_namespace(0).and_then(|m| m.version.clone()).unwrap_or_default();
+    let nodes = if missing.is_empty() {
+        0
+    } else {
+        let (table, diags) = crate::emit::rust::ns0_table(model, &rust_config(model), &missing);
+        if diags.has_errors() {
+            return Err(format!("the table of ns0's missing nodes cannot be built:\n{}", diags.render(&model.sources)));
+        }
+        manager.add_ns0_nodes(leak(table))?
     };
-    let (tables, diags) = node_tables(model, &cfg);
-    (tables.into_iter().map(leak).collect(), diags)
+    // The InstanceDeclarations of ns0's types (variables with a ModellingRule) get the model's DataType and
+    // ValueRank where async-opcua's differ: instances are made from the served declarations, and verify and
+    // clients hold them to the nodesets.
+    let mut aligned = Vec::new();
+    for ix in (0..model.nodes.len() as u32).map(crate::model::NodeIx) {
+        let n = model.node(ix);
+        if n.id.ns != 0 || n.class != NodeClass::Variable || n.modelling_rule.is_none() || missing.contains(&ix) {
+            continue;
+        }
+        let (Some(id), Some(dt)) = (instances::server_id(manager, model, ix), n.attrs.data_type.and_then(|dt| instances::server_id(manager, model, dt)))
+        else {
+            continue;
+        };
+        if manager.align_ns0_variable(&id, &dt, n.attrs.value_rank.unwrap_or(-1)) {
+            let parent = n.parent.map(|p| format!("{}/", model.node(p).browse_name.name)).unwrap_or_default();
+            aligned.push(format!("{parent}{}", n.browse_name.name));
+        }
+    }
+    aligned.sort();
+    let mut types: Vec<String> = missing
+        .iter()
+        .map(|&ix| model.node(ix))
+        .filter(|n| n.class == NodeClass::ObjectType)
+        .map(|n| n.browse_name.name.clone())
+        .collect();
+    types.sort();
+    Ok(Ns0Added { nodes, types, version, aligned })
 }
 
 /// A node table built in memory, made as `'static` as a generated one.
@@ -124,11 +192,31 @@ pub async fn serve(model: &Model, opts: &ServeOptions) -> Result<(), String> {
     let handle = server.handle().clone();
     let stop = stop_requested(opts.seconds);
     let running = server.start();
+    // ns0's missing nodes are added, and instances made, once async-opcua has loaded ns0 into its address
+    // space and the type tree (when the server starts running): before, a reference type of the files that
+    // derives from ns0's HasComponent is not known to be hierarchical, and which members an instance gets
+    // would depend on timing.
+    wait_for_ns0_types(&handle).await?;
+    let added = add_missing_ns0(&manager, model)?;
+    if added.nodes > 0 {
+        let types = match added.types.len() {
+            0 => String::new(),
+            n => format!(", {n} ObjectType(s) among them: {}", added.types.join(", ")),
+        };
+        eprintln!(
+            "note: {} node(s) of the model's OPC UA namespace ({}) that async-opcua's ns0 lacks are served from the model{types}",
+            added.nodes, added.version
+        );
+    }
+    if !added.aligned.is_empty() {
+        eprintln!(
+            "note: {} InstanceDeclaration(s) of the OPC UA namespace served with the DataType and ValueRank of the model's ({}), where async-opcua's differ: {}",
+            added.aligned.len(),
+            added.version,
+            added.aligned.join(", ")
+        );
+    }
     if opts.instantiate_all {
-        // Instances are made once async-opcua has loaded ns0's types into the type tree (when the server
-        // starts running): before, a reference type of the files that derives from ns0's HasComponent is
-        // not known to be hierarchical, and which members an instance gets would depend on timing.
-        wait_for_ns0_types(&handle).await?;
         let done = instances::instantiate_all(&manager, model);
         for (what, why) in &done.failures {
             eprintln!("warning: {what} is not instantiated: {why}");
@@ -152,7 +240,7 @@ pub async fn serve(model: &Model, opts: &ServeOptions) -> Result<(), String> {
 /// Waits (at most 30 s) until the running server's type tree holds ns0's reference types. async-opcua loads
 /// them under one write lock when the server starts, so once HasComponent is known to be hierarchical, all
 /// of ns0 is there.
-async fn wait_for_ns0_types(handle: &opcua::server::ServerHandle) -> Result<(), String> {
+pub async fn wait_for_ns0_types(handle: &opcua::server::ServerHandle) -> Result<(), String> {
     use opcua::nodes::TypeTree;
     use opcua::types::ReferenceTypeId;
     let (component, hierarchical) = (ReferenceTypeId::HasComponent.into(), ReferenceTypeId::HierarchicalReferences.into());

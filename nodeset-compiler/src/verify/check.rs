@@ -48,6 +48,11 @@ pub struct Report {
     pub namespaces: Vec<String>,
     /// Round trips of the snapshot.
     pub round_trips: u32,
+    /// Variables read from a server whose value in the nodesets holds structures, compared field by field
+    /// with what the server sent (`verify::structures`; a static snapshot holds no bytes to compare).
+    pub structures_compared: usize,
+    /// Each of them whose content differs: its path and the first difference.
+    pub structure_mismatches: Vec<String>,
 }
 
 impl Report {
@@ -284,8 +289,34 @@ impl<'a> Checker<'a> {
         }
         if node.class == NodeClass::Variable {
             self.check_variable(node, path, decl.or(actual_type));
+            #[cfg(feature = "verify")]
+            self.compare_structure(node, path, decl);
         }
         self.check_children(node, path, decl, actual_type);
+    }
+
+    /// The content of a structure value read from a server against the nodesets: a static instance's own
+    /// value, or, for an instance created from a declaration outside ns0 (whose value it copies), the
+    /// declaration's. ns0's declarations are left out: async-opcua serves its own ns0 values.
+    #[cfg(feature = "verify")]
+    fn compare_structure(&mut self, node: &'a RemoteNode, path: &str, decl: Option<NodeIx>) {
+        let Some(got) = &node.extension_objects else { return };
+        let model = self.model;
+        let variable = |ix: NodeIx| model.node(ix).class == NodeClass::Variable;
+        let source = match self.lookup(&node.id) {
+            Some(own) => Some(own).filter(|&ix| variable(ix)),
+            None => decl.filter(|&d| variable(d) && model.node(d).id.ns != 0),
+        };
+        let Some(ix) = source else { return };
+        let to_server = |ns: u16| self.to_model.iter().position(|m| *m == Some(ns)).and_then(|i| u16::try_from(i).ok());
+        match super::structures::compare(model, ix, got, &to_server) {
+            Ok(false) => {}
+            Ok(true) => self.report.structures_compared += 1,
+            Err(e) => {
+                self.report.structures_compared += 1;
+                self.report.structure_mismatches.push(format!("{path}: {e}"));
+            }
+        }
     }
 
     /// NodeClass and TypeDefinition against the declaration.

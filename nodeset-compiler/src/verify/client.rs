@@ -285,6 +285,7 @@ pub async fn read_all_batched(session: &Arc<Session>, max_batch: Option<usize>) 
                                     data_type: None,
                                     value_rank: None,
                                     value: None,
+                                    extension_objects: None,
                                 },
                             );
                             next.push(target.clone());
@@ -329,12 +330,41 @@ pub async fn read_all_batched(session: &Arc<Session>, max_batch: Option<usize>) 
             match (a, dv.value) {
                 (0, Some(Variant::NodeId(id))) => node.data_type = Some(from_opcua(&id)),
                 (1, Some(Variant::Int32(r))) => node.value_rank = Some(r),
-                (2, value) => node.value = Some(shape(value.as_ref())),
+                (2, value) => {
+                    node.value = Some(shape(value.as_ref()));
+                    node.extension_objects = Some(extension_objects(value.as_ref()));
+                }
                 _ => {}
             }
         }
     }
     Ok(snap)
+}
+
+/// Each ExtensionObject of a value (the value, or the items of an array), in OPC UA binary: a body the
+/// client decoded (ns0's structures) encoded again, one it did not as the bytes the server sent.
+fn extension_objects(v: Option<&Variant>) -> Vec<Vec<u8>> {
+    use opcua::types::{BinaryEncodable, ContextOwned};
+    let ctx = ContextOwned::default();
+    let encode = |eo: &opcua::types::ExtensionObject| {
+        let mut out = Vec::new();
+        // An ExtensionObject whose encoding NodeId cannot be written is kept as no bytes: the comparison then
+        // reports what it lacks.
+        let _ = eo.encode(&mut out, &ctx.context());
+        out
+    };
+    match v {
+        Some(Variant::ExtensionObject(eo)) => vec![encode(eo)],
+        Some(Variant::Array(a)) => a
+            .values
+            .iter()
+            .filter_map(|i| match i {
+                Variant::ExtensionObject(eo) => Some(encode(eo)),
+                _ => None,
+            })
+            .collect(),
+        _ => Vec::new(),
+    }
 }
 
 fn shape(v: Option<&Variant>) -> RemoteValue {
@@ -366,7 +396,7 @@ fn from_opcua(id: &opcua::types::NodeId) -> NodeId {
     NodeId { ns: id.namespace, id: ident }
 }
 
-fn to_opcua(id: &NodeId) -> opcua::types::NodeId {
+pub(super) fn to_opcua(id: &NodeId) -> opcua::types::NodeId {
     match &id.id {
         Identifier::Numeric(n) => opcua::types::NodeId::new(id.ns, *n),
         Identifier::String(s) => opcua::types::NodeId::new(id.ns, opcua::types::UAString::from(s.as_ref())),

@@ -44,6 +44,7 @@ pub fn snapshot(model: &Model) -> Snapshot {
             data_type: variable.then(|| node.attrs.data_type.map(|d| model.node(d).id.clone()).unwrap_or(base)),
             value_rank: variable.then(|| node.attrs.value_rank.unwrap_or(-1)),
             value: if variable { value_shape(model, ix) } else { None },
+            extension_objects: None,
         }
     };
     for (i, _) in instance.iter().enumerate().filter(|(_, &is)| is) {
@@ -142,4 +143,39 @@ pub fn check_compiled(compiled: &mut Compiled, opts: &Options) {
     let found = diagnostics(&compiled.model, &opts.severities, opts.all_warnings);
     compiled.diagnostics.extend(found);
     compiled.diagnostics.sort(&compiled.model.sources);
+}
+
+/// What `check` finds on the static instances that a server serving `named` (with the models they require,
+/// found in `model_dirs`) shows a client, comparable with `verify`'s findings on that server
+/// ([`super::report::json_findings_by_uri`]): (code, severity, browse path by namespace URI), sorted. Every file
+/// loaded is checked, dependencies included, since a server serves the static instances of the required
+/// models too; findings below the Server object (a file's NamespaceMetadata, whose top has no namespace
+/// prefix) are left out, since a server's walk starts at the Objects folder's children outside namespace 0.
+/// `cargo xtask serve-corpus` and the tests of `verify` compare the two with this one function.
+pub fn static_findings_by_uri(named: &[std::path::PathBuf], model_dirs: &[std::path::PathBuf]) -> Result<Vec<(String, String, String)>, String> {
+    use crate::load::Input;
+    let opts = Options { model_dirs: model_dirs.to_vec(), ..Options::default() };
+    let loaded = crate::compile(named.iter().cloned().map(Input::Path).collect(), &opts);
+    if !loaded.ok() {
+        return Err(loaded.render_diagnostics().lines().next().unwrap_or_default().to_owned());
+    }
+    // Every file loaded, dependencies first: what the server loads. (The sources also hold files the loader
+    // only compared: of two files of one model it reads the one holding every node of the other.)
+    let defining: std::collections::BTreeSet<_> = loaded.model.models.iter().map(|m| m.file).collect();
+    let files: Vec<std::path::PathBuf> =
+        loaded.model.sources.files().filter(|(id, _)| defining.contains(id)).map(|(_, f)| f.path.clone()).collect();
+    let compiled = crate::compile(files.into_iter().map(Input::Path).collect(), &Options::default());
+    let mut report = check(&compiled.model);
+    report.apply(&Severities::new(), &compiled.model.sources);
+    let mut out: Vec<(String, String, String)> = report
+        .findings
+        .iter()
+        .filter(|f| f.path.split('/').next().is_some_and(|top| top.contains(':')))
+        .map(|f| {
+            let path = super::report::path_by_uri(&f.path, &report.namespaces);
+            (f.diagnostic.code.as_str().to_owned(), f.diagnostic.severity.as_str().to_owned(), path)
+        })
+        .collect();
+    out.sort();
+    Ok(out)
 }

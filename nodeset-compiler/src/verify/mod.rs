@@ -37,6 +37,8 @@ pub mod client;
 pub mod driver;
 pub mod instances;
 pub mod report;
+#[cfg(feature = "verify")]
+pub mod structures;
 
 use crate::nodeid::{NodeId, QualifiedName};
 use crate::raw::NodeClass;
@@ -61,6 +63,10 @@ pub struct RemoteNode {
     pub value_rank: Option<i32>,
     /// Variables only: the value, if it could be read.
     pub value: Option<RemoteValue>,
+    /// Variables read from a server: each ExtensionObject of the value (the value itself, or the items of
+    /// an array) in OPC UA binary as the server sent it, for [`structures`] to compare with the nodesets;
+    /// empty if the value holds none, `None` if the node was not read from a server.
+    pub extension_objects: Option<Vec<Vec<u8>>>,
 }
 
 /// A forward reference of a [`RemoteNode`].
@@ -113,6 +119,7 @@ impl RemoteNode {
             data_type: None,
             value_rank: None,
             value: None,
+            extension_objects: None,
         }
     }
 }

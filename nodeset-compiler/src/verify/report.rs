@@ -31,6 +31,17 @@ pub fn summary(report: &Report, url: &str, millis: u128) -> String {
         report.round_trips,
         millis
     );
+    if report.structures_compared > 0 || !report.structure_mismatches.is_empty() {
+        let _ = writeln!(
+            s,
+            "{} structure value(s) read back and compared with the nodesets, {} differ",
+            report.structures_compared,
+            report.structure_mismatches.len()
+        );
+        for m in &report.structure_mismatches {
+            let _ = writeln!(s, "error: structure value differs from the nodeset: {m}");
+        }
+    }
     for ns in &report.unknown_namespaces {
         let _ = writeln!(s, "note: no loaded nodeset defines the server's namespace {ns}; its types are not checked");
     }
@@ -38,7 +49,8 @@ pub fn summary(report: &Report, url: &str, millis: u128) -> String {
 }
 
 /// The report as one JSON object: `url`, `checked`, `instances`, `violations`, `warnings`, `round_trips`,
-/// `millis`, `unknown_namespaces`, `namespaces` (the server's NamespaceArray, which numbers the prefixes of the
+/// `millis`, `structures_compared`, `structure_mismatches` (path and first difference of each structure value
+/// that reads back other than the nodesets give it), `unknown_namespaces`, `namespaces` (the server's NamespaceArray, which numbers the prefixes of the
 /// paths) and `findings` (each with `code`, `severity`, `message`, `path`, `node`
 /// and, when the declaration is known, `declaration` with `file`, `line` and `column`).
 pub fn render_json(report: &Report, sources: &SourceMap, url: &str, millis: u128) -> String {
@@ -56,6 +68,13 @@ pub fn render_json(report: &Report, sources: &SourceMap, url: &str, millis: u128
     );
     let unknown: Vec<String> = report.unknown_namespaces.iter().map(|u| json_str(u)).collect();
     let namespaces: Vec<String> = report.namespaces.iter().map(|u| json_str(u)).collect();
+    let mismatches: Vec<String> = report.structure_mismatches.iter().map(|m| json_str(m)).collect();
+    let _ = write!(
+        out,
+        "\"structures_compared\":{},\"structure_mismatches\":[{}],",
+        report.structures_compared,
+        mismatches.join(",")
+    );
     let _ = write!(out, "\"unknown_namespaces\":[{}],\"namespaces\":[{}],\"findings\":[", unknown.join(","), namespaces.join(","));
     for (i, f) in report.findings.iter().enumerate() {
         if i > 0 {
@@ -105,5 +124,87 @@ pub fn json_str(s: &str) -> String {
         }
     }
     out.push('"');
+    out
+}
+
+/// A browse path (`2:DeviceSet/1:Robot`) with each namespace index replaced by `namespaces[index]`
+/// (`http://...DI/|DeviceSet/...`), so that paths of two numberings (a server's, a model's) compare.
+pub fn path_by_uri(path: &str, namespaces: &[String]) -> String {
+    let segments: Vec<String> = path
+        .split('/')
+        .map(|seg| match seg.split_once(':').and_then(|(ns, name)| Some((namespaces.get(ns.parse::<usize>().ok()?)?, name))) {
+            Some((uri, name)) => format!("{uri}|{name}"),
+            None => seg.to_owned(),
+        })
+        .collect();
+    segments.join("/")
+}
+
+/// The `"namespaces"` array of a report [`render_json`] wrote.
+pub fn json_namespaces(json: &str) -> Vec<String> {
+    let Some(at) = json.find("\"namespaces\":[") else { return Vec::new() };
+    let list = &json[at + 14..];
+    let list = &list[..list.find(']').unwrap_or(list.len())];
+    list.split(',').map(|u| u.trim().trim_matches('"').to_owned()).filter(|u| !u.is_empty()).collect()
+}
+
+/// The string value of `"key":"..."` at its first occurrence in `part`, unescaped.
+fn json_field(part: &str, key: &str) -> String {
+    let Some(at) = part.find(&format!("\"{key}\":\"")) else { return String::new() };
+    let mut out = String::new();
+    let mut chars = part[at + key.len() + 4..].chars();
+    while let Some(c) = chars.next() {
+        match c {
+            '"' => break,
+            '\\' => match chars.next() {
+                Some('n') => out.push('\n'),
+                Some('t') => out.push('\t'),
+                Some(n) => out.push(n),
+                None => {}
+            },
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// (code, severity, path, message) of every finding of a report [`render_json`] wrote, in its order.
+pub fn json_findings(json: &str) -> Vec<(String, String, String, String)> {
+    json.split("{\"code\":")
+        .skip(1)
+        .map(|part| {
+            let code: String = part.chars().skip(1).take_while(|&c| c != '"').collect();
+            (code, json_field(part, "severity"), json_field(part, "path"), json_field(part, "message"))
+        })
+        .collect()
+}
+
+/// (code, severity, path by namespace URI) of every finding of a report [`render_json`] wrote, sorted:
+/// comparable with [`super::instances::static_findings_by_uri`] across two numberings of the namespaces.
+pub fn json_findings_by_uri(json: &str) -> Vec<(String, String, String)> {
+    let namespaces = json_namespaces(json);
+    let mut out: Vec<(String, String, String)> =
+        json_findings(json).into_iter().map(|(code, severity, path, _)| (code, severity, path_by_uri(&path, &namespaces))).collect();
+    out.sort();
+    out
+}
+
+/// The findings only one side has, each side compared as a multiset: `check only: CODE SEVERITY PATH` and
+/// `verify only: ...`, sorted.
+pub fn disagreements(checked: &[(String, String, String)], verified: &[(String, String, String)]) -> Vec<String> {
+    let mut rest = verified.to_vec();
+    let mut checked = checked.to_vec();
+    checked.sort();
+    let mut out = Vec::new();
+    for c in checked {
+        match rest.iter().position(|v| *v == c) {
+            Some(i) => {
+                rest.remove(i);
+            }
+            None => out.push(format!("check only: {} {} {}", c.0, c.1, c.2)),
+        }
+    }
+    rest.sort();
+    out.extend(rest.into_iter().map(|v| format!("verify only: {} {} {}", v.0, v.1, v.2)));
     out
 }

@@ -640,6 +640,61 @@ impl ModelManager {
         }
     }
 
+    /// Adds the nodes of `table`, a table of namespace 0 (`own` 0), to the ns0 the server serves (async-opcua's
+    /// core node manager), with their references, and its types to the type tree; a node the served ns0
+    /// has already is left as it is. For a server of nodesets resolved against a newer ns0 than async-opcua's
+    /// (its 1.05.04; the registry package's is 1.05.07): `nodeset-compiler serve` gives the nodes its model's
+    /// ns0 has and the served one lacks, so that their types can be instantiated. Returns how many nodes
+    /// were added; call it once the server runs (async-opcua fills ns0 then).
+    pub fn add_ns0_nodes(&self, table: &'static NodeSetTable) -> Result<usize, String> {
+        let core = self.core_node_manager().ok_or("the server has no node manager of namespace 0")?;
+        let import = TableImport::ns0_supplement(table);
+        // The type tree first (see `ModelManager::bind_with`).
+        let mut tree = self.type_tree().write();
+        let mut space = core.address_space().write();
+        let rows = table.rows().map_err(|e| e.to_string())?;
+        let map = build_map(table, |_, uri| tree.namespaces().get_index(uri));
+        let fresh = rows.iter().filter_map(|r| map.try_id(r.id)).filter(|id| !space.node_exists(id)).count();
+        // The types reach the tree from an address space of the new nodes alone: the core's was loaded
+        // into it when the server started.
+        let mut added = AddressSpace::new();
+        added.import_node_set(&import, tree.namespaces_mut());
+        added.load_into_type_tree(&mut tree);
+        space.import_node_set(&import, tree.namespaces_mut());
+        Ok(fresh)
+    }
+
+    /// Gives the variable `id` of the served ns0 (async-opcua's core node manager) the DataType and ValueRank
+    /// given, where they differ; returns whether it changed anything. For the InstanceDeclarations of ns0's
+    /// types, when the nodesets were resolved against another ns0 than async-opcua's (1.05.03's
+    /// AuditClientUpdateMethodResultEventType has a `MethodId` of DataType NodeId, async-opcua's
+    /// ExpandedNodeId): `nodeset-compiler serve` gives the model's, so that the type clients browse and the
+    /// instances made from it agree with the nodesets. A value that no longer fits is dropped.
+    pub fn align_ns0_variable(&self, id: &NodeId, data_type: &NodeId, value_rank: i32) -> bool {
+        let Some(core) = self.core_node_manager() else { return false };
+        let tree = self.type_tree().read();
+        let mut space = core.address_space().write();
+        let Some(NodeType::Variable(v)) = space.find_mut(id) else { return false };
+        if v.data_type() == *data_type && v.value_rank() == value_rank {
+            return false;
+        }
+        v.set_data_type(data_type.clone());
+        v.set_value_rank(value_rank);
+        let value = v.value(TimestampsToReturn::Neither, &NumericRange::None, &DataEncoding::Binary, 0.0);
+        if let Some(value) = value.value {
+            let fits = Types { tree: &tree, space: None }.check(&value, data_type, value_rank, false).is_ok();
+            if !fits {
+                v.set_value(&NumericRange::None, Variant::Empty).ok();
+            }
+        }
+        true
+    }
+
+    /// Whether the ns0 the server serves (async-opcua's core node manager) has the node `id`.
+    pub fn ns0_has(&self, id: &NodeId) -> bool {
+        self.core_node_manager().is_some_and(|core| core.address_space().read().node_exists(id))
+    }
+
     /// The server's node manager of ns0, if it has one.
     pub(crate) fn core_node_manager(&self) -> Option<Arc<CoreNodeManager>> {
         self.nodes().node_managers.get_of_type::<CoreNodeManager>()

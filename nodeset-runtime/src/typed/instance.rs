@@ -105,7 +105,8 @@ impl Instantiate {
     }
 
     /// The NodeId of the new instance (default: a string NodeId in the server's instance namespace, the
-    /// BrowseName; its members get `<parent id>/<BrowseName>`).
+    /// BrowseName; its members get `<parent id>/<BrowseName>`, or `<parent id>/<namespace index>:<BrowseName>`
+    /// where members of two namespaces share the name).
     pub fn node_id(mut self, node_id: NodeId) -> Instantiate {
         self.node_id = Some(node_id);
         self
@@ -127,6 +128,9 @@ pub enum InstantiateError {
     UnknownPath(String),
     /// A type's members nest deeper than the instantiation allows (a type that contains itself).
     TooDeep(String),
+    /// Two members of one node would have the same BrowseName (two placeholder elements given one name, or
+    /// an element named like a member): the path of the second, with its namespace index.
+    DuplicateName(String),
     /// The instance was created but a typed handle could not be bound to it.
     Bind(BindError),
 }
@@ -144,6 +148,7 @@ impl fmt::Display for InstantiateError {
                 write!(f, "`{p}` is not an Optional member or a placeholder of the type (paths are BrowseNames joined by `/`)")
             }
             InstantiateError::TooDeep(p) => write!(f, "instance declarations nest too deep at `{p}`"),
+            InstantiateError::DuplicateName(p) => write!(f, "two members would be named `{p}`: give the placeholder elements names no other member has"),
             InstantiateError::Bind(e) => write!(f, "the instance was created, but: {e}"),
         }
     }
@@ -505,8 +510,9 @@ impl<'a> Planner<'a> {
         if depth >= MAX_DEPTH {
             return Err(InstantiateError::TooDeep(path.to_owned()));
         }
-        let siblings = members.clone();
-        for decl in members {
+        // First what to create below `parent`, then the NodeIds: they depend on the siblings.
+        let mut planned: Vec<(Decl, &'a NodeType, Vec<(QualifiedName, Option<NodeId>, String)>)> = Vec::new();
+        for decl in &members {
             let name = decl.browse_name.name.as_ref().to_owned();
             let member_path = format!("{path}{name}");
             let instances: Vec<(QualifiedName, Option<NodeId>, String)> = match decl.rule {
@@ -517,9 +523,9 @@ impl<'a> Planner<'a> {
                         self.used.insert(format!("o:{member_path}"));
                     }
                     // A path names one member: ensuring it asks for nothing where a Mandatory sibling of
-                    // the same name (in another namespace) is created anyway, and their NodeIds would collide.
+                    // the same name (in another namespace) is created anyway.
                     let ensured = self.options.ensure.contains(&member_path)
-                        && !siblings.iter().any(|m| m.rule == Rule::Mandatory && m.browse_name.name == decl.browse_name.name);
+                        && !members.iter().any(|m| m.rule == Rule::Mandatory && m.browse_name.name == decl.browse_name.name);
                     if wanted || self.options.all_optional || ensured {
                         vec![(decl.browse_name.clone(), None, member_path.clone())]
                     } else {
@@ -530,7 +536,7 @@ impl<'a> Planner<'a> {
                     let names = self.options.placeholders.get(&member_path).cloned().unwrap_or_default();
                     // A Mandatory sibling that fits the placeholder fills it (DI's
                     // `ParameterSet/<ParameterIdentifier>` is filled by Robotics' `SpeedOverride`).
-                    let filled = siblings.iter().any(|m| m.rule == Rule::Mandatory && self.spaces.fills(m, &decl));
+                    let filled = members.iter().any(|m| m.rule == Rule::Mandatory && self.spaces.fills(m, decl));
                     if names.is_empty() && decl.rule == Rule::MandatoryPlaceholder && !filled {
                         return Err(InstantiateError::MissingPlaceholder(member_path));
                     }
@@ -545,9 +551,14 @@ impl<'a> Planner<'a> {
                 Rule::Other => continue,
             };
             let Some(template) = self.spaces.find(&decl.id) else { continue };
+            planned.push((decl.clone(), template, instances));
+        }
+        let ids = member_ids(parent, path, planned.iter().flat_map(|(_, _, i)| i.iter().map(|(b, _, _)| b)))?;
+        let mut ids = ids.into_iter();
+        for (decl, template, instances) in planned {
             let class = template.node_class();
             for (browse_name, type_override, instance_path) in instances {
-                let id = child_id(parent, browse_name.name.as_ref());
+                let id = ids.next().expect("one NodeId per planned member");
                 let type_id = type_override.clone().or_else(|| self.spaces.type_definition(&decl.id));
                 let members = match class {
                     NodeClass::Method => self.spaces.declared_children(&decl.id),
@@ -576,6 +587,28 @@ pub(crate) fn child_id(parent: &NodeId, name: &str) -> NodeId {
         other => other.to_string(),
     };
     NodeId::new(parent.namespace, format!("{base}/{name}"))
+}
+
+/// The NodeIds of the members `names` of `parent` (at `path`), in their order: `<parent id>/<name>`
+/// ([`child_id`]), and where members of two namespaces share a name (ShearerLoader's `RoofOffset` has ns0's
+/// `EURange` and Mining's), `<parent id>/<namespace index>:<name>` for each of them, so that neither depends on
+/// which comes first and a name no other member has keeps the plain form. Two members of one BrowseName are
+/// refused: clients could not tell them apart by browse path either.
+fn member_ids<'q>(parent: &NodeId, path: &str, names: impl Iterator<Item = &'q QualifiedName>) -> Result<Vec<NodeId>, InstantiateError> {
+    let names: Vec<&QualifiedName> = names.collect();
+    let mut namespaces: BTreeMap<&str, BTreeSet<u16>> = BTreeMap::new();
+    for n in &names {
+        if !namespaces.entry(n.name.as_ref()).or_default().insert(n.namespace_index) {
+            return Err(InstantiateError::DuplicateName(format!("{path}{}:{}", n.namespace_index, n.name.as_ref())));
+        }
+    }
+    Ok(names
+        .iter()
+        .map(|n| match namespaces[n.name.as_ref()].len() {
+            1 => child_id(parent, n.name.as_ref()),
+            _ => child_id(parent, &format!("{}:{}", n.namespace_index, n.name.as_ref())),
+        })
+        .collect())
 }
 
 /// Whether a reference type is hierarchical: one of ns0's (known without the type tree, which holds ns0's

@@ -34,7 +34,7 @@ mod recursion;
 mod table;
 
 pub use objects::marker_name;
-pub use table::NodeTable;
+pub use table::{layout_value, Item as ValueItem, NodeTable};
 
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::model::{ids, DataTypeKind, Model, NodeIx, StructureKind};
@@ -78,6 +78,15 @@ pub struct RustOutput {
     pub files: Vec<OutFile>,
     /// The errors and warnings of generation.
     pub diagnostics: Diagnostics,
+}
+
+/// A node table of the OPC UA namespace holding only `nodes` (nodes of ns0): for a server whose ns0 (async-opcua's)
+/// lacks nodes the model's ns0 has (`nodeset-compiler serve` adds them to it).
+pub fn ns0_table(model: &Model, cfg: &RustConfig, nodes: &BTreeSet<NodeIx>) -> (NodeTable, Diagnostics) {
+    let mut g = Gen::new(model, cfg, 0, "opcua");
+    g.only = Some(nodes);
+    let table = g.table_data();
+    (table, g.diags)
 }
 
 /// A default module name for a model URI: the last path segment in snake case (`.../Robotics/` -> `robotics`).
@@ -184,6 +193,8 @@ struct Gen<'m> {
     handle_names_cache: std::cell::RefCell<BTreeMap<u16, std::rc::Rc<BTreeMap<NodeIx, String>>>>,
     value_type_cache: std::cell::RefCell<std::collections::HashMap<(Option<NodeIx>, i32), syn::Type>>,
     ns0_types: BTreeSet<&'static str>,
+    /// The nodes of the namespace a node table holds, if not all of them (see [`ns0_table`]).
+    only: Option<&'m BTreeSet<NodeIx>>,
 }
 
 fn ident(s: &str) -> Ident {
@@ -279,6 +290,7 @@ impl<'m> Gen<'m> {
             handle_names_cache: Default::default(),
             value_type_cache: Default::default(),
             ns0_types: async_opcua_ns0::TYPES.iter().copied().collect(),
+            only: None,
         }
     }
 

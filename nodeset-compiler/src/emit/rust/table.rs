@@ -20,7 +20,8 @@ use crate::model::{DataTypeKind, Model, NodeIx, StructureKind};
 use crate::nodeid::Identifier;
 use crate::raw::NodeClass;
 use crate::write::OutFile;
-use values::{item_text, Item, Layout};
+use values::{item_text, Layout};
+pub use values::{layout_value, Item};
 use proc_macro2::Literal;
 use quote::quote;
 use std::collections::BTreeSet;
@@ -194,7 +195,10 @@ impl Gen<'_> {
         let mut used: BTreeSet<u16> = BTreeSet::new();
         used.insert(self.ns);
         let mine: Vec<NodeIx> =
-            (0..model.nodes.len() as u32).map(NodeIx).filter(|&ix| model.node(ix).id.ns == self.ns).collect();
+            (0..model.nodes.len() as u32)
+                .map(NodeIx)
+                .filter(|&ix| model.node(ix).id.ns == self.ns && self.only.is_none_or(|only| only.contains(&ix)))
+                .collect();
         for &ix in &mine {
             let n = model.node(ix);
             used.insert(n.browse_name.ns);

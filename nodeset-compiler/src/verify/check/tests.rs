@@ -75,7 +75,7 @@ fn object(snap: &mut Snapshot, node: NodeId, name: &str, refs: Vec<RemoteReferen
     let browse_name = QualifiedName { ns: 2, name: name.into() };
     snap.nodes.insert(
         node.clone(),
-        RemoteNode { id: node, class: NodeClass::Object, browse_name, references: refs, data_type: None, value_rank: None, value: None },
+        RemoteNode { id: node, class: NodeClass::Object, browse_name, references: refs, data_type: None, value_rank: None, value: None, extension_objects: None },
     );
 }
 
@@ -91,6 +91,7 @@ fn size(snap: &mut Snapshot, node: NodeId, value: RemoteValue) {
             data_type: Some(NodeId::numeric(0, 11)),
             value_rank: Some(-1),
             value: Some(value),
+            extension_objects: None,
         },
     );
 }
@@ -218,6 +219,7 @@ fn a_variable_takes_the_place_of_the_placeholder_of_its_data_type() {
             data_type: Some(NodeId::numeric(0, 12)),
             value_rank: Some(-1),
             value: Some(RemoteValue::Scalar(BuiltinType::String)),
+            extension_objects: None,
         },
     );
     let report = check(&model, &snap);

@@ -25,7 +25,7 @@ const MAX_DEPTH: usize = 40;
 
 /// A value as the table holds it. NodeIds are the model's (global namespace indices) until written.
 #[derive(Debug)]
-pub(super) enum Item {
+pub enum Item {
     /// A value without structures: a scalar of a built-in type or an array of them.
     Value(Variant),
     /// An array of Argument structures (InputArguments, OutputArguments).
@@ -75,6 +75,13 @@ fn variant_namespaces(v: &Variant, out: &mut BTreeSet<u16>) {
         Variant::Variant(inner) => variant_namespaces(inner, out),
         _ => {}
     }
+}
+
+/// A node's value laid out as the table holds it, structures in the order of their OPC UA binary encoding:
+/// what a server of the table sends (`verify` compares the structure values it reads with it,
+/// `verify::structures`). `Ok(None)` for a null value; the reason if the table cannot hold it.
+pub fn layout_value(model: &Model, v: Variant) -> Result<Option<Item>, String> {
+    Layout { model }.node_value(v)
 }
 
 /// Lays out values against the model's DataTypes.
