@@ -28,6 +28,7 @@
 //! [`NodeSetTable`]: https://docs.rs/nodeset-models (runtime::table::NodeSetTable)
 
 mod async_opcua_ns0;
+mod built;
 mod objects;
 mod programs;
 mod recursion;
@@ -184,6 +185,10 @@ struct Gen<'m> {
     handle_names_cache: std::cell::RefCell<BTreeMap<u16, std::rc::Rc<BTreeMap<NodeIx, String>>>>,
     value_type_cache: std::cell::RefCell<std::collections::HashMap<(Option<NodeIx>, i32), syn::Type>>,
     ns0_types: BTreeSet<&'static str>,
+    /// The `Handle::build` bodies of `objects.rs`, built directly, by placeholder index (see `built`).
+    bodies: Vec<syn::Expr>,
+    /// The field types of the handles in `objects.rs`, built directly, by placeholder index (see `built`).
+    built_types: Vec<syn::Type>,
 }
 
 fn ident(s: &str) -> Ident {
@@ -279,6 +284,8 @@ impl<'m> Gen<'m> {
             handle_names_cache: Default::default(),
             value_type_cache: Default::default(),
             ns0_types: async_opcua_ns0::TYPES.iter().copied().collect(),
+            bodies: Vec::new(),
+            built_types: Vec::new(),
         }
     }
 
@@ -298,9 +305,15 @@ impl<'m> Gen<'m> {
     }
 
     fn file(&self, name: &str, what: &str, tokens: TokenStream) -> OutFile {
-        let parsed: syn::File = syn::parse2(tokens)
-            .unwrap_or_else(|e| panic!("internal error: generated {name} for {} does not parse: {e}", self.uri()));
-        let text = prettyplease::unparse(&parsed);
+        self.print(name, what, &self.parse(name, tokens))
+    }
+
+    fn parse(&self, name: &str, tokens: TokenStream) -> syn::File {
+        syn::parse2(tokens).unwrap_or_else(|e| panic!("internal error: generated {name} for {} does not parse: {e}", self.uri()))
+    }
+
+    fn print(&self, name: &str, what: &str, parsed: &syn::File) -> OutFile {
+        let text = prettyplease::unparse(parsed);
         OutFile { path: module_dir(&self.module).join(name), contents: format!("{}{text}", self.header(what)) }
     }
 
