@@ -95,6 +95,16 @@ pub(super) fn generic(segments: &[&str], args: Vec<Type>) -> Type {
     path_type(path)
 }
 
+/// A tuple type `(A, B,)` as syn reads that text: each element with its comma (`()` when empty).
+pub(super) fn tuple(items: Vec<Type>) -> Type {
+    let mut elems = syn::punctuated::Punctuated::new();
+    for t in items {
+        elems.push_value(t);
+        elems.push_punct(Default::default());
+    }
+    Type::Tuple(syn::TypeTuple { paren_token: Default::default(), elems })
+}
+
 /// A path as a type.
 pub(super) fn path_type(path: Path) -> Type {
     Type::Path(TypePath { qself: None, path })
@@ -187,19 +197,27 @@ mod tests {
     #[test]
     fn built_types_print_as_their_text_parsed() {
         let value: Type = syn::parse_str("Vec<ua::LocalizedText>").unwrap();
-        let method: Type = syn::parse_str("t::Method<(String, String, Vec<String>), (super::types::UpdateBehavior,)>").unwrap();
+        let string = || generic(&["String"], Vec::new());
+        let method = generic(
+            &["t", "Method"],
+            vec![
+                tuple(vec![string(), string(), generic(&["Vec"], vec![string()])]),
+                tuple(vec![path_type(syn::parse_str("super::types::UpdateBehavior").unwrap())]),
+            ],
+        );
         let types = vec![
             generic(&["Option"], vec![generic(&["t", "Variable"], vec![value])]),
             generic(&["t", "ObjectNode"], Vec::new()),
             generic(&["t", "Placeholders"], vec![generic(&["Box"], vec![path_type(syn::parse_str("super::super::di::objects::TopologyElementType").unwrap())])]),
             method,
+            generic(&["t", "Method"], vec![tuple(Vec::new()), tuple(vec![generic(&["u8"], Vec::new())])]),
         ];
-        let text = "pub struct S { pub a: Option<t::Variable<Vec<ua::LocalizedText>>>, pub b: t::ObjectNode, pub c: t::Placeholders<Box<super::super::di::objects::TopologyElementType>>, pub get_update_behavior: t::Method<(String, String, Vec<String>), (super::types::UpdateBehavior,)> }";
+        let text = "pub struct S { pub a: Option<t::Variable<Vec<ua::LocalizedText>>>, pub b: t::ObjectNode, pub c: t::Placeholders<Box<super::super::di::objects::TopologyElementType>>, pub get_update_behavior: t::Method<(String, String, Vec<String>), (super::types::UpdateBehavior,)>, pub e: t::Method<(), (u8,)> }";
         let parsed: syn::File = syn::parse_str(text).unwrap();
         let placeholders: Vec<String> = (0..types.len()).map(|k| type_placeholder(k).to_string()).collect();
         let with = format!(
-            "pub struct S {{ pub a: {}, pub b: {}, pub c: {}, pub get_update_behavior: {} }}",
-            placeholders[0], placeholders[1], placeholders[2], placeholders[3]
+            "pub struct S {{ pub a: {}, pub b: {}, pub c: {}, pub get_update_behavior: {}, pub e: {} }}",
+            placeholders[0], placeholders[1], placeholders[2], placeholders[3], placeholders[4]
         );
         let mut filled: syn::File = syn::parse_str(&with).unwrap();
         fill(&mut filled, Vec::new(), types);

@@ -346,13 +346,12 @@ impl Gen<'_> {
     /// `Vec<ua::Variant>` beyond twelve arguments.
     fn method_io(&self, decl: NodeIx) -> (syn::Type, syn::Type) {
         let info = self.model.methods.get(&decl).cloned().unwrap_or_default();
+        // Built, not parsed (see `built`).
         let tuple = |args: &[crate::model::Argument]| -> syn::Type {
-            let items: Vec<syn::Type> = args.iter().map(|a| self.value_type(a.data_type, a.value_rank)).collect();
-            if items.len() > 12 {
-                syn::parse_quote! { Vec<ua::Variant> }
-            } else {
-                syn::parse_quote! { (#(#items,)*) }
+            if args.len() > 12 {
+                return built::generic(&["Vec"], vec![built::generic(&["ua", "Variant"], Vec::new())]);
             }
+            built::tuple(args.iter().map(|a| self.value_type(a.data_type, a.value_rank)).collect())
         };
         (tuple(&info.inputs), tuple(&info.outputs))
     }
