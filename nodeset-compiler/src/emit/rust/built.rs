@@ -8,14 +8,15 @@
 //! same text (the same nodes, no spans that prettyplease reads), so prettyplease prints them byte for byte
 //! as before; the handle's `impl` is still parsed, with the body's index as a placeholder
 //! ([`placeholder`]), and [`fill`] puts each body in its place. The field types (`Option<t::Variable<f64>>`,
-//! built from the syn trees the value types already are) go the same way ([`type_placeholder`]). `cargo xtask generate --check` and the
+//! built from the syn trees the value types already are) go the same way ([`type_placeholder`]), with the
+//! fields' doc attributes ([`doc_attrs`]). `cargo xtask generate --check` and the
 //! `rust_output` snapshots hold the output to what it was.
 
 use proc_macro2::{Ident, Literal, Span, TokenStream};
 use quote::quote;
 use syn::{
-    AngleBracketedGenericArguments, Expr, ExprIndex, ExprLit, ExprMethodCall, ExprPath, ExprStruct, FieldValue, GenericArgument, ImplItem,
-    Item, Lit, Member, Path, PathArguments, PathSegment, Stmt, Type, TypePath,
+    AngleBracketedGenericArguments, AttrStyle, Attribute, Expr, ExprIndex, ExprLit, ExprMethodCall, ExprPath, ExprStruct, FieldValue, GenericArgument, ImplItem,
+    Item, Lit, Member, Meta, MetaNameValue, Path, PathArguments, PathSegment, Stmt, Type, TypePath,
 };
 
 /// A one-segment path expression (`b`, `id`, `NS`).
@@ -95,6 +96,22 @@ pub(super) fn generic(segments: &[&str], args: Vec<Type>) -> Type {
     path_type(path)
 }
 
+/// The doc attributes `super::doc` writes as tokens for `text`: `#[doc = " line"]` a line.
+pub(super) fn doc_attrs(text: &str) -> Vec<Attribute> {
+    text.lines()
+        .map(|l| Attribute {
+            pound_token: Default::default(),
+            style: AttrStyle::Outer,
+            bracket_token: Default::default(),
+            meta: Meta::NameValue(MetaNameValue {
+                path: Path::from(Ident::new("doc", Span::call_site())),
+                eq_token: Default::default(),
+                value: str_lit(&format!(" {}", l.trim_end())),
+            }),
+        })
+        .collect()
+}
+
 /// A tuple type `(A, B,)` as syn reads that text: each element with its comma (`()` when empty).
 pub(super) fn tuple(items: Vec<Type>) -> Type {
     let mut elems = syn::punctuated::Punctuated::new();
@@ -113,7 +130,7 @@ pub(super) fn path_type(path: Path) -> Type {
 /// The prefix of the stand-ins for built field types: no generated type name has it (they are UpperCamel).
 const TYPE_PLACEHOLDER: &str = "NODESET_COMPILER_TYPE_";
 
-/// The stand-in for the `k`th built field type: the type `NODESET_COMPILER_TYPE_k`.
+/// The stand-in for the `k`th built field (its doc attributes and type): the type `NODESET_COMPILER_TYPE_k`.
 pub(super) fn type_placeholder(k: usize) -> TokenStream {
     let name = Ident::new(&format!("{TYPE_PLACEHOLDER}{k}"), Span::call_site());
     quote! { #name }
@@ -126,20 +143,24 @@ pub(super) fn placeholder(k: usize) -> TokenStream {
 }
 
 /// Puts each built body where its placeholder is: the body of a top-level `impl`'s `build` function that
-/// is the literal `k` becomes `bodies[k]`. Every body is used once.
+/// is the literal `k` becomes `bodies[k]`; a top-level struct's field of type `NODESET_COMPILER_TYPE_k`
+/// gets the type of `fields[k]`, and its doc attributes before any it has. Every one is used once.
 ///
 /// # Panics
 ///
 /// If a placeholder has no body or a body no placeholder: an internal error of the emitter.
-pub(super) fn fill(file: &mut syn::File, bodies: Vec<Expr>, types: Vec<Type>) {
+pub(super) fn fill(file: &mut syn::File, bodies: Vec<Expr>, fields: Vec<(Vec<Attribute>, Type)>) {
     let mut bodies: Vec<Option<Expr>> = bodies.into_iter().map(Some).collect();
-    let mut types: Vec<Option<Type>> = types.into_iter().map(Some).collect();
+    let mut types: Vec<Option<(Vec<Attribute>, Type)>> = fields.into_iter().map(Some).collect();
     for item in &mut file.items {
         if let Item::Struct(st) = item {
             for field in st.fields.iter_mut() {
                 let Type::Path(TypePath { qself: None, path }) = &field.ty else { continue };
                 let Some(k) = path.get_ident().and_then(|i| i.to_string().strip_prefix(TYPE_PLACEHOLDER)?.parse::<usize>().ok()) else { continue };
-                field.ty = types.get_mut(k).and_then(Option::take).expect("internal error: a type placeholder without its type");
+                let (mut attrs, ty) = types.get_mut(k).and_then(Option::take).expect("internal error: a type placeholder without its type");
+                attrs.append(&mut field.attrs);
+                field.attrs = attrs;
+                field.ty = ty;
             }
             continue;
         }
@@ -212,7 +233,7 @@ mod tests {
             method,
             generic(&["t", "Method"], vec![tuple(Vec::new()), tuple(vec![generic(&["u8"], Vec::new())])]),
         ];
-        let text = "pub struct S { pub a: Option<t::Variable<Vec<ua::LocalizedText>>>, pub b: t::ObjectNode, pub c: t::Placeholders<Box<super::super::di::objects::TopologyElementType>>, pub get_update_behavior: t::Method<(String, String, Vec<String>), (super::types::UpdateBehavior,)>, pub e: t::Method<(), (u8,)> }";
+        let text = "pub struct S { #[doc = \" `A` (Optional). Two\"] #[doc = \" lines, \\\"quoted\\\"\"] pub a: Option<t::Variable<Vec<ua::LocalizedText>>>, pub b: t::ObjectNode, pub c: t::Placeholders<Box<super::super::di::objects::TopologyElementType>>, pub get_update_behavior: t::Method<(String, String, Vec<String>), (super::types::UpdateBehavior,)>, pub e: t::Method<(), (u8,)> }";
         let parsed: syn::File = syn::parse_str(text).unwrap();
         let placeholders: Vec<String> = (0..types.len()).map(|k| type_placeholder(k).to_string()).collect();
         let with = format!(
@@ -220,7 +241,9 @@ mod tests {
             placeholders[0], placeholders[1], placeholders[2], placeholders[3], placeholders[4]
         );
         let mut filled: syn::File = syn::parse_str(&with).unwrap();
-        fill(&mut filled, Vec::new(), types);
+        let mut docs: Vec<Vec<Attribute>> = vec![doc_attrs("`A` (Optional). Two  \nlines, \"quoted\"")];
+        docs.resize(types.len(), Vec::new());
+        fill(&mut filled, Vec::new(), docs.into_iter().zip(types).collect());
         assert_eq!(prettyplease::unparse(&filled), prettyplease::unparse(&parsed));
     }
 }

@@ -187,8 +187,8 @@ struct Gen<'m> {
     ns0_types: BTreeSet<&'static str>,
     /// The `Handle::build` bodies of `objects.rs`, built directly, by placeholder index (see `built`).
     bodies: Vec<syn::Expr>,
-    /// The field types of the handles in `objects.rs`, built directly, by placeholder index (see `built`).
-    built_types: Vec<syn::Type>,
+    /// The field doc attributes and types of the handles in `objects.rs`, built directly, by placeholder index (see `built`).
+    built_types: Vec<(Vec<syn::Attribute>, syn::Type)>,
 }
 
 fn ident(s: &str) -> Ident {

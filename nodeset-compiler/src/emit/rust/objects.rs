@@ -505,9 +505,8 @@ impl Gen<'_> {
         for f in fields {
             let fname = ident(&f.name);
             let ty = built::type_placeholder(self.built_types.len());
-            self.built_types.push(f.ty);
-            let d = doc(&f.doc);
-            decls.push(quote! { #d pub #fname: #ty });
+            self.built_types.push((built::doc_attrs(&f.doc), f.ty));
+            decls.push(quote! { pub #fname: #ty });
             binds.push((fname, f.bind));
         }
         let body = built::placeholder(self.bodies.len());
