@@ -217,41 +217,53 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
     let mut texts: Vec<(usize, FileId)> = Vec::new();
     // Every file read, so that none is read twice (see the termination argument below).
     let mut seen = Seen::default();
-    let t_read = crate::timing::span("read named files");
-    for input in inputs {
-        let mut d = Diagnostics::new();
-        let (path, display, bytes) = match input {
-            Input::Path(p) => match std::fs::read(&p) {
-                Ok(b) => {
-                    seen.add_path(canonical(&p));
-                    (p.clone(), p.display().to_string(), b)
-                }
-                Err(e) => {
-                    d.push(
-                        Diagnostic::new(Code::Io, format!("cannot read {}: {}", p.display(), io_reason(&e)))
-                            .help("check the path; folders of required models go after --models"),
-                    );
-                    said.push(d);
-                    continue;
-                }
-            },
-            Input::Text { name, text } => (PathBuf::from(&name), name, text.into_bytes()),
-        };
-        if let Some(id) = add_source(&mut sources, path, display, bytes, true, &mut d) {
-            seen.add_source(id, &sources);
-            texts.push((said.len(), id));
+    // While the named files are read and parsed, another thread scans the model folders and reads the
+    // best file of the OPC UA base model there, which nearly every run goes on to need (every file requires
+    // it): see [`Early`]. On one core, nothing is done early.
+    let early_wanted = !opts.model_dirs.is_empty() && crate::par::cores() > 1;
+    let (early, parsed_at) = std::thread::scope(|s| {
+        let early = early_wanted.then(|| s.spawn(|| Early::gather(&opts.model_dirs)));
+        let t_read = crate::timing::span("read named files");
+        for input in inputs {
+            let mut d = Diagnostics::new();
+            let (path, display, bytes) = match input {
+                Input::Path(p) => match std::fs::read(&p) {
+                    Ok(b) => {
+                        seen.add_path(canonical(&p));
+                        (p.clone(), p.display().to_string(), b)
+                    }
+                    Err(e) => {
+                        d.push(
+                            Diagnostic::new(Code::Io, format!("cannot read {}: {}", p.display(), io_reason(&e)))
+                                .help("check the path; folders of required models go after --models"),
+                        );
+                        said.push(d);
+                        continue;
+                    }
+                },
+                Input::Text { name, text } => (PathBuf::from(&name), name, text.into_bytes()),
+            };
+            if let Some(id) = add_source(&mut sources, path, display, bytes, true, &mut d) {
+                seen.add_source(id, &sources);
+                texts.push((said.len(), id));
+            }
+            said.push(d);
         }
-        said.push(d);
-    }
-    drop(t_read);
-    let t_parse = crate::timing::span("parse named files");
-    let jobs: Vec<(FileId, &str)> = texts.iter().map(|&(_, id)| (id, sources.get(id).text.as_str())).collect();
-    let mut parsed_at: Vec<Option<RawNodeSet>> = (0..said.len()).map(|_| None).collect();
-    for (&(i, _), (set, d)) in texts.iter().zip(parse::parse_files(&jobs, &opts.limits)) {
-        said[i].extend(d);
-        parsed_at[i] = set;
-    }
-    drop(t_parse);
+        drop(t_read);
+        let t_parse = crate::timing::span("parse named files");
+        let jobs: Vec<(FileId, &str)> = texts.iter().map(|&(_, id)| (id, sources.get(id).text.as_str())).collect();
+        let mut parsed_at: Vec<Option<RawNodeSet>> = (0..said.len()).map(|_| None).collect();
+        for (&(i, _), (set, d)) in texts.iter().zip(parse::parse_files(&jobs, &opts.limits)) {
+            said[i].extend(d);
+            parsed_at[i] = set;
+        }
+        drop(t_parse);
+        (early.map(|h| h.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic))), parsed_at)
+    });
+    let (mut index, mut prefetched) = match early {
+        Some(e) => (Some(e.index), e.ns0),
+        None => (None, None),
+    };
     for d in said {
         diags.extend(d);
     }
@@ -308,7 +320,6 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
     // file under other paths all end at `seen`. (Before `seen`, a named file without <Models> whose first
     // NamespaceUri it only refers to found itself in the folder as that namespace's file, read itself again,
     // and so on without end.)
-    let mut index: Option<Vec<Candidate>> = None;
     let mut queue: Vec<usize> = (0..parsed.len()).collect();
     let mut checked: BTreeSet<(String, FileId)> = BTreeSet::new();
     while let Some(i) = queue.pop() {
@@ -359,7 +370,7 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
             same_kind.sort_by_key(|c| (c.path.parent() != requirer_dir.as_deref(), c.path.as_os_str().len(), c.path.clone()));
             let mut older: Option<(&Candidate, Vec<u8>)> = None;
             for c in same_kind {
-                if let Some(bytes) = read_new(c, &mut seen, &sources, req.span, diags) {
+                if let Some(bytes) = read_new(c, &mut seen, &sources, &mut prefetched, req.span, diags) {
                     older = Some((c, bytes));
                     break;
                 }
@@ -381,7 +392,7 @@ pub fn load(inputs: Vec<Input>, opts: &LoadOptions, diags: &mut Diagnostics) -> 
                         None => {
                             // A file read before provides its models, so the folder's best file for a model not
                             // provided is new unless it failed to parse (then nothing is read again).
-                            let Some(bytes) = read_new(c, &mut seen, &sources, req.span, diags) else { continue };
+                            let Some(bytes) = read_new(c, &mut seen, &sources, &mut prefetched, req.span, diags) else { continue };
                             let display = c.path.display().to_string();
                             read_and_parse(&mut sources, c.path.clone(), display, bytes, false, &opts.limits, diags)
                         }
@@ -587,6 +598,30 @@ fn model_info(m: &RawModel, file: FileId, ns: u16) -> ModelInfo {
     }
 }
 
+/// What the loader does early, on another thread, while the named files are read and parsed: the scan of
+/// the model folders, and the read of the file the loader would take there for the OPC UA base model.
+/// Both are what the loader would do later anyway (the folders are scanned at the first requirement the
+/// named files do not meet, and every file requires the base model); the read is used only if the loader
+/// goes on to read that very file ([`read_new`]), so nothing the loader decides depends on it.
+struct Early {
+    index: Vec<Candidate>,
+    ns0: Option<Prefetched>,
+}
+
+/// A file of the model folders read early: its canonical path and what reading it gave.
+struct Prefetched {
+    id: PathBuf,
+    bytes: std::io::Result<Vec<u8>>,
+}
+
+impl Early {
+    fn gather(dirs: &[PathBuf]) -> Early {
+        let index = folders::scan_dirs(dirs);
+        let ns0 = folders::ranked(&index, NS0_URI).first().map(|c| Prefetched { id: c.id.clone(), bytes: std::fs::read(&c.path) });
+        Early { index, ns0 }
+    }
+}
+
 fn read_and_parse(
     sources: &mut SourceMap,
     path: PathBuf,
@@ -608,13 +643,24 @@ fn read_and_parse(
 
 /// Reads a file of the model folders unless it was read before, under any path or with the same content
 /// (then `None`): what bounds the loader's work. The file counts as read from here on, whatever comes of it.
-fn read_new(c: &Candidate, seen: &mut Seen, sources: &SourceMap, at: Span, diags: &mut Diagnostics) -> Option<Vec<u8>> {
+fn read_new(
+    c: &Candidate,
+    seen: &mut Seen,
+    sources: &SourceMap,
+    prefetched: &mut Option<Prefetched>,
+    at: Span,
+    diags: &mut Diagnostics,
+) -> Option<Vec<u8>> {
     if seen.has_path(&c.id) {
         return None;
     }
     seen.add_path(c.id.clone());
     let _t = crate::timing::span("read required file");
-    match std::fs::read(&c.path) {
+    let read = match prefetched.take_if(|p| p.id == c.id) {
+        Some(p) => p.bytes,
+        None => std::fs::read(&c.path),
+    };
+    match read {
         Ok(bytes) => seen.same_as(&bytes, sources).is_none().then_some(bytes),
         Err(e) => {
             diags.push(Diagnostic::new(Code::Io, format!("cannot read {}: {}", c.path.display(), io_reason(&e))).at(at));

@@ -281,20 +281,24 @@ pub(super) fn scan_header(path: &Path) -> Option<Header> {
         }
         let at_end = n < want || n == HEADER_LIMIT;
         buf.truncate(n);
-        if at_end || header_complete(&String::from_utf8_lossy(&buf)) {
+        if at_end || header_complete(&buf) {
             break;
         }
         chunk *= 2;
     }
-    let text = String::from_utf8_lossy(&buf);
-    if !text.contains("UANodeSet") {
+    // The tests look for ASCII text only, and a lossy reading as UTF-8 keeps every ASCII byte where it is
+    // among the others: searching the bytes finds what searching that reading finds, without converting
+    // the whole prefix (once per chunk, that conversion was most of a scan). Only the `<Models>` element
+    // (or, without one, the whole prefix) is read as text, lossily as before.
+    if find(&buf, b"UANodeSet").is_none() {
         return None;
     }
-    let Some(start) = text.find("<Models>") else {
-        return Some(Header { models: Vec::new(), own_namespace: first_namespace_uri(&text) });
+    let Some(start) = find(&buf, b"<Models>") else {
+        return Some(Header { models: Vec::new(), own_namespace: first_namespace_uri(&String::from_utf8_lossy(&buf)) });
     };
-    let end = text[start..].find("</Models>")? + start + "</Models>".len();
-    let mut reader = quick_xml::Reader::from_str(&text[start..end]);
+    let end = find(&buf[start..], b"</Models>")? + start + "</Models>".len();
+    let models = String::from_utf8_lossy(&buf[start..end]);
+    let mut reader = quick_xml::Reader::from_str(&models);
     let mut out = Vec::new();
     loop {
         match reader.read_event() {
@@ -329,6 +333,11 @@ fn first_namespace_uri(text: &str) -> Option<String> {
 }
 
 /// Whether a prefix of a file already decides [`scan_header`]'s answer (see there).
-fn header_complete(text: &str) -> bool {
-    text.contains("UANodeSet") && text.find("<Models>").is_some_and(|start| text[start..].contains("</Models>"))
+fn header_complete(prefix: &[u8]) -> bool {
+    find(prefix, b"UANodeSet").is_some() && find(prefix, b"<Models>").is_some_and(|start| find(&prefix[start..], b"</Models>").is_some())
+}
+
+/// Where `needle` first occurs in `haystack`.
+fn find(haystack: &[u8], needle: &[u8]) -> Option<usize> {
+    memchr::memmem::find(haystack, needle)
 }

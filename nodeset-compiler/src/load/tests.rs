@@ -41,6 +41,14 @@ fn header_scan_stops_at_models_but_answers_as_the_full_prefix_would() {
     assert_eq!(models_of_file(&dir.join("0.xml")), Some(vec!["http://x/".to_string()]));
     assert_eq!(models_of_file(&dir.join("4.xml")), Some(vec!["http://old/".to_string()]));
     assert_eq!(models_of_file(&dir.join("3.xml")), None);
+    // Bytes that are not UTF-8, before `<Models>` and inside it: the scan searches the bytes, and reads the
+    // element as lossy UTF-8 text (a replacement character where the bad byte was).
+    let bad = dir.join("bad.xml");
+    let mut bytes = b"<UANodeSet>\xFF\xE2<Models><Model ModelUri=\"http://x/\" Version=\"1.\xFF\"/></Models>".to_vec();
+    bytes.extend_from_slice(b"</UANodeSet>");
+    std::fs::write(&bad, &bytes).unwrap();
+    let want = Header { models: vec![("http://x/".to_string(), Some("1.\u{FFFD}".to_string()), None)], own_namespace: None };
+    assert_eq!(scan_header(&bad), Some(want));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

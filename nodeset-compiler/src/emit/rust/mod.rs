@@ -28,6 +28,7 @@
 //! [`NodeSetTable`]: https://docs.rs/nodeset-models (runtime::table::NodeSetTable)
 
 mod async_opcua_ns0;
+mod built;
 mod objects;
 mod programs;
 mod recursion;
@@ -195,6 +196,10 @@ struct Gen<'m> {
     ns0_types: BTreeSet<&'static str>,
     /// The nodes of the namespace a node table holds, if not all of them (see [`ns0_table`]).
     only: Option<&'m BTreeSet<NodeIx>>,
+    /// The `Handle::build` bodies of `objects.rs`, built directly, by placeholder index (see `built`).
+    bodies: Vec<syn::Expr>,
+    /// The field doc attributes and types of the handles in `objects.rs`, built directly, by placeholder index (see `built`).
+    built_types: Vec<(Vec<syn::Attribute>, syn::Type)>,
 }
 
 fn ident(s: &str) -> Ident {
@@ -291,6 +296,8 @@ impl<'m> Gen<'m> {
             value_type_cache: Default::default(),
             ns0_types: async_opcua_ns0::TYPES.iter().copied().collect(),
             only: None,
+            bodies: Vec::new(),
+            built_types: Vec::new(),
         }
     }
 
@@ -310,9 +317,15 @@ impl<'m> Gen<'m> {
     }
 
     fn file(&self, name: &str, what: &str, tokens: TokenStream) -> OutFile {
-        let parsed: syn::File = syn::parse2(tokens)
-            .unwrap_or_else(|e| panic!("internal error: generated {name} for {} does not parse: {e}", self.uri()));
-        let text = prettyplease::unparse(&parsed);
+        self.print(name, what, &self.parse(name, tokens))
+    }
+
+    fn parse(&self, name: &str, tokens: TokenStream) -> syn::File {
+        syn::parse2(tokens).unwrap_or_else(|e| panic!("internal error: generated {name} for {} does not parse: {e}", self.uri()))
+    }
+
+    fn print(&self, name: &str, what: &str, parsed: &syn::File) -> OutFile {
+        let text = prettyplease::unparse(parsed);
         OutFile { path: module_dir(&self.module).join(name), contents: format!("{}{text}", self.header(what)) }
     }
 

@@ -37,7 +37,7 @@ use proc_macro2::{Literal, TokenStream};
 use quote::{quote, ToTokens};
 
 use super::programs::Item;
-use super::{doc, ident, lit, Gen};
+use super::{built, doc, ident, lit, Gen};
 use crate::model::{DataTypeKind, Model, ModellingRule, NodeIx};
 use crate::nodeid::Identifier;
 use crate::names::{Case, Scope, Target};
@@ -78,8 +78,10 @@ fn escape_segment(name: &str) -> String {
 /// One member as a field of a handle struct.
 struct Field {
     name: String,
-    ty: TokenStream,
-    bind: TokenStream,
+    /// Built directly (see `built`), from the value types' syn trees.
+    ty: syn::Type,
+    /// `b.build_child(id, NS[k], "Name")` and the like, built directly (see `built`).
+    bind: syn::Expr,
     doc: String,
 }
 
@@ -344,13 +346,12 @@ impl Gen<'_> {
     /// `Vec<ua::Variant>` beyond twelve arguments.
     fn method_io(&self, decl: NodeIx) -> (syn::Type, syn::Type) {
         let info = self.model.methods.get(&decl).cloned().unwrap_or_default();
+        // Built, not parsed (see `built`).
         let tuple = |args: &[crate::model::Argument]| -> syn::Type {
-            let items: Vec<syn::Type> = args.iter().map(|a| self.value_type(a.data_type, a.value_rank)).collect();
-            if items.len() > 12 {
-                syn::parse_quote! { Vec<ua::Variant> }
-            } else {
-                syn::parse_quote! { (#(#items,)*) }
+            if args.len() > 12 {
+                return built::generic(&["Vec"], vec![built::generic(&["ua", "Variant"], Vec::new())]);
             }
+            built::tuple(args.iter().map(|a| self.value_type(a.data_type, a.value_rank)).collect())
         };
         (tuple(&info.inputs), tuple(&info.outputs))
     }
@@ -404,15 +405,17 @@ impl Gen<'_> {
         for &(m, _) in members {
             let n = model.node(m);
             let Some(rule) = self.rule(m) else { continue };
-            let k = Literal::usize_unsuffixed(self.ns_index(uris, n.browse_name.ns));
-            let bname = lit(&n.browse_name.name);
+            let k = self.ns_index(uris, n.browse_name.ns);
             let mut boxed = false;
             let handle = match n.class {
                 NodeClass::Variable => {
                     let vt = self.value_type(n.attrs.data_type, n.attrs.value_rank.unwrap_or(-1));
-                    quote! { t::Variable<#vt> }
+                    built::generic(&["t", "Variable"], vec![vt])
                 }
-                NodeClass::Method => self.method_type(m),
+                NodeClass::Method => {
+                    let (i, o) = self.method_io(m);
+                    built::generic(&["t", "Method"], vec![i, o])
+                }
                 NodeClass::Object
                     if depth < NESTED_DEPTH
                         && !rule.is_placeholder()
@@ -425,29 +428,34 @@ impl Gen<'_> {
                     let sub = self.decl_members(m);
                     let text = format!("`{}`, a member of `{}` with children of its own.", n.browse_name.name, prefix.trim_end_matches('_'));
                     nested.push(self.handle_struct(&sname, &text, None, None, &sub, names, uris, nested_prefix(&sname), depth + 1));
-                    let s = ident(&sname);
-                    quote! { #s }
+                    built::path_type(syn::Path::from(ident(&sname)))
                 }
                 // Another type's handle is boxed: the member may be of the owner's type or of a subtype of a
                 // type that contains the owner, and by value that struct would have no finite size.
                 NodeClass::Object => match n.type_definition.and_then(|t| self.handle_path(t, names)) {
                     Some(h) => {
                         boxed = true;
-                        h.to_token_stream()
+                        built::path_type(h)
                     }
-                    None => quote! { t::ObjectNode },
+                    None => built::generic(&["t", "ObjectNode"], Vec::new()),
                 },
                 _ => continue,
             };
             // Placeholders are kept in a list, on the heap already.
-            let single = if boxed { quote! { Box<#handle> } } else { handle.clone() };
+            let single = if boxed { built::generic(&["Box"], vec![handle.clone()]) } else { handle.clone() };
             let (ty, bind) = match rule {
-                ModellingRule::Mandatory => (single, quote! { b.build_child(id, NS[#k], #bname) }),
-                ModellingRule::Optional => (quote! { Option<#single> }, quote! { b.build_optional(id, NS[#k], #bname) }),
+                ModellingRule::Mandatory => {
+                    (single, built::binder_call("build_child", vec![built::id(), built::ns(k), built::str_lit(&n.browse_name.name)]))
+                }
+                ModellingRule::Optional => (
+                    built::generic(&["Option"], vec![single]),
+                    built::binder_call("build_optional", vec![built::id(), built::ns(k), built::str_lit(&n.browse_name.name)]),
+                ),
                 _ => {
                     let Some(td) = n.type_definition else { continue };
-                    let tid = self.ns_node_id(uris, td);
-                    (quote! { t::Placeholders<#handle> }, quote! { b.build_placeholders(id, #tid) })
+                    // Rare enough to parse: the NodeId's expression has several forms (`ns_node_id`).
+                    let tid: syn::Expr = syn::parse2(self.ns_node_id(uris, td)).expect("internal error: a NodeId expression does not parse");
+                    (built::generic(&["t", "Placeholders"], vec![handle]), built::binder_call("build_placeholders", vec![built::id(), tid]))
                 }
             };
             let mut text = format!("`{}` ({}).", n.browse_name.name, rule.name());
@@ -486,19 +494,23 @@ impl Gen<'_> {
             quote! { #[allow(non_snake_case)] }
         };
         let mut decls = vec![quote! { #[doc = " The instance."] pub node: #node_ty }];
-        let mut binds = vec![quote! { node: b.build_this(id) }];
+        let build_this = || built::binder_call("build_this", vec![built::id()]);
+        let mut binds = vec![(ident("node"), build_this())];
         let mut deref = quote! {};
         if let Some(base) = &base {
             decls.push(quote! { #[doc = " The members inherited from the supertype (also reached through `Deref`)."] pub base: #base });
-            binds.push(quote! { base: b.build_this(id) });
+            binds.push((ident("base"), build_this()));
             deref = quote! { t::deref_base!(#sname => #base); };
         }
-        for f in &fields {
-            let (fname, ty, bind) = (ident(&f.name), &f.ty, &f.bind);
-            let d = doc(&f.doc);
-            decls.push(quote! { #d pub #fname: #ty });
-            binds.push(quote! { #fname: #bind });
+        for f in fields {
+            let fname = ident(&f.name);
+            let ty = built::type_placeholder(self.built_types.len());
+            self.built_types.push((built::doc_attrs(&f.doc), f.ty));
+            decls.push(quote! { pub #fname: #ty });
+            binds.push((fname, f.bind));
         }
+        let body = built::placeholder(self.bodies.len());
+        self.bodies.push(built::self_struct(binds));
         let mut tokens = quote! {
             #docs
             #[derive(Clone)]
@@ -508,7 +520,7 @@ impl Gen<'_> {
             impl t::Handle for #sname {
                 #[inline]
                 fn build(b: &t::Binder<'_>, id: &ua::NodeId) -> Self {
-                    Self { #(#binds),* }
+                    #body
                 }
             }
             #deref
@@ -735,7 +747,9 @@ impl Gen<'_> {
             const NS: &[&str] = &[#(#ns_items),*];
         };
         tokens.extend(items);
-        let mut file = self.file("objects.rs", "Typed handles", tokens);
+        let mut parsed = self.parse("objects.rs", tokens);
+        built::fill(&mut parsed, std::mem::take(&mut self.bodies), std::mem::take(&mut self.built_types));
+        let mut file = self.print("objects.rs", "Typed handles", &parsed);
         file.contents.push_str(
             "/// Member markers of each ObjectType and VariableType, named from browse paths (`ParameterSet__ActualPosition`).\n\
              #[allow(non_snake_case, non_camel_case_types)]\n\
