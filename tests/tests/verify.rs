@@ -561,3 +561,20 @@ fn serve_follows_the_model_where_the_served_ns0_differs() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// serve-corpus accepts a violation below `Objects/Instances` only where `check` names the defect of the
+/// nodeset behind it: I4AAS gives four `Keys` declarations a scalar value with ValueRank 1 (check's NS0209,
+/// pointing into the Value), which every instance holds (verify's NS0406, pointing at the declaration).
+#[test]
+fn check_explains_the_instance_findings_of_a_value_that_contradicts_its_type() {
+    let file = vendor().join("Opc.Ua.I4AAS.NodeSet2.xml");
+    let explains = nodeset_compiler::verify::instances::findings_check_explains(&[file.clone()], &[vendor()]).unwrap();
+    let path = file.canonicalize().unwrap().display().to_string();
+    for line in [2537, 3839, 3886, 3923] {
+        let why = explains.get(&("NS0406".to_owned(), path.clone(), line)).unwrap_or_else(|| panic!("line {line}: {explains:?}"));
+        assert!(why.starts_with("warning[NS0209]: the value of `Keys` is a scalar, but its ValueRank is 1"), "{why}");
+    }
+    // Only declarations check names: DI has no such defect.
+    let di = vendor().join("Opc.Ua.Di.NodeSet2.xml");
+    assert_eq!(nodeset_compiler::verify::instances::findings_check_explains(&[di], &[vendor()]).unwrap().len(), 0);
+}

@@ -13,11 +13,13 @@
 //! define, nodes created below `Objects/Instances`, nodes verify checked, violations below
 //! `Objects/Instances` and elsewhere, disagreements with `check`, structure values read back and compared
 //! with the files), then each file with violations below `Objects/Instances`, types not instantiated,
-//! disagreements or structure values that differ, with the reasons. Fails when a violation below
-//! `Objects/Instances`, a disagreement with `check` or a structure value that differs remains.
+//! disagreements or structure values that differ, with the reasons. A violation below `Objects/Instances`
+//! that a diagnostic of `check` on the same files explains as a defect of the nodeset (the same declaration:
+//! `findings_check_explains`) is listed with that diagnostic and does not fail the run. Fails when another
+//! violation below `Objects/Instances`, a disagreement with `check` or a structure value that differs remains.
 
 use crate::util::workspace_root;
-use nodeset_compiler::verify::instances::static_findings_by_uri;
+use nodeset_compiler::verify::instances::{findings_check_explains, static_findings_by_uri};
 use nodeset_compiler::verify::report as verify_report;
 use process_support::Process;
 use std::path::{Path, PathBuf};
@@ -54,6 +56,9 @@ struct Outcome {
     checked: u64,
     /// (code, path, message) of each finding below `Objects/Instances`.
     below: Vec<(String, String, String)>,
+    /// Violations below `Objects/Instances` that a diagnostic of `check` on the same files explains as a
+    /// defect of the nodeset (the violation, then check's diagnostic).
+    explained: Vec<(String, String)>,
     /// Findings elsewhere (static instances of the files).
     elsewhere: usize,
     /// Findings on the static instances only one of verify and check has: `verify only: ...` or
@@ -104,12 +109,13 @@ pub fn run(args: Args) -> Result<(), String> {
             match &o.failed {
                 Some(why) => format!("not verified: {}", why.lines().next().unwrap_or_default()),
                 None => format!(
-                    "{}/{} types, {} instance nodes, {} checked, {} below Instances, {} elsewhere, {} disagreement(s) with check, {} structure value(s) compared, {} differ",
+                    "{}/{} types, {} instance nodes, {} checked, {} below Instances ({} explained by check), {} elsewhere, {} disagreement(s) with check, {} structure value(s) compared, {} differ",
                     o.instantiated,
                     o.types,
                     o.instance_nodes,
                     o.checked,
-                    o.below.len(),
+                    o.below.len() + o.explained.len(),
+                    o.explained.len(),
                     o.elsewhere,
                     o.disagreements.len(),
                     o.structures,
@@ -135,7 +141,10 @@ fn report(outcomes: &[Outcome], took: Duration) -> Result<(), String> {
     println!("  nodes created below Objects/Instances: {}", sum(|o| o.instance_nodes));
     println!("  state machines served: {}", sum(|o| o.machines));
     println!("  nodes verify checked: {}", served.iter().map(|o| o.checked).sum::<u64>());
-    println!("  violations below Objects/Instances: {below}");
+    println!(
+        "  violations below Objects/Instances: {below} not explained, {} explained by a diagnostic of check (defects of the nodesets)",
+        sum(|o| o.explained.len())
+    );
     println!("  findings elsewhere (static instances of the files): {}", sum(|o| o.elsewhere));
     println!("  disagreements of verify and check on the static instances: {disagreements}");
     println!("  structure values read back and compared with the files: {} ({mismatches} differ)", sum(|o| o.structures));
@@ -143,7 +152,11 @@ fn report(outcomes: &[Outcome], took: Duration) -> Result<(), String> {
         println!("\nnot verified: {}\n  {}", o.name, o.failed.as_deref().unwrap_or_default().replace('\n', "\n  "));
     }
     for o in served.iter().filter(|o| {
-        !o.below.is_empty() || !o.not_instantiated.is_empty() || !o.disagreements.is_empty() || !o.structure_mismatches.is_empty()
+        !o.below.is_empty()
+            || !o.explained.is_empty()
+            || !o.not_instantiated.is_empty()
+            || !o.disagreements.is_empty()
+            || !o.structure_mismatches.is_empty()
     }) {
         println!("\n{}:", o.name);
         for why in &o.not_instantiated {
@@ -151,6 +164,9 @@ fn report(outcomes: &[Outcome], took: Duration) -> Result<(), String> {
         }
         for (code, path, message) in &o.below {
             println!("  {code} {path}: {message}");
+        }
+        for (violation, why) in &o.explained {
+            println!("  {violation}: explained by check's {why}");
         }
         for d in &o.disagreements {
             println!("  {d}");
@@ -236,10 +252,21 @@ fn serve_and_verify(exe: &Path, unit: &[PathBuf], models: &Path, work: &Path, i:
             o.structures = number(&json, "structures_compared").unwrap_or(0) as usize;
             o.structure_mismatches = strings(&json, "structure_mismatches");
             let namespaces = verify_report::json_namespaces(&json);
+            // check's explanations, computed for the files with a violation below Instances only.
+            let mut explains = None;
             let mut verified = Vec::new();
-            for (code, severity, path, message) in verify_report::json_findings(&json) {
+            let declarations = verify_report::json_declarations(&json);
+            for ((code, severity, path, message), declaration) in verify_report::json_findings(&json).into_iter().zip(declarations) {
                 if path.split('/').next().is_some_and(|top| top.ends_with(":Instances")) {
-                    o.below.push((code, path, message.replace('\n', " ")));
+                    let explained = declaration.and_then(|(file, line)| {
+                        explains.get_or_insert_with(|| findings_check_explains(unit, &[models.to_path_buf()]));
+                        let key = (code.clone(), canonical(&file), line);
+                        explains.as_ref()?.as_ref().ok()?.get(&key).map(|d| format!("{d} ({}:{line})", key.1))
+                    });
+                    match explained {
+                        Some(why) => o.explained.push((format!("{code} {path}"), why)),
+                        None => o.below.push((code, path, message.replace('\n', " "))),
+                    }
                 } else {
                     o.elsewhere += 1;
                     verified.push((code, severity, verify_report::path_by_uri(&path, &namespaces)));
@@ -298,6 +325,11 @@ fn strings(json: &str, key: &str) -> Vec<String> {
     }
     let list = &list[..list.find("\"]").map_or(0, |e| e + 1)];
     list.split("\",\"").map(|m| m.trim_matches('"').replace("\\\"", "\"")).filter(|m| !m.is_empty()).collect()
+}
+
+/// `file` canonicalized, as text (as it is when it cannot be).
+fn canonical(file: &str) -> String {
+    std::fs::canonicalize(file).map_or_else(|_| file.to_owned(), |p| p.display().to_string())
 }
 
 fn rel(root: &Path, f: &Path) -> String {

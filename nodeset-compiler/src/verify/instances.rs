@@ -145,6 +145,39 @@ pub fn check_compiled(compiled: &mut Compiled, opts: &Options) {
     compiled.diagnostics.sort(&compiled.model.sources);
 }
 
+/// The instance findings of `verify` that a diagnostic of `check` explains as a defect of the nodeset, for the
+/// files `named` (with their required models from `model_dirs`): each `(code verify gives, file, line of the
+/// declaration's start tag)` with the diagnostic's text. A value in a type that contradicts its DataType
+/// (`check`'s NS0209) is served as written, and every instance of the type then holds it (`verify`'s NS0406,
+/// which points at the declaration's start tag while NS0209 points into its Value).
+pub fn findings_check_explains(
+    named: &[std::path::PathBuf],
+    model_dirs: &[std::path::PathBuf],
+) -> Result<std::collections::BTreeMap<(String, String, usize), String>, String> {
+    use crate::diag::Code;
+    use crate::load::Input;
+    let opts = Options { model_dirs: model_dirs.to_vec(), ..Options::default() };
+    let compiled = crate::compile(named.iter().cloned().map(Input::Path).collect(), &opts);
+    if !compiled.ok() {
+        return Err(compiled.render_diagnostics().lines().next().unwrap_or_default().to_owned());
+    }
+    let model = &compiled.model;
+    let mut out = std::collections::BTreeMap::new();
+    for d in compiled.diagnostics.items.iter().filter(|d| d.code == Code::ValueTypeMismatch) {
+        let Some(span) = d.span else { continue };
+        // The node whose element holds the diagnostic: the last one of its file that starts before it.
+        let Some(node) = model.nodes.iter().filter(|n| n.file == span.file && n.span.start <= span.start).max_by_key(|n| n.span.start)
+        else {
+            continue;
+        };
+        let file = model.sources.get(span.file);
+        let (line, _) = file.line_col(node.span.start);
+        let path = std::fs::canonicalize(&file.path).unwrap_or_else(|_| file.path.clone());
+        out.insert(("NS0406".to_owned(), path.display().to_string(), line), format!("{}[{}]: {}", d.severity.as_str(), d.code.as_str(), d.message));
+    }
+    Ok(out)
+}
+
 /// What `check` finds on the static instances that a server serving `named` (with the models they require,
 /// found in `model_dirs`) shows a client, comparable with `verify`'s findings on that server
 /// ([`super::report::json_findings_by_uri`]): (code, severity, browse path by namespace URI), sorted. Every file

@@ -179,6 +179,21 @@ pub fn json_findings(json: &str) -> Vec<(String, String, String, String)> {
         .collect()
 }
 
+/// The declaration (file, line) of every finding of a report [`render_json`] wrote, in the order of
+/// [`json_findings`]; `None` for a finding without one.
+pub fn json_declarations(json: &str) -> Vec<Option<(String, usize)>> {
+    json.split("{\"code\":")
+        .skip(1)
+        .map(|part| {
+            let at = part.find("\"declaration\":{")?;
+            let declaration = &part[at..];
+            let file = json_field(declaration, "file");
+            let line = declaration.split("\"line\":").nth(1)?.chars().take_while(char::is_ascii_digit).collect::<String>();
+            Some((file, line.parse().ok()?))
+        })
+        .collect()
+}
+
 /// (code, severity, path by namespace URI) of every finding of a report [`render_json`] wrote, sorted:
 /// comparable with [`super::instances::static_findings_by_uri`] across two numberings of the namespaces.
 pub fn json_findings_by_uri(json: &str) -> Vec<(String, String, String)> {
