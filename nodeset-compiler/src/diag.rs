@@ -125,6 +125,7 @@ codes! {
         Some("the entry is dropped: the node grants that role nothing");
     IncompatibleOverride = "NS0221", Warning, "a declaration overrides one of a supertype it is not compatible with",
         Some("the override is used as declared");
+    TwoModellingRules = "NS0222", Warning, "a node has HasModellingRule references to two different rules", Some("the last one is kept; the others are left out of the node tables, so that a server sees the rule the model has");
     // Generating code.
     NameCollision = "NS0301", Warning, "two names map to one identifier in generated code", Some("the names are told apart by a suffix");
     UnsupportedFeature = "NS0302", Warning, "a model feature has no faithful representation in generated code",

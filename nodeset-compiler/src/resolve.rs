@@ -783,14 +783,38 @@ fn link_types(model: &mut Model, broken: &HashSet<NodeIx>, diags: &mut Diagnosti
         let ix = NodeIx(i as u32);
         let mut type_def = None;
         let mut rule = None;
+        // Every HasModellingRule reference: (its index, target, span).
+        let mut rules: Vec<(usize, NodeIx, Span)> = Vec::new();
         let mut parent = model.nodes[i].parent;
-        for r in &model.nodes[i].references {
+        for (k, r) in model.nodes[i].references.iter().enumerate() {
             if r.forward && Some(r.reference_type) == has_type_def {
                 type_def = Some((r.target, r.span));
             } else if r.forward && Some(r.reference_type) == has_rule {
                 rule = Some((r.target, r.span));
+                rules.push((k, r.target, r.span));
             } else if !r.forward && parent.is_none() && model.is_hierarchical(r.reference_type) {
                 parent = Some(r.target);
+            }
+        }
+        if let Some(&(_, kept, kept_span)) = rules.last().filter(|&&(_, kept, _)| rules.iter().any(|r| r.1 != kept)) {
+            // Two rules: the model keeps the last; the others leave the node tables, or a server's instantiate
+            // would pick one of them by the order of its reference store.
+            let name = |r: NodeIx| model.nodes[r.index()].browse_name.name.clone();
+            let others: Vec<String> = rules.iter().filter(|r| r.1 != kept).map(|r| format!("`{}`", name(r.1))).collect();
+            let mut d = Diagnostic::new(
+                Code::TwoModellingRules,
+                format!("`{}` has the ModellingRules {} and `{}`", model.nodes[i].browse_name.name, others.join(", "), name(kept)),
+            )
+            .at(kept_span)
+            .with_span_label("the one kept");
+            for &(_, r, span) in rules.iter().filter(|r| r.1 != kept) {
+                d = d.label(span, format!("`{}`, left out", name(r)));
+            }
+            diags.push(d.help("remove the HasModellingRule reference that is wrong"));
+            for &(k, r, _) in &rules {
+                if r != kept {
+                    model.nodes[i].references[k].declared = false;
+                }
             }
         }
         let node = &model.nodes[i];

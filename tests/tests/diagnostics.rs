@@ -775,6 +775,21 @@ fn bad_modelling_rule() {
 }
 
 #[test]
+fn two_modelling_rules() {
+    let r = file("two_modelling_rules");
+    let d = r.warning("NS0222");
+    r.here(d, "ReferenceType=\"HasModellingRule\">i=80").has_help(d);
+    assert_eq!(d.labels.len(), 1, "a label points at the rule left out\n{}", r.rendered);
+    // The model keeps the last rule, and the node table carries only that one: a server sees what the model says.
+    let model = &r.out.model;
+    let speed = model.nodes.iter().find(|n| n.browse_name.name == "Speed" && n.id.ns != 0).unwrap();
+    assert_eq!(speed.modelling_rule, Some(nodeset_compiler::model::ModellingRule::Optional));
+    let rules: Vec<bool> = speed.references.iter().filter(|x| x.forward && model.node(x.reference_type).browse_name.name == "HasModellingRule").map(|x| x.declared).collect();
+    assert_eq!(rules, [false, true], "only the kept rule goes to the node tables");
+    r.snapshot();
+}
+
+#[test]
 fn bad_data_type_attribute() {
     let r = file("bad_data_type_attribute");
     let d = r.error("NS0212");
